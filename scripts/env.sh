@@ -12,6 +12,10 @@ export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"
 export OMP_WAIT_POLICY=PASSIVE
 export PYTHONUNBUFFERED=1
 if [ -f "$CLOTHWIND_BUILD/devel/setup.bash" ]; then
+  # ROS's setup scripts read unset variables: relax nounset while sourcing them.
+  case $- in *u*) _cw_nounset=1; set +u ;; *) _cw_nounset=0 ;; esac
   # shellcheck disable=SC1091
   source "$CLOTHWIND_BUILD/devel/setup.bash"
+  [ "$_cw_nounset" = 1 ] && set -u
+  unset _cw_nounset
 fi
