@@ -1,0 +1,153 @@
+#include "sensors/pixel_format.h"
+
+#include <linux/videodev2.h>
+
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+namespace clothwind {
+namespace sensors {
+namespace {
+
+TEST(PixelFormatTest, ParsesNamesAndRejectsUnknownOnes) {
+  PixelFormat f = PixelFormat::kYuyv;
+  std::string error;
+  ASSERT_TRUE(ParsePixelFormat("mjpg", &f, &error));
+  EXPECT_EQ(f, PixelFormat::kMjpeg);
+  ASSERT_TRUE(ParsePixelFormat("GREY", &f, &error));
+  EXPECT_EQ(f, PixelFormat::kGrey);
+  ASSERT_TRUE(ParsePixelFormat("yuyv", &f, &error));
+  EXPECT_EQ(f, PixelFormat::kYuyv);
+  EXPECT_FALSE(ParsePixelFormat("NV12", &f, &error));
+  EXPECT_NE(error.find("NV12"), std::string::npos);
+  EXPECT_NE(error.find("YUYV, MJPEG, GREY"), std::string::npos);
+  EXPECT_EQ(f, PixelFormat::kYuyv);  // untouched on failure
+}
+
+TEST(PixelFormatTest, FourccRoundTripsAndPrints) {
+  for (PixelFormat f : {PixelFormat::kYuyv, PixelFormat::kMjpeg, PixelFormat::kGrey}) {
+    PixelFormat back;
+    ASSERT_TRUE(PixelFormatFromFourcc(PixelFormatFourcc(f), &back));
+    EXPECT_EQ(back, f);
+  }
+  PixelFormat back;
+  EXPECT_TRUE(PixelFormatFromFourcc(V4L2_PIX_FMT_JPEG, &back));
+  EXPECT_EQ(back, PixelFormat::kMjpeg);
+  EXPECT_FALSE(PixelFormatFromFourcc(V4L2_PIX_FMT_NV12, &back));
+  EXPECT_EQ(FourccToString(V4L2_PIX_FMT_YUYV), "YUYV");
+  EXPECT_EQ(FourccToString(V4L2_PIX_FMT_MJPEG), "MJPG");
+  EXPECT_EQ(RosEncodingFor(PixelFormat::kGrey), "mono8");
+  EXPECT_EQ(RosEncodingFor(PixelFormat::kMjpeg), "bgr8");
+}
+
+TEST(PixelFormatTest, GreyHonoursStrideAndCopiesPixels) {
+  const int w = 5, h = 3, stride = 8;
+  std::vector<uint8_t> buf(stride * h, 0xEE);  // padding bytes must not leak into the image
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) buf[r * stride + c] = static_cast<uint8_t>(10 * r + c);
+  cv::Mat image;
+  std::string error;
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kGrey, buf.data(), buf.size(), w, h, stride, &image,
+                             &error))
+      << error;
+  ASSERT_EQ(image.type(), CV_8UC1);
+  ASSERT_EQ(image.cols, w);
+  ASSERT_EQ(image.rows, h);
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) EXPECT_EQ(image.at<uint8_t>(r, c), 10 * r + c);
+  buf[0] = 99;  // the image owns its pixels: the driver buffer is re-queued right away
+  EXPECT_EQ(image.at<uint8_t>(0, 0), 0);
+}
+
+// Builds a YUYV buffer where every pixel has the same Y, U, V.
+std::vector<uint8_t> UniformYuyv(int w, int h, int stride, uint8_t y, uint8_t u, uint8_t v) {
+  std::vector<uint8_t> buf(stride * h, 0);
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; c += 2) {
+      uint8_t* p = &buf[r * stride + 2 * c];
+      p[0] = y; p[1] = u; p[2] = y; p[3] = v;
+    }
+  return buf;
+}
+
+TEST(PixelFormatTest, YuyvConvertsWithBt601Colours) {
+  const int w = 4, h = 2, stride = 12;  // 8 bytes of pixels + 4 of padding per row
+  cv::Mat image;
+  std::string error;
+  // Neutral chroma: a grey level, equal channels, brighter Y gives brighter grey.
+  auto dark = UniformYuyv(w, h, stride, 40, 128, 128);
+  auto light = UniformYuyv(w, h, stride, 200, 128, 128);
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kYuyv, dark.data(), dark.size(), w, h, stride, &image,
+                             &error)) << error;
+  ASSERT_EQ(image.type(), CV_8UC3);
+  cv::Vec3b d = image.at<cv::Vec3b>(1, 3);
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kYuyv, light.data(), light.size(), w, h, stride, &image,
+                             &error)) << error;
+  cv::Vec3b l = image.at<cv::Vec3b>(1, 3);
+  EXPECT_EQ(d[0], d[1]);
+  EXPECT_EQ(d[1], d[2]);
+  EXPECT_EQ(l[0], l[2]);
+  EXPECT_GT(l[1], d[1] + 100);
+  // Strong V (Cr) is red: R (channel 2 in BGR) dominates; strong U (Cb) is blue.
+  auto red = UniformYuyv(w, h, stride, 100, 128, 230);
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kYuyv, red.data(), red.size(), w, h, stride, &image,
+                             &error)) << error;
+  cv::Vec3b r = image.at<cv::Vec3b>(0, 0);
+  EXPECT_GT(r[2], r[1] + 60);
+  EXPECT_GT(r[2], r[0] + 60);
+  auto blue = UniformYuyv(w, h, stride, 100, 230, 128);
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kYuyv, blue.data(), blue.size(), w, h, stride, &image,
+                             &error)) << error;
+  cv::Vec3b b = image.at<cv::Vec3b>(0, 0);
+  EXPECT_GT(b[0], b[1] + 60);
+  EXPECT_GT(b[0], b[2] + 60);
+  // Against the BT.601 formula R = Y + 1.402 (V-128) within rounding of either range convention.
+  const double r_full = 100 + 1.402 * (230 - 128);
+  const double r_limited = 1.164 * (100 - 16) + 1.596 * (230 - 128);
+  const double r_expected = std::min(255.0, r_full);
+  EXPECT_TRUE(std::abs(r[2] - r_expected) <= 3 || std::abs(r[2] - std::min(255.0, r_limited)) <= 3)
+      << "R=" << int(r[2]);
+}
+
+TEST(PixelFormatTest, YuyvRejectsShortBufferAndOddWidth) {
+  cv::Mat image;
+  std::string error;
+  auto buf = UniformYuyv(4, 2, 8, 100, 128, 128);
+  EXPECT_FALSE(ConvertToImage(PixelFormat::kYuyv, buf.data(), buf.size() - 1, 4, 2, 8, &image,
+                              &error));
+  EXPECT_NE(error.find("needs 16"), std::string::npos) << error;
+  EXPECT_FALSE(ConvertToImage(PixelFormat::kYuyv, buf.data(), buf.size(), 3, 2, 8, &image,
+                              &error));
+  EXPECT_NE(error.find("even width"), std::string::npos) << error;
+}
+
+TEST(PixelFormatTest, MjpegDecodesToBgrAndReportsGarbage) {
+  cv::Mat original(48, 64, CV_8UC3);
+  for (int r = 0; r < original.rows; ++r)
+    for (int c = 0; c < original.cols; ++c)
+      original.at<cv::Vec3b>(r, c) = cv::Vec3b(static_cast<uint8_t>(4 * c), 60,
+                                               static_cast<uint8_t>(5 * r));
+  std::vector<uint8_t> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", original, jpeg, {cv::IMWRITE_JPEG_QUALITY, 95}));
+  cv::Mat image;
+  std::string error;
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kMjpeg, jpeg.data(), jpeg.size(), 64, 48, 0, &image,
+                             &error)) << error;
+  ASSERT_EQ(image.type(), CV_8UC3);
+  EXPECT_LT(cv::norm(image, original, cv::NORM_L1) / original.total() / 3, 3.0);
+  // The negotiated size must match what the JPEG says.
+  EXPECT_FALSE(ConvertToImage(PixelFormat::kMjpeg, jpeg.data(), jpeg.size(), 640, 480, 0, &image,
+                              &error));
+  EXPECT_NE(error.find("64x48"), std::string::npos) << error;
+  std::vector<uint8_t> garbage(500, 0x5a);
+  EXPECT_FALSE(ConvertToImage(PixelFormat::kMjpeg, garbage.data(), garbage.size(), 64, 48, 0,
+                              &image, &error));
+  EXPECT_NE(error.find("MJPEG decode failed"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace sensors
+}  // namespace clothwind
