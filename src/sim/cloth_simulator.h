@@ -1,0 +1,114 @@
+#ifndef CLOTHWIND_SIM_CLOTH_SIMULATOR_H_
+#define CLOTHWIND_SIM_CLOTH_SIMULATOR_H_
+
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "sim/material.h"
+#include "sim/mesh.h"
+#include "sim/wind_field.h"
+
+namespace clothwind::sim {
+
+// Settings of one simulation (an ArcSim scene's numbers; defaults are the flag scene's).
+struct SimOptions {
+  double dt = 0.005;                                // time step [s] (ArcSim: frame_time/frame_steps)
+  Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -9.8);  // [m/s^2]
+  double wind_density = 1.0;                        // ArcSim wind "density" [kg/m^3]
+  double wind_drag = 0.0;                           // ArcSim wind "drag" [kg/(m^2 s)]
+  std::vector<int> handles;                         // pinned vertex indices (fixed in place)
+  // Principal-stretch limits (ArcSim "strain_limits", e.g. 0.95, 1.05); 0 / inf switch a side off.
+  double strain_min = 0.0;
+  double strain_max = std::numeric_limits<double>::infinity();
+  int strain_limit_iterations = 6;                  // projection sweeps per step
+  double repulsion_thickness = 10e-3;               // ArcSim magic.repulsion_thickness [m]
+  double collision_stiffness = 1e6;                 // ArcSim magic.collision_stiffness [N/m^3]
+  bool self_collision = true;                       // vertex-face repulsion on/off
+  double cg_tolerance = 1e-6;                       // relative residual of the linear solve
+  int cg_max_iterations = 300;
+};
+
+// Energies of the current state [J].
+struct ClothEnergy {
+  double kinetic = 0;
+  double gravitational = 0;  // -sum m g.x
+  double stretching = 0;     // with the stiffness evaluated at the current strain
+  double bending = 0;
+  double Total() const { return kinetic + gravitational + stretching + bending; }
+};
+
+// What the last step did (for benches and diagnostics).
+struct StepStats {
+  int cg_iterations = 0;
+  double cg_relative_residual = 0;
+  int repulsion_pairs = 0;
+  int strain_limited_faces = 0;  // faces outside the limits before projection
+};
+
+// ArcSim-style cloth: Wang et al. 2011 anisotropic nonlinear stretching and direction/curvature
+// dependent bending (material.h), gravity, ArcSim's explicit wind force, pinned handles,
+// vertex-face repulsion, strain limiting, and one Newton step of backward Euler per time step:
+//   (M - h (h + gamma) K) dv = h (f + (h + gamma) K v),   x += h (v + dv),
+// K the force Jacobian, gamma the material's Rayleigh damping. The mesh is fixed (no adaptive
+// remeshing; use RefineMesh for resolution). Instances share nothing: separate instances may run
+// concurrently; one instance is not thread-safe. Results are deterministic (serial sums).
+class ClothSimulator {
+ public:
+  // Inputs:
+  //   mesh      cloth mesh: V initial world positions [m], F faces, U rest coordinates [m]
+  //   material  cloth material (multipliers applied)
+  //   options   simulation settings
+  //   wind      air velocity field (nullptr = still air)
+  // Throws std::invalid_argument on an invalid mesh (ValidateMesh), handles out of range,
+  // dt <= 0, or bad options.
+  ClothSimulator(Mesh mesh, Material material, SimOptions options,
+                 std::shared_ptr<const WindField> wind);
+  ~ClothSimulator();
+  ClothSimulator(ClothSimulator&&) noexcept;
+  ClothSimulator& operator=(ClothSimulator&&) noexcept;
+
+  // Advances the state by one time step options().dt.
+  void Step();
+
+  // Simulated time [s] (steps taken * dt).
+  double time() const;
+
+  // #V by 3 current positions [m] / velocities [m/s].
+  const Eigen::MatrixX3d& positions() const;
+  const Eigen::MatrixX3d& velocities() const;
+
+  // Replaces the state (e.g. to restart from a saved one). Handles stay where the given positions
+  // put them. Inputs: #V by 3 positions [m] and velocities [m/s]. Throws on shape mismatch / NaN.
+  void SetState(const Eigen::MatrixX3d& positions, const Eigen::MatrixX3d& velocities);
+
+  // Replaces the wind field (nullptr = still air).
+  void set_wind(std::shared_ptr<const WindField> wind);
+
+  // The mesh as constructed (F, U, initial V), the material and the options.
+  const Mesh& mesh() const;
+  const Material& material() const;
+  const SimOptions& options() const;
+
+  // #V lumped node masses [kg] (a third of each adjacent face's rest area times density).
+  const Eigen::VectorXd& masses() const;
+
+  // Energies of the current state.
+  ClothEnergy Energy() const;
+
+  // Total external + internal force on every node at the current state (#V by 3) [N]: for tests
+  // and diagnostics (handles included, not zeroed).
+  Eigen::MatrixX3d Forces() const;
+
+  const StepStats& last_step_stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace clothwind::sim
+
+#endif  // CLOTHWIND_SIM_CLOTH_SIMULATOR_H_

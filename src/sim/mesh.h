@@ -1,0 +1,66 @@
+#ifndef CLOTHWIND_SIM_MESH_H_
+#define CLOTHWIND_SIM_MESH_H_
+
+#include <string>
+
+#include <Eigen/Core>
+
+namespace clothwind::sim {
+
+// A triangle cloth mesh with one material-space (rest) coordinate per vertex.
+//
+// ArcSim keeps the rest shape in material space: from the OBJ's `vt` lines when present, else
+// from the x,y of the positions as read (before the scene transform is applied). We do the same,
+// one material coordinate per vertex (no texture seams).
+struct Mesh {
+  Eigen::MatrixX3d V;  // #V by 3 world positions [m]
+  Eigen::MatrixX3i F;  // #F by 3 vertex indices (0-based), counter-clockwise in material space
+  Eigen::MatrixX2d U;  // #V by 2 material-space rest coordinates [m]
+};
+
+// Reads a Wavefront OBJ: `v x y z`, optional `vt u v`, `f a b c ...` (also a/t, a/t/n, a//n;
+// polygons are fan-triangulated; negative (relative) indices are accepted). Without `vt`, U is
+// the x,y of the positions (ArcSim's rule). The result is validated (ValidateMesh).
+// Inputs:
+//   path  file to read
+// Returns the mesh. Throws std::runtime_error naming path:line and what was expected on bad input.
+Mesh ReadObj(const std::string& path);
+
+// Writes `v` (positions), `vt` (material coordinates) and `f a/a b/b c/c` lines, atomically
+// (temporary file then rename), with full double precision so ReadObj(WriteObj(m)) == m.
+// Inputs:
+//   path  destination
+//   mesh  mesh to write (U may be empty: then no vt lines)
+// Throws std::runtime_error when the file cannot be written.
+void WriteObj(const std::string& path, const Mesh& mesh);
+
+// Checks: V, F, U shapes agree; no NaN/inf; indices in range; no repeated index in a face; no
+// degenerate triangle (world and material area > 1e-12 m^2 relative to the squared edge scale).
+// Inputs:
+//   mesh  mesh to check
+//   what  name used in the error message (e.g. the file name)
+// Throws std::invalid_argument naming `what`, the offending vertex/face index and the problem.
+void ValidateMesh(const Mesh& mesh, const std::string& what = "mesh");
+
+// Uniform 1-to-4 midpoint subdivision, repeated until every edge (in world space and in material
+// space) is at most max_edge. New vertices are edge midpoints in both V and U, so area, boundary
+// and the (planar) rest shape are preserved exactly; the original vertices keep their indices
+// (handles stay valid), new ones follow.
+// Inputs:
+//   mesh      mesh to refine (valid)
+//   max_edge  longest allowed edge [m], > 0
+// Returns the refined mesh.
+Mesh RefineMesh(const Mesh& mesh, double max_edge);
+
+// Longest edge of the mesh in world space [m] (0 for an empty mesh).
+double MaxEdgeLength(const Mesh& mesh);
+
+// Sum of triangle areas in world space [m^2].
+double SurfaceArea(const Mesh& mesh);
+
+// Sum of triangle areas in material space [m^2].
+double RestArea(const Mesh& mesh);
+
+}  // namespace clothwind::sim
+
+#endif  // CLOTHWIND_SIM_MESH_H_
