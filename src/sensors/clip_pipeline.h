@@ -1,0 +1,110 @@
+#ifndef CLOTHWIND_SENSORS_CLIP_PIPELINE_H_
+#define CLOTHWIND_SENSORS_CLIP_PIPELINE_H_
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "sensors/clip_assembler.h"
+#include "sensors/clip_preprocess.h"
+#include "sensors/frame_resampler.h"
+#include "sensors/wind_label.h"
+
+namespace clothwind::sensors {
+
+// Settings of the clip buffer (ROS parameters of clip_buffer_node of the same names).
+struct ClipPipelineOptions {
+  double frame_rate = 25.0;    // output rate [Hz]
+  double gap_tolerance = 0.1;  // largest camera frame interval bridged [s]; beyond it the clip breaks
+  int num_frames = 30;         // N_t
+  int stride = 30;             // a clip every `stride` output frames
+  int size = 300;              // output frame side [px]
+  SquareRoi roi;               // crop in source pixels; size 0: centred square
+  double label_window = 60.0;  // anemometer window before each clip's last frame [s]
+  // A finished clip waits until the data (frame or reading stamps) has reached its end plus this
+  // long [s] before it is labelled, so readings stamped inside its window that arrive a little late
+  // still count. 1.5 s covers a 1 Hz anemometer's next reading plus transport.
+  double label_delay = 1.5;
+};
+
+// A clip with its label, ready to publish or record.
+struct LabelledClip {
+  AssembledClip clip;
+  SquareRoi roi;             // resolved crop in source pixels
+  int source_width = 0;      // source image size [px]
+  int source_height = 0;
+  double frame_rate = 25.0;  // [Hz]
+  WindLabel label;
+};
+
+// Counters for diagnostics.
+struct ClipPipelineStats {
+  uint64_t frames_in = 0;         // camera frames pushed
+  uint64_t frames_dropped = 0;    // ignored: stamp not after the previous one, or bad image
+  uint64_t frames_out = 0;        // resampled frames produced
+  uint64_t gaps = 0;              // holes in the camera stream longer than gap_tolerance
+  uint64_t clips_made = 0;        // clips assembled
+  uint64_t clips_released = 0;    // clips labelled and handed out
+  uint64_t clips_unlabelled = 0;  // released with no reading in their window
+  uint64_t readings_in = 0;       // usable anemometer readings
+  uint64_t readings_late = 0;     // readings stamped inside an already released clip's window
+  double last_gap = 0.0;          // length of the last gap [s]
+};
+
+// The ROS-free clip buffer: camera frames and anemometer readings in (each by stamp), labelled
+// clips out. Frames go through FrameResampler (nearest frame by stamp onto a 25 fps grid),
+// PreprocessClipFrame (crop, grey, resize) and ClipAssembler (N_t frames every stride, broken at
+// gaps); finished clips wait in a queue until their label is due (see label_delay), then get the
+// WindLabeller's statistics over [last frame - label_window, last frame].
+class ClipPipeline {
+ public:
+  explicit ClipPipeline(const ClipPipelineOptions& options);
+
+  // Pushes one camera frame.
+  // Inputs:
+  //   stamp     capture time [s] (header.stamp)
+  //   image     rows x cols, type ClipSourceCvType(encoding); only read during the call
+  //   encoding  its pixel layout
+  // Throws std::invalid_argument (roi does not fit, wrong type) after counting it as dropped.
+  void AddFrame(double stamp, const cv::Mat& image, ClipSourceEncoding encoding);
+
+  // Pushes one anemometer reading (any arrival order).
+  void AddReading(const LabelReading& reading);
+
+  // Clips whose label is due (data time >= end + label_delay), oldest first.
+  std::vector<LabelledClip> TakeReady();
+
+  // Every waiting clip, labelled with the readings held now (the stream ended or stalled).
+  std::vector<LabelledClip> Flush();
+
+  // Forgets the streams (e.g. time jumped back when a bag restarts); counters are kept.
+  void Reset();
+
+  size_t pending() const { return pending_.size(); }
+  const ClipPipelineStats& stats() const { return stats_; }
+  const ClipPipelineOptions& options() const { return options_; }
+
+ private:
+  void Emit(const FrameResampler::Tick& tick, const cv::Mat& image);
+  LabelledClip Release(AssembledClip clip);
+
+  ClipPipelineOptions options_;
+  FrameResampler resampler_;
+  ClipAssembler assembler_;
+  WindLabeller labeller_;
+  cv::Mat previous_;            // preprocessed previous camera frame (a tick may still pick it)
+  SquareRoi roi_;               // resolved for the current source size
+  int source_width_ = 0, source_height_ = 0;
+  double data_time_;            // largest stamp seen on either stream [s]
+  double released_end_;         // end of the last released clip [s]
+  std::deque<AssembledClip> pending_;
+  ClipPipelineStats stats_;
+};
+
+}  // namespace clothwind::sensors
+
+#endif  // CLOTHWIND_SENSORS_CLIP_PIPELINE_H_

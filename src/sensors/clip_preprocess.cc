@@ -1,0 +1,79 @@
+#include "sensors/clip_preprocess.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+namespace clothwind::sensors {
+
+ClipSourceEncoding ParseClipSourceEncoding(const std::string& encoding) {
+  if (encoding == "mono8" || encoding == "8UC1") return ClipSourceEncoding::kMono8;
+  if (encoding == "mono16" || encoding == "16UC1") return ClipSourceEncoding::kMono16;
+  if (encoding == "bgr8" || encoding == "8UC3") return ClipSourceEncoding::kBgr8;
+  if (encoding == "rgb8") return ClipSourceEncoding::kRgb8;
+  if (encoding == "bgra8" || encoding == "8UC4") return ClipSourceEncoding::kBgra8;
+  if (encoding == "rgba8") return ClipSourceEncoding::kRgba8;
+  throw std::invalid_argument("image encoding '" + encoding +
+                              "' not supported; expected mono8, mono16, bgr8, rgb8, bgra8 or rgba8");
+}
+
+int ClipSourceCvType(ClipSourceEncoding encoding) {
+  switch (encoding) {
+    case ClipSourceEncoding::kMono8: return CV_8UC1;
+    case ClipSourceEncoding::kMono16: return CV_16UC1;
+    case ClipSourceEncoding::kBgr8:
+    case ClipSourceEncoding::kRgb8: return CV_8UC3;
+    case ClipSourceEncoding::kBgra8:
+    case ClipSourceEncoding::kRgba8: return CV_8UC4;
+  }
+  return -1;
+}
+
+SquareRoi ResolveRoi(const SquareRoi& requested, int width, int height) {
+  if (width <= 0 || height <= 0)
+    throw std::invalid_argument("roi: image size " + std::to_string(width) + "x" +
+                                std::to_string(height) + " is empty");
+  if (requested.size <= 0) {
+    const int side = std::min(width, height);
+    return {(width - side) / 2, (height - side) / 2, side};
+  }
+  if (requested.x < 0 || requested.y < 0 || requested.x + requested.size > width ||
+      requested.y + requested.size > height)
+    throw std::invalid_argument("roi [x=" + std::to_string(requested.x) + ", y=" +
+                                std::to_string(requested.y) + ", size=" + std::to_string(requested.size) +
+                                "] does not fit in a " + std::to_string(width) + "x" +
+                                std::to_string(height) + " image");
+  return requested;
+}
+
+cv::Mat PreprocessClipFrame(const cv::Mat& image, ClipSourceEncoding encoding, const SquareRoi& roi,
+                            int out_size) {
+  if (out_size <= 0) throw std::invalid_argument("clip frame size must be > 0, got " + std::to_string(out_size));
+  if (image.type() != ClipSourceCvType(encoding))
+    throw std::invalid_argument("image type does not match its encoding");
+  const SquareRoi r = ResolveRoi(roi, image.cols, image.rows);
+  // Crop first (a view, no copy) so colour conversion only touches the pixels we keep.
+  const cv::Mat crop = image(cv::Rect(r.x, r.y, r.size, r.size));
+  cv::Mat grey;
+  switch (encoding) {
+    case ClipSourceEncoding::kMono8: grey = crop; break;
+    case ClipSourceEncoding::kMono16: crop.convertTo(grey, CV_8U, 1.0 / 256.0); break;
+    case ClipSourceEncoding::kBgr8: cv::cvtColor(crop, grey, cv::COLOR_BGR2GRAY); break;
+    case ClipSourceEncoding::kRgb8: cv::cvtColor(crop, grey, cv::COLOR_RGB2GRAY); break;
+    case ClipSourceEncoding::kBgra8: cv::cvtColor(crop, grey, cv::COLOR_BGRA2GRAY); break;
+    case ClipSourceEncoding::kRgba8: cv::cvtColor(crop, grey, cv::COLOR_RGBA2GRAY); break;
+  }
+  cv::Mat out;
+  if (r.size == out_size) {
+    out = grey.clone();
+  } else {
+    // INTER_AREA averages the source pixels under each output pixel when shrinking (no aliasing of
+    // the fine flag texture); when enlarging it behaves like bilinear.
+    cv::resize(grey, out, cv::Size(out_size, out_size), 0, 0,
+               r.size > out_size ? cv::INTER_AREA : cv::INTER_LINEAR);
+  }
+  return out;
+}
+
+}  // namespace clothwind::sensors

@@ -1,0 +1,78 @@
+#include "sensors/clip_preprocess.h"
+
+#include <gtest/gtest.h>
+
+namespace clothwind::sensors {
+namespace {
+
+TEST(ClipPreprocessTest, DefaultRoiIsCentredSquare) {
+  const SquareRoi r = ResolveRoi({}, 320, 240);
+  EXPECT_EQ(r.x, 40);
+  EXPECT_EQ(r.y, 0);
+  EXPECT_EQ(r.size, 240);
+  const SquareRoi p = ResolveRoi({}, 240, 320);
+  EXPECT_EQ(p.x, 0);
+  EXPECT_EQ(p.y, 40);
+}
+
+TEST(ClipPreprocessTest, RoiOutsideImageIsAnError) {
+  EXPECT_NO_THROW(ResolveRoi({20, 10, 230}, 320, 240));
+  EXPECT_THROW(ResolveRoi({100, 10, 240}, 320, 240), std::invalid_argument);
+  EXPECT_THROW(ResolveRoi({-1, 0, 10}, 320, 240), std::invalid_argument);
+}
+
+TEST(ClipPreprocessTest, CropsGreysAndResizes) {
+  // A bgr image: pure blue left of column 100, pure red from column 100; the roi covers only red
+  // in its right half, so the output's left half is the luma of blue and its right half of red.
+  cv::Mat image(240, 320, CV_8UC3, cv::Scalar(255, 0, 0));
+  image(cv::Rect(100, 0, 220, 240)).setTo(cv::Scalar(0, 0, 255));
+  const cv::Mat out = PreprocessClipFrame(image, ClipSourceEncoding::kBgr8, {50, 20, 100}, 50);
+  ASSERT_EQ(out.type(), CV_8UC1);
+  ASSERT_EQ(out.rows, 50);
+  ASSERT_EQ(out.cols, 50);
+  // BT.601 luma: blue 0.114 * 255 = 29, red 0.299 * 255 = 76.
+  EXPECT_NEAR(out.at<uint8_t>(25, 10), 29, 1);
+  EXPECT_NEAR(out.at<uint8_t>(25, 40), 76, 1);
+  // rgb8 of the same bytes reads red and blue swapped.
+  const cv::Mat swapped = PreprocessClipFrame(image, ClipSourceEncoding::kRgb8, {50, 20, 100}, 50);
+  EXPECT_NEAR(swapped.at<uint8_t>(25, 10), 76, 1);
+  EXPECT_NEAR(swapped.at<uint8_t>(25, 40), 29, 1);
+}
+
+TEST(ClipPreprocessTest, AreaResizeAveragesFineTexture) {
+  // A 1-pixel checkerboard 0/200 shrunk 4x must average to ~100 everywhere (no aliasing).
+  cv::Mat image(400, 400, CV_8UC1);
+  for (int r = 0; r < 400; ++r)
+    for (int c = 0; c < 400; ++c) image.at<uint8_t>(r, c) = ((r + c) % 2) ? 200 : 0;
+  const cv::Mat out = PreprocessClipFrame(image, ClipSourceEncoding::kMono8, {}, 100);
+  double lo, hi;
+  cv::minMaxLoc(out, &lo, &hi);
+  EXPECT_GE(lo, 99);
+  EXPECT_LE(hi, 101);
+}
+
+TEST(ClipPreprocessTest, Mono16ScaledToEightBitsAndOutputIsACopy) {
+  cv::Mat image(300, 300, CV_16UC1, cv::Scalar(256 * 123));
+  const cv::Mat out = PreprocessClipFrame(image, ClipSourceEncoding::kMono16, {}, 300);
+  EXPECT_EQ(out.at<uint8_t>(150, 150), 123);
+  cv::Mat mono(300, 300, CV_8UC1, cv::Scalar(7));
+  const cv::Mat copy = PreprocessClipFrame(mono, ClipSourceEncoding::kMono8, {}, 300);
+  mono.setTo(9);
+  EXPECT_EQ(copy.at<uint8_t>(0, 0), 7);
+}
+
+TEST(ClipPreprocessTest, EncodingsParseOrExplain) {
+  EXPECT_EQ(ParseClipSourceEncoding("bgr8"), ClipSourceEncoding::kBgr8);
+  EXPECT_EQ(ParseClipSourceEncoding("mono8"), ClipSourceEncoding::kMono8);
+  try {
+    ParseClipSourceEncoding("yuv422");
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("yuv422"), std::string::npos);
+  }
+  cv::Mat wrong(10, 10, CV_8UC1);
+  EXPECT_THROW(PreprocessClipFrame(wrong, ClipSourceEncoding::kBgr8, {}, 5), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace clothwind::sensors

@@ -1,0 +1,175 @@
+#include "sensors/dataset_writer.h"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
+
+namespace clothwind::sensors {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr int kFormatVersion = 1;
+
+// NaN and inf become null in JSON (nlohmann does that too, but say it explicitly).
+nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+std::string TempSuffix() {
+  static uint64_t counter = 0;
+  return ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+}
+
+}  // namespace
+
+void WriteFileAtomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + TempSuffix();
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error("cannot open " + tmp + " for writing: " + std::strerror(errno));
+    out << text;
+    out.flush();
+    if (!out) throw std::runtime_error("cannot write " + tmp + ": " + std::strerror(errno));
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp);
+    throw std::runtime_error("cannot rename " + tmp + " to " + path + ": " + ec.message());
+  }
+}
+
+std::string ClipFolderName(double first_stamp, uint64_t sequence) {
+  const double whole = std::floor(first_stamp);
+  const std::time_t seconds = static_cast<std::time_t>(whole);
+  const int millis = std::min(999, static_cast<int>(std::lround((first_stamp - whole) * 1000.0)));
+  std::tm tm{};
+  gmtime_r(&seconds, &tm);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "clip-%04d%02d%02d-%02d%02d%02d.%03d-%06llu", tm.tm_year + 1900,
+                tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, millis,
+                static_cast<unsigned long long>(sequence));
+  return buf;
+}
+
+nlohmann::json ClipLabelJson(const LabelledClip& c, const ClipSourceInfo& source, const std::string& name) {
+  const auto& frames = c.clip.frames;
+  nlohmann::json stamps = nlohmann::json::array(), source_stamps = nlohmann::json::array();
+  for (const auto& f : frames) {
+    stamps.push_back(f.stamp);
+    source_stamps.push_back(f.source_stamp);
+  }
+  const auto& l = c.label;
+  nlohmann::json j;
+  j["format"] = "clothwind-clip";
+  j["version"] = kFormatVersion;
+  j["name"] = name;
+  j["kind"] = "real";  // recorded from a camera, as FlagReal (simulated examples say "sim")
+  j["sequence"] = c.clip.sequence;
+  j["num_frames"] = frames.size();
+  j["frame_rate"] = c.frame_rate;
+  j["width"] = frames.empty() ? 0 : frames.front().image.cols;
+  j["height"] = frames.empty() ? 0 : frames.front().image.rows;
+  j["encoding"] = "mono8";
+  j["frame_pattern"] = "%03d.jpg";
+  j["start"] = frames.empty() ? 0.0 : frames.front().stamp;
+  j["end"] = frames.empty() ? 0.0 : frames.back().stamp;
+  j["frame_stamps"] = stamps;
+  j["source_frame_stamps"] = source_stamps;
+  j["roi"] = {{"x", c.roi.x}, {"y", c.roi.y}, {"size", c.roi.size}};
+  j["source"] = {{"width", c.source_width}, {"height", c.source_height}, {"frame_id", source.frame_id},
+                 {"description", source.description}, {"camera_info", source.camera}};
+  j["wind_speed"] = Number(l.mean);  // the training target, as in simulated examples
+  j["wind"] = {{"window", l.window},          {"end", l.end},
+               {"mean", Number(l.mean)},      {"std", Number(l.std)},
+               {"count", l.count},            {"direction_mean", Number(l.direction_mean)},
+               {"first_stamp", Number(l.first_stamp)}, {"last_stamp", Number(l.last_stamp)}};
+  return j;
+}
+
+DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality)
+    : root_(root), jpeg_quality_(jpeg_quality) {
+  if (jpeg_quality < 1 || jpeg_quality > 100)
+    throw std::invalid_argument("jpeg_quality must be in 1..100, got " + std::to_string(jpeg_quality));
+  std::error_code ec;
+  fs::create_directories(root_, ec);
+  if (ec) throw std::runtime_error("cannot create dataset folder " + root_ + ": " + ec.message());
+  const std::string index_path = root_ + "/index.json";
+  if (fs::exists(index_path)) {
+    std::ifstream in(index_path);
+    try {
+      index_ = nlohmann::json::parse(in);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(index_path + ": not valid JSON (" + e.what() + ")");
+    }
+    if (!index_.is_object() || !index_.contains("clips") || !index_["clips"].is_array())
+      throw std::runtime_error(index_path + ": expected an object with an array \"clips\"");
+  } else {
+    index_ = {{"format", "clothwind-dataset"}, {"version", kFormatVersion}, {"kind", "real"},
+              {"clips", nlohmann::json::array()}};
+  }
+}
+
+std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo& source) {
+  if (clip.clip.frames.empty()) throw std::invalid_argument("cannot record an empty clip");
+  const std::string name = ClipFolderName(clip.clip.frames.front().stamp, clip.clip.sequence);
+  const std::string final_dir = root_ + "/" + name;
+  const std::string tmp_dir = root_ + "/." + name + TempSuffix();
+  std::error_code ec;
+  fs::create_directory(tmp_dir, ec);
+  if (ec) throw std::runtime_error("cannot create " + tmp_dir + ": " + ec.message());
+  try {
+    const std::vector<int> params{cv::IMWRITE_JPEG_QUALITY, jpeg_quality_};
+    for (size_t i = 0; i < clip.clip.frames.size(); ++i) {
+      char file[32];
+      std::snprintf(file, sizeof file, "/%03zu.jpg", i);
+      if (!cv::imwrite(tmp_dir + file, clip.clip.frames[i].image, params))
+        throw std::runtime_error("cannot write " + tmp_dir + file);
+    }
+    const nlohmann::json label = ClipLabelJson(clip, source, name);
+    WriteFileAtomically(tmp_dir + "/label.json", label.dump(2) + "\n");
+    if (fs::exists(final_dir)) {  // replayed again: replace the old folder
+      const std::string old_dir = root_ + "/." + name + ".old" + TempSuffix();
+      fs::rename(final_dir, old_dir);
+      fs::rename(tmp_dir, final_dir);
+      fs::remove_all(old_dir);
+    } else {
+      fs::rename(tmp_dir, final_dir);
+    }
+    auto& clips = index_["clips"];
+    for (auto it = clips.begin(); it != clips.end(); ++it) {
+      if ((*it)["name"] == name) {
+        clips.erase(it);
+        break;
+      }
+    }
+    clips.push_back({{"name", name},
+                     {"sequence", clip.clip.sequence},
+                     {"start", label["start"]},
+                     {"end", label["end"]},
+                     {"num_frames", label["num_frames"]},
+                     {"wind_speed", label["wind_speed"]},
+                     {"wind_std", label["wind"]["std"]},
+                     {"wind_count", label["wind"]["count"]}});
+    WriteIndex();
+  } catch (const fs::filesystem_error& e) {
+    fs::remove_all(tmp_dir, ec);
+    throw std::runtime_error(std::string("recording clip ") + name + ": " + e.what());
+  } catch (...) {
+    fs::remove_all(tmp_dir, ec);
+    throw;
+  }
+  return final_dir;
+}
+
+void DatasetWriter::WriteIndex() { WriteFileAtomically(root_ + "/index.json", index_.dump(1) + "\n"); }
+
+}  // namespace clothwind::sensors

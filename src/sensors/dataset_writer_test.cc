@@ -1,0 +1,119 @@
+#include "sensors/dataset_writer.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+namespace clothwind::sensors {
+namespace {
+namespace fs = std::filesystem;
+
+class DatasetWriterTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() / ("clothwind_dataset_writer_test_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  static LabelledClip MakeClip(uint64_t sequence, double t0, int frames = 4) {
+    LabelledClip c;
+    c.clip.sequence = sequence;
+    for (int i = 0; i < frames; ++i) {
+      cv::Mat img(32, 32, CV_8UC1, cv::Scalar(40 * i + 20));
+      c.clip.frames.push_back({i, t0 + i / 25.0, t0 + i / 25.0 + 0.003, img});
+    }
+    c.roi = {40, 0, 240};
+    c.source_width = 320;
+    c.source_height = 240;
+    c.label = ComputeWindLabel({{t0 - 1.0, 3.0, 0.5}, {t0, 5.0, 0.5}}, t0 + 0.12, 60.0);
+    return c;
+  }
+
+  static nlohmann::json Read(const fs::path& p) {
+    std::ifstream in(p);
+    return nlohmann::json::parse(in);
+  }
+
+  fs::path root_;
+};
+
+TEST_F(DatasetWriterTest, WritesFramesLabelAndIndex) {
+  DatasetWriter w(root_.string(), 95);
+  const std::string dir = w.Write(MakeClip(3, 1700000000.5), {"camera_optical_frame", "test", nullptr});
+  EXPECT_EQ(fs::path(dir).filename().string(), "clip-20231114-221320.500-000003");
+  for (int i = 0; i < 4; ++i) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%03d.jpg", i);
+    const cv::Mat img = cv::imread((fs::path(dir) / name).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(img.empty()) << name;
+    EXPECT_EQ(img.type(), CV_8UC1);
+    EXPECT_NEAR(img.at<uint8_t>(16, 16), 40 * i + 20, 2);  // JPEG round trip of a flat image
+  }
+  const auto label = Read(fs::path(dir) / "label.json");
+  EXPECT_EQ(label["format"], "clothwind-clip");
+  EXPECT_EQ(label["num_frames"], 4);
+  EXPECT_DOUBLE_EQ(label["wind"]["mean"].get<double>(), 4.0);
+  EXPECT_DOUBLE_EQ(label["wind_speed"].get<double>(), 4.0);
+  EXPECT_DOUBLE_EQ(label["wind"]["std"].get<double>(), 1.0);
+  EXPECT_EQ(label["wind"]["count"], 2);
+  EXPECT_EQ(label["roi"]["x"], 40);
+  EXPECT_EQ(label["source"]["frame_id"], "camera_optical_frame");
+  EXPECT_NEAR(label["frame_stamps"][3].get<double>() - label["frame_stamps"][0].get<double>(), 0.12, 1e-6);
+  const auto index = Read(root_ / "index.json");
+  ASSERT_EQ(index["clips"].size(), 1u);
+  EXPECT_EQ(index["clips"][0]["name"], fs::path(dir).filename().string());
+  // Nothing temporary is left behind.
+  for (const auto& e : fs::directory_iterator(root_))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
+TEST_F(DatasetWriterTest, ReopenAppendsAndRewriteReplaces) {
+  {
+    DatasetWriter w(root_.string());
+    w.Write(MakeClip(0, 1700000000.0), {});
+    w.Write(MakeClip(1, 1700000001.2), {});
+  }
+  DatasetWriter again(root_.string());
+  EXPECT_EQ(again.size(), 2u);
+  again.Write(MakeClip(1, 1700000001.2, 3), {});  // same clip replayed: replaced, not duplicated
+  again.Write(MakeClip(2, 1700000002.4), {});
+  EXPECT_EQ(again.size(), 3u);
+  EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 3u);
+  const auto replaced = Read(root_ / ClipFolderName(1700000001.2, 1) / "label.json");
+  EXPECT_EQ(replaced["num_frames"], 3);
+  EXPECT_FALSE(fs::exists(root_ / ClipFolderName(1700000001.2, 1) / "003.jpg"));
+  int folders = 0;
+  for (const auto& e : fs::directory_iterator(root_)) folders += e.is_directory();
+  EXPECT_EQ(folders, 3);
+}
+
+TEST_F(DatasetWriterTest, CorruptIndexIsAClearError) {
+  fs::create_directories(root_);
+  std::ofstream(root_ / "index.json") << "{ not json";
+  try {
+    DatasetWriter w(root_.string());
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("index.json"), std::string::npos);
+  }
+}
+
+TEST_F(DatasetWriterTest, AtomicFileWriteReplacesContent) {
+  fs::create_directories(root_);
+  const std::string p = (root_ / "a.txt").string();
+  WriteFileAtomically(p, "one");
+  WriteFileAtomically(p, "two");
+  std::ifstream in(p);
+  std::string s;
+  in >> s;
+  EXPECT_EQ(s, "two");
+  EXPECT_THROW(WriteFileAtomically((root_ / "missing" / "b.txt").string(), "x"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace clothwind::sensors
