@@ -1,0 +1,124 @@
+#include "sensors/fine_offset_record.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace clothwind::sensors {
+namespace {
+
+// A WH1080 record laid out byte by byte as the public memory map documents it:
+// delay 5 min, indoor 45 % 21.0 C, outdoor 80 % 13.8 C, 1011.0 hPa, wind average 2.8 m/s,
+// gust 29.8 m/s (low byte 0x2A plus high nibble 1 in byte 11), direction 6 (SE), rain 0x0124.
+const std::vector<uint8_t> kRecord = {0x05, 0x2D, 0xD2, 0x00, 0x50, 0x8A, 0x00, 0x7E,
+                                      0x27, 0x1C, 0x2A, 0x10, 0x06, 0x24, 0x01, 0x00};
+
+TEST(FineOffsetRecord, DecodesTheDocumentedLayout) {
+  FineOffsetRecord r;
+  std::string err;
+  ASSERT_TRUE(ParseFineOffsetRecord(kRecord, &r, &err)) << err;
+  EXPECT_EQ(r.delay_minutes, 5);
+  EXPECT_EQ(r.humidity_out, 80);
+  EXPECT_NEAR(r.temperature_out, 13.8, 1e-9);
+  EXPECT_NEAR(r.pressure_abs, 1011.0, 1e-9);
+  EXPECT_NEAR(r.wind_average, 2.8, 1e-9);
+  EXPECT_NEAR(r.wind_gust, 29.8, 1e-9);
+  EXPECT_EQ(r.direction_index, 6);
+  EXPECT_FALSE(r.lost_contact);
+}
+
+TEST(FineOffsetRecord, HighNibblesExtendBothSpeeds) {
+  std::vector<uint8_t> b = kRecord;
+  b[11] = 0x21;  // average += 0x100, gust += 0x200
+  FineOffsetRecord r;
+  std::string err;
+  ASSERT_TRUE(ParseFineOffsetRecord(b, &r, &err));
+  EXPECT_NEAR(r.wind_average, (0x1C + 0x100) * 0.1, 1e-9);
+  EXPECT_NEAR(r.wind_gust, (0x2A + 0x200) * 0.1, 1e-9);
+}
+
+TEST(FineOffsetRecord, NegativeTemperatureIsSignMagnitude) {
+  std::vector<uint8_t> b = kRecord;
+  b[5] = 0x05;
+  b[6] = 0x80;
+  FineOffsetRecord r;
+  std::string err;
+  ASSERT_TRUE(ParseFineOffsetRecord(b, &r, &err));
+  EXPECT_NEAR(r.temperature_out, -0.5, 1e-9);
+}
+
+TEST(FineOffsetRecord, InvalidFlags) {
+  std::vector<uint8_t> b = kRecord;
+  b[12] = 0x86;  // bit 7: direction invalid
+  FineOffsetRecord r;
+  std::string err;
+  ASSERT_TRUE(ParseFineOffsetRecord(b, &r, &err));
+  EXPECT_EQ(r.direction_index, -1);
+  WindReading w = FineOffsetToReading(r);
+  EXPECT_TRUE(w.valid);
+  EXPECT_TRUE(std::isnan(WindDirection(w)));
+
+  b = kRecord;
+  b[15] = 0x40;  // lost contact with the outdoor unit
+  ASSERT_TRUE(ParseFineOffsetRecord(b, &r, &err));
+  EXPECT_TRUE(r.lost_contact);
+  EXPECT_FALSE(FineOffsetToReading(r).valid);
+
+  b = kRecord;
+  b[9] = 0xFF;  // no average
+  ASSERT_TRUE(ParseFineOffsetRecord(b, &r, &err));
+  EXPECT_TRUE(std::isnan(r.wind_average));
+  EXPECT_FALSE(FineOffsetToReading(r).valid);
+
+  EXPECT_FALSE(ParseFineOffsetRecord({0x01, 0x02}, &r, &err));
+  EXPECT_NE(err.find("16"), std::string::npos);
+}
+
+TEST(FineOffsetRecord, ReadingUsesCompassConvention) {
+  FineOffsetRecord r;
+  std::string err;
+  ASSERT_TRUE(ParseFineOffsetRecord(kRecord, &r, &err));
+  const WindReading w = FineOffsetToReading(r);
+  EXPECT_EQ(w.source, "fine_offset");
+  EXPECT_DOUBLE_EQ(w.from_angle_deg, 135.0);  // index 6 * 22.5: from the south-east
+  EXPECT_EQ(w.reference, AngleReference::kEarth);
+  EXPECT_NEAR(WindDirection(w), 3 * M_PI / 4, 1e-12);  // blowing to the north-west in ENU
+  EXPECT_NEAR(w.gust, 29.8, 1e-9);
+}
+
+TEST(FineOffsetRecord, CurrentAddressFromFixedBlock) {
+  std::vector<uint8_t> fixed(32, 0);
+  fixed[0] = 0x55;
+  fixed[1] = 0xAA;
+  fixed[0x1E] = 0x40;
+  fixed[0x1F] = 0x05;
+  uint16_t a = 0;
+  std::string err;
+  ASSERT_TRUE(FineOffsetCurrentAddress(fixed, &a, &err)) << err;
+  EXPECT_EQ(a, 0x0540);
+  fixed[0x1F] = 0x00;
+  fixed[0x1E] = 0x10;  // inside the fixed block: corrupt read
+  EXPECT_FALSE(FineOffsetCurrentAddress(fixed, &a, &err));
+  EXPECT_NE(err.find("0x0010"), std::string::npos);
+  EXPECT_FALSE(FineOffsetCurrentAddress(std::vector<uint8_t>(16, 0), &a, &err));
+}
+
+TEST(FineOffsetRecord, ReadCommandAndHex) {
+  const auto c = FineOffsetReadCommand(0x0540);
+  const std::array<uint8_t, 8> expected = {0xA1, 0x05, 0x40, 0x20, 0xA1, 0x05, 0x40, 0x20};
+  EXPECT_EQ(c, expected);
+  const std::string hex = HexEncode(kRecord);
+  EXPECT_EQ(hex, "052DD200508A007E271C2A1006240100");
+  std::vector<uint8_t> back;
+  ASSERT_TRUE(HexDecode(hex, &back));
+  EXPECT_EQ(back, kRecord);
+  EXPECT_FALSE(HexDecode("0A1", &back));
+  EXPECT_FALSE(HexDecode("0G", &back));
+  const ParseResult p = ParseFineOffsetHex(hex);
+  ASSERT_EQ(p.status, ParseStatus::kOk) << p.error;
+  EXPECT_NEAR(p.reading.speed, 2.8, 1e-9);
+  EXPECT_EQ(ParseFineOffsetHex("zz").status, ParseStatus::kMalformed);
+}
+
+}  // namespace
+}  // namespace clothwind::sensors

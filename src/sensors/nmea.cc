@@ -1,0 +1,249 @@
+#include "sensors/nmea.h"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "sensors/protocol_fields.h"
+
+namespace clothwind::sensors {
+namespace {
+
+ParseResult Fail(ParseStatus s, std::string msg) {
+  ParseResult r;
+  r.status = s;
+  r.error = std::move(msg);
+  return r;
+}
+
+bool NmeaSpeedUnit(const std::string& f, SpeedUnit* unit) {
+  if (f == "M") *unit = SpeedUnit::kMetresPerSecond;
+  else if (f == "N") *unit = SpeedUnit::kKnots;
+  else if (f == "K") *unit = SpeedUnit::kKilometresPerHour;
+  else if (f == "S") *unit = SpeedUnit::kMilesPerHour;  // statute miles per hour
+  else return false;
+  return true;
+}
+
+ParseResult ParseMwv(const NmeaSentence& s) {
+  // $--MWV,<angle>,<R|T>,<speed>,<K|M|N|S>,<A|V>
+  const std::string where = s.talker + "MWV";
+  if (s.fields.size() < 5)
+    return Fail(ParseStatus::kMalformed, where + ": expected 5 fields (angle,ref,speed,unit,status), got " +
+                                             std::to_string(s.fields.size()));
+  ParseResult r;
+  WindReading& w = r.reading;
+  w.source = "nmea_mwv";
+  const std::string& status = s.fields[4];
+  if (status != "A" && status != "V")
+    return Fail(ParseStatus::kMalformed, where + " field 5 (status): expected A or V, got '" + status + "'");
+  w.valid = status == "A";
+  w.status = status;
+  const std::string& ref = s.fields[1];
+  if (ref != "R" && ref != "T")
+    return Fail(ParseStatus::kMalformed, where + " field 2 (reference): expected R or T, got '" + ref + "'");
+  w.relative = ref == "R";
+  double angle = kNaN, speed = kNaN;
+  std::string err;
+  if (!ParseOptionalNumber(s.fields[0], &angle, &err))
+    return Fail(ParseStatus::kMalformed, where + " field 1 (angle): " + err);
+  if (!ParseOptionalNumber(s.fields[2], &speed, &err))
+    return Fail(ParseStatus::kMalformed, where + " field 3 (speed): " + err);
+  if (std::isfinite(angle) && (angle < 0.0 || angle > 360.0))
+    return Fail(ParseStatus::kMalformed, where + " field 1 (angle): expected 0..360 deg, got " + s.fields[0]);
+  if (std::isfinite(speed) && speed < 0.0)
+    return Fail(ParseStatus::kMalformed, where + " field 3 (speed): expected >= 0, got " + s.fields[2]);
+  SpeedUnit unit;
+  if (std::isfinite(speed) && !NmeaSpeedUnit(s.fields[3], &unit))
+    return Fail(ParseStatus::kMalformed,
+                where + " field 4 (unit): expected K, M, N or S, got '" + s.fields[3] + "'");
+  if (std::isfinite(speed)) w.speed = SpeedToMetresPerSecond(speed, unit);
+  if (w.valid && (!std::isfinite(speed) || !std::isfinite(angle)))
+    return Fail(ParseStatus::kMalformed, where + ": status A but angle or speed empty");
+  w.from_angle_deg = angle;
+  w.reference = std::isfinite(angle) ? AngleReference::kInstrument : AngleReference::kNone;
+  r.status = ParseStatus::kOk;
+  return r;
+}
+
+ParseResult ParseMwd(const NmeaSentence& s) {
+  // $--MWD,<dir true>,T,<dir magnetic>,M,<speed kn>,N,<speed m/s>,M
+  const std::string where = s.talker + "MWD";
+  if (s.fields.size() < 8)
+    return Fail(ParseStatus::kMalformed, where + ": expected 8 fields, got " + std::to_string(s.fields.size()));
+  const char* expected_units[] = {"T", "M", "N", "M"};
+  for (int i = 0; i < 4; ++i) {
+    const std::string& u = s.fields[2 * i + 1];
+    if (!u.empty() && u != expected_units[i])
+      return Fail(ParseStatus::kMalformed, where + " field " + std::to_string(2 * i + 2) + ": expected '" +
+                                               expected_units[i] + "', got '" + u + "'");
+  }
+  double v[4];
+  std::string err;
+  for (int i = 0; i < 4; ++i)
+    if (!ParseOptionalNumber(s.fields[2 * i], &v[i], &err))
+      return Fail(ParseStatus::kMalformed, where + " field " + std::to_string(2 * i + 1) + ": " + err);
+  ParseResult r;
+  WindReading& w = r.reading;
+  w.source = "nmea_mwd";
+  w.relative = false;
+  // Prefer the true bearing: a magnetic one needs the local declination, which we do not know.
+  if (std::isfinite(v[0])) {
+    w.from_angle_deg = v[0];
+    w.status = "true";
+  } else if (std::isfinite(v[1])) {
+    w.from_angle_deg = v[1];
+    w.status = "magnetic";
+  }
+  if (std::isfinite(w.from_angle_deg) && (w.from_angle_deg < 0.0 || w.from_angle_deg > 360.0))
+    return Fail(ParseStatus::kMalformed, where + ": direction expected 0..360 deg");
+  w.reference = std::isfinite(w.from_angle_deg) ? AngleReference::kEarth : AngleReference::kNone;
+  if (std::isfinite(v[3])) w.speed = v[3];
+  else if (std::isfinite(v[2])) w.speed = SpeedToMetresPerSecond(v[2], SpeedUnit::kKnots);
+  else return Fail(ParseStatus::kMalformed, where + ": neither knots (field 5) nor m/s (field 7) speed given");
+  if (w.speed < 0.0) return Fail(ParseStatus::kMalformed, where + ": negative speed");
+  r.status = ParseStatus::kOk;
+  return r;
+}
+
+std::string Upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+ParseResult ParseXdr(const NmeaSentence& s) {
+  // $--XDR,<type>,<value>,<units>,<name>[,<type>,<value>,<units>,<name>...]
+  // There is no standard wind transducer type, so quadruplets are recognised by their name:
+  // WIND/WSPD/WDIR/WGUST style names; direction needs units D (degrees), speeds M, N or K.
+  const std::string where = s.talker + "XDR";
+  if (s.fields.empty() || s.fields.size() % 4 != 0)
+    return Fail(ParseStatus::kMalformed,
+                where + ": expected quadruplets (type,value,units,name), got " + std::to_string(s.fields.size()) +
+                    " fields");
+  ParseResult r;
+  WindReading& w = r.reading;
+  w.source = "nmea_xdr";
+  bool any = false;
+  for (size_t q = 0; q < s.fields.size(); q += 4) {
+    const std::string name = Upper(s.fields[q + 3]);
+    const bool windish = name.find("WIND") != std::string::npos || name.rfind("WSPD", 0) == 0 ||
+                         name.rfind("WDIR", 0) == 0 || name.rfind("WGUST", 0) == 0;
+    if (!windish) continue;
+    double value;
+    std::string err;
+    if (!ParseOptionalNumber(s.fields[q + 1], &value, &err))
+      return Fail(ParseStatus::kMalformed,
+                  where + " quadruplet '" + s.fields[q + 3] + "' field " + std::to_string(q + 2) + ": " + err);
+    if (!std::isfinite(value)) continue;
+    const std::string& units = s.fields[q + 2];
+    if (name.find("DIR") != std::string::npos) {
+      if (units != "D")
+        return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] +
+                                                 "': direction units expected D (degrees), got '" + units + "'");
+      w.from_angle_deg = value;
+      w.reference = AngleReference::kInstrument;
+      any = true;
+    } else {
+      SpeedUnit unit;
+      if (!NmeaSpeedUnit(units, &unit))
+        return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] +
+                                                 "': speed units expected M, N, K or S, got '" + units + "'");
+      if (value < 0.0)
+        return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] + "': negative speed");
+      if (name.find("GUST") != std::string::npos) w.gust = SpeedToMetresPerSecond(value, unit);
+      else w.speed = SpeedToMetresPerSecond(value, unit);
+      any = true;
+    }
+  }
+  if (!any) {
+    r.status = ParseStatus::kNotWind;
+    return r;
+  }
+  if (!std::isfinite(w.speed))
+    return Fail(ParseStatus::kMalformed, where + ": wind quadruplets but no wind speed");
+  r.status = ParseStatus::kOk;
+  return r;
+}
+
+}  // namespace
+
+uint8_t NmeaChecksum(const std::string& body) {
+  uint8_t c = 0;
+  for (unsigned char ch : body) c ^= ch;
+  return c;
+}
+
+std::string WithNmeaChecksum(const std::string& body) {
+  char hex[4];
+  std::snprintf(hex, sizeof(hex), "%02X", NmeaChecksum(body));
+  return "$" + body + "*" + hex;
+}
+
+bool SplitNmeaSentence(const std::string& record, NmeaSentence* out, ParseResult* error) {
+  auto fail = [&](ParseStatus s, const std::string& m) {
+    *error = Fail(s, "NMEA: " + m);
+    return false;
+  };
+  if (record.empty() || (record[0] != '$' && record[0] != '!')) return fail(ParseStatus::kMalformed, "expected '$' at start");
+  for (unsigned char c : record)
+    if (c < 0x20 || c > 0x7E) return fail(ParseStatus::kMalformed, "non-printable byte in sentence");
+  std::string body;
+  const size_t star = record.find('*');
+  out->has_checksum = star != std::string::npos;
+  if (out->has_checksum) {
+    body = record.substr(1, star - 1);
+    const std::string hex = record.substr(star + 1);
+    if (hex.size() != 2 || !std::isxdigit(static_cast<unsigned char>(hex[0])) ||
+        !std::isxdigit(static_cast<unsigned char>(hex[1])))
+      return fail(ParseStatus::kMalformed, "expected two hex digits after '*', got '" + hex + "'");
+    const unsigned expected = static_cast<unsigned>(std::strtoul(hex.c_str(), nullptr, 16));
+    const unsigned actual = NmeaChecksum(body);
+    if (expected != actual) {
+      char msg[96];
+      std::snprintf(msg, sizeof(msg), "checksum mismatch: sentence says %02X, computed %02X", expected, actual);
+      return fail(ParseStatus::kChecksumError, msg);
+    }
+  } else {
+    body = record.substr(1);
+  }
+  const size_t comma = body.find(',');
+  const std::string address = body.substr(0, comma);
+  if (address.size() < 4 || address.size() > 6)
+    return fail(ParseStatus::kMalformed, "address field '" + address + "' is not <talker><type>");
+  for (char c : address)
+    if (!std::isalnum(static_cast<unsigned char>(c)))
+      return fail(ParseStatus::kMalformed, "address field '" + address + "' is not alphanumeric");
+  if (address[0] == 'P') {
+    out->talker = "P";
+    out->type = address.substr(1);
+  } else {
+    out->talker = address.substr(0, 2);
+    out->type = address.substr(2);
+  }
+  out->fields.clear();
+  if (comma != std::string::npos) {
+    size_t start = comma + 1;
+    while (true) {
+      const size_t next = body.find(',', start);
+      out->fields.push_back(body.substr(start, next == std::string::npos ? std::string::npos : next - start));
+      if (next == std::string::npos) break;
+      start = next + 1;
+    }
+  }
+  return true;
+}
+
+ParseResult ParseNmea(const std::string& record) {
+  NmeaSentence s;
+  ParseResult r;
+  if (!SplitNmeaSentence(record, &s, &r)) return r;
+  if (s.type == "MWV") return ParseMwv(s);
+  if (s.type == "MWD") return ParseMwd(s);
+  if (s.type == "XDR") return ParseXdr(s);
+  r.status = ParseStatus::kNotWind;
+  r.error = "NMEA " + s.talker + s.type + " carries no wind";
+  return r;
+}
+
+}  // namespace clothwind::sensors

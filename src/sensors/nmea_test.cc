@@ -1,0 +1,140 @@
+#include "sensors/nmea.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace clothwind::sensors {
+namespace {
+
+constexpr double kKnot = 1852.0 / 3600.0;
+
+TEST(Nmea, ChecksumMatchesThePublishedGgaExample) {
+  // The classic NMEA 0183 GGA example sentence, checksum 47 as published.
+  NmeaSentence s;
+  ParseResult err;
+  ASSERT_TRUE(SplitNmeaSentence("$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47", &s, &err))
+      << err.error;
+  EXPECT_EQ(s.talker, "GP");
+  EXPECT_EQ(s.type, "GGA");
+  EXPECT_EQ(s.fields.size(), 14u);
+  EXPECT_EQ(ParseNmea("$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47").status,
+            ParseStatus::kNotWind);
+}
+
+TEST(Nmea, MwvRelativeKnots) {
+  const ParseResult r = ParseNmea("$IIMWV,229.0,R,5.8,N,A*39");
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_NEAR(r.reading.speed, 5.8 * kKnot, 1e-9);
+  EXPECT_DOUBLE_EQ(r.reading.from_angle_deg, 229.0);
+  EXPECT_EQ(r.reading.reference, AngleReference::kInstrument);
+  EXPECT_TRUE(r.reading.relative);
+  EXPECT_TRUE(r.reading.valid);
+  EXPECT_EQ(r.reading.source, "nmea_mwv");
+  EXPECT_NEAR(WindDirection(r.reading), WrapAngle(M_PI - 229.0 * M_PI / 180), 1e-12);
+}
+
+TEST(Nmea, MwvUnits) {
+  ParseResult r = ParseNmea("$WIMWV,045.0,T,12.6,M,A*12");
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_DOUBLE_EQ(r.reading.speed, 12.6);
+  EXPECT_FALSE(r.reading.relative);
+  r = ParseNmea("$IIMWV,090.0,R,36.0,K,A*04");
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_NEAR(r.reading.speed, 10.0, 1e-12);
+  r = ParseNmea("$IIMWV,180.0,T,10.0,S,A*1E");
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_NEAR(r.reading.speed, 4.4704, 1e-9);
+  // Lower-case checksum digits are accepted; a missing checksum too.
+  EXPECT_EQ(ParseNmea("$IIMWV,180.0,T,10.0,S,A*1e").status, ParseStatus::kOk);
+  EXPECT_EQ(ParseNmea("$IIMWV,180.0,T,10.0,S,A").status, ParseStatus::kOk);
+}
+
+TEST(Nmea, MwvStatusVoidIsAnInvalidReading) {
+  ParseResult r = ParseNmea("$IIMWV,270.0,R,3.0,N,V*2C");
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_FALSE(r.reading.valid);
+  r = ParseNmea("$IIMWV,,R,,N,V*2A");
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_FALSE(r.reading.valid);
+  EXPECT_TRUE(std::isnan(r.reading.speed));
+  EXPECT_TRUE(std::isnan(WindDirection(r.reading)));
+}
+
+TEST(Nmea, BadChecksumIsRejected) {
+  const ParseResult r = ParseNmea("$IIMWV,229.0,R,5.8,N,A*38");
+  EXPECT_EQ(r.status, ParseStatus::kChecksumError);
+  EXPECT_NE(r.error.find("38"), std::string::npos);
+  EXPECT_NE(r.error.find("39"), std::string::npos);
+  // One flipped digit in the payload is caught as well.
+  EXPECT_EQ(ParseNmea("$IIMWV,228.0,R,5.8,N,A*39").status, ParseStatus::kChecksumError);
+}
+
+TEST(Nmea, MalformedSentencesNameTheProblem) {
+  ParseResult r = ParseNmea(WithNmeaChecksum("IIMWV,229.0,R,5.8"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("5 fields"), std::string::npos) << r.error;
+  r = ParseNmea(WithNmeaChecksum("IIMWV,229.0,R,5.8,X,A"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("field 4"), std::string::npos) << r.error;
+  r = ParseNmea(WithNmeaChecksum("IIMWV,229.0,Q,5.8,N,A"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  r = ParseNmea(WithNmeaChecksum("IIMWV,229.0,R,5.8,N,B"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  r = ParseNmea(WithNmeaChecksum("IIMWV,400.0,R,5.8,N,A"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  r = ParseNmea(WithNmeaChecksum("IIMWV,22x.0,R,5.8,N,A"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  r = ParseNmea(WithNmeaChecksum("IIMWV,229.0,R,-5.8,N,A"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  r = ParseNmea(WithNmeaChecksum("IIMWV,229.0,R,nan,N,A"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_EQ(ParseNmea("$IIMWV,229.0,R,5.8,N,A*3").status, ParseStatus::kMalformed);
+  EXPECT_EQ(ParseNmea("$\x01\x7f\xff garbage").status, ParseStatus::kMalformed);
+  EXPECT_EQ(ParseNmea("$").status, ParseStatus::kMalformed);
+  EXPECT_EQ(ParseNmea("").status, ParseStatus::kMalformed);
+  EXPECT_EQ(ParseNmea("IIMWV,229.0,R,5.8,N,A").status, ParseStatus::kMalformed);
+}
+
+TEST(Nmea, MwdPrefersTrueBearingAndMetresPerSecond) {
+  const ParseResult r = ParseNmea("$WIMWD,270.0,T,265.5,M,10.0,N,5.1,M*6E");
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_DOUBLE_EQ(r.reading.speed, 5.1);
+  EXPECT_DOUBLE_EQ(r.reading.from_angle_deg, 270.0);
+  EXPECT_EQ(r.reading.reference, AngleReference::kEarth);
+  EXPECT_FALSE(r.reading.relative);
+  EXPECT_EQ(r.reading.source, "nmea_mwd");
+  EXPECT_NEAR(WindDirection(r.reading), 0.0, 1e-12);  // a westerly blows east
+}
+
+TEST(Nmea, MwdFallsBackToKnotsAndMagnetic) {
+  ParseResult r = ParseNmea(WithNmeaChecksum("WIMWD,,T,90.0,M,10.0,N,,M"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_NEAR(r.reading.speed, 10.0 * kKnot, 1e-9);
+  EXPECT_DOUBLE_EQ(r.reading.from_angle_deg, 90.0);
+  EXPECT_EQ(r.reading.status, "magnetic");
+  r = ParseNmea(WithNmeaChecksum("WIMWD,90.0,T,,M,,N,,M"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  r = ParseNmea(WithNmeaChecksum("WIMWD,90.0,T,,M,10,K,,M"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+}
+
+TEST(Nmea, XdrWindQuadruplets) {
+  ParseResult r = ParseNmea("$WIXDR,A,225.0,D,WINDDIR,N,7.5,M,WINDSPEED*49");
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_DOUBLE_EQ(r.reading.speed, 7.5);
+  EXPECT_DOUBLE_EQ(r.reading.from_angle_deg, 225.0);
+  EXPECT_EQ(r.reading.source, "nmea_xdr");
+  r = ParseNmea(WithNmeaChecksum("WIXDR,G,10.0,N,WSPD,G,20.0,N,WGUST"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_NEAR(r.reading.speed, 10.0 * kKnot, 1e-9);
+  EXPECT_NEAR(r.reading.gust, 20.0 * kKnot, 1e-9);
+  EXPECT_TRUE(std::isnan(r.reading.from_angle_deg));
+  EXPECT_EQ(ParseNmea("$WIXDR,C,21.5,C,AIRTEMP,P,1.013,B,BARO*3F").status, ParseStatus::kNotWind);
+  EXPECT_EQ(ParseNmea(WithNmeaChecksum("WIXDR,A,225.0,R,WINDDIR,N,7.5,M,WINDSPEED")).status,
+            ParseStatus::kMalformed);
+  EXPECT_EQ(ParseNmea(WithNmeaChecksum("WIXDR,A,225.0,D")).status, ParseStatus::kMalformed);
+}
+
+}  // namespace
+}  // namespace clothwind::sensors

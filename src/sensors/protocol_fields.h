@@ -1,0 +1,24 @@
+// Strict field parsing shared by the anemometer protocols: a field is either empty (the
+// instrument's "no value") or a complete finite number; anything else is an error.
+#ifndef CLOTHWIND_SENSORS_PROTOCOL_FIELDS_H_
+#define CLOTHWIND_SENSORS_PROTOCOL_FIELDS_H_
+
+#include <string>
+
+namespace clothwind::sensors {
+
+// Parses a decimal number field, allowing surrounding spaces.
+// Inputs:
+//   field  text of the field
+// Outputs:
+//   value  the number, or NaN for an empty field
+//   error  why it failed (quotes the field)
+// Returns false when the field is neither empty nor a complete finite number.
+bool ParseOptionalNumber(const std::string& field, double* value, std::string* error);
+
+// Removes leading and trailing spaces and tabs.
+std::string TrimSpaces(const std::string& s);
+
+}  // namespace clothwind::sensors
+
+#endif  // CLOTHWIND_SENSORS_PROTOCOL_FIELDS_H_
