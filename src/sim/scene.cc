@@ -1,0 +1,420 @@
+#include "sim/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "sim/json_comments.h"
+
+namespace clothwind::sim {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const char* TypeName(const json& j) { return j.type_name(); }
+
+// Walks the JSON with the file name and the JSON path at hand, so every message names both.
+class Reader {
+ public:
+  Reader(std::string file, WarningSink warn) : file_(std::move(file)), warn_(std::move(warn)) {}
+
+  [[noreturn]] void Fail(const std::string& path, const std::string& what) const {
+    throw std::runtime_error(file_ + ": " + path + ": " + what);
+  }
+  void Warn(const std::string& path, const std::string& what) const {
+    warn_(file_ + ": " + path + ": " + what);
+  }
+
+  void ExpectObject(const json& j, const std::string& path) const {
+    if (!j.is_object()) Fail(path, std::string("expected an object, got ") + TypeName(j));
+  }
+  void ExpectArray(const json& j, const std::string& path) const {
+    if (!j.is_array()) Fail(path, std::string("expected an array, got ") + TypeName(j));
+  }
+  // Warns about keys that are neither understood nor deliberately ignored.
+  void CheckKeys(const json& obj, const std::string& path, const std::set<std::string>& known,
+                 const std::set<std::string>& ignored = {}) const {
+    for (auto it = obj.begin(); it != obj.end(); ++it) {
+      const std::string child = path.empty() ? it.key() : path + "." + it.key();
+      if (known.count(it.key())) continue;
+      if (ignored.count(it.key())) {
+        Warn(child, "ArcSim key not supported by this simulator, ignored");
+      } else {
+        Warn(child, "unknown key, ignored");
+      }
+    }
+  }
+
+  double Number(const json& j, const std::string& path) const {
+    if (!j.is_number()) Fail(path, std::string("expected a number, got ") + TypeName(j));
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) Fail(path, "expected a finite number");
+    return v;
+  }
+  double Positive(const json& j, const std::string& path) const {
+    const double v = Number(j, path);
+    if (!(v > 0)) Fail(path, "expected a number > 0, got " + std::to_string(v));
+    return v;
+  }
+  double NonNegative(const json& j, const std::string& path) const {
+    const double v = Number(j, path);
+    if (v < 0) Fail(path, "expected a number >= 0, got " + std::to_string(v));
+    return v;
+  }
+  int Integer(const json& j, const std::string& path) const {
+    if (!j.is_number_integer()) Fail(path, std::string("expected an integer, got ") + TypeName(j));
+    return j.get<int>();
+  }
+  std::string String(const json& j, const std::string& path) const {
+    if (!j.is_string()) Fail(path, std::string("expected a string, got ") + TypeName(j));
+    return j.get<std::string>();
+  }
+  std::vector<double> Numbers(const json& j, const std::string& path, size_t min_n,
+                              size_t max_n) const {
+    ExpectArray(j, path);
+    if (j.size() < min_n || j.size() > max_n) {
+      Fail(path, "expected " +
+                     (min_n == max_n ? std::to_string(min_n)
+                                     : std::to_string(min_n) + " to " + std::to_string(max_n)) +
+                     " numbers, got " + std::to_string(j.size()));
+    }
+    std::vector<double> v;
+    for (size_t i = 0; i < j.size(); ++i) v.push_back(Number(j[i], Index(path, i)));
+    return v;
+  }
+  Eigen::Vector3d Vector3(const json& j, const std::string& path) const {
+    const auto v = Numbers(j, path, 3, 3);
+    return {v[0], v[1], v[2]};
+  }
+  // A file named in the scene, resolved (ResolveScenePath) and required to exist.
+  std::string File(const json& j, const std::string& path) const {
+    const std::string rel = String(j, path);
+    const std::string found = ResolveScenePath(file_, rel);
+    if (found.empty()) {
+      const fs::path dir = fs::path(file_).parent_path();
+      Fail(path, "file '" + rel + "' not found (looked next to the scene in " + dir.string() +
+                     ", in " + dir.parent_path().string() + " and in the working directory)");
+    }
+    return found;
+  }
+
+  static std::string Index(const std::string& path, size_t i) {
+    return path + "[" + std::to_string(i) + "]";
+  }
+
+ private:
+  std::string file_;
+  WarningSink warn_;
+};
+
+SceneTransform ParseTransform(const Reader& r, const json& j, const std::string& path) {
+  r.ExpectObject(j, path);
+  r.CheckKeys(j, path, {"translate", "rotate", "scale"});
+  SceneTransform t;
+  if (j.contains("translate")) t.translate = r.Vector3(j["translate"], path + ".translate");
+  if (j.contains("rotate")) {
+    const auto v = r.Numbers(j["rotate"], path + ".rotate", 4, 4);
+    t.rotate_deg = v[0];
+    t.rotate_axis = Eigen::Vector3d(v[1], v[2], v[3]);
+    if (t.rotate_deg != 0.0 && t.rotate_axis.norm() == 0.0) {
+      r.Fail(path + ".rotate", "rotation axis [1..3] must not be zero");
+    }
+  }
+  if (j.contains("scale")) t.scale = r.Positive(j["scale"], path + ".scale");
+  return t;
+}
+
+SceneMaterial ParseMaterial(const Reader& r, const json& j, const std::string& path) {
+  r.ExpectObject(j, path);
+  r.CheckKeys(j, path,
+              {"data", "thicken", "density_mult", "stretching_mult", "bending_mult", "damping",
+               "strain_limits"},
+              {"yield_curv", "weakening", "plastic_flow", "plastic_limit"});
+  SceneMaterial m;
+  if (!j.contains("data")) r.Fail(path + ".data", "missing (the material JSON file)");
+  m.data = r.File(j["data"], path + ".data");
+  if (j.contains("thicken")) m.thicken = r.Positive(j["thicken"], path + ".thicken");
+  if (j.contains("density_mult")) m.density_mult = r.Positive(j["density_mult"], path + ".density_mult");
+  if (j.contains("stretching_mult")) {
+    m.stretching_mult = r.Positive(j["stretching_mult"], path + ".stretching_mult");
+  }
+  if (j.contains("bending_mult")) m.bending_mult = r.Positive(j["bending_mult"], path + ".bending_mult");
+  if (j.contains("damping")) m.damping = r.NonNegative(j["damping"], path + ".damping");
+  if (j.contains("strain_limits")) {
+    const auto v = r.Numbers(j["strain_limits"], path + ".strain_limits", 2, 2);
+    if (!(v[0] > 0 && v[0] <= 1 && v[1] >= 1)) {
+      r.Fail(path + ".strain_limits", "expected [min, max] with 0 < min <= 1 <= max");
+    }
+    m.strain_min = v[0];
+    m.strain_max = v[1];
+    m.has_strain_limits = true;
+  }
+  return m;
+}
+
+SceneRemeshing ParseRemeshing(const Reader& r, const json& j, const std::string& path) {
+  r.ExpectObject(j, path);
+  r.CheckKeys(j, path, {"refine_angle", "refine_compression", "refine_velocity", "size", "aspect_min"});
+  SceneRemeshing m;
+  m.present = true;
+  if (j.contains("refine_angle")) m.refine_angle = r.NonNegative(j["refine_angle"], path + ".refine_angle");
+  if (j.contains("refine_compression")) {
+    m.refine_compression = r.NonNegative(j["refine_compression"], path + ".refine_compression");
+  }
+  if (j.contains("refine_velocity")) {
+    m.refine_velocity = r.NonNegative(j["refine_velocity"], path + ".refine_velocity");
+  }
+  if (j.contains("aspect_min")) m.aspect_min = r.NonNegative(j["aspect_min"], path + ".aspect_min");
+  if (!j.contains("size")) r.Fail(path + ".size", "missing ([min, max] edge length, m)");
+  const auto v = r.Numbers(j["size"], path + ".size", 2, 2);
+  if (!(v[0] > 0 && v[1] >= v[0])) r.Fail(path + ".size", "expected [min, max] with 0 < min <= max [m]");
+  m.size_min = v[0];
+  m.size_max = v[1];
+  return m;
+}
+
+SceneCloth ParseCloth(const Reader& r, const json& j, const std::string& path) {
+  r.ExpectObject(j, path);
+  r.CheckKeys(j, path, {"mesh", "transform", "materials", "remeshing"}, {"velocity"});
+  SceneCloth c;
+  if (!j.contains("mesh")) r.Fail(path + ".mesh", "missing (the cloth's OBJ file)");
+  c.mesh = r.File(j["mesh"], path + ".mesh");
+  if (j.contains("transform")) c.transform = ParseTransform(r, j["transform"], path + ".transform");
+  if (!j.contains("materials")) r.Fail(path + ".materials", "missing (at least one material)");
+  r.ExpectArray(j["materials"], path + ".materials");
+  if (j["materials"].empty()) r.Fail(path + ".materials", "expected at least one material");
+  for (size_t i = 0; i < j["materials"].size(); ++i) {
+    c.materials.push_back(ParseMaterial(r, j["materials"][i], Reader::Index(path + ".materials", i)));
+  }
+  if (c.materials.size() > 1) {
+    r.Warn(path + ".materials", "only the first material is simulated (one material per cloth)");
+  }
+  if (j.contains("remeshing")) c.remeshing = ParseRemeshing(r, j["remeshing"], path + ".remeshing");
+  return c;
+}
+
+SceneHandle ParseHandle(const Reader& r, const json& j, const std::string& path, int n_motions) {
+  r.ExpectObject(j, path);
+  r.CheckKeys(j, path, {"nodes", "cloth", "motion", "start_time", "end_time", "type"},
+              {"label", "center", "radius", "obstacle", "pivot"});
+  SceneHandle h;
+  if (j.contains("type")) {
+    const std::string type = r.String(j["type"], path + ".type");
+    if (type != "node") r.Fail(path + ".type", "only node handles are supported, got '" + type + "'");
+  }
+  if (!j.contains("nodes")) r.Fail(path + ".nodes", "missing (node indices to pin)");
+  r.ExpectArray(j["nodes"], path + ".nodes");
+  for (size_t i = 0; i < j["nodes"].size(); ++i) {
+    const std::string p = Reader::Index(path + ".nodes", i);
+    const int n = r.Integer(j["nodes"][i], p);
+    if (n < 0) r.Fail(p, "node index must be >= 0, got " + std::to_string(n));
+    h.nodes.push_back(n);
+  }
+  if (j.contains("cloth")) h.cloth = r.Integer(j["cloth"], path + ".cloth");
+  if (j.contains("motion")) {
+    h.motion = r.Integer(j["motion"], path + ".motion");
+    if (h.motion < 0 || h.motion >= n_motions) {
+      r.Fail(path + ".motion", "motion index " + std::to_string(h.motion) + " out of range (" +
+                                   std::to_string(n_motions) + " motions)");
+    }
+    r.Warn(path + ".motion", "moving handles are not simulated; the handle stays fixed");
+  }
+  if (j.contains("start_time")) h.start_time = r.NonNegative(j["start_time"], path + ".start_time");
+  if (j.contains("end_time")) h.end_time = r.NonNegative(j["end_time"], path + ".end_time");
+  return h;
+}
+
+ShearProfile ParseShear(const Reader& r, const json& j, const std::string& path) {
+  r.ExpectObject(j, path);
+  r.CheckKeys(j, path, {"profile", "exponent", "roughness", "reference_height", "ground_z"});
+  ShearProfile s;
+  const std::string kind = j.contains("profile") ? r.String(j["profile"], path + ".profile") : "power";
+  if (kind == "power") {
+    s.kind = ShearProfile::Kind::kPower;
+  } else if (kind == "log") {
+    s.kind = ShearProfile::Kind::kLog;
+  } else if (kind == "none") {
+    s.kind = ShearProfile::Kind::kNone;
+  } else {
+    r.Fail(path + ".profile", "expected \"power\", \"log\" or \"none\", got \"" + kind + "\"");
+  }
+  if (j.contains("exponent")) s.exponent = r.NonNegative(j["exponent"], path + ".exponent");
+  if (j.contains("roughness")) s.roughness = r.Positive(j["roughness"], path + ".roughness");
+  if (j.contains("reference_height")) {
+    s.reference_height = r.Positive(j["reference_height"], path + ".reference_height");
+  }
+  if (j.contains("ground_z")) s.ground_z = r.Number(j["ground_z"], path + ".ground_z");
+  if (s.kind == ShearProfile::Kind::kLog && s.reference_height <= s.roughness) {
+    r.Fail(path + ".reference_height", "must exceed the roughness length");
+  }
+  return s;
+}
+
+uint64_t Seed(const Reader& r, const json& j, const std::string& path) {
+  if (!j.is_number_unsigned() && !(j.is_number_integer() && j.get<int64_t>() >= 0)) {
+    r.Fail(path, std::string("expected an integer >= 0, got ") + TypeName(j));
+  }
+  return j.get<uint64_t>();
+}
+
+TurbulenceParams ParseTurbulence(const Reader& r, const json& j, const std::string& path) {
+  r.ExpectObject(j, path);
+  r.CheckKeys(j, path, {"intensity", "length_scale", "component_ratios", "modes", "seed"});
+  TurbulenceParams t;
+  if (j.contains("intensity")) t.intensity = r.NonNegative(j["intensity"], path + ".intensity");
+  if (j.contains("length_scale")) t.length_scale = r.Positive(j["length_scale"], path + ".length_scale");
+  if (j.contains("component_ratios")) {
+    const auto v = r.Numbers(j["component_ratios"], path + ".component_ratios", 3, 3);
+    for (int i = 0; i < 3; ++i) {
+      if (v[i] < 0) r.Fail(path + ".component_ratios", "ratios must be >= 0");
+      t.component_ratios[i] = v[i];
+    }
+  }
+  if (j.contains("modes")) {
+    t.modes = r.Integer(j["modes"], path + ".modes");
+    if (t.modes < 1) r.Fail(path + ".modes", "expected at least 1 mode");
+  }
+  if (j.contains("seed")) t.seed = Seed(r, j["seed"], path + ".seed");
+  return t;
+}
+
+GustParams ParseGusts(const Reader& r, const json& j, const std::string& path) {
+  r.ExpectObject(j, path);
+  r.CheckKeys(j, path, {"rate", "amplitude", "amplitude_spread", "duration", "horizon", "seed"});
+  GustParams g;
+  if (j.contains("rate")) g.rate = r.NonNegative(j["rate"], path + ".rate");
+  if (j.contains("amplitude")) g.amplitude = r.Number(j["amplitude"], path + ".amplitude");
+  if (j.contains("amplitude_spread")) {
+    g.amplitude_spread = r.NonNegative(j["amplitude_spread"], path + ".amplitude_spread");
+    if (g.amplitude_spread > 1) r.Fail(path + ".amplitude_spread", "expected a number in [0, 1]");
+  }
+  if (j.contains("duration")) g.duration = r.Positive(j["duration"], path + ".duration");
+  if (j.contains("horizon")) g.horizon = r.Positive(j["horizon"], path + ".horizon");
+  if (j.contains("seed")) g.seed = Seed(r, j["seed"], path + ".seed");
+  return g;
+}
+
+WindSpec ParseWind(const Reader& r, const json& j, const std::string& path) {
+  r.ExpectObject(j, path);
+  r.CheckKeys(j, path, {"velocity", "density", "drag", "shear", "turbulence", "gusts"});
+  WindSpec w;
+  if (j.contains("velocity")) w.velocity = r.Vector3(j["velocity"], path + ".velocity");
+  if (j.contains("density")) w.density = r.NonNegative(j["density"], path + ".density");
+  if (j.contains("drag")) w.drag = r.NonNegative(j["drag"], path + ".drag");
+  if (j.contains("shear")) w.shear = ParseShear(r, j["shear"], path + ".shear");
+  if (j.contains("turbulence")) w.turbulence = ParseTurbulence(r, j["turbulence"], path + ".turbulence");
+  if (j.contains("gusts")) w.gusts = ParseGusts(r, j["gusts"], path + ".gusts");
+  return w;
+}
+
+}  // namespace
+
+std::string ResolveScenePath(const std::string& scene_path, const std::string& relative) {
+  std::error_code ec;
+  const fs::path rel(relative);
+  if (rel.is_absolute()) return fs::exists(rel, ec) ? rel.lexically_normal().string() : "";
+  const fs::path dir = fs::absolute(fs::path(scene_path), ec).parent_path();
+  for (const fs::path& base : {dir, dir.parent_path(), fs::current_path(ec)}) {
+    const fs::path candidate = base / rel;
+    if (fs::is_regular_file(candidate, ec)) return candidate.lexically_normal().string();
+  }
+  return "";
+}
+
+Scene ParseScene(const std::string& text, const std::string& path, const WarningSink& warn) {
+  const WarningSink sink = warn ? warn : [](const std::string& m) { std::cerr << "warning: " << m << "\n"; };
+  std::error_code ec;
+  const std::string abs_path = fs::absolute(fs::path(path), ec).lexically_normal().string();
+  const Reader r(abs_path, sink);
+  json j;
+  try {
+    j = json::parse(StripJsonComments(text));
+  } catch (const json::parse_error& e) {
+    // Name the line (and show it: it usually holds the key) rather than only a byte offset.
+    const size_t at = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
+    const size_t line = 1 + std::count(text.begin(), text.begin() + at, '\n');
+    const size_t begin = text.rfind('\n', at == 0 ? 0 : at - 1);
+    const size_t start = begin == std::string::npos ? 0 : begin + 1;
+    const size_t end = text.find('\n', start);
+    std::string shown = text.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    shown.erase(0, shown.find_first_not_of(" \t"));
+    throw std::runtime_error(abs_path + ":" + std::to_string(line) + ": not valid JSON near `" +
+                             shown + "` (numbers must be finite: NaN/Infinity are not JSON): " +
+                             e.what());
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(abs_path + ": " + e.what());
+  }
+  r.ExpectObject(j, "(top level)");
+  r.CheckKeys(j, "",
+              {"frame_time", "frame_steps", "duration", "end_time", "end_frame", "cloths", "motions",
+               "handles", "gravity", "wind", "magic"},
+              {"obstacles", "morphs", "friction", "obs_friction", "disable"});
+  Scene s;
+  s.path = abs_path;
+  if (j.contains("frame_time")) s.frame_time = r.Positive(j["frame_time"], "frame_time");
+  if (j.contains("frame_steps")) {
+    s.frame_steps = r.Integer(j["frame_steps"], "frame_steps");
+    if (s.frame_steps < 1) r.Fail("frame_steps", "expected an integer >= 1");
+  }
+  if (j.contains("duration") && j.contains("end_time")) {
+    r.Warn("end_time", "both duration and end_time given; using end_time");
+  }
+  if (j.contains("duration")) s.duration = r.Positive(j["duration"], "duration");
+  if (j.contains("end_time")) s.duration = r.Positive(j["end_time"], "end_time");
+  if (j.contains("end_frame")) {
+    s.duration = r.Integer(j["end_frame"], "end_frame") * s.frame_time;
+    if (!(s.duration > 0)) r.Fail("end_frame", "expected an integer >= 1");
+  }
+  if (j.contains("motions")) {
+    r.ExpectArray(j["motions"], "motions");
+    for (const auto& m : j["motions"]) s.motions.push_back(m);
+  }
+  if (!j.contains("cloths")) r.Fail("cloths", "missing (at least one cloth)");
+  r.ExpectArray(j["cloths"], "cloths");
+  if (j["cloths"].empty()) r.Fail("cloths", "expected at least one cloth");
+  for (size_t i = 0; i < j["cloths"].size(); ++i) {
+    s.cloths.push_back(ParseCloth(r, j["cloths"][i], Reader::Index("cloths", i)));
+  }
+  if (j.contains("handles")) {
+    r.ExpectArray(j["handles"], "handles");
+    for (size_t i = 0; i < j["handles"].size(); ++i) {
+      const std::string p = Reader::Index("handles", i);
+      s.handles.push_back(ParseHandle(r, j["handles"][i], p, static_cast<int>(s.motions.size())));
+      if (s.handles.back().cloth < 0 || s.handles.back().cloth >= static_cast<int>(s.cloths.size())) {
+        r.Fail(p + ".cloth", "cloth index out of range (" + std::to_string(s.cloths.size()) + " cloths)");
+      }
+    }
+  }
+  if (j.contains("gravity")) s.gravity = r.Vector3(j["gravity"], "gravity");
+  if (j.contains("wind")) s.wind = ParseWind(r, j["wind"], "wind");
+  if (j.contains("magic")) {
+    const json& m = j["magic"];
+    r.ExpectObject(m, "magic");
+    r.CheckKeys(m, "magic", {"repulsion_thickness", "collision_stiffness"},
+                {"fixed_high_res_mesh", "handle_stiffness", "projection_thickness",
+                 "edge_flip_threshold", "rib_stiffening", "combine_tensors", "preserve_creases"});
+    if (m.contains("repulsion_thickness")) {
+      s.magic.repulsion_thickness = r.NonNegative(m["repulsion_thickness"], "magic.repulsion_thickness");
+    }
+    if (m.contains("collision_stiffness")) {
+      s.magic.collision_stiffness = r.NonNegative(m["collision_stiffness"], "magic.collision_stiffness");
+    }
+  }
+  return s;
+}
+
+Scene LoadScene(const std::string& path, const WarningSink& warn) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open scene file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ParseScene(ss.str(), path, warn);
+}
+
+}  // namespace clothwind::sim

@@ -1,0 +1,105 @@
+#include "sim/scene_builder.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+
+namespace clothwind::sim {
+
+double DefaultMaxEdge(const SceneRemeshing& remeshing) {
+  if (!remeshing.present) return 0.0;
+  return std::sqrt(remeshing.size_min * remeshing.size_max);
+}
+
+Eigen::MatrixX3d ApplyTransform(const SceneTransform& t, const Eigen::MatrixX3d& V) {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  if (t.rotate_deg != 0.0) {
+    R = Eigen::AngleAxisd(t.rotate_deg * M_PI / 180.0, t.rotate_axis.normalized()).toRotationMatrix();
+  }
+  Eigen::MatrixX3d out = (t.scale * V) * R.transpose();
+  out.rowwise() += t.translate.transpose();
+  return out;
+}
+
+SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
+  SceneSetup setup;
+  setup.scene = scene;
+  setup.wind = scene.wind;
+  auto fail = [&](const std::string& key, const std::string& what) {
+    throw std::runtime_error(scene.path + ": " + key + ": " + what);
+  };
+  for (size_t c = 0; c < scene.cloths.size(); ++c) {
+    const SceneCloth& sc = scene.cloths[c];
+    const std::string key = "cloths[" + std::to_string(c) + "]";
+    ClothSetup cloth;
+    Mesh mesh;
+    try {
+      mesh = ReadObj(sc.mesh);
+    } catch (const std::exception& e) {
+      fail(key + ".mesh", e.what());
+    }
+    // Rest coordinates scale with the cloth so a scaled cloth starts unstressed.
+    mesh.U *= sc.transform.scale;
+    mesh.V = ApplyTransform(sc.transform, mesh.V);
+    try {
+      ValidateMesh(mesh, sc.mesh);
+    } catch (const std::exception& e) {
+      fail(key + ".mesh", e.what());
+    }
+    cloth.original_vertices = static_cast<int>(mesh.V.rows());
+    cloth.max_edge = options.max_edge > 0 ? options.max_edge : DefaultMaxEdge(sc.remeshing);
+    if (cloth.max_edge > 0) {
+      try {
+        mesh = RefineMesh(mesh, cloth.max_edge);
+      } catch (const std::exception& e) {
+        fail(key + ".remeshing", e.what());
+      }
+    }
+    cloth.mesh = std::move(mesh);
+
+    const SceneMaterial& sm = sc.materials.front();
+    MaterialMultipliers mult;
+    mult.density = sm.density_mult;
+    mult.stretching = sm.stretching_mult;
+    mult.bending = sm.bending_mult;
+    mult.thicken = sm.thicken;
+    mult.damping = sm.damping;
+    try {
+      cloth.material = LoadArcSimMaterial(sm.data, mult);
+    } catch (const std::exception& e) {
+      fail(key + ".materials[0].data", e.what());
+    }
+
+    SimOptions& o = cloth.options;
+    o.dt = scene.time_step();
+    o.gravity = scene.gravity;
+    o.wind_density = scene.wind.density;
+    o.wind_drag = scene.wind.drag;
+    if (sm.has_strain_limits) {
+      o.strain_min = sm.strain_min;
+      o.strain_max = sm.strain_max;
+    }
+    o.repulsion_thickness = scene.magic.repulsion_thickness;
+    o.collision_stiffness = scene.magic.collision_stiffness;
+    setup.cloths.push_back(std::move(cloth));
+  }
+  // Handles index the ORIGINAL mesh; RefineMesh keeps original vertices first, so the indices
+  // stay valid after refinement.
+  for (size_t h = 0; h < scene.handles.size(); ++h) {
+    const SceneHandle& sh = scene.handles[h];
+    ClothSetup& cloth = setup.cloths[sh.cloth];
+    for (size_t i = 0; i < sh.nodes.size(); ++i) {
+      const int n = sh.nodes[i];
+      if (n >= cloth.original_vertices) {
+        fail("handles[" + std::to_string(h) + "].nodes[" + std::to_string(i) + "]",
+             "node " + std::to_string(n) + " out of range: cloth " + std::to_string(sh.cloth) +
+                 "'s mesh has " + std::to_string(cloth.original_vertices) + " nodes");
+      }
+      cloth.options.handles.push_back(n);
+    }
+  }
+  return setup;
+}
+
+}  // namespace clothwind::sim

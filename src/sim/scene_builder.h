@@ -1,0 +1,58 @@
+#ifndef CLOTHWIND_SIM_SCENE_BUILDER_H_
+#define CLOTHWIND_SIM_SCENE_BUILDER_H_
+
+#include <string>
+#include <vector>
+
+#include "sim/cloth_simulator.h"
+#include "sim/material.h"
+#include "sim/mesh.h"
+#include "sim/scene.h"
+#include "sim/wind_spec.h"
+
+namespace clothwind::sim {
+
+// One cloth ready to simulate: its mesh transformed into the world and refined, its material
+// loaded with the scene's multipliers, and the simulator settings the scene implies.
+struct ClothSetup {
+  Mesh mesh;          // world positions, rest coordinates, faces (refined)
+  Material material;  // multipliers applied
+  SimOptions options; // dt, gravity, wind density/drag, handles (refined indices), limits, magic
+  int original_vertices = 0;  // #V of the OBJ before refinement (handles index these)
+  double max_edge = 0.0;      // edge length the mesh was refined to [m] (0: not refined)
+};
+
+// A scene loaded from disk once, so that many simulations (threads, parameter vectors) can share
+// it without touching files again. Plain data: callers may edit it (e.g. wind) before simulating.
+struct SceneSetup {
+  Scene scene;
+  std::vector<ClothSetup> cloths;
+  WindSpec wind;  // the scene's wind (copied from scene.wind; edit this one)
+};
+
+struct BuildOptions {
+  // Longest edge after refinement [m]. 0: from the scene's remeshing size range [a, b], the
+  // geometric mean sqrt(a b) (the middle of ArcSim's adaptive range on a log scale: 0.1 m for
+  // the flag's [0.02, 0.5] m; docs/scenes.md); no remeshing block: no refinement.
+  double max_edge = 0.0;
+};
+
+// Loads meshes and materials and derives simulator settings.
+// Inputs:
+//   scene    parsed scene (LoadScene)
+//   options  resolution
+// Returns the setup. Throws std::runtime_error naming the scene file and the key (e.g.
+// "cloths[0].mesh", "handles[0].nodes[1]") when a mesh or material cannot be read or is invalid
+// (degenerate triangles, NaN), or a handle node is out of range.
+SceneSetup BuildScene(const Scene& scene, const BuildOptions& options = {});
+
+// The resolution BuildScene picks for a remeshing block (see BuildOptions::max_edge) [m].
+double DefaultMaxEdge(const SceneRemeshing& remeshing);
+
+// Applies a scene transform to positions: x -> translate + R(rotate) (scale x).
+// Inputs: V #V by 3 [m]. Returns #V by 3 [m].
+Eigen::MatrixX3d ApplyTransform(const SceneTransform& transform, const Eigen::MatrixX3d& V);
+
+}  // namespace clothwind::sim
+
+#endif  // CLOTHWIND_SIM_SCENE_BUILDER_H_

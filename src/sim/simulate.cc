@@ -1,0 +1,77 @@
+#include "sim/simulate.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include <tbb/parallel_for.h>
+
+namespace clothwind::sim {
+
+Theta SceneTheta(const SceneSetup& setup, int cloth) {
+  if (cloth < 0 || cloth >= static_cast<int>(setup.cloths.size())) {
+    throw std::out_of_range("cloth index " + std::to_string(cloth) + " out of range");
+  }
+  return ThetaFrom(setup.cloths[cloth].material, setup.wind);
+}
+
+Trajectory SimulateTrajectory(const SceneSetup& setup, const Theta& theta,
+                              const SimulateOptions& options) {
+  if (options.cloth < 0 || options.cloth >= static_cast<int>(setup.cloths.size())) {
+    throw std::out_of_range("cloth index " + std::to_string(options.cloth) + " out of range (" +
+                            std::to_string(setup.cloths.size()) + " cloths)");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const ClothSetup& cloth = setup.cloths[options.cloth];
+  Material material = cloth.material;
+  WindSpec wind = setup.wind;
+  ApplyTheta(theta, &material, &wind);
+  if (options.seed) wind.SetSeed(*options.seed);
+
+  const double duration = options.duration >= 0 ? options.duration : setup.scene.duration;
+  const double frame_time = setup.scene.frame_time;
+  const int steps_per_frame = setup.scene.frame_steps;
+  const int frames = static_cast<int>(std::lround(duration / frame_time));
+
+  ClothSimulator sim(cloth.mesh, material, cloth.options, MakeWindField(wind));
+  Trajectory t;
+  t.faces = cloth.mesh.F;
+  t.uv = cloth.mesh.U.cast<float>();
+  t.frame_time = frame_time;
+  t.frames.reserve(frames + 1);
+  t.frames.push_back(sim.positions().cast<float>());
+  for (int f = 1; f <= frames; ++f) {
+    for (int s = 0; s < steps_per_frame; ++s) sim.Step();
+    t.steps += steps_per_frame;
+    t.frames.push_back(sim.positions().cast<float>());
+    if (options.progress && !options.progress(f, frames)) break;
+  }
+  t.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return t;
+}
+
+std::vector<Trajectory> SimulateTrajectories(const SceneSetup& setup,
+                                             const std::vector<Theta>& thetas,
+                                             const SimulateOptions& options,
+                                             const std::vector<uint64_t>& seeds) {
+  if (!seeds.empty() && seeds.size() != thetas.size()) {
+    throw std::invalid_argument("SimulateTrajectories: " + std::to_string(seeds.size()) +
+                                " seeds for " + std::to_string(thetas.size()) + " thetas");
+  }
+  std::vector<Trajectory> out(thetas.size());
+  std::atomic<int> done{0};
+  const int total = static_cast<int>(thetas.size());
+  tbb::parallel_for(size_t{0}, thetas.size(), [&](size_t i) {
+    SimulateOptions one = options;
+    one.progress = nullptr;
+    if (!seeds.empty()) one.seed = seeds[i];
+    out[i] = SimulateTrajectory(setup, thetas[i], one);
+    const int n = ++done;
+    if (options.progress) options.progress(n, total);
+  });
+  return out;
+}
+
+}  // namespace clothwind::sim
