@@ -1,0 +1,125 @@
+#include "sensors/frame_source_folder.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "sensors/frame_timestamp_fake_clock.h"
+
+namespace clothwind {
+namespace sensors {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr int64_t kMs = 1000000;
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (fs::temp_directory_path() / "clothwind_folder_XXXXXX").string();
+    path_ = mkdtemp(tmpl.data());
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+// Writes frame_%04d.png, frame k a uniform image of value 10 k.
+void WriteFrames(const std::string& dir, int n, int channels) {
+  for (int k = 0; k < n; ++k) {
+    cv::Mat m(24, 32, channels == 1 ? CV_8UC1 : CV_8UC3, cv::Scalar::all(10 * k));
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%04d.png", k);
+    ASSERT_TRUE(cv::imwrite(dir + "/" + name, m));
+  }
+}
+
+TEST(ImageFolderSourceTest, PlaysImagesInNameOrderAtTheRate) {
+  TempDir dir;
+  WriteFrames(dir.path(), 12, 1);
+  std::ofstream(dir.path() + "/notes.txt") << "ignored";
+  FakeClock clock;
+  ImageFolderSource source(dir.path(), 25.0, false, &clock);
+  ASSERT_TRUE(source.Open()) << source.error();
+  EXPECT_EQ(source.files().size(), 12u);
+  int64_t previous = 0;
+  for (int k = 0; k < 12; ++k) {
+    Frame f;
+    ASSERT_EQ(source.Read(&f, 1.0), ReadStatus::kFrame) << source.error();
+    EXPECT_EQ(f.encoding, "mono8");
+    EXPECT_EQ(f.image.at<uint8_t>(3, 3), 10 * k);  // frame_0010 after frame_0009
+    EXPECT_EQ(f.sequence, static_cast<uint64_t>(k));
+    if (k > 0) {
+      EXPECT_EQ(f.stamp_ns - previous, 40 * kMs);
+    }
+    previous = f.stamp_ns;
+  }
+  Frame f;
+  EXPECT_EQ(source.Read(&f, 1.0), ReadStatus::kEnd);
+  EXPECT_DOUBLE_EQ(source.NominalRate(), 25.0);
+}
+
+TEST(ImageFolderSourceTest, LoopsWithIncreasingStamps) {
+  TempDir dir;
+  WriteFrames(dir.path(), 3, 3);
+  FakeClock clock;
+  ImageFolderSource source(dir.path(), 10.0, true, &clock);
+  ASSERT_TRUE(source.Open());
+  int64_t previous = 0;
+  for (int k = 0; k < 7; ++k) {
+    Frame f;
+    ASSERT_EQ(source.Read(&f, 1.0), ReadStatus::kFrame);
+    EXPECT_EQ(f.encoding, "bgr8");
+    EXPECT_EQ(f.image.type(), CV_8UC3);
+    EXPECT_EQ(f.image.at<cv::Vec3b>(0, 0)[1], 10 * (k % 3));
+    EXPECT_GT(f.stamp_ns, previous);
+    previous = f.stamp_ns;
+  }
+}
+
+TEST(ImageFolderSourceTest, ClearErrorsForMissingEmptyAndInconsistentFolders) {
+  FakeClock clock;
+  ImageFolderSource missing("/nonexistent/clothwind/frames", 10.0, false, &clock);
+  EXPECT_FALSE(missing.Open());
+  EXPECT_NE(missing.error().find("/nonexistent/clothwind/frames does not exist"), std::string::npos);
+
+  TempDir empty;
+  ImageFolderSource none(empty.path(), 10.0, false, &clock);
+  EXPECT_FALSE(none.Open());
+  EXPECT_NE(none.error().find("holds no images"), std::string::npos);
+
+  TempDir mixed;
+  WriteFrames(mixed.path(), 2, 1);
+  ASSERT_TRUE(cv::imwrite(mixed.path() + "/frame_0002.png", cv::Mat(10, 10, CV_8UC1, cv::Scalar(0))));
+  ImageFolderSource source(mixed.path(), 10.0, false, &clock);
+  ASSERT_TRUE(source.Open());
+  Frame f;
+  ASSERT_EQ(source.Read(&f, 1.0), ReadStatus::kFrame);
+  ASSERT_EQ(source.Read(&f, 1.0), ReadStatus::kFrame);
+  EXPECT_EQ(source.Read(&f, 1.0), ReadStatus::kError);
+  EXPECT_NE(source.error().find("frame_0002.png is 10x10 mono8, expected 32x24 mono8"),
+            std::string::npos) << source.error();
+  EXPECT_EQ(source.Read(&f, 1.0), ReadStatus::kEnd);
+}
+
+TEST(ImageFolderSourceTest, NormalizesSixteenBitAndAlpha) {
+  cv::Mat image;
+  std::string encoding;
+  ASSERT_TRUE(NormalizeRecordedImage(cv::Mat(2, 2, CV_16UC1, cv::Scalar(65535)), &image, &encoding));
+  EXPECT_EQ(encoding, "mono8");
+  EXPECT_EQ(image.at<uint8_t>(0, 0), 255);
+  ASSERT_TRUE(NormalizeRecordedImage(cv::Mat(2, 2, CV_8UC4, cv::Scalar(1, 2, 3, 4)), &image, &encoding));
+  EXPECT_EQ(encoding, "bgr8");
+  EXPECT_EQ(image.at<cv::Vec3b>(1, 1), cv::Vec3b(1, 2, 3));
+  EXPECT_FALSE(NormalizeRecordedImage(cv::Mat(2, 2, CV_8UC2), &image, &encoding));
+}
+
+}  // namespace
+}  // namespace sensors
+}  // namespace clothwind

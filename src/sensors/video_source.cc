@@ -1,0 +1,111 @@
+#include "sensors/video_source.h"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <system_error>
+
+#include "sensors/frame_source_folder.h"
+
+namespace clothwind {
+namespace sensors {
+
+VideoFileSource::VideoFileSource(std::string path, double fallback_rate_hz, bool loop,
+                                 Clock* clock)
+    : path_(std::move(path)), fallback_rate_hz_(fallback_rate_hz), loop_(loop), clock_(clock) {}
+
+bool VideoFileSource::OpenCapture() {
+  capture_.release();
+  try {
+    if (!capture_.open(path_)) return false;
+  } catch (const cv::Exception& e) {
+    error_ = "video " + path_ + ": " + e.what();
+    return false;
+  }
+  return capture_.isOpened();
+}
+
+bool VideoFileSource::Open() {
+  Close();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path_, ec)) {
+    error_ = "video file " + path_ + " does not exist or is not a file";
+    return false;
+  }
+  if (!OpenCapture()) {
+    if (error_.empty()) error_ = "OpenCV cannot open video " + path_ + " (unknown container/codec?)";
+    return false;
+  }
+  const double file_rate = capture_.get(cv::CAP_PROP_FPS);
+  // Containers without a rate report 0 (or nonsense); some report 1000 (ms time base).
+  rate_hz_ = (std::isfinite(file_rate) && file_rate > 0 && file_rate < 1000) ? file_rate
+                                                                             : fallback_rate_hz_;
+  if (!(rate_hz_ > 0)) {
+    error_ = "video " + path_ + " reports no frame rate and the fallback rate is not > 0";
+    capture_.release();
+    return false;
+  }
+  pacer_ = std::make_unique<FramePacer>(clock_, rate_hz_);
+  sequence_ = 0;
+  loops_ = 0;
+  open_ = true;
+  error_.clear();
+  return true;
+}
+
+ReadStatus VideoFileSource::Read(Frame* frame, double max_wait_s) {
+  if (!open_) {
+    error_ = "video " + path_ + " is not open";
+    return ReadStatus::kError;
+  }
+  if (!pending_valid_) {
+    cv::Mat raw;
+    if (!capture_.read(raw) || raw.empty()) {
+      if (!loop_) return ReadStatus::kEnd;
+      // Seeking back is unreliable across backends; reopening is not.
+      if (!OpenCapture() || !capture_.read(raw) || raw.empty()) {
+        error_ = "video " + path_ + ": cannot restart for looping";
+        return ReadStatus::kError;
+      }
+      ++loops_;
+    }
+    Frame f;
+    if (!NormalizeRecordedImage(raw, &f.image, &f.encoding)) {
+      error_ = "video " + path_ + ": frame with " + std::to_string(raw.channels()) + " channels";
+      return ReadStatus::kError;
+    }
+    f.sequence = sequence_++;
+    pending_ = std::move(f);
+    pending_valid_ = true;
+  }
+  int64_t stamp = 0;
+  if (!pacer_->WaitNext(max_wait_s, &stamp)) return ReadStatus::kNoFrame;
+  *frame = std::move(pending_);
+  frame->stamp_ns = stamp;
+  pending_valid_ = false;
+  return ReadStatus::kFrame;
+}
+
+void VideoFileSource::Close() {
+  capture_.release();
+  open_ = false;
+  pending_valid_ = false;
+}
+
+std::string VideoFileSource::Describe() const {
+  std::ostringstream s;
+  s << "video " << path_ << " @" << rate_hz_ << " Hz" << (loop_ ? ", looping" : "");
+  return s.str();
+}
+
+std::map<std::string, std::string> VideoFileSource::Status() const {
+  return {{"source", "video"},
+          {"path", path_},
+          {"state", open_ ? "open" : "closed"},
+          {"frames read", std::to_string(sequence_)},
+          {"loops", std::to_string(loops_)},
+          {"rate [Hz]", std::to_string(rate_hz_)}};
+}
+
+}  // namespace sensors
+}  // namespace clothwind

@@ -1,0 +1,82 @@
+#include "sensors/video_source.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <opencv2/videoio.hpp>
+
+#include "sensors/frame_timestamp_fake_clock.h"
+
+namespace clothwind {
+namespace sensors {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr int64_t kMs = 1000000;
+
+class VideoSourceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string tmpl = (fs::temp_directory_path() / "clothwind_video_XXXXXX").string();
+    dir_ = mkdtemp(tmpl.data());
+    path_ = dir_ + "/clip.avi";
+    // Motion-JPEG in AVI: OpenCV writes this without external codecs.
+    cv::VideoWriter writer(path_, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 12.5,
+                           cv::Size(64, 48));
+    if (!writer.isOpened()) GTEST_SKIP() << "OpenCV cannot write MJPG/AVI here";
+    for (int k = 0; k < 8; ++k) writer.write(cv::Mat(48, 64, CV_8UC3, cv::Scalar(20 * k, 100, 50)));
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string dir_, path_;
+};
+
+TEST_F(VideoSourceTest, PlaysAtTheFileRateToTheEnd) {
+  FakeClock clock;
+  VideoFileSource source(path_, 30.0, false, &clock);
+  ASSERT_TRUE(source.Open()) << source.error();
+  EXPECT_NEAR(source.NominalRate(), 12.5, 1e-6);
+  int64_t previous = 0;
+  for (int k = 0; k < 8; ++k) {
+    Frame f;
+    ASSERT_EQ(source.Read(&f, 1.0), ReadStatus::kFrame) << k << " " << source.error();
+    EXPECT_EQ(f.encoding, "bgr8");
+    ASSERT_EQ(f.image.cols, 64);
+    ASSERT_EQ(f.image.rows, 48);
+    EXPECT_NEAR(f.image.at<cv::Vec3b>(24, 32)[0], 20 * k, 6);  // frame order survives
+    if (k > 0) {
+      EXPECT_EQ(f.stamp_ns - previous, 80 * kMs);
+    }
+    previous = f.stamp_ns;
+  }
+  Frame f;
+  EXPECT_EQ(source.Read(&f, 1.0), ReadStatus::kEnd);
+}
+
+TEST_F(VideoSourceTest, LoopsWithIncreasingStamps) {
+  FakeClock clock;
+  VideoFileSource source(path_, 30.0, true, &clock);
+  ASSERT_TRUE(source.Open()) << source.error();
+  int64_t previous = 0;
+  for (int k = 0; k < 20; ++k) {
+    Frame f;
+    ASSERT_EQ(source.Read(&f, 1.0), ReadStatus::kFrame) << k << " " << source.error();
+    EXPECT_NEAR(f.image.at<cv::Vec3b>(24, 32)[0], 20 * (k % 8), 6) << k;
+    EXPECT_GT(f.stamp_ns, previous);
+    previous = f.stamp_ns;
+  }
+  EXPECT_EQ(source.Status().at("loops"), "2");
+}
+
+TEST_F(VideoSourceTest, MissingFileIsAClearError) {
+  FakeClock clock;
+  VideoFileSource source(dir_ + "/nope.mp4", 30.0, false, &clock);
+  EXPECT_FALSE(source.Open());
+  EXPECT_NE(source.error().find("nope.mp4 does not exist"), std::string::npos) << source.error();
+}
+
+}  // namespace
+}  // namespace sensors
+}  // namespace clothwind
