@@ -1,0 +1,221 @@
+#include "sim/cloth_forces.h"
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+namespace clothwind::sim {
+namespace {
+
+// Central differences of a scalar function of an N-vector.
+template <int N, typename Fn>
+Eigen::Matrix<double, N, 1> NumericGradient(const Eigen::Matrix<double, N, 1>& x, Fn fn, double h) {
+  Eigen::Matrix<double, N, 1> g;
+  for (int i = 0; i < N; ++i) {
+    Eigen::Matrix<double, N, 1> a = x, b = x;
+    a[i] += h;
+    b[i] -= h;
+    g[i] = (fn(a) - fn(b)) / (2 * h);
+  }
+  return g;
+}
+
+// Central differences of a vector function (columns = d/dx_j).
+template <int N, typename Fn>
+Eigen::Matrix<double, N, N> NumericJacobian(const Eigen::Matrix<double, N, 1>& x, Fn fn, double h) {
+  Eigen::Matrix<double, N, N> J;
+  for (int j = 0; j < N; ++j) {
+    Eigen::Matrix<double, N, 1> a = x, b = x;
+    a[j] += h;
+    b[j] -= h;
+    J.col(j) = (fn(a) - fn(b)) / (2 * h);
+  }
+  return J;
+}
+
+// A stretched, sheared, bent-in-space triangle with a non-trivial rest shape.
+struct TriangleCase {
+  TriangleRest rest;
+  Vector9d x;
+};
+
+TriangleCase MakeTriangle(int seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-0.03, 0.03);
+  const Eigen::Vector2d u0(0.0, 0.0), u1(0.1 + jitter(rng), jitter(rng)), u2(0.03 + jitter(rng), 0.09);
+  TriangleCase c;
+  c.rest = MakeTriangleRest(u0, u1, u2);
+  // Embed with a rotation and a stretch of a few percent plus noise.
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7 + seed, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Vector2d u[3] = {u0, u1, u2};
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector3d p(1.06 * u[i].x(), 0.97 * u[i].y() + 0.05 * u[i].x(), 0);
+    c.x.segment<3>(3 * i) = R * p + Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng)) * 0.1;
+  }
+  return c;
+}
+
+TEST(StretchingForceTest, ForceIsMinusEnergyGradient) {
+  const Eigen::Vector4d k(120.0, 30.0, 200.0, 45.0);
+  for (int seed = 0; seed < 5; ++seed) {
+    const TriangleCase c = MakeTriangle(seed);
+    auto energy = [&](const Vector9d& y) { return StretchingForce(y, c.rest, k, false).energy; };
+    const Vector9d numeric = -NumericGradient<9>(c.x, energy, 1e-7);
+    const Vector9d force = StretchingForce(c.x, c.rest, k, false).force;
+    ASSERT_GT(force.norm(), 1e-3) << "test case should be strained";
+    EXPECT_LT((force - numeric).norm(), 1e-6 * force.norm()) << "seed " << seed;
+  }
+}
+
+TEST(StretchingForceTest, ExactJacobianMatchesFiniteDifferences) {
+  const Eigen::Vector4d k(120.0, 30.0, 200.0, 45.0);
+  for (int seed = 0; seed < 5; ++seed) {
+    const TriangleCase c = MakeTriangle(seed);
+    auto force = [&](const Vector9d& y) { return StretchingForce(y, c.rest, k, false).force; };
+    const Matrix9d numeric = NumericJacobian<9>(c.x, force, 1e-7);
+    const Matrix9d J = StretchingForce(c.x, c.rest, k, false).jacobian;
+    EXPECT_LT((J - numeric).norm(), 1e-6 * J.norm()) << "seed " << seed;
+    EXPECT_LT((J - J.transpose()).norm(), 1e-12 * J.norm());
+  }
+}
+
+TEST(StretchingForceTest, DefiniteJacobianIsNegativeSemidefiniteAndExactUnderTension) {
+  const Eigen::Vector4d k(120.0, 30.0, 200.0, 45.0);
+  // Compressed state: the definite Jacobian must have no positive eigenvalue.
+  TriangleCase c = MakeTriangle(3);
+  c.x *= 0.9;
+  const Matrix9d J = StretchingForce(c.x, c.rest, k, true).jacobian;
+  Eigen::SelfAdjointEigenSolver<Matrix9d> eig(J);
+  EXPECT_LT(eig.eigenvalues().maxCoeff(), 1e-9 * J.norm());
+  // Uniform tension, no shear: definite == exact.
+  const TriangleRest rest = MakeTriangleRest({0, 0}, {0.1, 0}, {0, 0.1});
+  Vector9d x;
+  x << 0, 0, 0, 0.105, 0, 0, 0, 0.104, 0;
+  const Matrix9d Jd = StretchingForce(x, rest, k, true).jacobian;
+  const Matrix9d Je = StretchingForce(x, rest, k, false).jacobian;
+  EXPECT_LT((Jd - Je).norm(), 1e-12 * Je.norm());
+}
+
+TEST(StretchingForceTest, RestStateHasNoForceAndRigidMotionsNoEnergy) {
+  const Eigen::Vector4d k(120.0, 30.0, 200.0, 45.0);
+  const TriangleRest rest = MakeTriangleRest({0.1, 0.2}, {0.3, 0.25}, {0.15, 0.4});
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.3, -1, 0.2).normalized()).toRotationMatrix();
+  Vector9d x;
+  const Eigen::Vector2d u[3] = {{0.1, 0.2}, {0.3, 0.25}, {0.15, 0.4}};
+  for (int i = 0; i < 3; ++i) x.segment<3>(3 * i) = R * Eigen::Vector3d(u[i].x(), u[i].y(), 0) + Eigen::Vector3d(1, 2, 3);
+  const StretchingTerms s = StretchingForce(x, rest, k, true);
+  EXPECT_NEAR(s.energy, 0, 1e-18);
+  EXPECT_LT(s.force.norm(), 1e-12);
+  EXPECT_NEAR(rest.area, 0.5 * std::abs(0.2 * 0.2 - 0.05 * 0.05), 1e-15);
+}
+
+Vector12d MakeHinge(double fold, int seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-0.01, 0.01);
+  Vector12d x;
+  // Edge along x; x2 on +y side, x3 on -y side folded up by `fold` radians.
+  x.segment<3>(0) = Eigen::Vector3d(0, 0, 0);
+  x.segment<3>(3) = Eigen::Vector3d(0.1, 0, 0);
+  x.segment<3>(6) = Eigen::Vector3d(0.04, 0.08, 0);
+  x.segment<3>(9) = Eigen::Vector3d(0.06, -0.08 * std::cos(fold), 0.08 * std::sin(fold));
+  for (int i = 0; i < 12; ++i) x[i] += jitter(rng);
+  return x;
+}
+
+TEST(BendingForceTest, DihedralGradientMatchesFiniteDifferences) {
+  for (double fold : {-1.0, -0.3, 0.2, 0.9, 2.0}) {
+    const Vector12d x = MakeHinge(fold, 7);
+    Vector12d g;
+    DihedralAngle(x, &g);
+    const Vector12d numeric = NumericGradient<12>(x, [](const Vector12d& y) { return DihedralAngle(y); }, 1e-7);
+    EXPECT_LT((g - numeric).norm(), 1e-6 * g.norm()) << "fold " << fold;
+  }
+}
+
+TEST(BendingForceTest, FlatHingeHasZeroAngleAndSignFollowsArcSim) {
+  Vector12d x = MakeHinge(0.0, 0);
+  for (int i = 2; i < 12; i += 3) x[i] = 0;  // exactly planar
+  EXPECT_NEAR(DihedralAngle(x), 0.0, 1e-12);
+  Vector12d up = x;
+  Vector12d g;
+  DihedralAngle(x, &g);
+  up.segment<3>(6) += 1e-3 * g.segment<3>(6).normalized();
+  EXPECT_GT(DihedralAngle(up), 0.0);
+}
+
+TEST(BendingForceTest, ForceIsMinusEnergyGradientAndJacobianExactAtRestAngle) {
+  const double ke = 3e-5, l = 0.1, a = 0.008;
+  for (double fold : {-0.8, 0.4, 1.5}) {
+    const Vector12d x = MakeHinge(fold, 3);
+    const double theta_rest = 0.1;
+    auto energy = [&](const Vector12d& y) { return BendingForce(y, ke, l, a, theta_rest).energy; };
+    const Vector12d f = BendingForce(x, ke, l, a, theta_rest).force;
+    const Vector12d numeric = -NumericGradient<12>(x, energy, 1e-7);
+    EXPECT_LT((f - numeric).norm(), 1e-6 * f.norm()) << "fold " << fold;
+    // At theta == theta_rest the Gauss-Newton Jacobian is the exact one.
+    const double theta = DihedralAngle(x);
+    auto force = [&](const Vector12d& y) { return Vector12d(BendingForce(y, ke, l, a, theta).force); };
+    const Matrix12d J = BendingForce(x, ke, l, a, theta).jacobian;
+    const Matrix12d Jn = NumericJacobian<12>(x, force, 1e-6);
+    EXPECT_LT((J - Jn).norm(), 1e-5 * J.norm()) << "fold " << fold;
+    Eigen::SelfAdjointEigenSolver<Matrix12d> eig(J);
+    EXPECT_LT(eig.eigenvalues().maxCoeff(), 1e-12 * J.norm());
+  }
+}
+
+TEST(WindForceTest, MatchesArcSimFormula) {
+  Vector9d x, v;
+  x << 0, 0, 0, 1, 0, 0, 0, 1, 0;  // normal +z
+  v << 0, 0, 1, 0, 0, 2, 0, 0, 3;   // mean face velocity (0, 0, 2)
+  const Eigen::Vector3d wind(3, 1, -1);
+  const double area = 0.25, density = 1.2, drag = 0.4;
+  const Vector9d f = WindForce(x, v, wind, area, density, drag);
+  // v_rel = (3, 1, -3); v_n = -3; normal part: 1.2*0.25*3*(-3) = -2.7 along z;
+  // tangential: 0.4*0.25*(3, 1, 0) = (0.3, 0.1, 0).
+  const Eigen::Vector3d expected(0.3, 0.1, -2.7);
+  for (int i = 0; i < 3; ++i) EXPECT_LT((f.segment<3>(3 * i) - expected / 3).norm(), 1e-12);
+  // Flipping the face orientation does not change the force (|v_n| v_n n is even in n).
+  Vector9d xf = x;
+  xf.segment<3>(3).swap(xf.segment<3>(6));
+  EXPECT_LT((WindForce(xf, v, wind, area, density, drag) - f).norm(), 1e-12);
+  // Cloth moving with the wind feels nothing.
+  Vector9d vw;
+  vw << wind, wind, wind;
+  EXPECT_LT(WindForce(x, vw, wind, area, density, drag).norm(), 1e-12);
+}
+
+TEST(RepulsionForceTest, ForceIsMinusEnergyGradientAndJacobianNearContact) {
+  Vector12d x;
+  x << 0.3, 0.25, 0.004, 0, 0, 0, 1, 0.1, 0.05, 0.1, 1, -0.03;
+  const double h = 0.01, k = 5e3;
+  const RepulsionTerms r = RepulsionForce(x, 1.0, h, k);
+  ASSERT_TRUE(r.active);
+  auto energy = [&](const Vector12d& y) { return RepulsionForce(y, 1.0, h, k).energy; };
+  const Vector12d numeric = -NumericGradient<12>(x, energy, 1e-8);
+  EXPECT_LT((r.force - numeric).norm(), 1e-6 * r.force.norm());
+  // Momentum: forces sum to zero.
+  EXPECT_LT((r.force.segment<3>(0) + r.force.segment<3>(3) + r.force.segment<3>(6) + r.force.segment<3>(9)).norm(),
+            1e-12 * r.force.norm());
+  // Close to the thickness the Gauss-Newton Jacobian approaches the exact one.
+  Vector12d near = x;
+  const Eigen::Vector3d n = (x.segment<3>(6) - x.segment<3>(3)).cross(x.segment<3>(9) - x.segment<3>(3)).normalized();
+  const double d = n.dot(x.segment<3>(0) - x.segment<3>(3));
+  near.segment<3>(0) += (0.999 * h - d) * n;
+  auto force = [&](const Vector12d& y) { return Vector12d(RepulsionForce(y, 1.0, h, k).force); };
+  const Matrix12d Jn = NumericJacobian<12>(near, force, 1e-8);
+  const Matrix12d J = RepulsionForce(near, 1.0, h, k).jacobian;
+  EXPECT_LT((J - Jn).norm(), 1e-2 * J.norm());
+  // Beyond the thickness or on the other side of the face plane w.r.t. `side`: inactive/pushing.
+  Vector12d far = x;
+  far[2] = 0.5;
+  EXPECT_FALSE(RepulsionForce(far, 1.0, h, k).active);
+  EXPECT_GT(RepulsionForce(x, 1.0, h, k).force.segment<3>(0).dot(n), 0);
+  EXPECT_LT(RepulsionForce(x, -1.0, h, k).force.segment<3>(0).dot(n), 0);
+}
+
+}  // namespace
+}  // namespace clothwind::sim

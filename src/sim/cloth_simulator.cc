@@ -1,0 +1,424 @@
+#include "sim/cloth_simulator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <utility>
+
+#include <Eigen/LU>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include "sim/cloth_forces.h"
+#include "sim/strain_limiter.h"
+#include "sim/vertex_face_proximity.h"
+
+namespace clothwind::sim {
+namespace {
+
+// A hinge: interior edge (x0, x1) with opposite vertices x2 (face (x0,x1,x2)) and x3
+// (face (x1,x0,x3)), and its rest data.
+struct Hinge {
+  int v[4];
+  double rest_length;
+  double rest_area_sum;
+  Eigen::Vector2d du;  // material-space edge direction (picks the bending table row)
+  int block[16] = {};  // block index of (v[i], v[j]) in the system matrix
+};
+
+struct Face {
+  int v[3];
+  TriangleRest rest;
+  int block[9] = {};
+};
+
+}  // namespace
+
+struct ClothSimulator::Impl {
+  Mesh mesh;
+  Material material;
+  SimOptions options;
+  std::shared_ptr<const WindField> wind;
+
+  int nv = 0;
+  std::vector<Face> faces;
+  std::vector<Hinge> hinges;
+  Eigen::VectorXd mass;
+  Eigen::VectorXd vertex_area;      // a third of the adjacent rest areas [m^2]
+  std::vector<char> pinned;
+  Eigen::MatrixX3d x, v;
+  double t = 0;
+  long steps = 0;
+  StepStats stats;
+
+  // Block-sparse (3x3 blocks) symmetric system matrix with a fixed pattern, stored in full.
+  std::vector<int> row_start;   // nv + 1
+  std::vector<int> col;         // per block
+  std::vector<int> diag_block;  // per vertex
+  std::vector<Eigen::Matrix3d> J;  // force Jacobian blocks
+  std::vector<Eigen::Matrix3d> A;  // system blocks
+  Eigen::VectorXd f, b, dv, r, z, p, q;
+  std::vector<Eigen::Matrix3d> precond;
+
+  std::unique_ptr<VertexFaceProximity> proximity;
+  std::unique_ptr<StrainLimiter> limiter;
+
+  void Build();
+  int BlockIndex(int i, int j) const;
+  void ComputeForces(bool with_jacobian, bool with_repulsion);
+  void Solve();
+  ClothEnergy Energy() const;
+};
+
+int ClothSimulator::Impl::BlockIndex(int i, int j) const {
+  auto begin = col.begin() + row_start[i], end = col.begin() + row_start[i + 1];
+  auto it = std::lower_bound(begin, end, j);
+  if (it == end || *it != j) throw std::logic_error("ClothSimulator: block not in pattern");
+  return static_cast<int>(it - col.begin());
+}
+
+void ClothSimulator::Impl::Build() {
+  ValidateMesh(mesh, "ClothSimulator mesh");
+  nv = static_cast<int>(mesh.V.rows());
+  if (!(options.dt > 0) || !std::isfinite(options.dt))
+    throw std::invalid_argument("SimOptions.dt must be finite and > 0, got " + std::to_string(options.dt));
+  if (!options.gravity.allFinite()) throw std::invalid_argument("SimOptions.gravity must be finite");
+  if (!(options.wind_density >= 0) || !(options.wind_drag >= 0))
+    throw std::invalid_argument("SimOptions.wind_density and wind_drag must be >= 0");
+  if (!(options.strain_min >= 0) || !(options.strain_max > 0) || options.strain_min >= options.strain_max ||
+      (options.strain_min > 1) || (options.strain_max < 1))
+    throw std::invalid_argument("SimOptions strain limits must satisfy 0 <= strain_min <= 1 <= strain_max");
+  if (!(options.repulsion_thickness >= 0) || !(options.collision_stiffness >= 0))
+    throw std::invalid_argument("SimOptions.repulsion_thickness and collision_stiffness must be >= 0");
+  if (!(options.cg_tolerance > 0) || options.cg_max_iterations < 1)
+    throw std::invalid_argument("SimOptions.cg_tolerance must be > 0 and cg_max_iterations >= 1");
+  if (!(material.density > 0) || material.stretching_samples.empty())
+    throw std::invalid_argument("ClothSimulator: material is not initialised (use MakeMaterial/LoadArcSimMaterial)");
+  pinned.assign(nv, 0);
+  for (int h : options.handles) {
+    if (h < 0 || h >= nv)
+      throw std::invalid_argument("SimOptions.handles: vertex index " + std::to_string(h) +
+                                  " out of range [0, " + std::to_string(nv) + ")");
+    pinned[h] = 1;
+  }
+
+  // Faces, masses.
+  const int nf = static_cast<int>(mesh.F.rows());
+  faces.resize(nf);
+  mass = Eigen::VectorXd::Zero(nv);
+  vertex_area = Eigen::VectorXd::Zero(nv);
+  for (int fi = 0; fi < nf; ++fi) {
+    Face& face = faces[fi];
+    for (int c = 0; c < 3; ++c) face.v[c] = mesh.F(fi, c);
+    face.rest = MakeTriangleRest(mesh.U.row(face.v[0]), mesh.U.row(face.v[1]), mesh.U.row(face.v[2]));
+    for (int c = 0; c < 3; ++c) vertex_area[face.v[c]] += face.rest.area / 3.0;
+  }
+  mass = material.density * vertex_area;
+  for (int i = 0; i < nv; ++i)
+    if (!(mass[i] > 0))
+      throw std::invalid_argument("ClothSimulator mesh: vertex " + std::to_string(i) +
+                                  " belongs to no face (zero mass)");
+
+  // Hinges from directed half-edges.
+  std::map<std::pair<int, int>, std::pair<int, int>> half;  // (a,b) -> (face, opposite vertex)
+  for (int fi = 0; fi < nf; ++fi)
+    for (int c = 0; c < 3; ++c) {
+      const int a = faces[fi].v[c], b2 = faces[fi].v[(c + 1) % 3], o = faces[fi].v[(c + 2) % 3];
+      if (!half.emplace(std::make_pair(a, b2), std::make_pair(fi, o)).second)
+        throw std::invalid_argument("ClothSimulator mesh: edge (" + std::to_string(a) + ", " +
+                                    std::to_string(b2) +
+                                    ") is used twice in the same direction (non-manifold edge or "
+                                    "inconsistently oriented faces)");
+    }
+  hinges.clear();
+  for (const auto& [edge, fo] : half) {
+    const int a = edge.first, b2 = edge.second;
+    if (a > b2) continue;
+    auto other = half.find({b2, a});
+    if (other == half.end()) continue;  // boundary edge
+    Hinge h;
+    h.v[0] = a;
+    h.v[1] = b2;
+    h.v[2] = fo.second;
+    h.v[3] = other->second.second;
+    h.du = (mesh.U.row(b2) - mesh.U.row(a)).transpose();
+    h.rest_length = h.du.norm();
+    h.rest_area_sum = faces[fo.first].rest.area + faces[other->second.first].rest.area;
+    hinges.push_back(h);
+  }
+
+  // Block pattern: vertex pairs sharing a face or a hinge.
+  std::vector<std::vector<int>> adj(nv);
+  auto link = [&](int i, int j) { adj[i].push_back(j); };
+  for (int i = 0; i < nv; ++i) link(i, i);
+  for (const Face& face : faces)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) link(face.v[i], face.v[j]);
+  for (const Hinge& h : hinges) {
+    link(h.v[2], h.v[3]);
+    link(h.v[3], h.v[2]);
+  }
+  row_start.assign(nv + 1, 0);
+  col.clear();
+  for (int i = 0; i < nv; ++i) {
+    std::sort(adj[i].begin(), adj[i].end());
+    adj[i].erase(std::unique(adj[i].begin(), adj[i].end()), adj[i].end());
+    row_start[i] = static_cast<int>(col.size());
+    col.insert(col.end(), adj[i].begin(), adj[i].end());
+  }
+  row_start[nv] = static_cast<int>(col.size());
+  diag_block.resize(nv);
+  for (int i = 0; i < nv; ++i) diag_block[i] = BlockIndex(i, i);
+  for (Face& face : faces)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) face.block[3 * i + j] = BlockIndex(face.v[i], face.v[j]);
+  for (Hinge& h : hinges)
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) h.block[4 * i + j] = BlockIndex(h.v[i], h.v[j]);
+  J.assign(col.size(), Eigen::Matrix3d::Zero());
+  A.assign(col.size(), Eigen::Matrix3d::Zero());
+  precond.assign(nv, Eigen::Matrix3d::Zero());
+  const int n3 = 3 * nv;
+  f.setZero(n3);
+  b.setZero(n3);
+  dv.setZero(n3);
+  r.setZero(n3);
+  z.setZero(n3);
+  p.setZero(n3);
+  q.setZero(n3);
+
+  x = mesh.V;
+  v = Eigen::MatrixX3d::Zero(nv, 3);
+  proximity = std::make_unique<VertexFaceProximity>(mesh.F, nv);
+  limiter = std::make_unique<StrainLimiter>(mesh, mass, pinned);
+}
+
+void ClothSimulator::Impl::ComputeForces(bool with_jacobian, bool with_repulsion) {
+  f.setZero();
+  if (with_jacobian)
+    for (auto& blk : J) blk.setZero();
+  auto xv = [&](int i) { return x.row(i).transpose(); };
+  // Gravity.
+  for (int i = 0; i < nv; ++i) f.segment<3>(3 * i) += mass[i] * options.gravity;
+  // Stretching and wind, per face.
+  for (const Face& face : faces) {
+    Vector9d xf, vf;
+    for (int c = 0; c < 3; ++c) {
+      xf.segment<3>(3 * c) = xv(face.v[c]);
+      vf.segment<3>(3 * c) = v.row(face.v[c]).transpose();
+    }
+    const Eigen::Vector4d k = material.StretchingStiffness(GreenStrain(xf, face.rest));
+    const StretchingTerms st = StretchingForce(xf, face.rest, k, /*definite=*/true);
+    Vector9d fe = st.force;
+    if (options.wind_density > 0 || options.wind_drag > 0) {
+      Eigen::Vector3d air = Eigen::Vector3d::Zero();
+      if (wind) air = wind->Velocity((xf.segment<3>(0) + xf.segment<3>(3) + xf.segment<3>(6)) / 3.0, t);
+      fe += WindForce(xf, vf, air, face.rest.area, options.wind_density, options.wind_drag);
+    }
+    for (int c = 0; c < 3; ++c) f.segment<3>(3 * face.v[c]) += fe.segment<3>(3 * c);
+    if (with_jacobian)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) J[face.block[3 * i + j]] += st.jacobian.block<3, 3>(3 * i, 3 * j);
+  }
+  // Bending, per hinge.
+  for (const Hinge& h : hinges) {
+    Vector12d xh;
+    for (int c = 0; c < 4; ++c) xh.segment<3>(3 * c) = xv(h.v[c]);
+    const double theta = DihedralAngle(xh);
+    const double curvature = std::abs(theta) * h.rest_length / h.rest_area_sum;
+    const double ke = material.BendingStiffness(curvature, h.du);
+    const BendingTerms bt = BendingForce(xh, ke, h.rest_length, h.rest_area_sum, 0.0);
+    for (int c = 0; c < 4; ++c) f.segment<3>(3 * h.v[c]) += bt.force.segment<3>(3 * c);
+    if (with_jacobian)
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) J[h.block[4 * i + j]] += bt.jacobian.block<3, 3>(3 * i, 3 * j);
+  }
+  // Vertex-face repulsion: force in full, Jacobian on the diagonal blocks only (the pairs are not
+  // in the fixed pattern; the diagonal part of a negative semidefinite Jacobian stays so).
+  stats.repulsion_pairs = 0;
+  if (with_repulsion && options.self_collision && options.repulsion_thickness > 0 &&
+      options.collision_stiffness > 0) {
+    const auto& pairs = proximity->pairs();
+    for (const auto& pr : pairs) {
+      Vector12d xr;
+      xr.segment<3>(0) = xv(pr.vertex);
+      for (int c = 0; c < 3; ++c) xr.segment<3>(3 + 3 * c) = xv(mesh.F(pr.face, c));
+      const double stiffness = options.collision_stiffness * vertex_area[pr.vertex];
+      const RepulsionTerms rt = RepulsionForce(xr, pr.side, options.repulsion_thickness, stiffness);
+      if (!rt.active) continue;
+      ++stats.repulsion_pairs;
+      int ids[4] = {pr.vertex, mesh.F(pr.face, 0), mesh.F(pr.face, 1), mesh.F(pr.face, 2)};
+      for (int c = 0; c < 4; ++c) {
+        f.segment<3>(3 * ids[c]) += rt.force.segment<3>(3 * c);
+        if (with_jacobian) J[diag_block[ids[c]]] += rt.jacobian.block<3, 3>(3 * c, 3 * c);
+      }
+    }
+  }
+}
+
+void ClothSimulator::Impl::Solve() {
+  const double h = options.dt;
+  const double hk = h * (h + material.damping);
+  // A = M - h (h + gamma) J;  b = h (f + (h + gamma) J v).
+  for (int i = 0; i < nv; ++i) {
+    Eigen::Vector3d Jv = Eigen::Vector3d::Zero();
+    for (int k = row_start[i]; k < row_start[i + 1]; ++k) {
+      A[k] = -hk * J[k];
+      Jv += J[k] * v.row(col[k]).transpose();
+    }
+    A[diag_block[i]].diagonal().array() += mass[i];
+    b.segment<3>(3 * i) = h * (f.segment<3>(3 * i) + (h + material.damping) * Jv);
+    if (pinned[i]) {
+      b.segment<3>(3 * i).setZero();
+      precond[i].setZero();
+    } else {
+      precond[i] = A[diag_block[i]].inverse();
+    }
+  }
+  auto multiply = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
+    for (int i = 0; i < nv; ++i) {
+      Eigen::Vector3d s = Eigen::Vector3d::Zero();
+      if (!pinned[i])
+        for (int k = row_start[i]; k < row_start[i + 1]; ++k) s += A[k] * in.segment<3>(3 * col[k]);
+      out.segment<3>(3 * i) = s;
+    }
+  };
+  // Preconditioned conjugate gradients, warm-started with the previous step's dv.
+  for (int i = 0; i < nv; ++i)
+    if (pinned[i]) dv.segment<3>(3 * i).setZero();
+  multiply(dv, q);
+  r = b - q;
+  const double bnorm = std::max(b.norm(), 1e-300);
+  auto precondition = [&]() {
+    for (int i = 0; i < nv; ++i) z.segment<3>(3 * i) = precond[i] * r.segment<3>(3 * i);
+  };
+  precondition();
+  p = z;
+  double rz = r.dot(z);
+  int it = 0;
+  double rel = r.norm() / bnorm;
+  while (rel > options.cg_tolerance && it < options.cg_max_iterations) {
+    multiply(p, q);
+    const double pq = p.dot(q);
+    if (!(pq > 0)) break;
+    const double alpha = rz / pq;
+    dv += alpha * p;
+    r -= alpha * q;
+    ++it;
+    rel = r.norm() / bnorm;
+    if (rel <= options.cg_tolerance) break;
+    precondition();
+    const double rz_new = r.dot(z);
+    p = z + (rz_new / rz) * p;
+    rz = rz_new;
+  }
+  stats.cg_iterations = it;
+  stats.cg_relative_residual = rel;
+}
+
+ClothEnergy ClothSimulator::Impl::Energy() const {
+  ClothEnergy e;
+  for (int i = 0; i < nv; ++i) {
+    e.kinetic += 0.5 * mass[i] * v.row(i).squaredNorm();
+    e.gravitational -= mass[i] * options.gravity.dot(x.row(i).transpose());
+  }
+  for (const Face& face : faces) {
+    Vector9d xf;
+    for (int c = 0; c < 3; ++c) xf.segment<3>(3 * c) = x.row(face.v[c]).transpose();
+    const Eigen::Matrix2d G = GreenStrain(xf, face.rest);
+    const Eigen::Vector4d k = material.StretchingStiffness(G);
+    e.stretching += 0.5 * face.rest.area *
+                    (k[0] * G(0, 0) * G(0, 0) + 2 * k[1] * G(0, 0) * G(1, 1) + k[2] * G(1, 1) * G(1, 1) +
+                     2 * k[3] * G(0, 1) * G(0, 1));
+  }
+  for (const Hinge& h : hinges) {
+    Vector12d xh;
+    for (int c = 0; c < 4; ++c) xh.segment<3>(3 * c) = x.row(h.v[c]).transpose();
+    const double theta = DihedralAngle(xh);
+    const double ke = material.BendingStiffness(std::abs(theta) * h.rest_length / h.rest_area_sum, h.du);
+    e.bending += 0.25 * ke * h.rest_length * h.rest_length / (2 * h.rest_area_sum) * theta * theta;
+  }
+  return e;
+}
+
+ClothSimulator::ClothSimulator(Mesh mesh, Material material, SimOptions options,
+                               std::shared_ptr<const WindField> wind)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->mesh = std::move(mesh);
+  impl_->material = std::move(material);
+  impl_->options = std::move(options);
+  impl_->wind = std::move(wind);
+  impl_->Build();
+}
+
+ClothSimulator::~ClothSimulator() = default;
+ClothSimulator::ClothSimulator(ClothSimulator&&) noexcept = default;
+ClothSimulator& ClothSimulator::operator=(ClothSimulator&&) noexcept = default;
+
+void ClothSimulator::Step() {
+  Impl& s = *impl_;
+  const double h = s.options.dt;
+  const bool repel = s.options.self_collision && s.options.repulsion_thickness > 0 &&
+                     s.options.collision_stiffness > 0;
+  if (repel) s.proximity->Update(s.x, s.options.repulsion_thickness);
+  s.ComputeForces(/*with_jacobian=*/true, repel);
+  s.Solve();
+  for (int i = 0; i < s.nv; ++i) {
+    if (s.pinned[i]) {
+      s.v.row(i).setZero();
+      continue;
+    }
+    s.v.row(i) += s.dv.segment<3>(3 * i).transpose();
+    s.x.row(i) += h * s.v.row(i);
+  }
+  s.stats.strain_limited_faces = 0;
+  if (s.options.strain_min > 0 || std::isfinite(s.options.strain_max)) {
+    s.stats.strain_limited_faces = s.limiter->Project(s.options.strain_min, s.options.strain_max,
+                                                      s.options.strain_limit_iterations, h, &s.x, &s.v);
+  }
+  ++s.steps;
+  s.t = s.steps * h;
+}
+
+double ClothSimulator::time() const { return impl_->t; }
+const Eigen::MatrixX3d& ClothSimulator::positions() const { return impl_->x; }
+const Eigen::MatrixX3d& ClothSimulator::velocities() const { return impl_->v; }
+
+void ClothSimulator::SetState(const Eigen::MatrixX3d& positions, const Eigen::MatrixX3d& velocities) {
+  Impl& s = *impl_;
+  if (positions.rows() != s.nv || velocities.rows() != s.nv)
+    throw std::invalid_argument("ClothSimulator::SetState: expected " + std::to_string(s.nv) +
+                                " rows of positions and velocities");
+  if (!positions.allFinite() || !velocities.allFinite())
+    throw std::invalid_argument("ClothSimulator::SetState: non-finite positions or velocities");
+  s.x = positions;
+  s.v = velocities;
+  for (int i = 0; i < s.nv; ++i)
+    if (s.pinned[i]) s.v.row(i).setZero();
+  s.dv.setZero();
+}
+
+void ClothSimulator::set_wind(std::shared_ptr<const WindField> wind) { impl_->wind = std::move(wind); }
+const Mesh& ClothSimulator::mesh() const { return impl_->mesh; }
+const Material& ClothSimulator::material() const { return impl_->material; }
+const SimOptions& ClothSimulator::options() const { return impl_->options; }
+const Eigen::VectorXd& ClothSimulator::masses() const { return impl_->mass; }
+ClothEnergy ClothSimulator::Energy() const { return impl_->Energy(); }
+
+Eigen::MatrixX3d ClothSimulator::Forces() const {
+  Impl& s = *impl_;
+  const bool repel = s.options.self_collision && s.options.repulsion_thickness > 0 &&
+                     s.options.collision_stiffness > 0;
+  if (repel) s.proximity->Update(s.x, s.options.repulsion_thickness);
+  s.ComputeForces(/*with_jacobian=*/false, repel);
+  Eigen::MatrixX3d out(s.nv, 3);
+  for (int i = 0; i < s.nv; ++i) out.row(i) = s.f.segment<3>(3 * i).transpose();
+  return out;
+}
+
+const StepStats& ClothSimulator::last_step_stats() const { return impl_->stats; }
+
+}  // namespace clothwind::sim

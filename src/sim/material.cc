@@ -1,0 +1,201 @@
+#include "sim/material.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+#include <nlohmann/json.hpp>
+
+
+namespace clothwind::sim {
+namespace {
+
+// ArcSim's stretching sample grid: 30 samples per axis over G00, G11 in [-0.25, 0.7167] and
+// |G01| in [0, 0.9667] (dde.cpp).
+constexpr int kSamples = 30;
+
+// ArcSim's JSON reader accepts `//` and `/* */` comments (paper.json starts with some); blank
+// them (keeping newlines, so parser positions stay valid) outside strings.
+std::string BlankComments(std::string s) {
+  bool in_string = false;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (in_string) {
+      if (s[i] == '\\') ++i;
+      else if (s[i] == '"') in_string = false;
+    } else if (s[i] == '"') {
+      in_string = true;
+    } else if (s[i] == '/' && i + 1 < s.size() && s[i + 1] == '/') {
+      for (; i < s.size() && s[i] != '\n'; ++i) s[i] = ' ';
+    } else if (s[i] == '/' && i + 1 < s.size() && s[i + 1] == '*') {
+      for (; i < s.size() && !(s[i] == '*' && i + 1 < s.size() && s[i + 1] == '/'); ++i)
+        if (s[i] != '\n') s[i] = ' ';
+      if (i < s.size()) s[i] = s[i + 1] = ' ';
+    }
+  }
+  return s;
+}
+
+// One stretching sample, as ArcSim's evaluate_stretching_sample: the principal stretch w0 (the
+// larger one) and its direction in material space pick a point between the unstretched row and
+// the 5 directional rows (stretch 1 + 1/6 at full weight); negative stiffnesses clamp to 0 and
+// the result is doubled.
+Eigen::Vector4d EvaluateStretchingSample(const Eigen::Matrix2d& G,
+                                         const std::array<std::array<Eigen::Vector4d, 5>, 2>& d) {
+  const Eigen::Matrix2d C = 2.0 * G + Eigen::Matrix2d::Identity();  // right Cauchy-Green tensor
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(C);
+  // Eigen sorts ascending; ArcSim's first eigenpair is the largest.
+  const double w0 = std::sqrt(std::max(0.0, eig.eigenvalues()[1]));
+  const Eigen::Vector2d dir = eig.eigenvectors().col(1);
+  // Direction folded into [0, 90] degrees: the samples hold |G01|, so a direction and its
+  // mirror image are the same sample; ArcSim's |atan2| / pi * 8 clamps at 4 for the same range.
+  double angle = std::atan2(std::abs(dir.y()), std::abs(dir.x()));  // [0, pi/2]
+  double angle_weight = std::clamp(angle / M_PI * 8.0, 0.0, 4.0 - 1e-6);
+  const int angle_id = static_cast<int>(angle_weight);
+  angle_weight -= angle_id;
+  const double strain_weight = std::clamp((w0 - 1.0) * 6.0, 0.0, 1.0 - 1e-6);
+  Eigen::Vector4d k = d[0][angle_id] * (1 - strain_weight) * (1 - angle_weight) +
+                      d[1][angle_id] * strain_weight * (1 - angle_weight) +
+                      d[0][angle_id + 1] * (1 - strain_weight) * angle_weight +
+                      d[1][angle_id + 1] * strain_weight * angle_weight;
+  return 2.0 * k.cwiseMax(0.0);
+}
+
+void CheckPositive(double value, const char* what) {
+  if (!(std::isfinite(value) && value > 0))
+    throw std::invalid_argument(std::string("material: ") + what + " must be finite and > 0, got " +
+                                std::to_string(value));
+}
+
+}  // namespace
+
+Eigen::Vector4d Material::StretchingStiffness(const Eigen::Matrix2d& G) const {
+  double a = std::clamp((G(0, 0) + 0.25) * kSamples, 0.0, kSamples - 1 - 1e-5);
+  double b = std::clamp((G(1, 1) + 0.25) * kSamples, 0.0, kSamples - 1 - 1e-5);
+  double c = std::clamp(std::abs(G(0, 1)) * kSamples, 0.0, kSamples - 1 - 1e-5);
+  const int ai = std::min(static_cast<int>(a), kSamples - 2);
+  const int bi = std::min(static_cast<int>(b), kSamples - 2);
+  const int ci = std::min(static_cast<int>(c), kSamples - 2);
+  a -= ai;
+  b -= bi;
+  c -= ci;
+  Eigen::Vector4d k = Eigen::Vector4d::Zero();
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int l = 0; l < 2; ++l) {
+        const double w = (i ? a : 1 - a) * (j ? b : 1 - b) * (l ? c : 1 - c);
+        k += w * stretching_samples[((ai + i) * kSamples + (bi + j)) * kSamples + (ci + l)];
+      }
+  return k;
+}
+
+double Material::BendingStiffness(double curvature, const Eigen::Vector2d& du) const {
+  // Curvature samples every 10 1/m (ArcSim: value = curv/2 * 0.2, clamped to [0, 4]). ArcSim
+  // passes a signed curvature and so extrapolates below the first sample for negative dihedrals,
+  // which depends on the arbitrary edge orientation; the measured tables are for a magnitude.
+  double value = std::min(std::abs(curvature) * 0.1, 4.0);
+  int value_i = std::clamp(static_cast<int>(value), 0, 3);
+  value -= value_i;
+  // Edge direction in material space folded to [0, 2] (0, 45, 90 degrees), ArcSim's bias_angle.
+  double bias = std::atan2(du.y(), du.x()) * 4.0 / M_PI;
+  if (bias < 0) bias = -bias;
+  if (bias > 4) bias = 8 - bias;
+  if (bias > 2) bias = 4 - bias;
+  const int bias_id = std::clamp(static_cast<int>(bias), 0, 1);
+  bias -= bias_id;
+  const double ke = bending[bias_id][value_i] * (1 - bias) * (1 - value) +
+                    bending[bias_id + 1][value_i] * bias * (1 - value) +
+                    bending[bias_id][value_i + 1] * (1 - bias) * value +
+                    bending[bias_id + 1][value_i + 1] * bias * value;
+  return std::max(ke, 0.0);
+}
+
+Material MakeMaterial(double density, const Eigen::Matrix<double, 6, 4>& stretching,
+                      const Eigen::Matrix<double, 3, 5>& bending, const MaterialMultipliers& mult) {
+  CheckPositive(density, "density");
+  CheckPositive(mult.density, "density multiplier");
+  CheckPositive(mult.stretching, "stretching multiplier");
+  CheckPositive(mult.bending, "bending multiplier");
+  CheckPositive(mult.thicken, "thicken");
+  if (!(std::isfinite(mult.damping) && mult.damping >= 0))
+    throw std::invalid_argument("material: damping must be finite and >= 0");
+  if (!stretching.allFinite()) throw std::invalid_argument("material: stretching table has non-finite values");
+  if (!bending.allFinite()) throw std::invalid_argument("material: bending table has non-finite values");
+  Material m;
+  m.density = density * mult.density * mult.thicken;
+  m.stretching_scale = mult.stretching * mult.thicken;
+  m.damping = mult.damping;
+  // ArcSim's layout: d[0][*] = row 0 for every direction, d[1][i] = row i + 1.
+  for (int i = 0; i < 5; ++i) {
+    m.stretching_data[0][i] = stretching.row(0).transpose();
+    m.stretching_data[1][i] = stretching.row(i + 1).transpose();
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 5; ++j) m.bending[i][j] = bending(i, j) * mult.bending * mult.thicken;
+  m.stretching_samples.resize(kSamples * kSamples * kSamples);
+  for (int i = 0; i < kSamples; ++i)
+    for (int j = 0; j < kSamples; ++j)
+      for (int k = 0; k < kSamples; ++k) {
+        Eigen::Matrix2d G;
+        G(0, 0) = -0.25 + i / double(kSamples);
+        G(1, 1) = -0.25 + j / double(kSamples);
+        G(0, 1) = G(1, 0) = k / double(kSamples);
+        m.stretching_samples[(i * kSamples + j) * kSamples + k] =
+            m.stretching_scale * EvaluateStretchingSample(G, m.stretching_data);
+      }
+  return m;
+}
+
+Material LoadArcSimMaterial(const std::string& path, const MaterialMultipliers& mult) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open material file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(BlankComments(ss.str()));
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(path + ": not valid JSON: " + e.what());
+  }
+  if (!j.is_object()) throw std::runtime_error(path + ": expected a JSON object at the top level");
+  auto number = [&](const nlohmann::json& v, const std::string& field) {
+    if (!v.is_number())
+      throw std::runtime_error(path + ": field '" + field + "' must be a number, got " + v.dump());
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) throw std::runtime_error(path + ": field '" + field + "' is not finite");
+    return x;
+  };
+  auto table = [&](const char* field, int rows, int cols) {
+    if (!j.contains(field)) throw std::runtime_error(path + ": missing field '" + field + "'");
+    const auto& t = j[field];
+    if (!t.is_array() || static_cast<int>(t.size()) != rows)
+      throw std::runtime_error(path + ": field '" + field + "' must be an array of " +
+                               std::to_string(rows) + " rows of " + std::to_string(cols) + " numbers");
+    Eigen::MatrixXd out(rows, cols);
+    for (int r = 0; r < rows; ++r) {
+      if (!t[r].is_array() || static_cast<int>(t[r].size()) != cols)
+        throw std::runtime_error(path + ": field '" + field + "' row " + std::to_string(r) +
+                                 " must have " + std::to_string(cols) + " numbers");
+      for (int c = 0; c < cols; ++c)
+        out(r, c) = number(t[r][c], std::string(field) + "[" + std::to_string(r) + "][" +
+                                        std::to_string(c) + "]");
+    }
+    return out;
+  };
+  if (!j.contains("density")) throw std::runtime_error(path + ": missing field 'density'");
+  const double density = number(j["density"], "density");
+  if (!(density > 0)) throw std::runtime_error(path + ": field 'density' must be > 0 [kg/m^2]");
+  const Eigen::Matrix<double, 6, 4> stretching = table("stretching", 6, 4);
+  const Eigen::Matrix<double, 3, 5> bending = table("bending", 3, 5);
+  if ((bending.array() < 0).any())
+    throw std::runtime_error(path + ": field 'bending' has negative stiffnesses");
+  try {
+    return MakeMaterial(density, stretching, bending, mult);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
+}  // namespace clothwind::sim

@@ -1,0 +1,156 @@
+#include "sim/material.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace clothwind::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+Eigen::Matrix<double, 6, 4> Table6x4(double base) {
+  Eigen::Matrix<double, 6, 4> s;
+  for (int r = 0; r < 6; ++r) s.row(r) << base * (1 + r), base * 0.2, base * (2 + r), base * 0.5;
+  return s;
+}
+
+Eigen::Matrix<double, 3, 5> Table3x5() {
+  Eigen::Matrix<double, 3, 5> b;
+  b << 1, 2, 3, 4, 5, 10, 20, 30, 40, 50, 100, 200, 300, 400, 500;
+  return b * 1e-6;
+}
+
+TEST(MaterialTest, UnstrainedStiffnessIsTwiceRowZeroAndMultipliersScale) {
+  const Material m = MakeMaterial(0.2, Table6x4(10), Table3x5());
+  // At a grid point under slight compression the principal stretch is below 1: the sample is
+  // row 0, doubled as ArcSim does. (At G = 0 itself ArcSim's grid interpolates 10 % of the way to
+  // the stretched row, since G = 0 lies between samples.)
+  const Eigen::Matrix2d Gc = Eigen::Vector2d(-1.0 / 60, -1.0 / 60).asDiagonal();
+  const Eigen::Vector4d k0 = m.StretchingStiffness(Gc);
+  EXPECT_LT((k0 - 2 * Table6x4(10).row(0).transpose()).norm(), 1e-9);
+  MaterialMultipliers mult;
+  mult.stretching = 3;
+  mult.bending = 5;
+  mult.density = 7;
+  mult.thicken = 2;
+  const Material s = MakeMaterial(0.2, Table6x4(10), Table3x5(), mult);
+  EXPECT_DOUBLE_EQ(s.density, 0.2 * 7 * 2);
+  EXPECT_LT((s.StretchingStiffness(Gc) - 6 * k0).norm(), 1e-9);
+  EXPECT_LT((s.StretchingStiffness(Eigen::Matrix2d::Zero()) - 6 * m.StretchingStiffness(Eigen::Matrix2d::Zero())).norm(), 1e-9);
+  const Eigen::Vector2d along_u(1, 0);
+  EXPECT_NEAR(s.BendingStiffness(0, along_u), 10 * m.BendingStiffness(0, along_u), 1e-18);
+}
+
+TEST(MaterialTest, StiffnessGrowsWithStretchTowardsDirectionalRow) {
+  const Material m = MakeMaterial(0.2, Table6x4(10), Table3x5());
+  // Stretch 1 + 1/6 along u (G00 = ((7/6)^2 - 1)/2, on a grid-aligned direction): row 1 (0 deg).
+  const double s = 7.0 / 6.0;
+  Eigen::Matrix2d G = Eigen::Matrix2d::Zero();
+  G(0, 0) = 0.5 * (s * s - 1);
+  const Eigen::Vector4d k = m.StretchingStiffness(G);
+  const Eigen::Vector4d row1 = 2 * Table6x4(10).row(1).transpose();
+  EXPECT_LT((k - row1).norm(), 0.05 * row1.norm()) << k.transpose();
+  // Along v: row 5 (90 degrees) is stiffer in this table.
+  Eigen::Matrix2d Gv = Eigen::Matrix2d::Zero();
+  Gv(1, 1) = G(0, 0);
+  EXPECT_GT(m.StretchingStiffness(Gv)[0], k[0]);
+  // Monotone in between.
+  Eigen::Matrix2d Gh = 0.5 * G;
+  EXPECT_GT(m.StretchingStiffness(Gh)[0], m.StretchingStiffness(Eigen::Matrix2d::Zero())[0]);
+  EXPECT_LT(m.StretchingStiffness(Gh)[0], k[0]);
+}
+
+TEST(MaterialTest, BendingInterpolatesDirectionAndCurvature) {
+  const Material m = MakeMaterial(0.2, Table6x4(10), Table3x5());
+  const auto b = Table3x5();
+  EXPECT_NEAR(m.BendingStiffness(0, {1, 0}), b(0, 0), 1e-15);
+  EXPECT_NEAR(m.BendingStiffness(0, {0, 1}), b(2, 0), 1e-15);
+  EXPECT_NEAR(m.BendingStiffness(0, {-1, -1}), b(1, 0), 1e-15);     // 45 degrees either way
+  EXPECT_NEAR(m.BendingStiffness(20, {1, 0}), b(0, 2), 1e-15);       // curvature 20 1/m: column 2
+  EXPECT_NEAR(m.BendingStiffness(-20, {1, 0}), b(0, 2), 1e-15);      // magnitude
+  EXPECT_NEAR(m.BendingStiffness(15, {0, -1}), 0.5 * (b(2, 1) + b(2, 2)), 1e-15);
+  EXPECT_NEAR(m.BendingStiffness(1e3, {1, 0}), b(0, 4), 1e-15);      // clamped beyond 40 1/m
+}
+
+std::string WriteText(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/clothwind_material_test_" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+void ExpectThrowContaining(const std::function<void()>& fn, const std::string& needle) {
+  try {
+    fn();
+    ADD_FAILURE() << "expected an exception containing '" << needle << "'";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(MaterialTest, BadFilesFailNamingFileAndField) {
+  ExpectThrowContaining([] { LoadArcSimMaterial("/nonexistent/cloth.json"); }, "/nonexistent/cloth.json: cannot open");
+  const std::string rows = "[[1,2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4]]";
+  const std::string bend = "[[1,2,3,4,5],[1,2,3,4,5],[1,2,3,4,5]]";
+  const std::string no_density = WriteText("nodensity.json", "{\"stretching\": " + rows + ", \"bending\": " + bend + "}");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(no_density); }, no_density + ": missing field 'density'");
+  const std::string short_rows = WriteText("short.json", "{\"density\": 0.1, \"stretching\": [[1,2,3,4]], \"bending\": " + bend + "}");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(short_rows); }, "field 'stretching' must be an array of 6 rows");
+  const std::string bad_value = WriteText("badvalue.json", "{\"density\": 0.1, \"stretching\": " + rows +
+                                                               ", \"bending\": [[1,2,3,4,5],[1,\"x\",3,4,5],[1,2,3,4,5]]}");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(bad_value); }, "field 'bending[1][1]' must be a number");
+  const std::string negative = WriteText("negdensity.json", "{\"density\": -1, \"stretching\": " + rows + ", \"bending\": " + bend + "}");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(negative); }, "field 'density' must be > 0");
+  const std::string broken = WriteText("broken.json", "{\"density\": ");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(broken); }, broken + ": not valid JSON");
+  const std::string commented = WriteText("commented.json", "// a comment like paper.json's\n{\"density\": 0.1, /* x */ \"stretching\": " +
+                                                                rows + ", \"bending\": " + bend + "}");
+  EXPECT_NO_THROW(LoadArcSimMaterial(commented));
+  MaterialMultipliers bad;
+  bad.thicken = 0;
+  ExpectThrowContaining([&] { LoadArcSimMaterial(commented, bad); }, "thicken must be finite and > 0");
+}
+
+TEST(MaterialTest, EveryArcSimMaterialLoadsWithSaneValues) {
+  const char* shared = std::getenv("CLOTHWIND_SHARED_DIR");
+  if (!shared || !fs::is_directory(fs::path(shared) / "arcsim" / "materials"))
+    GTEST_SKIP() << "CLOTHWIND_SHARED_DIR/arcsim/materials not available";
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(shared) / "arcsim" / "materials")) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    const Material m = LoadArcSimMaterial(entry.path().string());
+    ++count;
+    EXPECT_GT(m.density, 0.01);
+    EXPECT_LT(m.density, 2.0);  // kg/m^2: fabrics ~0.1-0.5, aluminium foil/paper in range
+    const Eigen::Vector4d k0 = m.StretchingStiffness(Eigen::Matrix2d::Zero());
+    EXPECT_TRUE(k0.allFinite());
+    EXPECT_TRUE((k0.array() >= 0).all());
+    // Every material resists uniaxial stretch along both material axes.
+    Eigen::Matrix2d G = Eigen::Matrix2d::Zero();
+    G(0, 0) = 0.05;
+    EXPECT_GT(m.StretchingStiffness(G)[0], 0);
+    G.setZero();
+    G(1, 1) = 0.05;
+    EXPECT_GT(m.StretchingStiffness(G)[2], 0);
+    for (double curv : {0.0, 5.0, 50.0})
+      for (const Eigen::Vector2d du : {Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 1), Eigen::Vector2d(0, 1)}) {
+        const double kb = m.BendingStiffness(curv, du);
+        EXPECT_GE(kb, 0);
+        EXPECT_LT(kb, 1e-2);  // N m: cloth ~1e-5, paper 4e-4
+      }
+  }
+  EXPECT_GE(count, 10);
+  // camel-ponte-roma with thicken 2 (the flag scene): twice the density.
+  const Material flag = LoadArcSimMaterial((fs::path(shared) / "arcsim/materials/camel-ponte-roma.json").string(),
+                                           MaterialMultipliers{1, 1, 1, 2, 0});
+  EXPECT_NEAR(flag.density, 2 * 0.284, 1e-12);
+}
+
+}  // namespace
+}  // namespace clothwind::sim

@@ -1,0 +1,295 @@
+#include "sim/mesh.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace clothwind::sim {
+namespace {
+
+[[noreturn]] void ObjError(const std::string& path, int line, const std::string& what) {
+  throw std::runtime_error(path + ":" + std::to_string(line) + ": " + what);
+}
+
+// Parses an OBJ index (1-based, or negative = relative to the end) into a 0-based one.
+int ObjIndex(const std::string& token, int count, const std::string& path, int line,
+             const char* kind) {
+  if (token.empty()) ObjError(path, line, std::string("empty ") + kind + " index");
+  size_t used = 0;
+  long value = 0;
+  try {
+    value = std::stol(token, &used);
+  } catch (const std::exception&) {
+    ObjError(path, line, std::string("expected an integer ") + kind + " index, got '" + token + "'");
+  }
+  if (used != token.size())
+    ObjError(path, line, std::string("expected an integer ") + kind + " index, got '" + token + "'");
+  long index = value > 0 ? value - 1 : count + value;
+  if (value == 0 || index < 0 || index >= count)
+    ObjError(path, line, std::string(kind) + " index " + token + " out of range (have " +
+                             std::to_string(count) + ")");
+  return static_cast<int>(index);
+}
+
+double TriangleArea3(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  return 0.5 * (b - a).cross(c - a).norm();
+}
+
+double TriangleArea2(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const Eigen::Vector2d e1 = b - a, e2 = c - a;
+  return 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+}
+
+}  // namespace
+
+Mesh ReadObj(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open OBJ file");
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Eigen::Vector2d> texcoords;
+  std::vector<Eigen::Vector3i> faces;
+  std::vector<Eigen::Vector3i> face_tex;  // -1 when a corner has no vt
+  std::string line;
+  int line_no = 0;
+  auto read_numbers = [&](std::istringstream& s, int n, double* out, const char* what) {
+    for (int i = 0; i < n; ++i) {
+      std::string tok;
+      if (!(s >> tok))
+        ObjError(path, line_no, std::string("expected ") + std::to_string(n) + " numbers after '" +
+                                    what + "'");
+      char* end = nullptr;
+      out[i] = std::strtod(tok.c_str(), &end);
+      if (end == tok.c_str() || *end != '\0')
+        ObjError(path, line_no, std::string("expected a number in '") + what + "' line, got '" +
+                                    tok + "'");
+      if (!std::isfinite(out[i]))
+        ObjError(path, line_no, std::string("non-finite value '") + tok + "' in '" + what + "'");
+    }
+  };
+  while (std::getline(in, line)) {
+    ++line_no;
+    std::istringstream s(line);
+    std::string key;
+    if (!(s >> key) || key[0] == '#') continue;
+    if (key == "v") {
+      double x[3];
+      read_numbers(s, 3, x, "v");
+      positions.emplace_back(x[0], x[1], x[2]);
+    } else if (key == "vt") {
+      double u[2];
+      read_numbers(s, 2, u, "vt");
+      texcoords.emplace_back(u[0], u[1]);
+    } else if (key == "f") {
+      std::vector<int> vi, ti;
+      std::string tok;
+      while (s >> tok) {
+        const size_t slash = tok.find('/');
+        const std::string vtok = tok.substr(0, slash);
+        vi.push_back(ObjIndex(vtok, static_cast<int>(positions.size()), path, line_no, "vertex"));
+        int t = -1;
+        if (slash != std::string::npos) {
+          const size_t slash2 = tok.find('/', slash + 1);
+          const std::string ttok = tok.substr(slash + 1, slash2 == std::string::npos
+                                                              ? std::string::npos
+                                                              : slash2 - slash - 1);
+          if (!ttok.empty())
+            t = ObjIndex(ttok, static_cast<int>(texcoords.size()), path, line_no, "texture");
+        }
+        ti.push_back(t);
+      }
+      if (vi.size() < 3)
+        ObjError(path, line_no, "a face needs at least 3 vertices, got " + std::to_string(vi.size()));
+      for (size_t k = 2; k < vi.size(); ++k) {  // fan triangulation of polygons
+        faces.emplace_back(vi[0], vi[k - 1], vi[k]);
+        face_tex.emplace_back(ti[0], ti[k - 1], ti[k]);
+      }
+    }
+    // Other keywords (vn, g, o, s, usemtl, ArcSim's nv/ny/...) carry nothing we simulate.
+  }
+  if (positions.empty()) throw std::runtime_error(path + ": no vertices ('v' lines)");
+  if (faces.empty()) throw std::runtime_error(path + ": no faces ('f' lines)");
+
+  Mesh mesh;
+  const int nv = static_cast<int>(positions.size());
+  mesh.V.resize(nv, 3);
+  for (int i = 0; i < nv; ++i) mesh.V.row(i) = positions[i].transpose();
+  mesh.F.resize(static_cast<int>(faces.size()), 3);
+  for (size_t f = 0; f < faces.size(); ++f) mesh.F.row(f) = faces[f].transpose();
+  // Material coordinates: the vt of each vertex when all its corners agree, else ArcSim's x,y.
+  mesh.U = mesh.V.leftCols(2);
+  bool any_tex = false;
+  std::vector<int> vt_of(nv, -1);
+  for (size_t f = 0; f < faces.size(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      const int t = face_tex[f][c], v = faces[f][c];
+      if (t < 0) continue;
+      any_tex = true;
+      if (vt_of[v] >= 0 && (texcoords[vt_of[v]] - texcoords[t]).norm() > 1e-12)
+        throw std::runtime_error(path + ": vertex " + std::to_string(v + 1) +
+                                 " has different texture coordinates in different faces "
+                                 "(texture seams are not supported)");
+      vt_of[v] = t;
+    }
+  }
+  if (any_tex) {
+    for (int v = 0; v < nv; ++v) {
+      if (vt_of[v] < 0)
+        throw std::runtime_error(path + ": vertex " + std::to_string(v + 1) +
+                                 " has no texture coordinate while others do");
+      mesh.U.row(v) = texcoords[vt_of[v]].transpose();
+    }
+  }
+  ValidateMesh(mesh, path);
+  return mesh;
+}
+
+void WriteObj(const std::string& path, const Mesh& mesh) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw std::runtime_error(path + ": cannot write (" + tmp + ")");
+    out.precision(17);
+    out << "# clothwind mesh: " << mesh.V.rows() << " vertices, " << mesh.F.rows() << " faces\n";
+    for (int i = 0; i < mesh.V.rows(); ++i)
+      out << "v " << mesh.V(i, 0) << ' ' << mesh.V(i, 1) << ' ' << mesh.V(i, 2) << '\n';
+    const bool tex = mesh.U.rows() == mesh.V.rows() && mesh.U.rows() > 0;
+    if (tex)
+      for (int i = 0; i < mesh.U.rows(); ++i) out << "vt " << mesh.U(i, 0) << ' ' << mesh.U(i, 1) << '\n';
+    for (int f = 0; f < mesh.F.rows(); ++f) {
+      out << 'f';
+      for (int c = 0; c < 3; ++c) {
+        out << ' ' << mesh.F(f, c) + 1;
+        if (tex) out << '/' << mesh.F(f, c) + 1;
+      }
+      out << '\n';
+    }
+    out.flush();
+    if (!out) throw std::runtime_error(path + ": write failed (" + tmp + ")");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot rename " + tmp + " into place");
+  }
+}
+
+void ValidateMesh(const Mesh& mesh, const std::string& what) {
+  const int nv = static_cast<int>(mesh.V.rows());
+  if (nv == 0) throw std::invalid_argument(what + ": mesh has no vertices");
+  if (mesh.F.rows() == 0) throw std::invalid_argument(what + ": mesh has no faces");
+  if (mesh.U.rows() != nv)
+    throw std::invalid_argument(what + ": U has " + std::to_string(mesh.U.rows()) +
+                                " rows, expected one per vertex (" + std::to_string(nv) + ")");
+  for (int i = 0; i < nv; ++i) {
+    if (!mesh.V.row(i).allFinite())
+      throw std::invalid_argument(what + ": vertex " + std::to_string(i) +
+                                  " has a non-finite position (NaN or inf)");
+    if (!mesh.U.row(i).allFinite())
+      throw std::invalid_argument(what + ": vertex " + std::to_string(i) +
+                                  " has a non-finite material coordinate (NaN or inf)");
+  }
+  const double scale = std::max(1e-300, (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).norm());
+  const double uscale = std::max(1e-300, (mesh.U.colwise().maxCoeff() - mesh.U.colwise().minCoeff()).norm());
+  for (int f = 0; f < mesh.F.rows(); ++f) {
+    const Eigen::Vector3i t = mesh.F.row(f).transpose();
+    for (int c = 0; c < 3; ++c)
+      if (t[c] < 0 || t[c] >= nv)
+        throw std::invalid_argument(what + ": face " + std::to_string(f) + " has vertex index " +
+                                    std::to_string(t[c]) + " out of range [0, " +
+                                    std::to_string(nv) + ")");
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
+      throw std::invalid_argument(what + ": face " + std::to_string(f) + " repeats a vertex");
+    const double a = TriangleArea3(mesh.V.row(t[0]), mesh.V.row(t[1]), mesh.V.row(t[2]));
+    if (!(a > 1e-12 * scale * scale))
+      throw std::invalid_argument(what + ": face " + std::to_string(f) +
+                                  " is degenerate (zero area in world space)");
+    const double ua = TriangleArea2(mesh.U.row(t[0]), mesh.U.row(t[1]), mesh.U.row(t[2]));
+    if (!(ua > 1e-12 * uscale * uscale))
+      throw std::invalid_argument(what + ": face " + std::to_string(f) +
+                                  " is degenerate in material space (zero rest area)");
+  }
+}
+
+Mesh RefineMesh(const Mesh& input, double max_edge) {
+  if (!(max_edge > 0)) throw std::invalid_argument("RefineMesh: max_edge must be > 0");
+  ValidateMesh(input, "RefineMesh input");
+  Mesh mesh = input;
+  auto longest = [](const Mesh& m) {
+    double l = 0;
+    for (int f = 0; f < m.F.rows(); ++f)
+      for (int c = 0; c < 3; ++c) {
+        const int a = m.F(f, c), b = m.F(f, (c + 1) % 3);
+        l = std::max(l, (m.V.row(a) - m.V.row(b)).norm());
+        l = std::max(l, (m.U.row(a) - m.U.row(b)).norm());
+      }
+    return l;
+  };
+  for (int level = 0; longest(mesh) > max_edge; ++level) {
+    if (level >= 12) throw std::invalid_argument("RefineMesh: max_edge too small (over 12 levels)");
+    const int nv = static_cast<int>(mesh.V.rows()), nf = static_cast<int>(mesh.F.rows());
+    std::map<std::pair<int, int>, int> midpoint;
+    std::vector<Eigen::Vector3d> newV;
+    std::vector<Eigen::Vector2d> newU;
+    auto mid = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      auto it = midpoint.find(key);
+      if (it != midpoint.end()) return it->second;
+      const int id = nv + static_cast<int>(newV.size());
+      newV.push_back(0.5 * (mesh.V.row(a) + mesh.V.row(b)).transpose());
+      newU.push_back(0.5 * (mesh.U.row(a) + mesh.U.row(b)).transpose());
+      midpoint.emplace(key, id);
+      return id;
+    };
+    Eigen::MatrixX3i F(4 * nf, 3);
+    for (int f = 0; f < nf; ++f) {
+      const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
+      const int ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
+      F.row(4 * f + 0) << a, ab, ca;
+      F.row(4 * f + 1) << ab, b, bc;
+      F.row(4 * f + 2) << ca, bc, c;
+      F.row(4 * f + 3) << ab, bc, ca;
+    }
+    Mesh next;
+    next.V.resize(nv + newV.size(), 3);
+    next.U.resize(nv + newU.size(), 2);
+    next.V.topRows(nv) = mesh.V;
+    next.U.topRows(nv) = mesh.U;
+    for (size_t i = 0; i < newV.size(); ++i) {
+      next.V.row(nv + i) = newV[i].transpose();
+      next.U.row(nv + i) = newU[i].transpose();
+    }
+    next.F = F;
+    mesh = std::move(next);
+  }
+  return mesh;
+}
+
+double MaxEdgeLength(const Mesh& mesh) {
+  double l = 0;
+  for (int f = 0; f < mesh.F.rows(); ++f)
+    for (int c = 0; c < 3; ++c)
+      l = std::max(l, (mesh.V.row(mesh.F(f, c)) - mesh.V.row(mesh.F(f, (c + 1) % 3))).norm());
+  return l;
+}
+
+double SurfaceArea(const Mesh& mesh) {
+  double a = 0;
+  for (int f = 0; f < mesh.F.rows(); ++f)
+    a += TriangleArea3(mesh.V.row(mesh.F(f, 0)), mesh.V.row(mesh.F(f, 1)), mesh.V.row(mesh.F(f, 2)));
+  return a;
+}
+
+double RestArea(const Mesh& mesh) {
+  double a = 0;
+  for (int f = 0; f < mesh.F.rows(); ++f)
+    a += TriangleArea2(mesh.U.row(mesh.F(f, 0)), mesh.U.row(mesh.F(f, 1)), mesh.U.row(mesh.F(f, 2)));
+  return a;
+}
+
+}  // namespace clothwind::sim

@@ -1,0 +1,156 @@
+#include "sim/mesh.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace clothwind::sim {
+namespace {
+
+std::string TempPath(const std::string& name) {
+  return ::testing::TempDir() + "/clothwind_mesh_test_" + name;
+}
+
+std::string WriteText(const std::string& name, const std::string& text) {
+  const std::string path = TempPath(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+// A 3 m x 2 m rectangle of two triangles, like ArcSim's coarse flag in spirit.
+Mesh Rectangle() {
+  Mesh m;
+  m.V.resize(4, 3);
+  m.V << 0, 0, 0, 3, 0, 0, 3, 2, 0, 0, 2, 0;
+  m.F.resize(2, 3);
+  m.F << 0, 1, 2, 0, 2, 3;
+  m.U = m.V.leftCols(2);
+  return m;
+}
+
+// Boundary edges as sets of position pairs (to compare across refinement).
+std::multiset<std::pair<int, int>> BoundaryEdges(const Mesh& m) {
+  std::map<std::pair<int, int>, int> count;
+  for (int f = 0; f < m.F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) ++count[std::minmax(m.F(f, c), m.F(f, (c + 1) % 3))];
+  std::multiset<std::pair<int, int>> out;
+  for (const auto& [e, n] : count)
+    if (n == 1) out.insert(e);
+  return out;
+}
+
+TEST(ObjTest, RoundTripIsExact) {
+  Mesh m = RefineMesh(Rectangle(), 0.8);
+  m.V.col(2) = m.V.col(0).array().sin() * 0.1;  // non-planar world positions, planar U
+  m.U *= 1.0 / 3.0;
+  const std::string path = TempPath("roundtrip.obj");
+  WriteObj(path, m);
+  const Mesh r = ReadObj(path);
+  EXPECT_EQ(r.V, m.V);
+  EXPECT_EQ(r.U, m.U);
+  EXPECT_EQ(r.F, m.F);
+  std::ifstream tmp(path + ".tmp");
+  EXPECT_FALSE(tmp.good()) << "temporary file left behind";
+}
+
+TEST(ObjTest, WithoutTextureCoordinatesRestShapeIsXY) {
+  const std::string path = WriteText("novt.obj",
+                                     "# comment\nv 0 0 5\nv 1 0 5\nv 1 1 5\nv 0 1 5\n"
+                                     "f 1 2 3 4\n");  // a quad: fan-triangulated
+  const Mesh m = ReadObj(path);
+  ASSERT_EQ(m.F.rows(), 2);
+  EXPECT_EQ(m.U(2, 0), 1.0);
+  EXPECT_EQ(m.U(2, 1), 1.0);
+  EXPECT_DOUBLE_EQ(RestArea(m), 1.0);
+}
+
+TEST(ObjTest, ReadsSlashFormsAndNegativeIndices) {
+  const std::string path = WriteText("slashes.obj",
+                                     "v 0 0 0\nv 2 0 0\nv 0 2 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                                     "vn 0 0 1\nf 1/1/1 2/2/1 -1/-1/1\n");
+  const Mesh m = ReadObj(path);
+  EXPECT_EQ(m.U(1, 0), 1.0);  // from vt, not from x
+  EXPECT_DOUBLE_EQ(SurfaceArea(m), 2.0);
+  EXPECT_DOUBLE_EQ(RestArea(m), 0.5);
+}
+
+void ExpectThrowContaining(const std::function<void()>& fn, const std::string& needle) {
+  try {
+    fn();
+    ADD_FAILURE() << "expected an exception containing '" << needle << "'";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(ObjTest, BadInputsFailWithFileAndLine) {
+  const std::string bad_index = WriteText("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n");
+  ExpectThrowContaining([&] { ReadObj(bad_index); }, bad_index + ":4: vertex index 7 out of range");
+  const std::string bad_number = WriteText("bad_number.obj", "v 0 0 0\nv 1 zero 0\n");
+  ExpectThrowContaining([&] { ReadObj(bad_number); }, bad_number + ":2:");
+  const std::string nan = WriteText("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+  ExpectThrowContaining([&] { ReadObj(nan); }, nan + ":2: non-finite");
+  const std::string degenerate = WriteText("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+  ExpectThrowContaining([&] { ReadObj(degenerate); }, "face 0 is degenerate");
+  ExpectThrowContaining([&] { ReadObj(TempPath("does_not_exist.obj")); }, "cannot open");
+  const std::string short_face = WriteText("short.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n");
+  ExpectThrowContaining([&] { ReadObj(short_face); }, short_face + ":3: a face needs at least 3");
+}
+
+TEST(ValidateMeshTest, RejectsNaNRangeAndDegenerate) {
+  Mesh m = Rectangle();
+  m.V(1, 2) = std::numeric_limits<double>::quiet_NaN();
+  ExpectThrowContaining([&] { ValidateMesh(m, "flag"); }, "flag: vertex 1 has a non-finite position");
+  m = Rectangle();
+  m.F(1, 2) = 9;
+  ExpectThrowContaining([&] { ValidateMesh(m); }, "face 1 has vertex index 9 out of range");
+  m = Rectangle();
+  m.U.row(2) = m.U.row(0);
+  ExpectThrowContaining([&] { ValidateMesh(m); }, "degenerate in material space");
+  m = Rectangle();
+  m.U.resize(3, 2);
+  ExpectThrowContaining([&] { ValidateMesh(m); }, "U has 3 rows");
+  EXPECT_NO_THROW(ValidateMesh(Rectangle()));
+}
+
+TEST(RefineMeshTest, PreservesAreaAndBoundaryAndBoundsEdges) {
+  Mesh m = Rectangle();
+  m.V.col(2) << 0, 0.5, 0.5, 0;  // a bent (but planar-per-triangle) world shape
+  const double area = SurfaceArea(m), rest = RestArea(m);
+  const Mesh r = RefineMesh(m, 0.25);
+  EXPECT_LE(MaxEdgeLength(r), 0.25);
+  EXPECT_NEAR(SurfaceArea(r), area, 1e-12 * area);
+  EXPECT_NEAR(RestArea(r), rest, 1e-12 * rest);
+  // Original vertices keep their indices and positions.
+  EXPECT_EQ(r.V.topRows(4), m.V);
+  // Every boundary vertex of the refined mesh lies on the original boundary (the rectangle's sides).
+  double perimeter = 0;
+  for (const auto& [a, b] : BoundaryEdges(r)) {
+    perimeter += (r.U.row(a) - r.U.row(b)).norm();
+    for (int v : {a, b}) {
+      const double u = r.U(v, 0), w = r.U(v, 1);
+      EXPECT_TRUE(std::abs(u) < 1e-12 || std::abs(u - 3) < 1e-12 || std::abs(w) < 1e-12 ||
+                  std::abs(w - 2) < 1e-12)
+          << "vertex " << v << " at " << u << ", " << w;
+    }
+  }
+  EXPECT_NEAR(perimeter, 10.0, 1e-12);
+  // Uniform 1-to-4: the face count is 2 * 4^levels, and vertices are shared (no duplicates).
+  EXPECT_EQ(r.F.rows() % 2, 0);
+  const int levels = static_cast<int>(std::round(std::log(r.F.rows() / 2.0) / std::log(4.0)));
+  EXPECT_EQ(r.F.rows(), 2 * (1 << (2 * levels)));
+  const int side = 1 << levels;
+  EXPECT_EQ(r.V.rows(), (side + 1) * (side + 1));
+  EXPECT_NO_THROW(ValidateMesh(r));
+  EXPECT_THROW(RefineMesh(m, 0.0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace clothwind::sim

@@ -1,0 +1,49 @@
+#ifndef CLOTHWIND_SIM_STRAIN_LIMITER_H_
+#define CLOTHWIND_SIM_STRAIN_LIMITER_H_
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "sim/mesh.h"
+
+namespace clothwind::sim {
+
+// Keeps every face's principal stretches (the singular values of its deformation gradient) within
+// [strain_min, strain_max], as ArcSim's strain limiting does, but by a few Gauss-Seidel sweeps of
+// per-face projections instead of ArcSim's global constrained optimisation (43 % of its run time):
+// a face out of limits is replaced by the closest (mass-weighted, rotation kept) shape whose
+// stretches are clamped to the limits; pinned vertices do not move. The same position change,
+// divided by the time step, is added to the velocities (ArcSim updates velocities likewise).
+class StrainLimiter {
+ public:
+  // Inputs:
+  //   mesh    F and U (rest coordinates) are used
+  //   mass    #V node masses [kg]
+  //   pinned  #V flags (non-zero: vertex does not move)
+  StrainLimiter(const Mesh& mesh, const Eigen::VectorXd& mass, const std::vector<char>& pinned);
+
+  // Inputs:
+  //   strain_min, strain_max  limits on principal stretches (0 / inf: that side off)
+  //   iterations              sweeps (stops early once every face is within limits)
+  //   dt                      time step [s] (> 0) for the velocity update
+  //   x, v                    #V by 3 positions [m] and velocities [m/s], updated in place
+  // Returns the number of faces that were outside the limits before projection.
+  int Project(double strain_min, double strain_max, int iterations, double dt, Eigen::MatrixX3d* x,
+              Eigen::MatrixX3d* v);
+
+ private:
+  struct Face {
+    int v[3];
+    Eigen::Matrix2d Dm_inv;
+    double w[3];            // projection weights (masses; huge for pinned vertices)
+    bool pinned[3];
+    Eigen::Vector2d du[3];  // u_i - weighted centroid of u
+  };
+  std::vector<Face> faces_;
+  Eigen::MatrixX3d before_;
+};
+
+}  // namespace clothwind::sim
+
+#endif  // CLOTHWIND_SIM_STRAIN_LIMITER_H_
