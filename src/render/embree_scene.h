@@ -1,0 +1,85 @@
+#ifndef CLOTHWIND_RENDER_EMBREE_SCENE_H_
+#define CLOTHWIND_RENDER_EMBREE_SCENE_H_
+
+#include <embree3/rtcore.h>
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "render/render_params.h"
+
+namespace clothwind::render {
+
+// What a ray hit.
+enum class Surface { kNone, kCloth, kPole, kFinial, kGround };
+
+struct Hit {
+  Surface surface = Surface::kNone;
+  float t = 0.0f;                 // [m] along the (unit) ray
+  Eigen::Vector3f point;          // [m] world
+  Eigen::Vector3f normal;         // unit shading normal, facing the ray's origin side
+  Eigen::Vector3f geom_normal;    // unit geometric normal, facing the ray's origin side
+  Eigen::Vector2f uv;             // cloth texture coordinates (cloth only)
+  bool back_face = false;         // cloth: the ray hit the side opposite the vertex normals
+};
+
+// The Embree scene of one clip: the cloth (updated every frame), a pole with a ball on top
+// (flag) or a rod on two posts (cloth), and the ground plane z = 0.
+//
+// The cloth comes as plain arrays in the simulator's frame (z up, hoist on the z axis, wind
+// along +x); the scene lifts it by p.mesh_height. Its BVH is refitted each frame when the
+// faces stay the same (the common case); new faces (remeshing) rebuild it.
+class EmbreeScene {
+ public:
+  // Inputs: p  render parameters (scene kind, mesh size and height).
+  explicit EmbreeScene(const RenderParams& p);
+  ~EmbreeScene();
+  EmbreeScene(const EmbreeScene&) = delete;
+  EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+  // Sets the cloth for the next frames.
+  // Inputs:
+  //   V   #V by 3 vertex positions [m], simulator frame
+  //   F   #F by 3 vertex indices (counter-clockwise seen from the front of the texture)
+  //   UV  #V by 2 texture coordinates in [0,1] (u from hoist to fly, v from bottom to top)
+  // Throws std::invalid_argument on mismatched sizes or out-of-range indices.
+  void SetCloth(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Eigen::MatrixXd& UV);
+
+  // Intersects a ray. Inputs: org [m], dir (unit), t_max [m]. Outputs: hit.
+  // Returns true if anything was hit before t_max.
+  bool Intersect(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t_max,
+                 Hit* hit) const;
+
+  // True if anything blocks the segment org + t dir, t in (0, t_max).
+  bool Occluded(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t_max) const;
+
+  // Per-vertex unit normals of the current cloth (#V by 3, world frame): area-weighted face
+  // normals, recomputed on every SetCloth.
+  const std::vector<Eigen::Vector3f>& cloth_normals() const { return normals_; }
+
+ private:
+  struct Cylinder {
+    unsigned geom_id;
+    Eigen::Vector3f a, axis;  // start point, unit axis
+  };
+  void AddCylinder(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float radius);
+  void AddGround();
+  void AddSphere(const Eigen::Vector3f& c, float radius);
+
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+  RTCGeometry cloth_ = nullptr;
+  unsigned cloth_id_ = RTC_INVALID_GEOMETRY_ID;
+  unsigned ground_id_ = RTC_INVALID_GEOMETRY_ID;
+  unsigned sphere_id_ = RTC_INVALID_GEOMETRY_ID;
+  std::vector<Cylinder> cylinders_;
+  float lift_ = 0.0f;  // mesh_height [m]
+  std::vector<Eigen::Vector3f> positions_;  // world, current frame
+  std::vector<Eigen::Vector3f> normals_;
+  std::vector<Eigen::Vector2f> uvs_;
+  std::vector<unsigned> faces_;  // 3 per face
+};
+
+}  // namespace clothwind::render
+
+#endif  // CLOTHWIND_RENDER_EMBREE_SCENE_H_

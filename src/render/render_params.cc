@@ -1,0 +1,197 @@
+#include "render/render_params.h"
+
+#include <stdexcept>
+
+#include "render/fabric_patterns.h"
+#include "render/flag_designs.h"
+#include "render/random.h"
+
+namespace clothwind::render {
+
+std::string SceneKindName(SceneKind kind) { return kind == SceneKind::kFlag ? "flag" : "cloth"; }
+
+SceneKind SceneKindFromName(const std::string& name) {
+  if (name == "flag") return SceneKind::kFlag;
+  if (name == "cloth") return SceneKind::kCloth;
+  throw std::invalid_argument("render params: field 'scene' is '" + name +
+                              "', expected 'flag' or 'cloth'");
+}
+
+RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
+                                const std::vector<std::string>& background_images) {
+  Rng rng(HashSeed(seed, 0x2e7a));
+  RenderParams p;
+  p.scene = kind;
+  p.seed = seed;
+  if (!background_images.empty())
+    p.background_image = background_images[rng.UniformInt(static_cast<int>(background_images.size()))];
+  p.background_seed = rng.Next();
+  p.background_offset = rng.Uniform(-20, 20);
+  p.background_scale = rng.Uniform(0.6, 1.0);
+  p.sun_height = rng.Uniform(4, 10);
+  p.sun_radius = rng.Uniform(0, 5);
+  p.sun_azimuth_deg = rng.Uniform(-180, 180);
+  p.sun_strength = rng.Uniform(2, 10);
+  p.sun_shadow_soft_size = rng.Uniform(2, 10);
+  p.sky_strength = rng.Uniform(0.7, 1.3);
+  p.texture_seed = rng.Next();
+  if (kind == SceneKind::kFlag) {
+    p.camera_height = rng.Uniform(0.2, 3);
+    p.camera_radius = rng.Uniform(4, 6);
+    p.camera_angle_deg = rng.Uniform(-15, 15);
+    p.camera_fov_deg = 50.0;
+    p.mesh_height = 4.6;
+    p.mesh_width = 3.0;
+    p.mesh_aspect_ratio = 1.5;
+    p.texture_kind = "flag";
+    p.texture_name = FlagDesignName(static_cast<FlagDesign>(rng.UniformInt(kNumFlagDesigns)));
+  } else {
+    p.camera_height = rng.Uniform(0.5, 2);
+    p.camera_radius = rng.Uniform(1, 2.5);
+    p.camera_angle_deg = rng.Uniform(-5, 5);
+    p.camera_fov_deg = 50.0;
+    p.mesh_height = 2.0;
+    p.mesh_width = 1.0;
+    p.mesh_aspect_ratio = 1.0;
+    p.texture_kind = "fabric";
+    p.texture_name =
+        FabricPatternName(static_cast<FabricPattern>(rng.UniformInt(kNumFabricPatterns)));
+  }
+  return p;
+}
+
+nlohmann::json ToJson(const RenderParams& p) {
+  return nlohmann::json{
+      {"scene", SceneKindName(p.scene)},
+      {"seed", p.seed},
+      {"background_image", p.background_image},
+      {"background_seed", p.background_seed},
+      {"background_offset", p.background_offset},
+      {"background_scale", p.background_scale},
+      {"sun_height", p.sun_height},
+      {"sun_radius", p.sun_radius},
+      {"sun_azimuth_deg", p.sun_azimuth_deg},
+      {"sun_strength", p.sun_strength},
+      {"sun_shadow_soft_size", p.sun_shadow_soft_size},
+      {"sky_strength", p.sky_strength},
+      {"samples", p.samples},
+      {"camera_height", p.camera_height},
+      {"camera_radius", p.camera_radius},
+      {"camera_angle_deg", p.camera_angle_deg},
+      {"camera_fov_deg", p.camera_fov_deg},
+      {"mesh_height", p.mesh_height},
+      {"mesh_width", p.mesh_width},
+      {"mesh_aspect_ratio", p.mesh_aspect_ratio},
+      {"texture_kind", p.texture_kind},
+      {"texture_name", p.texture_name},
+      {"texture_seed", p.texture_seed},
+      {"width", p.width},
+      {"height", p.height},
+      {"fps", p.fps},
+  };
+}
+
+namespace {
+const nlohmann::json& Field(const nlohmann::json& j, const char* name) {
+  if (!j.is_object()) throw std::invalid_argument("render params: expected a JSON object");
+  auto it = j.find(name);
+  if (it == j.end())
+    throw std::invalid_argument(std::string("render params: missing field '") + name + "'");
+  return *it;
+}
+double Number(const nlohmann::json& j, const char* name) {
+  const auto& f = Field(j, name);
+  if (!f.is_number())
+    throw std::invalid_argument(std::string("render params: field '") + name +
+                                "' must be a number, got " + f.dump());
+  return f.get<double>();
+}
+uint64_t Unsigned(const nlohmann::json& j, const char* name) {
+  const auto& f = Field(j, name);
+  if (!f.is_number_unsigned())
+    throw std::invalid_argument(std::string("render params: field '") + name +
+                                "' must be a non-negative integer, got " + f.dump());
+  return f.get<uint64_t>();
+}
+int Integer(const nlohmann::json& j, const char* name) {
+  const auto& f = Field(j, name);
+  if (!f.is_number_integer())
+    throw std::invalid_argument(std::string("render params: field '") + name +
+                                "' must be an integer, got " + f.dump());
+  return f.get<int>();
+}
+std::string String(const nlohmann::json& j, const char* name) {
+  const auto& f = Field(j, name);
+  if (!f.is_string())
+    throw std::invalid_argument(std::string("render params: field '") + name +
+                                "' must be a string, got " + f.dump());
+  return f.get<std::string>();
+}
+void Require(bool ok, const char* field, const std::string& expected, double value) {
+  if (!ok)
+    throw std::invalid_argument(std::string("render params: field '") + field + "' is " +
+                                std::to_string(value) + ", expected " + expected);
+}
+}  // namespace
+
+RenderParams RenderParamsFromJson(const nlohmann::json& j) {
+  RenderParams p;
+  p.scene = SceneKindFromName(String(j, "scene"));
+  p.seed = Unsigned(j, "seed");
+  p.background_image = String(j, "background_image");
+  p.background_seed = Unsigned(j, "background_seed");
+  p.background_offset = Number(j, "background_offset");
+  p.background_scale = Number(j, "background_scale");
+  p.sun_height = Number(j, "sun_height");
+  p.sun_radius = Number(j, "sun_radius");
+  p.sun_azimuth_deg = Number(j, "sun_azimuth_deg");
+  p.sun_strength = Number(j, "sun_strength");
+  p.sun_shadow_soft_size = Number(j, "sun_shadow_soft_size");
+  p.sky_strength = Number(j, "sky_strength");
+  p.samples = Integer(j, "samples");
+  p.camera_height = Number(j, "camera_height");
+  p.camera_radius = Number(j, "camera_radius");
+  p.camera_angle_deg = Number(j, "camera_angle_deg");
+  p.camera_fov_deg = Number(j, "camera_fov_deg");
+  p.mesh_height = Number(j, "mesh_height");
+  p.mesh_width = Number(j, "mesh_width");
+  p.mesh_aspect_ratio = Number(j, "mesh_aspect_ratio");
+  p.texture_kind = String(j, "texture_kind");
+  p.texture_name = String(j, "texture_name");
+  p.texture_seed = Unsigned(j, "texture_seed");
+  p.width = Integer(j, "width");
+  p.height = Integer(j, "height");
+  p.fps = Number(j, "fps");
+  ValidateRenderParams(p);
+  return p;
+}
+
+void ValidateRenderParams(const RenderParams& p) {
+  Require(p.background_scale > 0, "background_scale", "> 0", p.background_scale);
+  Require(p.sun_height > 0, "sun_height", "> 0 (the sun must be above the ground)", p.sun_height);
+  Require(p.sun_radius >= 0, "sun_radius", ">= 0", p.sun_radius);
+  Require(p.sun_strength >= 0, "sun_strength", ">= 0", p.sun_strength);
+  Require(p.sun_shadow_soft_size >= 0 && p.sun_shadow_soft_size < 90, "sun_shadow_soft_size",
+          "in [0, 90) degrees", p.sun_shadow_soft_size);
+  Require(p.sky_strength >= 0, "sky_strength", ">= 0", p.sky_strength);
+  Require(p.samples >= 1 && p.samples <= 1024, "samples", "in [1, 1024]", p.samples);
+  Require(p.camera_height > 0, "camera_height", "> 0", p.camera_height);
+  Require(p.camera_radius > 0, "camera_radius", "> 0", p.camera_radius);
+  Require(p.camera_fov_deg > 1 && p.camera_fov_deg < 170, "camera_fov_deg", "in (1, 170)",
+          p.camera_fov_deg);
+  Require(p.mesh_height >= 0, "mesh_height", ">= 0", p.mesh_height);
+  Require(p.mesh_width > 0, "mesh_width", "> 0", p.mesh_width);
+  Require(p.mesh_aspect_ratio > 0, "mesh_aspect_ratio", "> 0", p.mesh_aspect_ratio);
+  Require(p.width > 0 && p.width <= 8192, "width", "in [1, 8192]", p.width);
+  Require(p.height > 0 && p.height <= 8192, "height", "in [1, 8192]", p.height);
+  Require(p.fps > 0, "fps", "> 0", p.fps);
+  if (p.texture_kind == "flag")
+    FlagDesignFromName(p.texture_name);
+  else if (p.texture_kind == "fabric")
+    FabricPatternFromName(p.texture_name);
+  else
+    throw std::invalid_argument("render params: field 'texture_kind' is '" + p.texture_kind +
+                                "', expected 'flag' or 'fabric'");
+}
+
+}  // namespace clothwind::render

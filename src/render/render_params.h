@@ -1,0 +1,89 @@
+#ifndef CLOTHWIND_RENDER_RENDER_PARAMS_H_
+#define CLOTHWIND_RENDER_RENDER_PARAMS_H_
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace clothwind::render {
+
+// Which of the seed's two datasets a clip belongs to: FlagSim (3:2 flag on a pole) or
+// ClothSim (1:1 cloth hanging from a rod).
+enum class SceneKind { kFlag, kCloth };
+
+std::string SceneKindName(SceneKind kind);                // "flag" | "cloth"
+SceneKind SceneKindFromName(const std::string& name);     // throws on anything else
+
+// The render parameters ζ of one clip (seed Table 2), plus the few choices Table 2 leaves
+// open (sun azimuth, sky strength, field of view, texture colours), so that a clip is
+// reproducible from label.json alone. Lengths in metres, angles in degrees.
+struct RenderParams {
+  SceneKind scene = SceneKind::kFlag;
+  uint64_t seed = 0;  // pixel-sampling seed (anti-aliasing and shadow sample positions)
+
+  // Background (Table 2: background_image, background_offset, background_scale). An empty
+  // background_image means a procedural outdoor backdrop drawn from background_seed.
+  std::string background_image;
+  uint64_t background_seed = 0;
+  double background_offset = 0.0;  // [m] lateral shift of the backdrop, ~U(-20, 20)
+  double background_scale = 1.0;   // backdrop size factor, ~U(0.6, 1.0)
+
+  // Sun (Table 2). The sun is a distant disc light whose direction points from the mesh's foot
+  // (the ground point below the mesh's centre) to (sun_radius, sun_azimuth, sun_height).
+  double sun_height = 7.0;        // [m] ~U(4, 10)
+  double sun_radius = 2.5;        // [m] ~U(0, 5)
+  double sun_azimuth_deg = 0.0;   // [deg] from +x (downwind) counter-clockwise; ~U(-180, 180)
+  double sun_strength = 5.0;      // irradiance [W/m^2 in Blender's units], ~U(2, 10)
+  double sun_shadow_soft_size = 5.0;  // [deg] angular diameter of the sun disc, ~U(2, 10)
+  double sky_strength = 1.0;      // ambient sky irradiance factor, ~U(0.7, 1.3)
+
+  int samples = 4;  // anti-aliasing samples per pixel (each with one shadow ray)
+
+  // Camera (Table 2): on a circle of radius camera_radius about the mesh's centre, at
+  // camera_height above ground, camera_angle degrees off the side-on view, looking at the
+  // mesh's centre.
+  double camera_height = 1.6;     // [m] flag ~U(0.2, 3), cloth ~U(0.5, 2)
+  double camera_radius = 5.0;     // [m] horizontal distance, flag ~U(4, 6), cloth ~U(1, 2.5)
+  double camera_angle_deg = 0.0;  // [deg] flag ~U(-15, 15), cloth ~U(-5, 5)
+  double camera_fov_deg = 50.0;   // [deg] horizontal = vertical field of view (square frame)
+
+  // Mesh (Table 2): the simulator's frame is lifted by mesh_height (its origin, the hoist's
+  // lower corner for flags, goes to that height above the ground).
+  double mesh_height = 4.6;       // [m] flag 4.6, cloth 2
+  double mesh_width = 3.0;        // [m] length of the flag / width of the cloth at rest
+  double mesh_aspect_ratio = 1.5; // width : height, flag 3:2, cloth 1:1
+
+  // Texture (Table 2 mesh_texture): kind "flag" with a FlagDesign name, or kind "fabric" with a
+  // FabricPattern name; texture_seed picks its colours.
+  std::string texture_kind = "flag";
+  std::string texture_name = "vertical_tricolour";
+  uint64_t texture_seed = 0;
+
+  // Frame format of the seed's data: 300x300 RGB at 25 fps.
+  int width = 300;
+  int height = 300;
+  double fps = 25.0;
+
+  // Mesh height at rest [m] (mesh_width / mesh_aspect_ratio).
+  double MeshRestHeight() const { return mesh_width / mesh_aspect_ratio; }
+};
+
+// Draws ζ from the ranges of seed Table 2 for the given scene kind.
+// Inputs: kind; seed  everything drawn follows from it; background_images  candidate files
+//   (one is picked by seed); empty means procedural backdrops.
+RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
+                                const std::vector<std::string>& background_images = {});
+
+// JSON round trip (for label.json). FromJson requires every field and names the one that is
+// missing or of the wrong type (std::invalid_argument).
+nlohmann::json ToJson(const RenderParams& p);
+RenderParams RenderParamsFromJson(const nlohmann::json& j);
+
+// Checks the values are usable (positive sizes, samples >= 1, known texture, ...); throws
+// std::invalid_argument naming the field and the expected range.
+void ValidateRenderParams(const RenderParams& p);
+
+}  // namespace clothwind::render
+
+#endif  // CLOTHWIND_RENDER_RENDER_PARAMS_H_

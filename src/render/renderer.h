@@ -1,0 +1,87 @@
+#ifndef CLOTHWIND_RENDER_RENDERER_H_
+#define CLOTHWIND_RENDER_RENDERER_H_
+
+#include <Eigen/Core>
+#include <memory>
+#include <opencv2/core.hpp>
+
+#include "render/background.h"
+#include "render/camera.h"
+#include "render/embree_scene.h"
+#include "render/lighting.h"
+#include "render/render_params.h"
+#include "render/texture.h"
+
+namespace clothwind::render {
+
+struct RenderOptions {
+  int threads = 0;       // worker threads for the pixels; 0 = all the machine has
+  bool shadows = true;   // trace shadow rays (off: every surface sees the whole sun)
+  float translucency = 0.2f;  // fraction of light on one side of the cloth seen on the other
+};
+
+// Renders clips of one parameter set ζ: a direct-lighting ray tracer on Embree (camera rays,
+// one shadow ray to a point of the sun disc per sample, analytic sky/ground ambient), which
+// for these open outdoor scenes looks like Cycles' image at a small fraction of its cost.
+//
+// Build one Renderer per clip (textures, backdrop and static geometry are made once), then
+// call RenderLinear/RenderFrame for each frame's mesh. Not thread-safe itself; it uses
+// RenderOptions::threads workers inside each call. Images depend only on ζ and the mesh
+// (pixel samples come from HashSeed(ζ.seed, x, y)), not on the thread count.
+class Renderer {
+ public:
+  // Throws std::invalid_argument on invalid ζ and std::runtime_error if a background image
+  // cannot be read.
+  explicit Renderer(const RenderParams& p, const RenderOptions& options = RenderOptions());
+
+  // Renders scene radiance (linear RGB, CV_32FC3 in R,G,B order, height by width).
+  // Inputs:
+  //   V   #V by 3 cloth vertex positions [m] in the simulator's frame (z up, hoist on the
+  //       z axis from z = 0, wind along +x); lifted by ζ.mesh_height here
+  //   F   #F by 3 faces (vertex indices)
+  //   UV  #V by 2 texture coordinates in [0,1] (u hoist to fly, v bottom to top)
+  cv::Mat RenderLinear(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                       const Eigen::MatrixXd& UV);
+
+  // RenderLinear followed by Develop: an 8-bit frame (CV_8UC3, OpenCV's B,G,R order).
+  cv::Mat RenderFrame(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                      const Eigen::MatrixXd& UV);
+
+  // Radiance along one ray through the current scene (after RenderLinear/SetCloth).
+  // Inputs: org [m]; dir unit; sun_u1, sun_u2 in [0,1): which point of the sun disc the shadow
+  //   ray aims at.
+  Rgb Trace(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float sun_u1,
+            float sun_u2) const;
+
+  const RenderParams& params() const { return params_; }
+  const PinholeCamera& camera() const { return camera_; }
+  const Lighting& lighting() const { return lighting_; }
+  const Texture& cloth_texture() const { return texture_; }
+  const Backdrop& backdrop() const { return backdrop_; }
+  EmbreeScene& scene() { return *scene_; }
+  RenderOptions& options() { return options_; }
+
+ private:
+  Rgb Shade(const Hit& hit, const Eigen::Vector3f& dir, float sun_u1, float sun_u2) const;
+  Rgb GroundAlbedo(const Eigen::Vector3f& p) const;
+
+  RenderParams params_;
+  RenderOptions options_;
+  PinholeCamera camera_;
+  Lighting lighting_;
+  Texture texture_;
+  Texture grass_;
+  Backdrop backdrop_;
+  std::unique_ptr<EmbreeScene> scene_;
+};
+
+// Film response and sRGB encoding of a radiance image (CV_32FC3 RGB) into an 8-bit frame
+// (CV_8UC3 BGR), per channel: ToSrgb8(Tone(L)).
+cv::Mat Develop(const cv::Mat& linear_rgb);
+
+// The cloth texture ζ names (flag design or fabric pattern with ζ.texture_seed's colours).
+Texture MakeClothTexture(const RenderParams& p);
+
+}  // namespace clothwind::render
+
+#endif  // CLOTHWIND_RENDER_RENDERER_H_

@@ -1,0 +1,56 @@
+#ifndef CLOTHWIND_RENDER_SENSOR_MODEL_H_
+#define CLOTHWIND_RENDER_SENSOR_MODEL_H_
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace clothwind::render {
+
+// What happens between the scene's light and the saved frame in a real camera, with each
+// effect switchable (all off by default, which gives exactly Develop() of one render) for the
+// sim-to-real work: exposure motion blur, sensor noise, JPEG compression.
+struct SensorModelParams {
+  // Exposure motion blur: the caller renders `subframes` meshes spread over the exposure time
+  // and the model averages their radiance. Off: only the middle sub-frame is used.
+  bool motion_blur = false;
+  int subframes = 1;  // how many sub-frames the caller should render when motion_blur is on
+
+  // Noise on the developed (display-linear, 0..1) signal y: Gaussian with variance
+  // y / full_well (shot noise; full_well = photo-electrons at white) + read_noise^2.
+  bool noise = false;
+  double full_well = 4000.0;
+  double read_noise = 0.004;
+
+  // JPEG: 0 = off; 1..100 encodes and decodes the frame at that quality (the seed's data are
+  // JPEG frames, so a learner sees block artefacts unless trained without).
+  int jpeg_quality = 0;
+};
+
+nlohmann::json ToJson(const SensorModelParams& s);
+// Throws std::invalid_argument naming a missing/mistyped field or an out-of-range value.
+SensorModelParams SensorModelParamsFromJson(const nlohmann::json& j);
+
+// Turns the radiance of one frame into its 8-bit image.
+// Inputs:
+//   linear_subframes  one or more radiance images (CV_32FC3 RGB, equal sizes) spread over the
+//                     exposure, in time order
+//   s                 the effects
+//   seed              noise seed (e.g. HashSeed(clip seed, frame index))
+// Returns CV_8UC3 (B,G,R order). Throws std::invalid_argument on empty or mismatched input.
+cv::Mat ApplySensorModel(const std::vector<cv::Mat>& linear_subframes,
+                         const SensorModelParams& s, uint64_t seed);
+
+// Encodes an 8-bit frame as ".jpg" (quality 1..100) or ".png" bytes.
+std::vector<uint8_t> EncodeFrame(const cv::Mat& bgr8, const std::string& ext, int jpeg_quality = 95);
+
+// Writes an 8-bit frame atomically (temporary name in the same folder, then rename); the
+// format follows the extension of `path` (.jpg/.jpeg/.png). Throws std::runtime_error naming
+// the path on failure.
+void WriteFrameAtomic(const std::string& path, const cv::Mat& bgr8, int jpeg_quality = 95);
+
+}  // namespace clothwind::render
+
+#endif  // CLOTHWIND_RENDER_SENSOR_MODEL_H_
