@@ -1,0 +1,256 @@
+#include "sim/scene.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "sim/scene_builder.h"
+
+namespace clothwind::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string SourceDir() {
+  const char* s = std::getenv("CLOTHWIND_SOURCE_DIR");
+  return s ? s : ".";
+}
+
+std::string SharedDir() {
+  const char* s = std::getenv("CLOTHWIND_SHARED_DIR");
+  return s ? s : "";
+}
+
+struct Warnings {
+  std::vector<std::string> list;
+  WarningSink sink() {
+    return [this](const std::string& m) { list.push_back(m); };
+  }
+};
+
+// Expects `f` to throw std::runtime_error whose message contains every one of `parts`.
+template <typename F>
+void ExpectErrorNaming(F f, const std::vector<std::string>& parts) {
+  try {
+    f();
+    ADD_FAILURE() << "expected an error naming " << parts.front();
+  } catch (const std::runtime_error& e) {
+    for (const auto& p : parts) {
+      EXPECT_NE(std::string(e.what()).find(p), std::string::npos)
+          << "error \"" << e.what() << "\" does not name \"" << p << "\"";
+    }
+  }
+}
+
+// A scratch ArcSim-like tree: <root>/conf/*.json, <root>/meshes/*.obj.
+class SceneFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() /
+            ("clothwind_scene_test_" + std::to_string(::getpid()) + "_" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(root_ / "conf");
+    fs::create_directories(root_ / "meshes");
+    Write("meshes/quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
+    material_ = SourceDir() + "/config/materials/camel-ponte-roma.json";
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  std::string Write(const std::string& rel, const std::string& text) {
+    const fs::path p = root_ / rel;
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  // A valid scene with `extra` spliced into the top-level object and `material` as the entry.
+  std::string SceneText(const std::string& extra = "", const std::string& cloth_extra = "",
+                        const std::string& handles = "[0, 3]") const {
+    return "{\n"
+           "  \"frame_time\": 0.04, \"frame_steps\": 4, \"duration\": 1,\n"
+           "  \"cloths\": [{\"mesh\": \"meshes/quad.obj\", " + cloth_extra +
+           "    \"materials\": [{\"data\": \"" + material_ + "\", \"thicken\": 2}]}],\n"
+           "  \"handles\": [{\"nodes\": " + handles + "}],\n"
+           "  \"gravity\": [0, 0, -9.8]" + extra + "\n}\n";
+  }
+
+  fs::path root_;
+  std::string material_;
+};
+
+TEST(LoadScene, ReadsArcSimsOwnFlagScene) {
+  const std::string shared = SharedDir();
+  const std::string path = shared + "/arcsim/conf/flag.json";
+  if (shared.empty() || !fs::exists(path)) GTEST_SKIP() << "no " << path;
+  Warnings w;
+  const Scene s = LoadScene(path, w.sink());
+  EXPECT_TRUE(w.list.empty()) << w.list.front();
+  EXPECT_DOUBLE_EQ(s.frame_time, 0.04);
+  EXPECT_EQ(s.frame_steps, 8);
+  EXPECT_DOUBLE_EQ(s.time_step(), 0.005);
+  EXPECT_DOUBLE_EQ(s.duration, 20);
+  ASSERT_EQ(s.cloths.size(), 1u);
+  EXPECT_EQ(fs::path(s.cloths[0].mesh), fs::path(shared + "/arcsim/meshes/flag.obj").lexically_normal());
+  EXPECT_DOUBLE_EQ(s.cloths[0].transform.rotate_deg, 120);
+  EXPECT_EQ(s.cloths[0].transform.rotate_axis, Eigen::Vector3d(1, 1, 1));
+  ASSERT_EQ(s.cloths[0].materials.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.cloths[0].materials[0].thicken, 2);
+  EXPECT_DOUBLE_EQ(s.cloths[0].materials[0].strain_min, 0.95);
+  EXPECT_DOUBLE_EQ(s.cloths[0].materials[0].strain_max, 1.05);
+  EXPECT_DOUBLE_EQ(s.cloths[0].remeshing.size_min, 0.02);
+  EXPECT_DOUBLE_EQ(s.cloths[0].remeshing.size_max, 0.5);
+  ASSERT_EQ(s.handles.size(), 1u);
+  EXPECT_EQ(s.handles[0].nodes, (std::vector<int>{0, 3}));
+  EXPECT_EQ(s.gravity, Eigen::Vector3d(0, 0, -9.8));
+  EXPECT_EQ(s.wind.velocity, Eigen::Vector3d(10, 0, 0));
+  EXPECT_DOUBLE_EQ(s.wind.density, 1.0);  // ArcSim's defaults
+  EXPECT_DOUBLE_EQ(s.wind.drag, 0.0);
+  EXPECT_DOUBLE_EQ(s.magic.repulsion_thickness, 0.01);
+  EXPECT_DOUBLE_EQ(s.magic.collision_stiffness, 1e6);
+}
+
+TEST(BuildScene, ArcSimFlagHangsInTheYZPlaneWithTheHoistOnTheZAxis) {
+  const std::string path = SharedDir() + "/arcsim/conf/flag.json";
+  if (SharedDir().empty() || !fs::exists(path)) GTEST_SKIP() << "no " << path;
+  const SceneSetup setup = BuildScene(LoadScene(path));
+  ASSERT_EQ(setup.cloths.size(), 1u);
+  const ClothSetup& c = setup.cloths[0];
+  EXPECT_EQ(c.original_vertices, 58);
+  EXPECT_NEAR(c.max_edge, 0.1, 1e-12);  // sqrt(0.02 * 0.5)
+  EXPECT_LE(MaxEdgeLength(c.mesh), 0.1 + 1e-9);
+  EXPECT_NEAR(SurfaceArea(c.mesh), 6.0, 1e-9);
+  EXPECT_NEAR(RestArea(c.mesh), 6.0, 1e-9);
+  EXPECT_LT(c.mesh.V.col(0).cwiseAbs().maxCoeff(), 1e-9);  // x = 0: the y-z plane
+  EXPECT_LT((c.mesh.V.row(0) - Eigen::RowVector3d(0, 0, 0)).norm(), 1e-9);
+  EXPECT_LT((c.mesh.V.row(3) - Eigen::RowVector3d(0, 0, 2)).norm(), 1e-9);  // hoist top
+  EXPECT_LT((c.mesh.V.row(1) - Eigen::RowVector3d(0, 3, 0)).norm(), 1e-9);  // fly bottom
+  EXPECT_EQ(c.options.handles, (std::vector<int>{0, 3}));
+  EXPECT_NEAR(c.material.density, 2 * 0.284, 1e-12);
+  EXPECT_DOUBLE_EQ(c.options.dt, 0.005);
+  EXPECT_DOUBLE_EQ(c.options.strain_min, 0.95);
+  EXPECT_DOUBLE_EQ(c.options.strain_max, 1.05);
+  EXPECT_DOUBLE_EQ(c.options.wind_density, 1.0);
+  EXPECT_EQ(setup.wind.velocity, Eigen::Vector3d(10, 0, 0));
+}
+
+TEST(LoadScene, ReadsOurFlagAndClothScenes) {
+  Warnings w;
+  const Scene flag = LoadScene(SourceDir() + "/config/scenes/flag.json", w.sink());
+  const Scene cloth = LoadScene(SourceDir() + "/config/scenes/cloth.json", w.sink());
+  EXPECT_TRUE(w.list.empty()) << w.list.front();
+  EXPECT_EQ(flag.gravity, Eigen::Vector3d(0, 0, -9.81));  // Listing 1
+  EXPECT_EQ(cloth.wind.velocity.z(), 0.0);                // Listing 2: horizontal wind
+  const SceneSetup f = BuildScene(flag);
+  EXPECT_NEAR(f.cloths[0].material.density, 2 * 0.135, 1e-12);  // Listing 3 x thicken 2
+  EXPECT_NEAR(SurfaceArea(f.cloths[0].mesh), 6.0, 1e-9);
+  EXPECT_LT((f.cloths[0].mesh.V.row(3) - Eigen::RowVector3d(0, 0, 2)).norm(), 1e-9);
+  const SceneSetup c = BuildScene(cloth, BuildOptions{0.25});
+  EXPECT_NEAR(SurfaceArea(c.cloths[0].mesh), 1.0, 1e-9);
+  EXPECT_LE(MaxEdgeLength(c.cloths[0].mesh), 0.25 + 1e-9);
+  // Handles 2 and 3 are the top corners (z = 1).
+  for (int n : c.cloths[0].options.handles) EXPECT_NEAR(c.cloths[0].mesh.V(n, 2), 1.0, 1e-9);
+}
+
+TEST_F(SceneFiles, ValidSceneWithCommentsTransformAndExtensions) {
+  Warnings w;
+  const std::string path = Write(
+      "conf/s.json",
+      "// comment line\n" +
+          SceneText(",\n /* wind with our extensions */ \"wind\": {\"velocity\": [2, 0, 0],"
+                    " \"drag\": 0.5, \"turbulence\": {\"intensity\": 0.1, \"length_scale\": 30,"
+                    " \"seed\": 4}, \"gusts\": {\"rate\": 0.1, \"amplitude\": 1.5},"
+                    " \"shear\": {\"profile\": \"log\", \"roughness\": 0.05}}",
+                    "\"transform\": {\"translate\": [1, 2, 3], \"rotate\": [90, 0, 0, 1],"
+                    " \"scale\": 2},"));
+  const Scene s = LoadScene(path, w.sink());
+  EXPECT_TRUE(w.list.empty());
+  EXPECT_DOUBLE_EQ(s.wind.drag, 0.5);
+  EXPECT_DOUBLE_EQ(s.wind.turbulence.intensity, 0.1);
+  EXPECT_EQ(s.wind.turbulence.seed, 4u);
+  EXPECT_EQ(s.wind.shear.kind, ShearProfile::Kind::kLog);
+  // Found in the scene folder's parent (ArcSim's root), as ArcSim's relative paths are.
+  EXPECT_EQ(fs::path(s.cloths[0].mesh), (root_ / "meshes/quad.obj").lexically_normal());
+  const SceneSetup setup = BuildScene(s);
+  const Mesh& m = setup.cloths[0].mesh;
+  // x -> translate + Rz(90) (2 x): (1, 0, 0) -> (1, 2 + 2, 3).
+  EXPECT_LT((m.V.row(1) - Eigen::RowVector3d(1, 4, 3)).norm(), 1e-9);
+  EXPECT_NEAR(RestArea(m), 4.0, 1e-9);  // rest shape scaled too
+}
+
+TEST_F(SceneFiles, UnknownKeysWarnNamingKeyAndFile) {
+  Warnings w;
+  const std::string path = Write("conf/s.json", SceneText(", \"gravityy\": [0, 0, 1], \"obstacles\": []"));
+  LoadScene(path, w.sink());
+  ASSERT_EQ(w.list.size(), 2u);
+  EXPECT_NE(w.list[0].find("gravityy"), std::string::npos);
+  EXPECT_NE(w.list[0].find("unknown key"), std::string::npos);
+  EXPECT_NE(w.list[0].find(path), std::string::npos);
+  EXPECT_NE(w.list[1].find("obstacles"), std::string::npos);
+  EXPECT_NE(w.list[1].find("not supported"), std::string::npos);
+}
+
+TEST_F(SceneFiles, WrongTypesNameTheJsonPathAndFile) {
+  const std::string a = Write("conf/a.json", SceneText(", \"wind\": {\"velocity\": [1, \"x\", 0]}"));
+  ExpectErrorNaming([&] { LoadScene(a); }, {a, "wind.velocity[1]", "expected a number"});
+  std::string text = SceneText();
+  text.replace(text.find("\"" + material_ + "\""), material_.size() + 2, "42");
+  const std::string b = Write("conf/b.json", text);
+  ExpectErrorNaming([&] { LoadScene(b); }, {b, "cloths[0].materials[0].data", "expected a string"});
+  const std::string c = Write("conf/c.json", SceneText(", \"frame_steps\": 2.5").replace(0, 0, ""));
+  ExpectErrorNaming([&] { LoadScene(c); }, {c, "frame_steps"});
+  const std::string d = Write("conf/d.json", SceneText("", "\"transform\": {\"rotate\": [90, 1, 1]},"));
+  ExpectErrorNaming([&] { LoadScene(d); }, {d, "cloths[0].transform.rotate", "4 numbers"});
+  const std::string e = Write("conf/e.json", "{\"frame_time\": 0.04}");
+  ExpectErrorNaming([&] { LoadScene(e); }, {e, "cloths", "missing"});
+  const std::string f = Write("conf/f.json", SceneText(", \"wind\": {\"density\": -1}"));
+  ExpectErrorNaming([&] { LoadScene(f); }, {f, "wind.density", ">= 0"});
+}
+
+TEST_F(SceneFiles, NaNIsRejectedNamingFileLineAndKey) {
+  std::string text = SceneText();
+  text.replace(text.find("0.04"), 4, "NaN");
+  const std::string path = Write("conf/nan.json", text);
+  ExpectErrorNaming([&] { LoadScene(path); }, {path + ":2", "frame_time", "NaN"});
+}
+
+TEST_F(SceneFiles, MissingFilesNameTheKeyAndWhereItLooked) {
+  std::string text = SceneText();
+  text.replace(text.find("meshes/quad.obj"), 15, "meshes/nope.obj");
+  const std::string path = Write("conf/m.json", text);
+  ExpectErrorNaming([&] { LoadScene(path); }, {path, "cloths[0].mesh", "nope.obj", "not found"});
+  ExpectErrorNaming([&] { LoadScene((root_ / "conf/absent.json").string()); }, {"absent.json"});
+}
+
+TEST_F(SceneFiles, HandleOutOfRangeNamesTheHandleAndFile) {
+  const std::string path = Write("conf/h.json", SceneText("", "", "[0, 3, 4]"));
+  const Scene s = LoadScene(path);
+  ExpectErrorNaming([&] { BuildScene(s); }, {path, "handles[0].nodes[2]", "out of range", "4 nodes"});
+}
+
+TEST_F(SceneFiles, DegenerateTrianglesAndBadMeshesNameTheMeshKey) {
+  Write("meshes/quad.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
+  const std::string path = Write("conf/deg.json", SceneText());
+  const Scene s = LoadScene(path);
+  ExpectErrorNaming([&] { BuildScene(s); }, {path, "cloths[0].mesh", "quad.obj"});
+  Write("meshes/quad.obj", "v 0 0 0\nv 1 0 nan\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
+  ExpectErrorNaming([&] { BuildScene(LoadScene(path)); }, {path, "cloths[0].mesh"});
+}
+
+TEST(ResolveScenePath, AbsoluteNextToSceneThenParentThenWorkingDirectory) {
+  const fs::path root = fs::temp_directory_path() / ("clothwind_resolve_" + std::to_string(::getpid()));
+  fs::create_directories(root / "conf");
+  std::ofstream(root / "conf" / "near.obj") << "x";
+  std::ofstream(root / "far.obj") << "x";
+  const std::string scene = (root / "conf" / "s.json").string();
+  EXPECT_EQ(ResolveScenePath(scene, "near.obj"), (root / "conf" / "near.obj").string());
+  EXPECT_EQ(ResolveScenePath(scene, "far.obj"), (root / "far.obj").string());
+  EXPECT_EQ(ResolveScenePath(scene, (root / "far.obj").string()), (root / "far.obj").string());
+  EXPECT_EQ(ResolveScenePath(scene, "missing.obj"), "");
+  fs::remove_all(root);
+}
+
+}  // namespace
+}  // namespace clothwind::sim

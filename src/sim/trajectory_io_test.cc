@@ -1,0 +1,83 @@
+#include "sim/trajectory_io.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+namespace clothwind::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+Trajectory Sample() {
+  Trajectory t;
+  t.faces.resize(2, 3);
+  t.faces << 0, 1, 2, 0, 2, 3;
+  t.uv.resize(4, 2);
+  t.uv << 0, 0, 1, 0, 1, 1, 0, 1;
+  t.frame_time = 0.04;
+  for (int k = 0; k < 3; ++k) {
+    FramePositions p(4, 3);
+    for (int v = 0; v < 4; ++v) p.row(v) << 0.1f * k, t.uv(v, 0), t.uv(v, 1) - 0.01f * k * v;
+    t.frames.push_back(p);
+  }
+  return t;
+}
+
+std::string TempPath(const std::string& name) {
+  return (fs::temp_directory_path() / ("cwtraj_" + std::to_string(::getpid()) + "_" + name)).string();
+}
+
+TEST(TrajectoryIo, RoundTripIsExactAndSizeMatchesTheDocumentedLayout) {
+  const Trajectory t = Sample();
+  const std::string path = TempPath("ok.cwtraj");
+  WriteTrajectory(path, t);
+  EXPECT_EQ(fs::file_size(path), 32u + 12 * 2 + 8 * 4 + 12 * 4 * 3);
+  // Header bytes as documented.
+  std::ifstream in(path, std::ios::binary);
+  char header[32];
+  in.read(header, 32);
+  EXPECT_EQ(std::string(header, 6), "CWTRAJ");
+  EXPECT_EQ(header[8], 1);   // version, little-endian
+  EXPECT_EQ(header[12], 4);  // #V
+  EXPECT_EQ(header[16], 2);  // #F
+  EXPECT_EQ(header[20], 3);  // #frames
+  const Trajectory r = ReadTrajectory(path);
+  EXPECT_EQ(r.faces, t.faces);
+  EXPECT_EQ(r.uv, t.uv);
+  EXPECT_DOUBLE_EQ(r.frame_time, t.frame_time);
+  ASSERT_EQ(r.num_frames(), 3);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(r.frames[k], t.frames[k]);
+  // No temporary file left behind.
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(fs::temp_directory_path())) {
+    if (e.path().string().rfind(path, 0) == 0) ++files;
+  }
+  EXPECT_EQ(files, 1);
+  fs::remove(path);
+}
+
+TEST(TrajectoryIo, CorruptFilesFailNamingTheFileAndProblem) {
+  const std::string path = TempPath("bad.cwtraj");
+  WriteTrajectory(path, Sample());
+  fs::resize_file(path, fs::file_size(path) - 4);
+  try {
+    ReadTrajectory(path);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("implies"), std::string::npos) << e.what();
+  }
+  std::ofstream(path, std::ios::binary) << "NOTATRAJECTORY_AT_ALL_PADDING_PADDING_PADDING";
+  EXPECT_THROW(ReadTrajectory(path), std::runtime_error);
+  fs::remove(path);
+  EXPECT_THROW(ReadTrajectory(path), std::runtime_error);
+  Trajectory t = Sample();
+  t.frames[1].resize(3, 3);
+  EXPECT_THROW(WriteTrajectory(path, t), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace clothwind::sim
