@@ -1,0 +1,326 @@
+// anemometer_node: reads a wind instrument and publishes clothwind/WindMeasurement.
+//   ~input = serial (default): termios serial port, NMEA 0183 / Gill WindSonic / CSV (auto-detected)
+//            usb:              Fine Offset WH1080/WH3080-class station over libusb
+//            topic:            parses anemometer/raw (RawSentence) from a rosbag replay
+// In serial/usb modes every record is published as anemometer/raw (stamp = arrival of its first
+// byte) and every reading as anemometer/wind with the same stamp. In topic mode the wind is
+// stamped with the raw message's stamp, so a replay with use_sim_time keeps the recorded timing.
+// The device is opened with back-off retries (a port that does not exist yet is not an error),
+// and a vanished device is re-opened the same way. See docs/anemometer.md.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <clothwind/RawSentence.h>
+#include <clothwind/WindMeasurement.h>
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+
+#include "ros_bridge/wind_conversions.h"
+#include "sensors/anemometer_protocol.h"
+#include "sensors/anemometer_stream.h"
+#include "sensors/fine_offset_record.h"
+#include "sensors/fine_offset_usb.h"
+#include "sensors/serial_port.h"
+
+namespace {
+
+using clothwind::sensors::AnemometerDecoder;
+using clothwind::sensors::AnemometerProtocol;
+using clothwind::sensors::AnemometerProtocolName;
+using clothwind::sensors::ParseResult;
+using clothwind::sensors::ParseStatus;
+
+// Retry delays for opening the device: short first (a udev symlink appearing), then longer.
+class Backoff {
+ public:
+  Backoff(double initial, double maximum) : initial_(initial), max_(maximum), delay_(initial) {}
+  void Reset() { delay_ = initial_; }
+  double Next() {
+    const double d = delay_;
+    delay_ = std::min(delay_ * 2.0, max_);
+    return d;
+  }
+
+ private:
+  double initial_, max_, delay_;
+};
+
+class AnemometerNode {
+ public:
+  AnemometerNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh), backoff_(0.1, 2.0) {}
+
+  bool Init() {
+    pnh_.param<std::string>("input", input_, "serial");
+    pnh_.param<std::string>("frame_id", frame_id_, "anemometer");
+    std::string protocol_name;
+    pnh_.param<std::string>("protocol", protocol_name, "auto");
+    AnemometerProtocol protocol;
+    if (!clothwind::sensors::ParseAnemometerProtocol(protocol_name, &protocol)) {
+      ROS_FATAL("~protocol: '%s' unknown (expected auto, nmea, gill, csv or fine_offset)", protocol_name.c_str());
+      return false;
+    }
+    if (input_ == "usb" && protocol == AnemometerProtocol::kAuto) protocol = AnemometerProtocol::kFineOffset;
+    decoder_ = AnemometerDecoder(protocol);
+    double initial, maximum;
+    pnh_.param("reconnect_initial_delay", initial, 0.1);
+    pnh_.param("reconnect_max_delay", maximum, 2.0);
+    backoff_ = Backoff(std::max(0.01, initial), std::max(initial, maximum));
+
+    updater_.add("anemometer", this, &AnemometerNode::Diagnose);
+    if (input_ == "serial") {
+      pnh_.param<std::string>("port", serial_.port, "/dev/ttyUSB0");
+      pnh_.param("baud", serial_.baud, 4800);
+      pnh_.param("data_bits", serial_.data_bits, 8);
+      std::string parity;
+      pnh_.param<std::string>("parity", parity, "none");
+      if (!clothwind::sensors::ParseParity(parity, &serial_.parity)) {
+        ROS_FATAL("~parity: '%s' unknown (expected none, even or odd)", parity.c_str());
+        return false;
+      }
+      pnh_.param("stop_bits", serial_.stop_bits, 1);
+      std::string error;
+      if (!clothwind::sensors::ValidateSerialConfig(serial_, &error)) {
+        ROS_FATAL("~%s", error.c_str());
+        return false;
+      }
+      pnh_.param("stale_timeout", stale_timeout_, 5.0);
+      updater_.setHardwareID(serial_.port);
+      state_ = "waiting for " + serial_.port;
+    } else if (input_ == "usb") {
+      pnh_.param("usb_poll_period", usb_poll_period_, 10.0);
+      // The outdoor unit transmits every 48 s; allow two missed transmissions before warning.
+      pnh_.param("stale_timeout", stale_timeout_, 3.0 * clothwind::sensors::kFineOffsetSensorPeriod);
+      updater_.setHardwareID("usb:1941:8021");
+      state_ = "waiting for USB station 1941:8021";
+    } else if (input_ == "topic") {
+      pnh_.param("stale_timeout", stale_timeout_, 5.0);
+      updater_.setHardwareID("topic:" + nh_.resolveName("anemometer/raw"));
+      raw_sub_ = nh_.subscribe("anemometer/raw", 100, &AnemometerNode::OnRaw, this);
+      state_ = "subscribed to " + raw_sub_.getTopic();
+    } else {
+      ROS_FATAL("~input: '%s' unknown (expected serial, usb or topic)", input_.c_str());
+      return false;
+    }
+    if (input_ != "topic") raw_pub_ = nh_.advertise<clothwind::RawSentence>("anemometer/raw", 100);
+    wind_pub_ = nh_.advertise<clothwind::WindMeasurement>("anemometer/wind", 100);
+    ROS_INFO("anemometer_node: input %s, protocol %s, frame %s", input_.c_str(), protocol_name.c_str(),
+             frame_id_.c_str());
+    return true;
+  }
+
+  void Run() {
+    while (ros::ok()) {
+      if (input_ == "serial") StepSerial();
+      else if (input_ == "usb") StepUsb();
+      else ros::WallDuration(0.02).sleep();
+      ros::spinOnce();
+      updater_.update();
+    }
+    // Release the device on SIGINT (roscpp's handler ends ros::ok()).
+    if (port_.is_open()) ROS_INFO("anemometer_node: closing %s", serial_.port.c_str());
+    port_.Close();
+    usb_.Close();
+  }
+
+ private:
+  void StepSerial() {
+    const ros::WallTime now = ros::WallTime::now();
+    if (!port_.is_open()) {
+      if (now < next_attempt_) {
+        ros::WallDuration(std::min(0.05, (next_attempt_ - now).toSec())).sleep();
+        return;
+      }
+      std::string error;
+      if (port_.Open(serial_, &error)) {
+        ROS_INFO("anemometer_node: opened %s at %d baud", serial_.port.c_str(), serial_.baud);
+        framer_.Reset();
+        backoff_.Reset();
+        state_ = "connected";
+        ++connects_;
+      } else {
+        const double delay = backoff_.Next();
+        ROS_WARN_THROTTLE(10.0, "anemometer_node: %s; retrying (every <= %.1f s)", error.c_str(), delay);
+        state_ = "waiting: " + error;
+        next_attempt_ = now + ros::WallDuration(delay);
+      }
+      return;
+    }
+    uint8_t buffer[512];
+    size_t n = 0;
+    std::string error;
+    const auto status = port_.Read(buffer, sizeof(buffer), 50, &n, &error);
+    if (status == clothwind::sensors::SerialPort::ReadStatus::kData) {
+      // All bytes of one read share its arrival time; a record is stamped with its first byte's.
+      const ros::Time arrival = ros::Time::now();
+      std::vector<clothwind::sensors::RawRecord> records;
+      framer_.Feed(buffer, n, arrival.toSec(), &records);
+      for (const auto& r : records) HandleRecord(r.data, ros::Time().fromSec(r.stamp), frame_id_, true);
+    } else if (status == clothwind::sensors::SerialPort::ReadStatus::kFailed) {
+      ROS_WARN("anemometer_node: %s; reconnecting", error.c_str());
+      state_ = "disconnected: " + error;
+      ++disconnects_;
+      next_attempt_ = now + ros::WallDuration(backoff_.Next());
+    }
+  }
+
+  void StepUsb() {
+    const ros::WallTime now = ros::WallTime::now();
+    if (!usb_.is_open()) {
+      if (now < next_attempt_) {
+        ros::WallDuration(std::min(0.05, (next_attempt_ - now).toSec())).sleep();
+        return;
+      }
+      std::string error;
+      if (usb_.Open(&error)) {
+        ROS_INFO("anemometer_node: opened Fine Offset station");
+        backoff_.Reset();
+        state_ = "connected";
+        ++connects_;
+        next_poll_ = now;
+      } else {
+        // USB stations are unplugged for long stretches: back off to the poll period.
+        const double delay = std::max(backoff_.Next(), 1.0);
+        ROS_WARN_THROTTLE(30.0, "anemometer_node: %s; retrying", error.c_str());
+        state_ = "waiting: " + error;
+        next_attempt_ = now + ros::WallDuration(delay);
+      }
+      return;
+    }
+    if (now < next_poll_) {
+      ros::WallDuration(std::min(0.05, (next_poll_ - now).toSec())).sleep();
+      return;
+    }
+    next_poll_ = now + ros::WallDuration(usb_poll_period_);
+    const ros::Time stamp = ros::Time::now();
+    std::vector<uint8_t> record;
+    uint16_t address = 0;
+    std::string error;
+    if (!usb_.ReadCurrentRecord(&record, &address, &error)) {
+      ++usb_read_errors_;
+      last_error_ = error;
+      ROS_WARN_THROTTLE(30.0, "anemometer_node: %s", error.c_str());
+      if (!usb_.is_open()) {
+        state_ = "disconnected: " + error;
+        ++disconnects_;
+        next_attempt_ = now + ros::WallDuration(backoff_.Next());
+      }
+      return;
+    }
+    // The station rewrites the current record only when its sensor transmits (every 48 s) or a
+    // new history slot starts: publish on change, at the device's own rate.
+    if (record == last_usb_record_ && address == last_usb_address_) return;
+    last_usb_record_ = record;
+    last_usb_address_ = address;
+    HandleRecord(clothwind::sensors::HexEncode(record), stamp, frame_id_, true);
+  }
+
+  void OnRaw(const clothwind::RawSentence::ConstPtr& msg) {
+    const std::string frame = msg->header.frame_id.empty() ? frame_id_ : msg->header.frame_id;
+    HandleRecord(clothwind::ros_bridge::RawSentenceBytes(*msg), msg->header.stamp, frame, false);
+  }
+
+  void HandleRecord(const std::string& data, const ros::Time& stamp, const std::string& frame, bool publish_raw) {
+    AnemometerProtocol used = AnemometerProtocol::kAuto;
+    const ParseResult r = decoder_.Decode(data, &used);
+    if (publish_raw) {
+      const std::string protocol = used == AnemometerProtocol::kAuto ? "" : AnemometerProtocolName(used);
+      raw_pub_.publish(clothwind::ros_bridge::ToRawSentence(data, protocol, stamp, frame));
+    }
+    if (r.status == ParseStatus::kOk) {
+      wind_pub_.publish(clothwind::ros_bridge::ToWindMeasurement(r.reading, stamp, frame));
+      if (r.reading.valid) {
+        last_valid_ = r.reading;
+        last_valid_wall_ = ros::WallTime::now();
+        have_valid_ = true;
+      }
+    } else if (r.status != ParseStatus::kNotWind) {
+      last_error_ = r.error;
+      ROS_DEBUG("anemometer_node: %s", r.error.c_str());
+    }
+  }
+
+  void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    const auto& c = decoder_.counters();
+    const ros::WallTime now = ros::WallTime::now();
+    double rate = 0.0;
+    if (!last_diag_wall_.isZero()) {
+      const double dt = (now - last_diag_wall_).toSec();
+      if (dt > 0.0) rate = static_cast<double>(c.readings - last_diag_readings_) / dt;
+    }
+    const bool new_errors = c.checksum_failures + c.parse_errors > last_diag_errors_;
+    last_diag_wall_ = now;
+    last_diag_readings_ = c.readings;
+    last_diag_errors_ = c.checksum_failures + c.parse_errors;
+    const double age = have_valid_ ? (now - last_valid_wall_).toSec() : -1.0;
+
+    const bool connected = input_ == "topic" || port_.is_open() || usb_.is_open();
+    if (!connected) stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "not connected: " + state_);
+    else if (!have_valid_) stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "connected, no valid reading yet");
+    else if (age > stale_timeout_) stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "valid readings stale");
+    else if (new_errors) stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "receiving, with bad records");
+    else stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "receiving");
+
+    stat.add("input", input_);
+    stat.add("connection", state_);
+    const AnemometerProtocol p = decoder_.protocol();
+    stat.add("protocol", std::string(AnemometerProtocolName(p)) +
+                             (decoder_.auto_mode() ? (p == AnemometerProtocol::kAuto ? " (detecting)" : " (detected)")
+                                                   : " (configured)"));
+    stat.add("records", c.records);
+    stat.add("readings", c.readings);
+    stat.add("invalid readings (instrument flagged)", c.invalid_readings);
+    stat.addf("reading rate [Hz]", "%.3f", rate);
+    stat.add("checksum failures", c.checksum_failures);
+    stat.add("parse errors", c.parse_errors);
+    stat.add("bytes dropped by framing", framer_.dropped_bytes());
+    stat.add("last error", last_error_);
+    stat.add("connects", connects_);
+    stat.add("disconnects", disconnects_);
+    if (have_valid_) {
+      stat.addf("last valid speed [m/s]", "%.3f", last_valid_.speed);
+      stat.addf("last valid direction [rad]", "%.4f", clothwind::sensors::WindDirection(last_valid_));
+      stat.addf("last valid age [s]", "%.2f", age);
+    } else {
+      stat.add("last valid age [s]", "none yet");
+    }
+    if (input_ == "usb") {
+      stat.add("usb read errors", usb_read_errors_);
+      stat.addf("usb poll period [s]", "%.1f", usb_poll_period_);
+      stat.add("update period", "the station's wind average is a ~48 s mean, refreshed every 48 s");
+    }
+  }
+
+  ros::NodeHandle nh_, pnh_;
+  ros::Publisher raw_pub_, wind_pub_;
+  ros::Subscriber raw_sub_;
+  diagnostic_updater::Updater updater_;
+  std::string input_, frame_id_, state_, last_error_;
+  clothwind::sensors::SerialConfig serial_;
+  clothwind::sensors::SerialPort port_;
+  clothwind::sensors::FineOffsetUsb usb_;
+  clothwind::sensors::RecordFramer framer_;
+  AnemometerDecoder decoder_;
+  Backoff backoff_;
+  ros::WallTime next_attempt_, next_poll_, last_valid_wall_, last_diag_wall_;
+  double stale_timeout_ = 5.0;
+  double usb_poll_period_ = 10.0;
+  std::vector<uint8_t> last_usb_record_;
+  uint16_t last_usb_address_ = 0;
+  uint64_t connects_ = 0, disconnects_ = 0, usb_read_errors_ = 0;
+  uint64_t last_diag_readings_ = 0, last_diag_errors_ = 0;
+  clothwind::sensors::WindReading last_valid_;
+  bool have_valid_ = false;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "anemometer_node");
+  AnemometerNode node{ros::NodeHandle(), ros::NodeHandle("~")};
+  if (!node.Init()) return 1;
+  node.Run();
+  return 0;
+}

@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+"""anemometer_node ~input:=topic (rosbag replay): RawSentence in, WindMeasurement out with the
+raw message's stamp and frame; garbage and bad checksums give nothing."""
+import functools
+import math
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from clothwind.msg import RawSentence, WindMeasurement
+
+
+class AnemometerTopicTest(unittest.TestCase):
+    def setUp(self):
+        rospy.init_node('anemometer_pty_topic', anonymous=True)
+        self.lock = threading.Lock()
+        self.winds = []
+        self.sub = rospy.Subscriber('/replay/anemometer/wind', WindMeasurement, self.on_wind, queue_size=50)
+        self.pub = rospy.Publisher('/replay/anemometer/raw', RawSentence, queue_size=50)
+        deadline = time.time() + 20.0
+        while time.time() < deadline and (self.pub.get_num_connections() == 0 or
+                                          self.sub.get_num_connections() == 0):
+            time.sleep(0.1)
+        self.assertGreater(self.pub.get_num_connections(), 0, 'replay node not subscribed')
+        time.sleep(0.5)
+
+    def on_wind(self, m):
+        with self.lock:
+            self.winds.append(m)
+
+    def send(self, data, secs, nsecs, protocol=''):
+        m = RawSentence()
+        m.header.stamp = rospy.Time(secs, nsecs)
+        m.header.frame_id = 'recorded_frame'
+        m.data = data
+        m.protocol = protocol
+        self.pub.publish(m)
+        time.sleep(0.2)
+
+    def test_replay_keeps_stamps(self):
+        body = 'Q,229,002.74,M,00,'
+        cs = functools.reduce(lambda a, c: a ^ c, body.encode('ascii'), 0)
+        gill = '\x02' + body + '\x03' + '%02X' % cs
+        self.send(gill, 1234, 5678, 'gill')
+        self.send('\\xFF\\x00 garbage', 1235, 0)
+        self.send(gill[:-1] + ('0' if gill[-1] != '0' else '1'), 1236, 0, 'gill')  # bad checksum
+        self.send(gill, 1237, 999999999, 'gill')
+        time.sleep(1.0)
+        with self.lock:
+            winds = list(self.winds)
+        self.assertEqual(len(winds), 2, [(w.header.stamp.to_sec(), w.speed) for w in winds])
+        self.assertEqual(winds[0].header.stamp, rospy.Time(1234, 5678))
+        self.assertEqual(winds[1].header.stamp, rospy.Time(1237, 999999999))
+        for w in winds:
+            self.assertEqual(w.header.frame_id, 'recorded_frame')
+            self.assertAlmostEqual(w.speed, 2.74, places=9)
+            self.assertAlmostEqual(w.direction, math.pi - math.radians(229.0), places=9)
+            self.assertEqual(w.source, 'gill')
+            self.assertTrue(w.valid)
+
+
+if __name__ == '__main__':
+    rostest.rosrun('clothwind', 'anemometer_pty_topic', AnemometerTopicTest)
