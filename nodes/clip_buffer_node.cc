@@ -1,0 +1,219 @@
+// clip_buffer_node: camera frames + anemometer readings in, labelled 25 fps clips out.
+//
+// Subscribes  camera/image_raw (sensor_msgs/Image), camera/camera_info (kept for recorded
+//             clips' metadata), anemometer/wind (clothwind/WindMeasurement)
+// Publishes   clips (clothwind/Clip), clips/preview (sensor_msgs/Image mono8: the latest clip's
+//             middle frame, only built while someone subscribes), /diagnostics
+// All the logic is in sensors::ClipPipeline and sensors::DatasetWriter (see docs/clips.md).
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+
+#include <clothwind/Clip.h>
+#include <clothwind/WindMeasurement.h>
+
+#include "ros_bridge/clip_conversions.h"
+#include "sensors/clip_pipeline.h"
+#include "sensors/dataset_writer.h"
+
+namespace clothwind {
+namespace {
+
+class ClipBufferNode {
+ public:
+  ClipBufferNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
+    sensors::ClipPipelineOptions o;
+    pnh.param("frame_rate", o.frame_rate, o.frame_rate);
+    pnh.param("num_frames", o.num_frames, o.num_frames);
+    pnh.param("stride", o.stride, o.stride);
+    pnh.param("size", o.size, o.size);
+    pnh.param("gap_tolerance", o.gap_tolerance, o.gap_tolerance);
+    pnh.param("label_window", o.label_window, o.label_window);
+    pnh.param("label_delay", o.label_delay, o.label_delay);
+    std::vector<int> roi;
+    if (pnh.getParam("roi", roi)) {
+      if (roi.size() == 3) {
+        o.roi = {roi[0], roi[1], roi[2]};
+      } else if (!roi.empty()) {
+        throw std::invalid_argument("~roi: expected [x, y, size] in source pixels (or [] for the centred square), got " +
+                                    std::to_string(roi.size()) + " numbers");
+      }
+    }
+    pnh.param("flush_after", flush_after_, 3.0);
+    pnh.param("frame_id", frame_id_, std::string());
+    int queue = 60, jpeg_quality = 95;
+    pnh.param("queue_size", queue, queue);
+    pnh.param("jpeg_quality", jpeg_quality, jpeg_quality);
+    std::string record_dir;
+    pnh.param("record_dir", record_dir, std::string());
+    pipeline_ = std::make_unique<sensors::ClipPipeline>(o);
+    if (!record_dir.empty()) {
+      writer_ = std::make_unique<sensors::DatasetWriter>(record_dir, jpeg_quality);
+      ROS_INFO("clip_buffer: recording clips to %s (%zu already there)", record_dir.c_str(), writer_->size());
+    }
+
+    clip_pub_ = nh.advertise<clothwind::Clip>("clips", 4);
+    preview_pub_ = nh.advertise<sensor_msgs::Image>("clips/preview", 1, true);
+    image_sub_ = nh.subscribe("camera/image_raw", queue, &ClipBufferNode::OnImage, this,
+                              ros::TransportHints().tcpNoDelay());
+    info_sub_ = nh.subscribe("camera/camera_info", 1, &ClipBufferNode::OnCameraInfo, this);
+    wind_sub_ = nh.subscribe("anemometer/wind", 200, &ClipBufferNode::OnWind, this);
+    source_.description = "clip_buffer_node " + image_sub_.getTopic();
+
+    updater_.setHardwareID("clip_buffer");
+    updater_.add("clip buffer", this, &ClipBufferNode::Diagnose);
+    flush_timer_ = nh.createWallTimer(ros::WallDuration(0.25), &ClipBufferNode::OnTimer, this);
+    ROS_INFO("clip_buffer: %d frames at %.1f fps every %d frames, %dx%d, roi %s, label window %.0f s (delay %.1f s), "
+             "gap tolerance %.3f s",
+             o.num_frames, o.frame_rate, o.stride, o.size, o.size,
+             o.roi.size > 0 ? ("[" + std::to_string(o.roi.x) + ", " + std::to_string(o.roi.y) + ", " +
+                               std::to_string(o.roi.size) + "]").c_str()
+                            : "centre square",
+             o.label_window, o.label_delay, o.gap_tolerance);
+  }
+
+  // Labels and records whatever is still waiting (called on shutdown; nothing is published then).
+  void Finish() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& c : pipeline_->Flush()) Record(c);
+  }
+
+ private:
+  void OnImage(const sensor_msgs::ImageConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_input_ = ros::WallTime::now();
+    if (frame_id_.empty() || frame_id_from_msg_) {
+      frame_id_ = msg->header.frame_id;
+      frame_id_from_msg_ = true;
+    }
+    try {
+      cv::Mat view;
+      sensors::ClipSourceEncoding encoding;
+      ros_bridge::ImageView(*msg, &view, &encoding);
+      pipeline_->AddFrame(msg->header.stamp.toSec(), view, encoding);
+    } catch (const std::exception& e) {
+      last_error_ = e.what();
+      ROS_ERROR_THROTTLE(5.0, "clip_buffer: frame dropped: %s", e.what());
+    }
+    Publish(pipeline_->TakeReady());
+  }
+
+  void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_input_ = ros::WallTime::now();
+    pipeline_->AddReading(ros_bridge::ToLabelReading(*msg));
+    Publish(pipeline_->TakeReady());
+  }
+
+  void OnCameraInfo(const sensor_msgs::CameraInfo::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!writer_) return;
+    source_.camera = ros_bridge::CameraInfoJson(*msg);
+  }
+
+  // The stream stalled or ended (end of a bag): label what waits with the readings held now.
+  void OnTimer(const ros::WallTimerEvent&) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (pipeline_->pending() > 0 && (ros::WallTime::now() - last_input_).toSec() > flush_after_) {
+      ROS_INFO("clip_buffer: no input for %.1f s, labelling %zu waiting clip(s) with the readings held",
+               flush_after_, pipeline_->pending());
+      Publish(pipeline_->Flush());
+    }
+    updater_.update();
+  }
+
+  void Publish(const std::vector<sensors::LabelledClip>& clips) {
+    for (const auto& c : clips) {
+      if (c.label.count == 0)
+        ROS_WARN_THROTTLE(10.0, "clip_buffer: clip %lu has no anemometer reading in its %.0f s window",
+                          static_cast<unsigned long>(c.clip.sequence), c.label.window);
+      auto msg = boost::make_shared<clothwind::Clip>(ros_bridge::ToClipMsg(c, frame_id_));
+      if (preview_pub_.getNumSubscribers() > 0) {
+        const auto& middle = c.clip.frames[c.clip.frames.size() / 2];
+        std_msgs::Header h = msg->header;
+        h.stamp = ros::Time(middle.stamp);
+        preview_pub_.publish(ros_bridge::MonoImageMsg(middle.image, h));
+      }
+      clip_pub_.publish(msg);
+      Record(c);
+    }
+  }
+
+  void Record(const sensors::LabelledClip& c) {
+    if (!writer_) return;
+    try {
+      source_.frame_id = frame_id_;
+      writer_->Write(c, source_);
+      ++recorded_;
+    } catch (const std::exception& e) {
+      last_error_ = e.what();
+      ROS_ERROR_THROTTLE(5.0, "clip_buffer: recording failed: %s", e.what());
+    }
+  }
+
+  void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    const auto& s = pipeline_->stats();
+    if (!last_error_.empty()) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, last_error_);
+    } else if (s.clips_released > 0 && s.clips_unlabelled == s.clips_released) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "clips have no anemometer label");
+    } else if (s.frames_in == 0) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no camera frames yet");
+    } else {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "making clips");
+    }
+    stat.add("frames in", s.frames_in);
+    stat.add("frames dropped", s.frames_dropped);
+    stat.add("frames out (25 fps)", s.frames_out);
+    stat.add("gaps", s.gaps);
+    stat.add("last gap [s]", s.last_gap);
+    stat.add("clips made", s.clips_made);
+    stat.add("clips published", s.clips_released);
+    stat.add("clips without label", s.clips_unlabelled);
+    stat.add("clips waiting for label", pipeline_->pending());
+    stat.add("readings in", s.readings_in);
+    stat.add("readings too late", s.readings_late);
+    stat.add("clips recorded", recorded_);
+  }
+
+  ros::NodeHandle nh_;
+  std::mutex mutex_;
+  std::unique_ptr<sensors::ClipPipeline> pipeline_;
+  std::unique_ptr<sensors::DatasetWriter> writer_;
+  sensors::ClipSourceInfo source_;
+  std::string frame_id_;
+  bool frame_id_from_msg_ = false;
+  double flush_after_ = 3.0;
+  ros::WallTime last_input_;
+  std::string last_error_;
+  uint64_t recorded_ = 0;
+  ros::Publisher clip_pub_, preview_pub_;
+  ros::Subscriber image_sub_, info_sub_, wind_sub_;
+  ros::WallTimer flush_timer_;
+  diagnostic_updater::Updater updater_;
+};
+
+}  // namespace
+}  // namespace clothwind
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "clip_buffer");
+  ros::NodeHandle nh, pnh("~");
+  try {
+    clothwind::ClipBufferNode node(nh, pnh);
+    ros::spin();
+    node.Finish();
+  } catch (const std::exception& e) {
+    ROS_FATAL("clip_buffer: %s", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,96 @@
+#include "ros_bridge/clip_conversions.h"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+namespace clothwind::ros_bridge {
+
+void ImageView(const sensor_msgs::Image& msg, cv::Mat* view, sensors::ClipSourceEncoding* encoding) {
+  *encoding = sensors::ParseClipSourceEncoding(msg.encoding);
+  const int type = sensors::ClipSourceCvType(*encoding);
+  const size_t row_bytes = static_cast<size_t>(msg.width) * CV_ELEM_SIZE(type);
+  if (msg.width == 0 || msg.height == 0) throw std::invalid_argument("image is empty (width or height 0)");
+  if (msg.step < row_bytes)
+    throw std::invalid_argument("image step " + std::to_string(msg.step) + " < width * pixel size " +
+                                std::to_string(row_bytes));
+  if (msg.data.size() < static_cast<size_t>(msg.step) * msg.height)
+    throw std::invalid_argument("image data has " + std::to_string(msg.data.size()) + " bytes, expected step * height = " +
+                                std::to_string(static_cast<size_t>(msg.step) * msg.height));
+  if (*encoding == sensors::ClipSourceEncoding::kMono16 && msg.is_bigendian)
+    throw std::invalid_argument("big-endian mono16 images are not supported");
+  *view = cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width), type,
+                  const_cast<uint8_t*>(msg.data.data()), msg.step);
+}
+
+sensors::LabelReading ToLabelReading(const clothwind::WindMeasurement& msg) {
+  sensors::LabelReading r;
+  r.stamp = msg.header.stamp.toSec();
+  r.speed = msg.valid ? msg.speed : std::numeric_limits<double>::quiet_NaN();
+  r.direction = msg.direction;
+  return r;
+}
+
+clothwind::Clip ToClipMsg(const sensors::LabelledClip& c, const std::string& frame_id) {
+  clothwind::Clip msg;
+  const auto& frames = c.clip.frames;
+  if (frames.empty()) throw std::invalid_argument("clip has no frames");
+  msg.header.stamp = ros::Time(frames.front().stamp);
+  msg.header.frame_id = frame_id;
+  msg.sequence = c.clip.sequence;
+  msg.frame_rate = static_cast<float>(c.frame_rate);
+  msg.num_frames = static_cast<uint32_t>(frames.size());
+  msg.height = static_cast<uint32_t>(frames.front().image.rows);
+  msg.width = static_cast<uint32_t>(frames.front().image.cols);
+  msg.encoding = "mono8";
+  const size_t frame_bytes = static_cast<size_t>(msg.height) * msg.width;
+  msg.data.resize(frame_bytes * frames.size());
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const cv::Mat& img = frames[i].image;
+    if (img.type() != CV_8UC1 || static_cast<uint32_t>(img.rows) != msg.height ||
+        static_cast<uint32_t>(img.cols) != msg.width)
+      throw std::invalid_argument("clip frame " + std::to_string(i) + " is not a mono8 image of the clip's size");
+    uint8_t* dst = msg.data.data() + i * frame_bytes;
+    for (int r = 0; r < img.rows; ++r) std::memcpy(dst + static_cast<size_t>(r) * img.cols, img.ptr(r), img.cols);
+    msg.frame_stamps.push_back(ros::Time(frames[i].stamp));
+  }
+  msg.roi.x_offset = c.roi.x;
+  msg.roi.y_offset = c.roi.y;
+  msg.roi.width = c.roi.size;
+  msg.roi.height = c.roi.size;
+  msg.roi.do_rectify = false;
+  msg.source_width = c.source_width;
+  msg.source_height = c.source_height;
+  msg.label_window = c.label.window;
+  msg.wind_mean = c.label.mean;
+  msg.wind_std = c.label.std;
+  msg.wind_count = c.label.count;
+  msg.wind_direction_mean = c.label.direction_mean;
+  return msg;
+}
+
+sensor_msgs::Image MonoImageMsg(const cv::Mat& image, const std_msgs::Header& header) {
+  sensor_msgs::Image msg;
+  msg.header = header;
+  msg.height = image.rows;
+  msg.width = image.cols;
+  msg.encoding = "mono8";
+  msg.is_bigendian = 0;
+  msg.step = image.cols;
+  msg.data.resize(static_cast<size_t>(image.rows) * image.cols);
+  for (int r = 0; r < image.rows; ++r)
+    std::memcpy(msg.data.data() + static_cast<size_t>(r) * image.cols, image.ptr(r), image.cols);
+  return msg;
+}
+
+nlohmann::json CameraInfoJson(const sensor_msgs::CameraInfo& info) {
+  return {{"width", info.width},
+          {"height", info.height},
+          {"frame_id", info.header.frame_id},
+          {"distortion_model", info.distortion_model},
+          {"D", info.D},
+          {"K", std::vector<double>(info.K.begin(), info.K.end())}};
+}
+
+}  // namespace clothwind::ros_bridge

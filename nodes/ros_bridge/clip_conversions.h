@@ -1,0 +1,46 @@
+// Conversions between ROS messages and the ROS-free clip buffer core (src/sensors/clip_*).
+#ifndef CLOTHWIND_NODES_ROS_BRIDGE_CLIP_CONVERSIONS_H_
+#define CLOTHWIND_NODES_ROS_BRIDGE_CLIP_CONVERSIONS_H_
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+
+#include <clothwind/Clip.h>
+#include <clothwind/WindMeasurement.h>
+
+#include "sensors/clip_pipeline.h"
+
+namespace clothwind::ros_bridge {
+
+// Wraps an Image message's pixels as a cv::Mat (no copy: valid while `msg` lives).
+// Inputs:
+//   msg  image in mono8, mono16, bgr8, rgb8, bgra8 or rgba8 (little-endian for mono16)
+// Outputs:
+//   view      msg.height x msg.width matrix over msg.data (respecting msg.step)
+//   encoding  its layout
+// Throws std::invalid_argument naming the field (encoding, step, data size) that is wrong.
+void ImageView(const sensor_msgs::Image& msg, cv::Mat* view, sensors::ClipSourceEncoding* encoding);
+
+// The label reading of a WindMeasurement: its stamp, speed and direction; a reading flagged
+// invalid gets a NaN speed (the labeller skips it).
+sensors::LabelReading ToLabelReading(const clothwind::WindMeasurement& msg);
+
+// A labelled clip as a clothwind/Clip message.
+// Inputs:
+//   clip      labelled clip (num_frames frames of size x size mono8)
+//   frame_id  the camera's optical frame
+clothwind::Clip ToClipMsg(const sensors::LabelledClip& clip, const std::string& frame_id);
+
+// A mono8 Image message holding a copy of `image` (CV_8UC1).
+sensor_msgs::Image MonoImageMsg(const cv::Mat& image, const std_msgs::Header& header);
+
+// The camera_info facts worth keeping with a recorded clip (size, K, D, distortion model).
+nlohmann::json CameraInfoJson(const sensor_msgs::CameraInfo& info);
+
+}  // namespace clothwind::ros_bridge
+
+#endif  // CLOTHWIND_NODES_ROS_BRIDGE_CLIP_CONVERSIONS_H_

@@ -1,0 +1,161 @@
+// clothwind make-session: a synthetic recorded field session as a rosbag, with the topics and
+// messages the live camera_node and anemometer_node publish, so replay.launch treats it exactly as
+// a real recording (header stamps = capture/arrival times; bag times = header stamps).
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include <opencv2/imgcodecs.hpp>
+#include <rosbag/bag.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+
+#include <clothwind/RawSentence.h>
+
+#include "sensors/synthetic_session.h"
+#include "verb_registry.h"
+
+namespace clothwind::tools {
+namespace {
+
+struct MakeSessionArgs {
+  double minutes = 1.5;
+  std::string out;
+  uint64_t seed = 1;
+  double fps = 30.0;
+  int width = 320;
+  int height = 240;
+  double wind_mean = 4.0;
+  double drop_probability = 0.0;
+  double start_time = 1700000000.0;
+  std::string compression = "lz4";
+  std::string camera_frame = "camera_optical_frame";
+  std::string anemometer_frame = "anemometer";
+  std::string preview;
+};
+
+// A pinhole camera_info for the synthetic camera: ~60 degree horizontal field of view, no distortion.
+sensor_msgs::CameraInfo MakeCameraInfo(int width, int height) {
+  sensor_msgs::CameraInfo info;
+  info.width = width;
+  info.height = height;
+  info.distortion_model = "plumb_bob";
+  info.D = {0, 0, 0, 0, 0};
+  const double f = 0.5 * width / std::tan(30.0 * M_PI / 180.0);
+  const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
+  info.K = {f, 0, cx, 0, f, cy, 0, 0, 1};
+  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  info.P = {f, 0, cx, 0, 0, f, cy, 0, 0, 0, 1, 0};
+  return info;
+}
+
+int Run(const MakeSessionArgs& a) {
+  if (a.minutes <= 0.0) throw std::invalid_argument("--minutes must be > 0");
+  sensors::SyntheticSessionOptions o;
+  o.duration = a.minutes * 60.0;
+  o.seed = a.seed;
+  o.fps = a.fps;
+  o.width = a.width;
+  o.height = a.height;
+  o.wind_base = a.wind_mean;
+  o.drop_probability = a.drop_probability;
+  o.start_time = a.start_time;
+  const sensors::SyntheticSession session(o);
+
+  namespace fs = std::filesystem;
+  const fs::path out(a.out);
+  if (out.has_parent_path()) fs::create_directories(out.parent_path());
+  const std::string tmp = a.out + ".tmp-" + std::to_string(::getpid());
+  rosbag::Bag bag;
+  bag.open(tmp, rosbag::bagmode::Write);
+  if (a.compression == "lz4") bag.setCompression(rosbag::compression::LZ4);
+  else if (a.compression == "bz2") bag.setCompression(rosbag::compression::BZ2);
+  else if (a.compression != "none")
+    throw std::invalid_argument("--compression: expected none, lz4 or bz2, got '" + a.compression + "'");
+
+  sensor_msgs::CameraInfo info = MakeCameraInfo(a.width, a.height);
+  info.header.frame_id = a.camera_frame;
+  const auto& stamps = session.frame_stamps();
+  const auto& readings = session.readings();
+  size_t fi = 0, ri = 0;
+  double speed_sum = 0.0;
+  try {
+    // Merge both streams in stamp order, as they were "recorded".
+    while (fi < stamps.size() || ri < readings.size()) {
+      const bool frame_next = ri >= readings.size() || (fi < stamps.size() && stamps[fi] <= readings[ri].stamp);
+      if (frame_next) {
+        const ros::Time t(stamps[fi]);
+        const cv::Mat img = session.RenderFrame(fi);
+        if (fi == 0 && !a.preview.empty()) cv::imwrite(a.preview, img);
+        sensor_msgs::Image msg;
+        msg.header.seq = static_cast<uint32_t>(fi);
+        msg.header.stamp = t;
+        msg.header.frame_id = a.camera_frame;
+        msg.height = img.rows;
+        msg.width = img.cols;
+        msg.encoding = "bgr8";
+        msg.is_bigendian = 0;
+        msg.step = img.cols * 3;
+        msg.data.assign(img.data, img.data + img.total() * img.elemSize());
+        bag.write("camera/image_raw", t, msg);
+        info.header.seq = msg.header.seq;
+        info.header.stamp = t;
+        bag.write("camera/camera_info", t, info);
+        ++fi;
+      } else {
+        const auto& r = readings[ri];
+        const ros::Time t(r.stamp);
+        RawSentence msg;
+        msg.header.seq = static_cast<uint32_t>(ri);
+        msg.header.stamp = t;
+        msg.header.frame_id = a.anemometer_frame;
+        msg.data = r.sentence;
+        msg.protocol = "nmea";
+        bag.write("anemometer/raw", t, msg);
+        speed_sum += r.speed;
+        ++ri;
+      }
+    }
+    bag.close();
+    fs::rename(tmp, out);
+  } catch (...) {
+    bag.close();
+    fs::remove(tmp);
+    throw;
+  }
+  std::printf("make-session: %s: %.1f s, %zu frames %dx%d bgr8 at %.1f fps, %zu MWV sentences at 1 Hz "
+              "(mean %.2f m/s), seed %llu, %.1f MB\n",
+              a.out.c_str(), o.duration, stamps.size(), a.width, a.height, a.fps, readings.size(),
+              readings.empty() ? NAN : speed_sum / readings.size(), static_cast<unsigned long long>(a.seed),
+              fs::file_size(out) / 1e6);
+  return 0;
+}
+
+const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::function<int()> {
+  auto args = std::make_shared<MakeSessionArgs>();
+  auto* sub = app.add_subcommand("make-session",
+                                 "Write a synthetic field session (camera + NMEA anemometer) as a rosbag");
+  sub->add_option("--minutes", args->minutes, "session length [min]")->capture_default_str();
+  sub->add_option("--out", args->out, "output bag")->required();
+  sub->add_option("--seed", args->seed, "random seed")->capture_default_str();
+  sub->add_option("--fps", args->fps, "camera rate [Hz]")->capture_default_str();
+  sub->add_option("--width", args->width, "image width [px]")->capture_default_str();
+  sub->add_option("--height", args->height, "image height [px]")->capture_default_str();
+  sub->add_option("--wind-mean", args->wind_mean, "long-term mean wind [m/s]")->capture_default_str();
+  sub->add_option("--drop-probability", args->drop_probability, "chance a frame is lost")->capture_default_str();
+  sub->add_option("--start-time", args->start_time, "stamp of the session start [s since epoch]")
+      ->capture_default_str();
+  sub->add_option("--compression", args->compression, "none | lz4 | bz2")->capture_default_str();
+  sub->add_option("--camera-frame", args->camera_frame, "camera frame_id")->capture_default_str();
+  sub->add_option("--anemometer-frame", args->anemometer_frame, "anemometer frame_id")->capture_default_str();
+  sub->add_option("--preview", args->preview, "also write the first frame to this image file");
+  return [args] { return Run(*args); };
+}};
+
+}  // namespace
+}  // namespace clothwind::tools
