@@ -106,8 +106,8 @@ class AnemometerNode {
     }
     if (input_ != "topic") raw_pub_ = nh_.advertise<clothwind::RawSentence>("anemometer/raw", 100);
     wind_pub_ = nh_.advertise<clothwind::WindMeasurement>("anemometer/wind", 100);
-    ROS_INFO("anemometer_node: input %s, protocol %s, frame %s", input_.c_str(), protocol_name.c_str(),
-             frame_id_.c_str());
+    ROS_INFO("anemometer_node: input %s, protocol %s, frame %s", input_.c_str(),
+             AnemometerProtocolName(decoder_.protocol()), frame_id_.c_str());
     return true;
   }
 

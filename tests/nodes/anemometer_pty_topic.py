@@ -10,6 +10,7 @@ import unittest
 import rospy
 import rostest
 from clothwind.msg import RawSentence, WindMeasurement
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 
 
 class AnemometerTopicTest(unittest.TestCase):
@@ -59,6 +60,26 @@ class AnemometerTopicTest(unittest.TestCase):
             self.assertAlmostEqual(w.direction, math.pi - math.radians(229.0), places=9)
             self.assertEqual(w.source, 'gill')
             self.assertTrue(w.valid)
+
+    def test_usb_without_station_keeps_retrying(self):
+        got = []
+
+        def on_diag(m):
+            for s in m.status:
+                if s.hardware_id == 'usb:1941:8021':
+                    got.append(s)
+
+        sub = rospy.Subscriber('/diagnostics', DiagnosticArray, on_diag, queue_size=10)
+        deadline = time.time() + 10.0
+        while time.time() < deadline and len(got) < 3:
+            time.sleep(0.2)
+        sub.unregister()
+        self.assertGreaterEqual(len(got), 3, 'usb-mode node published no diagnostics (crashed?)')
+        self.assertEqual(got[-1].level, DiagnosticStatus.ERROR)
+        self.assertIn('not connected', got[-1].message)
+        values = {kv.key: kv.value for kv in got[-1].values}
+        self.assertEqual(values['input'], 'usb')
+        self.assertIn('48 s', values['update period'])
 
 
 if __name__ == '__main__':
