@@ -61,7 +61,9 @@ WindReading FineOffsetToReading(const FineOffsetRecord& r) {
   w.relative = false;
   w.speed = r.wind_average;
   w.gust = r.wind_gust;
-  if (r.direction_index >= 0) {
+  // The vane keeps pointing somewhere in calm air; like other Fine Offset software, report no
+  // direction when the average is zero.
+  if (r.direction_index >= 0 && !(r.wind_average == 0.0)) {
     w.from_angle_deg = r.direction_index * 22.5;
     w.reference = AngleReference::kEarth;
   }

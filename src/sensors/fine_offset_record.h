@@ -70,8 +70,8 @@ bool FineOffsetCurrentAddress(const std::vector<uint8_t>& fixed, uint16_t* addre
 bool ParseFineOffsetRecord(const std::vector<uint8_t>& bytes, FineOffsetRecord* record, std::string* error);
 
 // Converts a record to a wind reading: speed = average, gust, direction as a compass bearing
-// (north-aligned station: AngleReference::kEarth). valid is false when contact was lost or the
-// average is missing.
+// (north-aligned station: AngleReference::kEarth), none in calm air (average 0). valid is false
+// when contact was lost or the average is missing.
 // Inputs:
 //   record  decoded record
 // Returns the reading (source "fine_offset").

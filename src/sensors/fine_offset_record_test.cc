@@ -70,6 +70,15 @@ TEST(FineOffsetRecord, InvalidFlags) {
   EXPECT_TRUE(std::isnan(r.wind_average));
   EXPECT_FALSE(FineOffsetToReading(r).valid);
 
+  b = kRecord;
+  b[9] = 0x00;  // calm: the vane's position means nothing
+  ASSERT_TRUE(ParseFineOffsetRecord(b, &r, &err));
+  w = FineOffsetToReading(r);
+  EXPECT_TRUE(w.valid);
+  EXPECT_EQ(w.speed, 0.0);
+  EXPECT_TRUE(std::isnan(WindDirection(w)));
+  EXPECT_EQ(WindVelocity(w)[0], 0.0);
+
   EXPECT_FALSE(ParseFineOffsetRecord({0x01, 0x02}, &r, &err));
   EXPECT_NE(err.find("16"), std::string::npos);
 }

@@ -2,6 +2,8 @@
 
 #include <libusb.h>
 
+#include <algorithm>
+
 #include "sensors/fine_offset_record.h"
 
 namespace clothwind::sensors {
@@ -96,11 +98,19 @@ bool FineOffsetUsb::ReadCurrentRecord(std::vector<uint8_t>* record, uint16_t* ad
   // Reads are 32 bytes from any address; reading at the record itself gets it whole even when
   // it straddles a 32-byte boundary (the memory wraps at the top, so clamp to 0xFFE0).
   const uint16_t start = *address > 0xFFE0 ? 0xFFE0 : *address;
-  std::vector<uint8_t> chunk;
-  if (!ReadChunk(start, &chunk, error)) return false;
   const size_t offset = *address - start;
-  record->assign(chunk.begin() + offset, chunk.begin() + offset + kFineOffsetRecordSize);
-  return true;
+  // The console may be writing the record while we read it: accept two identical reads.
+  std::vector<uint8_t> chunk, again;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    if (!ReadChunk(start, &chunk, error)) return false;
+    if (!ReadChunk(start, &again, error)) return false;
+    if (std::equal(chunk.begin() + offset, chunk.begin() + offset + kFineOffsetRecordSize, again.begin() + offset)) {
+      record->assign(chunk.begin() + offset, chunk.begin() + offset + kFineOffsetRecordSize);
+      return true;
+    }
+  }
+  *error = "fine_offset USB: current record kept changing between reads";
+  return false;
 }
 
 }  // namespace clothwind::sensors
