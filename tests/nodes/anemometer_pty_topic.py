@@ -48,7 +48,13 @@ class AnemometerTopicTest(unittest.TestCase):
         self.send('\\xFF\\x00 garbage', 1235, 0)
         self.send(gill[:-1] + ('0' if gill[-1] != '0' else '1'), 1236, 0, 'gill')  # bad checksum
         self.send(gill, 1237, 999999999, 'gill')
-        time.sleep(1.0)
+        deadline = time.time() + 10.0
+        while time.time() < deadline:
+            with self.lock:
+                if len(self.winds) >= 2:
+                    break
+            time.sleep(0.1)
+        time.sleep(0.5)
         with self.lock:
             winds = list(self.winds)
         self.assertEqual(len(winds), 2, [(w.header.stamp.to_sec(), w.speed) for w in winds])
