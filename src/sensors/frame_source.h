@@ -53,6 +53,11 @@ class FrameSource {
   // Releases the source (idempotent).
   virtual void Close() = 0;
 
+  // True between a successful Open and Close. A V4L2 camera stays "open" while it is
+  // reconnecting (it heals itself); a recording closes itself when nothing in it is readable any
+  // more, and then needs Open again.
+  virtual bool IsOpen() const = 0;
+
   // Last error message ("" when none).
   virtual std::string error() const = 0;
 

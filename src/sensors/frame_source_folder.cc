@@ -74,6 +74,7 @@ bool ImageFolderSource::Open() {
   }
   std::sort(files_.begin(), files_.end());
   next_ = 0;
+  consecutive_failures_ = 0;
   sequence_ = 0;
   first_cols_ = first_rows_ = 0;
   first_encoding_.clear();
@@ -130,8 +131,14 @@ ReadStatus ImageFolderSource::Read(Frame* frame, double max_wait_s) {
     if (!LoadNext(&why)) {
       error_ = why;
       ++next_;  // skip the bad file rather than failing on it forever
+      if (++consecutive_failures_ >= files_.size()) {
+        // Not one readable image in a whole round (folder deleted?): close, so Open re-lists.
+        error_ = "image folder " + folder_ + ": no image readable any more (last: " + why + ")";
+        Close();
+      }
       return ReadStatus::kError;
     }
+    consecutive_failures_ = 0;
   }
   int64_t stamp = 0;
   if (!pacer_.WaitNext(max_wait_s, &stamp)) return ReadStatus::kNoFrame;

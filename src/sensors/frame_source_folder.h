@@ -27,6 +27,7 @@ class ImageFolderSource : public FrameSource {
   bool Open() override;
   ReadStatus Read(Frame* frame, double max_wait_s) override;
   void Close() override;
+  bool IsOpen() const override { return open_; }
   std::string error() const override { return error_; }
   std::string Describe() const override;
   double NominalRate() const override { return pacer_.rate_hz(); }
@@ -43,6 +44,7 @@ class ImageFolderSource : public FrameSource {
   FramePacer pacer_;
   std::vector<std::string> files_;
   size_t next_ = 0;
+  size_t consecutive_failures_ = 0;
   uint64_t sequence_ = 0;
   bool open_ = false;
   bool pending_valid_ = false;

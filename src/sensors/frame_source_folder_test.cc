@@ -108,6 +108,28 @@ TEST(ImageFolderSourceTest, ClearErrorsForMissingEmptyAndInconsistentFolders) {
   EXPECT_EQ(source.Read(&f, 1.0), ReadStatus::kEnd);
 }
 
+TEST(ImageFolderSourceTest, ClosesItselfWhenNothingIsReadableAnyMore) {
+  FakeClock clock;
+  {
+    TempDir dir;
+    WriteFrames(dir.path(), 3, 1);
+    ImageFolderSource source(dir.path(), 10.0, true, &clock);
+    ASSERT_TRUE(source.Open());
+    Frame f;
+    ASSERT_EQ(source.Read(&f, 1.0), ReadStatus::kFrame);
+    fs::remove_all(dir.path());
+    int errors = 0;
+    while (source.IsOpen() && errors < 10) {
+      ASSERT_EQ(source.Read(&f, 1.0), ReadStatus::kError);
+      ++errors;
+    }
+    EXPECT_EQ(errors, 3);  // one full round of unreadable files
+    EXPECT_FALSE(source.IsOpen());
+    EXPECT_NE(source.error().find("no image readable any more"), std::string::npos) << source.error();
+    EXPECT_FALSE(source.Open());
+  }
+}
+
 TEST(ImageFolderSourceTest, NormalizesSixteenBitAndAlpha) {
   cv::Mat image;
   std::string encoding;

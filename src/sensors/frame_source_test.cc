@@ -56,3 +56,48 @@ TEST(FramePacerTest, LateReadsKeepTheScheduleButLongStallsRestartIt) {
 }  // namespace
 }  // namespace sensors
 }  // namespace clothwind
+
+#include "sensors/frame_source_factory.h"
+
+namespace clothwind {
+namespace sensors {
+namespace {
+
+TEST(MakeFrameSourceTest, BuildsEachKindAndNamesBadOptions) {
+  FakeClock clock;
+  std::string error;
+  FrameSourceOptions o;
+  o.source = "v4l2";
+  auto v4l2 = MakeFrameSource(o, &clock, {}, &error);
+  ASSERT_NE(v4l2, nullptr) << error;
+  EXPECT_EQ(v4l2->Status().at("device"), "/dev/video0");
+  o.pixel_format = "NV12";
+  EXPECT_EQ(MakeFrameSource(o, &clock, {}, &error), nullptr);
+  EXPECT_NE(error.find("'NV12' is not one of YUYV, MJPEG, GREY"), std::string::npos) << error;
+  o.pixel_format = "MJPEG";
+  o.width = 0;
+  EXPECT_EQ(MakeFrameSource(o, &clock, {}, &error), nullptr);
+  EXPECT_NE(error.find("width and height"), std::string::npos) << error;
+
+  FrameSourceOptions f;
+  f.source = "folder";
+  EXPECT_EQ(MakeFrameSource(f, &clock, {}, &error), nullptr);
+  EXPECT_NE(error.find("'folder' needs a path"), std::string::npos) << error;
+  f.path = "/tmp";
+  auto folder = MakeFrameSource(f, &clock, {}, &error);
+  ASSERT_NE(folder, nullptr);
+  EXPECT_EQ(folder->Status().at("source"), "folder");
+  f.source = "video";
+  EXPECT_EQ(MakeFrameSource(f, &clock, {}, &error)->Status().at("source"), "video");
+  f.source = "rtsp";
+  EXPECT_EQ(MakeFrameSource(f, &clock, {}, &error), nullptr);
+  EXPECT_NE(error.find("'rtsp' is not one of v4l2, video, folder"), std::string::npos);
+  f.source = "folder";
+  f.fps = 0;
+  EXPECT_EQ(MakeFrameSource(f, &clock, {}, &error), nullptr);
+  EXPECT_NE(error.find("must be > 0 Hz"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sensors
+}  // namespace clothwind

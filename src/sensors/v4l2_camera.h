@@ -82,6 +82,9 @@ class V4l2Camera : public FrameSource {
   // STREAMOFF, munmap, close. Reads after Close reopen the device.
   void Close() override;
 
+  // True from Open (even a failed one: Reads keep retrying) until Close.
+  bool IsOpen() const override { return state_ != "closed"; }
+
   std::string error() const override { return error_; }
   std::string Describe() const override;
   double NominalRate() const override { return negotiated_.fps > 0 ? negotiated_.fps : options_.fps; }

@@ -65,6 +65,7 @@ ReadStatus VideoFileSource::Read(Frame* frame, double max_wait_s) {
       // Seeking back is unreliable across backends; reopening is not.
       if (!OpenCapture() || !capture_.read(raw) || raw.empty()) {
         error_ = "video " + path_ + ": cannot restart for looping";
+        Close();
         return ReadStatus::kError;
       }
       ++loops_;

@@ -26,6 +26,7 @@ class VideoFileSource : public FrameSource {
   bool Open() override;
   ReadStatus Read(Frame* frame, double max_wait_s) override;
   void Close() override;
+  bool IsOpen() const override { return open_; }
   std::string error() const override { return error_; }
   std::string Describe() const override;
   double NominalRate() const override { return rate_hz_; }

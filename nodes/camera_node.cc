@@ -1,0 +1,213 @@
+// camera_node: frames from a V4L2 camera (or, for tests and bench work, a video file or an image
+// folder played at its native rate) published as camera/image_raw + camera/camera_info.
+//
+// Publishes   camera/image_raw (sensor_msgs/Image, mono8 for GREY, bgr8 otherwise; through
+//             image_transport), camera/camera_info (sensor_msgs/CameraInfo, same stamp),
+//             /diagnostics (rate and stamp age of camera/image_raw, source state, negotiated
+//             format, dropped frames, reconnects)
+// Services    camera/set_camera_info (camera_info_manager: camera_calibration stores here)
+// Parameters  ~source (v4l2 | video | folder), ~device (/dev/video0), ~path (video file or image
+//             folder), ~pixel_format (YUYV | MJPEG | GREY), ~width, ~height [px], ~fps [Hz],
+//             ~rate [Hz] (folder rate; default ~fps), ~loop, ~buffers, ~timeout [s],
+//             ~auto_exposure (bool), ~exposure_absolute [100 us], ~gain, ~frame_id
+//             (camera_optical_frame), ~camera_name (camera), ~camera_info_url
+// Frame stamps are capture instants from the driver's buffer timestamps mapped to ROS time
+// (src/sensors/frame_timestamp.h), not the time of publishing. See docs/camera.md.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include <camera_info_manager/camera_info_manager.h>
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/publisher.h>
+#include <image_transport/image_transport.h>
+#include <ros/ros.h>
+
+#include "ros_bridge/image_conversions.h"
+#include "sensors/frame_source.h"
+#include "sensors/frame_source_factory.h"
+#include "sensors/frame_timestamp.h"
+
+namespace {
+
+using clothwind::sensors::Frame;
+using clothwind::sensors::FrameSource;
+using clothwind::sensors::FrameSourceOptions;
+using clothwind::sensors::LogLevel;
+using clothwind::sensors::ReadStatus;
+
+// Monotonic clock from the system, "ROS time" from ros::Time::now() (the wall clock, or /clock
+// under use_sim_time), so stamps are in the time base every subscriber compares against.
+class RosClock : public clothwind::sensors::SystemClock {
+ public:
+  int64_t RosNs() override { return static_cast<int64_t>(ros::Time::now().toNSec()); }
+};
+
+FrameSourceOptions ReadOptions(ros::NodeHandle& pnh) {
+  FrameSourceOptions o;
+  pnh.param<std::string>("source", o.source, "v4l2");
+  if (o.source == "v4l2") {
+    pnh.param<std::string>("device", o.path, "/dev/video0");
+  } else {
+    pnh.param<std::string>("path", o.path, "");
+  }
+  pnh.param<std::string>("pixel_format", o.pixel_format, "YUYV");
+  pnh.param("width", o.width, 640);
+  pnh.param("height", o.height, 480);
+  pnh.param("fps", o.fps, 30.0);
+  if (o.source == "folder") pnh.param("rate", o.fps, o.fps);
+  pnh.param("buffers", o.buffers, 4);
+  pnh.param("timeout", o.timeout_s, 2.0);
+  pnh.param("loop", o.loop, false);
+  if (pnh.hasParam("auto_exposure")) {
+    bool on = true;
+    pnh.getParam("auto_exposure", on);
+    o.auto_exposure = on ? 1 : 0;
+  }
+  pnh.param("exposure_absolute", o.exposure_absolute, -1);
+  pnh.param("gain", o.gain, -1);
+  return o;
+}
+
+void RosLog(LogLevel level, const std::string& message) {
+  switch (level) {
+    case LogLevel::kInfo: ROS_INFO_STREAM(message); break;
+    case LogLevel::kWarn: ROS_WARN_STREAM(message); break;
+    case LogLevel::kError: ROS_ERROR_STREAM(message); break;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "camera_node");
+  ros::NodeHandle nh;
+  ros::NodeHandle pnh("~");
+
+  const FrameSourceOptions options = ReadOptions(pnh);
+  std::string frame_id, camera_name, camera_info_url;
+  pnh.param<std::string>("frame_id", frame_id, "camera_optical_frame");
+  pnh.param<std::string>("camera_name", camera_name, "camera");
+  pnh.param<std::string>("camera_info_url", camera_info_url, "");
+
+  RosClock clock;
+  std::string error;
+  std::unique_ptr<FrameSource> source = clothwind::sensors::MakeFrameSource(options, &clock, RosLog, &error);
+  if (!source) {
+    ROS_FATAL_STREAM("camera_node: bad parameters: " << error);
+    return 1;
+  }
+
+  ros::NodeHandle camera_nh(nh, "camera");
+  camera_info_manager::CameraInfoManager info_manager(camera_nh, camera_name, camera_info_url);
+  if (!camera_info_url.empty() && !info_manager.isCalibrated()) {
+    ROS_WARN_STREAM("camera_node: no calibration loaded from '" << camera_info_url
+                    << "'; camera_info carries the image size only");
+  }
+  image_transport::ImageTransport transport(nh);
+  image_transport::CameraPublisher publisher = transport.advertiseCamera("camera/image_raw", 1);
+
+  diagnostic_updater::Updater updater;
+  updater.setHardwareID(options.source == "v4l2" ? options.path : options.source + ":" + options.path);
+  double min_rate = options.fps, max_rate = options.fps;  // the nominal rate, once known
+  // Stamps are capture instants: a little in the past (latency), never in the future.
+  diagnostic_updater::TopicDiagnostic topic_diagnostic(
+      "camera/image_raw", updater,
+      diagnostic_updater::FrequencyStatusParam(&min_rate, &max_rate, 0.1, 10),
+      diagnostic_updater::TimeStampStatusParam(-0.05, 0.5));
+  uint64_t published = 0, read_errors = 0, last_drops_seen = 0;
+  std::string last_error;
+  bool opened = false, ended = false;
+  updater.add("camera source", [&](diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    const auto status = source->Status();
+    for (const auto& kv : status) stat.add(kv.first, kv.second);
+    stat.add("published", published);
+    stat.add("read errors", read_errors);
+    stat.add("frame_id", frame_id);
+    const auto state = status.count("state") ? status.at("state") : std::string("?");
+    uint64_t drops = 0;
+    if (status.count("dropped frames")) drops = std::stoull(status.at("dropped frames"));
+    if (!opened) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "cannot open: " + last_error);
+    } else if (ended) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "recording ended");
+    } else if (state != "streaming" && state != "open") {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, state + ": " + last_error);
+    } else if (drops > last_drops_seen) {
+      stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu frames dropped since last report",
+                    static_cast<unsigned long long>(drops - last_drops_seen));
+    } else {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::OK, state + ": " + source->Describe());
+    }
+    last_drops_seen = drops;
+  });
+
+  double open_backoff_s = 0.25;
+  bool warned_size = false;
+  while (ros::ok()) {
+    if (!opened) {
+      if (source->Open()) {
+        opened = true;
+        const double rate = source->NominalRate();
+        if (rate > 0) min_rate = max_rate = rate;
+        ROS_INFO_STREAM("camera_node: publishing " << source->Describe() << " on "
+                        << publisher.getTopic() << " in frame " << frame_id);
+      } else {
+        last_error = source->error();
+        ROS_ERROR_STREAM_THROTTLE(5.0, "camera_node: " << last_error << " (retrying)");
+        updater.update();
+        ros::WallDuration(open_backoff_s).sleep();
+        open_backoff_s = std::min(open_backoff_s * 2.0, 5.0);
+        ros::spinOnce();
+        continue;
+      }
+    }
+    if (ended) {
+      ros::WallDuration(0.1).sleep();
+    } else {
+      Frame frame;
+      const ReadStatus status = source->Read(&frame, 0.1);
+      if (status == ReadStatus::kFrame) {
+        try {
+          sensor_msgs::ImagePtr image = clothwind::ros_bridge::ToImageMsg(frame, frame_id);
+          bool mismatch = false;
+          sensor_msgs::CameraInfoPtr info =
+              clothwind::ros_bridge::CameraInfoFor(info_manager.getCameraInfo(), *image, &mismatch);
+          if (mismatch && !warned_size) {
+            ROS_WARN_STREAM("camera_node: the calibration is for another image size than "
+                            << image->width << "x" << image->height
+                            << "; publishing camera_info without it");
+            warned_size = true;
+          }
+          publisher.publish(image, info);
+          topic_diagnostic.tick(image->header.stamp);
+          ++published;
+          const double rate = source->NominalRate();  // may change after a reconnect
+          if (rate > 0) min_rate = max_rate = rate;
+        } catch (const std::exception& e) {
+          ++read_errors;
+          last_error = e.what();
+          ROS_ERROR_STREAM_THROTTLE(2.0, "camera_node: " << last_error);
+        }
+      } else if (status == ReadStatus::kError) {
+        ++read_errors;
+        last_error = source->error();
+        ROS_WARN_STREAM_THROTTLE(2.0, "camera_node: " << last_error);
+        if (!source->IsOpen()) {  // a recording that became unreadable: Open again, with backoff
+          opened = false;
+          open_backoff_s = 0.25;
+        }
+      } else if (status == ReadStatus::kEnd) {
+        ended = true;
+        ROS_INFO_STREAM("camera_node: end of " << source->Describe() << " after " << published
+                        << " frames (set ~loop to repeat)");
+      }
+    }
+    updater.update();
+    ros::spinOnce();
+  }
+  // SIGINT/shutdown: STREAMOFF, munmap, close before exiting.
+  source->Close();
+  return 0;
+}

@@ -1,0 +1,186 @@
+#!/usr/bin/env python3
+"""rostest for camera_node in folder mode (see tests/camera_node.test).
+
+Writes two PNG sequences (colour 40x30 and grey 24x16) into folders the nodes are already
+polling for (written under a temporary name, then renamed, so a node never sees half a folder),
+then checks the published images and camera_info. PNGs are written with zlib only: the test
+needs no OpenCV in Python.
+"""
+import os
+import shutil
+import struct
+import sys
+import tempfile
+import threading
+import time
+import unittest
+import zlib
+
+import rospy
+import rostest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from sensor_msgs.msg import CameraInfo, Image
+
+N_FRAMES = 10
+
+
+def write_png(path, width, height, channels, pixel):
+    """pixel(x, y) -> tuple of `channels` bytes (RGB or grey)."""
+    raw = bytearray()
+    for y in range(height):
+        raw.append(0)  # filter type none
+        for x in range(width):
+            raw.extend(pixel(x, y))
+    colour_type = 2 if channels == 3 else 0
+
+    def chunk(tag, data):
+        body = tag + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+
+    png = b"\x89PNG\r\n\x1a\n"
+    png += chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, colour_type, 0, 0, 0))
+    png += chunk(b"IDAT", zlib.compress(bytes(raw)))
+    png += chunk(b"IEND", b"")
+    with open(path, "wb") as f:
+        f.write(png)
+
+
+def colour_value(k):
+    return 20 + 20 * k
+
+
+def grey_value(k):
+    return 200 - 15 * k
+
+
+def write_folder(target, width, height, channels, value):
+    staging = tempfile.mkdtemp(prefix=".staging_", dir=os.path.dirname(target))
+    for k in range(N_FRAMES):
+        v = value(k)
+        if channels == 3:
+            pixel = lambda x, y, v=v: (v, 255 - v, 7)  # R, G, B
+        else:
+            pixel = lambda x, y, v=v: (v,)
+        write_png(os.path.join(staging, "frame_%04d.png" % k), width, height, channels, pixel)
+    os.rename(staging, target)
+
+
+class Collector:
+    def __init__(self, prefix):
+        self.lock = threading.Lock()
+        self.images = []  # (receive time, msg)
+        self.infos = []
+        rospy.Subscriber(prefix + "camera/image_raw", Image, self.on_image, queue_size=50)
+        rospy.Subscriber(prefix + "camera/camera_info", CameraInfo, self.on_info, queue_size=50)
+
+    def on_image(self, msg):
+        with self.lock:
+            self.images.append((rospy.get_time(), msg))
+
+    def on_info(self, msg):
+        with self.lock:
+            self.infos.append(msg)
+
+    def wait_for(self, count, timeout):
+        deadline = time.time() + timeout
+        while time.time() < deadline and not rospy.is_shutdown():
+            with self.lock:
+                if len(self.images) >= count:
+                    return True
+            time.sleep(0.05)
+        return False
+
+
+class CameraFolderTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("camera_folder_check")
+        cls.colour_folder = rospy.get_param("~colour_folder")
+        cls.grey_folder = rospy.get_param("~grey_folder")
+        cls.diagnostics = []
+        rospy.Subscriber("/diagnostics", DiagnosticArray, lambda m: cls.diagnostics.append(m))
+        cls.colour = Collector("/")
+        cls.grey = Collector("/mono/")
+        time.sleep(1.0)  # the nodes are polling for folders that do not exist yet
+        write_folder(cls.colour_folder, 40, 30, 3, colour_value)
+        write_folder(cls.grey_folder, 24, 16, 1, grey_value)
+
+    @classmethod
+    def tearDownClass(cls):
+        for folder in (cls.colour_folder, cls.grey_folder):
+            shutil.rmtree(folder, ignore_errors=True)
+
+    def check_stream(self, collector, rate, width, height, encoding, channels, frame_id, expected):
+        # Two full loops of the folder, plus some, after the first image.
+        n = 2 * N_FRAMES + 5
+        self.assertTrue(collector.wait_for(n, timeout=n / rate + 20.0),
+                        "only %d images within the timeout" % len(collector.images))
+        time.sleep(0.5)  # camera_info travels on its own connection: let the last ones land
+        with collector.lock:
+            images = list(collector.images)[:n]
+            infos = list(collector.infos)
+        period = 1.0 / rate
+        stamps = [m.header.stamp.to_sec() for _, m in images]
+        # Stamps strictly increasing and evenly spaced at the folder rate (they are the due
+        # instants of the schedule, not the publishing times).
+        for a, b in zip(stamps, stamps[1:]):
+            self.assertAlmostEqual(b - a, period, delta=0.002, msg="stamp step %.4f s" % (b - a))
+        # Arrival rate matches too (a real-time check, so loosely).
+        arrival = [t for t, _ in images]
+        measured = (len(arrival) - 1) / (arrival[-1] - arrival[0])
+        self.assertAlmostEqual(measured, rate, delta=0.15 * rate)
+        # Stamps are recent (not stale, not in the future).
+        for (t, m) in images:
+            age = t - m.header.stamp.to_sec()
+            self.assertGreater(age, -0.01)
+            self.assertLess(age, 0.5)
+        # Format, size, frame, and content in filename order, looping.
+        first = None
+        for i, (_, m) in enumerate(images):
+            self.assertEqual(m.encoding, encoding)
+            self.assertEqual((m.width, m.height), (width, height))
+            self.assertEqual(m.step, width * channels)
+            self.assertEqual(len(m.data), width * height * channels)
+            self.assertEqual(m.header.frame_id, frame_id)
+            pixel = tuple(bytearray(m.data[(height // 2 * width + width // 2) * channels:][:channels]))
+            k = [expected(j) for j in range(N_FRAMES)].index(pixel)
+            if first is None:
+                first = k
+            self.assertEqual(k, (first + i) % N_FRAMES, "image %d shows frame %d" % (i, k))
+        # camera_info with every image, same stamp, same frame, image size (uncalibrated).
+        info_by_stamp = {c.header.stamp: c for c in infos}
+        for _, m in images:
+            self.assertIn(m.header.stamp, info_by_stamp, "no camera_info with stamp %s" % m.header.stamp)
+            info = info_by_stamp[m.header.stamp]
+            self.assertEqual(info.header.frame_id, frame_id)
+            self.assertEqual((info.width, info.height), (width, height))
+
+    def test_colour_folder(self):
+        # PNG RGB (v, 255-v, 7) arrives as bgr8 (7, 255-v, v).
+        self.check_stream(self.colour, 20.0, 40, 30, "bgr8", 3, "test_camera_optical_frame",
+                          lambda k: (7, 255 - colour_value(k), colour_value(k)))
+
+    def test_grey_folder(self):
+        self.check_stream(self.grey, 12.5, 24, 16, "mono8", 1, "camera_optical_frame",
+                          lambda k: (grey_value(k),))
+
+    def test_diagnostics(self):
+        self.assertTrue(self.colour.wait_for(N_FRAMES, timeout=30.0))
+        deadline = time.time() + 10.0
+        seen = {}
+        while time.time() < deadline and len(seen) < 2:
+            for array in list(self.diagnostics):
+                for s in array.status:
+                    if s.name.startswith("camera_node: ") and s.level == DiagnosticStatus.OK:
+                        seen[s.name] = {kv.key: kv.value for kv in s.values}
+            time.sleep(0.2)
+        self.assertIn("camera_node: camera/image_raw topic status", seen)
+        self.assertIn("camera_node: camera source", seen)
+        source = seen["camera_node: camera source"]
+        self.assertEqual(source["source"], "folder")
+        self.assertEqual(source["images"], str(N_FRAMES))
+        self.assertEqual(source["frame_id"], "test_camera_optical_frame")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("clothwind", "camera_node_folder", CameraFolderTest, sys.argv)
