@@ -1,0 +1,145 @@
+// clip_report_node: listens to `clips` during a replay and, when the replay is over, prints what
+// came out (a table: sequence, start, end, frames, spacing, wind label) with totals, writes the same
+// as JSON (~summary) and exits, which ends the launch when the node is marked required.
+//
+// "Over": the clock (sim time from rosbag play --clock) has not moved for ~idle_timeout wall
+// seconds after it started, and no clip has arrived in that time either (the clip buffer labels
+// its last waiting clips ~flush_after wall seconds after its input stops). ~max_wall bounds it.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <ros/ros.h>
+
+#include <clothwind/Clip.h>
+
+#include "sensors/dataset_writer.h"
+
+namespace {
+
+struct Row {
+  uint64_t sequence;
+  double start, end;
+  uint32_t frames;
+  double max_spacing_error;  // largest |frame interval - 1/rate| [s]
+  double mean, std, direction;
+  uint32_t count, width, height;
+};
+
+class ClipReport {
+ public:
+  explicit ClipReport(ros::NodeHandle& pnh) {
+    pnh.param("idle_timeout", idle_timeout_, 8.0);
+    pnh.param("max_wall", max_wall_, 0.0);
+    pnh.param("summary", summary_path_, std::string());
+    ros::NodeHandle nh;
+    sub_ = nh.subscribe("clips", 50, &ClipReport::OnClip, this);
+    start_wall_ = last_change_ = ros::WallTime::now();
+    timer_ = nh.createWallTimer(ros::WallDuration(0.5), &ClipReport::OnTimer, this);
+  }
+
+ private:
+  void OnClip(const clothwind::Clip::ConstPtr& c) {
+    last_change_ = ros::WallTime::now();
+    Row r{};
+    r.sequence = c->sequence;
+    r.frames = c->num_frames;
+    r.start = c->frame_stamps.empty() ? NAN : c->frame_stamps.front().toSec();
+    r.end = c->frame_stamps.empty() ? NAN : c->frame_stamps.back().toSec();
+    for (size_t i = 1; i < c->frame_stamps.size(); ++i) {
+      const double dt = (c->frame_stamps[i] - c->frame_stamps[i - 1]).toSec();
+      r.max_spacing_error = std::max(r.max_spacing_error, std::fabs(dt - 1.0 / c->frame_rate));
+    }
+    r.mean = c->wind_mean;
+    r.std = c->wind_std;
+    r.count = c->wind_count;
+    r.direction = c->wind_direction_mean;
+    r.width = c->width;
+    r.height = c->height;
+    rate_ = c->frame_rate;
+    window_ = c->label_window;
+    rows_.push_back(r);
+  }
+
+  void OnTimer(const ros::WallTimerEvent&) {
+    const ros::Time now = ros::Time::now();
+    if (now != last_clock_) {
+      last_clock_ = now;
+      last_change_ = ros::WallTime::now();
+      clock_started_ = clock_started_ || !now.isZero();
+    }
+    const double idle = (ros::WallTime::now() - last_change_).toSec();
+    const double wall = (ros::WallTime::now() - start_wall_).toSec();
+    if ((clock_started_ && idle > idle_timeout_) || (max_wall_ > 0 && wall > max_wall_)) {
+      Print(wall);
+      ros::shutdown();
+    }
+  }
+
+  void Print(double wall) {
+    std::printf("\nclip_report: %zu clip(s) from the replay\n", rows_.size());
+    std::printf("%5s  %-12s  %-12s  %6s  %7s  %9s  %8s  %8s  %5s  %8s\n", "seq", "start [s]", "end [s]",
+                "frames", "span", "dt err", "wind", "std", "count", "dir");
+    const double t0 = rows_.empty() ? 0.0 : rows_.front().start;
+    double label_sum = 0;
+    size_t labelled = 0, frames = 0;
+    double worst_spacing = 0;
+    nlohmann::json clips = nlohmann::json::array();
+    for (const auto& r : rows_) {
+      std::printf("%5llu  %12.3f  %12.3f  %6u  %6.3fs  %7.1fus  %8.3f  %8.3f  %5u  %8.3f\n",
+                  static_cast<unsigned long long>(r.sequence), r.start - t0, r.end - t0, r.frames, r.end - r.start,
+                  r.max_spacing_error * 1e6, r.mean, r.std, r.count, r.direction);
+      frames += r.frames;
+      worst_spacing = std::max(worst_spacing, r.max_spacing_error);
+      if (r.count > 0) {
+        label_sum += r.mean;
+        ++labelled;
+      }
+      clips.push_back({{"sequence", r.sequence}, {"start", r.start}, {"end", r.end}, {"frames", r.frames},
+                       {"width", r.width}, {"height", r.height}, {"max_spacing_error", r.max_spacing_error},
+                       {"wind_mean", std::isfinite(r.mean) ? nlohmann::json(r.mean) : nlohmann::json()},
+                       {"wind_std", std::isfinite(r.std) ? nlohmann::json(r.std) : nlohmann::json()},
+                       {"wind_count", r.count}});
+    }
+    const double covered = rows_.empty() ? 0.0 : rows_.back().end - rows_.front().start;
+    std::printf("totals: %zu clips, %zu frames at %.1f fps (%dx%d), %zu labelled (label window %.0f s, mean of "
+                "labels %.3f m/s), first to last frame %.2f s, worst frame spacing error %.1f us, wall %.1f s\n",
+                rows_.size(), frames, rate_, rows_.empty() ? 0 : static_cast<int>(rows_.front().width),
+                rows_.empty() ? 0 : static_cast<int>(rows_.front().height), labelled, window_,
+                labelled ? label_sum / labelled : NAN, covered, worst_spacing * 1e6, wall);
+    std::fflush(stdout);
+    if (!summary_path_.empty()) {
+      nlohmann::json j = {{"clips", clips},
+                          {"total_clips", rows_.size()},
+                          {"total_frames", frames},
+                          {"labelled_clips", labelled},
+                          {"frame_rate", rate_},
+                          {"label_window", window_},
+                          {"wall_seconds", wall}};
+      clothwind::sensors::WriteFileAtomically(summary_path_, j.dump(1) + "\n");
+    }
+  }
+
+  double idle_timeout_ = 8.0, max_wall_ = 0.0;
+  std::string summary_path_;
+  ros::Subscriber sub_;
+  ros::WallTimer timer_;
+  ros::WallTime start_wall_, last_change_;
+  ros::Time last_clock_;
+  bool clock_started_ = false;
+  std::vector<Row> rows_;
+  double rate_ = 0.0, window_ = 0.0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "clip_report");
+  ros::NodeHandle pnh("~");
+  ClipReport report(pnh);
+  ros::spin();
+  return 0;
+}
