@@ -1,6 +1,7 @@
 #include "render/background.h"
 
 #include <algorithm>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -79,7 +80,7 @@ Texture ProceduralBackdrop(uint64_t seed, int width, int height) {
                  s_grass = rng.Next();
   const bool hills = rng.Uniform() < 0.6;
   const float hill_base = static_cast<float>(rng.Uniform(4, 10));
-  const float tree_base = static_cast<float>(rng.Uniform(6, 15));
+  const float tree_base = static_cast<float>(rng.Uniform(7, 20));
   const float tree_gap = static_cast<float>(rng.Uniform(0.0, 0.45));  // fraction of open field
   const Rgb haze = Paint(200, 212, 222);
   const Rgb hill_col = Paint(95, 120, 105);
@@ -109,6 +110,19 @@ Texture ProceduralBackdrop(uint64_t seed, int width, int height) {
     b.window = Paint(60, 70, 85);
     buildings.push_back(b);
   }
+  struct Crown {
+    float x, r, c;  // centre [m] along the wall, radius [m], centre height [m]
+  };
+  std::vector<Crown> crowns;
+  // Neighbouring crowns overlap (spacing below the radius), so a tree line has no slits.
+  for (float x = -6.0f; x < kWidthM + 6.0f;) {
+    Crown cr;
+    cr.x = x;
+    cr.r = static_cast<float>(rng.Uniform(2.0, 5.0));
+    cr.c = tree_base + static_cast<float>(rng.Uniform(-4.0, 5.0)) - cr.r;
+    crowns.push_back(cr);
+    x += cr.r * static_cast<float>(rng.Uniform(0.5, 0.95));
+  }
   for (int y = 0; y < height; ++y) {
     const float z = (1.0f - (y + 0.5f) / height) * kHeightM;
     for (int x = 0; x < width; ++x) {
@@ -134,11 +148,17 @@ Texture ProceduralBackdrop(uint64_t seed, int width, int height) {
       }
       const float open = FractalNoise(X / 25.0f, 3.7f, s_tree + 1, 2);
       if (open > tree_gap * 0.9f + 0.05f) {
-        const float canopy = tree_base + 6.0f * FractalNoise(X / 8.0f, 1.3f, s_tree, 3) +
-                             2.0f * ValueNoise(X / 1.2f, 0.7f, s_tree + 2);
+        // Rounded crowns, slightly ragged, over a dense understorey.
+        float canopy = 0.5f * tree_base;
+        for (const Crown& cr : crowns) {
+          const float d = X - cr.x;
+          if (std::abs(d) < cr.r) canopy = std::max(canopy, cr.c + 0.9f * std::sqrt(cr.r * cr.r - d * d));
+        }
+        canopy += 0.5f * ValueNoise(X / 0.6f, 0.7f, s_tree + 2);
         if (z < canopy) {
-          const float leaf = FractalNoise(X / 1.5f, z / 1.5f, s_leaf, 4);
-          const float shade = std::clamp(0.3f + 0.9f * leaf + 0.02f * (z - canopy), 0.0f, 1.0f);
+          const float leaf = FractalNoise(X / 1.2f, z / 1.2f, s_leaf, 4);
+          const float shade =
+              std::clamp(0.15f + 0.9f * leaf + 0.35f * (z / std::max(canopy, 1.0f)), 0.0f, 1.0f);
           c = tree_dark + shade * (tree_light - tree_dark);
           a = 1.0f;
         }

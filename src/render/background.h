@@ -21,7 +21,7 @@ namespace clothwind::render {
 // is transparent, as procedural skies are) the renderer's sky shows. Texels hold radiance, so
 // the wall is not lit again: a photograph carries its own light.
 struct Backdrop {
-  static constexpr float kBackdropDistance = 35.0f;  // [m]
+  static constexpr float kBackdropDistance = 22.0f;  // [m]
   static constexpr float kBackdropHeight = 45.0f;    // [m] at scale 1
 
   Texture image;                     // radiance + alpha

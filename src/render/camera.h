@@ -12,14 +12,14 @@ namespace clothwind::render {
 // Image coordinates are continuous, x to the right and y down, with pixel (i, j) covering
 // [i, i+1) x [j, j+1), so its centre is (i + 0.5, j + 0.5). Intrinsics:
 //   fx = fy = (width / 2) / tan(fov / 2),  cx = width / 2,  cy = height / 2
-// (300x300 with fov 50 deg: f = 321.7 px, principal point (150, 150)).
+// (300x300 with the default fov of 45 deg: f = 362.1 px, principal point (150, 150)).
 // The camera frame is right (x), down (y), forward (z); world is z up (REP 103).
 struct PinholeCamera {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // [m] world
   Eigen::Vector3d right = Eigen::Vector3d::UnitX();     // world direction of image +x
   Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();     // world direction of image +y
   Eigen::Vector3d forward = Eigen::Vector3d::UnitY();   // viewing direction
-  double focal_px = 321.7;
+  double focal_px = 362.1;
   double cx = 150.0, cy = 150.0;
   int width = 300, height = 300;
 

@@ -1,5 +1,6 @@
 #include "render/embree_scene.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -26,7 +27,10 @@ EmbreeScene::EmbreeScene(const RenderParams& p) {
   if (!device_) throw std::runtime_error("Embree: rtcNewDevice failed");
   scene_ = rtcNewScene(device_);
   rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_DYNAMIC);
-  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_LOW);
+  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+  cloth_scene_ = rtcNewScene(device_);
+  rtcSetSceneFlags(cloth_scene_, RTC_SCENE_FLAG_DYNAMIC);
+  rtcSetSceneBuildQuality(cloth_scene_, RTC_BUILD_QUALITY_LOW);
   lift_ = static_cast<float>(p.mesh_height);
   const float w = static_cast<float>(p.mesh_width);
   const float h = static_cast<float>(p.MeshRestHeight());
@@ -51,6 +55,7 @@ EmbreeScene::EmbreeScene(const RenderParams& p) {
 
 EmbreeScene::~EmbreeScene() {
   if (cloth_) rtcReleaseGeometry(cloth_);
+  if (cloth_scene_) rtcReleaseScene(cloth_scene_);
   if (scene_) rtcReleaseScene(scene_);
   if (device_) rtcReleaseDevice(device_);
 }
@@ -168,6 +173,8 @@ void EmbreeScene::SetCloth(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     normals_[b] += n;
     normals_[c] += n;
   }
+  cloth_bounds_.setEmpty();
+  for (const auto& q : positions_) cloth_bounds_.extend(q);
   for (auto& n : normals_) {
     const float len = n.norm();
     n = len > 1e-20f ? Eigen::Vector3f(n / len) : Eigen::Vector3f::UnitX();
@@ -175,7 +182,7 @@ void EmbreeScene::SetCloth(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
 
   if (!same_faces) {
     if (cloth_) {
-      rtcDetachGeometry(scene_, cloth_id_);
+      rtcDetachGeometry(cloth_scene_, cloth_id_);
       rtcReleaseGeometry(cloth_);
     }
     cloth_ = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -191,13 +198,50 @@ void EmbreeScene::SetCloth(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     for (int k = 0; k < 3; ++k) vb[3 * i + k] = positions_[i][k];
   if (same_faces) rtcUpdateGeometryBuffer(cloth_, RTC_BUFFER_TYPE_VERTEX, 0);
   rtcCommitGeometry(cloth_);
-  if (!same_faces) cloth_id_ = rtcAttachGeometry(scene_, cloth_);
-  rtcCommitScene(scene_);
+  if (!same_faces) cloth_id_ = rtcAttachGeometry(cloth_scene_, cloth_);
+  rtcCommitScene(cloth_scene_);
   CheckDevice(device_, "updating the cloth");
 }
 
 bool EmbreeScene::Intersect(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t_max,
                             Hit* hit) const {
+  const bool s = RawIntersect(scene_, org, dir, t_max, hit);
+  Hit cloth_hit;
+  if (cloth_ && RawIntersect(cloth_scene_, org, dir, s ? hit->t : t_max, &cloth_hit)) {
+    *hit = cloth_hit;
+    return true;
+  }
+  return s;
+}
+
+bool EmbreeScene::IntersectStatic(const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
+                                  float t_max, Hit* hit) const {
+  return RawIntersect(scene_, org, dir, t_max, hit);
+}
+
+bool EmbreeScene::IntersectCloth(const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
+                                 float t_max, Hit* hit) const {
+  return cloth_ && RawIntersect(cloth_scene_, org, dir, t_max, hit);
+}
+
+bool EmbreeScene::Occluded(const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
+                           float t_max) const {
+  return RawOccluded(scene_, org, dir, t_max) ||
+         (cloth_ && RawOccluded(cloth_scene_, org, dir, t_max));
+}
+
+bool EmbreeScene::OccludedStatic(const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
+                                 float t_max) const {
+  return RawOccluded(scene_, org, dir, t_max);
+}
+
+bool EmbreeScene::OccludedCloth(const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
+                                float t_max) const {
+  return cloth_ && RawOccluded(cloth_scene_, org, dir, t_max);
+}
+
+bool EmbreeScene::RawIntersect(RTCScene scene, const Eigen::Vector3f& org,
+                               const Eigen::Vector3f& dir, float t_max, Hit* hit) const {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh;
@@ -211,7 +255,7 @@ bool EmbreeScene::Intersect(const Eigen::Vector3f& org, const Eigen::Vector3f& d
   rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(scene_, &ctx, &rh);
+  rtcIntersect1(scene, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
     hit->surface = Surface::kNone;
     return false;
@@ -224,7 +268,7 @@ bool EmbreeScene::Intersect(const Eigen::Vector3f& org, const Eigen::Vector3f& d
   hit->geom_normal = ng;
   hit->back_face = false;
   const unsigned gid = rh.hit.geomID;
-  if (gid == cloth_id_) {
+  if (scene == cloth_scene_) {
     hit->surface = Surface::kCloth;
     const unsigned* f = &faces_[3 * rh.hit.primID];
     const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
@@ -263,8 +307,8 @@ bool EmbreeScene::Intersect(const Eigen::Vector3f& org, const Eigen::Vector3f& d
   return true;
 }
 
-bool EmbreeScene::Occluded(const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
-                           float t_max) const {
+bool EmbreeScene::RawOccluded(RTCScene scene, const Eigen::Vector3f& org,
+                              const Eigen::Vector3f& dir, float t_max) const {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRay ray;
@@ -276,7 +320,7 @@ bool EmbreeScene::Occluded(const Eigen::Vector3f& org, const Eigen::Vector3f& di
   ray.mask = 0xFFFFFFFFu;
   ray.id = 0;
   ray.flags = 0;
-  rtcOccluded1(scene_, &ctx, &ray);
+  rtcOccluded1(scene, &ctx, &ray);
   return ray.tfar < 0.0f;
 }
 

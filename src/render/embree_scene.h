@@ -4,6 +4,7 @@
 #include <embree3/rtcore.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <vector>
 
 #include "render/render_params.h"
@@ -45,13 +46,25 @@ class EmbreeScene {
   // Throws std::invalid_argument on mismatched sizes or out-of-range indices.
   void SetCloth(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Eigen::MatrixXd& UV);
 
-  // Intersects a ray. Inputs: org [m], dir (unit), t_max [m]. Outputs: hit.
+  // Intersects a ray with everything. Inputs: org [m], dir (unit), t_max [m]. Outputs: hit.
   // Returns true if anything was hit before t_max.
   bool Intersect(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t_max,
                  Hit* hit) const;
+  // The same against the static part only (pole, ground) or the cloth only. The renderer
+  // caches what camera rays see of the static part, since the camera does not move in a clip.
+  bool IntersectStatic(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t_max,
+                       Hit* hit) const;
+  bool IntersectCloth(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t_max,
+                      Hit* hit) const;
 
-  // True if anything blocks the segment org + t dir, t in (0, t_max).
+  // True if anything (resp. the static part, the cloth) blocks the segment org + t dir,
+  // t in (0, t_max).
   bool Occluded(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t_max) const;
+  bool OccludedStatic(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t_max) const;
+  bool OccludedCloth(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t_max) const;
+
+  // Axis-aligned bounds of the current cloth (world) [m]; empty before SetCloth.
+  const Eigen::AlignedBox3f& cloth_bounds() const { return cloth_bounds_; }
 
   // Per-vertex unit normals of the current cloth (#V by 3, world frame): area-weighted face
   // normals, recomputed on every SetCloth.
@@ -67,8 +80,10 @@ class EmbreeScene {
   void AddSphere(const Eigen::Vector3f& c, float radius);
 
   RTCDevice device_ = nullptr;
-  RTCScene scene_ = nullptr;
+  RTCScene scene_ = nullptr;        // static: pole, finial, ground
+  RTCScene cloth_scene_ = nullptr;  // the cloth alone, refitted every frame
   RTCGeometry cloth_ = nullptr;
+  Eigen::AlignedBox3f cloth_bounds_;
   unsigned cloth_id_ = RTC_INVALID_GEOMETRY_ID;
   unsigned ground_id_ = RTC_INVALID_GEOMETRY_ID;
   unsigned sphere_id_ = RTC_INVALID_GEOMETRY_ID;
@@ -78,6 +93,11 @@ class EmbreeScene {
   std::vector<Eigen::Vector3f> normals_;
   std::vector<Eigen::Vector2f> uvs_;
   std::vector<unsigned> faces_;  // 3 per face
+
+  bool RawIntersect(RTCScene scene, const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
+                    float t_max, Hit* hit) const;
+  bool RawOccluded(RTCScene scene, const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
+                   float t_max) const;
 };
 
 }  // namespace clothwind::render

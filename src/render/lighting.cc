@@ -1,6 +1,7 @@
 #include "render/lighting.h"
 
 #include <algorithm>
+#include <Eigen/Geometry>
 #include <cmath>
 
 namespace clothwind::render {

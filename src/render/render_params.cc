@@ -39,7 +39,7 @@ RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
     p.camera_height = rng.Uniform(0.2, 3);
     p.camera_radius = rng.Uniform(4, 6);
     p.camera_angle_deg = rng.Uniform(-15, 15);
-    p.camera_fov_deg = 50.0;
+    p.camera_fov_deg = 45.0;
     p.mesh_height = 4.6;
     p.mesh_width = 3.0;
     p.mesh_aspect_ratio = 1.5;
@@ -49,7 +49,7 @@ RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
     p.camera_height = rng.Uniform(0.5, 2);
     p.camera_radius = rng.Uniform(1, 2.5);
     p.camera_angle_deg = rng.Uniform(-5, 5);
-    p.camera_fov_deg = 50.0;
+    p.camera_fov_deg = 45.0;
     p.mesh_height = 2.0;
     p.mesh_width = 1.0;
     p.mesh_aspect_ratio = 1.0;

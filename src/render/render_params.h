@@ -46,7 +46,7 @@ struct RenderParams {
   double camera_height = 1.6;     // [m] flag ~U(0.2, 3), cloth ~U(0.5, 2)
   double camera_radius = 5.0;     // [m] horizontal distance, flag ~U(4, 6), cloth ~U(1, 2.5)
   double camera_angle_deg = 0.0;  // [deg] flag ~U(-15, 15), cloth ~U(-5, 5)
-  double camera_fov_deg = 50.0;   // [deg] horizontal = vertical field of view (square frame)
+  double camera_fov_deg = 45.0;   // [deg] horizontal = vertical field of view (square frame)
 
   // Mesh (Table 2): the simulator's frame is lifted by mesh_height (its origin, the hoist's
   // lower corner for flags, goes to that height above the ground).

@@ -68,103 +68,212 @@ Rgb Renderer::GroundAlbedo(const Eigen::Vector3f& p) const {
   return grass_.Sample(p.x() / kGrassTile, p.y() / kGrassTile, Wrap::kRepeat);
 }
 
-Rgb Renderer::Shade(const Hit& hit, const Eigen::Vector3f& dir, float sun_u1,
-                    float sun_u2) const {
+namespace {
+enum What : uint8_t { kSky = 0, kBackdrop = 1, kGroundSeen = 2, kPoleSeen = 3, kClothSeen = 4 };
+
+// Slab test: can the ray org + t dir, t in (0, t_max), meet the box? Cheaper than asking
+// Embree, and most rays of a frame pass far from the cloth.
+inline bool RayMeetsBox(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t_max,
+                        const Eigen::AlignedBox3f& box) {
+  if (box.isEmpty()) return false;
+  float t0 = 0.0f, t1 = t_max;
+  for (int k = 0; k < 3; ++k) {
+    const float inv = 1.0f / dir[k];
+    float a = (box.min()[k] - org[k]) * inv, b = (box.max()[k] - org[k]) * inv;
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+}  // namespace
+
+Renderer::StaticSample Renderer::ComputeStatic(const Eigen::Vector3f& org,
+                                               const Eigen::Vector3f& dir,
+                                               const Eigen::Vector3f& sun) const {
+  StaticSample s;
+  s.dir = dir;
+  s.sun = sun;
+  Hit hit;
+  const bool any = scene_->IntersectStatic(org, dir, kFar, &hit);
+  float tb, alpha;
+  Rgb bg;
+  if (backdrop_.Intersect(org, dir, &tb, &bg, &alpha) && (!any || tb < hit.t)) {
+    s.t = tb;
+    s.what = alpha > 0.5f ? kBackdrop : kSky;
+    s.base = alpha >= 1.0f ? bg : Rgb(alpha * bg + (1.0f - alpha) * lighting_.SkyRadiance(dir));
+    return s;
+  }
+  if (!any) {
+    s.t = kFar;
+    s.what = kSky;
+    s.base = lighting_.SkyRadiance(dir);
+    return s;
+  }
+  s.t = hit.t;
   Rgb albedo;
   switch (hit.surface) {
-    case Surface::kCloth:
-      albedo = texture_.Sample(hit.uv.x(), hit.uv.y(), Wrap::kClamp);
-      break;
     case Surface::kGround:
       albedo = GroundAlbedo(hit.point);
+      s.what = kGroundSeen;
       break;
     case Surface::kFinial:
       albedo = kFinialAlbedo;
+      s.what = kPoleSeen;
       break;
     default:
       albedo = kPoleAlbedo;
+      s.what = kPoleSeen;
       break;
   }
+  const Rgb brdf = kInvPi * albedo;
+  s.base = brdf.cwiseProduct(lighting_.AmbientIrradiance(hit.normal));
+  // n.l from the sun's centre (the disc is a few degrees wide; sampling it here would only add
+  // grain), the sampled point of the disc for the shadow ray (soft shadow edges).
+  const float ndl = hit.normal.dot(lighting_.sun_dir);
+  if (ndl > 0.0f && hit.geom_normal.dot(sun) > 0.0f) {
+    s.shadow_org = hit.point + kShadowEps * hit.geom_normal;
+    s.can_see_sun = !options_.shadows || !scene_->OccludedStatic(s.shadow_org, sun, kFar);
+    s.sunlit = brdf.cwiseProduct(ndl * lighting_.sun_irradiance);
+  }
+  return s;
+}
+
+Rgb Renderer::ShadeCloth(const Hit& hit, const Eigen::Vector3f& sun) const {
+  const Rgb albedo = texture_.Sample(hit.uv.x(), hit.uv.y(), Wrap::kClamp);
   const Eigen::Vector3f& n = hit.normal;
-  const Eigen::Vector3f sun = lighting_.SampleSunDirection(sun_u1, sun_u2);
-  const float ndl = n.dot(sun);
-  Rgb irradiance = lighting_.AmbientIrradiance(n);
-  if (hit.surface == Surface::kCloth) {
-    // Light through the cloth: thin fabric glows on its shaded side.
-    const float t = options_.translucency;
-    irradiance += t * lighting_.AmbientIrradiance(-n);
-    const float side = ndl >= 0.0f ? 1.0f : -1.0f;
-    const float weight = ndl >= 0.0f ? ndl : -t * ndl;
-    if (weight > 0.0f) {
-      const Eigen::Vector3f org = hit.point + (side * kShadowEps) * hit.geom_normal;
-      if (!options_.shadows || !scene_->Occluded(org, sun, kFar))
-        irradiance += weight * lighting_.sun_irradiance;
-    }
-  } else if (ndl > 0.0f && hit.geom_normal.dot(sun) > 0.0f) {
-    const Eigen::Vector3f org = hit.point + kShadowEps * hit.geom_normal;
+  const float ndl = n.dot(lighting_.sun_dir);  // see ComputeStatic
+  // Light through the cloth: thin fabric glows on its shaded side.
+  const float tr = options_.translucency;
+  Rgb irradiance = lighting_.AmbientIrradiance(n) + tr * lighting_.AmbientIrradiance(-n);
+  const float side = ndl >= 0.0f ? 1.0f : -1.0f;
+  const float weight = ndl >= 0.0f ? ndl : -tr * ndl;
+  if (weight > 0.0f) {
+    const Eigen::Vector3f org = hit.point + (side * kShadowEps) * hit.geom_normal;
     if (!options_.shadows || !scene_->Occluded(org, sun, kFar))
-      irradiance += ndl * lighting_.sun_irradiance;
+      irradiance += weight * lighting_.sun_irradiance;
   }
   return (kInvPi * albedo).cwiseProduct(irradiance);
 }
 
+Rgb Renderer::Resolve(const Eigen::Vector3f& org, const StaticSample& s, uint8_t* what) const {
+  const Eigen::AlignedBox3f& box = scene_->cloth_bounds();
+  Hit hit;
+  if (RayMeetsBox(org, s.dir, s.t, box) && scene_->IntersectCloth(org, s.dir, s.t, &hit)) {
+    *what = kClothSeen;
+    return ShadeCloth(hit, s.sun);
+  }
+  *what = s.what;
+  if (s.can_see_sun &&
+      !(options_.shadows && RayMeetsBox(s.shadow_org, s.sun, kFar, box) &&
+        scene_->OccludedCloth(s.shadow_org, s.sun, kFar)))
+    return s.base + s.sunlit;
+  return s.base;
+}
+
 Rgb Renderer::Trace(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float sun_u1,
                     float sun_u2) const {
-  Hit hit;
-  const bool any = scene_->Intersect(org, dir, kFar, &hit);
-  float tb, alpha;
-  Rgb bg;
-  if (backdrop_.Intersect(org, dir, &tb, &bg, &alpha) && (!any || tb < hit.t)) {
-    if (alpha >= 1.0f) return bg;
-    return alpha * bg + (1.0f - alpha) * lighting_.SkyRadiance(dir);
+  uint8_t what;
+  return Resolve(org, ComputeStatic(org, dir, lighting_.SampleSunDirection(sun_u1, sun_u2)),
+                 &what);
+}
+
+namespace {
+// R2 low-discrepancy sequence (Roberts), shifted per pixel (Cranley-Patterson rotation):
+// evenly spread sub-pixel and sun-disc samples for any count. Sample 0 is the pixel centre.
+constexpr float kA1 = 0.7548776662f, kA2 = 0.5698402910f;
+
+struct PixelSample {
+  float jx, jy, su, sv;
+};
+inline PixelSample SampleOf(uint64_t seed, int x, int y, int s) {
+  Rng rng(HashSeed(seed, static_cast<uint64_t>(x), static_cast<uint64_t>(y)));
+  const float ox = rng.UniformF(), oy = rng.UniformF();
+  const float sx = rng.UniformF(), sy = rng.UniformF();
+  PixelSample p;
+  p.jx = s == 0 ? 0.5f : Fract(ox + s * kA1);
+  p.jy = s == 0 ? 0.5f : Fract(oy + s * kA2);
+  p.su = Fract(sx + s * kA1);
+  p.sv = Fract(sy + s * kA2);
+  return p;
+}
+
+template <typename Fn>
+void ForRows(int threads, int h, const Fn& fn) {
+  auto body = [&](const tbb::blocked_range<int>& r) {
+    for (int y = r.begin(); y < r.end(); ++y) fn(y);
+  };
+  if (threads == 1) {
+    body(tbb::blocked_range<int>(0, h));
+  } else {
+    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, h, 4), body); });
   }
-  if (!any) return lighting_.SkyRadiance(dir);
-  return Shade(hit, dir, sun_u1, sun_u2);
+}
+
+inline float Luma(const Rgb& c) { return Tone(0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]); }
+}  // namespace
+
+void Renderer::BuildCache() {
+  const int w = camera_.width, h = camera_.height, spp = params_.samples;
+  cache_.resize(static_cast<size_t>(w) * h * spp);
+  const Eigen::Vector3f org = camera_.position.cast<float>();
+  ForRows(options_.threads, h, [&](int y) {
+    for (int x = 0; x < w; ++x)
+      for (int s = 0; s < spp; ++s) {
+        const PixelSample ps = SampleOf(params_.seed, x, y, s);
+        const Eigen::Vector3f dir = camera_.RayDirection(x + ps.jx, y + ps.jy).cast<float>();
+        cache_[(static_cast<size_t>(y) * w + x) * spp + s] =
+            ComputeStatic(org, dir, lighting_.SampleSunDirection(ps.su, ps.sv));
+      }
+  });
 }
 
 cv::Mat Renderer::RenderLinear(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                const Eigen::MatrixXd& UV) {
   scene_->SetCloth(V, F, UV);
+  if (cache_.empty()) BuildCache();
   const int w = camera_.width, h = camera_.height, spp = params_.samples;
-  cv::Mat out(h, w, CV_32FC3);
   const Eigen::Vector3f org = camera_.position.cast<float>();
-  const Eigen::Vector3f fwd = camera_.forward.cast<float>();
-  const Eigen::Vector3f right = camera_.right.cast<float>() / static_cast<float>(camera_.focal_px);
-  const Eigen::Vector3f down = camera_.down.cast<float>() / static_cast<float>(camera_.focal_px);
-  const float cx = static_cast<float>(camera_.cx), cy = static_cast<float>(camera_.cy);
-  // R2 low-discrepancy sequence (Roberts), shifted per pixel (Cranley-Patterson rotation):
-  // evenly spread sub-pixel and sun-disc samples for any count.
-  constexpr float kA1 = 0.7548776662f, kA2 = 0.5698402910f;
-  auto rows = [&](const tbb::blocked_range<int>& r) {
-    for (int y = r.begin(); y < r.end(); ++y) {
-      cv::Vec3f* row = out.ptr<cv::Vec3f>(y);
-      for (int x = 0; x < w; ++x) {
-        Rng rng(HashSeed(params_.seed, static_cast<uint64_t>(x), static_cast<uint64_t>(y)));
-        const float ox = rng.UniformF(), oy = rng.UniformF();
-        const float sx = rng.UniformF(), sy = rng.UniformF();
-        Rgb sum = Rgb::Zero();
-        for (int s = 0; s < spp; ++s) {
-          float jx = 0.5f, jy = 0.5f;
-          if (spp > 1) {
-            jx = Fract(ox + s * kA1);
-            jy = Fract(oy + s * kA2);
-          }
-          const Eigen::Vector3f dir =
-              (fwd + (x + jx - cx) * right + (y + jy - cy) * down).normalized();
-          sum += Trace(org, dir, Fract(sx + s * kA1), Fract(sy + s * kA2));
-        }
-        sum /= static_cast<float>(spp);
-        row[x] = cv::Vec3f(sum[0], sum[1], sum[2]);
-      }
+  cv::Mat out(h, w, CV_32FC3);
+  std::vector<uint8_t> what(static_cast<size_t>(w) * h);
+  std::vector<float> luma(static_cast<size_t>(w) * h);
+  // Pass 1: one sample (the pixel centre) everywhere.
+  ForRows(options_.threads, h, [&](int y) {
+    cv::Vec3f* row = out.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < w; ++x) {
+      const size_t i = static_cast<size_t>(y) * w + x;
+      const Rgb c = Resolve(org, cache_[i * spp], &what[i]);
+      luma[i] = Luma(c);
+      row[x] = cv::Vec3f(c[0], c[1], c[2]);
     }
-  };
-  if (options_.threads == 1) {
-    rows(tbb::blocked_range<int>(0, h));
-  } else {
-    tbb::task_arena arena(options_.threads > 0 ? options_.threads
-                                               : tbb::task_arena::automatic);
-    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, h, 4), rows); });
-  }
+  });
+  if (spp == 1) return out;
+  // Pass 2: the remaining samples only where a neighbour sees another surface or differs in
+  // brightness (silhouettes, texture and shadow edges); elsewhere one sample is the answer.
+  constexpr float kContrast = 0.04f;
+  cv::Mat first = out.clone();
+  ForRows(options_.threads, h, [&](int y) {
+    cv::Vec3f* row = out.ptr<cv::Vec3f>(y);
+    const cv::Vec3f* row1 = first.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < w; ++x) {
+      const size_t i = static_cast<size_t>(y) * w + x;
+      bool edge = false;
+      const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+      for (int k = 0; k < 4 && !edge; ++k) {
+        if (nx[k] < 0 || nx[k] >= w || ny[k] < 0 || ny[k] >= h) continue;
+        const size_t j = static_cast<size_t>(ny[k]) * w + nx[k];
+        edge = what[j] != what[i] || std::abs(luma[j] - luma[i]) > kContrast;
+      }
+      if (!edge) continue;
+      Rgb sum(row1[x][0], row1[x][1], row1[x][2]);
+      uint8_t wt;
+      for (int s = 1; s < spp; ++s) sum += Resolve(org, cache_[i * spp + s], &wt);
+      sum /= static_cast<float>(spp);
+      row[x] = cv::Vec3f(sum[0], sum[1], sum[2]);
+    }
+  });
   return out;
 }
 

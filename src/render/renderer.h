@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <vector>
 #include <opencv2/core.hpp>
 
 #include "render/background.h"
@@ -47,7 +48,8 @@ class Renderer {
   cv::Mat RenderFrame(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                       const Eigen::MatrixXd& UV);
 
-  // Radiance along one ray through the current scene (after RenderLinear/SetCloth).
+  // Radiance along one ray through the current scene (after RenderLinear/SetCloth), without
+  // the cache (same result as a camera sample along that ray).
   // Inputs: org [m]; dir unit; sun_u1, sun_u2 in [0,1): which point of the sun disc the shadow
   //   ray aims at.
   Rgb Trace(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float sun_u1,
@@ -59,11 +61,35 @@ class Renderer {
   const Texture& cloth_texture() const { return texture_; }
   const Backdrop& backdrop() const { return backdrop_; }
   EmbreeScene& scene() { return *scene_; }
-  RenderOptions& options() { return options_; }
+  // Changing options drops the cache of static radiance.
+  void set_options(const RenderOptions& o) {
+    options_ = o;
+    cache_.clear();
+  }
+  const RenderOptions& options() const { return options_; }
 
  private:
-  Rgb Shade(const Hit& hit, const Eigen::Vector3f& dir, float sun_u1, float sun_u2) const;
+  // What one camera sample sees of the static scene (pole, ground, backdrop, sky), which does
+  // not change during a clip: computed on the first frame, reused on the others, so that a
+  // frame costs little more than the rays that meet the cloth or its shadow.
+  struct StaticSample {
+    Eigen::Vector3f dir;         // camera ray direction (unit)
+    Eigen::Vector3f shadow_org;  // where a shadow ray to the sun leaves the surface
+    Eigen::Vector3f sun;         // the sun-disc direction this sample uses
+    Rgb base = Rgb::Zero();      // radiance without direct sun (sky, backdrop, ambient)
+    Rgb sunlit = Rgb::Zero();    // radiance added when the sun sample is not blocked
+    float t = 0.0f;              // distance to the static surface / backdrop [m]
+    uint8_t what = 0;            // Surface (or sky/backdrop) seen, for the edge test
+    bool can_see_sun = false;    // lit unless the cloth is in the way
+  };
+
+  StaticSample ComputeStatic(const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
+                             const Eigen::Vector3f& sun) const;
+  // Radiance of one camera sample this frame; `what` gets the surface it saw.
+  Rgb Resolve(const Eigen::Vector3f& org, const StaticSample& s, uint8_t* what) const;
+  Rgb ShadeCloth(const Hit& hit, const Eigen::Vector3f& sun) const;
   Rgb GroundAlbedo(const Eigen::Vector3f& p) const;
+  void BuildCache();
 
   RenderParams params_;
   RenderOptions options_;
@@ -73,6 +99,7 @@ class Renderer {
   Texture grass_;
   Backdrop backdrop_;
   std::unique_ptr<EmbreeScene> scene_;
+  std::vector<StaticSample> cache_;  // width * height * samples, pixel-major
 };
 
 // Film response and sRGB encoding of a radiance image (CV_32FC3 RGB) into an 8-bit frame
