@@ -172,12 +172,14 @@ int main(int argc, char** argv) {
         try {
           sensor_msgs::ImagePtr image = clothwind::ros_bridge::ToImageMsg(frame, frame_id);
           bool mismatch = false;
+          const sensor_msgs::CameraInfo calibration = info_manager.getCameraInfo();
           sensor_msgs::CameraInfoPtr info =
-              clothwind::ros_bridge::CameraInfoFor(info_manager.getCameraInfo(), *image, &mismatch);
+              clothwind::ros_bridge::CameraInfoFor(calibration, *image, &mismatch);
           if (mismatch && !warned_size) {
-            ROS_WARN_STREAM("camera_node: the calibration is for another image size than "
+            ROS_WARN_STREAM("camera_node: the calibration (" << calibration.width << "x"
+                            << calibration.height << ") is for another size than the images ("
                             << image->width << "x" << image->height
-                            << "; publishing camera_info without it");
+                            << "); publishing camera_info without it");
             warned_size = true;
           }
           publisher.publish(image, info);

@@ -110,7 +110,7 @@ class CameraFolderTest(unittest.TestCase):
         for folder in (cls.colour_folder, cls.grey_folder):
             shutil.rmtree(folder, ignore_errors=True)
 
-    def check_stream(self, collector, rate, width, height, encoding, channels, frame_id, expected):
+    def check_stream(self, collector, rate, width, height, encoding, channels, frame_id, expected, K):
         # Two full loops of the folder, plus some, after the first image.
         n = 2 * N_FRAMES + 5
         self.assertTrue(collector.wait_for(n, timeout=n / rate + 20.0),
@@ -147,22 +147,25 @@ class CameraFolderTest(unittest.TestCase):
             if first is None:
                 first = k
             self.assertEqual(k, (first + i) % N_FRAMES, "image %d shows frame %d" % (i, k))
-        # camera_info with every image, same stamp, same frame, image size (uncalibrated).
+        # camera_info with every image, same stamp, same frame, image size, and the calibration
+        # only where it is for this size.
         info_by_stamp = {c.header.stamp: c for c in infos}
         for _, m in images:
             self.assertIn(m.header.stamp, info_by_stamp, "no camera_info with stamp %s" % m.header.stamp)
             info = info_by_stamp[m.header.stamp]
             self.assertEqual(info.header.frame_id, frame_id)
             self.assertEqual((info.width, info.height), (width, height))
+            self.assertEqual(list(info.K), K)
 
     def test_colour_folder(self):
         # PNG RGB (v, 255-v, 7) arrives as bgr8 (7, 255-v, v).
         self.check_stream(self.colour, 20.0, 40, 30, "bgr8", 3, "test_camera_optical_frame",
-                          lambda k: (7, 255 - colour_value(k), colour_value(k)))
+                          lambda k: (7, 255 - colour_value(k), colour_value(k)),
+                          K=[35.0, 0.0, 19.5, 0.0, 36.0, 14.5, 0.0, 0.0, 1.0])
 
     def test_grey_folder(self):
         self.check_stream(self.grey, 12.5, 24, 16, "mono8", 1, "camera_optical_frame",
-                          lambda k: (grey_value(k),))
+                          lambda k: (grey_value(k),), K=[0.0] * 9)
 
     def test_diagnostics(self):
         self.assertTrue(self.colour.wait_for(N_FRAMES, timeout=30.0))
