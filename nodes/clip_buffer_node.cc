@@ -38,14 +38,14 @@ class ClipBufferNode {
     pnh.param("gap_tolerance", o.gap_tolerance, o.gap_tolerance);
     pnh.param("label_window", o.label_window, o.label_window);
     pnh.param("label_delay", o.label_delay, o.label_delay);
-    std::vector<int> roi;
-    if (pnh.getParam("roi", roi)) {
-      if (roi.size() == 3) {
-        o.roi = {roi[0], roi[1], roi[2]};
-      } else if (!roi.empty()) {
-        throw std::invalid_argument("~roi: expected [x, y, size] in source pixels (or [] for the centred square), got " +
-                                    std::to_string(roi.size()) + " numbers");
-      }
+    if (pnh.hasParam("roi")) {
+      std::vector<double> roi;
+      if (!pnh.getParam("roi", roi) || (roi.size() != 3 && !roi.empty()))
+        throw std::invalid_argument("~roi: expected a list [x, y, size] in source pixels (or [] for the centred "
+                                    "square)");
+      if (roi.size() == 3)
+        o.roi = {static_cast<int>(std::lround(roi[0])), static_cast<int>(std::lround(roi[1])),
+                 static_cast<int>(std::lround(roi[2]))};
     }
     pnh.param("flush_after", flush_after_, 3.0);
     pnh.param("frame_id", frame_id_, std::string());

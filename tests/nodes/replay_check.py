@@ -5,8 +5,11 @@ Expected values are recomputed here from the bag's own messages (camera/image_ra
 pixels, anemometer/raw MWV sentences), independently of the C++ core: the 25 fps grid anchored at
 the first frame, nearest-frame choice, clips of 30 every 30 frames, the centred square crop, and
 mean/std/count/circular mean over [last frame - window, last frame] of the sentences' speeds."""
+import glob
+import json
 import math
 import os
+import shutil
 import sys
 import time
 import unittest
@@ -62,6 +65,11 @@ class ReplayTest(unittest.TestCase):
         rospy.init_node('replay_check')
         cls.bag_path = rospy.get_param('~bag')
         cls.window = rospy.get_param('~label_window', 60.0)
+        cls.expected_clips = rospy.get_param('~expected_clips', -1)        # -1: not fixed
+        cls.expected_readings = rospy.get_param('~expected_readings', -1)
+        cls.min_segments = rospy.get_param('~min_segments', 1)             # > 1: gaps expected
+        cls.max_segments = rospy.get_param('~max_segments', 1)
+        cls.record_dir = rospy.get_param('~record_dir', '')
         cls.clips, cls.previews = [], []
         rospy.Subscriber('clips', Clip, cls.clips.append, queue_size=100)
         rospy.Subscriber('clips/preview', Image, cls.previews.append, queue_size=10)
@@ -91,13 +99,23 @@ class ReplayTest(unittest.TestCase):
             time.sleep(0.2)
         time.sleep(1.0)  # anything extra would show up now
 
+    @classmethod
+    def tearDownClass(cls):
+        if cls.record_dir:
+            shutil.rmtree(cls.record_dir, ignore_errors=True)
+
     def test_session_is_as_generated(self):
-        self.assertGreater(len(self.frame_stamps), 1000)  # 24 s at 60 fps
-        self.assertEqual(len(self.readings), 23)          # 1 Hz, the last one arrives after the end
-        self.assertEqual(len(self.segments), 1)           # no dropped frames in this session
+        self.assertGreater(len(self.frame_stamps), 500)
+        if self.expected_readings >= 0:
+            self.assertEqual(len(self.readings), self.expected_readings)
+        # Unbroken stretches of camera frames (a hole longer than the gap tolerance splits them).
+        self.assertGreaterEqual(len(self.segments), self.min_segments)
+        self.assertLessEqual(len(self.segments), self.max_segments)
 
     def test_clip_count_and_sequence(self):
-        self.assertEqual(len(self.expected), 20)  # 600 ticks at 25 fps / 30
+        if self.expected_clips >= 0:
+            self.assertEqual(len(self.expected), self.expected_clips)
+        self.assertGreater(len(self.expected), 0)
         self.assertEqual(len(self.clips), len(self.expected))
         self.assertEqual([c.sequence for c in self.clips], list(range(len(self.clips))))
 
@@ -114,9 +132,18 @@ class ReplayTest(unittest.TestCase):
             self.assertAlmostEqual(stamps[-1] - stamps[0], (NUM_FRAMES - 1) / RATE, delta=2e-6)
             self.assertAlmostEqual(clip.header.stamp.to_sec(), stamps[0], delta=2e-6)
             self.assertEqual(clip.header.frame_id, 'camera_optical_frame')
-        # Back to back: each clip starts one frame period after the previous one ends.
+        # Back to back within an unbroken stretch: each clip starts one frame period after the
+        # previous one ends; across a gap, later than that (never stitched over the hole).
         for a, b in zip(self.clips, self.clips[1:]):
-            self.assertAlmostEqual((b.frame_stamps[0] - a.frame_stamps[-1]).to_sec(), 1.0 / RATE, delta=2e-6)
+            self.assertGreaterEqual((b.frame_stamps[0] - a.frame_stamps[-1]).to_sec(), 1.0 / RATE - 2e-6)
+            if len(self.segments) == 1:
+                self.assertAlmostEqual((b.frame_stamps[0] - a.frame_stamps[-1]).to_sec(), 1.0 / RATE, delta=2e-6)
+        # No clip spans a hole in the camera stream.
+        holes = [(a, b) for a, b in zip(self.frame_stamps, self.frame_stamps[1:]) if b - a > GAP_TOLERANCE]
+        for clip in self.clips:
+            start, end = clip.frame_stamps[0].to_sec(), clip.frame_stamps[-1].to_sec()
+            for a, b in holes:
+                self.assertFalse(start <= a and b <= end, 'clip %d spans the hole %.3f..%.3f' % (clip.sequence, a, b))
 
     def test_frames_are_cropped_grey_and_resized(self):
         for clip, exp in zip(self.clips, self.expected):
@@ -158,6 +185,29 @@ class ReplayTest(unittest.TestCase):
             self.assertLess(abs(diff), 1e-6)
         # The label drifts with the generated wind: not every clip has the same one.
         self.assertGreater(len({round(c.wind_mean, 6) for c in self.clips}), 1)
+
+    def test_recorded_dataset(self):
+        if not self.record_dir:
+            self.skipTest('not recording')
+        with open(os.path.join(self.record_dir, 'index.json')) as f:
+            index = json.load(f)
+        self.assertEqual(index['format'], 'clothwind-dataset')
+        self.assertEqual(len(index['clips']), len(self.clips))
+        self.assertEqual(glob.glob(os.path.join(self.record_dir, '.*')), [])  # no temporaries left
+        for entry, clip in zip(index['clips'], self.clips):
+            folder = os.path.join(self.record_dir, entry['name'])
+            with open(os.path.join(folder, 'label.json')) as f:
+                label = json.load(f)
+            self.assertEqual(label['sequence'], clip.sequence)
+            self.assertEqual(label['num_frames'], NUM_FRAMES)
+            self.assertAlmostEqual(label['wind']['mean'], clip.wind_mean, delta=1e-9)
+            self.assertEqual(label['wind']['count'], clip.wind_count)
+            self.assertEqual(label['roi'], {'x': 40, 'y': 0, 'size': 240})
+            for got, want in zip(label['frame_stamps'], clip.frame_stamps):
+                self.assertAlmostEqual(got, want.to_sec(), delta=2e-6)
+            for i in range(NUM_FRAMES):
+                with open(os.path.join(folder, '%03d.jpg' % i), 'rb') as f:
+                    self.assertEqual(f.read(2), b'\xff\xd8')  # JPEG start of image
 
     def test_preview_is_published(self):
         self.assertGreater(len(self.previews), 0)
