@@ -1,6 +1,5 @@
 #include "sim/scene_builder.h"
 
-#include <cmath>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
@@ -9,7 +8,7 @@ namespace clothwind::sim {
 
 double DefaultMaxEdge(const SceneRemeshing& remeshing) {
   if (!remeshing.present) return 0.0;
-  return std::sqrt(remeshing.size_min * remeshing.size_max);
+  return 0.5 * remeshing.size_max;
 }
 
 Eigen::MatrixX3d ApplyTransform(const SceneTransform& t, const Eigen::MatrixX3d& V) {

@@ -31,9 +31,13 @@ struct SceneSetup {
 };
 
 struct BuildOptions {
-  // Longest edge after refinement [m]. 0: from the scene's remeshing size range [a, b], the
-  // geometric mean sqrt(a b) (the middle of ArcSim's adaptive range on a log scale: 0.1 m for
-  // the flag's [0.02, 0.5] m; docs/scenes.md); no remeshing block: no refinement.
+  // Longest edge after refinement [m]. 0: half the upper end of the scene's remeshing size
+  // range (0.25 m for the flag's [0.02, 0.5] m): ArcSim keeps flat, slowly moving cloth at the
+  // upper size and refines only where curvature and velocity demand; a static mesh must resolve
+  // the flapping wave everywhere, whose wavelength on a 3 m flag at 10 m/s is ~2.5-3 m, so
+  // size_max/2 gives >= 10 edges per wavelength. At that size the ArcSim flag's droop and
+  // flapping match ArcSim's (flag_behaviour_test, docs/scenes.md) at a fraction of its cost.
+  // No remeshing block: no refinement.
   double max_edge = 0.0;
 };
 

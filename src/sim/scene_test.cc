@@ -119,8 +119,9 @@ TEST(BuildScene, ArcSimFlagHangsInTheYZPlaneWithTheHoistOnTheZAxis) {
   ASSERT_EQ(setup.cloths.size(), 1u);
   const ClothSetup& c = setup.cloths[0];
   EXPECT_EQ(c.original_vertices, 58);
-  EXPECT_NEAR(c.max_edge, 0.1, 1e-12);  // sqrt(0.02 * 0.5)
-  EXPECT_LE(MaxEdgeLength(c.mesh), 0.1 + 1e-9);
+  EXPECT_NEAR(c.max_edge, 0.25, 1e-12);  // half of the size range's upper end, 0.5 m
+  EXPECT_LE(MaxEdgeLength(c.mesh), 0.25 + 1e-9);
+  EXPECT_GT(c.mesh.V.rows(), 500);  // refined (811 vertices with RefineMesh's midpoint split)
   EXPECT_NEAR(SurfaceArea(c.mesh), 6.0, 1e-9);
   EXPECT_NEAR(RestArea(c.mesh), 6.0, 1e-9);
   EXPECT_LT(c.mesh.V.col(0).cwiseAbs().maxCoeff(), 1e-9);  // x = 0: the y-z plane

@@ -1,0 +1,144 @@
+#include "sim/simulate.h"
+
+#include <atomic>
+#include <cstdlib>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+namespace clothwind::sim {
+namespace {
+
+std::string SourceDir() {
+  const char* s = std::getenv("CLOTHWIND_SOURCE_DIR");
+  return s ? s : ".";
+}
+
+// Our flag scene, unrefined (63 vertices) and with turbulence and gusts, so seeds matter.
+SceneSetup SmallFlag() {
+  BuildOptions b;
+  b.max_edge = 0.6;  // the generated mesh's longest edge is 0.5 m: no refinement
+  SceneSetup s = BuildScene(LoadScene(SourceDir() + "/config/scenes/flag.json"), b);
+  s.wind.turbulence.intensity = 0.2;
+  s.wind.turbulence.length_scale = 5.0;
+  s.wind.gusts.rate = 2.0;
+  s.wind.gusts.amplitude = 2.0;
+  s.wind.gusts.duration = 0.3;
+  return s;
+}
+
+bool Identical(const Trajectory& a, const Trajectory& b) {
+  if (a.num_frames() != b.num_frames() || a.faces != b.faces || a.uv != b.uv) return false;
+  for (int f = 0; f < a.num_frames(); ++f) {
+    if (a.frames[f] != b.frames[f]) return false;
+  }
+  return true;
+}
+
+TEST(SimulateTrajectory, FramesStepsAndShapes) {
+  const SceneSetup setup = SmallFlag();
+  SimulateOptions o;
+  o.duration = 0.4;
+  o.seed = 1;
+  int calls = 0;
+  o.progress = [&](int done, int total) {
+    EXPECT_EQ(done, ++calls);
+    EXPECT_EQ(total, 10);
+    return true;
+  };
+  const Trajectory t = SimulateTrajectory(setup, SceneTheta(setup), o);
+  EXPECT_EQ(calls, 10);
+  EXPECT_EQ(t.num_frames(), 11);  // frame 0 + 0.4 s / 0.04 s
+  EXPECT_EQ(t.steps, 80);         // 8 steps per frame
+  EXPECT_EQ(t.num_vertices(), setup.cloths[0].mesh.V.rows());
+  EXPECT_EQ(t.faces, setup.cloths[0].mesh.F);
+  EXPECT_EQ(t.frames[0], setup.cloths[0].mesh.V.cast<float>());
+  EXPECT_DOUBLE_EQ(t.frame_time, 0.04);
+  EXPECT_GT(t.wall_seconds, 0.0);
+  // The cloth moved (gravity and wind), the handles did not.
+  EXPECT_GT((t.frames.back() - t.frames.front()).norm(), 0.05);
+  for (int h : setup.cloths[0].options.handles) {
+    EXPECT_EQ(t.frames.back().row(h), t.frames.front().row(h));
+  }
+}
+
+TEST(SimulateTrajectory, ProgressCanStopEarly) {
+  const SceneSetup setup = SmallFlag();
+  SimulateOptions o;
+  o.duration = 1.0;
+  o.progress = [](int done, int) { return done < 3; };
+  EXPECT_EQ(SimulateTrajectory(setup, SceneTheta(setup), o).num_frames(), 4);
+}
+
+TEST(SimulateTrajectory, DeterministicAcrossRunsAndThreadsAndSeedsMatter) {
+  const SceneSetup setup = SmallFlag();
+  const Theta theta = SceneTheta(setup);
+  SimulateOptions o;
+  o.duration = 0.4;
+  o.seed = 7;
+  const Trajectory a = SimulateTrajectory(setup, theta, o);
+  const Trajectory b = SimulateTrajectory(setup, theta, o);
+  EXPECT_TRUE(Identical(a, b));
+  // Two other threads at once, sharing the setup.
+  Trajectory c, d;
+  std::thread t1([&] { c = SimulateTrajectory(setup, theta, o); });
+  std::thread t2([&] { d = SimulateTrajectory(setup, theta, o); });
+  t1.join();
+  t2.join();
+  EXPECT_TRUE(Identical(a, c));
+  EXPECT_TRUE(Identical(a, d));
+  o.seed = 8;
+  EXPECT_FALSE(Identical(a, SimulateTrajectory(setup, theta, o)));
+}
+
+TEST(SimulateTrajectories, BatchMatchesSerialRunsInOrder) {
+  const SceneSetup setup = SmallFlag();
+  std::vector<Theta> thetas;
+  for (double w : {2.0, 5.0, 8.0}) {
+    Theta theta = SceneTheta(setup);
+    theta[kWindSpeedIndex] = w;
+    theta[kAreaWeightIndex] *= 1 + 0.1 * w;
+    thetas.push_back(theta);
+  }
+  SimulateOptions o;
+  o.duration = 0.2;
+  std::atomic<int> reported{0};
+  o.progress = [&](int, int total) {
+    EXPECT_EQ(total, 3);
+    ++reported;
+    return true;
+  };
+  const std::vector<uint64_t> seeds = {1, 2, 3};
+  const auto batch = SimulateTrajectories(setup, thetas, o, seeds);
+  EXPECT_EQ(reported.load(), 3);
+  ASSERT_EQ(batch.size(), 3u);
+  for (size_t i = 0; i < thetas.size(); ++i) {
+    SimulateOptions one;
+    one.duration = 0.2;
+    one.seed = seeds[i];
+    EXPECT_TRUE(Identical(batch[i], SimulateTrajectory(setup, thetas[i], one))) << i;
+  }
+  EXPECT_FALSE(Identical(batch[0], batch[2]));
+  EXPECT_THROW(SimulateTrajectories(setup, thetas, o, {1}), std::invalid_argument);
+}
+
+TEST(SimulateTrajectory, ThetaChangesTheMotionAndBadThetaThrows) {
+  const SceneSetup setup = SmallFlag();
+  SimulateOptions o;
+  o.duration = 0.3;
+  o.seed = 3;
+  const Theta theta = SceneTheta(setup);
+  Theta heavy = theta;
+  heavy[kAreaWeightIndex] *= 3;
+  // The same wind pushes a heavier flag less far downwind (+x) in the same time.
+  const auto mean_x = [](const Trajectory& t) { return t.frames.back().col(0).mean(); };
+  EXPECT_GT(mean_x(SimulateTrajectory(setup, theta, o)), mean_x(SimulateTrajectory(setup, heavy, o)));
+  Theta bad = theta;
+  bad[kWindSpeedIndex] = -1;
+  EXPECT_THROW(SimulateTrajectory(setup, bad, o), std::invalid_argument);
+  o.cloth = 1;
+  EXPECT_THROW(SimulateTrajectory(setup, theta, o), std::out_of_range);
+}
+
+}  // namespace
+}  // namespace clothwind::sim
