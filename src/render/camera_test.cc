@@ -1,0 +1,99 @@
+#include "render/camera.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace clothwind::render {
+namespace {
+
+TEST(PinholeCamera, KnownPointLandsOnKnownPixel) {
+  // Looking along +y from the origin with a 90 degree field of view: f = 150 px.
+  const PinholeCamera c = PinholeCamera::LookAt(Eigen::Vector3d::Zero(),
+                                                Eigen::Vector3d(0, 10, 0), 90.0, 300, 300);
+  EXPECT_NEAR(c.focal_px, 150.0, 1e-9);
+  Eigen::Vector2d px;
+  ASSERT_TRUE(c.Project(Eigen::Vector3d(1, 10, 0), &px));
+  EXPECT_NEAR(px.x(), 165.0, 1e-9);  // +x is to the right
+  EXPECT_NEAR(px.y(), 150.0, 1e-9);
+  ASSERT_TRUE(c.Project(Eigen::Vector3d(0, 10, -2), &px));
+  EXPECT_NEAR(px.x(), 150.0, 1e-9);
+  EXPECT_NEAR(px.y(), 180.0, 1e-9);  // below the axis is further down the image
+  EXPECT_FALSE(c.Project(Eigen::Vector3d(0, -1, 0), &px));  // behind
+  const Eigen::Matrix3d K = c.K();
+  EXPECT_NEAR(K(0, 0), 150.0, 1e-9);
+  EXPECT_NEAR(K(0, 2), 150.0, 1e-9);
+  EXPECT_NEAR(K(1, 2), 150.0, 1e-9);
+}
+
+TEST(PinholeCamera, RayThroughProjectionHitsThePoint) {
+  const PinholeCamera c = PinholeCamera::LookAt(Eigen::Vector3d(1, -4, 1.5),
+                                                Eigen::Vector3d(1.5, 0, 5.6), 45.0, 300, 300);
+  const Eigen::Vector3d p(2.3, 0.4, 6.1);
+  Eigen::Vector2d px;
+  ASSERT_TRUE(c.Project(p, &px));
+  const Eigen::Vector3d d = c.RayDirection(px.x(), px.y());
+  const Eigen::Vector3d to_p = (p - c.position).normalized();
+  EXPECT_NEAR((d - to_p).norm(), 0.0, 1e-12);
+}
+
+TEST(PlaceCamera, FlagCentreProjectsToImageCentreAndTableTwoPlacementHolds) {
+  RenderParams p;
+  p.camera_height = 1.3;
+  p.camera_radius = 5.2;
+  p.camera_angle_deg = 12.0;
+  const PinholeCamera c = PlaceCamera(p);
+  const Eigen::Vector3d centre = MeshCentre(p);
+  EXPECT_NEAR(centre.z(), 4.6 + 1.0, 1e-12);  // 2 m flag whose hoist starts at 4.6 m
+  Eigen::Vector2d px;
+  ASSERT_TRUE(c.Project(centre, &px));
+  EXPECT_NEAR(px.x(), 150.0, 1e-9);
+  EXPECT_NEAR(px.y(), 150.0, 1e-9);
+  EXPECT_NEAR(c.position.z(), 1.3, 1e-12);
+  EXPECT_NEAR(std::hypot(c.position.x() - centre.x(), c.position.y() - centre.y()), 5.2, 1e-9);
+  // The angle is measured from the side-on view (camera on -y).
+  const double angle = std::atan2(c.position.x() - centre.x(), -(c.position.y() - centre.y()));
+  EXPECT_NEAR(angle * 180.0 / M_PI, 12.0, 1e-9);  // counter-clockwise: towards +x (downwind)
+  EXPECT_NEAR(c.focal_px, 150.0 / std::tan(22.5 * M_PI / 180.0), 1e-9);
+}
+
+TEST(PlaceCamera, WindBlowsLeftToRightAndUpIsUp) {
+  RenderParams p;
+  p.camera_angle_deg = 0.0;
+  const PinholeCamera c = PlaceCamera(p);
+  Eigen::Vector2d a, b, top;
+  const Eigen::Vector3d centre = MeshCentre(p);
+  ASSERT_TRUE(c.Project(centre, &a));
+  ASSERT_TRUE(c.Project(centre + Eigen::Vector3d(1, 0, 0), &b));
+  ASSERT_TRUE(c.Project(centre + Eigen::Vector3d(0, 0, 1), &top));
+  EXPECT_GT(b.x(), a.x() + 10);  // downwind is to the right
+  EXPECT_LT(top.y(), a.y() - 10);  // up is up
+  // The pole (x = 0) is left of the flag's centre.
+  Eigen::Vector2d pole;
+  ASSERT_TRUE(c.Project(Eigen::Vector3d(0, 0, centre.z()), &pole));
+  EXPECT_LT(pole.x(), a.x());
+}
+
+TEST(PlaceCamera, ClothIsSeenFaceOn) {
+  RenderParams p;
+  p.scene = SceneKind::kCloth;
+  p.mesh_height = 2.0;
+  p.mesh_width = 1.0;
+  p.mesh_aspect_ratio = 1.0;
+  p.camera_radius = 1.5;
+  p.camera_height = 1.0;
+  p.camera_angle_deg = 0.0;
+  const PinholeCamera c = PlaceCamera(p);
+  const Eigen::Vector3d centre = MeshCentre(p);
+  EXPECT_NEAR(centre.y(), 0.5, 1e-12);
+  EXPECT_NEAR(centre.z(), 2.5, 1e-12);
+  EXPECT_NEAR(c.position.x(), -1.5, 1e-9);  // in front of the y-z plane, on -x
+  EXPECT_NEAR(c.position.y(), 0.5, 1e-9);
+  Eigen::Vector2d px;
+  ASSERT_TRUE(c.Project(centre, &px));
+  EXPECT_NEAR(px.x(), 150.0, 1e-9);
+  EXPECT_NEAR(px.y(), 150.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace clothwind::render

@@ -1,0 +1,257 @@
+#include "render/renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+
+#include "render/test_meshes.h"
+
+namespace clothwind::render {
+namespace {
+
+// A fixed ζ for the tests (small frames keep them fast).
+RenderParams TestParams() {
+  RenderParams p;
+  p.seed = 42;
+  p.background_seed = 7;
+  p.width = 120;
+  p.height = 120;
+  p.samples = 2;
+  p.camera_height = 1.5;
+  p.camera_radius = 5.0;
+  p.sun_height = 8.0;
+  p.sun_radius = 3.0;
+  p.sun_azimuth_deg = -60.0;  // in front of the flag (camera side) and to the right
+  p.sun_strength = 6.0;
+  p.sun_shadow_soft_size = 0.5;
+  p.texture_name = "vertical_tricolour";
+  p.texture_seed = 3;
+  return p;
+}
+
+Eigen::Vector3f F3(const Eigen::Vector3d& v) { return v.cast<float>(); }
+
+float Luma(const Rgb& c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+
+TEST(Renderer, SameParamsAndSeedGiveIdenticalBytesOnAnyThreadCount) {
+  const RenderParams p = TestParams();
+  const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, 0.3);
+  RenderOptions one;
+  one.threads = 1;
+  Renderer a(p, one), b(p);
+  const cv::Mat fa = a.RenderFrame(m.V, m.F, m.UV);
+  const cv::Mat fb = b.RenderFrame(m.V, m.F, m.UV);
+  ASSERT_EQ(fa.type(), CV_8UC3);
+  ASSERT_EQ(fa.rows, 120);
+  ASSERT_EQ(fa.cols, 120);
+  EXPECT_EQ(cv::norm(fa, fb, cv::NORM_INF), 0.0);
+  // Another pixel-sampling seed moves anti-aliasing and penumbra samples only a little.
+  RenderParams q = p;
+  q.seed = 43;
+  const cv::Mat fc = Renderer(q).RenderFrame(m.V, m.F, m.UV);
+  EXPECT_GT(cv::norm(fa, fc, cv::NORM_L1), 0.0);
+  // Another texture seed recolours the flag.
+  q = p;
+  q.texture_seed = 4;
+  const cv::Mat fd = Renderer(q).RenderFrame(m.V, m.F, m.UV);
+  EXPECT_GT(cv::norm(fa, fd, cv::NORM_L1) / (120.0 * 120.0), 1.0);
+}
+
+TEST(Renderer, FlagCentreIsInTheMiddleOfTheFrame) {
+  const RenderParams p = TestParams();
+  Renderer r(p);
+  const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, 0.0, /*amplitude=*/0.0);
+  r.RenderLinear(m.V, m.F, m.UV);
+  // The camera ray through the image centre meets the cloth near the flag's centre.
+  Hit hit;
+  const Eigen::Vector3f dir = F3(r.camera().RayDirection(60.0, 60.0));
+  ASSERT_TRUE(r.scene().Intersect(F3(r.camera().position), dir, 1e4f, &hit));
+  EXPECT_EQ(hit.surface, Surface::kCloth);
+  // The test flag droops 0.12 h at the fly end, so allow a few centimetres.
+  EXPECT_NEAR(hit.point.x(), 1.5, 0.1);
+  EXPECT_NEAR(hit.point.z(), 5.6, 0.15);
+}
+
+TEST(Renderer, PointInTheFlagsShadowIsDarkerOnlyWithShadows) {
+  RenderParams p = TestParams();
+  const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, 0.0, /*amplitude=*/0.0);
+  RenderOptions on, off;
+  off.shadows = false;
+  Renderer with(p, on), without(p, off);
+  with.RenderLinear(m.V, m.F, m.UV);
+  without.RenderLinear(m.V, m.F, m.UV);
+  // The ground point where the flag's centre casts its shadow (sun disc centre).
+  const Eigen::Vector3f sun = with.lighting().sun_dir;
+  const Eigen::Vector3f centre(1.5f, 0.0f, 5.5f);
+  const Eigen::Vector3f g = centre - sun * (centre.z() / sun.z());
+  const Eigen::Vector3f org = g + Eigen::Vector3f(0, 0, 0.5f), down(0, 0, -1);
+  const Rgb shadowed = with.Trace(org, down, 0.0f, 0.0f);
+  const Rgb lit = without.Trace(org, down, 0.0f, 0.0f);
+  EXPECT_LT(Luma(shadowed), 0.6f * Luma(lit));
+  // Without shadows the point is exactly as bright as with the flag moved out of the way.
+  ClothMesh far = m;
+  far.V.col(0).array() += 200.0;
+  Renderer moved(p, on);
+  moved.RenderLinear(far.V, far.F, far.UV);
+  EXPECT_NEAR(Luma(moved.Trace(org, down, 0.0f, 0.0f)), Luma(lit), 1e-6f);
+  // And a point far from any shadow is the same either way.
+  const Eigen::Vector3f org2(-6.0f, -3.0f, 0.5f);
+  EXPECT_NEAR(Luma(with.Trace(org2, down, 0.0f, 0.0f)), Luma(without.Trace(org2, down, 0.0f, 0.0f)),
+              1e-7f);
+}
+
+TEST(Renderer, PointInThePolesShadowIsDarkerOnlyWithShadows) {
+  RenderParams p = TestParams();
+  const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, 0.0, 0.0);
+  RenderOptions off;
+  off.shadows = false;
+  Renderer with(p), without(p, off);
+  with.RenderLinear(m.V, m.F, m.UV);
+  without.RenderLinear(m.V, m.F, m.UV);
+  const Eigen::Vector3f sun = with.lighting().sun_dir;
+  const Eigen::Vector3f on_pole(-0.035f, 0.0f, 1.5f);  // pole axis, below the flag
+  const Eigen::Vector3f g = on_pole - sun * (on_pole.z() / sun.z());
+  const Eigen::Vector3f org = g + Eigen::Vector3f(0, 0, 0.3f), down(0, 0, -1);
+  EXPECT_LT(Luma(with.Trace(org, down, 0.0f, 0.0f)), 0.6f * Luma(without.Trace(org, down, 0.0f, 0.0f)));
+}
+
+TEST(Renderer, BackFaceIsLitNotBlack) {
+  RenderParams p = TestParams();
+  p.sun_radius = 0.0;  // sun overhead: both faces of the vertical flag see the same light
+  const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, 0.0, 0.0);
+  Renderer r(p);
+  r.RenderLinear(m.V, m.F, m.UV);
+  const Eigen::Vector3f target(1.0f, 0.0f, 5.6f);
+  const Eigen::Vector3f front_org = target + Eigen::Vector3f(0, -3, 0);
+  const Eigen::Vector3f back_org = target + Eigen::Vector3f(0, 3, 0);
+  Hit hf, hb;
+  ASSERT_TRUE(r.scene().Intersect(front_org, Eigen::Vector3f(0, 1, 0), 10.0f, &hf));
+  ASSERT_TRUE(r.scene().Intersect(back_org, Eigen::Vector3f(0, -1, 0), 10.0f, &hb));
+  ASSERT_EQ(hf.surface, Surface::kCloth);
+  ASSERT_EQ(hb.surface, Surface::kCloth);
+  EXPECT_NE(hf.back_face, hb.back_face);
+  EXPECT_GT(hb.normal.y(), 0.99f);  // shading normal turned towards the viewer
+  const Rgb front = r.Trace(front_org, Eigen::Vector3f(0, 1, 0), 0.5f, 0.5f);
+  const Rgb back = r.Trace(back_org, Eigen::Vector3f(0, -1, 0), 0.5f, 0.5f);
+  EXPECT_GT(Luma(back), 0.05f);
+  EXPECT_NEAR(Luma(back), Luma(front), 1e-4f);
+  // With the sun on the front side the back is darker, but still lit (sky, translucency).
+  p.sun_radius = 5.0;
+  p.sun_azimuth_deg = -90.0;  // sun on -y, the front
+  p.sun_height = 5.0;
+  Renderer r2(p);
+  r2.RenderLinear(m.V, m.F, m.UV);
+  const Rgb front2 = r2.Trace(front_org, Eigen::Vector3f(0, 1, 0), 0.5f, 0.5f);
+  const Rgb back2 = r2.Trace(back_org, Eigen::Vector3f(0, -1, 0), 0.5f, 0.5f);
+  EXPECT_GT(Luma(front2), 1.5f * Luma(back2));
+  EXPECT_GT(Luma(back2), 0.05f);
+}
+
+TEST(Renderer, CachedFramesMatchUncachedTraceAcrossFrames) {
+  RenderParams p = TestParams();
+  p.samples = 1;
+  RenderOptions o;
+  o.shadows = false;  // then a sample does not depend on its sun-disc point
+  Renderer r(p, o);
+  for (double t : {0.0, 0.37}) {
+    const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, t);
+    const cv::Mat img = r.RenderLinear(m.V, m.F, m.UV);
+    for (int y = 5; y < 120; y += 23)
+      for (int x = 3; x < 120; x += 19) {
+        const Rgb c = r.Trace(F3(r.camera().position),
+                              F3(r.camera().RayDirection(x + 0.5, y + 0.5)), 0.3f, 0.3f);
+        const cv::Vec3f v = img.at<cv::Vec3f>(y, x);
+        EXPECT_NEAR(v[0], c[0], 1e-5f) << x << "," << y << " t=" << t;
+        EXPECT_NEAR(v[1], c[1], 1e-5f);
+        EXPECT_NEAR(v[2], c[2], 1e-5f);
+      }
+  }
+}
+
+TEST(Renderer, NewFacesRebuildTheClothAndMatchAFreshRenderer) {
+  const RenderParams p = TestParams();
+  const ClothMesh a = WavingFlag(25, 17, 3.0, 2.0, 0.1);
+  const ClothMesh b = WavingFlag(14, 9, 3.0, 2.0, 0.2);
+  Renderer r(p);
+  r.RenderFrame(a.V, a.F, a.UV);
+  const cv::Mat second = r.RenderFrame(b.V, b.F, b.UV);
+  const cv::Mat fresh = Renderer(p).RenderFrame(b.V, b.F, b.UV);
+  EXPECT_EQ(cv::norm(second, fresh, cv::NORM_INF), 0.0);
+}
+
+TEST(Renderer, BadMeshIsRejectedWithAClearError) {
+  Renderer r(TestParams());
+  ClothMesh m = WavingFlag(5, 4);
+  Eigen::MatrixXd uv = m.UV.topRows(3);
+  EXPECT_THROW(r.RenderLinear(m.V, m.F, uv), std::invalid_argument);
+  m.F(0, 1) = 999;
+  try {
+    r.RenderLinear(m.V, m.F, m.UV);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("999"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Backdrop, PhotographComesOutAsItself) {
+  const std::string dir = testing::TempDir() + "/render_bg_test";
+  std::filesystem::create_directories(dir);
+  const std::string file = dir + "/wall.png";
+  cv::Mat photo(60, 120, CV_8UC3, cv::Scalar(40, 120, 200));  // B, G, R
+  ASSERT_TRUE(cv::imwrite(file, photo));
+  const std::vector<std::string> files = ListBackgroundImages(dir);
+  ASSERT_EQ(files.size(), 1u);
+  RenderParams p = TestParams();
+  p.background_image = files[0];
+  p.background_offset = 13.0;
+  p.background_scale = 0.7;
+  Renderer r(p);
+  const Backdrop& b = r.backdrop();
+  EXPECT_NEAR(b.height, 0.7f * Backdrop::kBackdropHeight, 1e-4f);
+  EXPECT_NEAR(b.width, 2.0f * b.height, 1e-3f);
+  // The picture's centre moved 13 m sideways, along the camera's right.
+  const Eigen::Vector3d c = MeshCentre(p);
+  const Eigen::Vector3f foot(static_cast<float>(c.x()), static_cast<float>(c.y()), 0.0f);
+  EXPECT_NEAR((b.origin - foot).dot(b.across), 13.0f, 1e-3f);
+  EXPECT_NEAR((b.origin - foot).dot(-b.normal), Backdrop::kBackdropDistance, 1e-3f);
+  const Eigen::Vector3f cam = F3(r.camera().position);
+  const Eigen::Vector3f aim = b.origin + Eigen::Vector3f(0, 0, 0.5f * b.height);
+  float t, alpha;
+  Rgb rad;
+  ASSERT_TRUE(b.Intersect(cam, (aim - cam).normalized(), &t, &rad, &alpha));
+  EXPECT_NEAR(alpha, 1.0f, 1e-6f);
+  EXPECT_NEAR(ToSrgb8(Tone(rad[0])), 200, 1);
+  EXPECT_NEAR(ToSrgb8(Tone(rad[1])), 120, 1);
+  EXPECT_NEAR(ToSrgb8(Tone(rad[2])), 40, 1);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Backdrop, MissingFilesAreNamed) {
+  RenderParams p = TestParams();
+  p.background_image = "/nonexistent/photo.jpg";
+  try {
+    Renderer r(p);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/photo.jpg"), std::string::npos);
+  }
+  EXPECT_THROW(ListBackgroundImages("/nonexistent/folder"), std::runtime_error);
+}
+
+TEST(Backdrop, ProceduralHasGroundThingsBelowAndSkyAbove) {
+  for (uint64_t seed = 0; seed < 5; ++seed) {
+    const Texture t = ProceduralBackdrop(seed, 128, 64);
+    float top = 0, bottom = 0;
+    for (int x = 0; x < 128; ++x) {
+      top += t.alpha(x, 0);
+      bottom += t.alpha(x, 63);
+    }
+    EXPECT_EQ(top, 0.0f) << seed;        // 45 m up: sky
+    EXPECT_EQ(bottom, 128.0f) << seed;   // at the ground: field
+  }
+}
+
+}  // namespace
+}  // namespace clothwind::render
