@@ -376,7 +376,10 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
   }
 
   const int64_t now = clock_->MonotonicNs();
-  const int64_t loss_deadline = last_frame_mono_ns_ + static_cast<int64_t>(options_.timeout_s * 1e9);
+  // A slow camera (a long exposure at night) must not be mistaken for a dead one.
+  const double timeout_s =
+      std::max(options_.timeout_s, negotiated_.fps > 0 ? 5.0 / negotiated_.fps : 0.0);
+  const int64_t loss_deadline = last_frame_mono_ns_ + static_cast<int64_t>(timeout_s * 1e9);
   const int64_t wait_ns = std::max<int64_t>(0, std::min(max_wait_ns, loss_deadline - now));
   short revents = 0;
   const int r = io_->Poll(fd_, static_cast<int>((wait_ns + 999999) / 1000000), &revents);
@@ -388,7 +391,7 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
   if (r == 0) {
     if (clock_->MonotonicNs() >= loss_deadline) {
       ++stats_.timeouts;
-      Lost("no frame for " + FpsText(options_.timeout_s) + " s");
+      Lost("no frame for " + FpsText(timeout_s) + " s");
       return ReadStatus::kError;
     }
     return ReadStatus::kNoFrame;

@@ -22,7 +22,7 @@ struct V4l2Options {
   int height = 480;       // [px]
   double fps = 30.0;      // [Hz]
   int buffers = 4;        // mmap buffers to request (the driver may grant another count, >= 2)
-  double timeout_s = 2.0; // no frame for this long: the device is considered lost and reopened
+  double timeout_s = 2.0; // no frame for this long (at least 5 frame periods): device lost, reopened
   int auto_exposure = -1;      // -1 leave as is, 0 manual, 1 automatic
   int exposure_absolute = -1;  // V4L2_CID_EXPOSURE_ABSOLUTE [100 us]; -1 leave (>= 0 implies manual)
   int gain = -1;               // V4L2_CID_GAIN [device units]; -1 leave
