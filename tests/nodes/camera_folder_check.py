@@ -184,6 +184,23 @@ class CameraFolderTest(unittest.TestCase):
         self.assertEqual(source["images"], str(N_FRAMES))
         self.assertEqual(source["frame_id"], "test_camera_optical_frame")
 
+    def test_absent_v4l2_device_is_reported(self):
+        deadline = time.time() + 15.0
+        found = None
+        while time.time() < deadline and found is None:
+            for array in list(self.diagnostics):
+                for s in array.status:
+                    if s.name == "absent/camera_node: camera source":
+                        found = s
+            time.sleep(0.2)
+        self.assertIsNotNone(found, "no diagnostics from the node without a camera")
+        self.assertEqual(found.level, DiagnosticStatus.ERROR)
+        self.assertIn("/dev/clothwind_no_such_camera: cannot open: No such file or directory",
+                      found.message)
+        values = {kv.key: kv.value for kv in found.values}
+        self.assertEqual(values["source"], "v4l2")
+        self.assertEqual(values["published"], "0")
+
 
 if __name__ == "__main__":
     rostest.rosrun("clothwind", "camera_node_folder", CameraFolderTest, sys.argv)
