@@ -32,7 +32,7 @@ struct Row {
 class ClipReport {
  public:
   explicit ClipReport(ros::NodeHandle& pnh) {
-    pnh.param("idle_timeout", idle_timeout_, 8.0);
+    pnh.param("idle_timeout", idle_timeout_, 5.0);
     pnh.param("max_wall", max_wall_, 0.0);
     pnh.param("summary", summary_path_, std::string());
     ros::NodeHandle nh;
@@ -82,7 +82,7 @@ class ClipReport {
   void Print(double wall) {
     std::printf("\nclip_report: %zu clip(s) from the replay\n", rows_.size());
     std::printf("%5s  %-12s  %-12s  %6s  %7s  %9s  %8s  %8s  %5s  %8s\n", "seq", "start [s]", "end [s]",
-                "frames", "span", "dt err", "wind", "std", "count", "dir");
+                "frames", "span", "dt err", "wind m/s", "std", "count", "dir rad");
     const double t0 = rows_.empty() ? 0.0 : rows_.front().start;
     double label_sum = 0;
     size_t labelled = 0, frames = 0;
@@ -123,7 +123,7 @@ class ClipReport {
     }
   }
 
-  double idle_timeout_ = 8.0, max_wall_ = 0.0;
+  double idle_timeout_ = 5.0, max_wall_ = 0.0;
   std::string summary_path_;
   ros::Subscriber sub_;
   ros::WallTimer timer_;
