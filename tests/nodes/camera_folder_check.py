@@ -129,6 +129,11 @@ class CameraFolderTest(unittest.TestCase):
         arrival = [t for t, _ in images]
         measured = (len(arrival) - 1) / (arrival[-1] - arrival[0])
         self.assertAlmostEqual(measured, rate, delta=0.15 * rate)
+        steps = [b - a for a, b in zip(stamps, stamps[1:])]
+        ages = [t - m.header.stamp.to_sec() for t, m in images]
+        print("%s: %d images, arrival %.2f Hz (nominal %.2f), stamp step %.5f..%.5f s, "
+              "age at arrival %.1f..%.1f ms" % (encoding, len(images), measured, rate, min(steps),
+                                                max(steps), 1e3 * min(ages), 1e3 * max(ages)))
         # Stamps are recent (not stale, not in the future).
         for (t, m) in images:
             age = t - m.header.stamp.to_sec()
