@@ -161,11 +161,11 @@ RepulsionTerms RepulsionForce(const Vector12d& x, double side, double thickness,
   g.segment<3>(3) = -side * wa * n;
   g.segment<3>(6) = -side * wb * n;
   g.segment<3>(9) = -side * wc * n;
-  const double gap = thickness - d;
+  const double v = thickness - d;
   out.active = true;
-  out.energy = 0.5 * stiffness * gap * gap;
-  out.force = stiffness * gap * g;
-  out.jacobian = -stiffness * g * g.transpose();
+  out.energy = stiffness * v * v * v / (6 * thickness);
+  out.force = (stiffness * v * v / (2 * thickness)) * g;
+  out.jacobian = -(stiffness * v / thickness) * g * g.transpose();
   return out;
 }
 

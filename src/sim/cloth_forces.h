@@ -89,18 +89,20 @@ Vector9d WindForce(const Vector9d& x, const Vector9d& v, const Eigen::Vector3d& 
 struct RepulsionTerms {
   double energy = 0;   // [J]
   Vector12d force;     // [N] on (p, a, b, c)
-  Matrix12d jacobian;  // [N/m] Gauss-Newton: -stiffness * g g^T, g = dd/dx
+  Matrix12d jacobian;  // [N/m] Gauss-Newton: -stiffness v / h g g^T, g = dd/dx
   bool active = false; // within the thickness and the projection inside the triangle
 };
 
-// Vertex-face repulsion (a penalty spring like ArcSim's proximity forces): with q the projection
-// of p onto the plane of (a,b,c), barycentrics w (all >= 0 when active), n the unit normal,
-// d = side * n.(p - q) (side = +1 or -1: the side p is on), the energy within the thickness h is
-//   E = stiffness/2 (h - d)^2, for 0 <= h - d, else 0.
+// Vertex-face repulsion, ArcSim's proximity constraint (IneqCon): with q the projection of p onto
+// the plane of (a,b,c), barycentrics w (all >= 0 when active), n the unit normal,
+// d = side * n.(p - q) (side = +1 or -1: the side p is on) and the violation v = h - d > 0,
+//   E = stiffness v^3 / (6 h),  f = stiffness v^2 / (2 h) dd/dx,
+// a cubic penalty that starts smoothly at the thickness h (no energy jump when a pair appears).
+// ArcSim's stiffness is collision_stiffness times min(node area, face area).
 // Inputs:
 //   x          12-vector (p, a, b, c) [m]
 //   side       +1 or -1
-//   thickness  h [m]
+//   thickness  h [m] (> 0)
 //   stiffness  [N/m]
 RepulsionTerms RepulsionForce(const Vector12d& x, double side, double thickness, double stiffness);
 

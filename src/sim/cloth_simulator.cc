@@ -59,7 +59,13 @@ struct ClothSimulator::Impl {
   std::vector<int> col;         // per block
   std::vector<int> diag_block;  // per vertex
   std::vector<Eigen::Matrix3d> J;  // force Jacobian blocks
-  std::vector<Eigen::Matrix3d> A;  // system blocks
+  // Off-pattern blocks (repulsion pairs couple vertices that share no element), per step.
+  struct ExtraBlock {
+    int row, col;
+    Eigen::Matrix3d J;
+  };
+  std::vector<ExtraBlock> extra;
+  double repulsion_energy = 0;
   Eigen::VectorXd f, b, dv, r, z, p, q;
   std::vector<Eigen::Matrix3d> precond;
 
@@ -68,6 +74,7 @@ struct ClothSimulator::Impl {
 
   void Build();
   int BlockIndex(int i, int j) const;
+  int BlockIndexInFace(int face, int i, int j) const { return faces[face].block[3 * i + j]; }
   void ComputeForces(bool with_jacobian, bool with_repulsion);
   void Solve();
   ClothEnergy Energy() const;
@@ -179,7 +186,6 @@ void ClothSimulator::Impl::Build() {
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j) h.block[4 * i + j] = BlockIndex(h.v[i], h.v[j]);
   J.assign(col.size(), Eigen::Matrix3d::Zero());
-  A.assign(col.size(), Eigen::Matrix3d::Zero());
   precond.assign(nv, Eigen::Matrix3d::Zero());
   const int n3 = 3 * nv;
   f.setZero(n3);
@@ -192,7 +198,12 @@ void ClothSimulator::Impl::Build() {
 
   x = mesh.V;
   v = Eigen::MatrixX3d::Zero(nv, 3);
-  proximity = std::make_unique<VertexFaceProximity>(mesh.F, nv);
+  double mean_edge = 0;
+  for (const Face& face : faces)
+    for (int c = 0; c < 3; ++c)
+      mean_edge += (mesh.U.row(face.v[c]) - mesh.U.row(face.v[(c + 1) % 3])).norm();
+  mean_edge /= 3.0 * faces.size();
+  proximity = std::make_unique<VertexFaceProximity>(mesh.F, nv, mean_edge);
   limiter = std::make_unique<StrainLimiter>(mesh, mass, pinned);
 }
 
@@ -223,38 +234,51 @@ void ClothSimulator::Impl::ComputeForces(bool with_jacobian, bool with_repulsion
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) J[face.block[3 * i + j]] += st.jacobian.block<3, 3>(3 * i, 3 * j);
   }
-  // Bending, per hinge.
+  // Bending, per hinge (ArcSim's bending_force, inlined so the dihedral is evaluated once).
   for (const Hinge& h : hinges) {
-    Vector12d xh;
+    Vector12d xh, dtheta;
     for (int c = 0; c < 4; ++c) xh.segment<3>(3 * c) = xv(h.v[c]);
-    const double theta = DihedralAngle(xh);
+    const double theta = DihedralAngle(xh, &dtheta);
     const double curvature = std::abs(theta) * h.rest_length / h.rest_area_sum;
     const double ke = material.BendingStiffness(curvature, h.du);
-    const BendingTerms bt = BendingForce(xh, ke, h.rest_length, h.rest_area_sum, 0.0);
-    for (int c = 0; c < 4; ++c) f.segment<3>(3 * h.v[c]) += bt.force.segment<3>(3 * c);
+    const double c_half = 0.5 * ke * h.rest_length * h.rest_length / (2 * h.rest_area_sum);
+    for (int c = 0; c < 4; ++c) f.segment<3>(3 * h.v[c]) -= c_half * theta * dtheta.segment<3>(3 * c);
     if (with_jacobian)
-      for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) J[h.block[4 * i + j]] += bt.jacobian.block<3, 3>(3 * i, 3 * j);
+      for (int i = 0; i < 4; ++i) {
+        const Eigen::Vector3d gi = -c_half * dtheta.segment<3>(3 * i);
+        for (int j = 0; j < 4; ++j) J[h.block[4 * i + j]].noalias() += gi * dtheta.segment<3>(3 * j).transpose();
+      }
   }
-  // Vertex-face repulsion: force in full, Jacobian on the diagonal blocks only (the pairs are not
-  // in the fixed pattern; the diagonal part of a negative semidefinite Jacobian stays so).
+  // Vertex-face repulsion (ArcSim's proximity constraints), implicit with its full Gauss-Newton
+  // Jacobian: blocks outside the fixed pattern go to `extra`.
   stats.repulsion_pairs = 0;
-  if (with_repulsion && options.self_collision && options.repulsion_thickness > 0 &&
-      options.collision_stiffness > 0) {
-    const auto& pairs = proximity->pairs();
-    for (const auto& pr : pairs) {
+  extra.clear();
+  repulsion_energy = 0;
+  if (with_repulsion) {
+    for (const auto& pr : proximity->pairs()) {
       Vector12d xr;
       xr.segment<3>(0) = xv(pr.vertex);
       for (int c = 0; c < 3; ++c) xr.segment<3>(3 + 3 * c) = xv(mesh.F(pr.face, c));
-      const double stiffness = options.collision_stiffness * vertex_area[pr.vertex];
+      const double area = std::min(vertex_area[pr.vertex], faces[pr.face].rest.area);
+      const double stiffness = options.collision_stiffness * area;
       const RepulsionTerms rt = RepulsionForce(xr, pr.side, options.repulsion_thickness, stiffness);
       if (!rt.active) continue;
       ++stats.repulsion_pairs;
-      int ids[4] = {pr.vertex, mesh.F(pr.face, 0), mesh.F(pr.face, 1), mesh.F(pr.face, 2)};
-      for (int c = 0; c < 4; ++c) {
-        f.segment<3>(3 * ids[c]) += rt.force.segment<3>(3 * c);
-        if (with_jacobian) J[diag_block[ids[c]]] += rt.jacobian.block<3, 3>(3 * c, 3 * c);
-      }
+      repulsion_energy += rt.energy;
+      const int ids[4] = {pr.vertex, mesh.F(pr.face, 0), mesh.F(pr.face, 1), mesh.F(pr.face, 2)};
+      for (int c = 0; c < 4; ++c) f.segment<3>(3 * ids[c]) += rt.force.segment<3>(3 * c);
+      if (!with_jacobian) continue;
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+          const Eigen::Matrix3d blk = rt.jacobian.block<3, 3>(3 * i, 3 * j);
+          if (i == j) {
+            J[diag_block[ids[i]]] += blk;
+          } else if (i == 0 || j == 0) {  // vertex-to-face-vertex: never in the pattern
+            extra.push_back({ids[i], ids[j], blk});
+          } else {  // two vertices of the same face
+            J[BlockIndexInFace(pr.face, i - 1, j - 1)] += blk;
+          }
+        }
     }
   }
 }
@@ -262,29 +286,33 @@ void ClothSimulator::Impl::ComputeForces(bool with_jacobian, bool with_repulsion
 void ClothSimulator::Impl::Solve() {
   const double h = options.dt;
   const double hk = h * (h + material.damping);
-  // A = M - h (h + gamma) J;  b = h (f + (h + gamma) J v).
+  // A = M - h (h + gamma) J (applied blockwise, never stored);  b = h (f + (h + gamma) J v).
   for (int i = 0; i < nv; ++i) {
     Eigen::Vector3d Jv = Eigen::Vector3d::Zero();
-    for (int k = row_start[i]; k < row_start[i + 1]; ++k) {
-      A[k] = -hk * J[k];
-      Jv += J[k] * v.row(col[k]).transpose();
-    }
-    A[diag_block[i]].diagonal().array() += mass[i];
+    for (int k = row_start[i]; k < row_start[i + 1]; ++k) Jv.noalias() += J[k] * v.row(col[k]).transpose();
     b.segment<3>(3 * i) = h * (f.segment<3>(3 * i) + (h + material.damping) * Jv);
+  }
+  for (const ExtraBlock& e : extra)
+    b.segment<3>(3 * e.row).noalias() += h * (h + material.damping) * (e.J * v.row(e.col).transpose());
+  for (int i = 0; i < nv; ++i) {
     if (pinned[i]) {
       b.segment<3>(3 * i).setZero();
       precond[i].setZero();
     } else {
-      precond[i] = A[diag_block[i]].inverse();
+      Eigen::Matrix3d D = -hk * J[diag_block[i]];
+      D.diagonal().array() += mass[i];
+      precond[i] = D.inverse();
     }
   }
   auto multiply = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
     for (int i = 0; i < nv; ++i) {
       Eigen::Vector3d s = Eigen::Vector3d::Zero();
-      if (!pinned[i])
-        for (int k = row_start[i]; k < row_start[i + 1]; ++k) s += A[k] * in.segment<3>(3 * col[k]);
-      out.segment<3>(3 * i) = s;
+      for (int k = row_start[i]; k < row_start[i + 1]; ++k) s.noalias() += J[k] * in.segment<3>(3 * col[k]);
+      out.segment<3>(3 * i) = mass[i] * in.segment<3>(3 * i) - hk * s;
     }
+    for (const ExtraBlock& e : extra) out.segment<3>(3 * e.row).noalias() -= hk * (e.J * in.segment<3>(3 * e.col));
+    for (int i = 0; i < nv; ++i)
+      if (pinned[i]) out.segment<3>(3 * i).setZero();
   };
   // Preconditioned conjugate gradients, warm-started with the previous step's dv.
   for (int i = 0; i < nv; ++i)
@@ -341,6 +369,7 @@ ClothEnergy ClothSimulator::Impl::Energy() const {
     const double ke = material.BendingStiffness(std::abs(theta) * h.rest_length / h.rest_area_sum, h.du);
     e.bending += 0.25 * ke * h.rest_length * h.rest_length / (2 * h.rest_area_sum) * theta * theta;
   }
+  e.repulsion = repulsion_energy;
   return e;
 }
 
@@ -406,7 +435,10 @@ const Mesh& ClothSimulator::mesh() const { return impl_->mesh; }
 const Material& ClothSimulator::material() const { return impl_->material; }
 const SimOptions& ClothSimulator::options() const { return impl_->options; }
 const Eigen::VectorXd& ClothSimulator::masses() const { return impl_->mass; }
-ClothEnergy ClothSimulator::Energy() const { return impl_->Energy(); }
+ClothEnergy ClothSimulator::Energy() const {
+  Forces();  // refreshes the repulsion pairs and their energy at the current state
+  return impl_->Energy();
+}
 
 Eigen::MatrixX3d ClothSimulator::Forces() const {
   Impl& s = *impl_;

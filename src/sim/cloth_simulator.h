@@ -23,11 +23,12 @@ struct SimOptions {
   // Principal-stretch limits (ArcSim "strain_limits", e.g. 0.95, 1.05); 0 / inf switch a side off.
   double strain_min = 0.0;
   double strain_max = std::numeric_limits<double>::infinity();
-  int strain_limit_iterations = 6;                  // projection sweeps per step
+  int strain_limit_iterations = 10;                 // projection sweeps per step (max)
   double repulsion_thickness = 10e-3;               // ArcSim magic.repulsion_thickness [m]
   double collision_stiffness = 1e6;                 // ArcSim magic.collision_stiffness [N/m^3]
+                                                    // (times min(node area, face area) per pair)
   bool self_collision = true;                       // vertex-face repulsion on/off
-  double cg_tolerance = 1e-6;                       // relative residual of the linear solve
+  double cg_tolerance = 1e-3;                       // relative residual of the linear solve
   int cg_max_iterations = 300;
 };
 
@@ -37,7 +38,8 @@ struct ClothEnergy {
   double gravitational = 0;  // -sum m g.x
   double stretching = 0;     // with the stiffness evaluated at the current strain
   double bending = 0;
-  double Total() const { return kinetic + gravitational + stretching + bending; }
+  double repulsion = 0;      // vertex-face penalty energy (0 without self_collision)
+  double Total() const { return kinetic + gravitational + stretching + bending + repulsion; }
 };
 
 // What the last step did (for benches and diagnostics).

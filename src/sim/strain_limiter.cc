@@ -40,9 +40,13 @@ int StrainLimiter::Project(double strain_min, double strain_max, int iterations,
   const double lo2 = strain_min > 0 ? strain_min * strain_min * (1 - 1e-6) : -1.0;
   const double hi2 = std::isfinite(strain_max) ? strain_max * strain_max * (1 + 1e-6) : 1e300;
   int initially_violated = 0;
+  // After the first sweep only faces with a vertex moved by the previous sweep can be violated.
+  moved_.assign(x.rows(), 1);
+  moved_next_.assign(x.rows(), 0);
   for (int sweep = 0; sweep < iterations; ++sweep) {
     int violated = 0;
     for (const Face& face : faces_) {
+      if (!moved_[face.v[0]] && !moved_[face.v[1]] && !moved_[face.v[2]]) continue;
       const Eigen::Vector3d x0 = x.row(face.v[0]), x1 = x.row(face.v[1]), x2 = x.row(face.v[2]);
       Eigen::Matrix<double, 3, 2> Ds;
       Ds.col(0) = x1 - x0;
@@ -78,10 +82,15 @@ int StrainLimiter::Project(double strain_min, double strain_max, int iterations,
       const double wsum = face.w[0] + face.w[1] + face.w[2];
       const Eigen::Vector3d xc = (face.w[0] * x0 + face.w[1] * x1 + face.w[2] * x2) / wsum;
       for (int c = 0; c < 3; ++c)
-        if (!face.pinned[c]) x.row(face.v[c]) = (xc + Fn * face.du[c]).transpose();
+        if (!face.pinned[c]) {
+          x.row(face.v[c]) = (xc + Fn * face.du[c]).transpose();
+          moved_next_[face.v[c]] = 1;
+        }
     }
     if (sweep == 0) initially_violated = violated;
     if (violated == 0) break;
+    moved_.swap(moved_next_);
+    std::fill(moved_next_.begin(), moved_next_.end(), 0);
   }
   *vp += (x - before_) / dt;
   return initially_violated;

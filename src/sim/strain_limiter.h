@@ -42,6 +42,7 @@ class StrainLimiter {
   };
   std::vector<Face> faces_;
   Eigen::MatrixX3d before_;
+  std::vector<char> moved_, moved_next_;
 };
 
 }  // namespace clothwind::sim

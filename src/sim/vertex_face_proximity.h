@@ -2,7 +2,6 @@
 #define CLOTHWIND_SIM_VERTEX_FACE_PROXIMITY_H_
 
 #include <cstdint>
-#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -11,8 +10,8 @@ namespace clothwind::sim {
 
 // Finds vertex-face pairs of one mesh closer than a thickness (a vertex whose projection onto a
 // non-incident face's plane lies inside the face, within the thickness of it), with a spatial
-// hash of the vertices; the repulsion forces of the simulator act on these pairs. Results are
-// deterministic (sorted). Buffers are reused between calls.
+// hash grid of the vertices; the repulsion forces of the simulator act on these pairs. Results
+// are deterministic (ordered by face, then vertex). Buffers are reused between calls.
 class VertexFaceProximity {
  public:
   struct Pair {
@@ -24,19 +23,24 @@ class VertexFaceProximity {
   // Inputs:
   //   F             #F by 3 faces (indices < num_vertices)
   //   num_vertices  #V
-  VertexFaceProximity(const Eigen::MatrixX3i& F, int num_vertices);
+  //   cell_size     hash grid cell [m] (> 0), e.g. the mean edge length; raised to 2 thickness
+  VertexFaceProximity(const Eigen::MatrixX3i& F, int num_vertices, double cell_size);
 
   // Recomputes the pairs for positions X (#V by 3) [m] and thickness [m] (> 0).
   void Update(const Eigen::MatrixX3d& X, double thickness);
 
-  // Pairs found by the last Update, ordered by (face, vertex).
+  // Pairs found by the last Update.
   const std::vector<Pair>& pairs() const { return pairs_; }
 
  private:
   Eigen::MatrixX3i F_;
   int num_vertices_;
-  std::vector<std::pair<std::uint64_t, int>> cells_;  // (cell key, vertex), sorted
+  double cell_size_;
+  std::vector<int> bucket_head_;   // per hash bucket: first vertex, -1 if none
+  std::vector<int> next_;          // per vertex: next vertex in the same bucket
+  std::vector<std::uint64_t> key_; // per vertex: its cell key
   std::vector<Pair> pairs_;
+  std::vector<int> found_;         // scratch: vertices found for one face
 };
 
 }  // namespace clothwind::sim
