@@ -104,12 +104,19 @@ TEST(PixelFormatTest, YuyvConvertsWithBt601Colours) {
   cv::Vec3b b = image.at<cv::Vec3b>(0, 0);
   EXPECT_GT(b[0], b[1] + 60);
   EXPECT_GT(b[0], b[2] + 60);
-  // Against the BT.601 formula R = Y + 1.402 (V-128) within rounding of either range convention.
-  const double r_full = 100 + 1.402 * (230 - 128);
-  const double r_limited = 1.164 * (100 - 16) + 1.596 * (230 - 128);
-  const double r_expected = std::min(255.0, r_full);
-  EXPECT_TRUE(std::abs(r[2] - r_expected) <= 3 || std::abs(r[2] - std::min(255.0, r_limited)) <= 3)
-      << "R=" << int(r[2]);
+  // UVC cameras send BT.601 video range (Y 16..235): R = 1.164 (Y-16) + 1.596 (V-128),
+  // G = 1.164 (Y-16) - 0.813 (V-128) - 0.391 (U-128), B = 1.164 (Y-16) + 2.018 (U-128).
+  EXPECT_NEAR(r[0], 1.164 * 84, 1.0);                 // B = 97.8
+  EXPECT_NEAR(r[1], 1.164 * 84 - 0.813 * 102, 1.0);   // G = 14.9
+  EXPECT_EQ(r[2], 255);                               // R = 260.6, saturated
+  auto black = UniformYuyv(w, h, stride, 16, 128, 128);
+  auto white = UniformYuyv(w, h, stride, 235, 128, 128);
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kYuyv, black.data(), black.size(), w, h, stride, &image,
+                             &error)) << error;
+  EXPECT_EQ(image.at<cv::Vec3b>(0, 0), cv::Vec3b(0, 0, 0));
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kYuyv, white.data(), white.size(), w, h, stride, &image,
+                             &error)) << error;
+  EXPECT_EQ(image.at<cv::Vec3b>(1, 2), cv::Vec3b(255, 255, 255));
 }
 
 TEST(PixelFormatTest, YuyvRejectsShortBufferAndOddWidth) {

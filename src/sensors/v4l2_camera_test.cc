@@ -235,8 +235,8 @@ TEST(V4l2CameraTest, ConvertsEachFormat) {
       const cv::Vec3b p = f.image.at<cv::Vec3b>(239, 319);
       EXPECT_EQ(p[0], p[1]);
       EXPECT_EQ(p[1], p[2]);
-      // Y = v with neutral chroma: v in full range, or 1.164 (v - 16) in video range.
-      EXPECT_TRUE(std::abs(p[0] - v) <= 2 || std::abs(p[0] - 1.164 * (v - 16)) <= 2) << int(p[0]);
+      // Y = v with neutral chroma, BT.601 video range: 1.164 (v - 16).
+      EXPECT_NEAR(p[0], 1.164 * (v - 16), 1.0);
     } else {
       EXPECT_EQ(f.encoding, "bgr8");
       ASSERT_EQ(f.image.type(), CV_8UC3);
