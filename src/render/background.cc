@@ -37,6 +37,9 @@ Backdrop MakeBackdrop(const RenderParams& p, const PinholeCamera& camera) {
   if (p.background_image.empty()) {
     b.image = ProceduralBackdrop(p.background_seed);
   } else {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(p.background_image, ec))
+      throw std::runtime_error("background_image '" + p.background_image + "': no such file");
     cv::Mat img = cv::imread(p.background_image, cv::IMREAD_COLOR);
     if (img.empty())
       throw std::runtime_error("background_image '" + p.background_image +
@@ -123,49 +126,51 @@ Texture ProceduralBackdrop(uint64_t seed, int width, int height) {
     crowns.push_back(cr);
     x += cr.r * static_cast<float>(rng.Uniform(0.5, 0.95));
   }
+  // Silhouettes depend on the column only: compute them once per column.
+  std::vector<float> hill_top(width, -1.0f), canopy(width, -1.0f), field_top(width);
+  for (int x = 0; x < width; ++x) {
+    const float X = (x + 0.5f) / width * kWidthM;
+    if (hills) hill_top[x] = hill_base + 12.0f * FractalNoise(X / 35.0f, 0.5f, s_hill, 3);
+    const float open = FractalNoise(X / 25.0f, 3.7f, s_tree + 1, 2);
+    if (open > tree_gap * 0.9f + 0.05f) {
+      // Rounded crowns, slightly ragged, over a dense understorey.
+      float top = 0.5f * tree_base;
+      for (const Crown& cr : crowns) {
+        const float d = X - cr.x;
+        if (std::abs(d) < cr.r) top = std::max(top, cr.c + 0.9f * std::sqrt(cr.r * cr.r - d * d));
+      }
+      canopy[x] = top + 0.5f * ValueNoise(X / 0.6f, 0.7f, s_tree + 2);
+    }
+    field_top[x] = 1.2f + 0.6f * ValueNoise(X / 4.0f, 0.2f, s_grass);
+  }
   for (int y = 0; y < height; ++y) {
     const float z = (1.0f - (y + 0.5f) / height) * kHeightM;
     for (int x = 0; x < width; ++x) {
       const float X = (x + 0.5f) / width * kWidthM;
-      // Far to near: hills, buildings, trees, field; nearer layers paint over farther ones.
+      // Near to far: the first layer that covers the texel wins.
       Rgb c = Rgb::Zero();
-      float a = 0.0f;
-      if (hills) {
-        const float top = hill_base + 12.0f * FractalNoise(X / 35.0f, 0.5f, s_hill, 3);
-        if (z < top) {
-          c = 0.55f * hill_col + 0.45f * haze;
-          a = 1.0f;
-        }
-      }
-      for (const Building& b : buildings) {
-        if (X >= b.x0 && X < b.x1 && z < b.top) {
-          const float wx = std::fmod(X - b.x0, 3.0f), wz = std::fmod(z, 3.2f);
-          const bool window = wx > 1.0f && wx < 2.2f && wz > 1.0f && wz < 2.4f && z > 1.0f &&
-                              z < b.top - 1.0f;
-          c = 0.8f * (window ? b.window : b.wall) + 0.2f * haze;
-          a = 1.0f;
-        }
-      }
-      const float open = FractalNoise(X / 25.0f, 3.7f, s_tree + 1, 2);
-      if (open > tree_gap * 0.9f + 0.05f) {
-        // Rounded crowns, slightly ragged, over a dense understorey.
-        float canopy = 0.5f * tree_base;
-        for (const Crown& cr : crowns) {
-          const float d = X - cr.x;
-          if (std::abs(d) < cr.r) canopy = std::max(canopy, cr.c + 0.9f * std::sqrt(cr.r * cr.r - d * d));
-        }
-        canopy += 0.5f * ValueNoise(X / 0.6f, 0.7f, s_tree + 2);
-        if (z < canopy) {
-          const float leaf = FractalNoise(X / 1.2f, z / 1.2f, s_leaf, 4);
-          const float shade =
-              std::clamp(0.15f + 0.9f * leaf + 0.35f * (z / std::max(canopy, 1.0f)), 0.0f, 1.0f);
-          c = tree_dark + shade * (tree_light - tree_dark);
-          a = 1.0f;
-        }
-      }
-      if (z < 1.2f + 0.6f * ValueNoise(X / 4.0f, 0.2f, s_grass)) {
+      float a = 1.0f;
+      if (z < field_top[x]) {
         c = field * (0.85f + 0.3f * FractalNoise(X / 2.0f, z * 4.0f, s_grass + 1, 2));
-        a = 1.0f;
+      } else if (z < canopy[x]) {
+        const float leaf = FractalNoise(X / 1.2f, z / 1.2f, s_leaf, 3);
+        const float shade =
+            std::clamp(0.15f + 0.9f * leaf + 0.35f * (z / std::max(canopy[x], 1.0f)), 0.0f, 1.0f);
+        c = tree_dark + shade * (tree_light - tree_dark);
+      } else {
+        const Building* hit = nullptr;
+        for (const Building& b : buildings)
+          if (X >= b.x0 && X < b.x1 && z < b.top) hit = &b;  // later ones stand in front
+        if (hit) {
+          const float wx = std::fmod(X - hit->x0, 3.0f), wz = std::fmod(z, 3.2f);
+          const bool window = wx > 1.0f && wx < 2.2f && wz > 1.0f && wz < 2.4f && z > 1.0f &&
+                              z < hit->top - 1.0f;
+          c = 0.8f * (window ? hit->window : hit->wall) + 0.2f * haze;
+        } else if (z < hill_top[x]) {
+          c = 0.55f * hill_col + 0.45f * haze;
+        } else {
+          a = 0.0f;
+        }
       }
       t.at(x, y) = c;
       t.alpha(x, y) = a;

@@ -1,5 +1,6 @@
 #include "render/test_meshes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -42,6 +43,22 @@ ClothMesh WavingFlag(int nx, int ny, double width, double height, double time,
       const double xr = x - 0.08 * a * (1.0 - std::cos(2 * phase));
       const double zr = z - 0.12 * height * s * s + 0.05 * a * std::cos(phase);
       m.V.row(j * nx + i) << xr, y, zr;
+    }
+  return m;
+}
+
+ClothMesh HangingCloth(int nx, int ny, double width, double height, double time,
+                       double amplitude, double frequency) {
+  ClothMesh m = Grid(nx, ny);
+  const double omega = 2.0 * M_PI * frequency;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double s = m.UV(j * nx + i, 0), t = m.UV(j * nx + i, 1);
+      const double hang = 1.0 - t;  // 0 at the rod, 1 at the bottom edge
+      const double folds = std::sin(2.0 * M_PI * 2.5 * s + omega * time);
+      const double x = amplitude * hang * (0.6 + 0.4 * std::sin(omega * time + 1.3 * hang)) +
+                       0.04 * hang * folds;
+      m.V.row(j * nx + i) << x, s * width, t * height - 0.03 * hang * x / std::max(amplitude, 1e-9);
     }
   return m;
 }
