@@ -48,6 +48,11 @@ struct StepStats {
   double cg_relative_residual = 0;
   int repulsion_pairs = 0;
   int strain_limited_faces = 0;  // faces outside the limits before projection
+  // Wall time of the phases of the step [s] (steady clock), for benches.
+  double seconds_proximity = 0;
+  double seconds_forces = 0;
+  double seconds_solve = 0;
+  double seconds_strain_limit = 0;
 };
 
 // ArcSim-style cloth: Wang et al. 2011 anisotropic nonlinear stretching and direction/curvature
