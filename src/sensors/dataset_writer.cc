@@ -73,6 +73,7 @@ nlohmann::json ClipLabelJson(const LabelledClip& c, const ClipSourceInfo& source
   j["version"] = kFormatVersion;
   j["name"] = name;
   j["kind"] = "real";  // recorded from a camera, as FlagReal (simulated examples say "sim")
+  j["split"] = source.split;
   j["sequence"] = c.clip.sequence;
   j["num_frames"] = frames.size();
   j["frame_rate"] = c.frame_rate;
@@ -156,6 +157,7 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
                      {"start", label["start"]},
                      {"end", label["end"]},
                      {"num_frames", label["num_frames"]},
+                     {"split", label["split"]},
                      {"wind_speed", label["wind_speed"]},
                      {"wind_std", label["wind"]["std"]},
                      {"wind_count", label["wind"]["count"]}});

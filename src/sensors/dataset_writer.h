@@ -15,6 +15,7 @@ namespace clothwind::sensors {
 struct ClipSourceInfo {
   std::string frame_id;     // camera optical frame
   std::string description;  // e.g. "clip_buffer_node /camera/image_raw"
+  std::string split = "test";  // dataset split (docs/dataset.md); real clips evaluate, as FlagReal
   nlohmann::json camera;    // optional camera_info summary (K, D, size); null when unknown
 };
 

@@ -67,6 +67,9 @@ TEST_F(DatasetWriterTest, WritesFramesLabelAndIndex) {
   const auto index = Read(root_ / "index.json");
   ASSERT_EQ(index["clips"].size(), 1u);
   EXPECT_EQ(index["clips"][0]["name"], fs::path(dir).filename().string());
+  EXPECT_EQ(index["clips"][0]["split"], "test");
+  EXPECT_EQ(index["kind"], "real");
+  EXPECT_EQ(label["kind"], "real");
   // Nothing temporary is left behind.
   for (const auto& e : fs::directory_iterator(root_))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
