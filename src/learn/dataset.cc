@@ -1,0 +1,273 @@
+#include "learn/dataset.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "learn/model_config.h"
+
+namespace clothwind::learn {
+namespace fs = std::filesystem;
+namespace {
+
+nlohmann::json ReadJson(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path.string() + ": cannot open");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(path.string() + ": not valid JSON: " + e.what());
+  }
+}
+
+template <typename T>
+T Field(const nlohmann::json& j, const char* key, const fs::path& file, const char* expected) {
+  if (!j.is_object() || !j.contains(key)) {
+    throw std::runtime_error(file.string() + ": missing field \"" + key + "\" (" + expected + ")");
+  }
+  try {
+    return j.at(key).get<T>();
+  } catch (const nlohmann::json::exception&) {
+    throw std::runtime_error(file.string() + ": field \"" + key + "\" must be " + expected +
+                             ", got " + j.at(key).dump());
+  }
+}
+
+// A printf pattern with exactly one integer conversion (e.g. "%03d.jpg"), nothing else.
+bool ValidFramePattern(const std::string& p) {
+  size_t pos = p.find('%');
+  if (pos == std::string::npos || p.find('%', pos + 1) != std::string::npos) return false;
+  size_t i = pos + 1;
+  while (i < p.size() && (std::isdigit(static_cast<unsigned char>(p[i])) || p[i] == '0')) ++i;
+  return i < p.size() && p[i] == 'd' && p.find('/') == std::string::npos;
+}
+
+std::string FrameName(const ClipInfo& clip, int index) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer), clip.frame_pattern.c_str(), index);
+  return buffer;
+}
+
+}  // namespace
+
+Dataset ReadDataset(const fs::path& dir) {
+  const fs::path index_path = dir / "index.json";
+  const nlohmann::json index = ReadJson(index_path);
+  if (Field<std::string>(index, "format", index_path, "\"clothwind-dataset\"") != "clothwind-dataset") {
+    throw std::runtime_error(index_path.string() + ": field \"format\" must be \"clothwind-dataset\"");
+  }
+  Dataset dataset;
+  dataset.root = dir;
+  dataset.kind = Field<std::string>(index, "kind", index_path, "\"flag\", \"cloth\" or \"real\"");
+  if (!index.contains("clips") || !index["clips"].is_array()) {
+    throw std::runtime_error(index_path.string() + ": missing field \"clips\" (an array)");
+  }
+  for (size_t i = 0; i < index["clips"].size(); ++i) {
+    const nlohmann::json& entry = index["clips"][i];
+    ClipInfo clip;
+    clip.name = Field<std::string>(entry, "name", index_path, "a string");
+    if (clip.name.empty() || clip.name.find('/') != std::string::npos || clip.name[0] == '.') {
+      throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
+                               "].name must be a folder name, got \"" + clip.name + "\"");
+    }
+    clip.dir = dir / clip.name;
+    const fs::path label_path = clip.dir / "label.json";
+    const nlohmann::json label = ReadJson(label_path);
+    clip.wind_speed = Field<double>(label, "wind_speed", label_path, "a number [m/s]");
+    clip.num_frames = Field<int>(label, "num_frames", label_path, "a positive integer");
+    clip.frame_rate = Field<double>(label, "frame_rate", label_path, "a number [Hz]");
+    clip.width = Field<int>(label, "width", label_path, "a positive integer");
+    clip.height = Field<int>(label, "height", label_path, "a positive integer");
+    clip.frame_pattern = Field<std::string>(label, "frame_pattern", label_path, "a pattern like \"%03d.jpg\"");
+    const std::string encoding = Field<std::string>(label, "encoding", label_path, "\"mono8\" or \"rgb8\"");
+    if (encoding != "mono8" && encoding != "rgb8") {
+      throw std::runtime_error(label_path.string() + ": field \"encoding\" must be \"mono8\" or \"rgb8\", got \"" +
+                               encoding + "\"");
+    }
+    if (!std::isfinite(clip.wind_speed) || clip.num_frames < 1 || !(clip.frame_rate > 0) ||
+        clip.width < 1 || clip.height < 1) {
+      throw std::runtime_error(label_path.string() +
+                               ": wind_speed must be finite, num_frames/width/height positive, frame_rate > 0");
+    }
+    if (!ValidFramePattern(clip.frame_pattern)) {
+      throw std::runtime_error(label_path.string() + ": field \"frame_pattern\" must hold one integer "
+                               "conversion like \"%03d.jpg\", got \"" + clip.frame_pattern + "\"");
+    }
+    // The split is the index's (fixed by seed at generation); label.json may repeat it.
+    clip.split = entry.value("split", label.value("split", std::string("train")));
+    if (clip.split != "train" && clip.split != "val" && clip.split != "test") {
+      throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
+                               "].split must be \"train\", \"val\" or \"test\", got \"" + clip.split + "\"");
+    }
+    dataset.clips.push_back(std::move(clip));
+  }
+  return dataset;
+}
+
+std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& split) {
+  if (split != "all" && split != "train" && split != "val" && split != "test") {
+    throw std::invalid_argument("split must be train, val, test or all, got \"" + split + "\"");
+  }
+  std::vector<ClipInfo> out;
+  for (const ClipInfo& c : dataset.clips) {
+    if (split == "all" || c.split == split) out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count) {
+  if (first < 0 || count < 1 || first + count > clip.num_frames) {
+    throw std::runtime_error((clip.dir / "label.json").string() + ": frames " + std::to_string(first) + ".." +
+                             std::to_string(first + count - 1) + " requested but num_frames is " +
+                             std::to_string(clip.num_frames));
+  }
+  std::vector<cv::Mat> frames;
+  frames.reserve(count);
+  for (int i = first; i < first + count; ++i) {
+    const fs::path path = clip.dir / FrameName(clip, i);
+    if (!fs::exists(path)) throw std::runtime_error(path.string() + ": missing frame");
+    cv::Mat image = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+    if (image.empty()) throw std::runtime_error(path.string() + ": not a readable image");
+    if (image.cols != clip.width || image.rows != clip.height) {
+      throw std::runtime_error(path.string() + ": image is " + std::to_string(image.cols) + "x" +
+                               std::to_string(image.rows) + " but label.json says " + std::to_string(clip.width) +
+                               "x" + std::to_string(clip.height));
+    }
+    frames.push_back(image);
+  }
+  return frames;
+}
+
+int ChooseFirstFrame(int num_frames, const SampleOptions& options, std::mt19937_64& rng) {
+  if (num_frames < options.frames) {
+    throw std::runtime_error("clip has " + std::to_string(num_frames) + " frames, the model needs " +
+                             std::to_string(options.frames));
+  }
+  const int slack = num_frames - options.frames;
+  if (!options.augment) return slack / 2;
+  return std::uniform_int_distribution<int>(0, slack)(rng);
+}
+
+Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& options, std::mt19937_64& rng) {
+  if (static_cast<int>(frames.size()) != options.frames || frames.empty()) {
+    throw std::invalid_argument("MakeSample: " + std::to_string(frames.size()) + " frames given, " +
+                                std::to_string(options.frames) + " expected");
+  }
+  const int w = frames[0].cols, h = frames[0].rows;
+  const int side = std::min(w, h);
+  Sample sample;
+  if (options.augment) {
+    const double scale = options.crop_scales.empty()
+                             ? 1.0
+                             : options.crop_scales[std::uniform_int_distribution<size_t>(
+                                   0, options.crop_scales.size() - 1)(rng)];
+    const int crop = std::clamp(static_cast<int>(std::lround(side * scale)), 1, side);
+    const int x = std::uniform_int_distribution<int>(0, w - crop)(rng);
+    const int y = std::uniform_int_distribution<int>(0, h - crop)(rng);
+    sample.crop = cv::Rect(x, y, crop, crop);
+    sample.flipped = std::uniform_int_distribution<int>(0, 1)(rng) == 1;
+  } else {
+    sample.crop = cv::Rect((w - side) / 2, (h - side) / 2, side, side);
+  }
+  const int s = options.input_size;
+  sample.pixels.resize(static_cast<size_t>(options.frames) * s * s);
+  double sum = 0, sum2 = 0;
+  for (int t = 0; t < options.frames; ++t) {
+    const cv::Mat& f = frames[t];
+    if (f.type() != CV_8UC1 || f.cols != w || f.rows != h) {
+      throw std::invalid_argument("MakeSample: frame " + std::to_string(t) + " is not " + std::to_string(w) + "x" +
+                                  std::to_string(h) + " mono8");
+    }
+    cv::Mat resized;
+    cv::resize(f(sample.crop), resized, cv::Size(s, s), 0, 0,
+               sample.crop.width >= s ? cv::INTER_AREA : cv::INTER_LINEAR);
+    if (sample.flipped) cv::flip(resized, resized, 1);
+    cv::Mat out(s, s, CV_32F, sample.pixels.data() + static_cast<size_t>(t) * s * s);
+    resized.convertTo(out, CV_32F);
+    const cv::Scalar m = cv::sum(out);
+    sum += m[0];
+    sum2 += out.dot(out);
+  }
+  const double n = static_cast<double>(sample.pixels.size());
+  const double mean = sum / n;
+  const double std = std::sqrt(std::max(sum2 / n - mean * mean, 0.0));
+  const float inv = static_cast<float>(1.0 / std::max(std, 1e-3));
+  for (float& p : sample.pixels) p = (p - static_cast<float>(mean)) * inv;
+  return sample;
+}
+
+Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  const int first = ChooseFirstFrame(clip.num_frames, options, rng);
+  Sample sample = MakeSample(LoadFrames(clip, first, options.frames), options, rng);
+  sample.first_frame = first;
+  sample.wind_speed = static_cast<float>(clip.wind_speed);
+  return sample;
+}
+
+std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions& o) {
+  fs::create_directories(dir);
+  std::mt19937_64 rng(o.seed);
+  nlohmann::json clips = nlohmann::json::array();
+  std::vector<double> frequencies;
+  for (int i = 0; i < o.clips; ++i) {
+    const uint64_t seed = o.seed * 1000003ULL + static_cast<uint64_t>(i);
+    std::mt19937_64 clip_rng(seed);
+    const double speed = std::uniform_real_distribution<double>(0, o.max_speed)(clip_rng);
+    const double f = o.base_frequency + o.frequency_per_speed * speed;
+    frequencies.push_back(f);
+    const double phase = std::uniform_real_distribution<double>(0, 2 * M_PI)(clip_rng);
+    const int patch = o.size / 2;
+    const int x0 = std::uniform_int_distribution<int>(2, o.size - patch - 2)(clip_rng);
+    const int y0 = std::uniform_int_distribution<int>(2, o.size - patch - 2)(clip_rng);
+    const double wavelength = patch / 2.0;  // [px] two stripes across the patch
+    std::normal_distribution<double> noise(0.0, 3.0);
+    const uint64_t hash = (seed * 0x9E3779B97F4A7C15ULL) >> 33;
+    const std::string split = hash % 5 < 3 ? "train" : (hash % 5 == 3 ? "val" : "test");
+    char name[32];
+    std::snprintf(name, sizeof(name), "toy-%05d", i);
+    const fs::path tmp = dir / (std::string(".") + name + ".tmp");
+    fs::remove_all(tmp);
+    fs::create_directories(tmp);
+    for (int t = 0; t < o.frames; ++t) {
+      cv::Mat frame(o.size, o.size, CV_8UC1);
+      for (int y = 0; y < o.size; ++y) {
+        for (int x = 0; x < o.size; ++x) {
+          double v = 80 + 10 * std::sin(0.3 * x + 0.2 * y);
+          if (x >= x0 && x < x0 + patch && y >= y0 && y < y0 + patch) {
+            v = 140 + 60 * std::sin(2 * M_PI * (f * t / o.frame_rate - (x - x0) / wavelength) + phase);
+          }
+          frame.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(v + noise(clip_rng));
+        }
+      }
+      char file[32];
+      std::snprintf(file, sizeof(file), "%03d.jpg", t);
+      if (!cv::imwrite((tmp / file).string(), frame, {cv::IMWRITE_JPEG_QUALITY, 95})) {
+        throw std::runtime_error((tmp / file).string() + ": cannot write");
+      }
+    }
+    nlohmann::json label = {{"format", "clothwind-clip"}, {"version", 1},       {"name", name},
+                            {"kind", "sim"},              {"num_frames", o.frames},
+                            {"frame_rate", o.frame_rate}, {"width", o.size},   {"height", o.size},
+                            {"encoding", "mono8"},        {"frame_pattern", "%03d.jpg"},
+                            {"wind_speed", speed},        {"seed", seed},      {"split", split},
+                            {"generator", {{"name", "learn::WriteToyDataset"}, {"version", 1}}},
+                            {"toy_frequency", f}};
+    WriteFileAtomically(tmp / "label.json", label.dump(2));
+    fs::remove_all(dir / name);
+    fs::rename(tmp, dir / name);
+    clips.push_back({{"name", name}, {"wind_speed", speed}, {"split", split}});
+  }
+  nlohmann::json index = {{"format", "clothwind-dataset"}, {"version", 1}, {"kind", "flag"}, {"clips", clips}};
+  WriteFileAtomically(dir / "index.json", index.dump(2));
+  return frequencies;
+}
+
+}  // namespace clothwind::learn

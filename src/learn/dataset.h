@@ -1,0 +1,96 @@
+// Reading the clothwind dataset format (docs/dataset.md: index.json + <name>/label.json + JPEG
+// frames), the seed's training augmentations, and a small synthetic dataset for tests.
+// Torch-free: samples are plain float arrays, so tools and nodes need no torch headers.
+#ifndef CLOTHWIND_LEARN_DATASET_H_
+#define CLOTHWIND_LEARN_DATASET_H_
+
+#include <cstdint>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace clothwind::learn {
+
+// One example as listed by index.json and described by its label.json.
+struct ClipInfo {
+  std::string name;
+  std::filesystem::path dir;   // folder of its frames and label.json
+  std::string split;           // "train", "val" or "test"
+  double wind_speed = 0;       // regression target [m/s]
+  int num_frames = 0;
+  double frame_rate = 25;      // [Hz]
+  int width = 0, height = 0;   // [px]
+  std::string frame_pattern;   // printf pattern of one integer, e.g. "%03d.jpg"
+};
+
+struct Dataset {
+  std::filesystem::path root;
+  std::string kind;  // "flag", "cloth" or "real"
+  std::vector<ClipInfo> clips;
+};
+
+// Reads DIR/index.json and every listed DIR/<name>/label.json (frames are read lazily).
+// Throws std::runtime_error naming the file and the field that is missing or wrong.
+Dataset ReadDataset(const std::filesystem::path& dir);
+
+// The examples of one split ("train", "val", "test"), or all of them for "all".
+std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& split);
+
+// Frames first..first+count-1 of a clip as greyscale CV_8UC1 images (colour JPEGs converted).
+// Throws std::runtime_error naming the frame file when it is missing, unreadable or of a size
+// other than the label's.
+std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count);
+
+// How a clip becomes a network input [frames, input_size, input_size] (C = 1, greyscale).
+struct SampleOptions {
+  int frames = 30;        // N_t
+  int input_size = 112;   // output side [px]
+  bool augment = false;   // training: random temporal offset, multi-scale crop, flip
+  // Crop side as fractions of the frame's shorter side (multi-scale cropping, as TSN).
+  std::vector<double> crop_scales = {1.0, 0.875, 0.75, 0.66};
+};
+
+// A network input with the augmentation that produced it (for tests and logs).
+struct Sample {
+  std::vector<float> pixels;  // frames x input_size x input_size, per-clip zero mean, unit std
+  float wind_speed = 0;       // [m/s]
+  int first_frame = 0;        // temporal offset used
+  cv::Rect crop;              // square crop taken from the frames [px]
+  bool flipped = false;
+};
+
+// The frame window of a clip: uniformly random when augmenting, centred otherwise.
+int ChooseFirstFrame(int num_frames, const SampleOptions& options, std::mt19937_64& rng);
+
+// Turns greyscale frames (all of one size, count = options.frames) into a Sample: crop (random
+// multi-scale position and size when augmenting, the centred square of the shorter side
+// otherwise), resize to input_size (area interpolation), flip horizontally with probability
+// 1/2 when augmenting, and normalise the whole clip to zero mean and unit standard deviation.
+Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& options, std::mt19937_64& rng);
+
+// LoadFrames + MakeSample for one example, deterministic in `seed`.
+Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed);
+
+// A synthetic dataset in the docs/dataset.md format whose content is a known function of the
+// label: a textured patch ("flag") on a noisy background whose stripes travel at
+// frequency f = base_frequency + frequency_per_speed · v [Hz]; v uniform in [0, max_speed].
+struct ToyDatasetOptions {
+  int clips = 40;
+  int frames = 60;
+  int size = 64;               // frames are size x size
+  double frame_rate = 25;      // [Hz]
+  double max_speed = 10;       // [m/s]
+  double base_frequency = 1.0;        // [Hz]
+  double frequency_per_speed = 0.5;   // [Hz per m/s]
+  uint64_t seed = 1;
+};
+// Writes the dataset into `dir` (created; examples are replaced). Splits: 60% train, 20% val,
+// 20% test, by the example's seed. Returns the frequency of each example [Hz], in index order.
+std::vector<double> WriteToyDataset(const std::filesystem::path& dir, const ToyDatasetOptions& options);
+
+}  // namespace clothwind::learn
+
+#endif  // CLOTHWIND_LEARN_DATASET_H_

@@ -1,0 +1,218 @@
+// The dataset reader on a generated dataset in the docs/dataset.md format, its errors on bad
+// input, and the augmentations (shapes, determinism by seed, what each one does).
+#include "learn/dataset.h"
+
+#include <cmath>
+#include <fstream>
+#include <numeric>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+namespace clothwind::learn {
+namespace {
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+class DatasetTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::temp_directory_path() / ("clothwind_learn_dataset_" + std::to_string(::getpid())));
+    ToyDatasetOptions o;
+    o.clips = 10;
+    o.frames = 40;
+    o.size = 48;
+    frequencies_ = new std::vector<double>(WriteToyDataset(*dir_, o));
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+    delete frequencies_;
+  }
+  // A copy of the dataset to break.
+  fs::path Copy(const std::string& name) {
+    const fs::path copy = fs::temp_directory_path() / ("clothwind_learn_bad_" + name + std::to_string(::getpid()));
+    fs::remove_all(copy);
+    fs::copy(*dir_, copy, fs::copy_options::recursive);
+    copies_.push_back(copy);
+    return copy;
+  }
+  void TearDown() override {
+    for (const auto& c : copies_) fs::remove_all(c);
+  }
+  static fs::path* dir_;
+  static std::vector<double>* frequencies_;
+  std::vector<fs::path> copies_;
+};
+fs::path* DatasetTest::dir_ = nullptr;
+std::vector<double>* DatasetTest::frequencies_ = nullptr;
+
+void EditJson(const fs::path& file, const std::function<void(nlohmann::json&)>& edit) {
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(file));
+  edit(j);
+  std::ofstream(file) << j.dump();
+}
+
+TEST_F(DatasetTest, ReadsIndexLabelsAndFrames) {
+  const Dataset d = ReadDataset(*dir_);
+  ASSERT_EQ(d.clips.size(), 10u);
+  EXPECT_EQ(d.kind, "flag");
+  int per_split[3] = {0, 0, 0};
+  for (const ClipInfo& c : d.clips) {
+    EXPECT_EQ(c.num_frames, 40);
+    EXPECT_EQ(c.width, 48);
+    EXPECT_DOUBLE_EQ(c.frame_rate, 25);
+    EXPECT_GE(c.wind_speed, 0);
+    EXPECT_LE(c.wind_speed, 10);
+    per_split[c.split == "train" ? 0 : c.split == "val" ? 1 : 2]++;
+  }
+  EXPECT_EQ(SelectSplit(d, "all").size(), 10u);
+  EXPECT_EQ(static_cast<int>(SelectSplit(d, "train").size()), per_split[0]);
+  EXPECT_EQ(static_cast<int>(SelectSplit(d, "val").size()), per_split[1]);
+  EXPECT_THROW(SelectSplit(d, "training"), std::invalid_argument);
+  // The label is the generator's: the stripes' frequency is a known function of wind speed.
+  for (size_t i = 0; i < d.clips.size(); ++i) {
+    EXPECT_NEAR((*frequencies_)[i], 1.0 + 0.5 * d.clips[i].wind_speed, 1e-9);
+  }
+  const std::vector<cv::Mat> frames = LoadFrames(d.clips[0], 5, 3);
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[0].type(), CV_8UC1);
+  EXPECT_EQ(frames[0].size(), cv::Size(48, 48));
+  EXPECT_THROW(LoadFrames(d.clips[0], 38, 3), std::runtime_error);
+}
+
+TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
+  auto expect_error = [](const fs::path& dir, const std::string& file, const std::string& what) {
+    try {
+      const Dataset d = ReadDataset(dir);
+      for (const ClipInfo& c : d.clips) LoadFrames(c, 0, c.num_frames);
+      ADD_FAILURE() << "no error for " << what;
+    } catch (const std::runtime_error& e) {
+      EXPECT_THAT(e.what(), HasSubstr(file)) << what;
+      EXPECT_THAT(e.what(), HasSubstr(what));
+    }
+  };
+  {
+    const fs::path d = Copy("noindex");
+    fs::remove(d / "index.json");
+    expect_error(d, (d / "index.json").string(), "cannot open");
+  }
+  {
+    const fs::path d = Copy("format");
+    EditJson(d / "index.json", [](nlohmann::json& j) { j["format"] = "something"; });
+    expect_error(d, (d / "index.json").string(), "\"format\"");
+  }
+  {
+    const fs::path d = Copy("speed");
+    EditJson(d / "toy-00003" / "label.json", [](nlohmann::json& j) { j.erase("wind_speed"); });
+    expect_error(d, (d / "toy-00003" / "label.json").string(), "\"wind_speed\"");
+  }
+  {
+    const fs::path d = Copy("type");
+    EditJson(d / "toy-00002" / "label.json", [](nlohmann::json& j) { j["num_frames"] = "many"; });
+    expect_error(d, (d / "toy-00002" / "label.json").string(), "\"num_frames\"");
+  }
+  {
+    const fs::path d = Copy("pattern");
+    EditJson(d / "toy-00001" / "label.json", [](nlohmann::json& j) { j["frame_pattern"] = "%s.jpg"; });
+    expect_error(d, (d / "toy-00001" / "label.json").string(), "\"frame_pattern\"");
+  }
+  {
+    const fs::path d = Copy("frame");
+    fs::remove(d / "toy-00004" / "017.jpg");
+    expect_error(d, (d / "toy-00004" / "017.jpg").string(), "missing");
+  }
+  {
+    const fs::path d = Copy("size");
+    cv::imwrite((d / "toy-00005" / "000.jpg").string(), cv::Mat(30, 48, CV_8UC1, cv::Scalar(7)));
+    expect_error(d, (d / "toy-00005" / "000.jpg").string(), "48x30");
+  }
+  {
+    const fs::path d = Copy("json");
+    std::ofstream(d / "toy-00000" / "label.json") << "{ not json";
+    expect_error(d, (d / "toy-00000" / "label.json").string(), "not valid JSON");
+  }
+}
+
+double Mean(const std::vector<float>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); }
+
+TEST_F(DatasetTest, AugmentationShapesAndDeterminismBySeed) {
+  const ClipInfo clip = ReadDataset(*dir_).clips[0];
+  SampleOptions o;
+  o.frames = 30;
+  o.input_size = 32;
+  o.augment = true;
+  const Sample a = LoadSample(clip, o, 7), b = LoadSample(clip, o, 7);
+  ASSERT_EQ(a.pixels.size(), 30u * 32 * 32);
+  EXPECT_EQ(a.pixels, b.pixels);
+  EXPECT_EQ(a.first_frame, b.first_frame);
+  EXPECT_EQ(a.crop, b.crop);
+  EXPECT_FLOAT_EQ(a.wind_speed, static_cast<float>(clip.wind_speed));
+  // Per-clip normalisation: zero mean, unit standard deviation over the whole clip.
+  double m = Mean(a.pixels), var = 0;
+  for (float p : a.pixels) var += (p - m) * (p - m);
+  EXPECT_NEAR(m, 0, 1e-4);
+  EXPECT_NEAR(std::sqrt(var / a.pixels.size()), 1, 1e-3);
+  // Over seeds, every augmentation varies: offset in [0, 10], crop scales, flips.
+  std::set<int> offsets, crops;
+  int flipped = 0;
+  bool differs = false;
+  for (uint64_t seed = 0; seed < 40; ++seed) {
+    const Sample s = LoadSample(clip, o, seed);
+    ASSERT_EQ(s.pixels.size(), a.pixels.size());
+    EXPECT_GE(s.first_frame, 0);
+    EXPECT_LE(s.first_frame, 10);
+    EXPECT_TRUE(s.crop.x >= 0 && s.crop.y >= 0 && s.crop.br().x <= 48 && s.crop.br().y <= 48);
+    EXPECT_EQ(s.crop.width, s.crop.height);
+    offsets.insert(s.first_frame);
+    crops.insert(s.crop.width);
+    flipped += s.flipped;
+    differs |= s.pixels != a.pixels;
+  }
+  EXPECT_GT(offsets.size(), 4u);
+  EXPECT_EQ(crops, (std::set<int>{48, 42, 36, 32}));  // 1, .875, .75, .66 of 48
+  EXPECT_GT(flipped, 5);
+  EXPECT_LT(flipped, 35);
+  EXPECT_TRUE(differs);
+  // Evaluation: centred window, whole square, no flip; the seed does not matter.
+  o.augment = false;
+  const Sample e1 = LoadSample(clip, o, 1), e2 = LoadSample(clip, o, 99);
+  EXPECT_EQ(e1.pixels, e2.pixels);
+  EXPECT_EQ(e1.first_frame, 5);
+  EXPECT_EQ(e1.crop, cv::Rect(0, 0, 48, 48));
+  EXPECT_FALSE(e1.flipped);
+}
+
+TEST(MakeSample, FlipMirrorsTheFrames) {
+  // A horizontal ramp: the flipped sample is the mirror image of the unflipped one.
+  std::vector<cv::Mat> frames;
+  for (int t = 0; t < 4; ++t) {
+    cv::Mat f(16, 16, CV_8UC1);
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) f.at<uint8_t>(y, x) = static_cast<uint8_t>(10 * x + t);
+    frames.push_back(f);
+  }
+  SampleOptions o;
+  o.frames = 4;
+  o.input_size = 16;
+  o.augment = true;
+  o.crop_scales = {1.0};
+  Sample plain, mirrored;
+  for (uint64_t seed = 0; seed < 20 && (plain.pixels.empty() || mirrored.pixels.empty()); ++seed) {
+    std::mt19937_64 rng(seed);
+    Sample s = MakeSample(frames, o, rng);
+    (s.flipped ? mirrored : plain) = s;
+  }
+  ASSERT_FALSE(plain.pixels.empty());
+  ASSERT_FALSE(mirrored.pixels.empty());
+  for (int t = 0; t < 4; ++t)
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x)
+        EXPECT_FLOAT_EQ(mirrored.pixels[(t * 16 + y) * 16 + x], plain.pixels[(t * 16 + y) * 16 + 15 - x]);
+  EXPECT_LT(plain.pixels[0], plain.pixels[15]);  // the ramp rises left to right unflipped
+}
+
+}  // namespace
+}  // namespace clothwind::learn

@@ -1,0 +1,143 @@
+#include "learn/evaluate.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <unistd.h>
+
+#include "learn/dataset.h"
+#include "learn/predictor.h"
+
+namespace clothwind::learn {
+namespace fs = std::filesystem;
+
+Metrics ComputeMetrics(const std::vector<double>& truth, const std::vector<double>& predicted) {
+  if (truth.size() != predicted.size()) throw std::invalid_argument("ComputeMetrics: sizes differ");
+  Metrics m;
+  m.count = static_cast<int>(truth.size());
+  if (truth.empty()) {
+    m.rmse = m.acc05 = std::numeric_limits<double>::quiet_NaN();
+    return m;
+  }
+  double se = 0;
+  int within = 0;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const double e = predicted[i] - truth[i];
+    se += e * e;
+    if (std::abs(e) <= 0.5) ++within;
+  }
+  m.rmse = std::sqrt(se / truth.size());
+  m.acc05 = static_cast<double>(within) / truth.size();
+  return m;
+}
+
+EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::string& split, int threads,
+                    const std::string& device, int batch, const std::function<void(int, int)>& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  Predictor predictor(model, threads, device);
+  const std::vector<ClipInfo> clips = SelectSplit(ReadDataset(data), split);
+  if (clips.empty()) throw std::runtime_error((data / "index.json").string() + ": no examples in split " + split);
+  EvalResult r;
+  r.config = predictor.config();
+  r.split = split;
+  SampleOptions options;
+  options.frames = r.config.frames;
+  options.input_size = r.config.input_size;
+  batch = std::max(1, batch);
+  for (size_t i = 0; i < clips.size(); i += batch) {
+    std::vector<Sample> samples;
+    for (size_t j = i; j < std::min(clips.size(), i + batch); ++j) {
+      samples.push_back(LoadSample(clips[j], options, 0));
+    }
+    std::vector<const Sample*> pointers;
+    for (const Sample& s : samples) pointers.push_back(&s);
+    const std::vector<Prediction> predictions = predictor.Predict(pointers);
+    for (size_t j = 0; j < samples.size(); ++j) {
+      r.names.push_back(clips[i + j].name);
+      r.truth.push_back(clips[i + j].wind_speed);
+      r.predicted.push_back(predictions[j].speed);
+      r.predicted_std.push_back(predictions[j].speed_std);
+    }
+    if (progress) progress(static_cast<int>(r.truth.size()), static_cast<int>(clips.size()));
+  }
+  r.metrics = ComputeMetrics(r.truth, r.predicted);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+nlohmann::json EvalJson(const EvalResult& r) {
+  return {{"rmse", r.metrics.rmse},    {"acc05", r.metrics.acc05},      {"count", r.metrics.count},
+          {"model", r.config.Name()},  {"arch", r.config.arch},         {"modality", r.config.Modality()},
+          {"split", r.split},          {"seconds", r.seconds}};
+}
+
+std::string EvalTable(const EvalResult& r) {
+  std::ostringstream s;
+  const std::string model = r.config.arch == "sdn" ? "SDN" : "ResNet-18";
+  s << std::left << std::setw(28) << "Model" << std::setw(18) << "Input Modality" << std::setw(10) << "RMSE"
+    << "Acc@0.5\n";
+  s << std::setw(28) << (model + " (" + r.config.Name() + ")") << std::setw(18) << r.config.Modality()
+    << std::setw(10) << std::fixed << std::setprecision(3) << r.metrics.rmse << r.metrics.acc05 << "\n";
+  s << "(" << r.metrics.count << " examples, split " << r.split << ")\n";
+  return s.str();
+}
+
+bool RunGnuplot(const std::string& script, const fs::path& png, std::string* error) {
+  const std::string tmp = png.string() + ".tmp" + std::to_string(::getpid()) + ".png";
+  const fs::path script_path = png.string() + ".gp";
+  WriteFileAtomically(script_path, "set terminal pngcairo size 800,600 noenhanced\nset output '" + tmp + "'\n" +
+                                       script);
+  const std::string command = "gnuplot '" + script_path.string() + "' 2>'" + script_path.string() + ".err'";
+  const int rc = std::system(command.c_str());
+  if (rc != 0 || !fs::exists(tmp)) {
+    if (error) *error = "gnuplot failed (exit " + std::to_string(rc) + "), see " + script_path.string() + ".err";
+    fs::remove(tmp);
+    return false;
+  }
+  fs::rename(tmp, png);
+  fs::remove(script_path.string() + ".err");
+  return true;
+}
+
+bool PlotPredictions(const EvalResult& r, const fs::path& png, std::string* error) {
+  const fs::path data = png.string() + ".dat";
+  std::ostringstream d;
+  d << "# true_speed predicted_speed predicted_std name\n" << std::setprecision(6);
+  for (size_t i = 0; i < r.truth.size(); ++i) {
+    d << r.truth[i] << " " << r.predicted[i] << " " << r.predicted_std[i] << " " << r.names[i] << "\n";
+  }
+  WriteFileAtomically(data, d.str());
+  double hi = 1;
+  for (size_t i = 0; i < r.truth.size(); ++i) hi = std::max({hi, r.truth[i], r.predicted[i]});
+  hi = std::ceil(hi + 0.5);
+  std::ostringstream s;
+  s << std::setprecision(4) << "set title '" << r.config.Name() << " on " << r.split << ": RMSE "
+    << r.metrics.rmse << " m/s, Acc@0.5 " << r.metrics.acc05 << " (" << r.metrics.count << ")'\n"
+    << "set xlabel 'true wind speed [m/s]'\nset ylabel 'predicted wind speed [m/s]'\n"
+    << "set xrange [0:" << hi << "]\nset yrange [0:" << hi << "]\nset size square\nset key top left\nset grid\n"
+    << "plot x+0.5 with lines dt 2 lc 'grey' title '±0.5 m/s', x-0.5 with lines dt 2 lc 'grey' notitle, "
+    << "x with lines lc 'black' title 'ideal', '" << data.string()
+    << "' using 1:2:3 with yerrorbars pt 7 ps 0.5 lc 'blue' title 'prediction ± std'\n";
+  return RunGnuplot(s.str(), png, error);
+}
+
+bool PlotLearningCurve(const std::vector<EpochRecord>& log, const fs::path& png, std::string* error) {
+  const fs::path data = png.string() + ".dat";
+  std::ostringstream d;
+  d << "# epoch train_rmse val_rmse train_loss val_loss\n";
+  for (const EpochRecord& e : log) {
+    d << e.epoch << " " << e.train_rmse << " " << e.val_rmse << " " << e.train_loss << " " << e.val_loss << "\n";
+  }
+  WriteFileAtomically(data, d.str());
+  std::ostringstream s;
+  s << "set title 'learning curve'\nset xlabel 'epoch'\nset ylabel 'RMSE [m/s]'\nset grid\nset key top right\n"
+    << "plot '" << data.string() << "' using 1:2 with linespoints title 'train RMSE', '' using 1:3 with "
+    << "linespoints title 'validation RMSE'\n";
+  return RunGnuplot(s.str(), png, error);
+}
+
+}  // namespace clothwind::learn

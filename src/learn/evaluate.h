@@ -1,0 +1,71 @@
+// Evaluation of a wind network in Table 1's terms (RMSE, Acc@0.5) and the plots of training
+// and evaluation (gnuplot PNGs).
+#ifndef CLOTHWIND_LEARN_EVALUATE_H_
+#define CLOTHWIND_LEARN_EVALUATE_H_
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "learn/model_config.h"
+
+namespace clothwind::learn {
+
+struct Metrics {
+  double rmse = 0;   // [m/s] root mean squared error
+  double acc05 = 0;  // fraction of examples with |pred - true| <= 0.5 m/s
+  int count = 0;
+};
+
+// Table 1's metrics of predictions against labels (same length; empty gives count 0, NaNs).
+Metrics ComputeMetrics(const std::vector<double>& truth, const std::vector<double>& predicted);
+
+struct EvalResult {
+  ModelConfig config;
+  std::string split;
+  std::vector<std::string> names;
+  std::vector<double> truth, predicted, predicted_std;  // [m/s]
+  Metrics metrics;
+  double seconds = 0;  // wall time of the evaluation
+};
+
+// Evaluates the model (model.pt + model.json) over one split of a dataset with the evaluation
+// preprocessing (centred frame window, centred square crop, no flip).
+// Inputs: threads  torch threads; device  cpu|cuda|auto; batch  clips per forward pass;
+//         progress  called after each batch with (done, total) (may be empty).
+EvalResult Evaluate(const std::filesystem::path& model, const std::filesystem::path& data, const std::string& split,
+                    int threads, const std::string& device, int batch,
+                    const std::function<void(int, int)>& progress = {});
+
+// {"rmse": …, "acc05": …, "count": …} plus the model and split.
+nlohmann::json EvalJson(const EvalResult& result);
+
+// Table 1's layout: header and one row ("Model  Input Modality  RMSE  Acc@0.5").
+std::string EvalTable(const EvalResult& result);
+
+// Predicted against true wind speed, with the identity line and ±0.5 m/s band, as a PNG via
+// gnuplot (written atomically). Returns false (and says why in *error) if gnuplot fails.
+bool PlotPredictions(const EvalResult& result, const std::filesystem::path& png, std::string* error);
+
+// One line of the training log per epoch.
+struct EpochRecord {
+  int epoch = 0;
+  double lr = 0;
+  double train_loss = 0, val_loss = 0;  // WindLoss, normalised units
+  double train_rmse = 0, val_rmse = 0;  // [m/s]
+  double val_acc05 = 0;
+  double seconds = 0;                   // wall time of the epoch
+};
+
+// Training and validation RMSE per epoch as a PNG via gnuplot (atomically).
+bool PlotLearningCurve(const std::vector<EpochRecord>& log, const std::filesystem::path& png, std::string* error);
+
+// Runs a gnuplot script that writes `png`; the script and data are written next to it.
+bool RunGnuplot(const std::string& script, const std::filesystem::path& png, std::string* error);
+
+}  // namespace clothwind::learn
+
+#endif  // CLOTHWIND_LEARN_EVALUATE_H_

@@ -1,0 +1,90 @@
+#include "learn/model_config.h"
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace clothwind::learn {
+
+int ModelConfig::TrunkInputChannels() const {
+  return arch == "sdn" ? 2 * k * channels : frames * channels;
+}
+
+std::string ModelConfig::Name() const {
+  std::ostringstream s;
+  if (arch == "sdn") s << "sdn-k" << k;
+  else s << arch;
+  s << "-w" << width << "-" << input_size << "-" << frames << "f";
+  return s.str();
+}
+
+std::string ModelConfig::Modality() const {
+  std::ostringstream s;
+  s << frames * channels << "x" << input_size << "x" << input_size;
+  return s.str();
+}
+
+nlohmann::json ToJson(const ModelConfig& c) {
+  return {{"format", "clothwind-model"}, {"version", 1},   {"arch", c.arch},
+          {"frames", c.frames},          {"channels", c.channels},
+          {"k", c.k},                    {"include_dc", c.include_dc},
+          {"frame_rate", c.frame_rate},  {"width", c.width},
+          {"input_size", c.input_size},  {"label_mean", c.label_mean},
+          {"label_std", c.label_std}};
+}
+
+ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& where) {
+  auto need = [&](const char* key) -> const nlohmann::json& {
+    if (!j.is_object() || !j.contains(key)) {
+      throw std::runtime_error(where + ": missing field \"" + key + "\"");
+    }
+    return j.at(key);
+  };
+  ModelConfig c;
+  try {
+    if (need("format").get<std::string>() != "clothwind-model") {
+      throw std::runtime_error(where + ": field \"format\" must be \"clothwind-model\"");
+    }
+    c.arch = need("arch").get<std::string>();
+    c.frames = need("frames").get<int>();
+    c.channels = need("channels").get<int>();
+    c.k = need("k").get<int>();
+    c.include_dc = need("include_dc").get<bool>();
+    c.frame_rate = need("frame_rate").get<double>();
+    c.width = need("width").get<int>();
+    c.input_size = need("input_size").get<int>();
+    c.label_mean = need("label_mean").get<double>();
+    c.label_std = need("label_std").get<double>();
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(where + ": " + e.what());
+  }
+  if (c.arch != "sdn" && c.arch != "resnet18") {
+    throw std::runtime_error(where + ": field \"arch\" must be \"sdn\" or \"resnet18\", got \"" + c.arch + "\"");
+  }
+  if (c.frames < 1 || c.channels < 1 || c.width < 1 || c.input_size < 16 || c.k < 1 ||
+      !(c.frame_rate > 0) || !(c.label_std > 0)) {
+    throw std::runtime_error(where + ": frames, channels, width, k must be >= 1, input_size >= 16, "
+                             "frame_rate and label_std > 0");
+  }
+  return c;
+}
+
+std::filesystem::path ConfigPathFor(const std::filesystem::path& weights) {
+  std::filesystem::path p = weights;
+  return p.replace_extension(".json");
+}
+
+void WriteFileAtomically(const std::filesystem::path& path, const std::string& text) {
+  std::filesystem::path tmp = path;
+  tmp += ".tmp" + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    out.flush();
+    if (!out) throw std::runtime_error(tmp.string() + ": cannot write");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace clothwind::learn

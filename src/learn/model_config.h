@@ -1,0 +1,46 @@
+// The architecture hyper-parameters of a wind network, saved as JSON beside its weights so the
+// node, the eval verb and a resumed training rebuild exactly the network that was trained.
+#ifndef CLOTHWIND_LEARN_MODEL_CONFIG_H_
+#define CLOTHWIND_LEARN_MODEL_CONFIG_H_
+
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace clothwind::learn {
+
+struct ModelConfig {
+  std::string arch = "sdn";  // "sdn" (spectral layer + ResNet-18) or "resnet18" (frames as channels)
+  int frames = 30;           // N_t, input frames per clip
+  int channels = 1;          // C, colour channels per frame (1: greyscale, as the seed)
+  int k = 3;                 // SDN: spectral peaks kept per pixel (2kC trunk input channels)
+  bool include_dc = false;   // SDN: the DC bin among the candidate peaks
+  double frame_rate = 25.0;  // [Hz] of the clips the model reads
+  int width = 64;            // ResNet-18 base width (64 as the original; 16 trains on a CPU)
+  int input_size = 112;      // side of the square input [px] (224 as the seed, 112 for a CPU)
+  double label_mean = 0.0;   // [m/s] the network regresses (v - label_mean) / label_std
+  double label_std = 1.0;    // [m/s]
+
+  // Channels entering the ResNet trunk: 2kC for the SDN, N_t·C for the frame-stack baseline.
+  int TrunkInputChannels() const;
+  // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f".
+  std::string Name() const;
+  // Table 1's "input modality", e.g. "30x112x112".
+  std::string Modality() const;
+};
+
+// JSON round trip; FromJson throws std::runtime_error naming the missing or invalid field
+// (`where` names the file for the message).
+nlohmann::json ToJson(const ModelConfig& config);
+ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& where);
+
+// The JSON file that goes with a weights file: "run/model.pt" -> "run/model.json".
+std::filesystem::path ConfigPathFor(const std::filesystem::path& weights);
+
+// Writes `text` to `path` atomically (temporary file in the same folder, then rename).
+void WriteFileAtomically(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace clothwind::learn
+
+#endif  // CLOTHWIND_LEARN_MODEL_CONFIG_H_

@@ -1,0 +1,134 @@
+#include "learn/networks.h"
+
+#include <cmath>
+#include <string>
+
+#include <fstream>
+#include <stdexcept>
+#include <unistd.h>
+
+#include <ATen/ATen.h>
+#include <torch/serialize.h>
+
+namespace clothwind::learn {
+namespace {
+
+torch::nn::Conv2d Conv(int in, int out, int kernel, int stride) {
+  return torch::nn::Conv2d(
+      torch::nn::Conv2dOptions(in, out, kernel).stride(stride).padding(kernel / 2).bias(false));
+}
+
+}  // namespace
+
+BasicBlockImpl::BasicBlockImpl(int in_channels, int out_channels, int stride) {
+  conv1_ = register_module("conv1", Conv(in_channels, out_channels, 3, stride));
+  bn1_ = register_module("bn1", torch::nn::BatchNorm2d(out_channels));
+  conv2_ = register_module("conv2", Conv(out_channels, out_channels, 3, 1));
+  bn2_ = register_module("bn2", torch::nn::BatchNorm2d(out_channels));
+  if (stride != 1 || in_channels != out_channels) {
+    shortcut_ = register_module("shortcut", torch::nn::Sequential(Conv(in_channels, out_channels, 1, stride),
+                                                                  torch::nn::BatchNorm2d(out_channels)));
+  }
+}
+
+at::Tensor BasicBlockImpl::forward(const at::Tensor& x) {
+  at::Tensor y = at::relu(bn1_->forward(conv1_->forward(x)));
+  y = bn2_->forward(conv2_->forward(y));
+  return at::relu(y + (shortcut_ ? shortcut_->forward(x) : x));
+}
+
+ResNet18TrunkImpl::ResNet18TrunkImpl(int in_channels, int width) {
+  stem_ = register_module("stem", Conv(in_channels, width, 7, 2));
+  stem_bn_ = register_module("stem_bn", torch::nn::BatchNorm2d(width));
+  torch::nn::Sequential stages;
+  int channels = width;
+  for (int stage = 0; stage < 4; ++stage) {
+    const int out = width << stage;
+    stages->push_back(BasicBlock(channels, out, stage == 0 ? 1 : 2));
+    stages->push_back(BasicBlock(out, out, 1));
+    channels = out;
+  }
+  stages_ = register_module("stages", stages);
+  features_ = channels;
+  // He initialisation for convolutions (as torchvision's ResNet); batch norm starts at (1, 0).
+  for (auto& module : modules(/*include_self=*/false)) {
+    if (auto* conv = module->as<torch::nn::Conv2d>()) {
+      torch::nn::init::kaiming_normal_(conv->weight, 0.0, torch::kFanOut, torch::kReLU);
+    }
+  }
+}
+
+at::Tensor ResNet18TrunkImpl::forward(const at::Tensor& x) {
+  at::Tensor y = at::relu(stem_bn_->forward(stem_->forward(x)));
+  y = at::max_pool2d(y, {3, 3}, {2, 2}, {1, 1});
+  y = stages_->forward(y);
+  return at::adaptive_avg_pool2d(y, {1, 1}).flatten(1);
+}
+
+WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
+  if (config.arch != "sdn" && config.arch != "resnet18") {
+    throw std::invalid_argument("WindNet: unknown architecture \"" + config.arch + "\"");
+  }
+  trunk_ = register_module("trunk", ResNet18Trunk(config.TrunkInputChannels(), config.width));
+  head_ = register_module("head", torch::nn::Linear(trunk_->feature_size(), 2));
+}
+
+at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
+  if (clips.dim() != 5 || clips.size(1) != config_.channels || clips.size(2) != config_.frames) {
+    throw std::invalid_argument("WindNet " + config_.Name() + ": expected clips [N_b, " +
+                                std::to_string(config_.channels) + ", " + std::to_string(config_.frames) +
+                                ", H, W], got " + std::to_string(clips.dim()) + " dimensions " +
+                                (clips.dim() >= 3 ? "with C=" + std::to_string(clips.size(1)) +
+                                                        " N_t=" + std::to_string(clips.size(2))
+                                                  : std::string()));
+  }
+  if (config_.arch == "sdn") {
+    SpectralMaps maps = SpectralDecomposition(clips, config_.k, config_.frame_rate, config_.include_dc);
+    return at::cat({at::log1p(maps.power), maps.frequency * (2.0 / config_.frame_rate)}, 1);
+  }
+  return clips.reshape({clips.size(0), clips.size(1) * clips.size(2), clips.size(3), clips.size(4)});
+}
+
+at::Tensor WindNetImpl::forward(const at::Tensor& clips) {
+  at::Tensor out = head_->forward(trunk_->forward(TrunkInput(clips)));
+  return at::stack({out.select(1, 0), out.select(1, 1).clamp(-12.0, 8.0)}, 1);
+}
+
+at::Tensor WindLoss(const at::Tensor& output, const at::Tensor& target) {
+  at::Tensor mean = output.select(1, 0), log_var = output.select(1, 1);
+  at::Tensor residual2 = (mean - target).square();
+  at::Tensor nll = 0.5 * (log_var + residual2.detach() * at::exp(-log_var));
+  return (residual2 + nll).mean();
+}
+
+void SaveWindNet(WindNet& net, const std::filesystem::path& weights) {
+  std::filesystem::path tmp = weights;
+  tmp += ".tmp" + std::to_string(::getpid());
+  torch::save(net, tmp.string());
+  std::filesystem::rename(tmp, weights);
+  WriteFileAtomically(ConfigPathFor(weights), ToJson(net->config()).dump(2) + "\n");
+}
+
+WindNet LoadWindNet(const std::filesystem::path& weights) {
+  const std::filesystem::path config_path = ConfigPathFor(weights);
+  std::ifstream in(config_path);
+  if (!in) throw std::runtime_error(config_path.string() + ": cannot open (the model's architecture)");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(config_path.string() + ": not valid JSON: " + e.what());
+  }
+  WindNet net(ModelConfigFromJson(j, config_path.string()));
+  if (!std::filesystem::exists(weights)) throw std::runtime_error(weights.string() + ": no such file");
+  try {
+    torch::load(net, weights.string());
+  } catch (const c10::Error& e) {
+    throw std::runtime_error(weights.string() + ": does not hold the weights of a " + net->config().Name() +
+                             " network: " + e.what_without_backtrace());
+  }
+  net->eval();
+  return net;
+}
+
+}  // namespace clothwind::learn

@@ -1,0 +1,93 @@
+// The wind regression networks of Table 1 written with torch::nn: the SDN (spectral layer +
+// ResNet-18) and the ResNet-18 baseline that reads N_t frames stacked as channels. Both end in
+// a head predicting the (normalised) wind speed and its log variance.
+#ifndef CLOTHWIND_LEARN_NETWORKS_H_
+#define CLOTHWIND_LEARN_NETWORKS_H_
+
+#include <filesystem>
+
+#include <torch/nn/init.h>
+#include <torch/nn/module.h>
+#include <torch/nn/modules/batchnorm.h>
+#include <torch/nn/modules/container/sequential.h>
+#include <torch/nn/modules/conv.h>
+#include <torch/nn/modules/linear.h>
+#include <torch/nn/pimpl.h>
+
+#include "learn/model_config.h"
+#include "learn/spectral_layer.h"
+
+namespace clothwind::learn {
+
+// ResNet's basic block: two 3x3 convolutions with batch norm and an identity (or 1x1 strided
+// projection) shortcut.
+class BasicBlockImpl : public torch::nn::Module {
+ public:
+  BasicBlockImpl(int in_channels, int out_channels, int stride);
+  at::Tensor forward(const at::Tensor& x);
+
+ private:
+  torch::nn::Conv2d conv1_{nullptr}, conv2_{nullptr};
+  torch::nn::BatchNorm2d bn1_{nullptr}, bn2_{nullptr};
+  torch::nn::Sequential shortcut_{nullptr};
+};
+TORCH_MODULE(BasicBlock);
+
+// ResNet-18 trunk: 7x7/2 convolution, 3x3/2 max pool, four stages of two basic blocks
+// (widths w, 2w, 4w, 8w; stride 2 from the second stage), global average pooling.
+class ResNet18TrunkImpl : public torch::nn::Module {
+ public:
+  // in_channels  channels of the input image; width  w, the first stage's width (64 originally)
+  ResNet18TrunkImpl(int in_channels, int width);
+  // x [N_b, in_channels, H, W] -> features [N_b, 8w]
+  at::Tensor forward(const at::Tensor& x);
+  int feature_size() const { return features_; }
+
+ private:
+  torch::nn::Conv2d stem_{nullptr};
+  torch::nn::BatchNorm2d stem_bn_{nullptr};
+  torch::nn::Sequential stages_{nullptr};
+  int features_ = 0;
+};
+TORCH_MODULE(ResNet18Trunk);
+
+// A whole wind network as described by a ModelConfig.
+class WindNetImpl : public torch::nn::Module {
+ public:
+  explicit WindNetImpl(const ModelConfig& config);
+  // Inputs:
+  //   clips  [N_b, C, N_t, H, W] per-clip normalised frames (N_t = config.frames, H = W =
+  //          config.input_size)
+  // Outputs:
+  //   [N_b, 2]: column 0 the normalised speed (v - label_mean) / label_std, column 1 its log
+  //   variance (normalised units), clamped to [-12, 8]
+  at::Tensor forward(const at::Tensor& clips);
+  // The trunk's input image: the stacked spectral maps (SDN: log1p of the power, frequency
+  // divided by the Nyquist rate, so both are O(1)) or the frames as channels (baseline).
+  at::Tensor TrunkInput(const at::Tensor& clips) const;
+  const ModelConfig& config() const { return config_; }
+
+ private:
+  ModelConfig config_;
+  ResNet18Trunk trunk_{nullptr};
+  torch::nn::Linear head_{nullptr};
+};
+TORCH_MODULE(WindNet);
+
+// The training loss of a batch: mean squared error of the speed plus the Gaussian negative log
+// likelihood of the residual under the predicted variance, with the mean detached in the NLL so
+// the variance head cannot slow down the regression (normalised units).
+// Inputs: output [N_b, 2] of WindNet, target [N_b] normalised speeds. Output: scalar loss.
+at::Tensor WindLoss(const at::Tensor& output, const at::Tensor& target);
+
+// Saves the network's parameters and buffers (torch::save) to `weights` and its ModelConfig
+// to ConfigPathFor(weights), both atomically (temporary file, then rename).
+void SaveWindNet(WindNet& net, const std::filesystem::path& weights);
+
+// Loads a network saved by SaveWindNet (config from the JSON beside the weights), in eval mode
+// on the CPU. Throws std::runtime_error naming the file that is missing or does not match.
+WindNet LoadWindNet(const std::filesystem::path& weights);
+
+}  // namespace clothwind::learn
+
+#endif  // CLOTHWIND_LEARN_NETWORKS_H_

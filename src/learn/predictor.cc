@@ -1,0 +1,111 @@
+#include "learn/predictor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <ATen/ATen.h>
+#include <ATen/Parallel.h>
+#include <torch/cuda.h>
+#include <opencv2/imgproc.hpp>
+#include <ATen/core/grad_mode.h>
+
+#include "learn/networks.h"
+#include "learn/spectral_layer.h"
+
+namespace clothwind::learn {
+
+struct Predictor::Impl {
+  WindNet net{nullptr};
+  at::Device device = at::kCPU;
+};
+
+Predictor::Predictor(const std::filesystem::path& weights, int threads, const std::string& device)
+    : impl_(std::make_unique<Impl>()) {
+  if (threads > 0) at::set_num_threads(threads);
+  if (device == "cuda" && !torch::cuda::is_available()) {
+    throw std::runtime_error("device cuda requested but libtorch finds no CUDA device");
+  }
+  if (device != "cpu" && device != "cuda" && device != "auto") {
+    throw std::runtime_error("device must be cpu, cuda or auto, got \"" + device + "\"");
+  }
+  impl_->device = (device != "cpu" && torch::cuda::is_available()) ? at::Device(at::kCUDA) : at::Device(at::kCPU);
+  impl_->net = LoadWindNet(weights);
+  impl_->net->to(impl_->device);
+  impl_->net->eval();
+}
+
+Predictor::~Predictor() = default;
+
+const ModelConfig& Predictor::config() const { return impl_->net->config(); }
+
+std::string Predictor::device() const { return impl_->device.is_cuda() ? "cuda" : "cpu"; }
+
+std::vector<Prediction> Predictor::Predict(const std::vector<const Sample*>& samples) {
+  if (samples.empty()) return {};
+  const ModelConfig& c = config();
+  const int64_t per = static_cast<int64_t>(c.frames) * c.input_size * c.input_size;
+  at::Tensor batch = at::empty({static_cast<int64_t>(samples.size()), 1, c.frames, c.input_size, c.input_size});
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (static_cast<int64_t>(samples[i]->pixels.size()) != per) {
+      throw std::invalid_argument("Predictor: sample " + std::to_string(i) + " has " +
+                                  std::to_string(samples[i]->pixels.size()) + " values, the model reads " +
+                                  std::to_string(per));
+    }
+    std::copy(samples[i]->pixels.begin(), samples[i]->pixels.end(), batch[i].data_ptr<float>());
+  }
+  at::NoGradGuard no_grad;
+  at::Tensor out = impl_->net->forward(batch.to(impl_->device)).to(at::kCPU).to(at::kDouble).contiguous();
+  std::vector<Prediction> predictions(samples.size());
+  const double* o = out.data_ptr<double>();
+  for (size_t i = 0; i < samples.size(); ++i) {
+    predictions[i].speed = c.label_mean + c.label_std * o[2 * i];
+    predictions[i].speed_std = c.label_std * std::exp(0.5 * o[2 * i + 1]);
+  }
+  return predictions;
+}
+
+Sample Predictor::Prepare(const std::vector<cv::Mat>& frames) const {
+  const ModelConfig& c = config();
+  if (static_cast<int>(frames.size()) < c.frames) {
+    throw std::invalid_argument("clip has " + std::to_string(frames.size()) + " frames, the model " + c.Name() +
+                                " needs " + std::to_string(c.frames));
+  }
+  for (const cv::Mat& f : frames) {
+    if (f.type() != CV_8UC1 || f.size() != frames[0].size() || f.empty()) {
+      throw std::invalid_argument("clip frames must be non-empty mono8 images of one size");
+    }
+  }
+  SampleOptions options;
+  options.frames = c.frames;
+  options.input_size = c.input_size;
+  std::vector<cv::Mat> last(frames.end() - c.frames, frames.end());
+  std::mt19937_64 unused(0);
+  return MakeSample(last, options, unused);
+}
+
+Prediction Predictor::PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps* maps) {
+  Sample sample = Prepare(frames);
+  Prediction p = Predict({&sample})[0];
+  const ModelConfig& c = config();
+  if (maps != nullptr && c.arch == "sdn") {
+    at::Tensor clip = at::from_blob(sample.pixels.data(), {1, 1, c.frames, c.input_size, c.input_size}, at::kFloat);
+    SpectralMaps m = SpectralDecomposition(clip, 1, c.frame_rate, c.include_dc);
+    maps->power = cv::Mat(c.input_size, c.input_size, CV_32F);
+    maps->frequency = cv::Mat(c.input_size, c.input_size, CV_32F);
+    std::copy_n(m.power.contiguous().data_ptr<float>(), m.power.numel(), maps->power.ptr<float>());
+    std::copy_n(m.frequency.contiguous().data_ptr<float>(), m.frequency.numel(), maps->frequency.ptr<float>());
+  }
+  return p;
+}
+
+cv::Mat ColourMapped(const cv::Mat& value, double lo, double hi, int colormap) {
+  cv::Mat scaled;
+  const double range = hi > lo ? hi - lo : 1.0;
+  value.convertTo(scaled, CV_8U, 255.0 / range, -lo * 255.0 / range);  // saturates outside [lo, hi]
+  cv::Mat colour;
+  cv::applyColorMap(scaled, colour, colormap);
+  return colour;
+}
+
+}  // namespace clothwind::learn

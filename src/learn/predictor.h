@@ -1,0 +1,68 @@
+// Inference with a saved wind network, behind a torch-free interface (pimpl) so the node, the
+// eval verb and the bench need no torch headers.
+#ifndef CLOTHWIND_LEARN_PREDICTOR_H_
+#define CLOTHWIND_LEARN_PREDICTOR_H_
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "learn/dataset.h"
+#include "learn/model_config.h"
+
+namespace clothwind::learn {
+
+struct Prediction {
+  double speed = 0;      // [m/s]
+  double speed_std = 0;  // [m/s] predicted standard deviation (the network's uncertainty)
+};
+
+// The strongest spectral peak of every pixel of a clip (SDN models only), at input resolution.
+struct PeakMaps {
+  cv::Mat power;      // CV_32F input_size x input_size, periodogram of the strongest bin
+  cv::Mat frequency;  // CV_32F input_size x input_size, its frequency [Hz]
+};
+
+class Predictor {
+ public:
+  // Inputs:
+  //   weights  a model saved by training (model.pt with model.json beside it)
+  //   threads  torch intra-op threads (process-wide setting)
+  //   device   "cpu", "cuda" (error when absent) or "auto" (CUDA when libtorch finds one)
+  // Throws std::runtime_error naming the file when the model cannot be loaded.
+  Predictor(const std::filesystem::path& weights, int threads, const std::string& device);
+  ~Predictor();
+  Predictor(const Predictor&) = delete;
+  Predictor& operator=(const Predictor&) = delete;
+
+  const ModelConfig& config() const;
+  std::string device() const;  // "cpu" or "cuda"
+
+  // Predictions for prepared samples (each config().frames x input_size² floats, as MakeSample
+  // makes them), in one batch.
+  std::vector<Prediction> Predict(const std::vector<const Sample*>& samples);
+
+  // A raw greyscale clip as a node receives it: the last config().frames frames, centred square
+  // crop, resized and normalised as for evaluation. `maps` (may be null; SDN only) receives the
+  // strongest peak maps of the same input.
+  // Throws std::invalid_argument when there are too few frames or they are not equal CV_8UC1.
+  Prediction PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps* maps = nullptr);
+
+  // A clip with the evaluation preprocessing (no augmentation) from raw greyscale frames.
+  Sample Prepare(const std::vector<cv::Mat>& frames) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// A false-colour BGR image of `value` (CV_32F) scaled from [lo, hi] to OpenCV colour map
+// `colormap` (e.g. cv::COLORMAP_INFERNO); values outside are clamped.
+cv::Mat ColourMapped(const cv::Mat& value, double lo, double hi, int colormap);
+
+}  // namespace clothwind::learn
+
+#endif  // CLOTHWIND_LEARN_PREDICTOR_H_

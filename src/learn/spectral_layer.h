@@ -1,0 +1,46 @@
+// The spectral decomposition layer of the SDN (seed supplementary, Algorithm 1): every pixel's
+// signal along time is Hann-windowed and Fourier transformed; the k strongest periodogram bins
+// and their frequencies become 2kC image channels that ordinary 2D convolutions can read.
+#ifndef CLOTHWIND_LEARN_SPECTRAL_LAYER_H_
+#define CLOTHWIND_LEARN_SPECTRAL_LAYER_H_
+
+#include <ATen/core/Tensor.h>
+
+namespace clothwind::learn {
+
+// Power and frequency maps of a batch of clips.
+struct SpectralMaps {
+  at::Tensor power;      // [N_b, kC, H, W] periodogram of the selected bins (unit: input² )
+  at::Tensor frequency;  // [N_b, kC, H, W] their frequencies [Hz]
+};
+
+// The spectral decomposition of a batch of clips (Algorithm 1), batched on the input's device.
+//
+// Per pixel signal x_n (n = 0..N_t-1): the pixel's temporal mean is removed (a constant
+// detrend, as scipy.signal.periodogram does: otherwise a bright pixel's mean leaks through the
+// Hann window into bin 1), y_n = w_n (x_n - mean) with the periodic Hann window
+// w_n = 0.5 - 0.5 cos(2π n / N_t); X_j = Σ_n y_n e^{-2πi jn/N_t} (one-sided, j = 0..N_t/2);
+// periodogram I_j = |X_j|² / Σ_n w_n²; the k largest I_j in descending order (the order of
+// exactly equal powers is unspecified) and their frequencies f_j = j · frame_rate / N_t.
+// The DC bin (j = 0) is excluded unless include_dc: it carries no motion, and a frequency map
+// of zeros says nothing.
+// Channel c·k + i of either map is the i-th strongest bin of input channel c.
+//
+// Inputs:
+//   x           [N_b, C, N_t, H, W] floating tensor (any device)
+//   k           number of bins to keep, 1 ≤ k ≤ number of candidate bins (N_t/2 or N_t/2+1)
+//   frame_rate  sampling rate of the clip [Hz] (25 for FlagSim)
+//   include_dc  keep the DC bin among the candidates
+// Outputs:
+//   the two maps, each [N_b, kC, H, W], same dtype and device as x
+// Throws std::invalid_argument on a wrong rank, N_t < 2 or an impossible k.
+SpectralMaps SpectralDecomposition(const at::Tensor& x, int k, double frame_rate,
+                                   bool include_dc = false);
+
+// Algorithm 1's output as one image: [power, frequency] concatenated along channels,
+// [N_b, 2kC, H, W].
+at::Tensor StackSpectralMaps(const SpectralMaps& maps);
+
+}  // namespace clothwind::learn
+
+#endif  // CLOTHWIND_LEARN_SPECTRAL_LAYER_H_

@@ -1,0 +1,180 @@
+// The spectral layer against an independent O(N²) DFT written here, plus its batching and its
+// commutation with the spatial augmentations (crop, flip).
+#include "learn/spectral_layer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+
+namespace clothwind::learn {
+namespace {
+
+constexpr double kFps = 25.0;
+
+struct Bin {
+  double power;
+  int index;
+};
+
+// Periodogram of one signal by the textbook DFT after removing its mean, Hann window
+// w_n = 0.5 - 0.5 cos(2πn/N), normalised by Σ w_n².
+std::vector<Bin> NaivePeriodogram(std::vector<double> x, bool include_dc) {
+  const int n = static_cast<int>(x.size());
+  const double mean = std::accumulate(x.begin(), x.end(), 0.0) / n;
+  for (double& v : x) v -= mean;
+  std::vector<double> w(n);
+  double w2 = 0;
+  for (int i = 0; i < n; ++i) {
+    w[i] = 0.5 - 0.5 * std::cos(2 * M_PI * i / n);
+    w2 += w[i] * w[i];
+  }
+  std::vector<Bin> bins;
+  for (int j = include_dc ? 0 : 1; j <= n / 2; ++j) {
+    double re = 0, im = 0;
+    for (int i = 0; i < n; ++i) {
+      re += w[i] * x[i] * std::cos(2 * M_PI * j * i / n);
+      im -= w[i] * x[i] * std::sin(2 * M_PI * j * i / n);
+    }
+    bins.push_back({(re * re + im * im) / w2, j});
+  }
+  std::stable_sort(bins.begin(), bins.end(), [](const Bin& a, const Bin& b) { return a.power > b.power; });
+  return bins;
+}
+
+// Pixel signals of a [nb, c, nt, h, w] clip as a double tensor of known content.
+at::Tensor RandomClip(int64_t nb, int64_t c, int64_t nt, int64_t h, int64_t w, uint64_t seed) {
+  at::manual_seed(seed);
+  return at::randn({nb, c, nt, h, w}, at::kDouble);
+}
+
+std::vector<double> PixelSignal(const at::Tensor& x, int64_t b, int64_t c, int64_t y, int64_t xx) {
+  at::Tensor s = x.index({b, c, at::indexing::Slice(), y, xx}).contiguous().to(at::kDouble);
+  return std::vector<double>(s.data_ptr<double>(), s.data_ptr<double>() + s.numel());
+}
+
+TEST(SpectralLayer, OscillatingPixelsGiveTheirFrequencyAndPower) {
+  // Each pixel oscillates at its own whole-bin frequency on top of a bright mean (DC), so the
+  // strongest non-DC bin must be that frequency, in Hz at 25 fps.
+  const int64_t nt = 30, h = 3, w = 5;
+  at::Tensor x = at::zeros({1, 1, nt, h, w}, at::kDouble);
+  std::vector<int> expected_bin(h * w);
+  for (int64_t y = 0; y < h; ++y) {
+    for (int64_t xx = 0; xx < w; ++xx) {
+      const int bin = 1 + static_cast<int>((y * w + xx) % 14);
+      expected_bin[y * w + xx] = bin;
+      const double amplitude = 0.5 + 0.1 * xx, phase = 0.3 * y;
+      for (int64_t t = 0; t < nt; ++t) {
+        x.index_put_({0, 0, t, y, xx},
+                     100.0 + amplitude * std::cos(2 * M_PI * bin * t / nt + phase));
+      }
+    }
+  }
+  SpectralMaps maps = SpectralDecomposition(x, 1, kFps);
+  ASSERT_EQ(maps.power.sizes(), (at::IntArrayRef{1, 1, h, w}));
+  for (int64_t y = 0; y < h; ++y) {
+    for (int64_t xx = 0; xx < w; ++xx) {
+      const int bin = expected_bin[y * w + xx];
+      EXPECT_NEAR(maps.frequency.index({0, 0, y, xx}).item<double>(), bin * kFps / nt, 1e-9)
+          << "pixel " << y << "," << xx;
+      // A whole-bin cosine of amplitude A under a Hann window: |X_j| = A/2 · Σw = A N / 4 and
+      // Σw² = 3N/8; checked against this closed form and against the naive DFT.
+      const double amplitude = 0.5 + 0.1 * xx;
+      const double closed_form = std::pow(amplitude * nt / 4.0, 2) / (3.0 * nt / 8.0);
+      const auto naive = NaivePeriodogram(PixelSignal(x, 0, 0, y, xx), false);
+      EXPECT_EQ(naive[0].index, bin);
+      EXPECT_NEAR(maps.power.index({0, 0, y, xx}).item<double>(), naive[0].power, 1e-9 * naive[0].power);
+      EXPECT_NEAR(naive[0].power, closed_form, 1e-9 * closed_form);
+    }
+  }
+  // The bright mean (100) must not leak into the result: the same clip without it gives the
+  // same maps.
+  SpectralMaps dark = SpectralDecomposition(x - 100.0, 1, kFps);
+  EXPECT_TRUE(at::allclose(dark.power, maps.power, 1e-9, 1e-9));
+  EXPECT_TRUE(at::equal(dark.frequency, maps.frequency));
+}
+
+void ExpectMatchesNaive(const at::Tensor& x, int k, bool include_dc) {
+  SpectralMaps maps = SpectralDecomposition(x, k, kFps, include_dc);
+  const int64_t nb = x.size(0), c = x.size(1), nt = x.size(2), h = x.size(3), w = x.size(4);
+  ASSERT_EQ(maps.power.sizes(), (at::IntArrayRef{nb, k * c, h, w}));
+  ASSERT_EQ(maps.frequency.sizes(), (at::IntArrayRef{nb, k * c, h, w}));
+  for (int64_t b = 0; b < nb; ++b)
+    for (int64_t ch = 0; ch < c; ++ch)
+      for (int64_t y = 0; y < h; ++y)
+        for (int64_t xx = 0; xx < w; ++xx) {
+          const auto naive = NaivePeriodogram(PixelSignal(x, b, ch, y, xx), include_dc);
+          for (int i = 0; i < k; ++i) {
+            const double p = maps.power.index({b, ch * k + i, y, xx}).item<double>();
+            const double f = maps.frequency.index({b, ch * k + i, y, xx}).item<double>();
+            EXPECT_NEAR(p, naive[i].power, 1e-9 * (1 + naive[i].power))
+                << "b" << b << " c" << ch << " y" << y << " x" << xx << " peak " << i;
+            EXPECT_NEAR(f, naive[i].index * kFps / nt, 1e-12) << "peak " << i << " nt " << nt;
+          }
+        }
+}
+
+TEST(SpectralLayer, TopKMatchesNaiveDftForRandomSignals) {
+  // k and N_t as parameters, even and odd lengths, several channels.
+  ExpectMatchesNaive(RandomClip(2, 2, 30, 3, 4, 1), 3, false);
+  ExpectMatchesNaive(RandomClip(1, 3, 31, 2, 3, 2), 2, false);
+  ExpectMatchesNaive(RandomClip(2, 1, 20, 2, 2, 3), 4, true);
+  ExpectMatchesNaive(RandomClip(1, 1, 10, 3, 3, 4), 5, false);  // every candidate bin
+}
+
+TEST(SpectralLayer, FloatInputAgreesWithDouble) {
+  at::Tensor x = RandomClip(1, 1, 30, 4, 4, 5);
+  SpectralMaps d = SpectralDecomposition(x, 2, kFps);
+  SpectralMaps f = SpectralDecomposition(x.to(at::kFloat), 2, kFps);
+  EXPECT_EQ(f.power.scalar_type(), at::kFloat);
+  EXPECT_TRUE(at::allclose(f.power.to(at::kDouble), d.power, 1e-4, 1e-5));
+  EXPECT_TRUE(at::allclose(f.frequency.to(at::kDouble), d.frequency, 1e-6, 1e-6));
+}
+
+TEST(SpectralLayer, BatchEqualsPerExample) {
+  at::Tensor x = RandomClip(4, 2, 30, 5, 6, 6);
+  at::Tensor batched = StackSpectralMaps(SpectralDecomposition(x, 3, kFps));
+  ASSERT_EQ(batched.sizes(), (at::IntArrayRef{4, 2 * 3 * 2, 5, 6}));
+  for (int64_t b = 0; b < 4; ++b) {
+    at::Tensor one = StackSpectralMaps(SpectralDecomposition(x.narrow(0, b, 1), 3, kFps));
+    EXPECT_TRUE(at::equal(one, batched.narrow(0, b, 1))) << "example " << b;
+  }
+}
+
+TEST(SpectralLayer, CommutesWithCropAndHorizontalFlip) {
+  // The layer is per pixel, so caching its output and augmenting afterwards is equivalent to
+  // augmenting the clip first, for crops and flips (not for resampling).
+  at::Tensor x = RandomClip(2, 1, 30, 8, 9, 7);
+  auto layer = [](const at::Tensor& t) { return StackSpectralMaps(SpectralDecomposition(t, 2, kFps)); };
+  at::Tensor maps = layer(x);
+  EXPECT_TRUE(at::equal(layer(x.flip({4})), maps.flip({3})));
+  EXPECT_TRUE(at::equal(layer(x.narrow(3, 2, 5).narrow(4, 1, 6)), maps.narrow(2, 2, 5).narrow(3, 1, 6)));
+  // A temporal shift is not a spatial augmentation: it changes the result (sanity check that
+  // the comparisons above can fail).
+  EXPECT_FALSE(at::equal(layer(x.roll({3}, {2})), maps.flip({3})));
+}
+
+TEST(SpectralLayer, RejectsBadShapesAndK) {
+  EXPECT_THROW(SpectralDecomposition(at::zeros({1, 30, 4, 4}), 1, kFps), std::invalid_argument);
+  EXPECT_THROW(SpectralDecomposition(at::zeros({1, 1, 1, 4, 4}), 1, kFps), std::invalid_argument);
+  EXPECT_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), 16, kFps), std::invalid_argument);
+  EXPECT_NO_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), 15, kFps));
+  EXPECT_NO_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), 16, kFps, true));
+  EXPECT_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), 0, kFps), std::invalid_argument);
+}
+
+TEST(SpectralLayer, IsDifferentiableWithRespectToTheClip) {
+  // No weights, but gradients must flow to earlier layers (the power channels depend on x).
+  at::Tensor x = RandomClip(1, 1, 16, 2, 2, 8).requires_grad_(true);
+  at::Tensor out = StackSpectralMaps(SpectralDecomposition(x, 2, kFps)).sum();
+  out.backward();
+  ASSERT_TRUE(x.grad().defined());
+  EXPECT_GT(x.grad().abs().sum().item<double>(), 0);
+}
+
+}  // namespace
+}  // namespace clothwind::learn

@@ -1,0 +1,262 @@
+#include "learn/train.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <future>
+#include <iomanip>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include <ATen/ATen.h>
+#include <ATen/Parallel.h>
+#include <ATen/core/grad_mode.h>
+#include <nlohmann/json.hpp>
+#include <torch/cuda.h>
+#include <torch/types.h>
+#include <torch/nn/utils/clip_grad.h>
+#include <torch/optim/adam.h>
+#include <torch/serialize.h>
+
+#include "learn/dataset.h"
+#include "learn/networks.h"
+
+namespace clothwind::learn {
+namespace fs = std::filesystem;
+namespace {
+
+struct Batch {
+  at::Tensor clips;   // [B, 1, N_t, S, S]
+  at::Tensor speeds;  // [B] [m/s]
+};
+
+Batch LoadBatch(const std::vector<ClipInfo>& clips, const std::vector<size_t>& indices, size_t begin, size_t end,
+                const SampleOptions& options, uint64_t seed_base) {
+  const int64_t n = static_cast<int64_t>(end - begin), s = options.input_size;
+  Batch b{at::empty({n, 1, options.frames, s, s}), at::empty({n})};
+  for (size_t i = begin; i < end; ++i) {
+    const size_t clip = indices[i];
+    Sample sample = LoadSample(clips[clip], options, seed_base + clip);
+    std::copy(sample.pixels.begin(), sample.pixels.end(), b.clips[i - begin].data_ptr<float>());
+    b.speeds[i - begin] = sample.wind_speed;
+  }
+  return b;
+}
+
+nlohmann::json EpochJson(const EpochRecord& e) {
+  return {{"epoch", e.epoch},         {"lr", e.lr},           {"train_loss", e.train_loss},
+          {"val_loss", e.val_loss},   {"train_rmse", e.train_rmse}, {"val_rmse", e.val_rmse},
+          {"val_acc05", e.val_acc05}, {"seconds", e.seconds}};
+}
+
+EpochRecord EpochFromJson(const nlohmann::json& j) {
+  EpochRecord e;
+  e.epoch = j.at("epoch").get<int>();
+  e.lr = j.at("lr").get<double>();
+  e.train_loss = j.at("train_loss").get<double>();
+  e.val_loss = j.at("val_loss").get<double>();
+  e.train_rmse = j.at("train_rmse").get<double>();
+  e.val_rmse = j.at("val_rmse").get<double>();
+  e.val_acc05 = j.at("val_acc05").get<double>();
+  e.seconds = j.at("seconds").get<double>();
+  return e;
+}
+
+std::string LogTsv(const std::vector<EpochRecord>& log) {
+  std::ostringstream s;
+  s << "epoch\tlr\ttrain_loss\tval_loss\ttrain_rmse\tval_rmse\tval_acc05\tseconds\n" << std::setprecision(6);
+  for (const EpochRecord& e : log) {
+    s << e.epoch << "\t" << e.lr << "\t" << e.train_loss << "\t" << e.val_loss << "\t" << e.train_rmse << "\t"
+      << e.val_rmse << "\t" << e.val_acc05 << "\t" << e.seconds << "\n";
+  }
+  return s.str();
+}
+
+template <typename T>
+void SaveAtomically(T& object, const fs::path& path) {
+  fs::path tmp = path;
+  tmp += ".tmp";
+  torch::save(object, tmp.string());
+  fs::rename(tmp, path);
+}
+
+}  // namespace
+
+TrainResult Train(const TrainOptions& o) {
+  if (o.threads > 0) at::set_num_threads(o.threads);
+  if (o.device != "cpu" && o.device != "cuda" && o.device != "auto") {
+    throw std::runtime_error("device must be cpu, cuda or auto, got \"" + o.device + "\"");
+  }
+  if (o.device == "cuda" && !torch::cuda::is_available()) {
+    throw std::runtime_error("device cuda requested but libtorch finds no CUDA device");
+  }
+  if (o.epochs < 1 || o.batch < 1) throw std::runtime_error("epochs and batch must be at least 1");
+  const at::Device device = (o.device != "cpu" && torch::cuda::is_available()) ? at::Device(at::kCUDA)
+                                                                                 : at::Device(at::kCPU);
+  fs::create_directories(o.out);
+  TrainResult result;
+  result.device = device.is_cuda() ? "cuda" : "cpu";
+  result.model = o.out / "model.pt";
+
+  std::vector<ClipInfo> train, val;
+  if (!o.data.empty()) {
+    const Dataset dataset = ReadDataset(o.data);
+    train = SelectSplit(dataset, "train");
+    val = SelectSplit(dataset, "val");
+    if (!o.init_only && train.empty()) {
+      throw std::runtime_error((o.data / "index.json").string() + ": no examples in split train");
+    }
+    if (val.empty()) val = train;  // a dataset without a validation split validates on train
+  } else if (!o.init_only) {
+    throw std::runtime_error("training needs --data");
+  }
+
+  ModelConfig config = o.model;
+  config.channels = 1;  // greyscale input, as the seed
+  if (!train.empty()) {
+    double sum = 0, sum2 = 0;
+    for (const ClipInfo& c : train) {
+      sum += c.wind_speed;
+      sum2 += c.wind_speed * c.wind_speed;
+    }
+    config.label_mean = sum / train.size();
+    const double var = sum2 / train.size() - config.label_mean * config.label_mean;
+    config.label_std = var > 1e-12 ? std::sqrt(var) : 1.0;
+  }
+  const fs::path last = o.out / "last.pt", last_optim = o.out / "last_optim.pt", state_path = o.out / "state.json";
+  nlohmann::json state;
+  if (o.resume) {
+    std::ifstream in(state_path);
+    if (!in) throw std::runtime_error(state_path.string() + ": cannot open (nothing to resume)");
+    try {
+      state = nlohmann::json::parse(in);
+      config = ModelConfigFromJson(state.at("model"), state_path.string());
+      for (const auto& e : state.at("log")) result.log.push_back(EpochFromJson(e));
+    } catch (const nlohmann::json::exception& e) {
+      throw std::runtime_error(state_path.string() + ": " + e.what());
+    }
+  }
+  at::manual_seed(o.seed);
+  WindNet net(config);
+  torch::optim::Adam optimizer(net->parameters(), torch::optim::AdamOptions(o.lr).weight_decay(o.weight_decay));
+  if (o.resume) {
+    torch::load(net, last.string());
+    torch::load(optimizer, last_optim.string());
+  }
+  net->to(device);
+  if (o.init_only) {
+    SaveWindNet(net, result.model);
+    return result;
+  }
+
+  const int decay_epoch = o.lr_decay_epoch < 0 ? std::max(1, o.epochs / 2) : o.lr_decay_epoch;
+  result.best_val_rmse = std::numeric_limits<double>::infinity();
+  for (const EpochRecord& e : result.log) result.best_val_rmse = std::min(result.best_val_rmse, e.val_rmse);
+  SampleOptions train_options, val_options;
+  train_options.frames = val_options.frames = config.frames;
+  train_options.input_size = val_options.input_size = config.input_size;
+  train_options.augment = true;
+  const float mean = static_cast<float>(config.label_mean), inv_std = static_cast<float>(1.0 / config.label_std);
+
+  for (int epoch = static_cast<int>(result.log.size()) + 1; epoch <= o.epochs; ++epoch) {
+    const auto start = std::chrono::steady_clock::now();
+    EpochRecord record;
+    record.epoch = epoch;
+    record.lr = epoch > decay_epoch ? o.lr / o.lr_decay_factor : o.lr;
+    for (auto& group : optimizer.param_groups()) {
+      static_cast<torch::optim::AdamOptions&>(group.options()).lr(record.lr);
+    }
+    // The epoch's order and augmentations depend only on (seed, epoch): a resumed run repeats them.
+    std::vector<size_t> order(train.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::mt19937_64 rng(o.seed * 7919 + epoch);
+    std::shuffle(order.begin(), order.end(), rng);
+    const uint64_t seed_base = (o.seed * 1000003ULL + epoch) * 1000003ULL;
+    // A last batch of one cannot be batch-normalised at 1x1 spatial size; drop it.
+    size_t usable = order.size();
+    if (usable % o.batch == 1 && usable > 1) --usable;
+    const int steps = static_cast<int>((usable + o.batch - 1) / o.batch);
+    net->train();
+    double loss_sum = 0, se_sum = 0;
+    size_t seen = 0;
+    auto load = [&](size_t b) {
+      return std::async(std::launch::async, LoadBatch, std::cref(train), std::cref(order), b,
+                        std::min(usable, b + o.batch), std::cref(train_options), seed_base);
+    };
+    std::future<Batch> next = load(0);
+    for (int step = 0; step < steps; ++step) {
+      Batch batch = next.get();
+      const size_t following = static_cast<size_t>(step + 1) * o.batch;
+      if (following < usable) next = load(following);  // decode the next batch while this one trains
+      at::Tensor x = batch.clips.to(device), y = ((batch.speeds - mean) * inv_std).to(device);
+      optimizer.zero_grad();
+      at::Tensor out = net->forward(x);
+      at::Tensor loss = WindLoss(out, y);
+      loss.backward();
+      if (o.grad_clip > 0) torch::nn::utils::clip_grad_norm_(net->parameters(), o.grad_clip);
+      optimizer.step();
+      const int64_t n = x.size(0);
+      loss_sum += loss.item<double>() * n;
+      se_sum += ((out.select(1, 0).detach() - y).square().sum()).item<double>() * config.label_std * config.label_std;
+      seen += n;
+      if (o.progress) o.progress({epoch, o.epochs, step + 1, steps, loss_sum / seen});
+    }
+    record.train_loss = loss_sum / std::max<size_t>(seen, 1);
+    record.train_rmse = std::sqrt(se_sum / std::max<size_t>(seen, 1));
+
+    // Validation: evaluation preprocessing, no augmentation.
+    net->eval();
+    {
+      at::NoGradGuard no_grad;
+      std::vector<size_t> all(val.size());
+      std::iota(all.begin(), all.end(), 0);
+      std::vector<double> truth, predicted;
+      double val_loss = 0;
+      for (size_t b = 0; b < all.size(); b += o.batch) {
+        Batch batch = LoadBatch(val, all, b, std::min(all.size(), b + o.batch), val_options, 0);
+        at::Tensor y = (batch.speeds - mean) * inv_std;
+        at::Tensor out = net->forward(batch.clips.to(device)).to(at::kCPU);
+        val_loss += WindLoss(out, y).item<double>() * y.size(0);
+        at::Tensor speed = (out.select(1, 0) * config.label_std + config.label_mean).to(at::kDouble).contiguous();
+        at::Tensor label = batch.speeds.to(at::kDouble).contiguous();
+        for (int64_t i = 0; i < y.size(0); ++i) {
+          predicted.push_back(speed.data_ptr<double>()[i]);
+          truth.push_back(label.data_ptr<double>()[i]);
+        }
+      }
+      const Metrics m = ComputeMetrics(truth, predicted);
+      record.val_loss = val_loss / std::max<size_t>(val.size(), 1);
+      record.val_rmse = m.rmse;
+      record.val_acc05 = m.acc05;
+    }
+    record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.log.push_back(record);
+
+    // Checkpoint: weights on the CPU so any machine can load them.
+    net->to(at::kCPU);
+    if (record.val_rmse < result.best_val_rmse) {
+      result.best_val_rmse = record.val_rmse;
+      SaveWindNet(net, result.model);
+    }
+    SaveAtomically(net, last);
+    net->to(device);
+    SaveAtomically(optimizer, last_optim);
+    nlohmann::json log = nlohmann::json::array();
+    for (const EpochRecord& e : result.log) log.push_back(EpochJson(e));
+    state = {{"epoch", epoch}, {"model", ToJson(config)}, {"log", log}, {"seed", o.seed},
+             {"best_val_rmse", result.best_val_rmse}};
+    WriteFileAtomically(state_path, state.dump(2));
+    WriteFileAtomically(o.out / "log.tsv", LogTsv(result.log));
+    if (!PlotLearningCurve(result.log, o.out / "learning_curve.png", &result.plot_error)) {
+      // The plot is a convenience; training goes on without it.
+    }
+    if (o.epoch_done) o.epoch_done(record);
+  }
+  return result;
+}
+
+}  // namespace clothwind::learn

@@ -1,0 +1,62 @@
+// Training a wind network with the seed's recipe (supplementary section 4): Adam, lr 1e-2
+// divided by 10 after half the epochs (20 of 40), weight decay 2e-3, optional gradient-norm
+// clipping; random temporal offset, greyscale, multi-scale random crop, horizontal flip and
+// per-clip normalisation. Torch-free interface.
+#ifndef CLOTHWIND_LEARN_TRAIN_H_
+#define CLOTHWIND_LEARN_TRAIN_H_
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "learn/evaluate.h"
+#include "learn/model_config.h"
+
+namespace clothwind::learn {
+
+struct TrainProgress {
+  int epoch = 0, epochs = 0;  // 1-based epoch being trained
+  int step = 0, steps = 0;    // batches done in this epoch, of
+  double loss = 0;            // running mean training loss of this epoch
+};
+
+struct TrainOptions {
+  ModelConfig model;                 // arch, frames, k, width, input_size (label stats filled in)
+  std::filesystem::path data;        // dataset folder (docs/dataset.md); may be empty with init_only
+  std::filesystem::path out;         // run folder: model.pt/json (best), last.pt, log.tsv, plot
+  int epochs = 40;
+  int batch = 16;
+  double lr = 1e-2;
+  int lr_decay_epoch = -1;           // epochs before lr /= lr_decay_factor; -1: epochs / 2
+  double lr_decay_factor = 10;
+  double weight_decay = 2e-3;
+  double grad_clip = 0;              // max gradient norm; 0: off (the seed clips only RNNs)
+  int threads = 2;                   // torch intra-op threads
+  std::string device = "auto";       // cpu | cuda | auto
+  bool resume = false;               // continue from out/last.pt and out/state.json
+  bool init_only = false;            // write an initialised (untrained) model and stop
+  uint64_t seed = 1;
+  std::function<void(const TrainProgress&)> progress;  // after each batch (may be empty)
+  std::function<void(const EpochRecord&)> epoch_done;  // after each epoch (may be empty)
+};
+
+struct TrainResult {
+  std::vector<EpochRecord> log;      // every epoch so far (resumed ones included)
+  std::filesystem::path model;       // out/model.pt, the epoch with the lowest validation RMSE
+  double best_val_rmse = 0;
+  std::string device;                // where it trained
+  std::string plot_error;            // why the learning curve could not be drawn, if so
+};
+
+// Trains (or resumes) and writes to options.out:
+//   model.pt + model.json   best validation RMSE so far (what eval and sdn_node load)
+//   last.pt, last_optim.pt  the latest epoch (for --resume); state.json its epoch and log
+//   log.tsv                 one line per epoch; learning_curve.png (gnuplot)
+// every file written atomically. Throws std::runtime_error on bad data or options.
+TrainResult Train(const TrainOptions& options);
+
+}  // namespace clothwind::learn
+
+#endif  // CLOTHWIND_LEARN_TRAIN_H_
