@@ -15,8 +15,8 @@ namespace clothwind::sensors {
 struct ClipSourceInfo {
   std::string frame_id;     // camera optical frame
   std::string description;  // e.g. "clip_buffer_node /camera/image_raw"
-  std::string split = "test";  // dataset split (docs/dataset.md); real clips evaluate, as FlagReal
   nlohmann::json camera;    // optional camera_info summary (K, D, size); null when unknown
+  std::string split = "test";  // dataset split (docs/dataset.md); real clips evaluate, as FlagReal
 };
 
 // Folder name of a recorded clip: "clip-<UTC yyyymmdd-hhmmss.mmm of its first frame>-<seq>", so
