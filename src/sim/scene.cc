@@ -227,6 +227,9 @@ SceneHandle ParseHandle(const Reader& r, const json& j, const std::string& path,
   }
   if (j.contains("start_time")) h.start_time = r.NonNegative(j["start_time"], path + ".start_time");
   if (j.contains("end_time")) h.end_time = r.NonNegative(j["end_time"], path + ".end_time");
+  if (j.contains("start_time") || j.contains("end_time")) {
+    r.Warn(path, "handle start_time/end_time are not simulated; the handle holds throughout");
+  }
   return h;
 }
 

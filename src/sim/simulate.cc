@@ -34,7 +34,11 @@ Trajectory SimulateTrajectory(const SceneSetup& setup, const Theta& theta,
   const int steps_per_frame = setup.scene.frame_steps;
   const int frames = static_cast<int>(std::lround(duration / frame_time));
 
-  ClothSimulator sim(cloth.mesh, material, cloth.options, MakeWindField(wind));
+  SimOptions sim_options = cloth.options;
+  sim_options.wind_density = wind.density;  // the setup's wind may have been edited
+  sim_options.wind_drag = wind.drag;
+  ClothSimulator sim(cloth.mesh, material, sim_options,
+                     options.make_wind ? options.make_wind(wind) : MakeWindField(wind));
   Trajectory t;
   t.faces = cloth.mesh.F;
   t.uv = cloth.mesh.U.cast<float>();

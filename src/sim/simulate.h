@@ -19,6 +19,10 @@ struct SimulateOptions {
   // Called after every frame with (frames done, frames total); return false to stop early
   // (the trajectory then holds the frames done so far). May be empty.
   std::function<bool(int, int)> progress;
+  // Builds the wind field from the wind spec (after theta's wind speed and the seed are applied).
+  // Empty: MakeWindField. The sim-to-real work plugs further effects in here (e.g. wrap the
+  // standard field with a wake or a measured gust record); must be thread-safe when batched.
+  std::function<std::shared_ptr<const WindField>(const WindSpec&)> make_wind;
 };
 
 // Simulates one cloth of a scene with parameter vector theta (area weight, bending table, wind

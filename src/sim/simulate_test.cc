@@ -91,6 +91,28 @@ TEST(SimulateTrajectory, DeterministicAcrossRunsAndThreadsAndSeedsMatter) {
   EXPECT_FALSE(Identical(a, SimulateTrajectory(setup, theta, o)));
 }
 
+TEST(SimulateTrajectory, WindHookReceivesThetasWindAndItsFieldIsUsed) {
+  const SceneSetup setup = SmallFlag();
+  Theta theta = SceneTheta(setup);
+  theta[kWindSpeedIndex] = 7.0;
+  SimulateOptions o;
+  o.duration = 0.2;
+  Eigen::Vector3d seen = Eigen::Vector3d::Zero();
+  o.make_wind = [&](const WindSpec& spec) -> std::shared_ptr<const WindField> {
+    seen = spec.velocity;
+    return std::make_shared<SteadyWind>(Eigen::Vector3d::Zero());  // still air instead
+  };
+  const Trajectory hooked = SimulateTrajectory(setup, theta, o);
+  EXPECT_NEAR((seen - Eigen::Vector3d(7, 0, 0)).norm(), 0.0, 1e-12);
+  // The hook's still air was used: same as a scene without wind and gusts, unlike 7 m/s.
+  o.make_wind = nullptr;
+  EXPECT_FALSE(Identical(hooked, SimulateTrajectory(setup, theta, o)));
+  SceneSetup still = setup;
+  still.wind.gusts.rate = 0.0;
+  theta[kWindSpeedIndex] = 0.0;
+  EXPECT_TRUE(Identical(hooked, SimulateTrajectory(still, theta, o)));
+}
+
 TEST(SimulateTrajectories, BatchMatchesSerialRunsInOrder) {
   const SceneSetup setup = SmallFlag();
   std::vector<Theta> thetas;
