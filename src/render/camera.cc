@@ -44,6 +44,7 @@ Eigen::Matrix3d PinholeCamera::K() const {
 }
 
 Eigen::Vector3d MeshCentre(const RenderParams& p) {
+  if (p.has_look_at) return Eigen::Vector3d(p.look_at[0], p.look_at[1], p.look_at[2]);
   const double w = p.mesh_width, h = p.MeshRestHeight();
   if (p.scene == SceneKind::kFlag) return Eigen::Vector3d(0.5 * w, 0.0, p.mesh_height + 0.5 * h);
   return Eigen::Vector3d(0.0, 0.5 * w, p.mesh_height + 0.5 * h);

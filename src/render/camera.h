@@ -40,9 +40,10 @@ struct PinholeCamera {
   Eigen::Matrix3d K() const;
 };
 
-// The point the camera looks at: the centre of the mesh at rest in world coordinates, for a
-// flag flying downwind ((w/2, 0, mesh_height + h/2); the hoist is on the z axis and wind
-// along +x) and for a hanging cloth ((0, w/2, mesh_height + h/2); it hangs in the y-z plane).
+// The point the camera looks at: p.look_at when set (FrameClip), else the centre of the mesh at
+// rest in world coordinates, for a flag flying downwind ((w/2, 0, mesh_height + h/2); the hoist
+// is on the z axis and wind along +x) and for a hanging cloth ((0, w/2, mesh_height + h/2); it
+// hangs in the y-z plane).
 Eigen::Vector3d MeshCentre(const RenderParams& p);
 
 // The camera of seed Table 2: at horizontal distance camera_radius from MeshCentre, at

@@ -95,5 +95,50 @@ TEST(PlaceCamera, ClothIsSeenFaceOn) {
   EXPECT_NEAR(px.y(), 150.0, 1e-9);
 }
 
+TEST(FrameClip, HangingFlagStaysInTheFrame) {
+  // A flag hanging down the pole (1 m/s: droop ~80 deg): the hoist from z = 0 to 2, the fly
+  // end ~2.9 m lower, in the simulator's frame. Aimed at the flying rest centre its lower part
+  // leaves the frame; framed from the clip, every vertex is in view and the box centre is the
+  // image centre.
+  Eigen::MatrixXd V(6, 3);
+  V << 0, 0, 2, 0.3, 0, 0.5, 0.5, 0.1, -2.6, 0, 0, 0, 0.2, -0.1, -1.5, 0.4, 0, -0.8;
+  RenderParams p;
+  p.camera_height = 1.6;
+  p.camera_radius = 5.0;
+  auto all_in_view = [&](const RenderParams& q) {
+    const PinholeCamera c = PlaceCamera(q);
+    for (int i = 0; i < V.rows(); ++i) {
+      Eigen::Vector2d px;
+      const Eigen::Vector3d w = V.row(i).transpose() + Eigen::Vector3d(0, 0, q.mesh_height);
+      if (!c.Project(w, &px) || px.x() < 0 || px.x() > 300 || px.y() < 0 || px.y() > 300)
+        return false;
+    }
+    return true;
+  };
+  EXPECT_FALSE(all_in_view(p));
+  RenderParams framed = p;
+  FrameClip({V, V * 0.9}, &framed);
+  EXPECT_TRUE(all_in_view(framed));
+  EXPECT_NEAR(framed.look_at[2], 4.6 - 0.3, 1e-12);  // (2 + -2.6) / 2 lifted by 4.6
+  EXPECT_GT(framed.camera_fov_deg, p.camera_fov_deg);  // 4.6 m tall does not fit in 45 deg
+  EXPECT_LT(framed.camera_fov_deg, 60.0);
+  // A flying flag fits already: the field of view stays.
+  Eigen::MatrixXd flying(4, 3);
+  flying << 0, 0, 0, 0, 0, 2, 3, 0.3, 0.2, 3, -0.3, 1.9;
+  RenderParams f = p;
+  FrameClip({flying}, &f);
+  EXPECT_DOUBLE_EQ(f.camera_fov_deg, p.camera_fov_deg);
+  Eigen::Vector2d px;
+  ASSERT_TRUE(PlaceCamera(framed).Project(Eigen::Vector3d(0.25, 0.0, 4.3), &px));
+  EXPECT_NEAR(px.x(), 150.0, 1e-9);
+  EXPECT_NEAR(px.y(), 150.0, 1e-9);
+  // The aim survives label.json.
+  const RenderParams back = RenderParamsFromJson(nlohmann::json::parse(ToJson(framed).dump()));
+  EXPECT_TRUE(back.has_look_at);
+  EXPECT_DOUBLE_EQ(back.look_at[0], framed.look_at[0]);
+  EXPECT_DOUBLE_EQ(back.look_at[2], framed.look_at[2]);
+  EXPECT_THROW(FrameClip({}, &framed), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace clothwind::render

@@ -1,6 +1,10 @@
 #include "render/render_params.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
+
+#include "render/camera.h"
 
 #include "render/fabric_patterns.h"
 #include "render/flag_designs.h"
@@ -61,7 +65,7 @@ RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
 }
 
 nlohmann::json ToJson(const RenderParams& p) {
-  return nlohmann::json{
+  nlohmann::json j{
       {"scene", SceneKindName(p.scene)},
       {"seed", p.seed},
       {"background_image", p.background_image},
@@ -89,6 +93,37 @@ nlohmann::json ToJson(const RenderParams& p) {
       {"height", p.height},
       {"fps", p.fps},
   };
+  if (p.has_look_at) j["look_at"] = {p.look_at[0], p.look_at[1], p.look_at[2]};
+  return j;
+}
+
+void FrameClip(const std::vector<Eigen::MatrixXd>& frames, RenderParams* p) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const Eigen::MatrixXd& V : frames) {
+    if (V.cols() != 3 || V.rows() == 0)
+      throw std::invalid_argument("FrameClip: every frame must be #V by 3 with #V > 0");
+    lo = lo.cwiseMin(V.colwise().minCoeff().transpose());
+    hi = hi.cwiseMax(V.colwise().maxCoeff().transpose());
+  }
+  if (frames.empty()) throw std::invalid_argument("FrameClip: no frames");
+  const Eigen::Vector3d c = 0.5 * (lo + hi);
+  p->has_look_at = true;
+  p->look_at[0] = c.x();
+  p->look_at[1] = c.y();
+  p->look_at[2] = c.z() + p->mesh_height;
+  // Widen (never narrow) the field of view so the box fits with a 5 % margin: a flag hanging
+  // down the pole is taller than a flying one is long.
+  const PinholeCamera cam = PlaceCamera(*p);
+  double need = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d q((corner & 1) ? hi.x() : lo.x(), (corner & 2) ? hi.y() : lo.y(),
+                            ((corner & 4) ? hi.z() : lo.z()) + p->mesh_height);
+    const Eigen::Vector3d d = q - cam.position;
+    const double z = std::max(d.dot(cam.forward), 1e-3);
+    need = std::max({need, std::abs(d.dot(cam.right)) / z, std::abs(d.dot(cam.down)) / z});
+  }
+  const double fov = 2.0 * std::atan(need / 0.95) * 180.0 / M_PI;
+  p->camera_fov_deg = std::min(std::max(p->camera_fov_deg, fov), 120.0);
 }
 
 namespace {
@@ -162,6 +197,15 @@ RenderParams RenderParamsFromJson(const nlohmann::json& j) {
   p.width = Integer(j, "width");
   p.height = Integer(j, "height");
   p.fps = Number(j, "fps");
+  if (j.contains("look_at")) {
+    const auto& a = j["look_at"];
+    if (!a.is_array() || a.size() != 3 || !a[0].is_number() || !a[1].is_number() ||
+        !a[2].is_number())
+      throw std::invalid_argument("render params: field 'look_at' must be [x, y, z], got " +
+                                  a.dump());
+    p.has_look_at = true;
+    for (int k = 0; k < 3; ++k) p.look_at[k] = a[k].get<double>();
+  }
   ValidateRenderParams(p);
   return p;
 }

@@ -1,6 +1,7 @@
 #ifndef CLOTHWIND_RENDER_RENDER_PARAMS_H_
 #define CLOTHWIND_RENDER_RENDER_PARAMS_H_
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -47,6 +48,11 @@ struct RenderParams {
   double camera_radius = 5.0;     // [m] horizontal distance, flag ~U(4, 6), cloth ~U(1, 2.5)
   double camera_angle_deg = 0.0;  // [deg] flag ~U(-15, 15), cloth ~U(-5, 5)
   double camera_fov_deg = 45.0;   // [deg] horizontal = vertical field of view (square frame)
+  // Where the camera looks [m, world]; unset: the mesh's rest centre (see MeshCentre). Set by
+  // FrameClip from a clip's frames, so a hanging flag (low wind) is framed as well as a flying
+  // one, as the seed's real clips were cropped around the flag. JSON: [x, y, z] or absent.
+  bool has_look_at = false;
+  double look_at[3] = {0.0, 0.0, 0.0};
 
   // Mesh (Table 2): the simulator's frame is lifted by mesh_height (its origin, the hoist's
   // lower corner for flags, goes to that height above the ground).
@@ -79,6 +85,13 @@ RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
 // missing or of the wrong type (std::invalid_argument).
 nlohmann::json ToJson(const RenderParams& p);
 RenderParams RenderParamsFromJson(const nlohmann::json& j);
+
+// Aims the camera of a clip at the centre of the cloth's bounding box over all its frames
+// (sets p->look_at), instead of the flag's flying rest centre, and widens camera_fov_deg (never
+// narrows it; at most 120 deg) so that box fits in the frame with a 5 % margin.
+// Inputs: frames  each #V by 3 vertex positions [m] in the simulator's frame (as given to the
+//   renderer; p->mesh_height lifts them). Throws std::invalid_argument if there are none.
+void FrameClip(const std::vector<Eigen::MatrixXd>& frames, RenderParams* p);
 
 // Checks the values are usable (positive sizes, samples >= 1, known texture, ...); throws
 // std::invalid_argument naming the field and the expected range.
