@@ -8,6 +8,7 @@
 // like for like), else config/scenes/flag.json under $CLOTHWIND_SOURCE_DIR or the working dir.
 #include <time.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -53,7 +54,7 @@ double ThreadCpuSeconds() {
 
 int main(int argc, char** argv) {
   std::string scene_path = DefaultScene();
-  double duration = 4.0, max_edge = 0.0;
+  double duration = 4.0, max_edge = 0.0, cg_tolerance = 0.0;
   std::vector<double> winds = {1, 3, 6, 10};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -70,6 +71,8 @@ int main(int argc, char** argv) {
       duration = std::stod(next());
     } else if (a == "--max-edge") {
       max_edge = std::stod(next());
+    } else if (a == "--cg-tolerance") {
+      cg_tolerance = std::stod(next());
     } else if (a == "--winds") {
       winds.clear();
       std::stringstream ss(next());
@@ -77,18 +80,22 @@ int main(int argc, char** argv) {
       while (std::getline(ss, item, ',')) winds.push_back(std::stod(item));
     } else {
       std::fprintf(stderr,
-                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--winds 1,3,6,10]\n");
+                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--winds 1,3,6,10] [--cg-tolerance T]\n");
       return 2;
     }
   }
   BuildOptions build;
   build.max_edge = max_edge;
-  const SceneSetup setup = BuildScene(LoadScene(scene_path), build);
-  std::printf("scene %s, %.1f s simulated per wind, dt %.4f s, edges <= %.3f m, one thread\n",
-              scene_path.c_str(), duration, setup.cloths[0].options.dt, setup.cloths[0].max_edge);
+  SceneSetup setup = BuildScene(LoadScene(scene_path), build);
+  if (cg_tolerance > 0) {
+    for (auto& c : setup.cloths) c.options.cg_tolerance = cg_tolerance;
+  }
+  std::printf("scene %s, %.1f s simulated per wind, dt %.4f s, edges <= %.3f m, CG tolerance %g, one thread\n",
+              scene_path.c_str(), duration, setup.cloths[0].options.dt, setup.cloths[0].max_edge,
+              setup.cloths[0].options.cg_tolerance);
   std::printf("droop/RMS/frequency over the last half (cf. ArcSim: droop ~80/52/10 deg at 1/3/10 m/s, ~1.5 Hz at 10)\n\n");
-  std::printf("| wind (m/s) | vertices | faces | steps | wall s / sim s | CPU s / sim s | x real time | x faster than ArcSim | droop (deg) | lateral RMS (m) | vertical RMS (m) | frequency (Hz) |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("| wind (m/s) | vertices | faces | steps | wall s / sim s | CPU s / sim s | x real time | x faster than ArcSim | droop (deg) | lateral RMS (m) | vertical RMS (m) | frequency (Hz) | CG iterations / step |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   bool all_fast = true;
   for (double wind : winds) {
     Theta theta = SceneTheta(setup);
@@ -106,10 +113,11 @@ int main(int argc, char** argv) {
     const double arcsim = ArcSimWallPerSimSecond(wind);
     char vs[32] = "n/a";
     if (arcsim > 0) std::snprintf(vs, sizeof(vs), "%.0f", arcsim / per);
-    std::printf("| %g | %d | %d | %lld | %.3f | %.3f | %.2f | %s | %.1f | %.3f | %.3f | %.2f |\n", wind,
+    std::printf("| %g | %d | %d | %lld | %.3f | %.3f | %.2f | %s | %.1f | %.3f | %.3f | %.2f | %.1f |\n", wind,
                 t.num_vertices(), t.num_faces(), static_cast<long long>(t.steps), per, cpu / simulated,
                 1.0 / per, vs,
-                m.droop_deg, m.lateral_rms, m.vertical_rms, m.dominant_hz);
+                m.droop_deg, m.lateral_rms, m.vertical_rms, m.dominant_hz,
+                static_cast<double>(t.solver_iterations) / std::max<int64_t>(1, t.steps));
     std::fflush(stdout);
     all_fast = all_fast && per <= 0.2;
   }

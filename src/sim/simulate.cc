@@ -46,7 +46,10 @@ Trajectory SimulateTrajectory(const SceneSetup& setup, const Theta& theta,
   t.frames.reserve(frames + 1);
   t.frames.push_back(sim.positions().cast<float>());
   for (int f = 1; f <= frames; ++f) {
-    for (int s = 0; s < steps_per_frame; ++s) sim.Step();
+    for (int s = 0; s < steps_per_frame; ++s) {
+      sim.Step();
+      t.solver_iterations += sim.last_step_stats().cg_iterations;
+    }
     t.steps += steps_per_frame;
     t.frames.push_back(sim.positions().cast<float>());
     if (options.progress && !options.progress(f, frames)) break;

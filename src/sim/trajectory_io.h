@@ -21,6 +21,7 @@ struct Trajectory {
   // Run statistics (not stored in the binary file).
   int64_t steps = 0;                      // time steps taken
   double wall_seconds = 0.0;              // wall time of the simulation [s]
+  int64_t solver_iterations = 0;          // linear-solver (CG) iterations summed over the steps
 
   int num_vertices() const { return static_cast<int>(uv.rows()); }
   int num_faces() const { return static_cast<int>(faces.rows()); }
