@@ -94,6 +94,22 @@ TEST(ClipPipelineTest, LabelWaitsForLateReadingsByStamp) {
   EXPECT_EQ(p.stats().readings_late, 1u);
 }
 
+TEST(ClipPipelineTest, TimeJumpingBackStartsOver) {
+  // A bag played twice (rosbag play -l): the second pass must not mix with the first.
+  ClipPipeline p(SmallOptions());
+  for (int s = 0; s <= 3; ++s) p.AddReading({kT0 + s, 9.0, 0.0});
+  for (int i = 0; i < 90; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  EXPECT_GT(p.pending(), 0u);
+  // Back to the start: waiting clips and first-pass readings are dropped.
+  for (int i = 0; i < 20; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  p.AddReading({kT0 + 0.2, 1.0, 0.0});
+  const auto clips = p.Flush();
+  ASSERT_EQ(clips.size(), 1u);  // ticks 0..15 of the second pass: one clip of 10
+  EXPECT_NEAR(clips[0].clip.frames.front().stamp, kT0, 1e-6);
+  EXPECT_EQ(clips[0].label.count, 1u);
+  EXPECT_DOUBLE_EQ(clips[0].label.mean, 1.0);
+}
+
 TEST(ClipPipelineTest, BgrFramesAreCroppedToRoi) {
   ClipPipelineOptions o = SmallOptions();
   o.roi = {0, 0, 20};
