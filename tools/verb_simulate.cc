@@ -1,9 +1,6 @@
 // clothwind simulate SCENE.json --out DIR: runs an ArcSim scene through our cloth simulator and
 // writes ArcSim-style frame OBJs (0000_00.obj = frame 0, cloth 0), the binary trajectory
 // (sim/trajectory_io.h) and summary.json.
-#include <unistd.h>
-
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -21,6 +18,7 @@
 #include "sim/scene_builder.h"
 #include "sim/simulate.h"
 #include "sim/trajectory_io.h"
+#include "progress_bar.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -60,33 +58,6 @@ std::vector<double> ParseList(const std::string& text, size_t n, const std::stri
   }
   return v;
 }
-
-// "[#####.....]  45%  frame 225/500  3.2 sim s/s  2.1x real time  ETA 12 s" on one line.
-class ProgressBar {
- public:
-  explicit ProgressBar(double frame_time) : frame_time_(frame_time), tty_(::isatty(2)) {}
-  bool operator()(int done, int total) {
-    if (!tty_) return true;
-    const auto now = std::chrono::steady_clock::now();
-    if (done < total && now - last_ < std::chrono::milliseconds(200)) return true;
-    last_ = now;
-    const double wall = std::chrono::duration<double>(now - start_).count();
-    const double sim_rate = wall > 0 ? done * frame_time_ / wall : 0;  // simulated s per wall s
-    const double eta = sim_rate > 0 ? (total - done) * frame_time_ / sim_rate : 0;
-    const int width = 30, filled = total > 0 ? width * done / total : width;
-    std::fprintf(stderr, "\r[%s%s] %3d%%  frame %d/%d  %.2f sim s/s  ETA %.0f s   ",
-                 std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
-                 total > 0 ? 100 * done / total : 100, done, total, sim_rate, eta);
-    if (done == total) std::fprintf(stderr, "\n");
-    return true;
-  }
-
- private:
-  double frame_time_;
-  bool tty_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-  std::chrono::steady_clock::time_point last_{};
-};
 
 std::string FrameName(int frame, int cloth) {
   char name[32];
@@ -129,8 +100,13 @@ int Run(const SimulateArgs& a) {
       theta[sim::ParameterIndex(p.substr(0, eq))] = ParseList(p.substr(eq + 1), 1, "--param " + p)[0];
     }
     options.cloth = c;
-    ProgressBar bar(scene.frame_time);
-    options.progress = [&bar](int done, int total) { return bar(done, total); };
+    ProgressBar::Options bar_options;
+    bar_options.label = "simulate";
+    bar_options.unit = "frames";
+    bar_options.rate_scale = scene.frame_time;
+    bar_options.rate_unit = "sim s/s";
+    ProgressBar bar(bar_options);
+    options.progress = [&bar](int done, int total) { return bar.Update(done, total); };
     const sim::Trajectory t = sim::SimulateTrajectory(setup, theta, options);
     total_wall += t.wall_seconds;
     const std::string traj = (fs::path(a.out) / (c == 0 ? std::string("trajectory.cwtraj")

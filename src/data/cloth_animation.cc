@@ -1,0 +1,120 @@
+#include "data/cloth_animation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include "sim/mesh.h"
+
+namespace clothwind::data {
+
+namespace fs = std::filesystem;
+
+Eigen::MatrixXd NormalizeTextureCoordinates(const Eigen::MatrixXd& U, const Eigen::Vector2d& lo,
+                                            const Eigen::Vector2d& hi) {
+  if (U.cols() != 2) throw std::invalid_argument("texture coordinates: expected #V by 2");
+  if (!(hi.x() > lo.x() && hi.y() > lo.y()))
+    throw std::invalid_argument("texture coordinates: material space has no extent");
+  Eigen::MatrixXd T(U.rows(), 2);
+  for (int c = 0; c < 2; ++c) T.col(c) = (U.col(c).array() - lo[c]) / (hi[c] - lo[c]);
+  return T;
+}
+
+namespace {
+void Bounds(const Eigen::MatrixXd& U, Eigen::Vector2d* lo, Eigen::Vector2d* hi) {
+  *lo = U.colwise().minCoeff().transpose();
+  *hi = U.colwise().maxCoeff().transpose();
+}
+}  // namespace
+
+ClothAnimation AnimationFromTrajectory(const sim::Trajectory& t, int first, int count) {
+  if (count < 0) count = t.num_frames() - first;
+  if (first < 0 || count < 1 || first + count > t.num_frames())
+    throw std::out_of_range("trajectory frames [" + std::to_string(first) + ", " +
+                            std::to_string(first + count) + ") outside its " +
+                            std::to_string(t.num_frames()) + " frames");
+  ClothAnimation a;
+  a.frame_time = t.frame_time;
+  a.F = t.faces;
+  const Eigen::MatrixXd U = t.uv.cast<double>();
+  Eigen::Vector2d lo, hi;
+  Bounds(U, &lo, &hi);
+  a.UV = NormalizeTextureCoordinates(U, lo, hi);
+  a.frames.resize(count);
+  for (int i = 0; i < count; ++i) a.frames[i].V = t.frames[first + i].cast<double>();
+  return a;
+}
+
+ClothAnimation ReadObjSequence(const std::string& folder, int cloth, double frame_time) {
+  if (!(frame_time > 0)) throw std::invalid_argument("OBJ sequence: frame_time must be > 0 s");
+  ClothAnimation a;
+  a.frame_time = frame_time;
+  Eigen::Vector2d lo, hi;
+  for (int f = 0;; ++f) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%04d_%02d.obj", f, cloth);
+    const fs::path path = fs::path(folder) / name;
+    if (!fs::exists(path)) break;
+    const sim::Mesh m = sim::ReadObj(path.string());
+    const Eigen::MatrixXd U = m.U;
+    if (f == 0) Bounds(U, &lo, &hi);
+    ClothFrame frame;
+    frame.V = m.V;
+    frame.F = m.F;
+    frame.UV = NormalizeTextureCoordinates(U, lo, hi);
+    a.frames.push_back(std::move(frame));
+  }
+  if (a.frames.empty()) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "0000_%02d.obj", cloth);
+    throw std::runtime_error("OBJ sequence: " + (fs::path(folder) / name).string() +
+                             " not found (expected frames NNNN_CC.obj from 0000)");
+  }
+  // Frames that keep the first frame's topology share its faces and texture coordinates.
+  a.F = a.frames[0].F;
+  a.UV = a.frames[0].UV;
+  for (auto& frame : a.frames) {
+    if (frame.F.rows() == a.F.rows() && frame.F == a.F && frame.UV.rows() == a.UV.rows()) {
+      frame.F.resize(0, 3);
+      frame.UV.resize(0, 2);
+    }
+  }
+  return a;
+}
+
+ClothFrame FrameAt(const ClothAnimation& a, double t) {
+  if (a.frames.empty()) throw std::invalid_argument("FrameAt: empty animation");
+  const double x = std::clamp(t / a.frame_time, 0.0, static_cast<double>(a.frames.size() - 1));
+  const int i = std::min(static_cast<int>(std::floor(x)), a.num_frames() - 1);
+  const double w = x - i;
+  auto full = [&](int k) {
+    ClothFrame f = a.frames[k];
+    if (f.F.size() == 0) f.F = a.F;
+    if (f.UV.size() == 0) f.UV = a.UV;
+    return f;
+  };
+  ClothFrame f0 = full(i);
+  if (w < 1e-9 || i + 1 >= a.num_frames()) return f0;
+  const ClothFrame& next = a.frames[i + 1];
+  const Eigen::MatrixXi& next_F = next.F.size() == 0 ? a.F : next.F;
+  const bool same = next.V.rows() == f0.V.rows() && next_F.rows() == f0.F.rows() && next_F == f0.F;
+  if (!same) return w < 0.5 ? f0 : full(i + 1);
+  f0.V = (1.0 - w) * f0.V + w * next.V;
+  return f0;
+}
+
+std::vector<cv::Mat> RenderAnimation(render::Renderer* renderer, const ClothAnimation& a,
+                                     double start, int count, double fps) {
+  if (count < 1 || !(fps > 0)) throw std::invalid_argument("RenderAnimation: count >= 1, fps > 0");
+  std::vector<cv::Mat> images;
+  images.reserve(count);
+  for (int k = 0; k < count; ++k) {
+    const ClothFrame f = FrameAt(a, start + k / fps);
+    images.push_back(renderer->RenderFrame(f.V, f.F, f.UV));
+  }
+  return images;
+}
+
+}  // namespace clothwind::data

@@ -1,0 +1,391 @@
+#include "data/dataset_generator.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include <opencv2/imgcodecs.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+
+#include "data/cloth_animation.h"
+#include "data/contact_sheet.h"
+#include "data/dataset_index.h"
+#include "data/paths.h"
+#include "render/renderer.h"
+#include "sim/scene.h"
+#include "sim/scene_builder.h"
+#include "sim/simulate.h"
+#include "sim/trajectory_io.h"
+
+namespace clothwind::data {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+void Check(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("make-dataset: " + what);
+}
+
+void ValidateOptions(const DatasetOptions& o) {
+  Check(o.count >= 0, "--count must be >= 0");
+  Check(o.views >= 1 && o.views <= 64, "--views must be in 1..64");
+  Check(!o.out.empty(), "--out is required");
+  Check(o.shards >= 1 && o.shard >= 0 && o.shard < o.shards, "--shard i/N needs 0 <= i < N");
+  Check(o.jobs >= 0, "--jobs must be >= 0");
+  Check(o.warmup >= 0, "--warmup must be >= 0 s");
+  Check(o.frames >= 1, "--frames must be >= 1");
+  Check(o.fps > 0, "--fps must be > 0");
+  Check(o.samples >= 0, "--samples must be >= 0");
+  Check(o.size >= 16 && o.size <= 4096, "--size must be in 16..4096 px");
+  Check(o.frame_ext == "jpg" || o.frame_ext == "png", "frame format must be jpg or png");
+  Check(o.jpeg_quality >= 1 && o.jpeg_quality <= 100, "--jpeg-quality must be in 1..100");
+  Check(o.max_edge >= 0, "--max-edge must be >= 0 m");
+}
+
+std::string TempPrefix(const std::string& name) { return "." + name + ".tmp-"; }
+
+std::string TempDirName(const std::string& name) {
+  static std::atomic<uint64_t> counter{0};
+  return TempPrefix(name) + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+}
+
+// The simulation index of an example or temp folder name ("flag-000012-v1",
+// ".flag-000012-v1.tmp-..."), or -1 when the name is not one of ours.
+int64_t IndexOfName(const std::string& name, render::SceneKind kind) {
+  const std::string prefix = render::SceneKindName(kind) + "-";
+  size_t start = name[0] == '.' ? 1 : 0;
+  if (name.compare(start, prefix.size(), prefix) != 0) return -1;
+  start += prefix.size();
+  size_t end = start;
+  while (end < name.size() && std::isdigit(static_cast<unsigned char>(name[end]))) ++end;
+  if (end == start || end + 2 > name.size() || name.compare(end, 2, "-v") != 0) return -1;
+  return std::stoll(name.substr(start, end - start));
+}
+
+// Everything loaded once and shared (read-only) by the workers.
+struct Prepared {
+  sim::SceneSetup setup;
+  std::vector<Fabric> fabrics;  // ClothSim
+  sim::Theta base_theta;
+  SamplingRanges ranges;
+  std::string scene_name;
+};
+
+std::vector<std::string> FabricNames(const std::vector<Fabric>& fabrics) {
+  std::vector<std::string> names;
+  for (const auto& f : fabrics) names.push_back(f.name);
+  return names;
+}
+
+sim::MaterialMultipliers MultipliersOf(const sim::SceneMaterial& m) {
+  sim::MaterialMultipliers mult;
+  mult.density = m.density_mult;
+  mult.stretching = m.stretching_mult;
+  mult.bending = m.bending_mult;
+  mult.thicken = m.thicken;
+  mult.damping = m.damping;
+  return mult;
+}
+
+Prepared Prepare(const DatasetOptions& o) {
+  Prepared p;
+  const std::string scene_path = o.scene.empty() ? DefaultScenePath(o.kind) : o.scene;
+  const sim::Scene scene = sim::LoadScene(scene_path, [](const std::string&) {});
+  if (scene.cloths.empty()) throw std::runtime_error(scene_path + ": field 'cloths' is empty");
+  if (std::abs(scene.frame_time * o.fps - 1.0) > 1e-9)
+    throw std::runtime_error(scene_path + ": field 'frame_time' is " + std::to_string(scene.frame_time) +
+                             " s, expected 1/fps = " + std::to_string(1.0 / o.fps) + " s");
+  sim::BuildOptions build;
+  build.max_edge = o.max_edge;
+  p.setup = sim::BuildScene(scene, build);
+  p.base_theta = sim::SceneTheta(p.setup);
+  p.scene_name = fs::path(scene_path).filename().string();
+  p.ranges = o.ranges ? *o.ranges : DefaultRanges(o.kind);
+  if (o.kind == render::SceneKind::kCloth)
+    p.fabrics = LoadFabrics(o.materials_dir.empty() ? DefaultMaterialsDir() : o.materials_dir,
+                            scene_path, o.exclude_fabrics);
+  return p;
+}
+
+// The setup of one simulation: the shared one with this sample's fabric and wind direction.
+sim::SceneSetup SetupFor(const Prepared& p, const SimulationSample& s, render::SceneKind kind) {
+  sim::SceneSetup setup = p.setup;
+  if (kind == render::SceneKind::kCloth) setup.cloths[0].material = p.fabrics[s.fabric_index].material;
+  // ApplyTheta keeps the direction and sets the speed; a calm sample keeps +x.
+  setup.wind.velocity = s.wind_velocity.norm() > 0 ? s.wind_velocity : Eigen::Vector3d::UnitX();
+  return setup;
+}
+
+void CheckFinite(const sim::Trajectory& t) {
+  for (int f = 0; f < t.num_frames(); ++f) {
+    if (!t.frames[f].allFinite() || t.frames[f].cwiseAbs().maxCoeff() > 1e3)
+      throw std::runtime_error("simulation diverged at frame " + std::to_string(f));
+  }
+}
+
+// Writes one example: frames and label.json into a temporary folder, renamed into place.
+void WriteExample(const std::string& out, const std::string& name, const std::vector<cv::Mat>& images,
+                  const nlohmann::json& label, const DatasetOptions& o) {
+  const fs::path tmp = fs::path(out) / TempDirName(name);
+  fs::create_directory(tmp);
+  try {
+    std::vector<int> params;
+    if (o.frame_ext == "jpg") params = {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality};
+    for (size_t k = 0; k < images.size(); ++k) {
+      char file[32];
+      std::snprintf(file, sizeof(file), "%03zu.%s", k, o.frame_ext.c_str());
+      if (!cv::imwrite((tmp / file).string(), images[k], params))
+        throw std::runtime_error("cannot write " + (tmp / file).string());
+    }
+    sim::WriteFileAtomically((tmp / "label.json").string(), label.dump(2) + "\n");
+    fs::rename(tmp, fs::path(out) / name);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+}
+
+nlohmann::json RangesJson(const SamplingRanges& r) {
+  return {{"wind_min", r.wind_min},
+          {"wind_max", r.wind_max},
+          {"area_weight_factor", r.area_weight_factor},
+          {"bending_factor", r.bending_factor},
+          {"bending_jitter", r.bending_jitter},
+          {"cloth_area_weight_min", r.cloth_area_weight_min},
+          {"cloth_area_weight_max", r.cloth_area_weight_max}};
+}
+
+nlohmann::json IndexHeader(const DatasetOptions& o, const nlohmann::json& settings) {
+  return {{"format", "clothwind-dataset"},
+          {"version", kFormatVersion},
+          {"kind", render::SceneKindName(o.kind)},
+          {"generator", {{"name", kGeneratorName}, {"version", kGeneratorVersion}}},
+          {"dataset", settings},
+          {"count", o.count},
+          {"clips", nlohmann::json::array()}};
+}
+
+// Throws when DIR already holds a dataset whose settings differ from this run's.
+void CheckCompatible(const std::string& dir, const nlohmann::json& settings) {
+  const nlohmann::json existing = ReadIndex(dir);
+  if (existing.is_null() || !existing.contains("dataset")) return;
+  const nlohmann::json& old = existing["dataset"];
+  for (auto it = settings.begin(); it != settings.end(); ++it) {
+    if (!old.contains(it.key()) || old[it.key()] != it.value())
+      throw std::runtime_error((fs::path(dir) / "index.json").string() + ": field 'dataset." + it.key() +
+                               "' is " + (old.contains(it.key()) ? old[it.key()].dump() : "missing") +
+                               " but this run asks for " + it.value().dump() +
+                               " (resume with the same settings, or use another --out)");
+  }
+}
+
+}  // namespace
+
+std::vector<Fabric> LoadFabrics(const std::string& folder, const std::string& scene_path,
+                                const std::vector<std::string>& exclude) {
+  if (!fs::is_directory(folder)) throw std::runtime_error("materials folder " + folder + " not found");
+  const sim::Scene scene = sim::LoadScene(scene_path, [](const std::string&) {});
+  const sim::MaterialMultipliers mult =
+      scene.cloths.at(0).materials.empty() ? sim::MaterialMultipliers{} : MultipliersOf(scene.cloths[0].materials[0]);
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(folder)) {
+    if (e.path().extension() != ".json") continue;
+    const std::string stem = e.path().stem().string();
+    if (std::find(exclude.begin(), exclude.end(), stem) != exclude.end()) continue;
+    files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw std::runtime_error("materials folder " + folder + ": no *.json material");
+  std::vector<Fabric> fabrics;
+  for (const auto& f : files)
+    fabrics.push_back({f.stem().string(), f.string(), sim::LoadArcSimMaterial(f.string(), mult)});
+  return fabrics;
+}
+
+nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<std::string>& fabric_names) {
+  const std::string scene_path = o.scene.empty() ? DefaultScenePath(o.kind) : o.scene;
+  nlohmann::json backgrounds = nlohmann::json::array();
+  for (const auto& b : o.background_images) backgrounds.push_back(fs::path(b).filename().string());
+  return {{"kind", render::SceneKindName(o.kind)},
+          {"seed", o.seed},
+          {"views", o.views},
+          {"frames", o.frames},
+          {"fps", o.fps},
+          {"warmup", o.warmup},
+          {"max_edge", o.max_edge},
+          {"size", o.size},
+          {"samples", o.samples},
+          {"frame_format", o.frame_ext},
+          {"jpeg_quality", o.jpeg_quality},
+          {"val_fraction", o.val_fraction},
+          {"test_fraction", o.test_fraction},
+          {"ranges", RangesJson(o.ranges ? *o.ranges : DefaultRanges(o.kind))},
+          {"scene", fs::path(scene_path).filename().string()},
+          {"fabrics", fabric_names},
+          {"background_images", backgrounds},
+          {"generator_version", kGeneratorVersion}};
+}
+
+int64_t ReindexDataset(const std::string& dir, bool contact_sheet) {
+  nlohmann::json index = ReadIndex(dir);
+  if (index.is_null()) throw std::runtime_error(dir + "/index.json not found: not a dataset folder");
+  index = BuildIndex(dir, index);
+  WriteIndex(dir, index);
+  if (contact_sheet) WriteContactSheet(dir, index, (fs::path(dir) / "contact_sheet.png").string());
+  return static_cast<int64_t>(index["clips"].size());
+}
+
+DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCallback& progress) {
+  ValidateOptions(o);
+  const auto start = Clock::now();
+  const Prepared prep = Prepare(o);
+  const nlohmann::json settings = DatasetSettingsJson(o, FabricNames(prep.fabrics));
+  fs::create_directories(o.out);
+  CheckCompatible(o.out, settings);
+
+  DatasetSummary summary;
+  summary.jobs = o.jobs > 0 ? o.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+
+  // Left-overs of a killed run of this shard: its temporary folders (other shards' may be in
+  // use on other machines, so only ours are removed).
+  for (const auto& e : fs::directory_iterator(o.out)) {
+    const std::string name = e.path().filename().string();
+    if (name.empty() || name[0] != '.' || name.find(".tmp-") == std::string::npos) continue;
+    const int64_t i = IndexOfName(name, o.kind);
+    if (i >= 0 && i % o.shards == o.shard) fs::remove_all(e.path());
+  }
+
+  // This shard's simulations that still miss a view.
+  std::vector<int64_t> todo;
+  for (int64_t i = o.shard; i < o.count; i += o.shards) {
+    ++summary.assigned;
+    bool complete = true;
+    for (int v = 0; v < o.views && complete; ++v)
+      complete = fs::exists(fs::path(o.out) / ExampleName(o.kind, i, v) / "label.json");
+    if (complete) ++summary.skipped;
+    else todo.push_back(i);
+  }
+
+  std::mutex mutex;  // guards summary and progress
+  DatasetProgress state;
+  state.total = static_cast<int64_t>(todo.size());
+  const double frame_time = 1.0 / o.fps;
+  const int first_frame = static_cast<int>(std::lround(o.warmup / frame_time));
+
+  auto work = [&](int64_t i) {
+    double sim_s = 0, render_s = 0, write_s = 0;
+    int written = 0;
+    std::string last, error;
+    try {
+      const SimulationSample s = o.kind == render::SceneKind::kFlag
+                                     ? SampleFlagSimulation(prep.base_theta, o.seed, i, prep.ranges)
+                                     : SampleClothSimulation(prep.fabrics, o.seed, i, prep.ranges);
+      auto t0 = Clock::now();
+      const sim::SceneSetup setup = SetupFor(prep, s, o.kind);
+      sim::SimulateOptions so;
+      so.duration = (first_frame + o.frames - 1) * frame_time;
+      so.seed = s.seed;
+      const sim::Trajectory traj = sim::SimulateTrajectory(setup, s.theta, so);
+      CheckFinite(traj);
+      const ClothAnimation anim = AnimationFromTrajectory(traj, first_frame, o.frames);
+      sim_s += Seconds(t0);
+      ClipInfo info;
+      info.dataset = render::SceneKindName(o.kind);
+      info.dataset_seed = o.seed;
+      info.views = o.views;
+      info.split = SplitOf(s.seed, o.val_fraction, o.test_fraction);
+      info.num_frames = o.frames;
+      info.frame_rate = o.fps;
+      info.frame_ext = o.frame_ext;
+      info.scene = prep.scene_name;
+      info.max_edge = setup.cloths[0].max_edge;
+      info.vertices = traj.num_vertices();
+      info.faces = traj.num_faces();
+      info.time_step = setup.cloths[0].options.dt;
+      info.warmup = first_frame * frame_time;
+      for (int v = 0; v < o.views; ++v) {
+        const std::string name = ExampleName(o.kind, i, v);
+        if (fs::exists(fs::path(o.out) / name / "label.json")) continue;
+        t0 = Clock::now();
+        render::RenderParams zeta = SampleView(o.kind, s.seed, v, o.views, o.background_images);
+        if (o.samples > 0) zeta.samples = o.samples;
+        zeta.width = zeta.height = o.size;
+        zeta.fps = o.fps;
+        render::RenderOptions ro;
+        ro.threads = 1;  // parallel over simulations instead
+        render::Renderer renderer(zeta, ro);
+        const std::vector<cv::Mat> images = RenderAnimation(&renderer, anim, 0.0, o.frames, o.fps);
+        render_s += Seconds(t0);
+        t0 = Clock::now();
+        info.view = v;
+        WriteExample(o.out, name, images, SimExampleLabel(name, s, zeta, info), o);
+        write_s += Seconds(t0);
+        ++written;
+        last = name;
+      }
+    } catch (const std::exception& e) {
+      error = render::SceneKindName(o.kind) + " simulation " + std::to_string(i) + ": " + e.what();
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    summary.simulate_seconds += sim_s;
+    summary.render_seconds += render_s;
+    summary.write_seconds += write_s;
+    summary.examples_written += written;
+    ++summary.simulated;
+    ++state.done;
+    if (!error.empty()) {
+      ++summary.failed;
+      ++state.failed;
+      summary.errors.push_back(error);
+      state.last = "FAILED " + error;
+    } else {
+      state.last = last;
+    }
+    if (progress) progress(state);
+  };
+
+  if (!todo.empty()) {
+    tbb::task_arena arena(summary.jobs);
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, todo.size(), 1),
+                        [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t k = r.begin(); k < r.end(); ++k) work(todo[k]);
+                        },
+                        tbb::simple_partitioner());
+    });
+  }
+  std::sort(summary.errors.begin(), summary.errors.end());
+
+  // Every run rebuilds the index from the folders present: shards and resumed runs converge.
+  nlohmann::json index = BuildIndex(o.out, IndexHeader(o, settings));
+  WriteIndex(o.out, index);
+  summary.examples_in_index = static_cast<int64_t>(index["clips"].size());
+  summary.index_path = (fs::path(o.out) / "index.json").string();
+  if (o.contact_sheet) {
+    const std::string sheet = (fs::path(o.out) / "contact_sheet.png").string();
+    if (WriteContactSheet(o.out, index, sheet)) summary.contact_sheet_path = sheet;
+  }
+  summary.wall_seconds = Seconds(start);
+  return summary;
+}
+
+}  // namespace clothwind::data

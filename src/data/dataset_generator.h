@@ -1,0 +1,104 @@
+#ifndef CLOTHWIND_DATA_DATASET_GENERATOR_H_
+#define CLOTHWIND_DATA_DATASET_GENERATOR_H_
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "data/example_sampling.h"
+#include "render/render_params.h"
+
+namespace clothwind::data {
+
+// `clothwind make-dataset`: FlagSim / ClothSim datasets (docs/datasets.md).
+//
+// Simulation i (0 <= i < count) draws θ from SimulationSeed(seed, i), is simulated past the
+// start-up transient (`warmup`), and its next `frames` frames at `fps` are rendered from `views`
+// camera poses; each view is one example folder (ExampleName: "flag-000012-v1") of frames and a
+// label.json. Shard k of N does the simulations i ≡ k (mod N), so N machines give exactly the
+// files one machine would. A finished example is never redone (its folder exists) or seen half
+// written (each folder is written under ".<name>.tmp-<pid>-<n>" and renamed into place).
+struct DatasetOptions {
+  render::SceneKind kind = render::SceneKind::kFlag;
+  int64_t count = 0;           // simulations (examples = count × views)
+  int views = 1;               // camera poses per simulation
+  std::string out;             // dataset folder (created)
+  uint64_t seed = 1;           // global seed
+  int shard = 0, shards = 1;   // this run does simulations i with i % shards == shard
+  int jobs = 0;                // parallel simulations (0: all cores)
+
+  std::string scene;           // scene file; "" = DefaultScenePath(kind)
+  std::string materials_dir;   // ClothSim fabrics; "" = DefaultMaterialsDir()
+  // ClothSim skips these material files (ArcSim ships paper and aluminium, which are no fabric).
+  std::vector<std::string> exclude_fabrics{"aluminium", "paper"};
+  std::optional<SamplingRanges> ranges;  // unset: DefaultRanges(kind)
+
+  double max_edge = 0.0;       // mesh resolution [m]; 0 = the scene's default (BuildOptions)
+  double warmup = 5.0;         // [s] simulated before the first kept frame
+  int frames = 60;             // frames per example
+  double fps = 25.0;           // must equal 1 / the scene's frame_time
+  int samples = 0;             // anti-aliasing samples per pixel; 0 = ζ's default
+  int size = 300;              // frame width = height [px]
+  std::string frame_ext = "jpg";  // "jpg" | "png"
+  int jpeg_quality = 95;
+  double val_fraction = 0.1, test_fraction = 0.2;
+  std::vector<std::string> background_images;  // empty: procedural backdrops
+
+  bool contact_sheet = true;   // write DIR/contact_sheet.png at the end
+};
+
+// Progress after each simulation (called from worker threads, serialised by the generator).
+struct DatasetProgress {
+  int64_t done = 0;       // simulations finished (or failed) in this run
+  int64_t total = 0;      // simulations this run has to do (not already complete)
+  int64_t failed = 0;
+  std::string last;       // name of the last example finished
+};
+using DatasetProgressCallback = std::function<void(const DatasetProgress&)>;
+
+struct DatasetSummary {
+  int64_t assigned = 0;          // simulations of this shard
+  int64_t skipped = 0;           // already complete (all views present)
+  int64_t simulated = 0;         // simulations run now
+  int64_t examples_written = 0;  // example folders written now
+  int64_t failed = 0;            // simulations that failed (see errors)
+  int64_t examples_in_index = 0; // examples in DIR/index.json after this run (all shards)
+  std::vector<std::string> errors;
+  double wall_seconds = 0;
+  double simulate_seconds = 0;   // summed over workers
+  double render_seconds = 0;
+  double write_seconds = 0;      // encoding and writing files
+  int jobs = 1;
+  std::string index_path, contact_sheet_path;
+};
+
+// Generates (or resumes) a dataset. Throws std::invalid_argument on bad options and
+// std::runtime_error when DIR holds a dataset made with different settings (naming the field),
+// or the scene/materials cannot be loaded. Failures of single simulations do not stop the run:
+// they are counted and listed in the summary.
+DatasetSummary GenerateDataset(const DatasetOptions& options,
+                               const DatasetProgressCallback& progress = {});
+
+// The settings block ("dataset") stored in index.json: everything that defines the examples'
+// content (not shard, jobs or count), so resumed runs and shards can check they agree.
+nlohmann::json DatasetSettingsJson(const DatasetOptions& options,
+                                   const std::vector<std::string>& fabric_names);
+
+// Rebuilds DIR/index.json (and the contact sheet) from the example folders present, keeping the
+// existing header: the final merge after shards ran on several machines.
+// Returns the number of examples indexed. Throws std::runtime_error when DIR has no index.json.
+int64_t ReindexDataset(const std::string& dir, bool contact_sheet = true);
+
+// Loads the fabrics of a materials folder (every *.json not in `exclude`, sorted by name) with
+// the multipliers of the scene's first cloth material.
+// Throws std::runtime_error naming the folder when none is found, or a file that is invalid.
+std::vector<Fabric> LoadFabrics(const std::string& folder, const std::string& scene_path,
+                                const std::vector<std::string>& exclude);
+
+}  // namespace clothwind::data
+
+#endif  // CLOTHWIND_DATA_DATASET_GENERATOR_H_

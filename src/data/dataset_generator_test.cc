@@ -1,0 +1,265 @@
+#include "data/dataset_generator.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "data/dataset_index.h"
+#include "data/paths.h"
+#include "sim/scene.h"
+#include "sim/scene_builder.h"
+#include "sim/simulate.h"
+
+namespace clothwind::data {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A tiny FlagSim: coarse mesh, short simulations, small frames (a few seconds in all).
+DatasetOptions Tiny(const std::string& out, uint64_t seed = 1) {
+  DatasetOptions o;
+  o.kind = render::SceneKind::kFlag;
+  o.count = 3;
+  o.views = 1;
+  o.out = out;
+  o.seed = seed;
+  o.jobs = 2;
+  o.max_edge = 1.0;
+  o.warmup = 0.4;
+  o.frames = 6;
+  o.samples = 1;
+  o.size = 64;
+  return o;
+}
+
+std::string Bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Every file under dir (relative path -> bytes).
+std::map<std::string, std::string> Files(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) files[fs::relative(e.path(), dir).string()] = Bytes(e.path());
+  return files;
+}
+
+class DatasetGeneratorTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = fs::temp_directory_path() / ("clothwind_data_test_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+    reference_ = GenerateDataset(Tiny((root_ / "reference").string()));
+  }
+  static void TearDownTestSuite() { fs::remove_all(root_); }
+  static fs::path Ref() { return root_ / "reference"; }
+
+  static fs::path root_;
+  static DatasetSummary reference_;
+};
+fs::path DatasetGeneratorTest::root_;
+DatasetSummary DatasetGeneratorTest::reference_;
+
+TEST_F(DatasetGeneratorTest, IndexAndLabelsRoundTrip) {
+  ASSERT_TRUE(reference_.errors.empty()) << reference_.errors[0];
+  EXPECT_EQ(reference_.assigned, 3);
+  EXPECT_EQ(reference_.examples_written, 3);
+  const nlohmann::json index = ReadIndex(Ref().string());
+  ASSERT_FALSE(index.is_null());
+  EXPECT_EQ(index["format"], "clothwind-dataset");
+  EXPECT_EQ(index["version"], 1);
+  EXPECT_EQ(index["kind"], "flag");
+  ASSERT_EQ(index["clips"].size(), 3u);
+  const sim::SceneSetup setup = sim::BuildScene(sim::LoadScene(DefaultScenePath(render::SceneKind::kFlag)));
+  for (int i = 0; i < 3; ++i) {
+    const auto& entry = index["clips"][i];
+    const std::string name = ExampleName(render::SceneKind::kFlag, i, 0);
+    EXPECT_EQ(entry["name"], name);
+    const nlohmann::json label = ReadLabel((Ref() / name / "label.json").string());
+    // The label carries what the sampler drew for this index, exactly.
+    const SimulationSample s =
+        SampleFlagSimulation(sim::SceneTheta(setup), 1, i, DefaultRanges(render::SceneKind::kFlag));
+    const sim::Theta theta = LabelTheta(label);
+    for (int k = 0; k < sim::kNumParameters; ++k) EXPECT_EQ(theta[k], s.theta[k]) << k;
+    EXPECT_EQ(label["wind_speed"].get<double>(), s.theta[16]);
+    EXPECT_EQ(entry["wind_speed"], label["wind_speed"]);
+    EXPECT_EQ(label["seed"].get<uint64_t>(), s.seed);
+    EXPECT_EQ(label["kind"], "sim");
+    EXPECT_EQ(label["encoding"], "rgb8");
+    EXPECT_EQ(label["frame_rate"], 25.0);
+    EXPECT_EQ(label["num_frames"], 6);
+    EXPECT_EQ(label["theta_names"].size(), 17u);
+    EXPECT_EQ(label["generator"]["name"], kGeneratorName);
+    EXPECT_EQ(label["split"], SplitOf(s.seed, 0.1, 0.2));
+    EXPECT_EQ(entry["split"], label["split"]);
+    render::RenderParams zeta = SampleView(render::SceneKind::kFlag, s.seed, 0, 1);
+    zeta.samples = 1;
+    zeta.width = zeta.height = 64;
+    EXPECT_EQ(render::ToJson(LabelZeta(label)), render::ToJson(zeta));
+    for (int f = 0; f < 6; ++f) {
+      char file[16];
+      std::snprintf(file, sizeof(file), "%03d.jpg", f);
+      const cv::Mat img = cv::imread((Ref() / name / file).string(), cv::IMREAD_UNCHANGED);
+      ASSERT_FALSE(img.empty()) << file;
+      EXPECT_EQ(img.cols, 64);
+      EXPECT_EQ(img.rows, 64);
+      EXPECT_EQ(img.channels(), 3);
+    }
+    EXPECT_FALSE(fs::exists(Ref() / name / "006.jpg"));
+  }
+  EXPECT_TRUE(fs::exists(Ref() / "contact_sheet.png"));
+  // No temporary folder is left behind.
+  for (const auto& e : fs::directory_iterator(Ref())) EXPECT_NE(e.path().filename().string()[0], '.');
+}
+
+TEST_F(DatasetGeneratorTest, DeterministicBySeed) {
+  const fs::path again = root_ / "again", other = root_ / "other";
+  DatasetOptions o = Tiny(again.string());
+  o.jobs = 1;  // a different thread count must not matter
+  GenerateDataset(o);
+  EXPECT_EQ(Files(again), Files(Ref()));
+  GenerateDataset(Tiny(other.string(), 2));
+  const auto a = Files(Ref()), b = Files(other);
+  EXPECT_NE(a.at("flag-000000-v0/label.json"), b.at("flag-000000-v0/label.json"));
+  EXPECT_NE(a.at("flag-000000-v0/003.jpg"), b.at("flag-000000-v0/003.jpg"));
+}
+
+TEST_F(DatasetGeneratorTest, ResumesAfterAKillWithoutRedoingFinishedExamples) {
+  const fs::path dir = root_ / "resume";
+  fs::copy(Ref(), dir, fs::copy_options::recursive);
+  // The state a kill leaves: example 1 was being written (a temporary folder with a partial
+  // frame, no folder under its name); 0 and 2 were finished long ago.
+  fs::remove_all(dir / "flag-000001-v0");
+  const fs::path stale = dir / ".flag-000001-v0.tmp-999999-7";
+  fs::create_directories(stale);
+  std::ofstream(stale / "000.jpg") << "partial";
+  const auto old_time = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  for (const char* name : {"flag-000000-v0", "flag-000002-v0"}) {
+    fs::last_write_time(dir / name / "label.json", old_time);
+    fs::last_write_time(dir / name / "003.jpg", old_time);
+  }
+  const DatasetSummary s = GenerateDataset(Tiny(dir.string()));
+  EXPECT_EQ(s.skipped, 2);
+  EXPECT_EQ(s.simulated, 1);
+  EXPECT_EQ(s.examples_written, 1);
+  EXPECT_FALSE(fs::exists(stale));
+  for (const char* name : {"flag-000000-v0", "flag-000002-v0"}) {
+    EXPECT_EQ(fs::last_write_time(dir / name / "label.json"), old_time) << name;
+    EXPECT_EQ(fs::last_write_time(dir / name / "003.jpg"), old_time) << name;
+  }
+  // The redone example is the one a single uninterrupted run makes, and so is the index.
+  EXPECT_EQ(Files(dir), Files(Ref()));
+  // A second resume has nothing to do.
+  const DatasetSummary again = GenerateDataset(Tiny(dir.string()));
+  EXPECT_EQ(again.skipped, 3);
+  EXPECT_EQ(again.simulated, 0);
+}
+
+TEST_F(DatasetGeneratorTest, ShardsTogetherEqualOneRun) {
+  const fs::path dir = root_ / "shards";
+  int64_t total = 0;
+  for (int k : {2, 0, 1}) {  // any order
+    DatasetOptions o = Tiny(dir.string());
+    o.shard = k;
+    o.shards = 3;
+    o.jobs = 1;
+    const DatasetSummary s = GenerateDataset(o);
+    EXPECT_EQ(s.assigned, 1);
+    total += s.examples_written;
+  }
+  EXPECT_EQ(total, 3);
+  EXPECT_EQ(Files(dir), Files(Ref()));  // frames, labels, index.json and contact sheet
+  // Two shards of two: shard 0 does 0 and 2, shard 1 does 1.
+  DatasetOptions o = Tiny((root_ / "shards2").string());
+  o.shards = 2;
+  o.shard = 1;
+  const DatasetSummary s = GenerateDataset(o);
+  EXPECT_EQ(s.assigned, 1);
+  EXPECT_TRUE(fs::exists(root_ / "shards2" / "flag-000001-v0"));
+  EXPECT_FALSE(fs::exists(root_ / "shards2" / "flag-000000-v0"));
+}
+
+TEST_F(DatasetGeneratorTest, RefusesToMixSettingsInOneFolder) {
+  const fs::path dir = root_ / "mixed";
+  fs::copy(Ref(), dir, fs::copy_options::recursive);
+  DatasetOptions o = Tiny(dir.string(), 5);
+  try {
+    GenerateDataset(o);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("dataset.seed"), std::string::npos) << e.what();
+  }
+  // A larger count extends the dataset instead.
+  o = Tiny(dir.string());
+  o.count = 4;
+  const DatasetSummary s = GenerateDataset(o);
+  EXPECT_EQ(s.skipped, 3);
+  EXPECT_EQ(s.examples_in_index, 4);
+}
+
+TEST_F(DatasetGeneratorTest, ViewsRenderOneSimulationFromSeveralCameras) {
+  DatasetOptions o = Tiny((root_ / "views").string());
+  o.count = 1;
+  o.views = 2;
+  const DatasetSummary s = GenerateDataset(o);
+  EXPECT_EQ(s.examples_written, 2);
+  const auto a = ReadLabel((root_ / "views" / "flag-000000-v0" / "label.json").string());
+  const auto b = ReadLabel((root_ / "views" / "flag-000000-v1" / "label.json").string());
+  EXPECT_EQ(a["theta"], b["theta"]);
+  EXPECT_EQ(a["split"], b["split"]);
+  EXPECT_LT(a["zeta"]["camera_angle_deg"].get<double>(), 0.0);
+  EXPECT_GE(b["zeta"]["camera_angle_deg"].get<double>(), 0.0);
+  // View 0 of a 2-view dataset is not the frames of the 1-view one (another camera).
+  EXPECT_NE(Bytes(root_ / "views" / "flag-000000-v0" / "003.jpg"),
+            Bytes(Ref() / "flag-000000-v0" / "003.jpg"));
+}
+
+TEST_F(DatasetGeneratorTest, ClothSimUsesTheFabricsOfAFolder) {
+  const fs::path materials = root_ / "materials";
+  fs::create_directories(materials);
+  const std::string base = (fs::path(ConfigDir()) / "materials" / "camel-ponte-roma.json").string();
+  fs::copy_file(base, materials / "fabric-a.json");
+  fs::copy_file(base, materials / "fabric-b.json");
+  fs::copy_file(base, materials / "paper.json");  // excluded by default
+  DatasetOptions o = Tiny((root_ / "cloth").string());
+  o.kind = render::SceneKind::kCloth;
+  o.materials_dir = materials.string();
+  const DatasetSummary s = GenerateDataset(o);
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  const nlohmann::json index = ReadIndex((root_ / "cloth").string());
+  EXPECT_EQ(index["dataset"]["fabrics"], nlohmann::json({"fabric-a", "fabric-b"}));
+  ASSERT_EQ(index["clips"].size(), 3u);
+  for (const auto& c : index["clips"]) {
+    const auto label = ReadLabel((root_ / "cloth" / c["name"].get<std::string>() / "label.json").string());
+    EXPECT_EQ(label["dataset"], "cloth");
+    EXPECT_GE(label["theta"][0].get<double>(), 0.1);
+    EXPECT_LE(label["theta"][0].get<double>(), 0.4);
+    EXPECT_EQ(label["wind_velocity"][2].get<double>(), 0.0);
+    EXPECT_EQ(label["zeta"]["texture_kind"], "fabric");
+  }
+}
+
+TEST(DatasetOptionsTest, BadOptionsAreRejected) {
+  DatasetOptions o;
+  o.out = "/tmp/never";
+  o.count = 1;
+  o.shards = 2;
+  o.shard = 2;
+  EXPECT_THROW(GenerateDataset(o), std::invalid_argument);
+  o.shard = 0;
+  o.views = 0;
+  EXPECT_THROW(GenerateDataset(o), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace clothwind::data

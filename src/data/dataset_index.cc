@@ -1,0 +1,171 @@
+#include "data/dataset_index.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <vector>
+
+#include "sim/trajectory_io.h"
+
+namespace clothwind::data {
+
+namespace fs = std::filesystem;
+
+nlohmann::json SimExampleLabel(const std::string& name, const SimulationSample& s,
+                               const render::RenderParams& zeta, const ClipInfo& info) {
+  nlohmann::json theta = nlohmann::json::array(), names = nlohmann::json::array(),
+                 units = nlohmann::json::array();
+  for (int i = 0; i < sim::kNumParameters; ++i) {
+    theta.push_back(s.theta[i]);
+    names.push_back(sim::ParameterNames()[i]);
+    units.push_back(sim::ParameterUnits()[i]);
+  }
+  nlohmann::json j;
+  j["format"] = "clothwind-clip";
+  j["version"] = kFormatVersion;
+  j["name"] = name;
+  j["kind"] = "sim";
+  j["dataset"] = info.dataset;
+  j["num_frames"] = info.num_frames;
+  j["frame_rate"] = info.frame_rate;
+  j["width"] = zeta.width;
+  j["height"] = zeta.height;
+  j["encoding"] = "rgb8";
+  j["frame_pattern"] = "%03d." + info.frame_ext;
+  j["wind_speed"] = s.theta[sim::kWindSpeedIndex];
+  j["theta"] = theta;
+  j["theta_names"] = names;
+  j["theta_units"] = units;
+  j["wind_velocity"] = {s.wind_velocity.x(), s.wind_velocity.y(), s.wind_velocity.z()};
+  j["zeta"] = render::ToJson(zeta);
+  j["seed"] = s.seed;
+  j["dataset_seed"] = info.dataset_seed;
+  j["simulation"] = s.index;
+  j["view"] = info.view;
+  j["views"] = info.views;
+  j["fabric"] = s.fabric;
+  j["split"] = info.split;
+  j["generator"] = {{"name", kGeneratorName}, {"version", kGeneratorVersion}};
+  j["simulation_settings"] = {{"scene", info.scene},         {"max_edge", info.max_edge},
+                              {"vertices", info.vertices},   {"faces", info.faces},
+                              {"time_step", info.time_step}, {"warmup", info.warmup},
+                              {"frame_time", 1.0 / info.frame_rate}};
+  return j;
+}
+
+namespace {
+
+void Require(const nlohmann::json& j, const char* field, bool ok, const std::string& path,
+             const char* expected) {
+  if (!j.contains(field) || !ok)
+    throw std::runtime_error(path + ": field '" + field + "' " +
+                             (j.contains(field) ? "is " + j[field].dump() + ", expected " + expected
+                                                : std::string("is missing")));
+}
+
+nlohmann::json ReadJsonFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw std::runtime_error(path + ": not valid JSON (" + e.what() + ")");
+  }
+}
+
+}  // namespace
+
+nlohmann::json ReadLabel(const std::string& path) {
+  nlohmann::json j = ReadJsonFile(path);
+  if (!j.is_object()) throw std::runtime_error(path + ": expected a JSON object");
+  auto has = [&](const char* f) { return j.contains(f); };
+  Require(j, "format", has("format") && j["format"] == "clothwind-clip", path, "\"clothwind-clip\"");
+  Require(j, "version", has("version") && j["version"] == kFormatVersion, path, "1");
+  Require(j, "name", has("name") && j["name"].is_string(), path, "a string");
+  Require(j, "kind", has("kind") && (j["kind"] == "sim" || j["kind"] == "real"), path,
+          "\"sim\" or \"real\"");
+  Require(j, "num_frames", has("num_frames") && j["num_frames"].is_number_integer() && j["num_frames"] > 0,
+          path, "a positive integer");
+  Require(j, "frame_rate", has("frame_rate") && j["frame_rate"].is_number() && j["frame_rate"] > 0,
+          path, "a positive number");
+  Require(j, "width", has("width") && j["width"].is_number_integer(), path, "an integer");
+  Require(j, "height", has("height") && j["height"].is_number_integer(), path, "an integer");
+  Require(j, "encoding", has("encoding") && (j["encoding"] == "rgb8" || j["encoding"] == "mono8"), path,
+          "\"rgb8\" or \"mono8\"");
+  Require(j, "frame_pattern", has("frame_pattern") && j["frame_pattern"].is_string(), path, "a string");
+  Require(j, "wind_speed", has("wind_speed") && (j["wind_speed"].is_number() || j["wind_speed"].is_null()),
+          path, "a number");
+  return j;
+}
+
+sim::Theta LabelTheta(const nlohmann::json& label) {
+  if (!label.contains("theta") || !label["theta"].is_array() ||
+      label["theta"].size() != sim::kNumParameters)
+    throw std::runtime_error("label: field 'theta' must be an array of 17 numbers");
+  sim::Theta t;
+  for (int i = 0; i < sim::kNumParameters; ++i) {
+    if (!label["theta"][i].is_number())
+      throw std::runtime_error("label: theta[" + std::to_string(i) + "] is not a number");
+    t[i] = label["theta"][i].get<double>();
+  }
+  return t;
+}
+
+render::RenderParams LabelZeta(const nlohmann::json& label) {
+  if (!label.contains("zeta")) throw std::runtime_error("label: field 'zeta' is missing");
+  try {
+    return render::RenderParamsFromJson(label["zeta"]);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("label: zeta: ") + e.what());
+  }
+}
+
+nlohmann::json IndexEntry(const nlohmann::json& label) {
+  nlohmann::json e{{"name", label["name"]},
+                   {"wind_speed", label["wind_speed"]},
+                   {"num_frames", label["num_frames"]}};
+  for (const char* f : {"split", "seed", "simulation", "view", "fabric"})
+    if (label.contains(f)) e[f] = label[f];
+  if (label.contains("theta") && label["theta"].is_array() && !label["theta"].empty())
+    e["area_weight"] = label["theta"][sim::kAreaWeightIndex];
+  return e;
+}
+
+nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.empty() || name[0] == '.' || !entry.is_directory()) continue;
+    if (fs::exists(entry.path() / "label.json")) names.push_back(name);
+  }
+  std::sort(names.begin(), names.end());
+  nlohmann::json clips = nlohmann::json::array();
+  for (const auto& name : names) {
+    const std::string path = (fs::path(dir) / name / "label.json").string();
+    const nlohmann::json label = ReadLabel(path);
+    if (label["name"] != name)
+      throw std::runtime_error(path + ": field 'name' is " + label["name"].dump() +
+                               ", expected the folder's name \"" + name + "\"");
+    clips.push_back(IndexEntry(label));
+  }
+  header["clips"] = clips;
+  return header;
+}
+
+void WriteIndex(const std::string& dir, const nlohmann::json& index) {
+  sim::WriteFileAtomically((fs::path(dir) / "index.json").string(), index.dump(1) + "\n");
+}
+
+nlohmann::json ReadIndex(const std::string& dir) {
+  const std::string path = (fs::path(dir) / "index.json").string();
+  if (!fs::exists(path)) return nullptr;
+  nlohmann::json j = ReadJsonFile(path);
+  if (!j.is_object() || j.value("format", "") != "clothwind-dataset")
+    throw std::runtime_error(path + ": field 'format' must be \"clothwind-dataset\"");
+  if (!j.contains("clips") || !j["clips"].is_array())
+    throw std::runtime_error(path + ": field 'clips' must be an array");
+  return j;
+}
+
+}  // namespace clothwind::data

@@ -1,0 +1,72 @@
+#ifndef CLOTHWIND_DATA_DATASET_INDEX_H_
+#define CLOTHWIND_DATA_DATASET_INDEX_H_
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "data/example_sampling.h"
+#include "render/render_params.h"
+
+namespace clothwind::data {
+
+// label.json and index.json of simulated datasets (docs/dataset.md): format "clothwind-clip" /
+// "clothwind-dataset", version 1.
+constexpr char kGeneratorName[] = "clothwind make-dataset";
+constexpr int kGeneratorVersion = 1;
+constexpr int kFormatVersion = 1;
+
+// How an example's frames were made, for its label.
+struct ClipInfo {
+  std::string dataset;         // "flag" | "cloth"
+  uint64_t dataset_seed = 0;   // the global seed
+  int view = 0, views = 1;
+  std::string split;           // "train" | "val" | "test"
+  int num_frames = 60;
+  double frame_rate = 25.0;    // [Hz]
+  std::string frame_ext = "jpg";  // "jpg" | "png"
+  std::string scene;           // scene file name (no folders: labels must not depend on the machine)
+  double max_edge = 0.0;       // mesh resolution [m]
+  int vertices = 0, faces = 0;
+  double time_step = 0.005;    // [s]
+  double warmup = 0.0;         // simulated before frame 0 [s]
+};
+
+// label.json of a simulated example (every field docs/dataset.md lists: name, kind "sim",
+// num_frames, frame_rate, width, height, encoding "rgb8", frame_pattern, wind_speed = θ_e,
+// theta + theta_names + theta_units, wind_velocity, zeta, seed, generator, split; plus dataset,
+// dataset_seed, simulation, view, views, fabric and simulation settings).
+nlohmann::json SimExampleLabel(const std::string& name, const SimulationSample& s,
+                               const render::RenderParams& zeta, const ClipInfo& info);
+
+// Reads a label.json and checks its format, version and the fields every reader needs
+// (name, kind, num_frames, frame_rate, width, height, encoding, frame_pattern, wind_speed).
+// Throws std::runtime_error naming the file and the missing/wrong field.
+nlohmann::json ReadLabel(const std::string& path);
+
+// Reads theta (17 values) and zeta back from a simulated example's label.
+// Throws std::runtime_error naming the field when missing or malformed.
+sim::Theta LabelTheta(const nlohmann::json& label);
+render::RenderParams LabelZeta(const nlohmann::json& label);
+
+// The index entry of a label: name, wind_speed, split, and for simulated examples seed,
+// simulation, view, area_weight, fabric.
+nlohmann::json IndexEntry(const nlohmann::json& label);
+
+// Rebuilds index.json of `dir` from the example folders present (every non-hidden subfolder
+// with a label.json), sorted by name, so that any set of runs (shards, resumed runs) that left
+// the same folders gives the same index. `header` supplies the top-level fields (format,
+// version, kind, generator, dataset settings); "clips" is filled in.
+// Throws std::runtime_error naming a label.json that cannot be read.
+nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header);
+
+// Writes index.json atomically (temporary file + rename).
+void WriteIndex(const std::string& dir, const nlohmann::json& index);
+
+// Reads DIR/index.json; returns null when absent. Throws std::runtime_error naming the file
+// when it is not a clothwind-dataset index.
+nlohmann::json ReadIndex(const std::string& dir);
+
+}  // namespace clothwind::data
+
+#endif  // CLOTHWIND_DATA_DATASET_INDEX_H_

@@ -1,0 +1,123 @@
+#include "data/example_sampling.h"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "render/random.h"
+
+namespace clothwind::data {
+namespace {
+
+// Streams of one simulation's randomness (HashSeed(seed, stream)), kept apart so that adding a
+// draw to one part never shifts another.
+enum Stream : uint64_t { kTheta = 1, kWind = 2, kFabric = 3, kSplit = 4, kView = 5, kCamera = 6 };
+
+double LogUniform(render::Rng& rng, double factor) {
+  if (factor <= 1.0) return 1.0;
+  const double l = std::log(factor);
+  return std::exp(rng.Uniform(-l, l));
+}
+
+void CheckRanges(const SamplingRanges& r) {
+  if (!(r.wind_min >= 0 && r.wind_max >= r.wind_min))
+    throw std::invalid_argument("sampling ranges: expected 0 <= wind_min <= wind_max, got " +
+                                std::to_string(r.wind_min) + ", " + std::to_string(r.wind_max));
+  if (!(r.cloth_area_weight_min > 0 && r.cloth_area_weight_max >= r.cloth_area_weight_min))
+    throw std::invalid_argument("sampling ranges: expected 0 < cloth area weight min <= max");
+  if (!(r.area_weight_factor >= 1 && r.bending_factor >= 1 && r.bending_jitter >= 1))
+    throw std::invalid_argument("sampling ranges: perturbation factors must be >= 1");
+}
+
+}  // namespace
+
+SamplingRanges DefaultRanges(render::SceneKind kind) {
+  SamplingRanges r;
+  if (kind == render::SceneKind::kCloth) r.wind_max = 5.0;
+  return r;
+}
+
+uint64_t SimulationSeed(uint64_t global_seed, int64_t index) {
+  if (index < 0) throw std::invalid_argument("simulation index must be >= 0");
+  return render::HashSeed(global_seed, static_cast<uint64_t>(index), 0x5eedda7aULL);
+}
+
+SimulationSample SampleFlagSimulation(const sim::Theta& base, uint64_t global_seed, int64_t index,
+                                      const SamplingRanges& ranges) {
+  CheckRanges(ranges);
+  SimulationSample s;
+  s.index = index;
+  s.seed = SimulationSeed(global_seed, index);
+  s.fabric = "camel-ponte-roma";
+  render::Rng rng(render::HashSeed(s.seed, kTheta));
+  s.theta = base;
+  s.theta[sim::kAreaWeightIndex] = base[sim::kAreaWeightIndex] * LogUniform(rng, ranges.area_weight_factor);
+  const double stiffness = LogUniform(rng, ranges.bending_factor);
+  for (int k = 0; k < 15; ++k)
+    s.theta[sim::kBendingIndex + k] = base[sim::kBendingIndex + k] * stiffness * LogUniform(rng, ranges.bending_jitter);
+  render::Rng wind(render::HashSeed(s.seed, kWind));
+  s.theta[sim::kWindSpeedIndex] = wind.Uniform(ranges.wind_min, ranges.wind_max);
+  s.wind_velocity = Eigen::Vector3d(s.theta[sim::kWindSpeedIndex], 0, 0);
+  return s;
+}
+
+SimulationSample SampleClothSimulation(const std::vector<Fabric>& fabrics, uint64_t global_seed,
+                                       int64_t index, const SamplingRanges& ranges) {
+  CheckRanges(ranges);
+  if (fabrics.empty()) throw std::invalid_argument("ClothSim needs at least one fabric");
+  SimulationSample s;
+  s.index = index;
+  s.seed = SimulationSeed(global_seed, index);
+  render::Rng pick(render::HashSeed(s.seed, kFabric));
+  s.fabric_index = pick.UniformInt(static_cast<int>(fabrics.size()));
+  const Fabric& f = fabrics[s.fabric_index];
+  s.fabric = f.name;
+  render::Rng rng(render::HashSeed(s.seed, kTheta));
+  s.theta[sim::kAreaWeightIndex] = rng.Uniform(ranges.cloth_area_weight_min, ranges.cloth_area_weight_max);
+  for (int d = 0; d < 3; ++d)
+    for (int c = 0; c < 5; ++c) s.theta[sim::kBendingIndex + 5 * d + c] = f.material.bending[d][c];
+  render::Rng wind(render::HashSeed(s.seed, kWind));
+  const double speed = wind.Uniform(ranges.wind_min, ranges.wind_max);
+  const double azimuth = wind.Uniform(-M_PI, M_PI);
+  s.theta[sim::kWindSpeedIndex] = speed;
+  s.wind_velocity = Eigen::Vector3d(speed * std::cos(azimuth), speed * std::sin(azimuth), 0);
+  return s;
+}
+
+render::RenderParams SampleView(render::SceneKind kind, uint64_t simulation_seed, int view,
+                                int views, const std::vector<std::string>& background_images) {
+  if (views < 1 || view < 0 || view >= views)
+    throw std::invalid_argument("view " + std::to_string(view) + " of " + std::to_string(views) +
+                                ": expected 0 <= view < views");
+  render::RenderParams p =
+      render::SampleRenderParams(kind, render::HashSeed(simulation_seed, kView), background_images);
+  const bool flag = kind == render::SceneKind::kFlag;
+  render::Rng cam(render::HashSeed(simulation_seed, kCamera, static_cast<uint64_t>(view)));
+  if (view > 0) {  // the same scene seen from elsewhere (ranges of Table 2)
+    p.camera_height = flag ? cam.Uniform(0.2, 3) : cam.Uniform(0.5, 2);
+    p.camera_radius = flag ? cam.Uniform(4, 6) : cam.Uniform(1, 2.5);
+    p.seed = render::HashSeed(p.seed, static_cast<uint64_t>(view));
+  }
+  const double half = flag ? 15.0 : 5.0;
+  p.camera_angle_deg = -half + 2 * half * (view + cam.Uniform()) / views;
+  return p;
+}
+
+std::string SplitOf(uint64_t simulation_seed, double val_fraction, double test_fraction) {
+  if (!(val_fraction >= 0 && test_fraction >= 0 && val_fraction + test_fraction <= 1))
+    throw std::invalid_argument("split fractions: expected val, test >= 0 and val + test <= 1");
+  render::Rng rng(render::HashSeed(simulation_seed, kSplit));
+  const double u = rng.Uniform();
+  if (u < test_fraction) return "test";
+  if (u < test_fraction + val_fraction) return "val";
+  return "train";
+}
+
+std::string ExampleName(render::SceneKind kind, int64_t index, int view) {
+  char name[64];
+  std::snprintf(name, sizeof(name), "%s-%06lld-v%d", render::SceneKindName(kind).c_str(),
+                static_cast<long long>(index), view);
+  return name;
+}
+
+}  // namespace clothwind::data

@@ -1,0 +1,135 @@
+#include "data/example_sampling.h"
+
+#include <cmath>
+#include <set>
+
+#include <gtest/gtest.h>
+
+namespace clothwind::data {
+namespace {
+
+sim::Theta BaseTheta() {
+  sim::Theta t;
+  t[0] = 0.27;
+  for (int k = 1; k <= 15; ++k) t[k] = 3e-5 * k;
+  t[16] = 3.0;
+  return t;
+}
+
+TEST(ExampleSamplingTest, SimulationSeedDependsOnGlobalSeedAndIndexOnly) {
+  std::set<uint64_t> seen;
+  for (uint64_t g = 0; g < 5; ++g)
+    for (int64_t i = 0; i < 200; ++i) seen.insert(SimulationSeed(g, i));
+  EXPECT_EQ(seen.size(), 1000u);  // no collisions across seeds and indices
+  EXPECT_EQ(SimulationSeed(7, 12), SimulationSeed(7, 12));
+  EXPECT_THROW(SimulationSeed(7, -1), std::invalid_argument);
+}
+
+TEST(ExampleSamplingTest, FlagDrawsStayInTheirRangesAndCoverThem) {
+  const SamplingRanges r = DefaultRanges(render::SceneKind::kFlag);
+  const sim::Theta base = BaseTheta();
+  double wind_lo = 1e9, wind_hi = -1e9, aw_lo = 1e9, aw_hi = -1e9;
+  for (int i = 0; i < 2000; ++i) {
+    const SimulationSample s = SampleFlagSimulation(base, 3, i, r);
+    EXPECT_EQ(s.index, i);
+    EXPECT_EQ(s.seed, SimulationSeed(3, i));
+    const double aw = s.theta[0] / base[0];
+    EXPECT_GE(aw, 0.5 - 1e-12);
+    EXPECT_LE(aw, 2.0 + 1e-12);
+    for (int k = 1; k <= 15; ++k) {
+      const double f = s.theta[k] / base[k];
+      EXPECT_GE(f, 1.0 / (4 * 1.25) - 1e-12);
+      EXPECT_LE(f, 4 * 1.25 + 1e-12);
+    }
+    EXPECT_GE(s.theta[16], 0.0);
+    EXPECT_LT(s.theta[16], 10.0);
+    // The flag's wind blows along +x with the sampled speed.
+    EXPECT_DOUBLE_EQ(s.wind_velocity.x(), s.theta[16]);
+    EXPECT_EQ(s.wind_velocity.y(), 0.0);
+    wind_lo = std::min(wind_lo, s.theta[16]);
+    wind_hi = std::max(wind_hi, s.theta[16]);
+    aw_lo = std::min(aw_lo, aw);
+    aw_hi = std::max(aw_hi, aw);
+  }
+  EXPECT_LT(wind_lo, 0.1);
+  EXPECT_GT(wind_hi, 9.9);
+  EXPECT_LT(aw_lo, 0.55);
+  EXPECT_GT(aw_hi, 1.8);
+  // Bending entries are not all scaled alike (the table's shape varies).
+  const SimulationSample s = SampleFlagSimulation(base, 3, 0, r);
+  EXPECT_GT(std::abs(s.theta[1] / base[1] - s.theta[2] / base[2]), 1e-6);
+}
+
+TEST(ExampleSamplingTest, ClothDrawsFabricAreaWeightAndHorizontalWind) {
+  std::vector<Fabric> fabrics(3);
+  for (int f = 0; f < 3; ++f) {
+    fabrics[f].name = "fabric" + std::to_string(f);
+    for (int d = 0; d < 3; ++d)
+      for (int c = 0; c < 5; ++c) fabrics[f].material.bending[d][c] = 1e-5 * (f + 1) * (d + c + 1);
+  }
+  const SamplingRanges r = DefaultRanges(render::SceneKind::kCloth);
+  std::set<int> used;
+  double azimuth_spread = 0;
+  for (int i = 0; i < 500; ++i) {
+    const SimulationSample s = SampleClothSimulation(fabrics, 11, i, r);
+    used.insert(s.fabric_index);
+    EXPECT_EQ(s.fabric, fabrics[s.fabric_index].name);
+    EXPECT_GE(s.theta[0], 0.1);
+    EXPECT_LE(s.theta[0], 0.4);
+    EXPECT_DOUBLE_EQ(s.theta[1 + 5 * 2 + 3], fabrics[s.fabric_index].material.bending[2][3]);
+    EXPECT_EQ(s.wind_velocity.z(), 0.0);
+    EXPECT_NEAR(s.wind_velocity.norm(), s.theta[16], 1e-12);
+    EXPECT_LE(s.theta[16], 5.0);
+    azimuth_spread = std::max(azimuth_spread, std::abs(std::atan2(s.wind_velocity.y(), s.wind_velocity.x())));
+  }
+  EXPECT_EQ(used.size(), 3u);
+  EXPECT_GT(azimuth_spread, 3.0);  // directions cover the circle
+  EXPECT_THROW(SampleClothSimulation({}, 1, 0, r), std::invalid_argument);
+}
+
+TEST(ExampleSamplingTest, ViewsShareTheSceneAndSpreadTheCameraAngle) {
+  const uint64_t seed = SimulationSeed(1, 4);
+  const int views = 3;
+  const render::RenderParams v0 = SampleView(render::SceneKind::kFlag, seed, 0, views);
+  for (int v = 0; v < views; ++v) {
+    const render::RenderParams p = SampleView(render::SceneKind::kFlag, seed, v, views);
+    EXPECT_EQ(p.texture_name, v0.texture_name);
+    EXPECT_EQ(p.texture_seed, v0.texture_seed);
+    EXPECT_EQ(p.sun_azimuth_deg, v0.sun_azimuth_deg);
+    EXPECT_EQ(p.background_seed, v0.background_seed);
+    // Stratified angle: view v of 3 in [-15 + 10 v, -5 + 10 v).
+    EXPECT_GE(p.camera_angle_deg, -15.0 + 10.0 * v);
+    EXPECT_LT(p.camera_angle_deg, -5.0 + 10.0 * v);
+    EXPECT_GE(p.camera_radius, 4.0);
+    EXPECT_LT(p.camera_radius, 6.0);
+    EXPECT_NO_THROW(render::ValidateRenderParams(p));
+    if (v > 0) EXPECT_NE(p.seed, v0.seed);
+  }
+  const render::RenderParams c = SampleView(render::SceneKind::kCloth, seed, 1, 2);
+  EXPECT_GE(c.camera_angle_deg, 0.0);
+  EXPECT_LT(c.camera_angle_deg, 5.0);
+  EXPECT_EQ(c.texture_kind, "fabric");
+  EXPECT_THROW(SampleView(render::SceneKind::kFlag, seed, 3, 3), std::invalid_argument);
+}
+
+TEST(ExampleSamplingTest, SplitsFollowTheFractions) {
+  int counts[3] = {0, 0, 0};
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const std::string s = SplitOf(SimulationSeed(5, i), 0.1, 0.2);
+    counts[s == "train" ? 0 : s == "val" ? 1 : 2]++;
+    EXPECT_EQ(s, SplitOf(SimulationSeed(5, i), 0.1, 0.2));
+  }
+  EXPECT_NEAR(counts[0] / double(n), 0.7, 0.015);
+  EXPECT_NEAR(counts[1] / double(n), 0.1, 0.01);
+  EXPECT_NEAR(counts[2] / double(n), 0.2, 0.012);
+  EXPECT_THROW(SplitOf(1, 0.6, 0.6), std::invalid_argument);
+}
+
+TEST(ExampleSamplingTest, ExampleNames) {
+  EXPECT_EQ(ExampleName(render::SceneKind::kFlag, 12, 1), "flag-000012-v1");
+  EXPECT_EQ(ExampleName(render::SceneKind::kCloth, 1234567, 0), "cloth-1234567-v0");
+}
+
+}  // namespace
+}  // namespace clothwind::data

@@ -1,0 +1,75 @@
+#include "progress_bar.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace clothwind::tools {
+
+ProgressBar::ProgressBar(Options options)
+    : o_(std::move(options)),
+      tty_(o_.tty >= 0 ? o_.tty == 1 : ::isatty(::fileno(o_.stream)) == 1),
+      start_(std::chrono::steady_clock::now()) {}
+
+double ProgressBar::Elapsed() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+bool ProgressBar::Update(int64_t done, int64_t total, const std::string& note) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const double now = Elapsed();
+  const bool last = done >= total;
+  const double interval = tty_ ? 0.2 : o_.plain_interval;
+  if (!last && now - last_print_ < interval) return true;
+  last_print_ = now;
+  Print(done, total, note, now);
+  return true;
+}
+
+void ProgressBar::Print(int64_t done, int64_t total, const std::string& note, double now) {
+  const double rate = now > 0 ? done * o_.rate_scale / now : 0.0;  // in rate_unit
+  const double per_unit = done > 0 ? now / done : 0.0;             // [s per unit done]
+  const double eta = done > 0 ? (total - done) * per_unit : 0.0;
+  const int percent = total > 0 ? static_cast<int>(100 * std::min(done, total) / total) : 100;
+  char text[256];
+  std::snprintf(text, sizeof(text), "%3d%%  %lld/%lld %s  %.3g %s  %s %s", percent,
+                static_cast<long long>(done), static_cast<long long>(total), o_.unit.c_str(),
+                rate, o_.rate_unit.c_str(), done >= total ? "took" : "ETA",
+                done >= total ? FormatDuration(now).c_str()
+                              : (done > 0 ? FormatDuration(eta).c_str() : "?"));
+  const std::string label = o_.label.empty() ? "" : o_.label + " ";
+  if (tty_) {
+    constexpr int kWidth = 30;
+    const int filled = total > 0 ? static_cast<int>(kWidth * std::min(done, total) / total) : kWidth;
+    std::fprintf(o_.stream, "\r%s[%s%s] %s  %s\033[K", label.c_str(), std::string(filled, '#').c_str(),
+                 std::string(kWidth - filled, '.').c_str(), text, note.c_str());
+    open_line_ = done < total;
+    if (!open_line_) std::fprintf(o_.stream, "\n");
+  } else {
+    std::fprintf(o_.stream, "%s%s  %s\n", label.c_str(), text, note.c_str());
+  }
+  std::fflush(o_.stream);
+}
+
+void ProgressBar::Finish() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (tty_ && open_line_) std::fprintf(o_.stream, "\n");
+  open_line_ = false;
+}
+
+std::string FormatDuration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  char text[64];
+  const long long s = std::llround(seconds);
+  if (seconds < 60) {
+    std::snprintf(text, sizeof(text), "%.0f s", seconds);
+  } else if (s < 3600) {
+    std::snprintf(text, sizeof(text), "%lld min %02lld s", s / 60, s % 60);
+  } else {
+    std::snprintf(text, sizeof(text), "%lld h %02lld min", s / 3600, (s % 3600) / 60);
+  }
+  return text;
+}
+
+}  // namespace clothwind::tools

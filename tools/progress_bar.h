@@ -1,0 +1,59 @@
+#ifndef CLOTHWIND_TOOLS_PROGRESS_BAR_H_
+#define CLOTHWIND_TOOLS_PROGRESS_BAR_H_
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <mutex>
+#include <string>
+
+namespace clothwind::tools {
+
+// Progress of a long verb on stderr, shared by every verb. On a terminal it redraws one line
+//   "label [#####.....]  45%  225/500 frames  3.2 sim s/s  ETA 12 s  <note>"
+// at most five times a second; otherwise (a log file, a batch scheduler) it prints the same
+// text as plain lines, one every `plain_interval` seconds and one at the end, so logs stay short.
+// Update is thread-safe (worker threads may call it directly).
+class ProgressBar {
+ public:
+  struct Options {
+    std::string label;              // printed first, e.g. "make-dataset"
+    std::string unit = "items";     // what `done` counts
+    double rate_scale = 1.0;        // the rate shown is done * rate_scale per second ...
+    std::string rate_unit = "items/s";  // ... in this unit (e.g. frame_time and "sim s/s")
+    double plain_interval = 10.0;   // [s] between plain lines when not on a terminal
+    std::FILE* stream = stderr;
+    int tty = -1;                   // -1: detect (isatty); 0: plain lines; 1: redraw
+  };
+
+  explicit ProgressBar(Options options);
+  ProgressBar(const ProgressBar&) = delete;
+  ProgressBar& operator=(const ProgressBar&) = delete;
+
+  // Reports that `done` of `total` units are finished; `note` is appended (e.g. the last
+  // item's name). Returns true, so it can serve as a keep-going callback.
+  bool Update(int64_t done, int64_t total, const std::string& note = "");
+
+  // Ends the line on a terminal (call once when done; Update(total, total) also does).
+  void Finish();
+
+  // Seconds since construction.
+  double Elapsed() const;
+
+ private:
+  void Print(int64_t done, int64_t total, const std::string& note, double now);
+
+  Options o_;
+  bool tty_;
+  std::mutex mutex_;
+  std::chrono::steady_clock::time_point start_;
+  double last_print_ = -1e300;  // [s since start]
+  bool open_line_ = false;      // a redrawn line is on screen without its newline
+};
+
+// "12 s", "3 min 05 s", "2 h 04 min": a duration [s] for people.
+std::string FormatDuration(double seconds);
+
+}  // namespace clothwind::tools
+
+#endif  // CLOTHWIND_TOOLS_PROGRESS_BAR_H_

@@ -1,0 +1,148 @@
+// clothwind make-dataset --kind flag|cloth --count N --out DIR: FlagSim / ClothSim datasets of
+// simulated and rendered clips (docs/datasets.md), resumable, parallel, shardable.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "data/dataset_generator.h"
+#include "progress_bar.h"
+#include "verb_registry.h"
+
+namespace clothwind::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct MakeDatasetArgs {
+  data::DatasetOptions o;
+  std::string kind = "flag";
+  std::string shard = "0/1";
+  std::string format = "jpg";
+  double wind_min = -1, wind_max = -1;
+  bool reindex = false;
+  bool no_contact_sheet = false;
+  std::string backgrounds;  // folder of images
+};
+
+// "i/N" -> (i, N).
+void ParseShard(const std::string& text, int* shard, int* shards) {
+  const auto slash = text.find('/');
+  try {
+    if (slash == std::string::npos) throw std::invalid_argument(text);
+    size_t a = 0, b = 0;
+    *shard = std::stoi(text.substr(0, slash), &a);
+    *shards = std::stoi(text.substr(slash + 1), &b);
+    if (a != slash || b != text.size() - slash - 1) throw std::invalid_argument(text);
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--shard: expected i/N (e.g. 3/8), got '" + text + "'");
+  }
+  if (*shards < 1 || *shard < 0 || *shard >= *shards)
+    throw std::invalid_argument("--shard " + text + ": expected 0 <= i < N");
+}
+
+int Run(MakeDatasetArgs& a) {
+  data::DatasetOptions& o = a.o;
+  if (a.reindex) {
+    const int64_t n = data::ReindexDataset(o.out, !a.no_contact_sheet);
+    std::printf("make-dataset: %s/index.json rebuilt: %lld examples\n", o.out.c_str(), static_cast<long long>(n));
+    return 0;
+  }
+  o.kind = render::SceneKindFromName(a.kind);
+  ParseShard(a.shard, &o.shard, &o.shards);
+  o.frame_ext = a.format == "jpeg" ? "jpg" : a.format;
+  o.contact_sheet = !a.no_contact_sheet;
+  if (a.wind_min >= 0 || a.wind_max >= 0) {
+    data::SamplingRanges r = data::DefaultRanges(o.kind);
+    if (a.wind_min >= 0) r.wind_min = a.wind_min;
+    if (a.wind_max >= 0) r.wind_max = a.wind_max;
+    o.ranges = r;
+  }
+  if (!a.backgrounds.empty()) {
+    for (const auto& e : fs::directory_iterator(a.backgrounds)) {
+      const std::string ext = e.path().extension().string();
+      if (ext == ".jpg" || ext == ".jpeg" || ext == ".png") o.background_images.push_back(e.path().string());
+    }
+    std::sort(o.background_images.begin(), o.background_images.end());
+    if (o.background_images.empty())
+      throw std::invalid_argument("--backgrounds " + a.backgrounds + ": no .jpg/.png image in it");
+  }
+
+  ProgressBar::Options bar_options;
+  bar_options.label = "make-dataset";
+  bar_options.unit = "simulations";
+  bar_options.rate_scale = 60.0 * o.views;
+  bar_options.rate_unit = "clips/min";
+  ProgressBar bar(bar_options);
+  std::fprintf(stderr, "make-dataset: %s, %lld simulations x %d views, seed %llu, shard %d/%d, %s\n",
+               a.kind.c_str(), static_cast<long long>(o.count), o.views,
+               static_cast<unsigned long long>(o.seed), o.shard, o.shards, o.out.c_str());
+  const data::DatasetSummary s = data::GenerateDataset(o, [&](const data::DatasetProgress& p) {
+    bar.Update(p.done, p.total, p.last);
+  });
+  bar.Finish();
+
+  const double busy = s.simulate_seconds + s.render_seconds + s.write_seconds;
+  std::printf("make-dataset: %s\n", o.out.c_str());
+  std::printf("  shard %d/%d: %lld simulations assigned, %lld already complete, %lld run now "
+              "(%lld failed), %lld example folders written\n",
+              o.shard, o.shards, static_cast<long long>(s.assigned), static_cast<long long>(s.skipped),
+              static_cast<long long>(s.simulated), static_cast<long long>(s.failed),
+              static_cast<long long>(s.examples_written));
+  std::printf("  wall %.1f s on %d jobs; worker time: simulate %.1f s, render %.1f s, write %.1f s\n",
+              s.wall_seconds, s.jobs, s.simulate_seconds, s.render_seconds, s.write_seconds);
+  if (s.examples_written > 0) {
+    std::printf("  per example: %.2f s of worker time (render %.1f ms/frame); %.1f clips/min overall\n",
+                busy / s.examples_written, 1e3 * s.render_seconds / (s.examples_written * o.frames),
+                60.0 * s.examples_written / s.wall_seconds);
+  }
+  std::printf("  index: %s (%lld examples in the folder)\n", s.index_path.c_str(),
+              static_cast<long long>(s.examples_in_index));
+  if (!s.contact_sheet_path.empty()) std::printf("  contact sheet: %s\n", s.contact_sheet_path.c_str());
+  for (const auto& e : s.errors) std::fprintf(stderr, "make-dataset: FAILED %s\n", e.c_str());
+  return s.failed > 0 ? 1 : 0;
+}
+
+const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::function<int()> {
+  auto a = std::make_shared<MakeDatasetArgs>();
+  auto* sub = app.add_subcommand("make-dataset",
+                                 "FlagSim/ClothSim dataset: simulate, render clips from several views, "
+                                 "label; resumable, parallel, shardable");
+  sub->add_option("--kind", a->kind, "flag (FlagSim) or cloth (ClothSim)")
+      ->check(CLI::IsMember({"flag", "cloth"}))->capture_default_str();
+  sub->add_option("--count", a->o.count, "number of simulations (examples = count x views)");
+  sub->add_option("--out", a->o.out, "dataset folder")->required();
+  sub->add_option("--seed", a->o.seed, "global seed")->capture_default_str();
+  sub->add_option("--shard", a->shard, "i/N: do the simulations with index % N == i")->capture_default_str();
+  sub->add_option("--jobs", a->o.jobs, "parallel simulations (0: all cores)")->capture_default_str();
+  sub->add_option("--views", a->o.views, "camera poses rendered per simulation")->capture_default_str();
+  sub->add_option("--materials", a->o.materials_dir,
+                  "ClothSim fabrics folder (default: $CLOTHWIND_SHARED_DIR/arcsim/materials, else config/materials)");
+  sub->add_option("--scene", a->o.scene, "scene file (default: config/scenes/<kind>.json)");
+  sub->add_option("--max-edge", a->o.max_edge, "mesh resolution [m] (0: the scene's default)")->capture_default_str();
+  sub->add_option("--warmup", a->o.warmup, "simulated seconds before the first kept frame")->capture_default_str();
+  sub->add_option("--frames", a->o.frames, "frames per example")->capture_default_str();
+  sub->add_option("--samples", a->o.samples, "anti-aliasing samples per pixel (0: zeta's default)")
+      ->capture_default_str();
+  sub->add_option("--size", a->o.size, "frame width = height [px]")->capture_default_str();
+  sub->add_option("--format", a->format, "frame format")->check(CLI::IsMember({"jpg", "jpeg", "png"}))
+      ->capture_default_str();
+  sub->add_option("--jpeg-quality", a->o.jpeg_quality, "JPEG quality 1..100")->capture_default_str();
+  sub->add_option("--wind-min", a->wind_min, "lowest wind speed [m/s] (default: flag 0, cloth 0)");
+  sub->add_option("--wind-max", a->wind_max, "highest wind speed [m/s] (default: flag 10, cloth 5)");
+  sub->add_option("--val", a->o.val_fraction, "fraction of simulations in the val split")->capture_default_str();
+  sub->add_option("--test", a->o.test_fraction, "fraction of simulations in the test split")->capture_default_str();
+  sub->add_option("--backgrounds", a->backgrounds, "folder of background images (default: procedural)");
+  sub->add_flag("--reindex", a->reindex,
+                "only rebuild index.json and the contact sheet from the example folders (merge shards)");
+  sub->add_flag("--no-contact-sheet", a->no_contact_sheet, "skip contact_sheet.png");
+  return [a] {
+    if (!a->reindex && a->o.count <= 0) throw std::invalid_argument("--count N (N >= 1) is required");
+    return Run(*a);
+  };
+}};
+
+}  // namespace
+}  // namespace clothwind::tools

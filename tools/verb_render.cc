@@ -1,0 +1,150 @@
+// clothwind render INPUT --out DIR: renders a cloth animation as 25 fps frames (300x300 JPEG or
+// PNG by default) with the datasets' camera, light and scene sampling ζ (from --seed or a JSON
+// file), so any simulator's cloth renders the same way. INPUT is our binary trajectory
+// (.cwtraj, or a `clothwind simulate` folder holding trajectory.cwtraj) or a folder of
+// ArcSim-style frame OBJs (0000_00.obj, 0001_00.obj, ...; --obj prefers them).
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "data/cloth_animation.h"
+#include "progress_bar.h"
+#include "render/render_params.h"
+#include "render/renderer.h"
+#include "render/sensor_model.h"
+#include "sim/trajectory_io.h"
+#include "verb_registry.h"
+
+namespace clothwind::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RenderArgs {
+  std::string input;
+  std::string out;
+  std::string kind = "flag";
+  uint64_t seed = 1;
+  std::string zeta;        // JSON file (a ζ object, or a label.json with "zeta")
+  std::string format = "jpg";
+  int jpeg_quality = 95;
+  double start = 0.0;      // [s] into the animation
+  int count = 0;           // frames; 0 = to the end
+  double fps = 25.0;
+  double frame_time = 0.04;  // of an OBJ sequence [s]
+  int cloth = 0;
+  bool obj = false;
+  int samples = 0;
+  int threads = 0;
+};
+
+render::RenderParams LoadZeta(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("--zeta: cannot open " + path);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("--zeta " + path + ": not valid JSON (" + e.what() + ")");
+  }
+  if (j.contains("zeta")) j = j["zeta"];  // a dataset example's label.json
+  try {
+    return render::RenderParamsFromJson(j);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("--zeta " + path + ": " + e.what());
+  }
+}
+
+data::ClothAnimation LoadInput(const RenderArgs& a, std::string* what) {
+  const fs::path in(a.input);
+  if (fs::is_regular_file(in)) {
+    *what = "trajectory " + in.string();
+    return data::AnimationFromTrajectory(sim::ReadTrajectory(in.string()));
+  }
+  if (!fs::is_directory(in)) throw std::runtime_error(a.input + ": no such file or folder");
+  const fs::path traj = in / (a.cloth == 0 ? std::string("trajectory.cwtraj")
+                                            : "trajectory_" + std::to_string(a.cloth) + ".cwtraj");
+  if (!a.obj && fs::exists(traj)) {
+    *what = "trajectory " + traj.string();
+    return data::AnimationFromTrajectory(sim::ReadTrajectory(traj.string()));
+  }
+  *what = "OBJ frames in " + in.string();
+  return data::ReadObjSequence(in.string(), a.cloth, a.frame_time);
+}
+
+int Run(const RenderArgs& a) {
+  render::RenderParams zeta = a.zeta.empty()
+                                  ? render::SampleRenderParams(render::SceneKindFromName(a.kind), a.seed)
+                                  : LoadZeta(a.zeta);
+  if (a.samples > 0) zeta.samples = a.samples;
+  zeta.fps = a.fps;
+  render::ValidateRenderParams(zeta);
+  if (a.format != "jpg" && a.format != "png") throw std::invalid_argument("--format: jpg or png");
+  std::string what;
+  const data::ClothAnimation anim = LoadInput(a, &what);
+  if (a.start < 0 || a.start > anim.duration())
+    throw std::invalid_argument("--start " + std::to_string(a.start) + " s is outside the animation's " +
+                                std::to_string(anim.duration()) + " s");
+  const int available = static_cast<int>(std::floor((anim.duration() - a.start) * a.fps + 1e-9)) + 1;
+  const int count = a.count > 0 ? a.count : available;
+  if (count > available)
+    throw std::invalid_argument("--count " + std::to_string(count) + ": only " + std::to_string(available) +
+                                " frames at " + std::to_string(a.fps) + " fps from --start");
+  fs::create_directories(a.out);
+  sim::WriteFileAtomically((fs::path(a.out) / "zeta.json").string(), render::ToJson(zeta).dump(2) + "\n");
+
+  render::RenderOptions ro;
+  ro.threads = a.threads;
+  render::Renderer renderer(zeta, ro);
+  ProgressBar::Options bo;
+  bo.label = "render";
+  bo.unit = "frames";
+  bo.rate_unit = "frames/s";
+  ProgressBar bar(bo);
+  std::fprintf(stderr, "render: %s, %d frames at %.4g fps from %.3f s, %dx%d, %s %s\n", what.c_str(), count,
+               a.fps, a.start, zeta.width, zeta.height, zeta.texture_kind.c_str(), zeta.texture_name.c_str());
+  for (int k = 0; k < count; ++k) {
+    const data::ClothFrame f = data::FrameAt(anim, a.start + k / a.fps);
+    const cv::Mat image = renderer.RenderFrame(f.V, f.F, f.UV);
+    char name[32];
+    std::snprintf(name, sizeof(name), "%03d.%s", k, a.format.c_str());
+    render::WriteFrameAtomic((fs::path(a.out) / name).string(), image, a.jpeg_quality);
+    bar.Update(k + 1, count);
+  }
+  bar.Finish();
+  std::printf("render: %d frames -> %s (%.1f ms/frame), zeta in %s/zeta.json\n", count, a.out.c_str(),
+              1e3 * bar.Elapsed() / count, a.out.c_str());
+  return 0;
+}
+
+const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int()> {
+  auto a = std::make_shared<RenderArgs>();
+  auto* sub = app.add_subcommand("render",
+                                 "render a cloth trajectory (.cwtraj) or OBJ frame sequence to 25 fps frames");
+  sub->add_option("input", a->input, ".cwtraj file, or a folder with trajectory.cwtraj or NNNN_CC.obj frames")
+      ->required();
+  sub->add_option("--out", a->out, "output folder (000.jpg ..., zeta.json)")->required();
+  sub->add_option("--kind", a->kind, "scene sampling when no --zeta: flag or cloth")
+      ->check(CLI::IsMember({"flag", "cloth"}))->capture_default_str();
+  sub->add_option("--seed", a->seed, "seed of the render parameters zeta")->capture_default_str();
+  sub->add_option("--zeta", a->zeta, "zeta JSON file (or an example's label.json) instead of --seed");
+  sub->add_option("--format", a->format, "jpg or png")->capture_default_str();
+  sub->add_option("--jpeg-quality", a->jpeg_quality, "JPEG quality")->capture_default_str();
+  sub->add_option("--start", a->start, "first frame's time in the animation [s]")->capture_default_str();
+  sub->add_option("--count", a->count, "frames to render (0: to the end)")->capture_default_str();
+  sub->add_option("--fps", a->fps, "output frame rate")->capture_default_str();
+  sub->add_option("--frame-time", a->frame_time, "time between OBJ frames [s]")->capture_default_str();
+  sub->add_option("--cloth", a->cloth, "which cloth (the CC of NNNN_CC.obj)")->capture_default_str();
+  sub->add_flag("--obj", a->obj, "read the folder's OBJ frames even if it has a trajectory");
+  sub->add_option("--samples", a->samples, "anti-aliasing samples per pixel (0: zeta's)")->capture_default_str();
+  sub->add_option("--threads", a->threads, "render threads (0: all)")->capture_default_str();
+  return [a] { return Run(*a); };
+}};
+
+}  // namespace
+}  // namespace clothwind::tools
