@@ -50,6 +50,13 @@ struct StretchingTerms {
 StretchingTerms StretchingForce(const Vector9d& x, const TriangleRest& rest,
                                 const Eigen::Vector4d& k, bool definite);
 
+// StretchingForce with the Jacobian written as 3x3 blocks, jacobian[3 i + j] = d f_i / d x_j
+// (the simulator's hot path: assembled from four 3x3 outer products instead of 9x9 ones).
+// Inputs as StretchingForce. Outputs: force (9-vector) [N], jacobian (9 blocks) [N/m];
+// returns the energy [J].
+double StretchingForceBlocks(const Vector9d& x, const TriangleRest& rest, const Eigen::Vector4d& k,
+                             bool definite, Vector9d* force, Eigen::Matrix3d jacobian[9]);
+
 // Signed dihedral angle of the hinge x0-x1 shared by triangles (x0,x1,x2) and (x1,x0,x3):
 //   theta = atan2(e . (n0 x n1), n0 . n1), e = unit(x0 - x1), n0, n1 the unit face normals
 // (ArcSim's convention: theta grows as x2 moves along n0), 0 when flat [rad]; optionally its

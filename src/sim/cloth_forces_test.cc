@@ -100,6 +100,24 @@ TEST(StretchingForceTest, DefiniteJacobianIsNegativeSemidefiniteAndExactUnderTen
   EXPECT_LT((Jd - Je).norm(), 1e-12 * Je.norm());
 }
 
+TEST(StretchingForceTest, BlockFormMatchesMatrixForm) {
+  const Eigen::Vector4d k(120.0, 30.0, 200.0, 45.0);
+  for (int seed = 0; seed < 5; ++seed)
+    for (bool definite : {false, true}) {
+      TriangleCase c = MakeTriangle(seed);
+      if (seed % 2) c.x *= 0.93;  // some compressed cases, where the definite form differs
+      const StretchingTerms full = StretchingForce(c.x, c.rest, k, definite);
+      Vector9d f;
+      Eigen::Matrix3d blocks[9];
+      const double e = StretchingForceBlocks(c.x, c.rest, k, definite, &f, blocks);
+      EXPECT_NEAR(e, full.energy, 1e-12 * std::abs(full.energy));
+      EXPECT_LT((f - full.force).norm(), 1e-12 * full.force.norm());
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          EXPECT_LT((blocks[3 * i + j] - full.jacobian.block<3, 3>(3 * i, 3 * j)).norm(), 1e-12 * full.jacobian.norm());
+    }
+}
+
 TEST(StretchingForceTest, RestStateHasNoForceAndRigidMotionsNoEnergy) {
   const Eigen::Vector4d k(120.0, 30.0, 200.0, 45.0);
   const TriangleRest rest = MakeTriangleRest({0.1, 0.2}, {0.3, 0.25}, {0.15, 0.4});

@@ -165,10 +165,11 @@ void ClothSimulator::Impl::Build() {
   for (const Face& face : faces)
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) link(face.v[i], face.v[j]);
-  for (const Hinge& h : hinges) {
-    link(h.v[2], h.v[3]);
-    link(h.v[3], h.v[2]);
-  }
+  if (options.implicit_bending)
+    for (const Hinge& h : hinges) {
+      link(h.v[2], h.v[3]);
+      link(h.v[3], h.v[2]);
+    }
   row_start.assign(nv + 1, 0);
   col.clear();
   for (int i = 0; i < nv; ++i) {
@@ -185,7 +186,10 @@ void ClothSimulator::Impl::Build() {
       for (int j = 0; j < 3; ++j) face.block[3 * i + j] = BlockIndex(face.v[i], face.v[j]);
   for (Hinge& h : hinges)
     for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) h.block[4 * i + j] = BlockIndex(h.v[i], h.v[j]);
+      for (int j = 0; j < 4; ++j)
+        h.block[4 * i + j] = (options.implicit_bending || i + j != 5 || i == j)
+                                 ? BlockIndex(h.v[i], h.v[j])
+                                 : -1;
   J.assign(col.size(), Eigen::Matrix3d::Zero());
   precond.assign(nv, Eigen::Matrix3d::Zero());
   const int n3 = 3 * nv;
@@ -223,8 +227,9 @@ void ClothSimulator::Impl::ComputeForces(bool with_jacobian, bool with_repulsion
       vf.segment<3>(3 * c) = v.row(face.v[c]).transpose();
     }
     const Eigen::Vector4d k = material.StretchingStiffness(GreenStrain(xf, face.rest));
-    const StretchingTerms st = StretchingForce(xf, face.rest, k, /*definite=*/true);
-    Vector9d fe = st.force;
+    Vector9d fe;
+    Eigen::Matrix3d blocks[9];
+    StretchingForceBlocks(xf, face.rest, k, /*definite=*/true, &fe, blocks);
     if (options.wind_density > 0 || options.wind_drag > 0) {
       Eigen::Vector3d air = Eigen::Vector3d::Zero();
       if (wind) air = wind->Velocity((xf.segment<3>(0) + xf.segment<3>(3) + xf.segment<3>(6)) / 3.0, t);
@@ -233,7 +238,7 @@ void ClothSimulator::Impl::ComputeForces(bool with_jacobian, bool with_repulsion
     for (int c = 0; c < 3; ++c) f.segment<3>(3 * face.v[c]) += fe.segment<3>(3 * c);
     if (with_jacobian)
       for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) J[face.block[3 * i + j]] += st.jacobian.block<3, 3>(3 * i, 3 * j);
+        for (int j = 0; j < 3; ++j) J[face.block[3 * i + j]] += blocks[3 * i + j];
   }
   // Bending, per hinge (ArcSim's bending_force, inlined so the dihedral is evaluated once).
   for (const Hinge& h : hinges) {
@@ -244,10 +249,14 @@ void ClothSimulator::Impl::ComputeForces(bool with_jacobian, bool with_repulsion
     const double ke = material.BendingStiffness(curvature, h.du);
     const double c_half = 0.5 * ke * h.rest_length * h.rest_length / (2 * h.rest_area_sum);
     for (int c = 0; c < 4; ++c) f.segment<3>(3 * h.v[c]) -= c_half * theta * dtheta.segment<3>(3 * c);
-    if (with_jacobian)
+    if (with_jacobian && options.implicit_bending)
       for (int i = 0; i < 4; ++i) {
         const Eigen::Vector3d gi = -c_half * dtheta.segment<3>(3 * i);
-        for (int j = 0; j < 4; ++j) J[h.block[4 * i + j]].noalias() += gi * dtheta.segment<3>(3 * j).transpose();
+        for (int j = i; j < 4; ++j) {
+          const Eigen::Matrix3d blk = gi * dtheta.segment<3>(3 * j).transpose();
+          J[h.block[4 * i + j]] += blk;
+          if (j != i) J[h.block[4 * j + i]] += blk.transpose();
+        }
       }
   }
   // Vertex-face repulsion (ArcSim's proximity constraints), implicit with its full Gauss-Newton
