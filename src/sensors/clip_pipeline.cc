@@ -55,6 +55,7 @@ void ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
   }
   if (r.gap) {
     ++stats_.gaps;
+    stats_.last_gap = stamp - last_frame_;
     assembler_.Break();
   }
   if (r.restarted) assembler_.Break();
@@ -67,6 +68,7 @@ void ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
   }
   for (const auto& tick : r.ticks) Emit(tick, tick.from_previous ? previous_ : processed);
   previous_ = processed;
+  last_frame_ = stamp;
   data_time_ = std::max(data_time_, stamp);
 }
 

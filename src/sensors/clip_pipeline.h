@@ -100,6 +100,7 @@ class ClipPipeline {
   SquareRoi roi_;               // resolved for the current source size
   int source_width_ = 0, source_height_ = 0;
   double data_time_;            // largest stamp seen on either stream [s]
+  double last_frame_ = 0.0;     // stamp of the last accepted camera frame [s]
   double released_end_;         // end of the last released clip [s]
   std::deque<AssembledClip> pending_;
   ClipPipelineStats stats_;

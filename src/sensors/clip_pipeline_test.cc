@@ -57,6 +57,7 @@ TEST(ClipPipelineTest, GapBreaksTheClip) {
   for (int j = 0; j < 30; ++j) p.AddFrame(kT0 + (i + 15 + j) / 30.0, Numbered(i + 15 + j), ClipSourceEncoding::kMono8);
   const auto clips = p.Flush();
   EXPECT_EQ(p.stats().gaps, 1u);
+  EXPECT_NEAR(p.stats().last_gap, 16 / 30.0, 1e-6);  // frame 29 to frame 45
   for (const auto& c : clips) {
     const auto& f = c.clip.frames;
     // No clip spans the hole: its frames are exactly 40 ms apart.
