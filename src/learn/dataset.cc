@@ -224,10 +224,10 @@ std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions
     const double f = o.base_frequency + o.frequency_per_speed * speed;
     frequencies.push_back(f);
     const double phase = std::uniform_real_distribution<double>(0, 2 * M_PI)(clip_rng);
-    const int patch = o.size / 2;
-    const int x0 = std::uniform_int_distribution<int>(2, o.size - patch - 2)(clip_rng);
-    const int y0 = std::uniform_int_distribution<int>(2, o.size - patch - 2)(clip_rng);
-    const double wavelength = patch / 2.0;  // [px] two stripes across the patch
+    const int patch = 3 * o.size / 4;
+    const int x0 = std::uniform_int_distribution<int>(1, o.size - patch - 1)(clip_rng);
+    const int y0 = std::uniform_int_distribution<int>(1, o.size - patch - 1)(clip_rng);
+    const double wavelength = patch / 3.0;  // [px] three stripes across the patch
     std::normal_distribution<double> noise(0.0, 3.0);
     const uint64_t hash = (seed * 0x9E3779B97F4A7C15ULL) >> 33;
     const std::string split = hash % 5 < 3 ? "train" : (hash % 5 == 3 ? "val" : "test");

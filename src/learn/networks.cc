@@ -121,8 +121,22 @@ WindNet LoadWindNet(const std::filesystem::path& weights) {
   }
   WindNet net(ModelConfigFromJson(j, config_path.string()));
   if (!std::filesystem::exists(weights)) throw std::runtime_error(weights.string() + ": no such file");
+  // torch::load replaces tensors whatever their shape: compare with the architecture's.
+  std::vector<std::pair<std::string, std::vector<int64_t>>> expected;
+  for (const auto& item : net->named_parameters()) expected.emplace_back(item.key(), item.value().sizes().vec());
+  for (const auto& item : net->named_buffers()) expected.emplace_back(item.key(), item.value().sizes().vec());
   try {
     torch::load(net, weights.string());
+    auto parameters = net->named_parameters();
+    auto buffers = net->named_buffers();
+    for (const auto& [name, sizes] : expected) {
+      const at::Tensor* t = parameters.find(name);
+      if (t == nullptr) t = buffers.find(name);
+      if (t == nullptr || t->sizes().vec() != sizes) {
+        throw std::runtime_error(weights.string() + ": tensor " + name + " does not have the shape that " +
+                                 config_path.string() + " implies (" + net->config().Name() + ")");
+      }
+    }
   } catch (const c10::Error& e) {
     throw std::runtime_error(weights.string() + ": does not hold the weights of a " + net->config().Name() +
                              " network: " + e.what_without_backtrace());

@@ -1,0 +1,63 @@
+// clothwind eval: a trained wind network over a dataset split in Table 1's terms (RMSE,
+// Acc@0.5), a predicted-vs-true plot and optionally the figures as JSON; see docs/sdn.md.
+#include <iostream>
+#include <memory>
+
+#include "learn/evaluate.h"
+#include "learn/model_config.h"
+#include "progress_bar.h"
+#include "verb_registry.h"
+
+namespace clothwind::tools {
+namespace {
+
+struct EvalArgs {
+  std::string model, data, split = "test", json, plot;
+  int threads = 2, batch = 8;
+  std::string device = "auto";
+};
+
+VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
+  auto a = std::make_shared<EvalArgs>();
+  auto* sub = app.add_subcommand("eval", "evaluate a trained wind network (Table 1: RMSE, Acc@0.5)");
+  sub->add_option("--model", a->model, "model.pt of a training run (model.json beside it)")->required();
+  sub->add_option("--data", a->data, "dataset folder")->required();
+  sub->add_option("--split", a->split, "test, val, train or all")
+      ->check(CLI::IsMember({"test", "val", "train", "all"}))
+      ->capture_default_str();
+  sub->add_option("--json", a->json, "write {\"rmse\", \"acc05\", \"count\", ...} to this file");
+  sub->add_option("--plot", a->plot, "predicted-vs-true PNG (default: <model folder>/eval_<split>.png)");
+  sub->add_option("--threads", a->threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
+  sub->add_option("--batch", a->batch, "clips per forward pass")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--device", a->device, "cpu, cuda or auto")
+      ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
+      ->capture_default_str();
+  return [a]() {
+    ProgressBar::Options b;
+    b.label = "eval";
+    b.unit = "clips";
+    b.rate_unit = "clips/s";
+    ProgressBar bar(b);
+    const learn::EvalResult r = learn::Evaluate(a->model, a->data, a->split, a->threads, a->device, a->batch,
+                                                [&](int done, int total) { bar.Update(done, total); });
+    bar.Finish();
+    std::cout << learn::EvalTable(r);
+    const std::filesystem::path plot =
+        a->plot.empty() ? std::filesystem::path(a->model).parent_path() / ("eval_" + a->split + ".png")
+                        : std::filesystem::path(a->plot);
+    std::string error;
+    if (learn::PlotPredictions(r, plot, &error)) {
+      std::cout << "plot: " << plot.string() << "\n";
+    } else {
+      std::cerr << "plot not drawn: " << error << "\n";
+    }
+    if (!a->json.empty()) {
+      learn::WriteFileAtomically(a->json, learn::EvalJson(r).dump(2) + "\n");
+      std::cout << "json: " << a->json << "\n";
+    }
+    return 0;
+  };
+});
+
+}  // namespace
+}  // namespace clothwind::tools

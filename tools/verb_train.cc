@@ -1,0 +1,99 @@
+// clothwind train: trains the SDN or a ResNet-18 baseline of Table 1 on a dataset
+// (docs/dataset.md) with the seed's recipe; see docs/sdn.md.
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "learn/train.h"
+#include "progress_bar.h"
+#include "verb_registry.h"
+
+namespace clothwind::tools {
+namespace {
+
+struct TrainArgs {
+  learn::TrainOptions o;
+  std::string data, out;
+  int frames = 30;
+};
+
+VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
+  auto args = std::make_shared<TrainArgs>();
+  auto* sub = app.add_subcommand("train", "train the SDN or a ResNet-18 baseline (Table 1) on a dataset");
+  learn::TrainOptions& o = args->o;
+  sub->add_option("--model", o.model.arch, "sdn (spectral layer + ResNet-18) or resnet18 (frames as channels)")
+      ->check(CLI::IsMember({"sdn", "resnet18"}))
+      ->capture_default_str();
+  sub->add_option("--frames", args->frames, "input frames N_t (Table 1: 1, 10, 20 for resnet18; 20, 30 for sdn)")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  sub->add_option("--data", args->data, "dataset folder (index.json + examples)");
+  sub->add_option("--out", args->out, "run folder (model.pt/json, checkpoints, log.tsv, learning_curve.png)")
+      ->required();
+  sub->add_option("--epochs", o.epochs, "epochs (the seed: ~40)")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--batch", o.batch, "clips per batch")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--input-size", o.model.input_size, "input side [px] (224 as the seed, 112 on a CPU)")
+      ->check(CLI::Range(16, 1024))
+      ->capture_default_str();
+  sub->add_option("--width", o.model.width, "ResNet-18 base width (64 as the original)")
+      ->check(CLI::Range(1, 512))
+      ->capture_default_str();
+  sub->add_option("--k", o.model.k, "SDN: spectral peaks per pixel")->check(CLI::Range(1, 64))->capture_default_str();
+  sub->add_option("--threads", o.threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
+  sub->add_option("--device", o.device, "cpu, cuda or auto (CUDA when libtorch finds one)")
+      ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
+      ->capture_default_str();
+  sub->add_flag("--resume", o.resume, "continue the run in --out from its last epoch");
+  sub->add_flag("--init-only", o.init_only, "write an initialised (untrained) model and stop (tests, smoke runs)");
+  sub->add_option("--lr", o.lr, "initial learning rate (Adam)")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--lr-decay-epoch", o.lr_decay_epoch,
+                  "epochs at the initial rate before dividing it by 10 (-1: half the epochs, 20 of 40 as the seed)")
+      ->capture_default_str();
+  sub->add_option("--weight-decay", o.weight_decay, "Adam weight decay")->check(CLI::NonNegativeNumber)->capture_default_str();
+  sub->add_option("--grad-clip", o.grad_clip, "max gradient norm (0: off; the seed clips only its RNN baselines at 10)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  sub->add_option("--seed", o.seed, "seed of initialisation, data order and augmentation")->capture_default_str();
+  return [args]() {
+    learn::TrainOptions o = args->o;
+    o.model.frames = args->frames;
+    o.data = args->data;
+    o.out = args->out;
+    std::unique_ptr<ProgressBar> bar;
+    int bar_epoch = 0;
+    o.progress = [&](const learn::TrainProgress& p) {
+      if (p.epoch != bar_epoch) {
+        ProgressBar::Options b;
+        b.label = "train epoch " + std::to_string(p.epoch) + "/" + std::to_string(p.epochs);
+        b.unit = "batches";
+        b.rate_scale = o.batch;
+        b.rate_unit = "clips/s";
+        bar = std::make_unique<ProgressBar>(b);
+        bar_epoch = p.epoch;
+      }
+      std::ostringstream note;
+      note << "loss " << std::setprecision(4) << p.loss;
+      bar->Update(p.step, p.steps, note.str());
+    };
+    o.epoch_done = [&](const learn::EpochRecord& e) {
+      if (bar) bar->Finish();
+      std::cout << std::fixed << std::setprecision(4) << "epoch " << e.epoch << "/" << o.epochs << "  lr " << e.lr
+                << "  train loss " << e.train_loss << " rmse " << e.train_rmse << "  val loss " << e.val_loss
+                << " rmse " << e.val_rmse << " acc@0.5 " << e.val_acc05 << "  " << std::setprecision(1)
+                << e.seconds << " s" << std::endl;
+    };
+    const learn::TrainResult r = learn::Train(o);
+    if (o.init_only) {
+      std::cout << "initialised (untrained) model: " << r.model.string() << "\n";
+      return 0;
+    }
+    std::cout << "best validation RMSE " << std::setprecision(4) << r.best_val_rmse << " m/s; model "
+              << r.model.string() << " (trained on " << r.device << ")\n";
+    if (!r.plot_error.empty()) std::cerr << "learning curve not drawn: " << r.plot_error << "\n";
+    return 0;
+  };
+});
+
+}  // namespace
+}  // namespace clothwind::tools
