@@ -4,7 +4,8 @@
 //
 // "Over": the clock (sim time from rosbag play --clock) has not moved for ~idle_timeout wall
 // seconds after it started, and no clip has arrived in that time either (the clip buffer labels
-// its last waiting clips ~flush_after wall seconds after its input stops). ~max_wall bounds it.
+// its last waiting clips ~flush_after wall seconds after its input stops). ~max_wall bounds it;
+// ~start_timeout gives up when the clock never starts.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -34,6 +35,7 @@ class ClipReport {
   explicit ClipReport(ros::NodeHandle& pnh) {
     pnh.param("idle_timeout", idle_timeout_, 5.0);
     pnh.param("max_wall", max_wall_, 0.0);
+    pnh.param("start_timeout", start_timeout_, 60.0);
     pnh.param("summary", summary_path_, std::string());
     ros::NodeHandle nh;
     sub_ = nh.subscribe("clips", 50, &ClipReport::OnClip, this);
@@ -73,7 +75,12 @@ class ClipReport {
     }
     const double idle = (ros::WallTime::now() - last_change_).toSec();
     const double wall = (ros::WallTime::now() - start_wall_).toSec();
-    if ((clock_started_ && idle > idle_timeout_) || (max_wall_ > 0 && wall > max_wall_)) {
+    if (!clock_started_ && wall > start_timeout_) {
+      std::fprintf(stderr, "clip_report: the clock never started in %.0f s (is rosbag play waiting for a subscriber?)\n",
+                   start_timeout_);
+      Print(wall);
+      ros::shutdown();
+    } else if ((clock_started_ && idle > idle_timeout_) || (max_wall_ > 0 && wall > max_wall_)) {
       Print(wall);
       ros::shutdown();
     }
@@ -123,7 +130,7 @@ class ClipReport {
     }
   }
 
-  double idle_timeout_ = 5.0, max_wall_ = 0.0;
+  double idle_timeout_ = 5.0, max_wall_ = 0.0, start_timeout_ = 60.0;
   std::string summary_path_;
   ros::Subscriber sub_;
   ros::WallTimer timer_;
