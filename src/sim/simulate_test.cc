@@ -113,6 +113,30 @@ TEST(SimulateTrajectory, WindHookReceivesThetasWindAndItsFieldIsUsed) {
   EXPECT_TRUE(Identical(hooked, SimulateTrajectory(still, theta, o)));
 }
 
+TEST(SimulateTrajectory, HangingClothIsBlownDownwindAndLiftedByItsDiagonalWind) {
+  BuildOptions b;
+  b.max_edge = 0.3;
+  const SceneSetup setup = BuildScene(LoadScene(SourceDir() + "/config/scenes/cloth.json"), b);
+  SimulateOptions o;
+  o.duration = 0.4;
+  Theta theta = SceneTheta(setup);
+  theta[kWindSpeedIndex] = 4.0;  // along (1, 1, 0)/sqrt(2)
+  const Trajectory t = SimulateTrajectory(setup, theta, o);
+  const FramePositions& first = t.frames.front();
+  const FramePositions& last = t.frames.back();
+  for (int h : setup.cloths[0].options.handles) EXPECT_EQ(last.row(h), first.row(h));
+  // The cloth hangs in the y-z plane (top corners 2, 3 at z = 1); the wind's x component blows
+  // its free bottom corners (0, 1) downwind (+x) and lifts them. In still air they stay put.
+  theta[kWindSpeedIndex] = 0.0;
+  const Trajectory calm = SimulateTrajectory(setup, theta, o);
+  for (int corner : {0, 1}) {
+    const Eigen::Vector3f moved = (last.row(corner) - first.row(corner)).transpose();
+    EXPECT_GT(moved.x(), 0.1) << corner;
+    EXPECT_GT(moved.z(), 0.05) << corner;
+    EXPECT_LT((calm.frames.back().row(corner) - first.row(corner)).norm(), 0.02) << corner;
+  }
+}
+
 TEST(SimulateTrajectories, BatchMatchesSerialRunsInOrder) {
   const SceneSetup setup = SmallFlag();
   std::vector<Theta> thetas;
