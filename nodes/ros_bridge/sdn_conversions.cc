@@ -1,0 +1,71 @@
+#include "ros_bridge/sdn_conversions.h"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+#include <boost/make_shared.hpp>
+
+namespace clothwind::ros_bridge {
+
+std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg) {
+  if (msg.encoding != "mono8") {
+    throw std::invalid_argument("Clip.encoding must be \"mono8\", got \"" + msg.encoding + "\"");
+  }
+  if (msg.num_frames == 0 || msg.width == 0 || msg.height == 0) {
+    throw std::invalid_argument("Clip.num_frames, width and height must be positive (got " +
+                                std::to_string(msg.num_frames) + ", " + std::to_string(msg.width) + ", " +
+                                std::to_string(msg.height) + ")");
+  }
+  const size_t frame = static_cast<size_t>(msg.width) * msg.height;
+  const size_t expected = frame * msg.num_frames;
+  if (msg.data.size() != expected) {
+    throw std::invalid_argument("Clip.data has " + std::to_string(msg.data.size()) + " bytes, num_frames x height x width = " +
+                                std::to_string(msg.num_frames) + " x " + std::to_string(msg.height) + " x " +
+                                std::to_string(msg.width) + " = " + std::to_string(expected));
+  }
+  if (!msg.frame_stamps.empty() && msg.frame_stamps.size() != msg.num_frames) {
+    throw std::invalid_argument("Clip.frame_stamps has " + std::to_string(msg.frame_stamps.size()) +
+                                " stamps for num_frames = " + std::to_string(msg.num_frames));
+  }
+  std::vector<cv::Mat> frames;
+  frames.reserve(msg.num_frames);
+  for (uint32_t i = 0; i < msg.num_frames; ++i) {
+    frames.emplace_back(static_cast<int>(msg.height), static_cast<int>(msg.width), CV_8UC1,
+                        const_cast<uint8_t*>(msg.data.data() + i * frame));
+  }
+  return frames;
+}
+
+clothwind::WindEstimate ToWindEstimate(const clothwind::Clip& clip, const learn::Prediction& prediction,
+                                       double latency, const std::string& model) {
+  clothwind::WindEstimate e;
+  e.header.frame_id = clip.header.frame_id;
+  e.header.stamp = clip.frame_stamps.empty() ? clip.header.stamp : clip.frame_stamps.back();
+  e.clip_sequence = clip.sequence;
+  e.clip_start = clip.frame_stamps.empty() ? clip.header.stamp : clip.frame_stamps.front();
+  e.clip_end = e.header.stamp;
+  e.speed = prediction.speed;
+  e.speed_std = prediction.speed_std;
+  e.reference_speed = clip.wind_count > 0 ? clip.wind_mean : std::numeric_limits<double>::quiet_NaN();
+  e.latency = latency;
+  e.model = model;
+  return e;
+}
+
+sensor_msgs::ImagePtr BgrImageMsg(const cv::Mat& bgr, const std_msgs::Header& header) {
+  if (bgr.type() != CV_8UC3) throw std::invalid_argument("BgrImageMsg: expected a CV_8UC3 image");
+  auto msg = boost::make_shared<sensor_msgs::Image>();
+  msg->header = header;
+  msg->height = bgr.rows;
+  msg->width = bgr.cols;
+  msg->encoding = "bgr8";
+  msg->is_bigendian = 0;
+  msg->step = bgr.cols * 3;
+  msg->data.resize(static_cast<size_t>(msg->step) * bgr.rows);
+  for (int r = 0; r < bgr.rows; ++r) std::memcpy(&msg->data[r * msg->step], bgr.ptr(r), msg->step);
+  return msg;
+}
+
+}  // namespace clothwind::ros_bridge

@@ -1,0 +1,176 @@
+// sdn_node: estimates the wind speed of every clip (clothwind/Clip on `clips`) with a trained
+// wind network (SDN or baseline, src/learn/) and publishes
+//   wind/estimate   clothwind/WindEstimate (speed, its std, clip stamps, anemometer reference,
+//                   latency, model name)
+//   sdn/power       bgr8 Image: log power of each pixel's strongest spectral peak (inferno),
+//   sdn/frequency   bgr8 Image: its frequency, 0 .. Nyquist (jet); both for rviz, computed only
+//                   while someone subscribes, SDN models only.
+// Parameters: ~model (model.pt of a training run; model.json beside it), ~threads (2),
+// ~device (cpu | cuda | auto), ~queue_size (2 clips; older ones are dropped when the node lags).
+// Diagnostics: model, device, latency and rate; a malformed clip is an ERROR, not a crash. A
+// model that cannot be loaded is retried every 2 s (ERROR until it loads).
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <memory>
+#include <string>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <image_transport/image_transport.h>
+#include <opencv2/imgproc.hpp>
+#include <ros/ros.h>
+
+#include <clothwind/Clip.h>
+#include <clothwind/WindEstimate.h>
+
+#include "learn/predictor.h"
+#include "ros_bridge/sdn_conversions.h"
+
+namespace {
+
+class SdnNode {
+ public:
+  SdnNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : transport_(nh) {
+    pnh.param("model", model_path_, std::string());
+    pnh.param("threads", threads_, 2);
+    pnh.param("device", device_, std::string("cpu"));
+    int queue_size = 2;
+    pnh.param("queue_size", queue_size, 2);
+    estimate_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate", 10);
+    power_pub_ = transport_.advertise("sdn/power", 1);
+    frequency_pub_ = transport_.advertise("sdn/frequency", 1);
+    updater_.setHardwareID("sdn:" + model_path_);
+    updater_.add("sdn", this, &SdnNode::Diagnose);
+    diag_timer_ = nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { updater_.update(); });
+    TryLoad();
+    if (!predictor_) {
+      load_timer_ = nh.createWallTimer(ros::WallDuration(2.0), [this](const ros::WallTimerEvent&) {
+        if (!predictor_) TryLoad();
+      });
+    }
+    clip_sub_ = nh.subscribe("clips", queue_size, &SdnNode::OnClip, this);
+  }
+
+ private:
+  void TryLoad() {
+    try {
+      if (model_path_.empty()) throw std::runtime_error("parameter ~model is not set");
+      auto predictor = std::make_unique<clothwind::learn::Predictor>(model_path_, threads_, device_);
+      // Warm-up: the first forward pass allocates and picks kernels; keep that out of the
+      // first clip's latency.
+      const auto& c = predictor->config();
+      std::vector<cv::Mat> frames;
+      for (int i = 0; i < c.frames; ++i) frames.emplace_back(c.input_size, c.input_size, CV_8UC1, cv::Scalar(i % 7));
+      const auto t0 = std::chrono::steady_clock::now();
+      predictor->PredictFrames(frames);
+      const double warm = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      model_name_ = c.Name() + " (" + model_path_ + ")";
+      ROS_INFO("sdn_node: model %s on %s, %d threads, warm-up %.0f ms", model_name_.c_str(),
+               predictor->device().c_str(), threads_, 1e3 * warm);
+      predictor_ = std::move(predictor);
+      load_error_.clear();
+    } catch (const std::exception& e) {
+      if (load_error_ != e.what()) ROS_ERROR("sdn_node: cannot load the model: %s (retrying)", e.what());
+      load_error_ = e.what();
+    }
+    updater_.force_update();
+  }
+
+  void OnClip(const clothwind::Clip::ConstPtr& clip) {
+    const auto received = std::chrono::steady_clock::now();
+    if (!predictor_) {
+      ++dropped_;
+      return;
+    }
+    try {
+      const std::vector<cv::Mat> frames = clothwind::ros_bridge::ClipFrames(*clip);
+      const bool want_maps = power_pub_.getNumSubscribers() > 0 || frequency_pub_.getNumSubscribers() > 0;
+      clothwind::learn::PeakMaps maps;
+      const clothwind::learn::Prediction p = predictor_->PredictFrames(frames, want_maps ? &maps : nullptr);
+      const double latency = std::chrono::duration<double>(std::chrono::steady_clock::now() - received).count();
+      estimate_pub_.publish(clothwind::ros_bridge::ToWindEstimate(*clip, p, latency, model_name_));
+      if (want_maps && !maps.power.empty()) PublishMaps(*clip, maps);
+      ++estimates_;
+      latencies_.push_back(latency);
+      if (latencies_.size() > 50) latencies_.pop_front();
+      stamps_.push_back(ros::WallTime::now().toSec());
+      while (stamps_.size() > 1 && stamps_.back() - stamps_.front() > 30.0) stamps_.pop_front();
+    } catch (const std::exception& e) {
+      ++errors_;
+      last_error_ = "clip " + std::to_string(clip->sequence) + ": " + e.what();
+      error_pending_ = true;
+      ROS_ERROR_THROTTLE(5.0, "sdn_node: %s", last_error_.c_str());
+      updater_.force_update();
+    }
+  }
+
+  void PublishMaps(const clothwind::Clip& clip, const clothwind::learn::PeakMaps& maps) {
+    std_msgs::Header header = clip.header;
+    header.stamp = clip.frame_stamps.empty() ? clip.header.stamp : clip.frame_stamps.back();
+    if (power_pub_.getNumSubscribers() > 0) {
+      cv::Mat log_power;
+      cv::log(maps.power + 1.0f, log_power);
+      double max = 0;
+      cv::minMaxLoc(log_power, nullptr, &max);
+      power_pub_.publish(clothwind::ros_bridge::BgrImageMsg(
+          clothwind::learn::ColourMapped(log_power, 0, max > 0 ? max : 1, cv::COLORMAP_INFERNO), header));
+    }
+    if (frequency_pub_.getNumSubscribers() > 0) {
+      frequency_pub_.publish(clothwind::ros_bridge::BgrImageMsg(
+          clothwind::learn::ColourMapped(maps.frequency, 0, predictor_->config().frame_rate / 2, cv::COLORMAP_JET),
+          header));
+    }
+  }
+
+  void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    double mean = 0, max = 0;
+    for (double l : latencies_) {
+      mean += l;
+      max = std::max(max, l);
+    }
+    if (!latencies_.empty()) mean /= latencies_.size();
+    const double rate =
+        stamps_.size() > 1 ? (stamps_.size() - 1) / std::max(stamps_.back() - stamps_.front(), 1e-9) : 0.0;
+    if (!predictor_) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no model: " + load_error_);
+    } else if (error_pending_) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "malformed clip: " + last_error_);
+    } else {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "estimating");
+    }
+    error_pending_ = false;
+    stat.add("model", model_name_.empty() ? model_path_ : model_name_);
+    stat.add("device", predictor_ ? predictor_->device() : std::string("-"));
+    stat.add("threads", threads_);
+    stat.add("latency mean [s]", mean);
+    stat.add("latency max [s]", max);
+    stat.add("rate [clips/s]", rate);
+    stat.add("estimates", estimates_);
+    stat.add("malformed clips", errors_);
+    stat.add("clips dropped (no model)", dropped_);
+    stat.add("last error", last_error_);
+  }
+
+  image_transport::ImageTransport transport_;
+  ros::Publisher estimate_pub_;
+  image_transport::Publisher power_pub_, frequency_pub_;
+  ros::Subscriber clip_sub_;
+  diagnostic_updater::Updater updater_;
+  ros::WallTimer diag_timer_, load_timer_;
+  std::string model_path_, device_, model_name_, load_error_, last_error_;
+  int threads_ = 2;
+  std::unique_ptr<clothwind::learn::Predictor> predictor_;
+  std::deque<double> latencies_, stamps_;
+  uint64_t estimates_ = 0, errors_ = 0, dropped_ = 0;
+  bool error_pending_ = false;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "sdn_node");
+  ros::NodeHandle nh, pnh("~");
+  SdnNode node(nh, pnh);
+  ros::spin();
+  return 0;
+}

@@ -1,0 +1,148 @@
+#!/usr/bin/env python3
+"""rostest for sdn_node: publishes synthetic clips (one malformed) and checks the estimates,
+the diagnostics and the spectral images."""
+import math
+import sys
+import threading
+import unittest
+
+import rospy
+import rostest
+from clothwind.msg import Clip, WindEstimate
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from sensor_msgs.msg import Image
+
+
+def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0):
+    clip = Clip()
+    clip.header.frame_id = "camera_optical"
+    clip.header.stamp = start
+    clip.sequence = seq
+    clip.frame_stamps = [start + rospy.Duration.from_sec(i / rate) for i in range(count)]
+    clip.frame_rate = rate
+    clip.num_frames = count
+    clip.height = size
+    clip.width = size
+    clip.encoding = "mono8"
+    # Vertical stripes travelling at `frequency` Hz, brightness 40..220.
+    data = bytearray(count * size * size)
+    wavelength = size / 6.0
+    for t in range(count):
+        row = bytes(
+            int(130 + 90 * math.sin(2 * math.pi * (frequency * t / rate - x / wavelength))) for x in range(size))
+        base = t * size * size
+        for y in range(size):
+            data[base + y * size: base + (y + 1) * size] = row
+    clip.data = bytes(data)
+    clip.source_width = size
+    clip.source_height = size
+    clip.label_window = 60.0
+    clip.wind_mean = wind_mean
+    clip.wind_std = 0.3
+    clip.wind_count = 60 if not math.isnan(wind_mean) else 0
+    clip.wind_direction_mean = 0.0
+    return clip
+
+
+class SdnNodeTest(unittest.TestCase):
+    def setUp(self):
+        self.lock = threading.Lock()
+        self.estimates = []
+        self.statuses = []
+        self.power = []
+        self.frequency = []
+        rospy.Subscriber("wind/estimate", WindEstimate, self.on_estimate, queue_size=100)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics, queue_size=100)
+        rospy.Subscriber("sdn/power", Image, lambda m: self.append(self.power, m), queue_size=10)
+        rospy.Subscriber("sdn/frequency", Image, lambda m: self.append(self.frequency, m), queue_size=10)
+        self.pub = rospy.Publisher("clips", Clip, queue_size=100)
+
+    def append(self, where, msg):
+        with self.lock:
+            where.append(msg)
+
+    def on_estimate(self, msg):
+        self.append(self.estimates, msg)
+
+    def on_diagnostics(self, msg):
+        with self.lock:
+            for s in msg.status:
+                if "sdn" in s.name:
+                    self.statuses.append(s)
+
+    def wait_for(self, predicate, timeout, what):
+        deadline = rospy.get_time() + timeout
+        while not rospy.is_shutdown() and rospy.get_time() < deadline:
+            with self.lock:
+                if predicate():
+                    return
+            rospy.sleep(0.1)
+        self.fail("timed out waiting for " + what)
+
+    def test_estimates(self):
+        n = rospy.get_param("~clips", 6)
+        malformed_after = rospy.get_param("~malformed_after", 2)
+        size = rospy.get_param("~size", 300)
+        frequency = rospy.get_param("~stripe_frequency", 5.0)
+        # The node subscribes once its model is loaded and warmed up (it is made first).
+        self.wait_for(lambda: self.pub.get_num_connections() > 0, 120, "sdn_node to subscribe to clips")
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.statuses), 60,
+                      "an OK diagnostic (model loaded)")
+        # Wait until the node sees our image subscribers, so it computes the maps.
+        rospy.sleep(1.0)
+        start = rospy.Time(1700000000, 0)
+        sent = []
+        for i in range(n):
+            if i == malformed_after:
+                bad = make_clip(1000, start, 16, frequency, 4.0)
+                bad.data = bad.data[:-5]  # wrong data length
+                self.pub.publish(bad)
+            wind = float("nan") if i == 1 else 2.0 + i
+            clip = make_clip(i, start + rospy.Duration.from_sec(2.0 * i), size, frequency, wind)
+            sent.append(clip)
+            self.pub.publish(clip)
+        self.wait_for(lambda: len(self.estimates) >= n, 90, "%d estimates" % n)
+        rospy.sleep(1.0)
+        with self.lock:
+            estimates = list(self.estimates)
+        self.assertEqual(len(estimates), n, "one estimate per good clip, none for the malformed one")
+        by_seq = {e.clip_sequence: e for e in estimates}
+        self.assertEqual(sorted(by_seq), list(range(n)))
+        for clip in sent:
+            e = by_seq[clip.sequence]
+            self.assertEqual(e.header.stamp, clip.frame_stamps[-1])
+            self.assertEqual(e.clip_start, clip.frame_stamps[0])
+            self.assertEqual(e.clip_end, clip.frame_stamps[-1])
+            self.assertEqual(e.header.frame_id, "camera_optical")
+            if math.isnan(clip.wind_mean):
+                self.assertTrue(math.isnan(e.reference_speed))
+            else:
+                self.assertAlmostEqual(e.reference_speed, clip.wind_mean, places=9)
+            self.assertTrue(math.isfinite(e.speed))
+            self.assertTrue(math.isfinite(e.speed_std) and e.speed_std > 0)
+            self.assertTrue(0 < e.latency < 30, e.latency)
+            self.assertIn("sdn-k3", e.model)
+        # The malformed clip raised an ERROR naming the field, and the node carried on.
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.ERROR and "data" in s.message for s in self.statuses),
+                      10, "an ERROR diagnostic for the malformed clip")
+        # Spectral images: colour-mapped at the model's input size, stamped like the estimates.
+        self.wait_for(lambda: len(self.power) > 0 and len(self.frequency) > 0, 10, "sdn/power and sdn/frequency")
+        with self.lock:
+            freq_img = self.frequency[-1]
+            power_img = self.power[-1]
+        self.assertEqual(freq_img.encoding, "bgr8")
+        self.assertEqual((freq_img.width, freq_img.height), (64, 64))
+        self.assertIn(freq_img.header.stamp, [c.frame_stamps[-1] for c in sent])
+        self.assertEqual(power_img.encoding, "bgr8")
+        # Every pixel oscillates at the same frequency: the frequency image is one colour.
+        pixels = set(bytes(freq_img.data[i:i + 3]) for i in range(0, len(freq_img.data), 3))
+        self.assertEqual(len(pixels), 1, "uniform stripe frequency gives a uniform frequency map")
+        status = [s for s in self.statuses][-1]
+        keys = {kv.key: kv.value for kv in status.values}
+        self.assertIn("latency mean [s]", keys)
+        self.assertIn("rate [clips/s]", keys)
+
+
+if __name__ == "__main__":
+    rospy.init_node("sdn_check")
+    rostest.rosrun("clothwind", "sdn_node_estimates", SdnNodeTest, sys.argv)
