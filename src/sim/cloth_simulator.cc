@@ -1,6 +1,7 @@
 #include "sim/cloth_simulator.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -27,6 +28,7 @@ struct Hinge {
   double rest_length;
   double rest_area_sum;
   Eigen::Vector2d du;  // material-space edge direction (picks the bending table row)
+  std::array<double, 5> bending_row;  // the table interpolated for du
   int block[16] = {};  // block index of (v[i], v[j]) in the system matrix
 };
 
@@ -155,6 +157,7 @@ void ClothSimulator::Impl::Build() {
     h.du = (mesh.U.row(b2) - mesh.U.row(a)).transpose();
     h.rest_length = h.du.norm();
     h.rest_area_sum = faces[fo.first].rest.area + faces[other->second.first].rest.area;
+    h.bending_row = material.BendingRow(h.du);
     hinges.push_back(h);
   }
 
@@ -246,7 +249,7 @@ void ClothSimulator::Impl::ComputeForces(bool with_jacobian, bool with_repulsion
     for (int c = 0; c < 4; ++c) xh.segment<3>(3 * c) = xv(h.v[c]);
     const double theta = DihedralAngle(xh, &dtheta);
     const double curvature = std::abs(theta) * h.rest_length / h.rest_area_sum;
-    const double ke = material.BendingStiffness(curvature, h.du);
+    const double ke = Material::BendingStiffnessFromRow(curvature, h.bending_row);
     const double c_half = 0.5 * ke * h.rest_length * h.rest_length / (2 * h.rest_area_sum);
     for (int c = 0; c < 4; ++c) f.segment<3>(3 * h.v[c]) -= c_half * theta * dtheta.segment<3>(3 * c);
     if (with_jacobian && options.implicit_bending)
@@ -391,7 +394,7 @@ ClothEnergy ClothSimulator::Impl::Energy() const {
     Vector12d xh;
     for (int c = 0; c < 4; ++c) xh.segment<3>(3 * c) = x.row(h.v[c]).transpose();
     const double theta = DihedralAngle(xh);
-    const double ke = material.BendingStiffness(std::abs(theta) * h.rest_length / h.rest_area_sum, h.du);
+    const double ke = Material::BendingStiffnessFromRow(std::abs(theta) * h.rest_length / h.rest_area_sum, h.bending_row);
     e.bending += 0.25 * ke * h.rest_length * h.rest_length / (2 * h.rest_area_sum) * theta * theta;
   }
   e.repulsion = repulsion_energy;

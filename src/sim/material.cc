@@ -91,13 +91,7 @@ Eigen::Vector4d Material::StretchingStiffness(const Eigen::Matrix2d& G) const {
   return k;
 }
 
-double Material::BendingStiffness(double curvature, const Eigen::Vector2d& du) const {
-  // Curvature samples every 10 1/m (ArcSim: value = curv/2 * 0.2, clamped to [0, 4]). ArcSim
-  // passes a signed curvature and so extrapolates below the first sample for negative dihedrals,
-  // which depends on the arbitrary edge orientation; the measured tables are for a magnitude.
-  double value = std::min(std::abs(curvature) * 0.1, 4.0);
-  int value_i = std::clamp(static_cast<int>(value), 0, 3);
-  value -= value_i;
+std::array<double, 5> Material::BendingRow(const Eigen::Vector2d& du) const {
   // Edge direction in material space folded to [0, 2] (0, 45, 90 degrees), ArcSim's bias_angle.
   double bias = std::atan2(du.y(), du.x()) * 4.0 / M_PI;
   if (bias < 0) bias = -bias;
@@ -105,11 +99,24 @@ double Material::BendingStiffness(double curvature, const Eigen::Vector2d& du) c
   if (bias > 2) bias = 4 - bias;
   const int bias_id = std::clamp(static_cast<int>(bias), 0, 1);
   bias -= bias_id;
-  const double ke = bending[bias_id][value_i] * (1 - bias) * (1 - value) +
-                    bending[bias_id + 1][value_i] * bias * (1 - value) +
-                    bending[bias_id][value_i + 1] * (1 - bias) * value +
-                    bending[bias_id + 1][value_i + 1] * bias * value;
-  return std::max(ke, 0.0);
+  std::array<double, 5> row;
+  for (int j = 0; j < 5; ++j) row[j] = bending[bias_id][j] * (1 - bias) + bending[bias_id + 1][j] * bias;
+  return row;
+}
+
+double Material::BendingStiffnessFromRow(double curvature, const std::array<double, 5>& row) {
+  // Curvature samples every 10 1/m (ArcSim: value = curv/2 * 0.2, clamped to [0, 4]). ArcSim
+  // passes a signed curvature and so extrapolates below the first sample for negative dihedrals,
+  // which depends on the arbitrary edge orientation; the measured tables are for a magnitude.
+  double value = std::min(std::abs(curvature) * 0.1, 4.0);
+  const int value_i = std::clamp(static_cast<int>(value), 0, 3);
+  value -= value_i;
+  return std::max(row[value_i] * (1 - value) + row[value_i + 1] * value, 0.0);
+}
+
+double Material::BendingStiffness(double curvature, const Eigen::Vector2d& du) const {
+  // Bilinear in (direction, curvature), evaluated direction first (the simulator caches the row).
+  return BendingStiffnessFromRow(curvature, BendingRow(du));
 }
 
 Material MakeMaterial(double density, const Eigen::Matrix<double, 6, 4>& stretching,

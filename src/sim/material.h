@@ -46,6 +46,12 @@ struct Material {
   // Bending stiffness [N m] for a hinge whose edge has material-space direction du (2-vector,
   // any length > 0) and ArcSim curvature `curvature` = |theta| l / (A0 + A1) [1/m].
   double BendingStiffness(double curvature, const Eigen::Vector2d& du) const;
+
+  // The bending table interpolated for hinge direction du (5 curvature samples) [N m]; with
+  // BendingStiffnessFromRow this is BendingStiffness split in two, so the simulator computes the
+  // direction part once per hinge.
+  std::array<double, 5> BendingRow(const Eigen::Vector2d& du) const;
+  static double BendingStiffnessFromRow(double curvature, const std::array<double, 5>& row);
 };
 
 // Builds a material from the raw tables (as in ArcSim's JSON files) and multipliers.
