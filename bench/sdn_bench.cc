@@ -1,0 +1,105 @@
+// Wind network inference latency per clip as sdn_node sees it: 30 frames of 300x300 mono8 in,
+// crop/resize/normalise + forward pass, for the SDN and the frame-stack baseline at several
+// widths and input sizes, on 1 and 2 threads (the goal: <= 50 ms per 30-frame clip on 2 cores
+// at the shipped size). Models are initialised in a temporary folder (speed does not depend on
+// the weights). Prints a table.
+//
+//   sdn_bench [--repeats N] [--quick]
+#include <time.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "learn/predictor.h"
+#include "learn/train.h"
+
+namespace cl = clothwind::learn;
+namespace fs = std::filesystem;
+
+namespace {
+
+double CpuMs() {
+  timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+double NowMs() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+struct Case {
+  std::string arch;
+  int width, input_size, frames;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int repeats = 20;
+  bool quick = false;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--quick")) quick = true;
+    else {
+      std::fprintf(stderr, "usage: sdn_bench [--repeats N] [--quick]\n");
+      return 2;
+    }
+  }
+  std::vector<Case> cases = {{"sdn", 16, 112, 30}, {"sdn", 32, 112, 30}, {"sdn", 64, 112, 30},
+                             {"resnet18", 64, 112, 30}, {"sdn", 64, 224, 30}};
+  if (quick) cases = {{"sdn", 16, 112, 30}, {"sdn", 64, 112, 30}};
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_sdn_bench_" + std::to_string(::getpid()));
+  // A clip as the node receives it: 30 frames 300x300 of moving stripes.
+  std::vector<cv::Mat> frames;
+  for (int t = 0; t < 30; ++t) {
+    cv::Mat f(300, 300, CV_8UC1);
+    for (int y = 0; y < 300; ++y)
+      for (int x = 0; x < 300; ++x) f.at<uint8_t>(y, x) = static_cast<uint8_t>(128 + 100 * std::sin(0.05 * x + 0.9 * t));
+    frames.push_back(f);
+  }
+  std::printf("%-28s %7s %10s %10s %10s %14s\n", "model", "threads", "mean [ms]", "p90 [ms]",
+              "min [ms]", "cpu/clip [ms]");
+  for (const Case& c : cases) {
+    cl::TrainOptions o;
+    o.model.arch = c.arch;
+    o.model.width = c.width;
+    o.model.input_size = c.input_size;
+    o.model.frames = c.frames;
+    o.out = dir / (c.arch + std::to_string(c.width) + "_" + std::to_string(c.input_size));
+    o.init_only = true;
+    o.threads = 1;
+    const cl::TrainResult r = cl::Train(o);
+    for (int threads : {1, 2}) {
+      cl::Predictor p(r.model, threads, "cpu");
+      p.PredictFrames(frames);  // warm-up, as the node does
+      std::vector<double> ms;
+      const double cpu0 = CpuMs();
+      for (int i = 0; i < repeats; ++i) {
+        const double t0 = NowMs();
+        p.PredictFrames(frames);
+        ms.push_back(NowMs() - t0);
+      }
+      const double cpu = (CpuMs() - cpu0) / repeats;
+      std::sort(ms.begin(), ms.end());
+      double mean = 0;
+      for (double m : ms) mean += m;
+      mean /= ms.size();
+      std::printf("%-28s %7d %10.1f %10.1f %10.1f %14.1f\n", p.config().Name().c_str(), threads, mean,
+                  ms[std::min(ms.size() - 1, ms.size() * 9 / 10)], ms.front(), cpu);
+      std::fflush(stdout);
+    }
+  }
+  fs::remove_all(dir);
+  return 0;
+}
