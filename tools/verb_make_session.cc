@@ -1,6 +1,9 @@
 // clothwind make-session: a synthetic recorded field session as a rosbag, with the topics and
 // messages the live camera_node and anemometer_node publish, so replay.launch treats it exactly as
 // a real recording (header stamps = capture/arrival times; bag times = header stamps).
+// --frames procedural (default, fast: an OpenCV-drawn flag) or rendered (the flag simulated in the
+// session's wind and rendered by render/, with the anemometer's sentences from its sensor model
+// sampling the same wind field: data/rendered_flag_generator.h).
 #include <unistd.h>
 
 #include <cmath>
@@ -17,6 +20,8 @@
 
 #include <clothwind/RawSentence.h>
 
+#include "data/rendered_flag_generator.h"
+#include "progress_bar.h"
 #include "sensors/synthetic_session.h"
 #include "verb_registry.h"
 
@@ -37,6 +42,9 @@ struct MakeSessionArgs {
   std::string camera_frame = "camera_optical_frame";
   std::string anemometer_frame = "anemometer";
   std::string preview;
+  std::string frames = "procedural";  // procedural | rendered
+  data::RenderedSessionOptions rendered;
+  int64_t zeta_seed = -1;  // -1: the session's seed
 };
 
 // A pinhole camera_info for the synthetic camera: ~60 degree horizontal field of view, no distortion.
@@ -65,7 +73,28 @@ int Run(const MakeSessionArgs& a) {
   o.wind_base = a.wind_mean;
   o.drop_probability = a.drop_probability;
   o.start_time = a.start_time;
-  const sensors::SyntheticSession session(o);
+  std::shared_ptr<const data::RenderedFlagGenerator> rendered;
+  if (a.frames == "rendered") {
+    data::RenderedSessionOptions ro = a.rendered;
+    ro.zeta_seed = a.zeta_seed >= 0 ? static_cast<uint64_t>(a.zeta_seed) : a.seed;
+    rendered = std::make_shared<data::RenderedFlagGenerator>(o, ro);
+  } else if (a.frames != "procedural") {
+    throw std::invalid_argument("--frames: expected procedural or rendered, got '" + a.frames + "'");
+  }
+  const sensors::SyntheticSession session(o, rendered);
+  // Rendered sessions: the anemometer's sensor model samples the wind field the flag flew in.
+  const std::vector<sensors::SyntheticReading> model_readings =
+      rendered ? rendered->AnemometerReadings() : std::vector<sensors::SyntheticReading>{};
+  std::unique_ptr<ProgressBar> bar;
+  if (rendered) {
+    ProgressBar::Options bo;
+    bo.label = "make-session";
+    bo.unit = "frames";
+    bo.rate_unit = "frames/s";
+    bar = std::make_unique<ProgressBar>(bo);
+    std::fprintf(stderr, "make-session: rendering %zu frames of a simulated flag (%d vertices), %dx%d\n",
+                 session.frame_stamps().size(), rendered->num_vertices(), a.width, a.height);
+  }
 
   namespace fs = std::filesystem;
   const fs::path out(a.out);
@@ -81,7 +110,7 @@ int Run(const MakeSessionArgs& a) {
   sensor_msgs::CameraInfo info = MakeCameraInfo(a.width, a.height);
   info.header.frame_id = a.camera_frame;
   const auto& stamps = session.frame_stamps();
-  const auto& readings = session.readings();
+  const auto& readings = rendered ? model_readings : session.readings();
   size_t fi = 0, ri = 0;
   double speed_sum = 0.0;
   try {
@@ -107,6 +136,7 @@ int Run(const MakeSessionArgs& a) {
         info.header.stamp = t;
         bag.write("camera/camera_info", t, info);
         ++fi;
+        if (bar) bar->Update(static_cast<int64_t>(fi), static_cast<int64_t>(stamps.size()));
       } else {
         const auto& r = readings[ri];
         const ros::Time t(r.stamp);
@@ -128,9 +158,10 @@ int Run(const MakeSessionArgs& a) {
     fs::remove(tmp);
     throw;
   }
-  std::printf("make-session: %s: %.1f s, %zu frames %dx%d bgr8 at %.1f fps, %zu MWV sentences at 1 Hz "
+  if (bar) bar->Finish();
+  std::printf("make-session: %s: %s frames, %.1f s, %zu frames %dx%d bgr8 at %.1f fps, %zu MWV sentences at 1 Hz "
               "(mean %.2f m/s), seed %llu, %.1f MB\n",
-              a.out.c_str(), o.duration, stamps.size(), a.width, a.height, a.fps, readings.size(),
+              a.out.c_str(), a.frames.c_str(), o.duration, stamps.size(), a.width, a.height, a.fps, readings.size(),
               readings.empty() ? NAN : speed_sum / readings.size(), static_cast<unsigned long long>(a.seed),
               fs::file_size(out) / 1e6);
   return 0;
@@ -154,6 +185,19 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
   sub->add_option("--camera-frame", args->camera_frame, "camera frame_id")->capture_default_str();
   sub->add_option("--anemometer-frame", args->anemometer_frame, "anemometer frame_id")->capture_default_str();
   sub->add_option("--preview", args->preview, "also write the first frame to this image file");
+  sub->add_option("--frames", args->frames,
+                  "procedural (fast drawing) or rendered (simulated flag + anemometer sensor model)")
+      ->check(CLI::IsMember({"procedural", "rendered"}))->capture_default_str();
+  sub->add_option("--render-samples", args->rendered.samples, "rendered: anti-aliasing samples per pixel")
+      ->capture_default_str();
+  sub->add_option("--max-edge", args->rendered.max_edge, "rendered: flag mesh resolution [m] (0: the scene's)")
+      ->capture_default_str();
+  sub->add_option("--warmup", args->rendered.warmup, "rendered: flag simulated before the session starts [s]")
+      ->capture_default_str();
+  sub->add_option("--zeta-seed", args->zeta_seed,
+                  "rendered: seed of sun, sky, backdrop and flag design (default: --seed)");
+  sub->add_option("--camera-distance", args->rendered.camera_radius, "rendered: camera's distance to the flag [m]")
+      ->capture_default_str();
   return [args] { return Run(*args); };
 }};
 

@@ -41,7 +41,9 @@ struct DatasetOptions {
   double warmup = 5.0;         // [s] simulated before the first kept frame
   int frames = 60;             // frames per example
   double fps = 25.0;           // must equal 1 / the scene's frame_time
-  int samples = 0;             // anti-aliasing samples per pixel; 0 = ζ's default
+  // Anti-aliasing samples per pixel (0: ζ's default, 4). 2 looks the same at 300x300 after JPEG and
+  // renders a 60-frame clip in ~0.6 s on one core instead of ~1 s (docs/datasets.md).
+  int samples = 2;
   int size = 300;              // frame width = height [px]
   std::string frame_ext = "jpg";  // "jpg" | "png"
   int jpeg_quality = 95;
