@@ -4,6 +4,7 @@
 // so speed and fidelity are read together.
 //
 //   sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--winds 1,3,6,10]
+//             [--frame-steps N] [--cg-tolerance T]
 // Default scene: $CLOTHWIND_SHARED_DIR/arcsim/conf/flag.json (ArcSim's own, so the comparison is
 // like for like), else config/scenes/flag.json under $CLOTHWIND_SOURCE_DIR or the working dir.
 #include <time.h>
@@ -55,6 +56,7 @@ double ThreadCpuSeconds() {
 int main(int argc, char** argv) {
   std::string scene_path = DefaultScene();
   double duration = 4.0, max_edge = 0.0, cg_tolerance = 0.0;
+  BuildOptions build;
   std::vector<double> winds = {1, 3, 6, 10};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -71,6 +73,8 @@ int main(int argc, char** argv) {
       duration = std::stod(next());
     } else if (a == "--max-edge") {
       max_edge = std::stod(next());
+    } else if (a == "--frame-steps") {
+      build.frame_steps = std::stoi(next());
     } else if (a == "--cg-tolerance") {
       cg_tolerance = std::stod(next());
     } else if (a == "--winds") {
@@ -80,11 +84,10 @@ int main(int argc, char** argv) {
       while (std::getline(ss, item, ',')) winds.push_back(std::stod(item));
     } else {
       std::fprintf(stderr,
-                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--winds 1,3,6,10] [--cg-tolerance T]\n");
+                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T]\n");
       return 2;
     }
   }
-  BuildOptions build;
   build.max_edge = max_edge;
   SceneSetup setup = BuildScene(LoadScene(scene_path), build);
   if (cg_tolerance > 0) {

@@ -34,6 +34,7 @@ struct SimulateArgs {
   std::string turbulence;  // "I,L"
   int64_t seed = -1;
   double max_edge = 0;
+  int frame_steps = 0;
   std::vector<std::string> params;  // "name=value"
   bool no_obj = false;
 };
@@ -69,6 +70,7 @@ int Run(const SimulateArgs& a) {
   const sim::Scene scene = sim::LoadScene(a.scene);
   sim::BuildOptions build;
   build.max_edge = a.max_edge;
+  build.frame_steps = a.frame_steps;
   sim::SceneSetup setup = sim::BuildScene(scene, build);
   if (!a.wind.empty()) {
     const auto v = ParseList(a.wind, 3, "--wind");
@@ -167,6 +169,9 @@ const VerbRegistrar kRegistrar{"simulate", [](CLI::App& app) -> std::function<in
   sub->add_option("--seed", args->seed, "seed of the wind's turbulence and gusts");
   sub->add_option("--max-edge", args->max_edge,
                   "refine to this edge length [m] (default: half the upper end of the scene's remeshing size range)");
+  sub->add_option("--frame-steps", args->frame_steps,
+                  "time steps per frame (default: the scene's; fewer is faster but damps flapping)")
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--param", args->params, "set a theta entry, NAME=VALUE (repeatable; e.g. area_weight=0.3)");
   sub->add_flag("--no-obj", args->no_obj, "skip the per-frame OBJ files");
   return [args] { return Run(*args); };

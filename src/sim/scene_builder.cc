@@ -22,8 +22,10 @@ Eigen::MatrixX3d ApplyTransform(const SceneTransform& t, const Eigen::MatrixX3d&
 }
 
 SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
+  if (options.frame_steps < 0) throw std::invalid_argument("BuildOptions.frame_steps must be >= 0");
   SceneSetup setup;
   setup.scene = scene;
+  if (options.frame_steps > 0) setup.scene.frame_steps = options.frame_steps;
   setup.wind = scene.wind;
   auto fail = [&](const std::string& key, const std::string& what) {
     throw std::runtime_error(scene.path + ": " + key + ": " + what);
@@ -71,7 +73,7 @@ SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
     }
 
     SimOptions& o = cloth.options;
-    o.dt = scene.time_step();
+    o.dt = setup.scene.time_step();
     o.gravity = scene.gravity;
     o.wind_density = scene.wind.density;
     o.wind_drag = scene.wind.drag;

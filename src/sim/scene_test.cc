@@ -148,6 +148,12 @@ TEST(LoadScene, ReadsOurFlagAndClothScenes) {
   EXPECT_NEAR(f.cloths[0].material.density, 2 * 0.135, 1e-12);  // Listing 3 x thicken 2
   EXPECT_NEAR(SurfaceArea(f.cloths[0].mesh), 6.0, 1e-9);
   EXPECT_LT((f.cloths[0].mesh.V.row(3) - Eigen::RowVector3d(0, 0, 2)).norm(), 1e-9);
+  BuildOptions two_steps;
+  two_steps.frame_steps = 2;
+  const SceneSetup f2 = BuildScene(flag, two_steps);
+  EXPECT_EQ(f2.scene.frame_steps, 2);
+  EXPECT_DOUBLE_EQ(f2.cloths[0].options.dt, 0.02);
+  EXPECT_DOUBLE_EQ(f.cloths[0].options.dt, 0.005);
   const SceneSetup c = BuildScene(cloth, BuildOptions{0.25});
   EXPECT_NEAR(SurfaceArea(c.cloths[0].mesh), 1.0, 1e-9);
   EXPECT_LE(MaxEdgeLength(c.cloths[0].mesh), 0.25 + 1e-9);
