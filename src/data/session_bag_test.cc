@@ -1,0 +1,127 @@
+// `clothwind make-session` writes what the live nodes publish: topics, types, rates and stamps,
+// for the rendered flag (simulated + rendered, anemometer sensor model) and the procedural one.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+
+#include <clothwind/RawSentence.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BagContents {
+  std::map<std::string, std::string> types;  // topic -> datatype
+  std::vector<double> image_stamps, info_stamps, wind_stamps;
+  std::vector<std::string> sentences;
+  std::vector<sensor_msgs::Image> images;
+  bool stamps_match_bag_time = true;
+};
+
+BagContents ReadBag(const std::string& path) {
+  BagContents c;
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  rosbag::View view(bag);
+  for (const rosbag::MessageInstance& m : view) {
+    c.types[m.getTopic()] = m.getDataType();
+    const double bag_time = m.getTime().toSec();
+    double stamp = NAN;
+    if (auto img = m.instantiate<sensor_msgs::Image>()) {
+      stamp = img->header.stamp.toSec();
+      c.image_stamps.push_back(stamp);
+      if (c.images.size() < 40) c.images.push_back(*img);
+    } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
+      stamp = info->header.stamp.toSec();
+      c.info_stamps.push_back(stamp);
+    } else if (auto raw = m.instantiate<clothwind::RawSentence>()) {
+      stamp = raw->header.stamp.toSec();
+      c.wind_stamps.push_back(stamp);
+      c.sentences.push_back(raw->data);
+      EXPECT_EQ(raw->protocol, "nmea");
+    }
+    c.stamps_match_bag_time &= std::abs(stamp - bag_time) < 1e-6;
+  }
+  return c;
+}
+
+std::string MakeSession(const std::string& args, const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_session_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string bag = (dir / name).string();
+  const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes 0.1 --seed 3 --out " + bag +
+                          " " + args + " > " + (dir / (name + ".log")).string() + " 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  return bag;
+}
+
+void CheckSession(const BagContents& c, size_t frames) {
+  EXPECT_EQ(c.types.at("camera/image_raw"), "sensor_msgs/Image");
+  EXPECT_EQ(c.types.at("camera/camera_info"), "sensor_msgs/CameraInfo");
+  EXPECT_EQ(c.types.at("anemometer/raw"), "clothwind/RawSentence");
+  EXPECT_EQ(c.types.size(), 3u);
+  EXPECT_TRUE(c.stamps_match_bag_time);
+  // Camera: its native 30 fps with capture jitter, one camera_info per image.
+  ASSERT_EQ(c.image_stamps.size(), frames);
+  EXPECT_EQ(c.info_stamps, c.image_stamps);
+  for (size_t i = 1; i < c.image_stamps.size(); ++i)
+    EXPECT_NEAR(c.image_stamps[i] - c.image_stamps[i - 1], 1.0 / 30, 0.009) << i;
+  EXPECT_NEAR(c.image_stamps.front(), 1700000000.0, 0.01);
+  // Anemometer: 1 Hz, each sentence arriving 50 ms after its interval; valid NMEA checksums.
+  ASSERT_EQ(c.wind_stamps.size(), 5u);  // 6 s session: sentences at 1.05 .. 5.05 s
+  for (size_t k = 0; k < c.wind_stamps.size(); ++k) {
+    EXPECT_NEAR(c.wind_stamps[k], 1700000000.0 + (k + 1) + 0.05, 1e-6);
+    const std::string& s = c.sentences[k];
+    ASSERT_EQ(s.rfind("$WIMWV,", 0), 0u) << s;
+    uint8_t x = 0;
+    const size_t star = s.find('*');
+    ASSERT_NE(star, std::string::npos);
+    for (size_t i = 1; i < star; ++i) x ^= static_cast<uint8_t>(s[i]);
+    EXPECT_EQ(std::stoul(s.substr(star + 1), nullptr, 16), x) << s;
+    double angle = 0, speed = 0;
+    ASSERT_EQ(std::sscanf(s.c_str(), "$WIMWV,%lf,R,%lf,M,A", &angle, &speed), 2) << s;
+    EXPECT_GE(speed, 0.0);
+    EXPECT_LT(speed, 15.0);
+    EXPECT_GE(angle, 0.0);
+    EXPECT_LT(angle, 360.0);
+  }
+}
+
+TEST(SessionBagTest, RenderedSessionHasTheLiveNodesTopicsRatesAndStamps) {
+  const std::string bag = MakeSession(
+      "--frames rendered --width 160 --height 120 --max-edge 0.5 --render-samples 1 --warmup 1", "rendered.bag");
+  const BagContents c = ReadBag(bag);
+  CheckSession(c, 180);
+  ASSERT_FALSE(c.images.empty());
+  const auto& first = c.images.front();
+  EXPECT_EQ(first.encoding, "bgr8");
+  EXPECT_EQ(first.width, 160u);
+  EXPECT_EQ(first.height, 120u);
+  EXPECT_EQ(first.step, 160u * 3);
+  EXPECT_EQ(first.header.frame_id, "camera_optical_frame");
+  // The flag moves: frames a second apart differ in many pixels.
+  const auto& later = c.images.back();
+  int changed = 0;
+  for (size_t i = 0; i < first.data.size(); ++i) changed += std::abs(first.data[i] - later.data[i]) > 10;
+  EXPECT_GT(changed, 100);
+  fs::remove_all(fs::path(bag).parent_path());
+}
+
+TEST(SessionBagTest, ProceduralSessionStillWorks) {
+  const std::string bag = MakeSession("--frames procedural", "procedural.bag");
+  CheckSession(ReadBag(bag), 180);
+  fs::remove_all(fs::path(bag).parent_path());
+}
+
+}  // namespace
