@@ -485,8 +485,10 @@ Eigen::MatrixX3d ClothSimulator::Forces() const {
   Impl& s = *impl_;
   const bool repel = s.options.self_collision && s.options.repulsion_thickness > 0 &&
                      s.options.collision_stiffness > 0;
+  const StepStats kept = s.stats;  // last_step_stats() describes the last Step, not this call
   if (repel) s.proximity->Update(s.x, s.options.repulsion_thickness);
   s.ComputeForces(/*with_jacobian=*/false, repel);
+  s.stats = kept;
   Eigen::MatrixX3d out(s.nv, 3);
   for (int i = 0; i < s.nv; ++i) out.row(i) = s.f.segment<3>(3 * i).transpose();
   return out;
