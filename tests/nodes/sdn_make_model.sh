@@ -1,10 +1,15 @@
 #!/usr/bin/env bash
-# launch-prefix for sdn_node in tests: writes a tiny initialised model first (unless one newer
-# than the clothwind executable exists), then runs the node command that follows. The estimates of
-# such a model are meaningless; the tests check the node's plumbing (stamps, errors, images).
-# Usage (as launch-prefix): sdn_make_model.sh <model.pt> [clothwind train options...] -- <command...>
+# launch-prefix for sdn_node in tests: writes a tiny model first (unless one newer than the
+# clothwind executable exists), then runs the node command that follows.
+#   sdn_make_model.sh <model.pt> [clothwind train options...] -- <command...>
+#     an initialised (untrained) model: its estimates are meaningless, for plumbing tests;
+#   sdn_make_model.sh <model.pt> --toy <dataset dir> [train options...] -- <command...>
+#     makes the toy dataset (clothwind make-toy-dataset: stripes at f = 1 + 0.5 v Hz) and trains
+#     on it, for tests that check the estimates themselves.
 set -euo pipefail
 model="$1"; shift
+toy=""
+if [ "${1:-}" = "--toy" ]; then toy="$2"; shift 2; fi
 opts=()
 while [ $# -gt 0 ] && [ "$1" != "--" ]; do opts+=("$1"); shift; done
 [ $# -gt 0 ] && shift  # the "--"
@@ -24,6 +29,11 @@ if [ -z "$cli" ]; then
   exit 1
 fi
 if [ ! -f "$model" ] || [ "$cli" -nt "$model" ] || [ "$0" -nt "$model" ]; then
-  "$cli" train --init-only --out "$(dirname "$model")" "${opts[@]}"
+  if [ -n "$toy" ]; then
+    "$cli" make-toy-dataset --out "$toy" --clips 100 --frames 60 --size 32 --seed 1 >&2
+    "$cli" train --data "$toy" --out "$(dirname "$model")" "${opts[@]}" >&2
+  else
+    "$cli" train --init-only --out "$(dirname "$model")" "${opts[@]}" >&2
+  fi
 fi
 exec "$@"
