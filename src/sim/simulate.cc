@@ -33,6 +33,11 @@ Trajectory SimulateTrajectory(const SceneSetup& setup, const Theta& theta,
   const double frame_time = setup.scene.frame_time;
   const int steps_per_frame = setup.scene.frame_steps;
   const int frames = static_cast<int>(std::lround(duration / frame_time));
+  if (!(options.warmup >= 0) || !std::isfinite(options.warmup)) {
+    throw std::invalid_argument("SimulateOptions.warmup must be >= 0 [s]");
+  }
+  const int warmup_frames = static_cast<int>(std::lround(options.warmup / frame_time));
+  const int total = warmup_frames + frames;
 
   SimOptions sim_options = cloth.options;
   sim_options.wind_density = wind.density;  // the setup's wind may have been edited
@@ -44,15 +49,23 @@ Trajectory SimulateTrajectory(const SceneSetup& setup, const Theta& theta,
   t.uv = cloth.mesh.U.cast<float>();
   t.frame_time = frame_time;
   t.frames.reserve(frames + 1);
-  t.frames.push_back(sim.positions().cast<float>());
-  for (int f = 1; f <= frames; ++f) {
+  auto advance_one_frame = [&] {
     for (int s = 0; s < steps_per_frame; ++s) {
       sim.Step();
       t.solver_iterations += sim.last_step_stats().cg_iterations;
     }
     t.steps += steps_per_frame;
+  };
+  bool go_on = true;
+  for (int f = 1; f <= warmup_frames && go_on; ++f) {
+    advance_one_frame();
+    if (options.progress) go_on = options.progress(f, total);
+  }
+  t.frames.push_back(sim.positions().cast<float>());
+  for (int f = 1; f <= frames && go_on; ++f) {
+    advance_one_frame();
     t.frames.push_back(sim.positions().cast<float>());
-    if (options.progress && !options.progress(f, frames)) break;
+    if (options.progress) go_on = options.progress(warmup_frames + f, total);
   }
   t.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

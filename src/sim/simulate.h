@@ -13,7 +13,10 @@
 namespace clothwind::sim {
 
 struct SimulateOptions {
-  double duration = -1.0;        // simulated seconds; < 0: the scene's duration
+  double duration = -1.0;        // simulated seconds recorded; < 0: the scene's duration
+  // Simulated seconds run before frame 0 is recorded (rounded to whole frames), e.g. to let the
+  // flag's release from its flat start die out before a clip; time (and the wind) runs on.
+  double warmup = 0.0;
   std::optional<uint64_t> seed;  // seeds the wind's turbulence and gusts (WindSpec::SetSeed)
   int cloth = 0;                 // which of the scene's cloths (each is simulated alone)
   // Called after every frame with (frames done, frames total); return false to stop early
@@ -26,8 +29,9 @@ struct SimulateOptions {
 };
 
 // Simulates one cloth of a scene with parameter vector theta (area weight, bending table, wind
-// speed: parameters.h) and returns the frames in memory: frame 0 is the initial state, then one
-// frame every frame_time for the duration (round(duration / frame_time) + 1 frames).
+// speed: parameters.h) and returns the frames in memory: frame 0 is the state after the warm-up
+// (the initial state without one), then one frame every frame_time for the duration
+// (round(duration / frame_time) + 1 frames). Progress counts warm-up and recorded frames.
 //
 // Thread-safe: `setup` is only read; concurrent calls share nothing mutable. Deterministic: the
 // same setup, theta and seed give bit-identical frames, on any thread.

@@ -62,6 +62,29 @@ TEST(SimulateTrajectory, FramesStepsAndShapes) {
   }
 }
 
+TEST(SimulateTrajectory, WarmupDropsLeadingFramesOfTheSameRun) {
+  const SceneSetup setup = SmallFlag();
+  SimulateOptions o;
+  o.seed = 2;
+  o.duration = 0.4;
+  const Trajectory full = SimulateTrajectory(setup, SceneTheta(setup), o);
+  o.duration = 0.24;
+  o.warmup = 0.16;  // 4 frames
+  int last_done = 0, last_total = 0;
+  o.progress = [&](int done, int total) {
+    last_done = done, last_total = total;
+    return true;
+  };
+  const Trajectory warm = SimulateTrajectory(setup, SceneTheta(setup), o);
+  EXPECT_EQ(last_done, 10);
+  EXPECT_EQ(last_total, 10);
+  ASSERT_EQ(warm.num_frames(), 7);
+  EXPECT_EQ(warm.steps, full.steps);
+  for (int f = 0; f < warm.num_frames(); ++f) EXPECT_EQ(warm.frames[f], full.frames[f + 4]) << f;
+  o.warmup = -1;
+  EXPECT_THROW(SimulateTrajectory(setup, SceneTheta(setup), o), std::invalid_argument);
+}
+
 TEST(SimulateTrajectory, ProgressCanStopEarly) {
   const SceneSetup setup = SmallFlag();
   SimulateOptions o;
