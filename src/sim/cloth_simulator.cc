@@ -52,6 +52,7 @@ struct ClothSimulator::Impl {
   Eigen::VectorXd mass;
   Eigen::VectorXd vertex_area;      // a third of the adjacent rest areas [m^2]
   std::vector<char> pinned;
+  bool implicit_bending = true;
   Eigen::MatrixX3d x, v;
   double t = 0;
   long steps = 0;
@@ -168,7 +169,29 @@ void ClothSimulator::Impl::Build() {
   for (const Face& face : faces)
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) link(face.v[i], face.v[j]);
-  if (options.implicit_bending)
+  implicit_bending = options.bending_solve == BendingSolve::kImplicit;
+  if (options.bending_solve == BendingSolve::kAuto) {
+    // Gershgorin bound of h^2 M^-1 K_bend at rest: per hinge, K = c g g^T with c = ke shape / 2;
+    // row i of M^-1 K is bounded by c |g_i| sum_j |g_j| / m_i.
+    double bound = 0;
+    std::vector<double> row_sum(nv, 0.0);
+    for (const Hinge& h : hinges) {
+      Vector12d xh, g;
+      for (int c = 0; c < 4; ++c) xh.segment<3>(3 * c) = mesh.V.row(h.v[c]).transpose();
+      // Rest (flat) geometry from U gives the same gradient norms as any isometric placement.
+      for (int c = 0; c < 4; ++c) xh.segment<3>(3 * c) << mesh.U(h.v[c], 0), mesh.U(h.v[c], 1), 0;
+      DihedralAngle(xh, &g);
+      const double ke = *std::max_element(h.bending_row.begin(), h.bending_row.end());
+      const double c_half = 0.5 * ke * h.rest_length * h.rest_length / (2 * h.rest_area_sum);
+      double gsum = 0;
+      for (int c = 0; c < 4; ++c) gsum += g.segment<3>(3 * c).norm();
+      for (int c = 0; c < 4; ++c) row_sum[h.v[c]] += c_half * g.segment<3>(3 * c).norm() * gsum;
+    }
+    for (int i = 0; i < nv; ++i) bound = std::max(bound, options.dt * options.dt * row_sum[i] / mass[i]);
+    implicit_bending = bound > 0.5;
+  }
+  stats.implicit_bending = implicit_bending;
+  if (implicit_bending)
     for (const Hinge& h : hinges) {
       link(h.v[2], h.v[3]);
       link(h.v[3], h.v[2]);
@@ -190,7 +213,7 @@ void ClothSimulator::Impl::Build() {
   for (Hinge& h : hinges)
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j)
-        h.block[4 * i + j] = (options.implicit_bending || i + j != 5 || i == j)
+        h.block[4 * i + j] = (implicit_bending || i + j != 5 || i == j)
                                  ? BlockIndex(h.v[i], h.v[j])
                                  : -1;
   J.assign(col.size(), Eigen::Matrix3d::Zero());
@@ -252,7 +275,7 @@ void ClothSimulator::Impl::ComputeForces(bool with_jacobian, bool with_repulsion
     const double ke = Material::BendingStiffnessFromRow(curvature, h.bending_row);
     const double c_half = 0.5 * ke * h.rest_length * h.rest_length / (2 * h.rest_area_sum);
     for (int c = 0; c < 4; ++c) f.segment<3>(3 * h.v[c]) -= c_half * theta * dtheta.segment<3>(3 * c);
-    if (with_jacobian && options.implicit_bending)
+    if (with_jacobian && implicit_bending)
       for (int i = 0; i < 4; ++i) {
         const Eigen::Vector3d gi = -c_half * dtheta.segment<3>(3 * i);
         for (int j = i; j < 4; ++j) {

@@ -13,6 +13,9 @@
 
 namespace clothwind::sim {
 
+// How bending forces enter the time step.
+enum class BendingSolve { kAuto, kImplicit, kExplicit };
+
 // Settings of one simulation (an ArcSim scene's numbers; defaults are the flag scene's).
 struct SimOptions {
   double dt = 0.005;                                // time step [s] (ArcSim: frame_time/frame_steps)
@@ -28,11 +31,12 @@ struct SimOptions {
   double collision_stiffness = 1e6;                 // ArcSim magic.collision_stiffness [N/m^3]
                                                     // (times min(node area, face area) per pair)
   bool self_collision = true;                       // vertex-face repulsion on/off
-  // Bending in the implicit solve (ArcSim) or explicit. Cloth bending stiffness is tiny next to
-  // the mass at these steps (h^2 ke |grad theta|^2 / m << 1), so explicit bending is stable for
-  // the Wang et al. fabrics at dt 5 ms and saves ~20 % of the step (the hinge's two opposite
-  // vertices then need no matrix block).
-  bool implicit_bending = true;
+  // Bending in the implicit solve (ArcSim) or explicit. Cloth bending is so soft next to the
+  // node masses that explicit bending is stable by orders of magnitude at these steps, and it
+  // saves ~20 % of a step (a hinge's two opposite vertices then need no matrix block). kAuto
+  // bounds h^2 lambda_max(M^-1 K_bend) over the hinges (Gershgorin, with the table's largest
+  // stiffness) and goes implicit only if that bound exceeds 0.5 (explicit needs < ~4).
+  BendingSolve bending_solve = BendingSolve::kAuto;
   double cg_tolerance = 1e-3;                       // relative residual of the linear solve
   int cg_max_iterations = 300;
 };
@@ -53,6 +57,7 @@ struct StepStats {
   double cg_relative_residual = 0;
   int repulsion_pairs = 0;
   int strain_limited_faces = 0;  // faces outside the limits before projection
+  bool implicit_bending = false;  // what kAuto (or the option) chose
   // Wall time of the phases of the step [s] (steady clock), for benches.
   double seconds_proximity = 0;
   double seconds_forces = 0;

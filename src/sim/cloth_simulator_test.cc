@@ -59,7 +59,7 @@ TEST(ClothSimulatorTest, FreeFallMatchesBackwardEulerExactly) {
   SimOptions o = QuietOptions();
   o.dt = 0.01;
   o.cg_tolerance = 1e-13;
-  o.implicit_bending = false;  // (bending is exactly translation-invariant either way)
+  o.bending_solve = BendingSolve::kImplicit;  // (bending is exactly translation-invariant)
   ClothSimulator sim(m, TestMaterial(), o, nullptr);
   const Eigen::Vector3d v0(0.3, -0.2, 1.5);
   const Eigen::MatrixX3d V0 = Eigen::RowVector3d(v0.transpose()).replicate(m.V.rows(), 1);
@@ -132,7 +132,7 @@ TEST(ClothSimulatorTest, EnergyDoesNotGrowWithoutInput) {
       o.strain_max = 1.05;
     }
     o.self_collision = variant == 2;
-    o.implicit_bending = variant != 3;
+    o.bending_solve = variant == 3 ? BendingSolve::kExplicit : BendingSolve::kImplicit;
     ClothSimulator sim(m, TestMaterial(), o, nullptr);
     const double e0 = sim.Energy().Total();
     const double scale = sim.masses().sum() * 9.8 * 0.5;  // m g L
@@ -179,7 +179,7 @@ TEST(ClothSimulatorTest, HalvingTheTimeStepConvergesAtFirstOrder) {
       o.handles = top;
       o.cg_tolerance = 1e-12;
       o.cg_max_iterations = 2000;
-      o.implicit_bending = implicit_bending;
+      o.bending_solve = implicit_bending ? BendingSolve::kImplicit : BendingSolve::kExplicit;
       ClothSimulator sim(m, TestMaterial(), o, std::make_shared<SteadyWind>(Eigen::Vector3d(1, 0, 0)));
       const int n = static_cast<int>(std::lround(0.16 / dt));
       for (int i = 0; i < n; ++i) sim.Step();
@@ -225,6 +225,31 @@ TEST(ClothSimulatorTest, HandlesStayPutAndStrainLimitsHold) {
   EXPECT_LT(stretch[stretch.size() * 99 / 100], 1.06);
   EXPECT_LT(stretch.back(), 1.08);
   EXPECT_GT(sim.last_step_stats().strain_limited_faces, 0) << "the wind should strain the cloth";
+}
+
+TEST(ClothSimulatorTest, AutoBendingGoesImplicitOnlyForStiffBending) {
+  const Mesh m = HangingSheet(0.6, 0.6, 0.08);
+  SimOptions o;
+  ClothSimulator soft(m, TestMaterial(), o, nullptr);
+  EXPECT_FALSE(soft.last_step_stats().implicit_bending);
+  MaterialMultipliers stiff;
+  stiff.bending = 1e5;  // a sheet of metal rather than fabric
+  ClothSimulator hard(m, TestMaterial(stiff), o, nullptr);
+  EXPECT_TRUE(hard.last_step_stats().implicit_bending);
+  // Explicit bending that auto refuses does go wrong (a wild, non-physical motion); implicit not.
+  double speed[2];
+  for (BendingSolve mode : {BendingSolve::kExplicit, BendingSolve::kImplicit}) {
+    SimOptions forced = QuietOptions();
+    forced.bending_solve = mode;
+    forced.handles = {2, 3};
+    Mesh bent = m;
+    for (int i = 0; i < bent.V.rows(); ++i) bent.V(i, 1) = 0.05 * std::sin(10 * bent.U(i, 0));
+    ClothSimulator sim(bent, TestMaterial(stiff), forced, nullptr);
+    for (int i = 0; i < 100; ++i) sim.Step();
+    speed[mode == BendingSolve::kImplicit] = sim.velocities().rowwise().norm().maxCoeff();
+  }
+  EXPECT_LT(speed[1], 10.0);
+  EXPECT_FALSE(speed[0] < 2 * speed[1]) << speed[0] << " vs " << speed[1];  // NaN counts as wrong
 }
 
 TEST(ClothSimulatorTest, RepulsionKeepsFallingSheetAboveAnother) {
