@@ -69,6 +69,13 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
   if (config.arch != "sdn" && config.arch != "resnet18") {
     throw std::invalid_argument("WindNet: unknown architecture \"" + config.arch + "\"");
   }
+  if (config.arch == "sdn") {
+    const int candidates = config.frames / 2 + (config.include_dc ? 1 : 0);
+    if (config.frames < 2 || config.k < 1 || config.k > candidates) {
+      throw std::invalid_argument("WindNet: an SDN on " + std::to_string(config.frames) + " frames offers " +
+                                  std::to_string(candidates) + " frequency bins, k = " + std::to_string(config.k));
+    }
+  }
   trunk_ = register_module("trunk", ResNet18Trunk(config.TrunkInputChannels(), config.width));
   head_ = register_module("head", torch::nn::Linear(trunk_->feature_size(), 2));
 }
