@@ -37,7 +37,7 @@ struct SimOptions {
   // bounds h^2 lambda_max(M^-1 K_bend) over the hinges (Gershgorin, with the table's largest
   // stiffness) and goes implicit only if that bound exceeds 0.5 (explicit needs < ~4).
   BendingSolve bending_solve = BendingSolve::kAuto;
-  double cg_tolerance = 1e-3;                       // relative residual of the linear solve
+  double cg_tolerance = 1e-2;                       // relative residual of the linear solve
   int cg_max_iterations = 300;
 };
 
