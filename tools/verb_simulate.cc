@@ -96,6 +96,7 @@ int Run(const SimulateArgs& a) {
   summary["scene"] = scene.path;
   summary["cloths"] = nlohmann::json::array();
   double total_wall = 0;
+  sim::Theta theta0 = sim::SceneTheta(setup, 0);
   for (int c = 0; c < static_cast<int>(setup.cloths.size()); ++c) {
     sim::Theta theta = sim::SceneTheta(setup, c);
     for (const auto& p : a.params) {
@@ -103,6 +104,7 @@ int Run(const SimulateArgs& a) {
       if (eq == std::string::npos) throw std::invalid_argument("--param: expected NAME=VALUE, got '" + p + "'");
       theta[sim::ParameterIndex(p.substr(0, eq))] = ParseList(p.substr(eq + 1), 1, "--param " + p)[0];
     }
+    if (c == 0) theta0 = theta;
     options.cloth = c;
     ProgressBar::Options bar_options;
     bar_options.label = "simulate";
@@ -147,7 +149,8 @@ int Run(const SimulateArgs& a) {
     s["theta"] = th;
     summary["cloths"].push_back(s);
   }
-  const auto& w = setup.wind;
+  sim::WindSpec w = setup.wind;  // as simulated: speed from theta (cloth 0's)
+  sim::ApplyTheta(theta0, nullptr, &w);
   summary["wind"] = {{"velocity", {w.velocity.x(), w.velocity.y(), w.velocity.z()}},
                      {"density", w.density},
                      {"drag", w.drag},
