@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
   std::printf("droop/RMS/frequency over the last half (cf. ArcSim: droop ~80/52/10 deg at 1/3/10 m/s, ~1.5 Hz at 10)\n\n");
   std::printf("| wind (m/s) | vertices | faces | steps | wall s / sim s | CPU s / sim s | x real time | x faster than ArcSim | droop (deg) | lateral RMS (m) | vertical RMS (m) | frequency (Hz) | CG iterations / step |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-  bool all_fast = true;
+  bool all_fast_wall = true, all_fast_cpu = true;
   for (double wind : winds) {
     Theta theta = SceneTheta(setup);
     theta[kWindSpeedIndex] = wind;
@@ -122,8 +122,11 @@ int main(int argc, char** argv) {
                 m.droop_deg, m.lateral_rms, m.vertical_rms, m.dominant_hz,
                 static_cast<double>(t.solver_iterations) / std::max<int64_t>(1, t.steps));
     std::fflush(stdout);
-    all_fast = all_fast && per <= 0.2;
+    all_fast_wall = all_fast_wall && per <= 0.2;
+    all_fast_cpu = all_fast_cpu && cpu / simulated <= 0.2;
   }
-  std::printf("\ngoal >= 5x real time at every wind: %s\n", all_fast ? "met" : "NOT met");
+  std::printf("\ngoal >= 5x real time at every wind: %s in CPU time of the one thread, %s in wall time\n"
+              "(wall time also counts other jobs on a shared machine)\n",
+              all_fast_cpu ? "met" : "NOT met", all_fast_wall ? "met" : "NOT met");
   return 0;
 }
