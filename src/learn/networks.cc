@@ -133,7 +133,7 @@ WindNet LoadWindNet(const std::filesystem::path& weights) {
   for (const auto& item : net->named_parameters()) expected.emplace_back(item.key(), item.value().sizes().vec());
   for (const auto& item : net->named_buffers()) expected.emplace_back(item.key(), item.value().sizes().vec());
   try {
-    torch::load(net, weights.string());
+    torch::load(net, weights.string(), at::Device(at::kCPU));
     auto parameters = net->named_parameters();
     auto buffers = net->named_buffers();
     for (const auto& [name, sizes] : expected) {

@@ -144,10 +144,17 @@ TrainResult Train(const TrainOptions& o) {
   WindNet net(config);
   torch::optim::Adam optimizer(net->parameters(), torch::optim::AdamOptions(o.lr).weight_decay(o.weight_decay));
   if (o.resume) {
-    torch::load(net, last.string());
-    torch::load(optimizer, last_optim.string());
+    // Loaded onto the CPU whatever device wrote them, then moved with the network.
+    torch::load(net, last.string(), at::Device(at::kCPU));
+    torch::load(optimizer, last_optim.string(), at::Device(at::kCPU));
   }
   net->to(device);
+  for (auto& entry : optimizer.state()) {  // Adam's moments live beside their parameters
+    auto& state = static_cast<torch::optim::AdamParamState&>(*entry.second);
+    state.exp_avg(state.exp_avg().to(device));
+    state.exp_avg_sq(state.exp_avg_sq().to(device));
+    if (state.max_exp_avg_sq().defined()) state.max_exp_avg_sq(state.max_exp_avg_sq().to(device));
+  }
   if (o.init_only) {
     SaveWindNet(net, result.model);
     return result;
