@@ -248,6 +248,9 @@ nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<st
 int64_t ReindexDataset(const std::string& dir, bool contact_sheet) {
   nlohmann::json index = ReadIndex(dir);
   if (index.is_null()) throw std::runtime_error(dir + "/index.json not found: not a dataset folder");
+  if (index.value("kind", "") != "flag" && index.value("kind", "") != "cloth")
+    throw std::runtime_error(dir + "/index.json: field 'kind' is " + index.value("kind", nlohmann::json()).dump() +
+                             ", expected \"flag\" or \"cloth\" (only simulated datasets are re-indexed)");
   index = BuildIndex(dir, index);
   WriteIndex(dir, index);
   if (contact_sheet) WriteContactSheet(dir, index, (fs::path(dir) / "contact_sheet.png").string());

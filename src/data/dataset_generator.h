@@ -92,7 +92,8 @@ nlohmann::json DatasetSettingsJson(const DatasetOptions& options,
 
 // Rebuilds DIR/index.json (and the contact sheet) from the example folders present, keeping the
 // existing header: the final merge after shards ran on several machines.
-// Returns the number of examples indexed. Throws std::runtime_error when DIR has no index.json.
+// Returns the number of examples indexed. Throws std::runtime_error when DIR has no index.json or
+// it is not a simulated (flag/cloth) dataset: recorded datasets keep the clip writer's index.
 int64_t ReindexDataset(const std::string& dir, bool contact_sheet = true);
 
 // Loads the fabrics of a materials folder (every *.json not in `exclude`, sorted by name) with

@@ -249,6 +249,25 @@ TEST_F(DatasetGeneratorTest, ClothSimUsesTheFabricsOfAFolder) {
   }
 }
 
+TEST_F(DatasetGeneratorTest, ReindexMergesFoldersCopiedFromOtherMachines) {
+  // Shard 1 of 2 ran here; shard 0's folders arrive later (copied from another machine).
+  const fs::path dir = root_ / "merge";
+  DatasetOptions o = Tiny(dir.string());
+  o.shards = 2;
+  o.shard = 1;
+  GenerateDataset(o);
+  EXPECT_EQ(ReadIndex(dir.string())["clips"].size(), 1u);
+  for (const char* name : {"flag-000000-v0", "flag-000002-v0"})
+    fs::copy(Ref() / name, dir / name, fs::copy_options::recursive);
+  EXPECT_EQ(ReindexDataset(dir.string()), 3);
+  EXPECT_EQ(Files(dir), Files(Ref()));
+  // A recorded dataset's index is the clip writer's: not rebuilt from labels.
+  const fs::path real = root_ / "real";
+  fs::create_directories(real);
+  std::ofstream(real / "index.json") << R"({"format": "clothwind-dataset", "version": 1, "kind": "real", "clips": []})";
+  EXPECT_THROW(ReindexDataset(real.string()), std::runtime_error);
+}
+
 TEST(DatasetOptionsTest, BadOptionsAreRejected) {
   DatasetOptions o;
   o.out = "/tmp/never";

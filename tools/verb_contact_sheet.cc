@@ -1,0 +1,46 @@
+// clothwind contact-sheet DIR: a grid of a dataset's middle frames labelled with their wind speed
+// (any dataset in the docs/dataset.md format: simulated or recorded), to check it at a glance.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "data/contact_sheet.h"
+#include "data/dataset_index.h"
+#include "verb_registry.h"
+
+namespace clothwind::tools {
+namespace {
+
+struct ContactSheetArgs {
+  std::string dir;
+  std::string out;  // "" = DIR/contact_sheet.png
+  data::ContactSheetOptions options;
+};
+
+int Run(const ContactSheetArgs& a) {
+  const nlohmann::json index = data::ReadIndex(a.dir);
+  if (index.is_null()) throw std::runtime_error(a.dir + "/index.json not found: not a dataset folder");
+  const std::string out =
+      a.out.empty() ? (std::filesystem::path(a.dir) / "contact_sheet.png").string() : a.out;
+  if (!data::WriteContactSheet(a.dir, index, out, a.options)) {
+    std::printf("contact-sheet: %s has no clips\n", a.dir.c_str());
+    return 1;
+  }
+  std::printf("contact-sheet: %s (%zu clips in the index, up to %d shown)\n", out.c_str(), index["clips"].size(),
+              a.options.max_tiles);
+  return 0;
+}
+
+const VerbRegistrar kRegistrar{"contact-sheet", [](CLI::App& app) -> std::function<int()> {
+  auto a = std::make_shared<ContactSheetArgs>();
+  auto* sub = app.add_subcommand("contact-sheet", "grid of a dataset's middle frames with their wind speeds (PNG)");
+  sub->add_option("dir", a->dir, "dataset folder (with index.json)")->required();
+  sub->add_option("--out", a->out, "PNG to write (default: DIR/contact_sheet.png)");
+  sub->add_option("--tiles", a->options.max_tiles, "examples shown at most")->capture_default_str();
+  sub->add_option("--tile-size", a->options.tile, "tile size [px]")->capture_default_str();
+  return [a] { return Run(*a); };
+}};
+
+}  // namespace
+}  // namespace clothwind::tools
