@@ -124,7 +124,7 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
   sub->add_option("--max-edge", a->o.max_edge, "mesh resolution [m] (0: the scene's default)")->capture_default_str();
   sub->add_option("--warmup", a->o.warmup, "simulated seconds before the first kept frame")->capture_default_str();
   sub->add_option("--frames", a->o.frames, "frames per example")->capture_default_str();
-  sub->add_option("--samples", a->o.samples, "anti-aliasing samples per pixel (0: zeta's default)")
+  sub->add_option("--samples", a->o.samples, "anti-aliasing samples per pixel (0: zeta's default, 4)")
       ->capture_default_str();
   sub->add_option("--size", a->o.size, "frame width = height [px]")->capture_default_str();
   sub->add_option("--format", a->format, "frame format")->check(CLI::IsMember({"jpg", "jpeg", "png"}))
