@@ -84,30 +84,50 @@ StretchingTerms StretchingForce(const Vector9d& x, const TriangleRest& rest,
 
 double StretchingForceBlocks(const Vector9d& x, const TriangleRest& rest, const Eigen::Vector4d& k,
                              bool definite, Vector9d* force, Eigen::Matrix3d jacobian[9]) {
-  const Eigen::Matrix<double, 3, 2> B = ShapeCoefficients(rest);
-  const Eigen::Matrix<double, 3, 2> F = DeformationGradient(x, rest);
-  const Eigen::Vector3d Fu = F.col(0), Fv = F.col(1);
-  const double G00 = 0.5 * (Fu.dot(Fu) - 1), G11 = 0.5 * (Fv.dot(Fv) - 1), G01 = 0.5 * Fu.dot(Fv);
+  // Plain scalar code: this runs once per face per step.
+  const Eigen::Matrix2d& D = rest.Dm_inv;
+  double e1[3], e2[3], Fu[3], Fv[3];
+  for (int r = 0; r < 3; ++r) {
+    e1[r] = x[3 + r] - x[r];
+    e2[r] = x[6 + r] - x[r];
+    Fu[r] = e1[r] * D(0, 0) + e2[r] * D(1, 0);
+    Fv[r] = e1[r] * D(0, 1) + e2[r] * D(1, 1);
+  }
+  // B(i, c): d F.col(c) / d x_i (scalar multiple of the identity).
+  const double B[3][2] = {{-(D(0, 0) + D(1, 0)), -(D(0, 1) + D(1, 1))},
+                          {D(0, 0), D(0, 1)},
+                          {D(1, 0), D(1, 1)}};
+  const double uu = Fu[0] * Fu[0] + Fu[1] * Fu[1] + Fu[2] * Fu[2];
+  const double vv = Fv[0] * Fv[0] + Fv[1] * Fv[1] + Fv[2] * Fv[2];
+  const double uv = Fu[0] * Fv[0] + Fu[1] * Fv[1] + Fu[2] * Fv[2];
+  const double G00 = 0.5 * (uu - 1), G11 = 0.5 * (vv - 1), G01 = 0.5 * uv;
   const double A = rest.area;
   // f_i = -A (s_u B_i0 Fu + s_v B_i1 Fv + s_uv (B_i0 Fv + B_i1 Fu)), from dG/dx_i.
   const double su = k[0] * G00 + k[1] * G11, sv = k[1] * G00 + k[2] * G11, suv = k[3] * G01;
-  for (int i = 0; i < 3; ++i)
-    force->segment<3>(3 * i) = -A * ((su * B(i, 0) + suv * B(i, 1)) * Fu + (sv * B(i, 1) + suv * B(i, 0)) * Fv);
+  for (int i = 0; i < 3; ++i) {
+    const double cu = -A * (su * B[i][0] + suv * B[i][1]), cv = -A * (sv * B[i][1] + suv * B[i][0]);
+    for (int r = 0; r < 3; ++r) (*force)[3 * i + r] = cu * Fu[r] + cv * Fv[r];
+  }
   const double p00 = definite ? std::max(G00, 0.0) : G00;
   const double p11 = definite ? std::max(G11, 0.0) : G11;
   const double p01 = definite ? 0.0 : G01;
-  const Eigen::Matrix3d UU = Fu * Fu.transpose(), UV = Fu * Fv.transpose(), VV = Fv * Fv.transpose();
   const double hk3 = 0.5 * k[3];
   for (int i = 0; i < 3; ++i)
     for (int j = i; j < 3; ++j) {
-      const double a = B(i, 0) * B(j, 0), b = B(i, 0) * B(j, 1), c = B(i, 1) * B(j, 0),
-                   d = B(i, 1) * B(j, 1);
-      const double cuu = k[0] * a + hk3 * d, cuv = k[1] * b + hk3 * c, cvu = k[1] * c + hk3 * b,
-                   cvv = k[2] * d + hk3 * a;
-      const double diag = k[0] * p00 * a + k[1] * (p11 * a + p00 * d) + k[2] * p11 * d + k[3] * p01 * (b + c);
-      Eigen::Matrix3d blk = -A * (cuu * UU + cuv * UV + cvu * UV.transpose() + cvv * VV);
-      blk.diagonal().array() -= A * diag;
-      jacobian[3 * i + j] = blk;
+      const double a = B[i][0] * B[j][0], b = B[i][0] * B[j][1], c = B[i][1] * B[j][0],
+                   d = B[i][1] * B[j][1];
+      // Block = -A (cuu Fu Fu^T + cuv Fu Fv^T + cvu Fv Fu^T + cvv Fv Fv^T + diag I).
+      const double cuu = -A * (k[0] * a + hk3 * d), cuv = -A * (k[1] * b + hk3 * c),
+                   cvu = -A * (k[1] * c + hk3 * b), cvv = -A * (k[2] * d + hk3 * a);
+      const double diag =
+          -A * (k[0] * p00 * a + k[1] * (p11 * a + p00 * d) + k[2] * p11 * d + k[3] * p01 * (b + c));
+      Eigen::Matrix3d& blk = jacobian[3 * i + j];
+      for (int col = 0; col < 3; ++col) {
+        const double wu = cuu * Fu[col] + cuv * Fv[col];  // multiplies Fu[row]
+        const double wv = cvu * Fu[col] + cvv * Fv[col];  // multiplies Fv[row]
+        for (int row = 0; row < 3; ++row) blk(row, col) = wu * Fu[row] + wv * Fv[row];
+        blk(col, col) += diag;
+      }
       if (j != i) jacobian[3 * j + i] = blk.transpose();
     }
   return 0.5 * A * (k[0] * G00 * G00 + 2 * k[1] * G00 * G11 + k[2] * G11 * G11 + 2 * k[3] * G01 * G01);
