@@ -35,64 +35,95 @@ StrainLimiter::StrainLimiter(const Mesh& mesh, const Eigen::VectorXd& mass,
 int StrainLimiter::Project(double strain_min, double strain_max, int iterations, double dt,
                            Eigen::MatrixX3d* xp, Eigen::MatrixX3d* vp) {
   Eigen::MatrixX3d& x = *xp;
-  before_ = x;
+  const int n = static_cast<int>(x.rows());
+  // Work on an interleaved copy (x, y, z of a vertex adjacent in memory).
+  work_.resize(3 * n);
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) work_[3 * i + c] = x(i, c);
+  double* X = work_.data();
   // Squared limits with a small slack so converged faces are not touched again.
   const double lo2 = strain_min > 0 ? strain_min * strain_min * (1 - 1e-6) : -1.0;
   const double hi2 = std::isfinite(strain_max) ? strain_max * strain_max * (1 + 1e-6) : 1e300;
+  auto clampv = [&](double s) {
+    if (strain_min > 0) s = std::max(s, strain_min);
+    if (std::isfinite(strain_max)) s = std::min(s, strain_max);
+    return s;
+  };
   int initially_violated = 0;
   // After the first sweep only faces with a vertex moved by the previous sweep can be violated.
-  moved_.assign(x.rows(), 1);
-  moved_next_.assign(x.rows(), 0);
+  moved_.assign(n, 1);
+  moved_next_.assign(n, 0);
   for (int sweep = 0; sweep < iterations; ++sweep) {
     int violated = 0;
     for (const Face& face : faces_) {
       if (!moved_[face.v[0]] && !moved_[face.v[1]] && !moved_[face.v[2]]) continue;
-      const Eigen::Vector3d x0 = x.row(face.v[0]), x1 = x.row(face.v[1]), x2 = x.row(face.v[2]);
-      Eigen::Matrix<double, 3, 2> Ds;
-      Ds.col(0) = x1 - x0;
-      Ds.col(1) = x2 - x0;
-      const Eigen::Matrix<double, 3, 2> F = Ds * face.Dm_inv;
+      const double* x0 = X + 3 * face.v[0];
+      const double* x1 = X + 3 * face.v[1];
+      const double* x2 = X + 3 * face.v[2];
+      const Eigen::Matrix2d& D = face.Dm_inv;
+      double Fu[3], Fv[3];
+      for (int r = 0; r < 3; ++r) {
+        const double e1 = x1[r] - x0[r], e2 = x2[r] - x0[r];
+        Fu[r] = e1 * D(0, 0) + e2 * D(1, 0);
+        Fv[r] = e1 * D(0, 1) + e2 * D(1, 1);
+      }
       // Eigenvalues of C = F^T F in closed form (cheap rejection of faces within limits).
-      const double c00 = F.col(0).squaredNorm(), c11 = F.col(1).squaredNorm(),
-                   c01 = F.col(0).dot(F.col(1));
+      const double c00 = Fu[0] * Fu[0] + Fu[1] * Fu[1] + Fu[2] * Fu[2];
+      const double c11 = Fv[0] * Fv[0] + Fv[1] * Fv[1] + Fv[2] * Fv[2];
+      const double c01 = Fu[0] * Fv[0] + Fu[1] * Fv[1] + Fu[2] * Fv[2];
       const double mean = 0.5 * (c00 + c11);
       const double rad = std::sqrt(0.25 * (c00 - c11) * (c00 - c11) + c01 * c01);
       const double l_hi = mean + rad, l_lo = mean - rad;
       if (l_hi <= hi2 && l_lo >= lo2) continue;
       if (!(l_lo > 1e-16)) continue;  // collapsed face: no meaningful direction to restore
       ++violated;
-      // Eigenvectors of C: V = [e_hi, e_lo].
-      Eigen::Vector2d e_hi;
+      // Eigenvectors of C: e_hi, e_lo = perp(e_hi).
+      double eh0, eh1;
       if (std::abs(c01) > 1e-300) {
-        e_hi = Eigen::Vector2d(l_hi - c11, c01).normalized();
+        eh0 = l_hi - c11;
+        eh1 = c01;
+        const double inv = 1.0 / std::sqrt(eh0 * eh0 + eh1 * eh1);
+        eh0 *= inv;
+        eh1 *= inv;
+      } else if (c00 >= c11) {
+        eh0 = 1;
+        eh1 = 0;
       } else {
-        e_hi = c00 >= c11 ? Eigen::Vector2d(1, 0) : Eigen::Vector2d(0, 1);
+        eh0 = 0;
+        eh1 = 1;
       }
-      const Eigen::Vector2d e_lo(-e_hi.y(), e_hi.x());
+      const double el0 = -eh1, el1 = eh0;
       const double s_hi = std::sqrt(l_hi), s_lo = std::sqrt(l_lo);
-      auto clampv = [&](double s) {
-        if (strain_min > 0) s = std::max(s, strain_min);
-        if (std::isfinite(strain_max)) s = std::min(s, strain_max);
-        return s;
-      };
-      // F' = F V diag(s'/s) V^T.
-      const Eigen::Matrix<double, 3, 2> Fn =
-          (F * e_hi) * (clampv(s_hi) / s_hi) * e_hi.transpose() +
-          (F * e_lo) * (clampv(s_lo) / s_lo) * e_lo.transpose();
+      const double r_hi = clampv(s_hi) / s_hi, r_lo = clampv(s_lo) / s_lo;
+      // F' = F M, M = V diag(r) V^T (2 by 2, symmetric).
+      const double m00 = r_hi * eh0 * eh0 + r_lo * el0 * el0;
+      const double m01 = r_hi * eh0 * eh1 + r_lo * el0 * el1;
+      const double m11 = r_hi * eh1 * eh1 + r_lo * el1 * el1;
       const double wsum = face.w[0] + face.w[1] + face.w[2];
-      const Eigen::Vector3d xc = (face.w[0] * x0 + face.w[1] * x1 + face.w[2] * x2) / wsum;
-      for (int c = 0; c < 3; ++c)
-        if (!face.pinned[c]) {
-          x.row(face.v[c]) = (xc + Fn * face.du[c]).transpose();
-          moved_next_[face.v[c]] = 1;
-        }
+      double xc[3];
+      for (int r = 0; r < 3; ++r) xc[r] = (face.w[0] * x0[r] + face.w[1] * x1[r] + face.w[2] * x2[r]) / wsum;
+      for (int c = 0; c < 3; ++c) {
+        if (face.pinned[c]) continue;
+        // x_c' = xc + F M du_c.
+        const double a = m00 * face.du[c].x() + m01 * face.du[c].y();
+        const double b = m01 * face.du[c].x() + m11 * face.du[c].y();
+        double* xv = X + 3 * face.v[c];
+        for (int r = 0; r < 3; ++r) xv[r] = xc[r] + Fu[r] * a + Fv[r] * b;
+        moved_next_[face.v[c]] = 1;
+      }
     }
     if (sweep == 0) initially_violated = violated;
     if (violated == 0) break;
     moved_.swap(moved_next_);
     std::fill(moved_next_.begin(), moved_next_.end(), 0);
   }
-  *vp += (x - before_) / dt;
+  const double inv_dt = 1.0 / dt;
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double moved = X[3 * i + c] - x(i, c);
+      (*vp)(i, c) += moved * inv_dt;
+      x(i, c) = X[3 * i + c];
+    }
   return initially_violated;
 }
 

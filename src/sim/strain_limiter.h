@@ -41,7 +41,7 @@ class StrainLimiter {
     Eigen::Vector2d du[3];  // u_i - weighted centroid of u
   };
   std::vector<Face> faces_;
-  Eigen::MatrixX3d before_;
+  std::vector<double> work_;  // interleaved positions during the sweeps
   std::vector<char> moved_, moved_next_;
 };
 
