@@ -26,7 +26,7 @@ struct SimOptions {
   // Principal-stretch limits (ArcSim "strain_limits", e.g. 0.95, 1.05); 0 / inf switch a side off.
   double strain_min = 0.0;
   double strain_max = std::numeric_limits<double>::infinity();
-  int strain_limit_iterations = 10;                 // projection sweeps per step (max)
+  int strain_limit_iterations = 4;                  // projection sweeps per step (max)
   double repulsion_thickness = 10e-3;               // ArcSim magic.repulsion_thickness [m]
   double collision_stiffness = 1e6;                 // ArcSim magic.collision_stiffness [N/m^3]
                                                     // (times min(node area, face area) per pair)

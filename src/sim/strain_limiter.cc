@@ -24,6 +24,7 @@ StrainLimiter::StrainLimiter(const Mesh& mesh, const Eigen::VectorXd& mass,
       uc += face.w[c] * u[c];
     }
     uc /= wsum;
+    for (int c = 0; c < 3; ++c) face.w[c] /= wsum;  // normalised: the centroid is a plain weighted sum
     for (int c = 0; c < 3; ++c) face.du[c] = u[c] - uc;
     Eigen::Matrix2d Dm;
     Dm.col(0) = u[1] - u[0];
@@ -72,7 +73,11 @@ int StrainLimiter::Project(double strain_min, double strain_max, int iterations,
       const double c11 = Fv[0] * Fv[0] + Fv[1] * Fv[1] + Fv[2] * Fv[2];
       const double c01 = Fu[0] * Fv[0] + Fu[1] * Fv[1] + Fu[2] * Fv[2];
       const double mean = 0.5 * (c00 + c11);
-      const double rad = std::sqrt(0.25 * (c00 - c11) * (c00 - c11) + c01 * c01);
+      const double rad2 = 0.25 * (c00 - c11) * (c00 - c11) + c01 * c01;
+      // Within limits iff mean + rad <= hi2 and mean - rad >= lo2: decided without a square root.
+      const double room = std::min(hi2 - mean, mean - lo2);
+      if (room >= 0 && rad2 <= room * room) continue;
+      const double rad = std::sqrt(rad2);
       const double l_hi = mean + rad, l_lo = mean - rad;
       if (l_hi <= hi2 && l_lo >= lo2) continue;
       if (!(l_lo > 1e-16)) continue;  // collapsed face: no meaningful direction to restore
@@ -99,9 +104,8 @@ int StrainLimiter::Project(double strain_min, double strain_max, int iterations,
       const double m00 = r_hi * eh0 * eh0 + r_lo * el0 * el0;
       const double m01 = r_hi * eh0 * eh1 + r_lo * el0 * el1;
       const double m11 = r_hi * eh1 * eh1 + r_lo * el1 * el1;
-      const double wsum = face.w[0] + face.w[1] + face.w[2];
       double xc[3];
-      for (int r = 0; r < 3; ++r) xc[r] = (face.w[0] * x0[r] + face.w[1] * x1[r] + face.w[2] * x2[r]) / wsum;
+      for (int r = 0; r < 3; ++r) xc[r] = face.w[0] * x0[r] + face.w[1] * x1[r] + face.w[2] * x2[r];
       for (int c = 0; c < 3; ++c) {
         if (face.pinned[c]) continue;
         // x_c' = xc + F M du_c.

@@ -36,7 +36,7 @@ class StrainLimiter {
   struct Face {
     int v[3];
     Eigen::Matrix2d Dm_inv;
-    double w[3];            // projection weights (masses; huge for pinned vertices)
+    double w[3];            // projection weights (masses, huge for pinned vertices; sum 1)
     bool pinned[3];
     Eigen::Vector2d du[3];  // u_i - weighted centroid of u
   };
