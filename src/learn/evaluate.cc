@@ -1,5 +1,6 @@
 #include "learn/evaluate.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -78,9 +79,11 @@ nlohmann::json EvalJson(const EvalResult& r) {
 std::string EvalTable(const EvalResult& r) {
   std::ostringstream s;
   const std::string model = r.config.arch == "sdn" ? "SDN" : "ResNet-18";
-  s << std::left << std::setw(28) << "Model" << std::setw(18) << "Input Modality" << std::setw(10) << "RMSE"
+  const std::string name = model + " (" + r.config.Name() + ")";
+  const int width = std::max<int>(28, static_cast<int>(name.size()) + 2);
+  s << std::left << std::setw(width) << "Model" << std::setw(18) << "Input Modality" << std::setw(10) << "RMSE"
     << "Acc@0.5\n";
-  s << std::setw(28) << (model + " (" + r.config.Name() + ")") << std::setw(18) << r.config.Modality()
+  s << std::setw(width) << name << std::setw(18) << r.config.Modality()
     << std::setw(10) << std::fixed << std::setprecision(3) << r.metrics.rmse << r.metrics.acc05 << "\n";
   s << "(" << r.metrics.count << " examples, split " << r.split << ")\n";
   return s.str();
