@@ -92,6 +92,22 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
   EXPECT_DOUBLE_EQ(j["acc05"].get<double>(), again.acc05);
   EXPECT_EQ(j["count"].get<int>(), static_cast<int>(val.size()));
   for (double s : e.predicted_std) EXPECT_TRUE(std::isfinite(s) && s > 0);
+  // The plots are PNGs made by gnuplot (installed with the project's dependencies).
+  EXPECT_EQ(r.plot_error, "");
+  std::string error;
+  const fs::path png = r.model.parent_path() / "eval_val.png";
+  ASSERT_TRUE(PlotPredictions(e, png, &error)) << error;
+  for (const fs::path& p : {png, r.model.parent_path() / "learning_curve.png"}) {
+    std::ifstream in(p, std::ios::binary);
+    char magic[4] = {};
+    in.read(magic, 4);
+    EXPECT_EQ(std::string(magic + 1, 3), "PNG") << p;
+  }
+  // log.tsv: a header and one line per epoch.
+  std::ifstream log(r.model.parent_path() / "log.tsv");
+  int lines = 0;
+  for (std::string line; std::getline(log, line);) ++lines;
+  EXPECT_EQ(lines, 13);
 }
 
 TEST_F(TrainTest, CheckpointRoundTripGivesIdenticalPredictions) {
