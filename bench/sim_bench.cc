@@ -3,7 +3,7 @@
 // (/work/shared/reference/arcsim.md) and the flag's behaviour (droop, fly-corner RMS, frequency)
 // so speed and fidelity are read together.
 //
-//   sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--winds 1,3,6,10]
+//   sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10]
 //             [--frame-steps N] [--cg-tolerance T]
 // Default scene: $CLOTHWIND_SHARED_DIR/arcsim/conf/flag.json (ArcSim's own, so the comparison is
 // like for like), else config/scenes/flag.json under $CLOTHWIND_SOURCE_DIR or the working dir.
@@ -73,6 +73,8 @@ int main(int argc, char** argv) {
       duration = std::stod(next());
     } else if (a == "--max-edge") {
       max_edge = std::stod(next());
+    } else if (a == "--split-edge") {
+      build.split_edge = std::stod(next());
     } else if (a == "--frame-steps") {
       build.frame_steps = std::stoi(next());
     } else if (a == "--cg-tolerance") {
@@ -84,7 +86,7 @@ int main(int argc, char** argv) {
       while (std::getline(ss, item, ',')) winds.push_back(std::stod(item));
     } else {
       std::fprintf(stderr,
-                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T]\n");
+                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T]\n");
       return 2;
     }
   }

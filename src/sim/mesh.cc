@@ -1,5 +1,6 @@
 #include "sim/mesh.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -268,6 +269,90 @@ Mesh RefineMesh(const Mesh& input, double max_edge) {
     mesh = std::move(next);
   }
   return mesh;
+}
+
+Mesh SplitLongEdges(const Mesh& input, double max_edge) {
+  if (!(max_edge > 0)) throw std::invalid_argument("SplitLongEdges: max_edge must be > 0");
+  ValidateMesh(input, "SplitLongEdges input");
+  Mesh mesh = input;
+  auto length = [](const Mesh& m, int a, int b) {
+    return std::max((m.V.row(a) - m.V.row(b)).norm(), (m.U.row(a) - m.U.row(b)).norm());
+  };
+  for (int pass = 0;; ++pass) {
+    const int nv = static_cast<int>(mesh.V.rows()), nf = static_cast<int>(mesh.F.rows());
+    std::map<std::pair<int, int>, int> midpoint;
+    std::vector<Eigen::Vector3d> newV;
+    std::vector<Eigen::Vector2d> newU;
+    // Midpoint of edge (a, b) if it is long, else -1.
+    auto mid = [&](int a, int b) {
+      if (length(mesh, a, b) <= max_edge) return -1;
+      const auto key = std::minmax(a, b);
+      auto it = midpoint.find(key);
+      if (it != midpoint.end()) return it->second;
+      const int id = nv + static_cast<int>(newV.size());
+      newV.push_back(0.5 * (mesh.V.row(a) + mesh.V.row(b)).transpose());
+      newU.push_back(0.5 * (mesh.U.row(a) + mesh.U.row(b)).transpose());
+      midpoint.emplace(key, id);
+      return id;
+    };
+    auto u_of = [&](int i) -> Eigen::Vector2d {
+      return i < nv ? Eigen::Vector2d(mesh.U.row(i).transpose()) : newU[i - nv];
+    };
+    std::vector<Eigen::Vector3i> faces;
+    faces.reserve(4 * nf);
+    for (int f = 0; f < nf; ++f) {
+      const int v[3] = {mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2)};
+      int m[3];
+      for (int c = 0; c < 3; ++c) m[c] = mid(v[c], v[(c + 1) % 3]);
+      const int split = (m[0] >= 0) + (m[1] >= 0) + (m[2] >= 0);
+      if (split == 0) {
+        faces.emplace_back(v[0], v[1], v[2]);
+      } else if (split == 3) {
+        faces.emplace_back(v[0], m[0], m[2]);
+        faces.emplace_back(m[0], v[1], m[1]);
+        faces.emplace_back(m[2], m[1], v[2]);
+        faces.emplace_back(m[0], m[1], m[2]);
+      } else {
+        // Rotate (keeping the orientation) so that edge (a, b) is split, and for two splits
+        // also (b, c) while (c, a) is not.
+        int r = 0;
+        if (split == 1) {
+          while (m[r] < 0) ++r;
+        } else {
+          while (m[(r + 2) % 3] >= 0) ++r;
+        }
+        const int a = v[r], b = v[(r + 1) % 3], c = v[(r + 2) % 3], mab = m[r], mbc = m[(r + 1) % 3];
+        if (split == 1) {
+          faces.emplace_back(a, mab, c);
+          faces.emplace_back(mab, b, c);
+        } else {
+          faces.emplace_back(mab, b, mbc);
+          // The quad (a, mab, mbc, c), cut along its shorter diagonal.
+          if ((u_of(a) - u_of(mbc)).norm() <= (u_of(mab) - u_of(c)).norm()) {
+            faces.emplace_back(a, mab, mbc);
+            faces.emplace_back(a, mbc, c);
+          } else {
+            faces.emplace_back(a, mab, c);
+            faces.emplace_back(mab, mbc, c);
+          }
+        }
+      }
+    }
+    if (newV.empty()) return mesh;
+    if (pass >= 12) throw std::invalid_argument("SplitLongEdges: max_edge not reached in 12 passes");
+    Mesh next;
+    next.V.resize(nv + newV.size(), 3);
+    next.U.resize(nv + newU.size(), 2);
+    next.V.topRows(nv) = mesh.V;
+    next.U.topRows(nv) = mesh.U;
+    for (size_t i = 0; i < newV.size(); ++i) {
+      next.V.row(nv + i) = newV[i].transpose();
+      next.U.row(nv + i) = newU[i].transpose();
+    }
+    next.F.resize(faces.size(), 3);
+    for (size_t i = 0; i < faces.size(); ++i) next.F.row(i) = faces[i].transpose();
+    mesh = std::move(next);
+  }
 }
 
 double MaxEdgeLength(const Mesh& mesh) {

@@ -152,5 +152,49 @@ TEST(RefineMeshTest, PreservesAreaAndBoundaryAndBoundsEdges) {
   EXPECT_THROW(RefineMesh(m, 0.0), std::invalid_argument);
 }
 
+TEST(SplitLongEdgesTest, SplitsOnlyLongEdgesAndStaysConforming) {
+  // An irregular start: the rectangle refined once, then one vertex pulled sideways (in V and U)
+  // so its edges differ in length.
+  Mesh m = RefineMesh(Rectangle(), 0.5);  // edges 0.25, 0.375 and diagonals 0.45
+  ASSERT_GT(m.V.rows(), 4);
+  m.V(4, 0) += 0.1;
+  m.U(4, 0) += 0.1;
+  m.V.col(2) = 0.2 * m.V.col(0);  // tilted (planar) world shape
+  ValidateMesh(m);
+  const double area = SurfaceArea(m), rest = RestArea(m);
+  const double max_edge = 0.4;
+  const Mesh r = SplitLongEdges(m, max_edge);
+  EXPECT_LE(MaxEdgeLength(r), max_edge);
+  for (int f = 0; f < r.F.rows(); ++f)
+    for (int c = 0; c < 3; ++c)
+      EXPECT_LE((r.U.row(r.F(f, c)) - r.U.row(r.F(f, (c + 1) % 3))).norm(), max_edge + 1e-12);
+  EXPECT_NEAR(SurfaceArea(r), area, 1e-12 * area);
+  EXPECT_NEAR(RestArea(r), rest, 1e-12 * rest);
+  EXPECT_EQ(r.V.topRows(m.V.rows()), m.V);
+  EXPECT_EQ(r.U.topRows(m.U.rows()), m.U);
+  EXPECT_NO_THROW(ValidateMesh(r));
+  // Conforming and consistently oriented: every directed edge once, and every interior edge in
+  // both directions (no hanging midpoints); the boundary is the rectangle's perimeter.
+  std::set<std::pair<int, int>> directed;
+  for (int f = 0; f < r.F.rows(); ++f)
+    for (int c = 0; c < 3; ++c)
+      EXPECT_TRUE(directed.insert({r.F(f, c), r.F(f, (c + 1) % 3)}).second) << "face " << f;
+  double perimeter = 0;
+  for (const auto& [a, b] : directed)
+    if (!directed.count({b, a})) perimeter += (r.U.row(a) - r.U.row(b)).norm();
+  EXPECT_NEAR(perimeter, 10.0, 1e-12);
+  // Fewer vertices than uniform refinement to the same bound, and short edges kept: some edge
+  // of the input survives unsplit.
+  EXPECT_LT(r.V.rows(), RefineMesh(m, max_edge).V.rows());
+  int kept = 0;
+  for (const auto& [a, b] : directed) kept += (a < m.V.rows() && b < m.V.rows());
+  EXPECT_GT(kept, 0);
+  // Nothing to split: the same mesh.
+  const Mesh same = SplitLongEdges(r, max_edge);
+  EXPECT_EQ(same.V, r.V);
+  EXPECT_EQ(same.F, r.F);
+  EXPECT_THROW(SplitLongEdges(m, 0.0), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace clothwind::sim

@@ -1,5 +1,6 @@
 #include "sim/scene_builder.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
@@ -8,7 +9,12 @@ namespace clothwind::sim {
 
 double DefaultMaxEdge(const SceneRemeshing& remeshing) {
   if (!remeshing.present) return 0.0;
-  return 0.5 * remeshing.size_max;
+  return 0.4 * remeshing.size_max;
+}
+
+double DefaultUniformEdge(const SceneRemeshing& remeshing) {
+  if (!remeshing.present) return 0.0;
+  return remeshing.size_max;
 }
 
 Eigen::MatrixX3d ApplyTransform(const SceneTransform& t, const Eigen::MatrixX3d& V) {
@@ -49,14 +55,17 @@ SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
       fail(key + ".mesh", e.what());
     }
     cloth.original_vertices = static_cast<int>(mesh.V.rows());
-    cloth.max_edge = options.max_edge > 0 ? options.max_edge : DefaultMaxEdge(sc.remeshing);
-    if (cloth.max_edge > 0) {
-      try {
-        mesh = RefineMesh(mesh, cloth.max_edge);
-      } catch (const std::exception& e) {
-        fail(key + ".remeshing", e.what());
-      }
+    const double uniform = options.max_edge > 0 ? options.max_edge : DefaultUniformEdge(sc.remeshing);
+    const double split = options.split_edge > 0 ? options.split_edge
+                         : options.max_edge > 0 ? 0.0
+                                                : DefaultMaxEdge(sc.remeshing);
+    try {
+      if (uniform > 0) mesh = RefineMesh(mesh, uniform);
+      if (split > 0) mesh = SplitLongEdges(mesh, split);
+    } catch (const std::exception& e) {
+      fail(key + ".remeshing", e.what());
     }
+    cloth.max_edge = uniform > 0 && split > 0 ? std::min(uniform, split) : std::max(uniform, split);
     cloth.mesh = std::move(mesh);
 
     const SceneMaterial& sm = sc.materials.front();

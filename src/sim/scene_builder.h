@@ -19,7 +19,7 @@ struct ClothSetup {
   Material material;  // multipliers applied
   SimOptions options; // dt, gravity, wind density/drag, handles (refined indices), limits, magic
   int original_vertices = 0;  // #V of the OBJ before refinement (handles index these)
-  double max_edge = 0.0;      // edge length the mesh was refined to [m] (0: not refined)
+  double max_edge = 0.0;      // longest edge the mesh was refined to [m] (0: not refined)
 };
 
 // A scene loaded from disk once, so that many simulations (threads, parameter vectors) can share
@@ -31,17 +31,24 @@ struct SceneSetup {
 };
 
 struct BuildOptions {
-  // Longest edge after refinement [m]. 0: half the upper end of the scene's remeshing size
-  // range (0.25 m for the flag's [0.02, 0.5] m): ArcSim keeps flat, slowly moving cloth at the
-  // upper size and refines only where curvature and velocity demand; a static mesh must resolve
-  // the flapping wave everywhere, whose wavelength on a 3 m flag at 10 m/s is ~2.5-3 m, so
-  // size_max/2 gives >= 10 edges per wavelength. At that size the ArcSim flag's droop and
-  // flapping match ArcSim's (flag_behaviour_test, docs/scenes.md) at a fraction of its cost.
-  // No remeshing block: no refinement.
+  // Longest edge after uniform (RefineMesh, 1-to-4) refinement [m]; no remeshing block: none.
+  // 0: the scene's default resolution (DefaultMaxEdge): uniform refinement to size_max, then
+  // only the edges still longer than 0.4 size_max are split (SplitLongEdges). Why: ArcSim keeps
+  // flat, slowly moving cloth at the upper size and refines only where curvature and velocity
+  // demand; a static mesh must resolve the flapping wave everywhere, whose wavelength on a 3 m
+  // flag at 10 m/s is ~2.5-3 m, so every edge <= 0.4 size_max (0.2 m for the flag's [0.02, 0.5]
+  // m) gives >= 12 edges per wavelength; splitting only the long edges of ArcSim's irregular
+  // flag.obj gets there with 485 vertices, where uniform refinement to 0.25 m needs 811. At that
+  // resolution the ArcSim flag's droop and flapping match ArcSim's (flag_behaviour_test,
+  // docs/scenes.md), ~8x faster than real time on one core. (max_edge 0.25 reproduces the
+  // former 811-vertex default.)
   double max_edge = 0.0;
   // Time steps per frame; 0: the scene's frame_steps. Fewer steps are cheaper but damp the
   // flapping (ArcSim's flag at 10 m/s: ~1.4 Hz with 8 steps of 5 ms, ~0.9 Hz with 2 of 20 ms).
   int frame_steps = 0;
+  // > 0: after the uniform refinement, split only the edges still longer than this [m]
+  // (SplitLongEdges); with max_edge 0 it replaces the default's 0.4 size_max. 0: off (default).
+  double split_edge = 0.0;
 };
 
 // Loads meshes and materials and derives simulator settings.
@@ -53,8 +60,11 @@ struct BuildOptions {
 // (degenerate triangles, NaN), or a handle node is out of range.
 SceneSetup BuildScene(const Scene& scene, const BuildOptions& options = {});
 
-// The resolution BuildScene picks for a remeshing block (see BuildOptions::max_edge) [m].
+// The default resolution BuildScene picks for a remeshing block (see BuildOptions::max_edge):
+// the longest edge [m], 0.4 size_max (0 without a remeshing block). The mesh is first refined
+// uniformly to DefaultUniformEdge (size_max), then its longer edges are split.
 double DefaultMaxEdge(const SceneRemeshing& remeshing);
+double DefaultUniformEdge(const SceneRemeshing& remeshing);
 
 // Applies a scene transform to positions: x -> translate + R(rotate) (scale x).
 // Inputs: V #V by 3 [m]. Returns #V by 3 [m].

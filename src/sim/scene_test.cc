@@ -119,9 +119,14 @@ TEST(BuildScene, ArcSimFlagHangsInTheYZPlaneWithTheHoistOnTheZAxis) {
   ASSERT_EQ(setup.cloths.size(), 1u);
   const ClothSetup& c = setup.cloths[0];
   EXPECT_EQ(c.original_vertices, 58);
-  EXPECT_NEAR(c.max_edge, 0.25, 1e-12);  // half of the size range's upper end, 0.5 m
-  EXPECT_LE(MaxEdgeLength(c.mesh), 0.25 + 1e-9);
-  EXPECT_GT(c.mesh.V.rows(), 500);  // refined (811 vertices with RefineMesh's midpoint split)
+  EXPECT_NEAR(c.max_edge, 0.2, 1e-12);  // 0.4 of the size range's upper end, 0.5 m
+  EXPECT_LE(MaxEdgeLength(c.mesh), 0.2 + 1e-9);
+  // Refined (485 vertices: uniform to 0.5 m, then the longer edges split), fewer than the
+  // uniform refinement to 0.25 m (811 vertices, whose longest edge is still longer).
+  EXPECT_GT(c.mesh.V.rows(), 400);
+  const Mesh uniform = BuildScene(LoadScene(path), BuildOptions{0.25}).cloths[0].mesh;
+  EXPECT_LT(c.mesh.V.rows(), uniform.V.rows());
+  EXPECT_GT(MaxEdgeLength(uniform), MaxEdgeLength(c.mesh));
   EXPECT_NEAR(SurfaceArea(c.mesh), 6.0, 1e-9);
   EXPECT_NEAR(RestArea(c.mesh), 6.0, 1e-9);
   EXPECT_LT(c.mesh.V.col(0).cwiseAbs().maxCoeff(), 1e-9);  // x = 0: the y-z plane
