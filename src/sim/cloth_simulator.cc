@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -61,6 +62,7 @@ struct ClothSimulator::Impl {
   double t = 0;
   long steps = 0;
   StepStats stats;
+  std::string failure;  // why the state blew up ("" while it has not)
 
   // Block-sparse (3x3 blocks) symmetric system matrix with a fixed pattern, stored in full.
   std::vector<int> row_start;   // nv + 1
@@ -85,6 +87,7 @@ struct ClothSimulator::Impl {
   int BlockIndexInFace(int face, int i, int j) const { return faces[face].block[3 * i + j]; }
   void ComputeForces(bool with_jacobian, bool with_repulsion);
   void Solve();
+  void CheckState();
   ClothEnergy Energy() const;
 };
 
@@ -110,6 +113,7 @@ void ClothSimulator::Impl::Build() {
     throw std::invalid_argument("SimOptions.repulsion_thickness and collision_stiffness must be >= 0");
   if (!(options.cg_tolerance > 0) || options.cg_max_iterations < 1)
     throw std::invalid_argument("SimOptions.cg_tolerance must be > 0 and cg_max_iterations >= 1");
+  if (!(options.max_speed > 0)) throw std::invalid_argument("SimOptions.max_speed must be > 0 [m/s]");
   if (!(material.density > 0) || material.stretching_samples.empty())
     throw std::invalid_argument("ClothSimulator: material is not initialised (use MakeMaterial/LoadArcSimMaterial)");
   pinned.assign(nv, 0);
@@ -419,6 +423,40 @@ void ClothSimulator::Impl::Solve() {
   stats.cg_relative_residual = rel;
 }
 
+// Records (failure) and throws when the state has blown up: non-finite, or faster than
+// max_speed. One pass over x and v, negligible next to a step.
+void ClothSimulator::Impl::CheckState() {
+  const double max_speed2 = options.max_speed * options.max_speed;
+  // Non-finite forces first: CG then stops at once (NaN residual) and would leave the state
+  // finite but wrong, so they must be caught here rather than in x and v.
+  const bool forces_finite = f.allFinite();
+  for (int i = 0; i < nv; ++i) {
+    const double speed2 = v.row(i).squaredNorm();
+    const bool force_finite = forces_finite || f.segment<3>(3 * i).allFinite();
+    const bool finite = x.row(i).allFinite() && v.row(i).allFinite();
+    if (force_finite && finite && speed2 <= max_speed2) continue;
+    char what[512];
+    if (!force_finite)
+      std::snprintf(what, sizeof(what), "vertex %d has a non-finite force (wind field or element forces)", i);
+    else if (!finite)
+      std::snprintf(what, sizeof(what), "vertex %d has a non-finite %s", i,
+                    x.row(i).allFinite() ? "velocity" : "position");
+    else
+      std::snprintf(what, sizeof(what), "vertex %d moves at %.4g m/s (more than SimOptions.max_speed = %g m/s)",
+                    i, std::sqrt(speed2), options.max_speed);
+    char step[512];
+    std::snprintf(step, sizeof(step),
+                  "; that step: %d CG iterations (relative residual %.3g), %d strain-limited faces, "
+                  "%d repulsion pairs",
+                  stats.cg_iterations, stats.cg_relative_residual, stats.strain_limited_faces,
+                  stats.repulsion_pairs);
+    char head[128];
+    std::snprintf(head, sizeof(head), "ClothSimulator: the simulation blew up at t = %.4f s (step %ld): ", t, steps);
+    failure = std::string(head) + what + step;
+    throw std::runtime_error(failure);
+  }
+}
+
 ClothEnergy ClothSimulator::Impl::Energy() const {
   ClothEnergy e;
   for (int i = 0; i < nv; ++i) {
@@ -461,6 +499,7 @@ ClothSimulator& ClothSimulator::operator=(ClothSimulator&&) noexcept = default;
 
 void ClothSimulator::Step() {
   Impl& s = *impl_;
+  if (!s.failure.empty()) throw std::runtime_error(s.failure + " (stepped again after that)");
   using Clock = std::chrono::steady_clock;
   auto seconds = [](Clock::time_point a, Clock::time_point b) {
     return std::chrono::duration<double>(b - a).count();
@@ -495,6 +534,7 @@ void ClothSimulator::Step() {
   s.stats.seconds_strain_limit = seconds(t3, t4);
   ++s.steps;
   s.t = s.steps * h;
+  s.CheckState();
 }
 
 double ClothSimulator::time() const { return impl_->t; }
@@ -513,6 +553,7 @@ void ClothSimulator::SetState(const Eigen::MatrixX3d& positions, const Eigen::Ma
   for (int i = 0; i < s.nv; ++i)
     if (s.pinned[i]) s.v.row(i).setZero();
   s.dv.setZero();
+  s.failure.clear();
 }
 
 void ClothSimulator::set_wind(std::shared_ptr<const WindField> wind) { impl_->wind = std::move(wind); }

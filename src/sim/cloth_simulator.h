@@ -39,6 +39,9 @@ struct SimOptions {
   BendingSolve bending_solve = BendingSolve::kAuto;
   double cg_tolerance = 1e-2;                       // relative residual of the linear solve
   int cg_max_iterations = 300;
+  // A vertex faster than this [m/s] means the state has exploded (a flag in a 30 m/s gale moves
+  // at tens of m/s): Step throws instead of carrying on (see Step).
+  double max_speed = 1e3;
 };
 
 // Energies of the current state [J].
@@ -88,6 +91,11 @@ class ClothSimulator {
   ClothSimulator& operator=(ClothSimulator&&) noexcept;
 
   // Advances the state by one time step options().dt.
+  // Throws std::runtime_error, naming the simulated time, the vertex and what went wrong, when
+  // the step meets a non-finite force or leaves a non-finite position or velocity or a speed
+  // above options().max_speed (an exploded simulation: carrying on would only produce garbage,
+  // and slowly). The state is then left as the step made it, for diagnostics, and every further
+  // Step throws the same error until SetState gives a valid state.
   void Step();
 
   // Simulated time [s] (steps taken * dt).

@@ -23,6 +23,16 @@ std::uint64_t Mix(std::uint64_t key) {
   return key;
 }
 
+// Cell index of coordinate c for 1/cell = inv; callers pass finite c of moderate size.
+std::int64_t CellIndex(double c, double inv) { return static_cast<std::int64_t>(std::floor(c * inv)); }
+
+// A face whose bounding box spans more cells than this along an axis is skipped. A face of a
+// simulated cloth spans ~2-4 cells (the cell is about its edge length); thousands mean the state
+// has exploded (or holds inf/NaN, for which floor() cast to an integer is undefined). Looping
+// over such a box would take practically forever (cells^3), turning a blow-up into a hang,
+// while its pairs would be meaningless anyway: the simulator reports the exploded state itself.
+constexpr double kMaxCellsPerAxis = 32;
+
 }  // namespace
 
 VertexFaceProximity::VertexFaceProximity(const Eigen::MatrixX3i& F, int num_vertices, double cell_size)
@@ -42,10 +52,17 @@ void VertexFaceProximity::Update(const Eigen::MatrixX3d& X, double thickness) {
   const std::uint64_t mask = bucket_head_.size() - 1;
   std::fill(bucket_head_.begin(), bucket_head_.end(), -1);
   // Insert in reverse so each bucket lists vertices in increasing order.
+  // Vertices beyond +-kFar cells (or non-finite) are left out of the grid: converting their
+  // cell coordinate to an integer would overflow, and no face they could be near is searched.
+  constexpr double kFar = 1e15;
   for (int i = num_vertices_ - 1; i >= 0; --i) {
-    key_[i] = CellKey(static_cast<std::int64_t>(std::floor(X(i, 0) * inv)),
-                      static_cast<std::int64_t>(std::floor(X(i, 1) * inv)),
-                      static_cast<std::int64_t>(std::floor(X(i, 2) * inv)));
+    const Eigen::Vector3d c = X.row(i).transpose() * inv;
+    if (!c.allFinite() || !(c.cwiseAbs().maxCoeff() < kFar)) {
+      next_[i] = -1;
+      key_[i] = ~std::uint64_t{0};
+      continue;
+    }
+    key_[i] = CellKey(CellIndex(X(i, 0), inv), CellIndex(X(i, 1), inv), CellIndex(X(i, 2), inv));
     int& head = bucket_head_[Mix(key_[i]) & mask];
     next_[i] = head;
     head = i;
@@ -55,16 +72,17 @@ void VertexFaceProximity::Update(const Eigen::MatrixX3d& X, double thickness) {
     const Eigen::Vector3d a = X.row(ia), b = X.row(ib), c = X.row(ic);
     const Eigen::Vector3d lo = a.cwiseMin(b).cwiseMin(c).array() - thickness;
     const Eigen::Vector3d hi = a.cwiseMax(b).cwiseMax(c).array() + thickness;
+    // Exploded or non-finite face (see kMaxCellsPerAxis): skipped.
+    if (!lo.allFinite() || !hi.allFinite() || !((hi - lo).maxCoeff() * inv <= kMaxCellsPerAxis) ||
+        !(lo.cwiseAbs().maxCoeff() * inv < kFar) || !(hi.cwiseAbs().maxCoeff() * inv < kFar))
+      continue;
     const Eigen::Vector3d N = (b - a).cross(c - a);
     const double nn = N.squaredNorm();
-    if (nn == 0) continue;
+    if (!(nn > 0)) continue;
     const Eigen::Vector3d n = N / std::sqrt(nn);
-    const auto i0 = static_cast<std::int64_t>(std::floor(lo.x() * inv)),
-               i1 = static_cast<std::int64_t>(std::floor(hi.x() * inv));
-    const auto j0 = static_cast<std::int64_t>(std::floor(lo.y() * inv)),
-               j1 = static_cast<std::int64_t>(std::floor(hi.y() * inv));
-    const auto k0 = static_cast<std::int64_t>(std::floor(lo.z() * inv)),
-               k1 = static_cast<std::int64_t>(std::floor(hi.z() * inv));
+    const auto i0 = CellIndex(lo.x(), inv), i1 = CellIndex(hi.x(), inv);
+    const auto j0 = CellIndex(lo.y(), inv), j1 = CellIndex(hi.y(), inv);
+    const auto k0 = CellIndex(lo.z(), inv), k1 = CellIndex(hi.z(), inv);
     found_.clear();
     for (auto i = i0; i <= i1; ++i)
       for (auto j = j0; j <= j1; ++j)

@@ -26,7 +26,10 @@ class VertexFaceProximity {
   //   cell_size     hash grid cell [m] (> 0), e.g. the mean edge length; raised to 2 thickness
   VertexFaceProximity(const Eigen::MatrixX3i& F, int num_vertices, double cell_size);
 
-  // Recomputes the pairs for positions X (#V by 3) [m] and thickness [m] (> 0).
+  // Recomputes the pairs for positions X (#V by 3) [m] and thickness [m] (> 0). Stays bounded
+  // (about 33^3 cells per face at most) on any input: non-finite or astronomically far vertices
+  // are left out, and faces whose bounding box is non-finite or spans more than 32 cells along an
+  // axis (an exploded state, never a cloth's face: the cell is about an edge) are skipped.
   void Update(const Eigen::MatrixX3d& X, double thickness);
 
   // Pairs found by the last Update.
