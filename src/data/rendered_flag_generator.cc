@@ -67,9 +67,14 @@ cv::Mat RenderedFlagGenerator::Render(double t, const sensors::SyntheticWind& /*
   last_t_ = t;
   const double target = t + options_.warmup;  // simulator time
   const double dt = sim_->options().dt;
-  while (sim_->time() < target) {
-    previous_ = sim_->positions();
-    sim_->Step();
+  try {
+    while (sim_->time() < target) {
+      previous_ = sim_->positions();
+      sim_->Step();
+    }
+  } catch (const std::runtime_error& e) {  // the simulator's blow-up check: name the frame
+    throw std::runtime_error("rendered session: frame at session time " + std::to_string(t) + " s (simulator time " +
+                             std::to_string(target) + " s, warm-up included): " + e.what());
   }
   const Eigen::MatrixX3d& current = sim_->positions();
   if (!current.allFinite()) throw std::runtime_error("rendered session: the flag simulation diverged");
