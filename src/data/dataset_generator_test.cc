@@ -165,6 +165,24 @@ TEST_F(DatasetGeneratorTest, ResumesAfterAKillWithoutRedoingFinishedExamples) {
   EXPECT_EQ(again.simulated, 0);
 }
 
+TEST_F(DatasetGeneratorTest, BlownUpSimulationIsRecordedAsFailedAndWritesNothing) {
+  // A 1e5 m/s wind tears the flag apart in the first step: the simulator's blow-up check must
+  // stop each simulation (no hang, no half-written example) and the run must report them.
+  DatasetOptions o = Tiny((root_ / "blown_up").string());
+  o.count = 2;
+  SamplingRanges r = DefaultRanges(render::SceneKind::kFlag);
+  r.wind_min = r.wind_max = 1e5;
+  o.ranges = r;
+  const DatasetSummary s = GenerateDataset(o);
+  EXPECT_EQ(s.simulated, 2);
+  EXPECT_EQ(s.failed, 2);
+  EXPECT_EQ(s.examples_written, 0);
+  ASSERT_EQ(s.errors.size(), 2u);
+  for (const std::string& e : s.errors) EXPECT_NE(e.find("blew up at t = "), std::string::npos) << e;
+  for (const auto& entry : fs::directory_iterator(root_ / "blown_up"))
+    EXPECT_FALSE(entry.is_directory()) << "example folder written: " << entry.path();
+}
+
 TEST_F(DatasetGeneratorTest, ShardsTogetherEqualOneRun) {
   const fs::path dir = root_ / "shards";
   int64_t total = 0;
