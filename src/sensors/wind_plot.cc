@@ -1,0 +1,148 @@
+#include "sensors/wind_plot.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+namespace clothwind::sensors {
+namespace {
+
+// Plot area margins [px]: room for the y labels on the left, the legend on top, x labels below.
+constexpr int kLeft = 44, kRight = 10, kTop = 22, kBottom = 24;
+
+int PlotTop() { return kTop; }
+int PlotBottom(int height) { return height - kBottom; }
+
+int Column(double t, double t_now, double window, int width) {
+  const double x0 = kLeft, x1 = width - kRight;
+  return static_cast<int>(std::lround(x1 - (t_now - t) / window * (x1 - x0)));
+}
+
+std::string Format(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+// Draws one series as a polyline (and its std band), clipped to the shown window.
+void DrawSeries(cv::Mat& img, const WindHistory& h, double t_now, double window, double y_max,
+                const cv::Scalar& colour, bool band) {
+  std::vector<cv::Point> line;
+  for (const WindSample& s : h.samples()) {
+    if (s.t < t_now - window || s.t > t_now) continue;
+    const int x = Column(s.t, t_now, window, img.cols);
+    if (band && std::isfinite(s.std) && s.std > 0) {
+      // Pale version of the colour: the band stays behind the lines.
+      const cv::Scalar pale = (colour + cv::Scalar(255, 255, 255) * 2) / 3;
+      cv::line(img, {x, WindPlotRow(s.speed + s.std, y_max, img.rows)},
+               {x, WindPlotRow(std::max(0.0, s.speed - s.std), y_max, img.rows)}, pale, 3);
+    }
+    line.emplace_back(x, WindPlotRow(s.speed, y_max, img.rows));
+  }
+  if (line.size() == 1) cv::circle(img, line[0], 3, colour, cv::FILLED);
+  if (line.size() > 1) cv::polylines(img, line, false, colour, 2, cv::LINE_AA);
+  for (const cv::Point& p : line) cv::circle(img, p, 2, colour, cv::FILLED);
+}
+
+}  // namespace
+
+void WindHistory::Add(const WindSample& s) {
+  if (!std::isfinite(s.speed) || !std::isfinite(s.t)) return;
+  if (!samples_.empty() && s.t < samples_.back().t) samples_.clear();
+  samples_.push_back(s);
+  while (!samples_.empty() && samples_.front().t < s.t - span_) samples_.pop_front();
+}
+
+double WindHistory::Mean(double t_now, double window, int* count) const {
+  double sum = 0.0;
+  int n = 0;
+  for (const WindSample& s : samples_) {
+    if (s.t > t_now - window && s.t <= t_now) {
+      sum += s.speed;
+      ++n;
+    }
+  }
+  if (count) *count = n;
+  return n > 0 ? sum / n : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::string WindSummaryText(double estimate, double estimate_std, double anemometer_mean, double window) {
+  std::string text = "estimate ";
+  if (std::isfinite(estimate)) {
+    text += Format("%.1f", estimate);
+    if (std::isfinite(estimate_std) && estimate_std > 0) text += Format(" \xC2\xB1 %.1f", estimate_std);
+    text += " m/s";
+  } else {
+    text += "--";
+  }
+  text += " | anemometer ";
+  text += std::isfinite(anemometer_mean) ? Format("%.1f m/s", anemometer_mean) : std::string("--");
+  text += Format(" (%.0f s mean)", window);
+  return text;
+}
+
+double WindPlotAxisMax(double max_speed) {
+  if (!std::isfinite(max_speed) || max_speed < 2.0) return 2.0;
+  return std::ceil(max_speed * 1.1);  // headroom so the top line is not on the frame
+}
+
+int WindPlotRow(double speed, double y_max, int height) {
+  const double y0 = PlotBottom(height), y1 = PlotTop();
+  return static_cast<int>(std::lround(y0 - speed / y_max * (y0 - y1)));
+}
+
+cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer, double t_now, double window,
+                     int width, int height) {
+  if (width < 160 || height < 120) {
+    throw std::invalid_argument("DrawWindPlot: image " + std::to_string(width) + "x" + std::to_string(height) +
+                                " too small (expected at least 160x120)");
+  }
+  if (!(window > 0)) throw std::invalid_argument("DrawWindPlot: window must be > 0 s");
+  double top = 0.0;
+  for (const WindHistory* h : {&estimate, &anemometer}) {
+    for (const WindSample& s : h->samples()) {
+      if (s.t < t_now - window || s.t > t_now) continue;
+      top = std::max(top, s.speed + (std::isfinite(s.std) ? std::max(0.0, s.std) : 0.0));
+    }
+  }
+  const double y_max = WindPlotAxisMax(top);
+
+  cv::Mat img(height, width, CV_8UC3, kPlotBackground);
+  const cv::Scalar grid(225, 225, 225), ink(60, 60, 60);
+  const double font = 0.4;
+  // Horizontal grid at a round step, labelled in m/s.
+  const double step = y_max <= 4 ? 0.5 : y_max <= 10 ? 1.0 : y_max <= 20 ? 2.0 : 5.0;
+  for (double v = 0.0; v <= y_max + 1e-9; v += step) {
+    const int y = WindPlotRow(v, y_max, height);
+    cv::line(img, {kLeft, y}, {width - kRight, y}, grid, 1);
+    cv::putText(img, Format(step < 1 ? "%.1f" : "%.0f", v), {4, y + 4}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1,
+                cv::LINE_AA);
+  }
+  // Vertical grid every 10 s (every 30 s or 60 s for long windows), labelled in seconds before now.
+  const double tstep = window <= 60 ? 10 : window <= 240 ? 30 : 60;
+  for (double a = 0.0; a <= window + 1e-9; a += tstep) {
+    const int x = Column(t_now - a, t_now, window, width);
+    cv::line(img, {x, PlotTop()}, {x, PlotBottom(height)}, grid, 1);
+    cv::putText(img, Format("-%.0f s", a), {x - 14, height - 8}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1,
+                cv::LINE_AA);
+  }
+  cv::rectangle(img, {kLeft, PlotTop()}, {width - kRight, PlotBottom(height)}, ink, 1);
+
+  DrawSeries(img, estimate, t_now, window, y_max, kEstimateColour, true);
+  DrawSeries(img, anemometer, t_now, window, y_max, kAnemometerColour, false);
+
+  // Legend on the top margin.
+  cv::putText(img, "m/s", {4, 14}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1, cv::LINE_AA);
+  cv::line(img, {kLeft, 10}, {kLeft + 18, 10}, kEstimateColour, 2);
+  cv::putText(img, "estimate", {kLeft + 22, 14}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1, cv::LINE_AA);
+  cv::line(img, {kLeft + 100, 10}, {kLeft + 118, 10}, kAnemometerColour, 2);
+  cv::putText(img, "anemometer", {kLeft + 122, 14}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1, cv::LINE_AA);
+  return img;
+}
+
+}  // namespace clothwind::sensors

@@ -1,0 +1,84 @@
+// What the monitoring display shows of the wind: a short history of speeds (the estimator's and
+// the anemometer's), its windowed mean, the one-line summary text and a time-series image.
+// ROS-free so the drawing is tested without rviz; nodes/wind_display_node.cc only moves messages.
+#ifndef CLOTHWIND_SENSORS_WIND_PLOT_H_
+#define CLOTHWIND_SENSORS_WIND_PLOT_H_
+
+#include <deque>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace clothwind::sensors {
+
+// One speed at one time.
+struct WindSample {
+  double t = 0.0;      // [s] any monotonic clock shared by all series (ROS time in seconds)
+  double speed = 0.0;  // [m/s]
+  double std = 0.0;    // [m/s] one standard deviation; NaN or 0 when none
+};
+
+// A time-ordered speed history that forgets samples older than its span.
+class WindHistory {
+ public:
+  // Inputs:
+  //   span  [s] how much history to keep (> 0)
+  explicit WindHistory(double span) : span_(span) {}
+
+  // Appends a sample (non-finite speeds are ignored: they mean "no reading"). A sample older than
+  // the newest one (clock jumped back, e.g. a bag replayed again) clears the history first.
+  void Add(const WindSample& s);
+
+  // Mean speed of the samples with t in (t_now - window, t_now]; NaN when there are none.
+  // Inputs:
+  //   t_now   [s] end of the window
+  //   window  [s] length of the window
+  // Outputs:
+  //   count   number of samples averaged (may be null)
+  double Mean(double t_now, double window, int* count = nullptr) const;
+
+  const std::deque<WindSample>& samples() const { return samples_; }
+  bool empty() const { return samples_.empty(); }
+  const WindSample& back() const { return samples_.back(); }
+
+ private:
+  double span_;
+  std::deque<WindSample> samples_;
+};
+
+// The summary line, e.g. "estimate 3.4 ± 0.3 m/s | anemometer 3.2 m/s (60 s mean)"; a NaN
+// estimate or mean is written as "--", a NaN/zero std is left out.
+// Inputs:
+//   estimate, estimate_std  [m/s] latest estimate and its standard deviation
+//   anemometer_mean         [m/s] anemometer mean over the window
+//   window                  [s] the mean's window
+std::string WindSummaryText(double estimate, double estimate_std, double anemometer_mean, double window);
+
+// Colours (BGR) of the plot's series; the legend and docs/monitor.md name them.
+const cv::Scalar kEstimateColour(0, 140, 255);   // orange line, with a pale ±std band
+const cv::Scalar kAnemometerColour(200, 110, 0); // blue line
+const cv::Scalar kPlotBackground(255, 255, 255);
+
+// Draws estimate vs anemometer speed over the last `window` seconds: time on x (now at the right
+// edge), speed on y from 0 to a rounded-up maximum (at least 2 m/s), grid, axis labels, legend.
+// Inputs:
+//   estimate    estimator's history (std drawn as a band when finite and > 0)
+//   anemometer  anemometer's history
+//   t_now       [s] time at the right edge
+//   window      [s] time span shown (> 0)
+//   width, height  image size [px] (at least 160 by 120)
+// Returns a CV_8UC3 (bgr8) image height by width.
+// Throws std::invalid_argument for a size too small or a window <= 0.
+cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer, double t_now, double window,
+                     int width, int height);
+
+// The pixel row of a speed in a plot DrawWindPlot drew (for tests and overlays).
+// Inputs: speed [m/s], y_max [m/s] top of the axis, height [px] image height
+int WindPlotRow(double speed, double y_max, int height);
+
+// The axis top DrawWindPlot uses for histories whose largest speed (+std) is max_speed [m/s].
+double WindPlotAxisMax(double max_speed);
+
+}  // namespace clothwind::sensors
+
+#endif  // CLOTHWIND_SENSORS_WIND_PLOT_H_

@@ -1,0 +1,86 @@
+#include "sensors/wind_plot.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+namespace clothwind::sensors {
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool HasColourInColumnRange(const cv::Mat& img, int x0, int x1, int y0, int y1, const cv::Scalar& c) {
+  for (int y = std::max(0, y0); y <= std::min(img.rows - 1, y1); ++y) {
+    for (int x = std::max(0, x0); x <= std::min(img.cols - 1, x1); ++x) {
+      const cv::Vec3b p = img.at<cv::Vec3b>(y, x);
+      if (p[0] == c[0] && p[1] == c[1] && p[2] == c[2]) return true;
+    }
+  }
+  return false;
+}
+
+TEST(WindHistoryTest, MeanOverWindowAndForgetting) {
+  WindHistory h(100.0);
+  for (int i = 0; i <= 200; ++i) h.Add({static_cast<double>(i), static_cast<double>(i % 2), 0.0});
+  EXPECT_EQ(h.samples().front().t, 100.0);  // older than span forgotten
+  int n = 0;
+  // (190, 200]: t = 191..200, speeds 1,0,1,0,... -> mean 0.5
+  EXPECT_DOUBLE_EQ(h.Mean(200.0, 10.0, &n), 0.5);
+  EXPECT_EQ(n, 10);
+  EXPECT_TRUE(std::isnan(h.Mean(50.0, 10.0, &n)));
+  EXPECT_EQ(n, 0);
+  h.Add({201.0, kNaN, 0.0});  // no reading: ignored
+  EXPECT_EQ(h.back().t, 200.0);
+  h.Add({5.0, 2.0, 0.0});  // clock jumped back (bag replayed again): start afresh
+  EXPECT_EQ(h.samples().size(), 1u);
+}
+
+TEST(WindPlotTest, SummaryText) {
+  EXPECT_EQ(WindSummaryText(3.42, 0.31, 3.18, 60), "estimate 3.4 \xC2\xB1 0.3 m/s | anemometer 3.2 m/s (60 s mean)");
+  EXPECT_EQ(WindSummaryText(kNaN, kNaN, 2.0, 30), "estimate -- | anemometer 2.0 m/s (30 s mean)");
+  EXPECT_EQ(WindSummaryText(1.0, kNaN, kNaN, 60), "estimate 1.0 m/s | anemometer -- (60 s mean)");
+}
+
+TEST(WindPlotTest, SeriesDrawnAtTheirSpeeds) {
+  WindHistory est(300), anem(300);
+  for (int i = 0; i <= 60; ++i) {
+    est.Add({1000.0 + i, 6.0, 0.0});
+    anem.Add({1000.0 + i, 2.0, 0.0});
+  }
+  const int w = 400, h = 240;
+  const cv::Mat img = DrawWindPlot(est, anem, 1060.0, 60.0, w, h);
+  ASSERT_EQ(img.type(), CV_8UC3);
+  ASSERT_EQ(img.rows, h);
+  const double y_max = WindPlotAxisMax(6.0);
+  EXPECT_GE(y_max, 6.0);
+  const int r_est = WindPlotRow(6.0, y_max, h), r_anem = WindPlotRow(2.0, y_max, h);
+  EXPECT_LT(r_est, r_anem);  // faster wind is higher up
+  // In the middle of the plot each colour sits on its own row and not on the other's.
+  EXPECT_TRUE(HasColourInColumnRange(img, 180, 220, r_est - 1, r_est + 1, kEstimateColour));
+  EXPECT_TRUE(HasColourInColumnRange(img, 180, 220, r_anem - 1, r_anem + 1, kAnemometerColour));
+  EXPECT_FALSE(HasColourInColumnRange(img, 180, 220, r_anem - 1, r_anem + 1, kEstimateColour));
+  EXPECT_FALSE(HasColourInColumnRange(img, 180, 220, r_est - 1, r_est + 1, kAnemometerColour));
+}
+
+TEST(WindPlotTest, OnlyTheWindowIsShown) {
+  WindHistory est(1000), anem(1000);
+  // Estimates only long before the window: nothing of them may appear in the plot area.
+  for (int i = 0; i < 10; ++i) est.Add({static_cast<double>(i), 3.0, 0.5});
+  anem.Add({500.0, 1.0, 0.0});
+  const cv::Mat img = DrawWindPlot(est, anem, 500.0, 60.0, 320, 200);
+  // Legend swatches are in the top margin (rows < 22); the plot area must have no estimate colour.
+  EXPECT_FALSE(HasColourInColumnRange(img, 0, img.cols - 1, 22, img.rows - 1, kEstimateColour));
+  EXPECT_TRUE(HasColourInColumnRange(img, 0, img.cols - 1, 22, img.rows - 1, kAnemometerColour));
+}
+
+TEST(WindPlotTest, BadArguments) {
+  WindHistory a(10), b(10);
+  EXPECT_THROW(DrawWindPlot(a, b, 0.0, 60.0, 100, 200), std::invalid_argument);
+  EXPECT_THROW(DrawWindPlot(a, b, 0.0, 0.0, 320, 200), std::invalid_argument);
+  EXPECT_NO_THROW(DrawWindPlot(a, b, 0.0, 60.0, 320, 200));
+}
+
+}  // namespace
+}  // namespace clothwind::sensors
