@@ -128,8 +128,9 @@ cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer,
   for (double a = 0.0; a <= window + 1e-9; a += tstep) {
     const int x = Column(t_now - a, t_now, window, width);
     cv::line(img, {x, PlotTop()}, {x, PlotBottom(height)}, grid, 1);
-    cv::putText(img, a == 0.0 ? std::string("now") : Format("-%.0f s", a), {x - 14, height - 8}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1,
-                cv::LINE_AA);
+    const bool now = a == 0.0;  // the right edge: label kept inside the image
+    cv::putText(img, now ? std::string("now") : Format("-%.0f s", a), {now ? x - 26 : x - 14, height - 8},
+                cv::FONT_HERSHEY_SIMPLEX, font, ink, 1, cv::LINE_AA);
   }
   cv::rectangle(img, {kLeft, PlotTop()}, {width - kRight, PlotBottom(height)}, ink, 1);
 
