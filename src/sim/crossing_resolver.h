@@ -1,0 +1,81 @@
+#ifndef CLOTHWIND_SIM_CROSSING_RESOLVER_H_
+#define CLOTHWIND_SIM_CROSSING_RESOLVER_H_
+
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace clothwind::sim {
+
+// Undoes vertex-face crossings of one time step (a cheap stand-in for ArcSim's continuous
+// collision handling and impact zones). The repulsion (vertex_face_proximity.h) only sees pairs
+// that start a step within its thickness; a fold moving faster than thickness / dt jumps
+// through a face between two detections, and once through, the repulsion pushes the vertex
+// further along the side it is now on. After the step, this finds every vertex that changed
+// side of a non-incident face while its path crossed the face (linear motion of all four points
+// over the step, the crossing point tested against the face at that moment), and every pair of
+// edges that passed through each other (the sign of their tetrahedron's volume changed and the
+// closest points at that moment lie on both edges), moves it back to
+// its original side at `gap` from the face and removes the approaching normal velocity
+// (inelastic), both shared between the vertex and the face's corners by inverse mass (so
+// momentum and the centre of mass are kept). Sweeps repeat until none is left or
+// `max_sweeps`. Candidates come from a sweep and prune of the swept bounding boxes.
+// Deterministic. Buffers are reused.
+class CrossingResolver {
+ public:
+  // Inputs:
+  //   F             #F by 3 faces (indices < num_vertices)
+  //   inverse_mass  #V inverse node masses [1/kg] (0 = pinned)
+  CrossingResolver(const Eigen::MatrixX3i& F, const Eigen::VectorXd& inverse_mass);
+
+  // Inputs:
+  //   X0   #V by 3 positions at the start of the step [m]
+  //   gap  distance from the face the corrected vertex is put at [m] (>= 0)
+  //   max_sweeps  passes over the candidates (>= 1)
+  // Input/Outputs:
+  //   X    #V by 3 positions at the end of the step [m], corrected
+  //   V    #V by 3 velocities [m/s], approaching normal velocity of corrected pairs removed
+  // Returns the number of corrections made (a pair corrected in two sweeps counts twice).
+  int Resolve(const Eigen::MatrixX3d& X0, double gap, int max_sweeps, Eigen::MatrixX3d* X,
+              Eigen::MatrixX3d* V);
+
+ private:
+  struct Candidate {
+    int vertex;
+    int face;
+  };
+  void FindCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double gap);
+  void FindEdgeCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double gap);
+  // One pass over the candidates; returns the corrections made.
+  int SweepVertexFace(const Eigen::MatrixX3d& X0, double gap, Eigen::MatrixX3d* X, Eigen::MatrixX3d* V);
+  int SweepEdgeEdge(const Eigen::MatrixX3d& X0, double gap, Eigen::MatrixX3d* X, Eigen::MatrixX3d* V);
+  // Moves points id[k] by inverse mass along n so that sum_k coef[k] n.x[id[k]] >= gap, and
+  // removes the approaching part of sum_k coef[k] n.v[id[k]]. False when nothing could move.
+  bool Push(const int id[4], const double coef[4], const Eigen::Vector3d& n, double gap, Eigen::MatrixX3d* X,
+            Eigen::MatrixX3d* V) const;
+
+  // Overlapping pairs (i < j) of boxes_ grown by gap, into overlaps_; *order is the sorted order,
+  // kept between calls.
+  void SweepAndPrune(const Eigen::MatrixX3d& X1, double gap, std::vector<int>* order);
+  struct SapBox {
+    double lo0, hi0, lo1, hi1, lo2, hi2;  // sweep axis first; hi grown by gap
+    int id;
+  };
+
+  Eigen::MatrixX3i F_;
+  Eigen::VectorXd inverse_mass_;
+  std::vector<std::pair<int, int>> edges_;            // unique edges (a < b)
+  std::vector<Candidate> candidates_;                 // vertex-face pairs
+  std::vector<std::pair<int, int>> edge_candidates_;  // edge index pairs, no shared vertex
+  std::vector<Eigen::AlignedBox3d> boxes_;            // scratch: swept boxes
+  std::vector<int> vertex_face_order_;                // faces then vertices, sorted along one axis
+  std::vector<int> edge_order_;                       // edges, sorted along one axis
+  std::vector<SapBox> sap_;                           // scratch: boxes in sorted order
+  std::vector<std::pair<int, int>> overlaps_;         // scratch: overlapping box pairs
+};
+
+}  // namespace clothwind::sim
+
+#endif  // CLOTHWIND_SIM_CROSSING_RESOLVER_H_
