@@ -33,7 +33,7 @@ struct SimOptions {
   bool self_collision = true;                       // vertex-face repulsion on/off
   // With self_collision: passes of the post-step correction that moves vertices that jumped
   // through a face during the step back to their side (crossing_resolver.h); 0 = off.
-  int crossing_sweeps = 4;
+  int crossing_sweeps = 8;
   // Bending in the implicit solve (ArcSim) or explicit. Cloth bending is so soft next to the
   // node masses that explicit bending is stable by orders of magnitude at these steps, and it
   // saves ~20 % of a step (a hinge's two opposite vertices then need no matrix block). kAuto

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace clothwind::sim {
 namespace {
@@ -26,49 +27,76 @@ CrossingResolver::CrossingResolver(const Eigen::MatrixX3i& F, const Eigen::Vecto
 // Sweep and prune: the boxes (grown by gap) sorted by their low end along the axis over which
 // the positions spread most; each box is paired with the following ones that start before it
 // ends and overlap it along the other two axes. Deterministic (ties broken by index).
-void CrossingResolver::SweepAndPrune(const Eigen::MatrixX3d& X1, double gap, std::vector<int>* order) {
+void CrossingResolver::OverlappingPairs(double gap) {
   overlaps_.clear();
   const int n = static_cast<int>(boxes_.size());
-  for (const Eigen::AlignedBox3d& b : boxes_)
+  if (n == 0) return;
+  Eigen::AlignedBox3d all;
+  all.setEmpty();
+  Eigen::Vector3d mean_size = Eigen::Vector3d::Zero();
+  for (const Eigen::AlignedBox3d& b : boxes_) {
     if (!b.min().allFinite() || !b.max().allFinite()) return;  // exploded: the simulator reports it
-  const Eigen::Vector3d spread = X1.colwise().maxCoeff() - X1.colwise().minCoeff();
-  int axis = 0;
-  spread.maxCoeff(&axis);
-  const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-  // Insertion sort from the previous step's order: nearly sorted already, so about linear.
-  std::vector<int>& ord = *order;
-  if (static_cast<int>(ord.size()) != n) {
-    ord.resize(n);
-    for (int i = 0; i < n; ++i) ord[i] = i;
+    all.extend(b);
+    mean_size += b.sizes();
   }
-  auto less = [&](int a, int b) {
-    const double la = boxes_[a].min()[axis], lb = boxes_[b].min()[axis];
-    return la < lb || (la == lb && a < b);
+  // Cells about the mean box size, at most kMaxCells in all (an exploded state gets big cells).
+  constexpr double kMaxCells = 1 << 16;
+  const Eigen::Vector3d extent = all.sizes().array() + gap;
+  double cell = std::max(mean_size.maxCoeff() / n + gap, 1e-9);
+  while ((extent / cell).array().floor().matrix().prod() + 1 > kMaxCells ||
+         ((extent / cell).array() + 1).prod() > kMaxCells)
+    cell *= 2;
+  const double inv = 1.0 / cell;
+  Eigen::Array3i dims = ((extent * inv).array().floor() + 1).cast<int>();
+  const Eigen::Vector3d origin = all.min();
+  auto index = [&](double c, int axis) {
+    return std::clamp(static_cast<int>(std::floor((c - origin[axis]) * inv)), 0, dims[axis] - 1);
   };
-  for (int i = 1; i < n; ++i) {
-    const int key = ord[i];
-    int j = i - 1;
-    while (j >= 0 && less(key, ord[j])) {
-      ord[j + 1] = ord[j];
-      --j;
-    }
-    ord[j + 1] = key;
-  }
-  // Contiguous copy in sorted order, grown by gap at the high ends, for the scan.
-  sap_.resize(n);
+  lo_cell_.resize(n);
+  hi_cell_.resize(n);
+  const int num_cells = dims.prod();
+
+  cell_start_.assign(num_cells + 1, 0);
   for (int i = 0; i < n; ++i) {
-    const Eigen::AlignedBox3d& b = boxes_[ord[i]];
-    sap_[i] = {b.min()[axis], b.max()[axis] + gap, b.min()[u], b.max()[u] + gap, b.min()[w], b.max()[w] + gap,
-               ord[i]};
-  }
-  for (int i = 0; i < n; ++i) {
-    const SapBox& a = sap_[i];
-    for (int j = i + 1; j < n; ++j) {
-      const SapBox& b = sap_[j];
-      if (b.lo0 > a.hi0) break;
-      if (b.lo1 > a.hi1 || a.lo1 > b.hi1 || b.lo2 > a.hi2 || a.lo2 > b.hi2) continue;
-      overlaps_.emplace_back(std::min(a.id, b.id), std::max(a.id, b.id));
+    for (int a = 0; a < 3; ++a) {
+      lo_cell_[i][a] = index(boxes_[i].min()[a], a);
+      hi_cell_[i][a] = index(boxes_[i].max()[a] + gap, a);
     }
+    for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
+      for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
+        for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z) ++cell_start_[(x * dims[1] + y) * dims[2] + z + 1];
+  }
+  for (int c = 0; c < num_cells; ++c) cell_start_[c + 1] += cell_start_[c];
+  cell_entries_.resize(cell_start_[num_cells]);
+  cell_fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
+  for (int i = 0; i < n; ++i) {
+    const Entry entry{i, lo_cell_[i][0], lo_cell_[i][1], lo_cell_[i][2]};
+    for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
+      for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
+        for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z)
+          cell_entries_[cell_fill_[(x * dims[1] + y) * dims[2] + z]++] = entry;
+  }
+  // Each overlapping pair is reported once: from its lower-indexed box, in the cell holding the
+  // low corner of the two cell ranges' intersection. Only occupied cells are visited.
+  for (int i = 0; i < n; ++i) {
+    const Eigen::AlignedBox3d& bi = boxes_[i];
+    for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
+      for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
+        for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z) {
+          const int c = (x * dims[1] + y) * dims[2] + z;
+          for (int p = cell_start_[c + 1] - 1; p >= cell_start_[c]; --p) {
+            const Entry& e = cell_entries_[p];
+            const int j = e.id;
+            if (j <= i) break;  // entries ascend: the rest are lower
+            if (std::max(lo_cell_[i][0], e.x) != x || std::max(lo_cell_[i][1], e.y) != y ||
+                std::max(lo_cell_[i][2], e.z) != z)
+              continue;
+            const Eigen::AlignedBox3d& bj = boxes_[j];
+            if ((bj.min().array() > bi.max().array() + gap).any() || (bi.min().array() > bj.max().array() + gap).any())
+              continue;
+            overlaps_.emplace_back(i, j);
+          }
+        }
   }
 }
 
@@ -84,7 +112,7 @@ void CrossingResolver::FindEdgeCandidates(const Eigen::MatrixX3d& X0, const Eige
       boxes_[e].extend(X1.row(v).transpose());
     }
   }
-  SweepAndPrune(X1, gap, &edge_order_);
+  OverlappingPairs(gap);
   for (const auto& [i, j] : overlaps_) {
     const int a = edges_[i].first, b = edges_[i].second, c = edges_[j].first, d = edges_[j].second;
     if (c == a || c == b || d == a || d == b) continue;
@@ -109,7 +137,7 @@ void CrossingResolver::FindCandidates(const Eigen::MatrixX3d& X0, const Eigen::M
     boxes_[nf + v].extend(X0.row(v).transpose());
     boxes_[nf + v].extend(X1.row(v).transpose());
   }
-  SweepAndPrune(X1, gap, &vertex_face_order_);
+  OverlappingPairs(gap);
   for (const auto& [i, j] : overlaps_) {
     if ((i < nf) == (j < nf)) continue;  // face-face or vertex-vertex
     const int f = i, v = j - nf;  // i < j

@@ -21,7 +21,7 @@ namespace clothwind::sim {
 // its original side at `gap` from the face and removes the approaching normal velocity
 // (inelastic), both shared between the vertex and the face's corners by inverse mass (so
 // momentum and the centre of mass are kept). Sweeps repeat until none is left or
-// `max_sweeps`. Candidates come from a sweep and prune of the swept bounding boxes.
+// `max_sweeps`. Candidates come from a grid of the swept bounding boxes.
 // Deterministic. Buffers are reused.
 class CrossingResolver {
  public:
@@ -56,13 +56,9 @@ class CrossingResolver {
   bool Push(const int id[4], const double coef[4], const Eigen::Vector3d& n, double gap, Eigen::MatrixX3d* X,
             Eigen::MatrixX3d* V) const;
 
-  // Overlapping pairs (i < j) of boxes_ grown by gap, into overlaps_; *order is the sorted order,
-  // kept between calls.
-  void SweepAndPrune(const Eigen::MatrixX3d& X1, double gap, std::vector<int>* order);
-  struct SapBox {
-    double lo0, hi0, lo1, hi1, lo2, hi2;  // sweep axis first; hi grown by gap
-    int id;
-  };
+  // Pairs (i < j) of boxes_ that overlap when grown by gap, into overlaps_ (a uniform grid of
+  // about the mean box size, filled by counting sort).
+  void OverlappingPairs(double gap);
 
   Eigen::MatrixX3i F_;
   Eigen::VectorXd inverse_mass_;
@@ -70,9 +66,13 @@ class CrossingResolver {
   std::vector<Candidate> candidates_;                 // vertex-face pairs
   std::vector<std::pair<int, int>> edge_candidates_;  // edge index pairs, no shared vertex
   std::vector<Eigen::AlignedBox3d> boxes_;            // scratch: swept boxes
-  std::vector<int> vertex_face_order_;                // faces then vertices, sorted along one axis
-  std::vector<int> edge_order_;                       // edges, sorted along one axis
-  std::vector<SapBox> sap_;                           // scratch: boxes in sorted order
+  std::vector<Eigen::Array3i> lo_cell_, hi_cell_;    // scratch: cell range of each box
+  struct Entry {
+    int id;
+    int x, y, z;  // the box's lowest cell
+  };
+  std::vector<int> cell_start_, cell_fill_;  // scratch: grid, by counting sort
+  std::vector<Entry> cell_entries_;
   std::vector<std::pair<int, int>> overlaps_;         // scratch: overlapping box pairs
 };
 
