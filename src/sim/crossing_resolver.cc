@@ -27,7 +27,7 @@ CrossingResolver::CrossingResolver(const Eigen::MatrixX3i& F, const Eigen::Vecto
 // Sweep and prune: the boxes (grown by gap) sorted by their low end along the axis over which
 // the positions spread most; each box is paired with the following ones that start before it
 // ends and overlap it along the other two axes. Deterministic (ties broken by index).
-void CrossingResolver::OverlappingPairs(double gap) {
+void CrossingResolver::OverlappingPairs(double gap, int num_queries) {
   overlaps_.clear();
   const int n = static_cast<int>(boxes_.size());
   if (n == 0) return;
@@ -57,11 +57,13 @@ void CrossingResolver::OverlappingPairs(double gap) {
   const int num_cells = dims.prod();
 
   cell_start_.assign(num_cells + 1, 0);
+  const int first_inserted = num_queries;  // 0: all boxes against each other
   for (int i = 0; i < n; ++i) {
     for (int a = 0; a < 3; ++a) {
       lo_cell_[i][a] = index(boxes_[i].min()[a], a);
       hi_cell_[i][a] = index(boxes_[i].max()[a] + gap, a);
     }
+    if (i < first_inserted) continue;
     for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
       for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
         for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z) ++cell_start_[(x * dims[1] + y) * dims[2] + z + 1];
@@ -69,16 +71,17 @@ void CrossingResolver::OverlappingPairs(double gap) {
   for (int c = 0; c < num_cells; ++c) cell_start_[c + 1] += cell_start_[c];
   cell_entries_.resize(cell_start_[num_cells]);
   cell_fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
-  for (int i = 0; i < n; ++i) {
+  for (int i = first_inserted; i < n; ++i) {
     const Entry entry{i, lo_cell_[i][0], lo_cell_[i][1], lo_cell_[i][2]};
     for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
       for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
         for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z)
           cell_entries_[cell_fill_[(x * dims[1] + y) * dims[2] + z]++] = entry;
   }
-  // Each overlapping pair is reported once: from its lower-indexed box, in the cell holding the
+  // Each overlapping pair is reported once: from its lower-indexed box (the query), in the cell holding the
   // low corner of the two cell ranges' intersection. Only occupied cells are visited.
-  for (int i = 0; i < n; ++i) {
+  const int num_query = num_queries > 0 ? num_queries : n;
+  for (int i = 0; i < num_query; ++i) {
     const Eigen::AlignedBox3d& bi = boxes_[i];
     for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
       for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
@@ -112,7 +115,7 @@ void CrossingResolver::FindEdgeCandidates(const Eigen::MatrixX3d& X0, const Eige
       boxes_[e].extend(X1.row(v).transpose());
     }
   }
-  OverlappingPairs(gap);
+  OverlappingPairs(gap, 0);
   for (const auto& [i, j] : overlaps_) {
     const int a = edges_[i].first, b = edges_[i].second, c = edges_[j].first, d = edges_[j].second;
     if (c == a || c == b || d == a || d == b) continue;
@@ -137,9 +140,8 @@ void CrossingResolver::FindCandidates(const Eigen::MatrixX3d& X0, const Eigen::M
     boxes_[nf + v].extend(X0.row(v).transpose());
     boxes_[nf + v].extend(X1.row(v).transpose());
   }
-  OverlappingPairs(gap);
+  OverlappingPairs(gap, nf);  // faces against vertices
   for (const auto& [i, j] : overlaps_) {
-    if ((i < nf) == (j < nf)) continue;  // face-face or vertex-vertex
     const int f = i, v = j - nf;  // i < j
     if (F_(f, 0) == v || F_(f, 1) == v || F_(f, 2) == v) continue;
     candidates_.push_back({v, f});

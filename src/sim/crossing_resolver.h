@@ -57,8 +57,9 @@ class CrossingResolver {
             Eigen::MatrixX3d* V) const;
 
   // Pairs (i < j) of boxes_ that overlap when grown by gap, into overlaps_ (a uniform grid of
-  // about the mean box size, filled by counting sort).
-  void OverlappingPairs(double gap);
+  // about the mean box size, filled by counting sort). num_queries > 0: only pairs of a box
+  // i < num_queries with a box j >= num_queries; 0: all pairs.
+  void OverlappingPairs(double gap, int num_queries);
 
   Eigen::MatrixX3i F_;
   Eigen::VectorXd inverse_mass_;
