@@ -50,7 +50,8 @@ void CrossingResolver::OverlappingPairs(double gap, int num_queries) {
   Eigen::Array3i dims = ((extent * inv).array().floor() + 1).cast<int>();
   const Eigen::Vector3d origin = all.min();
   auto index = [&](double c, int axis) {
-    return std::clamp(static_cast<int>(std::floor((c - origin[axis]) * inv)), 0, dims[axis] - 1);
+    // c >= origin, so truncation is floor (std::floor is a library call without SSE4.1).
+    return std::min(static_cast<int>((c - origin[axis]) * inv), dims[axis] - 1);
   };
   lo_cell_.resize(n);
   hi_cell_.resize(n);
@@ -72,7 +73,10 @@ void CrossingResolver::OverlappingPairs(double gap, int num_queries) {
   cell_entries_.resize(cell_start_[num_cells]);
   cell_fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
   for (int i = first_inserted; i < n; ++i) {
-    const Entry entry{i, lo_cell_[i][0], lo_cell_[i][1], lo_cell_[i][2]};
+    const Eigen::AlignedBox3d& b = boxes_[i];
+    const Entry entry{{b.min().x(), b.min().y(), b.min().z()},
+                      {b.max().x() + gap, b.max().y() + gap, b.max().z() + gap},
+                      i, lo_cell_[i][0], lo_cell_[i][1], lo_cell_[i][2]};
     for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
       for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
         for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z)
@@ -81,26 +85,31 @@ void CrossingResolver::OverlappingPairs(double gap, int num_queries) {
   // Each overlapping pair is reported once: from its lower-indexed box (the query), in the cell holding the
   // low corner of the two cell ranges' intersection. Only occupied cells are visited.
   const int num_query = num_queries > 0 ? num_queries : n;
+  int count = 0;
   for (int i = 0; i < num_query; ++i) {
-    const Eigen::AlignedBox3d& bi = boxes_[i];
+    const double lo[3] = {boxes_[i].min().x(), boxes_[i].min().y(), boxes_[i].min().z()};
+    const double hi[3] = {boxes_[i].max().x() + gap, boxes_[i].max().y() + gap, boxes_[i].max().z() + gap};
+    const int cx = lo_cell_[i][0], cy = lo_cell_[i][1], cz = lo_cell_[i][2];
     for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
       for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
         for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z) {
           const int c = (x * dims[1] + y) * dims[2] + z;
-          for (int p = cell_start_[c + 1] - 1; p >= cell_start_[c]; --p) {
+          // Branch-free: every entry is written, and kept only if it passes (the tests are
+          // close to random, so branches would mostly mispredict).
+          const int begin = cell_start_[c], end = cell_start_[c + 1];
+          if (overlaps_.size() < static_cast<size_t>(count + end - begin)) overlaps_.resize(2 * (count + end - begin));
+          std::pair<int, int>* out = overlaps_.data();
+          for (int p = begin; p < end; ++p) {
             const Entry& e = cell_entries_[p];
-            const int j = e.id;
-            if (j <= i) break;  // entries ascend: the rest are lower
-            if (std::max(lo_cell_[i][0], e.x) != x || std::max(lo_cell_[i][1], e.y) != y ||
-                std::max(lo_cell_[i][2], e.z) != z)
-              continue;
-            const Eigen::AlignedBox3d& bj = boxes_[j];
-            if ((bj.min().array() > bi.max().array() + gap).any() || (bi.min().array() > bj.max().array() + gap).any())
-              continue;
-            overlaps_.emplace_back(i, j);
+            const bool keep = (e.id > i) & (std::max(cx, e.x) == x) & (std::max(cy, e.y) == y) &
+                              (std::max(cz, e.z) == z) & (e.lo[0] <= hi[0]) & (lo[0] <= e.hi[0]) &
+                              (e.lo[1] <= hi[1]) & (lo[1] <= e.hi[1]) & (e.lo[2] <= hi[2]) & (lo[2] <= e.hi[2]);
+            out[count] = {i, e.id};
+            count += keep;
           }
         }
   }
+  overlaps_.resize(count);
 }
 
 // Edge pairs (no shared vertex) whose swept boxes (start and end positions) overlap within gap.

@@ -68,7 +68,8 @@ class CrossingResolver {
   std::vector<std::pair<int, int>> edge_candidates_;  // edge index pairs, no shared vertex
   std::vector<Eigen::AlignedBox3d> boxes_;            // scratch: swept boxes
   std::vector<Eigen::Array3i> lo_cell_, hi_cell_;    // scratch: cell range of each box
-  struct Entry {
+  struct Entry {  // a box in a grid cell, with what the pair test needs (one cache line)
+    double lo[3], hi[3];  // hi grown by gap
     int id;
     int x, y, z;  // the box's lowest cell
   };
