@@ -99,9 +99,11 @@ void CrossingResolver::OverlappingPairs(double gap, int num_queries) {
           const int begin = cell_start_[c], end = cell_start_[c + 1];
           if (overlaps_.size() < static_cast<size_t>(count + end - begin)) overlaps_.resize(2 * (count + end - begin));
           std::pair<int, int>* out = overlaps_.data();
-          for (int p = begin; p < end; ++p) {
+          // Entries ascend by index: from the top down, stop at the first one not above i.
+          for (int p = end - 1; p >= begin; --p) {
             const Entry& e = cell_entries_[p];
-            const bool keep = (e.id > i) & (std::max(cx, e.x) == x) & (std::max(cy, e.y) == y) &
+            if (e.id <= i) break;
+            const bool keep = (std::max(cx, e.x) == x) & (std::max(cy, e.y) == y) &
                               (std::max(cz, e.z) == z) & (e.lo[0] <= hi[0]) & (lo[0] <= e.hi[0]) &
                               (e.lo[1] <= hi[1]) & (lo[1] <= e.hi[1]) & (e.lo[2] <= hi[2]) & (lo[2] <= e.hi[2]);
             out[count] = {i, e.id};

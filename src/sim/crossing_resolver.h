@@ -9,19 +9,20 @@
 
 namespace clothwind::sim {
 
-// Undoes vertex-face crossings of one time step (a cheap stand-in for ArcSim's continuous
-// collision handling and impact zones). The repulsion (vertex_face_proximity.h) only sees pairs
-// that start a step within its thickness; a fold moving faster than thickness / dt jumps
-// through a face between two detections, and once through, the repulsion pushes the vertex
-// further along the side it is now on. After the step, this finds every vertex that changed
-// side of a non-incident face while its path crossed the face (linear motion of all four points
-// over the step, the crossing point tested against the face at that moment), and every pair of
-// edges that passed through each other (the sign of their tetrahedron's volume changed and the
-// closest points at that moment lie on both edges), moves it back to
-// its original side at `gap` from the face and removes the approaching normal velocity
-// (inelastic), both shared between the vertex and the face's corners by inverse mass (so
-// momentum and the centre of mass are kept). Sweeps repeat until none is left or
-// `max_sweeps`. Candidates come from a grid of the swept bounding boxes.
+// Undoes the crossings of one time step (a cheap stand-in for ArcSim's continuous collision
+// handling and impact zones). The repulsion (vertex_face_proximity.h) only sees pairs that start
+// a step within its thickness; a fold moving faster than thickness / dt jumps through between
+// two detections, and once through, the repulsion pushes further along the side it is now on.
+// After the step, this finds
+//  - every vertex that changed side of a non-incident face while its path crossed the face
+//    (linear motion of all four points over the step, the crossing point tested against the
+//    face at that moment), and
+//  - every pair of edges (no shared vertex) that passed through each other (the sign of their
+//    tetrahedron's volume changed, and at that moment the lines met within both edges),
+// and moves the pair back to its original side, `gap` apart along the end normal, removing the
+// approaching normal velocity (inelastic); both are shared among the four points by inverse
+// mass, so momentum and the centre of mass are kept. Sweeps repeat until nothing is left to
+// correct or `max_sweeps`. Candidates come from a uniform grid of the swept bounding boxes.
 // Deterministic. Buffers are reused.
 class CrossingResolver {
  public:
