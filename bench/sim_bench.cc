@@ -4,7 +4,7 @@
 // so speed and fidelity are read together.
 //
 //   sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10]
-//             [--frame-steps N] [--cg-tolerance T]
+//             [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N (0 = off)]
 // Default scene: $CLOTHWIND_SHARED_DIR/arcsim/conf/flag.json (ArcSim's own, so the comparison is
 // like for like), else config/scenes/flag.json under $CLOTHWIND_SOURCE_DIR or the working dir.
 #include <time.h>
@@ -56,6 +56,7 @@ double ThreadCpuSeconds() {
 int main(int argc, char** argv) {
   std::string scene_path = DefaultScene();
   double duration = 4.0, max_edge = 0.0, cg_tolerance = 0.0;
+  int crossing_sweeps = -1;  // -1: the scene's (SimOptions default)
   BuildOptions build;
   std::vector<double> winds = {1, 3, 6, 10};
   for (int i = 1; i < argc; ++i) {
@@ -79,6 +80,8 @@ int main(int argc, char** argv) {
       build.frame_steps = std::stoi(next());
     } else if (a == "--cg-tolerance") {
       cg_tolerance = std::stod(next());
+    } else if (a == "--crossing-sweeps") {
+      crossing_sweeps = std::stoi(next());
     } else if (a == "--winds") {
       winds.clear();
       std::stringstream ss(next());
@@ -86,7 +89,7 @@ int main(int argc, char** argv) {
       while (std::getline(ss, item, ',')) winds.push_back(std::stod(item));
     } else {
       std::fprintf(stderr,
-                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T]\n");
+                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N]\n");
       return 2;
     }
   }
@@ -94,6 +97,9 @@ int main(int argc, char** argv) {
   SceneSetup setup = BuildScene(LoadScene(scene_path), build);
   if (cg_tolerance > 0) {
     for (auto& c : setup.cloths) c.options.cg_tolerance = cg_tolerance;
+  }
+  if (crossing_sweeps >= 0) {
+    for (auto& c : setup.cloths) c.options.crossing_sweeps = crossing_sweeps;
   }
   std::printf("scene %s, %.1f s simulated per wind, dt %.4f s, edges <= %.3f m, CG tolerance %g, one thread\n",
               scene_path.c_str(), duration, setup.cloths[0].options.dt, setup.cloths[0].max_edge,

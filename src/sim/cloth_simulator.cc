@@ -20,6 +20,7 @@
 #include <Eigen/Geometry>
 
 #include "sim/cloth_forces.h"
+#include "sim/crossing_resolver.h"
 #include "sim/strain_limiter.h"
 #include "sim/vertex_face_proximity.h"
 
@@ -42,6 +43,11 @@ struct Face {
   TriangleRest rest;
   int block[9] = {};
 };
+
+// A vertex moved back across a face it jumped through lands this fraction of the repulsion
+// thickness from it: inside the repulsion's reach (so the next step pushes it gently further),
+// with little penalty energy stored (1/8 of what the full thickness would store).
+constexpr double kCrossingGapFraction = 0.5;
 
 }  // namespace
 
@@ -81,6 +87,8 @@ struct ClothSimulator::Impl {
 
   std::unique_ptr<VertexFaceProximity> proximity;
   std::unique_ptr<StrainLimiter> limiter;
+  std::unique_ptr<CrossingResolver> resolver;
+  Eigen::MatrixX3d x_start;  // positions at the start of the step (for the crossing check)
 
   void Build();
   int BlockIndex(int i, int j) const;
@@ -244,6 +252,10 @@ void ClothSimulator::Impl::Build() {
   mean_edge /= 3.0 * faces.size();
   proximity = std::make_unique<VertexFaceProximity>(mesh.F, nv, mean_edge);
   limiter = std::make_unique<StrainLimiter>(mesh, mass, pinned);
+  Eigen::VectorXd inverse_mass(nv);
+  for (int i = 0; i < nv; ++i) inverse_mass[i] = pinned[i] ? 0.0 : 1.0 / mass[i];
+  resolver = std::make_unique<CrossingResolver>(mesh.F, inverse_mass);
+  x_start = x;
 }
 
 void ClothSimulator::Impl::ComputeForces(bool with_jacobian, bool with_repulsion) {
@@ -508,6 +520,7 @@ void ClothSimulator::Step() {
   const bool repel = s.options.self_collision && s.options.repulsion_thickness > 0 &&
                      s.options.collision_stiffness > 0;
   const auto t0 = Clock::now();
+  if (repel) s.x_start = s.x;
   if (repel) s.proximity->Update(s.x, s.options.repulsion_thickness);
   const auto t1 = Clock::now();
   s.ComputeForces(/*with_jacobian=*/true, repel);
@@ -527,6 +540,12 @@ void ClothSimulator::Step() {
     s.stats.strain_limited_faces = s.limiter->Project(s.options.strain_min, s.options.strain_max,
                                                       s.options.strain_limit_iterations, h, &s.x, &s.v);
   }
+  // Vertices that jumped through a face during the step go back to their side (see
+  // crossing_resolver.h): the repulsion alone lets fast folds pass through.
+  s.stats.crossings_resolved = 0;
+  if (repel && s.options.crossing_sweeps > 0)
+    s.stats.crossings_resolved = s.resolver->Resolve(s.x_start, kCrossingGapFraction * s.options.repulsion_thickness,
+                                                     s.options.crossing_sweeps, &s.x, &s.v);
   const auto t4 = Clock::now();
   s.stats.seconds_proximity = seconds(t0, t1);
   s.stats.seconds_forces = seconds(t1, t2);

@@ -31,6 +31,9 @@ struct SimOptions {
   double collision_stiffness = 1e6;                 // ArcSim magic.collision_stiffness [N/m^3]
                                                     // (times min(node area, face area) per pair)
   bool self_collision = true;                       // vertex-face repulsion on/off
+  // With self_collision: passes of the post-step correction that moves vertices that jumped
+  // through a face during the step back to their side (crossing_resolver.h); 0 = off.
+  int crossing_sweeps = 8;
   // Bending in the implicit solve (ArcSim) or explicit. Cloth bending is so soft next to the
   // node masses that explicit bending is stable by orders of magnitude at these steps, and it
   // saves ~20 % of a step (a hinge's two opposite vertices then need no matrix block). kAuto
@@ -60,6 +63,7 @@ struct StepStats {
   double cg_relative_residual = 0;
   int repulsion_pairs = 0;
   int strain_limited_faces = 0;  // faces outside the limits before projection
+  int crossings_resolved = 0;    // vertex-face crossings undone after the step
   bool implicit_bending = false;  // what kAuto (or the option) chose
   // Wall time of the phases of the step [s] (steady clock), for benches.
   double seconds_proximity = 0;

@@ -1,0 +1,84 @@
+#ifndef CLOTHWIND_SIM_CROSSING_RESOLVER_H_
+#define CLOTHWIND_SIM_CROSSING_RESOLVER_H_
+
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace clothwind::sim {
+
+// Undoes the crossings of one time step (a cheap stand-in for ArcSim's continuous collision
+// handling and impact zones). The repulsion (vertex_face_proximity.h) only sees pairs that start
+// a step within its thickness; a fold moving faster than thickness / dt jumps through between
+// two detections, and once through, the repulsion pushes further along the side it is now on.
+// After the step, this finds
+//  - every vertex that changed side of a non-incident face while its path crossed the face
+//    (linear motion of all four points over the step, the crossing point tested against the
+//    face at that moment), and
+//  - every pair of edges (no shared vertex) that passed through each other (the sign of their
+//    tetrahedron's volume changed, and at that moment the lines met within both edges),
+// and moves the pair back to its original side, `gap` apart along the end normal, removing the
+// approaching normal velocity (inelastic); both are shared among the four points by inverse
+// mass, so momentum and the centre of mass are kept. Sweeps repeat until nothing is left to
+// correct or `max_sweeps`. Candidates come from a uniform grid of the swept bounding boxes.
+// Deterministic. Buffers are reused.
+class CrossingResolver {
+ public:
+  // Inputs:
+  //   F             #F by 3 faces (indices < num_vertices)
+  //   inverse_mass  #V inverse node masses [1/kg] (0 = pinned)
+  CrossingResolver(const Eigen::MatrixX3i& F, const Eigen::VectorXd& inverse_mass);
+
+  // Inputs:
+  //   X0   #V by 3 positions at the start of the step [m]
+  //   gap  distance from the face the corrected vertex is put at [m] (>= 0)
+  //   max_sweeps  passes over the candidates (>= 1)
+  // Input/Outputs:
+  //   X    #V by 3 positions at the end of the step [m], corrected
+  //   V    #V by 3 velocities [m/s], approaching normal velocity of corrected pairs removed
+  // Returns the number of corrections made (a pair corrected in two sweeps counts twice).
+  int Resolve(const Eigen::MatrixX3d& X0, double gap, int max_sweeps, Eigen::MatrixX3d* X,
+              Eigen::MatrixX3d* V);
+
+ private:
+  struct Candidate {
+    int vertex;
+    int face;
+  };
+  void FindCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double gap);
+  void FindEdgeCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double gap);
+  // One pass over the candidates; returns the corrections made.
+  int SweepVertexFace(const Eigen::MatrixX3d& X0, double gap, Eigen::MatrixX3d* X, Eigen::MatrixX3d* V);
+  int SweepEdgeEdge(const Eigen::MatrixX3d& X0, double gap, Eigen::MatrixX3d* X, Eigen::MatrixX3d* V);
+  // Moves points id[k] by inverse mass along n so that sum_k coef[k] n.x[id[k]] >= gap, and
+  // removes the approaching part of sum_k coef[k] n.v[id[k]]. False when nothing could move.
+  bool Push(const int id[4], const double coef[4], const Eigen::Vector3d& n, double gap, Eigen::MatrixX3d* X,
+            Eigen::MatrixX3d* V) const;
+
+  // Pairs (i < j) of boxes_ that overlap when grown by gap, into overlaps_ (a uniform grid of
+  // about the mean box size, filled by counting sort). num_queries > 0: only pairs of a box
+  // i < num_queries with a box j >= num_queries; 0: all pairs.
+  void OverlappingPairs(double gap, int num_queries);
+
+  Eigen::MatrixX3i F_;
+  Eigen::VectorXd inverse_mass_;
+  std::vector<std::pair<int, int>> edges_;            // unique edges (a < b)
+  std::vector<Candidate> candidates_;                 // vertex-face pairs
+  std::vector<std::pair<int, int>> edge_candidates_;  // edge index pairs, no shared vertex
+  std::vector<Eigen::AlignedBox3d> boxes_;            // scratch: swept boxes
+  std::vector<Eigen::Array3i> lo_cell_, hi_cell_;    // scratch: cell range of each box
+  struct Entry {  // a box in a grid cell, with what the pair test needs (one cache line)
+    double lo[3], hi[3];  // hi grown by gap
+    int id;
+    int x, y, z;  // the box's lowest cell
+  };
+  std::vector<int> cell_start_, cell_fill_;  // scratch: grid, by counting sort
+  std::vector<Entry> cell_entries_;
+  std::vector<std::pair<int, int>> overlaps_;         // scratch: overlapping box pairs
+};
+
+}  // namespace clothwind::sim
+
+#endif  // CLOTHWIND_SIM_CROSSING_RESOLVER_H_
