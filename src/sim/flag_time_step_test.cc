@@ -9,8 +9,8 @@
 // Winds 6 and 10 m/s: the flapping regime, where 10 s statistics are stationary. Below ~3 m/s the
 // flag swings irregularly and slowly (ArcSim too: "no clear periodic flapping"), and the RMS of a
 // 10 s window varies by 2x between runs that differ only in round-off, so no step comparison there
-// can be meaningful. Measured (2026-11-21): frequency 1.23/1.42 Hz at 6 m/s and 1.64/1.85 Hz at
-// 10 m/s for 5/2.5 ms steps, i.e. the paper's 5 ms step lowers the flapping frequency by ~12 %.
+// can be meaningful. Measured (2026-11-21): frequency 1.14/1.31 Hz at 6 m/s and 1.73/1.75 Hz at
+// 10 m/s for 5/2.5 ms steps: the paper's 5 ms step lowers the flapping frequency by up to ~13 %.
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
