@@ -48,6 +48,52 @@ double TriangleArea2(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const E
   return 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
 }
 
+// Midpoints of a mesh's edges for subdivision: each edge's midpoint (world and rest coordinates)
+// is made once and numbered after the mesh's own vertices, which keep their indices (handles
+// refer to them).
+class EdgeMidpoints {
+ public:
+  explicit EdgeMidpoints(const Mesh& mesh) : mesh_(mesh), nv_(static_cast<int>(mesh.V.rows())) {}
+
+  // Index of the midpoint of edge (a, b), made on first request.
+  int Get(int a, int b) {
+    const auto key = std::minmax(a, b);
+    auto it = index_.find(key);
+    if (it != index_.end()) return it->second;
+    const int id = nv_ + static_cast<int>(V_.size());
+    V_.push_back(0.5 * (mesh_.V.row(a) + mesh_.V.row(b)).transpose());
+    U_.push_back(0.5 * (mesh_.U.row(a) + mesh_.U.row(b)).transpose());
+    index_.emplace(key, id);
+    return id;
+  }
+  // Rest coordinates of vertex i, old or new.
+  Eigen::Vector2d U(int i) const {
+    return i < nv_ ? Eigen::Vector2d(mesh_.U.row(i).transpose()) : U_[i - nv_];
+  }
+  bool empty() const { return V_.empty(); }
+  // The mesh's vertices followed by the midpoints, with faces F.
+  Mesh Build(Eigen::MatrixX3i F) const {
+    Mesh next;
+    next.V.resize(nv_ + V_.size(), 3);
+    next.U.resize(nv_ + U_.size(), 2);
+    next.V.topRows(nv_) = mesh_.V;
+    next.U.topRows(nv_) = mesh_.U;
+    for (size_t i = 0; i < V_.size(); ++i) {
+      next.V.row(nv_ + i) = V_[i].transpose();
+      next.U.row(nv_ + i) = U_[i].transpose();
+    }
+    next.F = std::move(F);
+    return next;
+  }
+
+ private:
+  const Mesh& mesh_;
+  int nv_;
+  std::map<std::pair<int, int>, int> index_;
+  std::vector<Eigen::Vector3d> V_;
+  std::vector<Eigen::Vector2d> U_;
+};
+
 }  // namespace
 
 Mesh ReadObj(const std::string& path) {
@@ -233,40 +279,18 @@ Mesh RefineMesh(const Mesh& input, double max_edge) {
   };
   for (int level = 0; longest(mesh) > max_edge; ++level) {
     if (level >= 12) throw std::invalid_argument("RefineMesh: max_edge too small (over 12 levels)");
-    const int nv = static_cast<int>(mesh.V.rows()), nf = static_cast<int>(mesh.F.rows());
-    std::map<std::pair<int, int>, int> midpoint;
-    std::vector<Eigen::Vector3d> newV;
-    std::vector<Eigen::Vector2d> newU;
-    auto mid = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      auto it = midpoint.find(key);
-      if (it != midpoint.end()) return it->second;
-      const int id = nv + static_cast<int>(newV.size());
-      newV.push_back(0.5 * (mesh.V.row(a) + mesh.V.row(b)).transpose());
-      newU.push_back(0.5 * (mesh.U.row(a) + mesh.U.row(b)).transpose());
-      midpoint.emplace(key, id);
-      return id;
-    };
+    const int nf = static_cast<int>(mesh.F.rows());
+    EdgeMidpoints mid(mesh);
     Eigen::MatrixX3i F(4 * nf, 3);
     for (int f = 0; f < nf; ++f) {
       const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
-      const int ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
+      const int ab = mid.Get(a, b), bc = mid.Get(b, c), ca = mid.Get(c, a);
       F.row(4 * f + 0) << a, ab, ca;
       F.row(4 * f + 1) << ab, b, bc;
       F.row(4 * f + 2) << ca, bc, c;
       F.row(4 * f + 3) << ab, bc, ca;
     }
-    Mesh next;
-    next.V.resize(nv + newV.size(), 3);
-    next.U.resize(nv + newU.size(), 2);
-    next.V.topRows(nv) = mesh.V;
-    next.U.topRows(nv) = mesh.U;
-    for (size_t i = 0; i < newV.size(); ++i) {
-      next.V.row(nv + i) = newV[i].transpose();
-      next.U.row(nv + i) = newU[i].transpose();
-    }
-    next.F = F;
-    mesh = std::move(next);
+    mesh = mid.Build(std::move(F));
   }
   return mesh;
 }
@@ -279,25 +303,11 @@ Mesh SplitLongEdges(const Mesh& input, double max_edge) {
     return std::max((m.V.row(a) - m.V.row(b)).norm(), (m.U.row(a) - m.U.row(b)).norm());
   };
   for (int pass = 0;; ++pass) {
-    const int nv = static_cast<int>(mesh.V.rows()), nf = static_cast<int>(mesh.F.rows());
-    std::map<std::pair<int, int>, int> midpoint;
-    std::vector<Eigen::Vector3d> newV;
-    std::vector<Eigen::Vector2d> newU;
+    const int nf = static_cast<int>(mesh.F.rows());
+    EdgeMidpoints midpoints(mesh);
     // Midpoint of edge (a, b) if it is long, else -1.
-    auto mid = [&](int a, int b) {
-      if (length(mesh, a, b) <= max_edge) return -1;
-      const auto key = std::minmax(a, b);
-      auto it = midpoint.find(key);
-      if (it != midpoint.end()) return it->second;
-      const int id = nv + static_cast<int>(newV.size());
-      newV.push_back(0.5 * (mesh.V.row(a) + mesh.V.row(b)).transpose());
-      newU.push_back(0.5 * (mesh.U.row(a) + mesh.U.row(b)).transpose());
-      midpoint.emplace(key, id);
-      return id;
-    };
-    auto u_of = [&](int i) -> Eigen::Vector2d {
-      return i < nv ? Eigen::Vector2d(mesh.U.row(i).transpose()) : newU[i - nv];
-    };
+    auto mid = [&](int a, int b) { return length(mesh, a, b) <= max_edge ? -1 : midpoints.Get(a, b); };
+    auto u_of = [&](int i) { return midpoints.U(i); };
     std::vector<Eigen::Vector3i> faces;
     faces.reserve(4 * nf);
     for (int f = 0; f < nf; ++f) {
@@ -338,20 +348,11 @@ Mesh SplitLongEdges(const Mesh& input, double max_edge) {
         }
       }
     }
-    if (newV.empty()) return mesh;
+    if (midpoints.empty()) return mesh;
     if (pass >= 12) throw std::invalid_argument("SplitLongEdges: max_edge not reached in 12 passes");
-    Mesh next;
-    next.V.resize(nv + newV.size(), 3);
-    next.U.resize(nv + newU.size(), 2);
-    next.V.topRows(nv) = mesh.V;
-    next.U.topRows(nv) = mesh.U;
-    for (size_t i = 0; i < newV.size(); ++i) {
-      next.V.row(nv + i) = newV[i].transpose();
-      next.U.row(nv + i) = newU[i].transpose();
-    }
-    next.F.resize(faces.size(), 3);
-    for (size_t i = 0; i < faces.size(); ++i) next.F.row(i) = faces[i].transpose();
-    mesh = std::move(next);
+    Eigen::MatrixX3i F(faces.size(), 3);
+    for (size_t i = 0; i < faces.size(); ++i) F.row(i) = faces[i].transpose();
+    mesh = midpoints.Build(std::move(F));
   }
 }
 
