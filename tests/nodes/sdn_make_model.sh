@@ -14,20 +14,7 @@ opts=()
 while [ $# -gt 0 ] && [ "$1" != "--" ]; do opts+=("$1"); shift; done
 [ $# -gt 0 ] && shift  # the "--"
 
-# The clothwind CLI lands in <build>/bin; the build's devel space is on CMAKE_PREFIX_PATH.
-cli=""
-if [ -n "${CLOTHWIND_BUILD:-}" ] && [ -x "$CLOTHWIND_BUILD/bin/clothwind" ]; then
-  cli="$CLOTHWIND_BUILD/bin/clothwind"
-else
-  IFS=: read -r -a prefixes <<< "${CMAKE_PREFIX_PATH:-}"
-  for p in "${prefixes[@]}"; do
-    if [ -x "$p/../bin/clothwind" ]; then cli="$p/../bin/clothwind"; break; fi
-  done
-fi
-if [ -z "$cli" ]; then
-  echo "sdn_make_model: cannot find the clothwind executable (set CLOTHWIND_BUILD)" >&2
-  exit 1
-fi
+source "$(dirname "$0")/clothwind_cli.sh"
 if [ ! -f "$model" ] || [ "$cli" -nt "$model" ] || [ "$0" -nt "$model" ]; then
   if [ -n "$toy" ]; then
     "$cli" make-toy-dataset --out "$toy" --clips 100 --frames 60 --size 32 --seed 1 >&2
