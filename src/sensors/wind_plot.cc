@@ -97,7 +97,7 @@ int WindPlotRow(double speed, double y_max, int height) {
 }
 
 cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer, double t_now, double window,
-                     int width, int height) {
+                     int width, int height, double t_origin) {
   if (width < 160 || height < 120) {
     throw std::invalid_argument("DrawWindPlot: image " + std::to_string(width) + "x" + std::to_string(height) +
                                 " too small (expected at least 160x120)");
@@ -123,14 +123,19 @@ cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer,
     cv::putText(img, Format(step < 1 ? "%.1f" : "%.0f", v), {4, y + 4}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1,
                 cv::LINE_AA);
   }
-  // Vertical grid every 10 s (every 30 s or 60 s for long windows), labelled in seconds before now.
+  // Vertical grid every 10 s (every 30 s or 60 s for long windows), labelled in seconds before now
+  // (live monitor) or in seconds since t_origin (a report over a whole session).
   const double tstep = window <= 60 ? 10 : window <= 240 ? 30 : 60;
+  const bool since_origin = std::isfinite(t_origin);
   for (double a = 0.0; a <= window + 1e-9; a += tstep) {
-    const int x = Column(t_now - a, t_now, window, width);
+    const double t = since_origin ? t_now - window + a : t_now - a;
+    const int x = Column(t, t_now, window, width);
     cv::line(img, {x, PlotTop()}, {x, PlotBottom(height)}, grid, 1);
-    const bool now = a == 0.0;  // the right edge: label kept inside the image
-    cv::putText(img, now ? std::string("now") : Format("-%.0f s", a), {now ? x - 26 : x - 14, height - 8},
-                cv::FONT_HERSHEY_SIMPLEX, font, ink, 1, cv::LINE_AA);
+    const bool right_edge = x > width - kRight - 30;  // its label kept inside the image
+    const std::string label = since_origin ? Format("%.0f s", t - t_origin) : a == 0.0 ? std::string("now")
+                                                                                      : Format("-%.0f s", a);
+    cv::putText(img, label, {right_edge ? x - 30 : x - 14, height - 8}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1,
+                cv::LINE_AA);
   }
   cv::rectangle(img, {kLeft, PlotTop()}, {width - kRight, PlotBottom(height)}, ink, 1);
 

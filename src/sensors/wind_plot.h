@@ -5,6 +5,7 @@
 #define CLOTHWIND_SENSORS_WIND_PLOT_H_
 
 #include <deque>
+#include <limits>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -67,10 +68,12 @@ const cv::Scalar kPlotBackground(255, 255, 255);
 //   t_now       [s] time at the right edge
 //   window      [s] time span shown (> 0)
 //   width, height  image size [px] (at least 160 by 120)
+//   t_origin    [s] NaN (default): time labelled as seconds before now (the live monitor);
+//               finite: time labelled as seconds since t_origin (a report over a session)
 // Returns a CV_8UC3 (bgr8) image height by width.
 // Throws std::invalid_argument for a size too small or a window <= 0.
 cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer, double t_now, double window,
-                     int width, int height);
+                     int width, int height, double t_origin = std::numeric_limits<double>::quiet_NaN());
 
 // The pixel row of a speed in a plot DrawWindPlot drew (for tests and overlays).
 // Inputs: speed [m/s], y_max [m/s] top of the axis, height [px] image height

@@ -1,0 +1,88 @@
+#include "sensors/estimate_report.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "sensors/wind_plot.h"
+
+namespace clothwind::sensors {
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+TEST(EstimateReportTest, MetricsOverLabelledRowsOnly) {
+  // Errors +0.3, -0.6, +0.9 on three labelled clips; one clip without a label, one NaN estimate.
+  const std::vector<EstimateRow> rows = {
+      {1, 10.0, 3.3, 0.2, 3.0, 0.010}, {2, 11.2, 4.4, 0.2, 5.0, 0.020}, {3, 12.4, 6.9, kNaN, 6.0, 0.030},
+      {4, 13.6, 2.0, 0.1, kNaN, 0.040}, {5, 14.8, kNaN, kNaN, 2.0, 0.050}};
+  const EstimateSummary s = SummariseEstimates(rows);
+  EXPECT_EQ(s.count, 5);
+  EXPECT_EQ(s.compared, 3);
+  EXPECT_NEAR(s.rmse, std::sqrt((0.09 + 0.36 + 0.81) / 3), 1e-12);
+  EXPECT_NEAR(s.acc05, 1.0 / 3, 1e-12);  // only +0.3 is within 0.5 m/s
+  EXPECT_NEAR(s.bias, 0.2, 1e-12);
+  EXPECT_NEAR(s.mean_label, 14.0 / 3, 1e-12);
+  EXPECT_NEAR(s.mean_latency, 0.030, 1e-12);
+  EXPECT_DOUBLE_EQ(s.max_latency, 0.050);
+}
+
+TEST(EstimateReportTest, NoLabelsGiveNaNNotZero) {
+  const EstimateSummary s = SummariseEstimates({{1, 1.0, 2.0, 0.1, kNaN, 0.0}});
+  EXPECT_EQ(s.compared, 0);
+  EXPECT_TRUE(std::isnan(s.rmse));
+  EXPECT_TRUE(std::isnan(s.acc05));
+  EXPECT_TRUE(std::isnan(SummariseEstimates({}).rmse));
+}
+
+TEST(EstimateReportTest, TableSortedByTimeWithSummary) {
+  const std::vector<EstimateRow> rows = {{7, 112.0, 5.0, 0.25, 4.0, 0.02}, {6, 110.8, 3.0, 0.25, 3.5, 0.02}};
+  const std::string table = EstimateTable(rows, 100.0);
+  const size_t a = table.find("\n    6 "), b = table.find("\n    7 ");
+  ASSERT_NE(a, std::string::npos) << table;
+  ASSERT_NE(b, std::string::npos) << table;
+  EXPECT_LT(a, b);
+  EXPECT_NE(table.find("10.80"), std::string::npos) << table;  // time since t0
+  EXPECT_NE(table.find("+1.00"), std::string::npos) << table;  // error of clip 7
+  EXPECT_NE(table.find("RMSE 0.791 m/s"), std::string::npos) << table;  // sqrt((1 + 0.25) / 2)
+  EXPECT_NE(table.find("Acc@0.5 0.500"), std::string::npos) << table;
+}
+
+TEST(EstimateReportTest, JsonRoundTripsAndWritesNaNAsNull) {
+  const std::vector<EstimateRow> rows = {{2, 2.0, 1.5, kNaN, 1.0, 0.01}, {1, 1.0, 1.0, 0.3, kNaN, 0.02}};
+  const nlohmann::json j = nlohmann::json::parse(EstimateJson(rows).dump());
+  ASSERT_EQ(j["estimates"].size(), 2u);
+  EXPECT_EQ(j["estimates"][0]["sequence"], 1);  // sorted by time
+  EXPECT_TRUE(j["estimates"][0]["reference"].is_null());
+  EXPECT_TRUE(j["estimates"][1]["speed_std"].is_null());
+  EXPECT_DOUBLE_EQ(j["rmse"].get<double>(), 0.5);
+  EXPECT_EQ(j["compared"], 1);
+}
+
+TEST(EstimateReportTest, PlotShowsBothSeriesAtTheirSpeeds) {
+  std::vector<EstimateRow> rows;
+  for (int i = 0; i < 60; ++i) rows.push_back({static_cast<uint64_t>(i), 1000.0 + 1.2 * i, 7.0, 0.0, 2.0, 0.01});
+  const int w = 800, h = 360;
+  const cv::Mat img = DrawEstimatePlot(rows, 998.8, w, h);
+  ASSERT_EQ(img.type(), CV_8UC3);
+  ASSERT_EQ(img.cols, w);
+  const double y_max = WindPlotAxisMax(7.0);
+  auto row_has = [&](int y, const cv::Scalar& c) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int x = w / 3; x < 2 * w / 3; ++x) {
+        const cv::Vec3b p = img.at<cv::Vec3b>(y + dy, x);
+        if (p[0] == c[0] && p[1] == c[1] && p[2] == c[2]) return true;
+      }
+    }
+    return false;
+  };
+  EXPECT_TRUE(row_has(WindPlotRow(7.0, y_max, h), kEstimateColour));
+  EXPECT_TRUE(row_has(WindPlotRow(2.0, y_max, h), kAnemometerColour));
+  EXPECT_FALSE(row_has(WindPlotRow(2.0, y_max, h), kEstimateColour));
+  EXPECT_THROW(DrawEstimatePlot({}, 0.0, w, h), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace clothwind::sensors
