@@ -1,6 +1,8 @@
 // clip_report_node: listens to `clips` during a replay and, when the replay is over, prints what
 // came out (a table: sequence, start, end, frames, spacing, wind label) with totals, writes the same
 // as JSON (~summary) and exits, which ends the launch when the node is marked required.
+// With ~estimates it also listens to `wind/estimate` (sdn_node) and adds a table of each clip's
+// estimate beside its anemometer label, the session's RMSE and Acc@0.5, and a plot (~estimate_plot).
 //
 // "Over": the clock (sim time from rosbag play --clock) has not moved for ~idle_timeout wall
 // seconds after it started, and no clip has arrived in that time either (the clip buffer labels
@@ -16,8 +18,11 @@
 #include <ros/ros.h>
 
 #include <clothwind/Clip.h>
+#include <clothwind/WindEstimate.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "sensors/dataset_writer.h"
+#include "sensors/estimate_report.h"
 
 namespace {
 
@@ -37,8 +42,11 @@ class ClipReport {
     pnh.param("max_wall", max_wall_, 0.0);
     pnh.param("start_timeout", start_timeout_, 60.0);
     pnh.param("summary", summary_path_, std::string());
+    pnh.param("estimates", want_estimates_, false);
+    pnh.param("estimate_plot", estimate_plot_path_, std::string());
     ros::NodeHandle nh;
     sub_ = nh.subscribe("clips", 50, &ClipReport::OnClip, this);
+    if (want_estimates_) estimate_sub_ = nh.subscribe("wind/estimate", 50, &ClipReport::OnEstimate, this);
     start_wall_ = last_change_ = ros::WallTime::now();
     timer_ = nh.createWallTimer(ros::WallDuration(0.5), &ClipReport::OnTimer, this);
   }
@@ -64,6 +72,27 @@ class ClipReport {
     rate_ = c->frame_rate;
     window_ = c->label_window;
     rows_.push_back(r);
+  }
+
+  void OnEstimate(const clothwind::WindEstimate::ConstPtr& e) {
+    last_change_ = ros::WallTime::now();
+    estimates_.push_back({e->clip_sequence, e->clip_end.toSec(), e->speed, e->speed_std, e->reference_speed,
+                          e->latency});
+  }
+
+  // The estimates' table, summary and plot (with ~estimates); adds them to the summary JSON.
+  void PrintEstimates(double t0, nlohmann::json* summary) {
+    namespace cs = clothwind::sensors;
+    std::printf("\nestimate_report: %zu estimate(s) from the replay (label: the clip's anemometer mean)\n",
+                estimates_.size());
+    std::printf("%s", cs::EstimateTable(estimates_, t0).c_str());
+    (*summary)["estimates"] = cs::EstimateJson(estimates_);
+    if (!estimate_plot_path_.empty() && !estimates_.empty()) {
+      std::vector<uchar> png;
+      cv::imencode(".png", cs::DrawEstimatePlot(estimates_, t0, 800, 360), png);
+      cs::WriteFileAtomically(estimate_plot_path_, std::string(png.begin(), png.end()));
+      std::printf("estimate plot: %s\n", estimate_plot_path_.c_str());
+    }
   }
 
   void OnTimer(const ros::WallTimerEvent&) {
@@ -117,22 +146,23 @@ class ClipReport {
                 rows_.size(), frames, rate_, rows_.empty() ? 0 : static_cast<int>(rows_.front().width),
                 rows_.empty() ? 0 : static_cast<int>(rows_.front().height), labelled, window_,
                 labelled ? label_sum / labelled : NAN, covered, worst_spacing * 1e6, wall);
+    nlohmann::json j = {{"clips", clips},
+                        {"total_clips", rows_.size()},
+                        {"total_frames", frames},
+                        {"labelled_clips", labelled},
+                        {"frame_rate", rate_},
+                        {"label_window", window_},
+                        {"wall_seconds", wall}};
+    if (want_estimates_) PrintEstimates(t0, &j);
     std::fflush(stdout);
-    if (!summary_path_.empty()) {
-      nlohmann::json j = {{"clips", clips},
-                          {"total_clips", rows_.size()},
-                          {"total_frames", frames},
-                          {"labelled_clips", labelled},
-                          {"frame_rate", rate_},
-                          {"label_window", window_},
-                          {"wall_seconds", wall}};
-      clothwind::sensors::WriteFileAtomically(summary_path_, j.dump(1) + "\n");
-    }
+    if (!summary_path_.empty()) clothwind::sensors::WriteFileAtomically(summary_path_, j.dump(1) + "\n");
   }
 
   double idle_timeout_ = 5.0, max_wall_ = 0.0, start_timeout_ = 60.0;
-  std::string summary_path_;
-  ros::Subscriber sub_;
+  std::string summary_path_, estimate_plot_path_;
+  bool want_estimates_ = false;
+  ros::Subscriber sub_, estimate_sub_;
+  std::vector<clothwind::sensors::EstimateRow> estimates_;
   ros::WallTimer timer_;
   ros::WallTime start_wall_, last_change_;
   ros::Time last_clock_;
