@@ -68,10 +68,13 @@ std::string EstimateTable(const std::vector<EstimateRow>& rows, double t0) {
                 "error", "latency");
   out += line;
   for (const EstimateRow& r : SortedByEnd(rows)) {
-    const std::string std_text = std::isfinite(r.speed_std) ? "\xC2\xB1" + std::to_string(r.speed_std).substr(0, 4) : "";
     char estimate[40];
-    std::snprintf(estimate, sizeof estimate, "%6.2f %-6s", r.speed, std_text.c_str());
-    std::snprintf(line, sizeof line, "%5llu  %10.2f  %15s  %10.2f  %+9.2f  %6.1fms\n",
+    if (std::isfinite(r.speed_std)) {
+      std::snprintf(estimate, sizeof estimate, "%6.2f \xC2\xB1%5.2f", r.speed, r.speed_std);
+    } else {
+      std::snprintf(estimate, sizeof estimate, "%6.2f       ", r.speed);
+    }
+    std::snprintf(line, sizeof line, "%5llu  %10.2f  %16s  %10.2f  %+9.2f  %6.1fms\n",
                   static_cast<unsigned long long>(r.sequence), r.end - t0, estimate, r.reference,
                   r.speed - r.reference, r.latency * 1e3);
     out += line;
