@@ -89,6 +89,10 @@ struct ClothSimulator::Impl {
   std::unique_ptr<StrainLimiter> limiter;
   std::unique_ptr<CrossingResolver> resolver;
   Eigen::MatrixX3d x_start;  // positions at the start of the step (for the crossing check)
+  // True when the resolver's vertex-face candidates of the last step cover every pair within the
+  // repulsion thickness at the current x (nothing moved since they were found): the next step's
+  // proximity search then filters them instead of running its own grid.
+  bool proximity_from_resolver = false;
 
   void Build();
   int BlockIndex(int i, int j) const;
@@ -521,7 +525,11 @@ void ClothSimulator::Step() {
                      s.options.collision_stiffness > 0;
   const auto t0 = Clock::now();
   if (repel) s.x_start = s.x;
-  if (repel) s.proximity->Update(s.x, s.options.repulsion_thickness);
+  if (repel && s.proximity_from_resolver)
+    s.proximity->UpdateFromCandidates(s.x, s.options.repulsion_thickness, s.resolver->vertex_face_candidates());
+  else if (repel)
+    s.proximity->Update(s.x, s.options.repulsion_thickness);
+  s.proximity_from_resolver = false;
   const auto t1 = Clock::now();
   s.ComputeForces(/*with_jacobian=*/true, repel);
   const auto t2 = Clock::now();
@@ -543,9 +551,13 @@ void ClothSimulator::Step() {
   // Vertices that jumped through a face during the step go back to their side (see
   // crossing_resolver.h): the repulsion alone lets fast folds pass through.
   s.stats.crossings_resolved = 0;
-  if (repel && s.options.crossing_sweeps > 0)
+  if (repel && s.options.crossing_sweeps > 0) {
+    // Reach = the repulsion thickness, so the candidates also serve the next step's proximity
+    // search, unless a correction has moved vertices since they were found.
     s.stats.crossings_resolved = s.resolver->Resolve(s.x_start, kCrossingGapFraction * s.options.repulsion_thickness,
-                                                     s.options.crossing_sweeps, &s.x, &s.v);
+                                                     s.options.repulsion_thickness, s.options.crossing_sweeps, &s.x, &s.v);
+    s.proximity_from_resolver = s.stats.crossings_resolved == 0 && s.x.allFinite();
+  }
   const auto t4 = Clock::now();
   s.stats.seconds_proximity = seconds(t0, t1);
   s.stats.seconds_forces = seconds(t1, t2);
@@ -573,6 +585,7 @@ void ClothSimulator::SetState(const Eigen::MatrixX3d& positions, const Eigen::Ma
     if (s.pinned[i]) s.v.row(i).setZero();
   s.dv.setZero();
   s.failure.clear();
+  s.proximity_from_resolver = false;  // the resolver's candidates were for the old positions
 }
 
 void ClothSimulator::set_wind(std::shared_ptr<const WindField> wind) { impl_->wind = std::move(wind); }

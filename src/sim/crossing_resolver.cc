@@ -4,6 +4,10 @@
 #include <cmath>
 #include <cstdio>
 
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 namespace clothwind::sim {
 namespace {
 
@@ -22,12 +26,33 @@ CrossingResolver::CrossingResolver(const Eigen::MatrixX3i& F, const Eigen::Vecto
     }
   std::sort(edges_.begin(), edges_.end());
   edges_.erase(std::unique(edges_.begin(), edges_.end()), edges_.end());
+  // Owners (see FindCandidates): the lowest-indexed face holding the vertex or edge.
+  const int nf = static_cast<int>(F_.rows());
+  const int nv = nf > 0 ? F_.maxCoeff() + 1 : 0;
+  std::vector<int> vertex_owner(nv, -1), edge_owner(edges_.size(), -1);
+  for (int f = nf - 1; f >= 0; --f)
+    for (int k = 0; k < 3; ++k) {
+      vertex_owner[F_(f, k)] = f;
+      const int a = F_(f, k), b = F_(f, (k + 1) % 3);
+      const auto it = std::lower_bound(edges_.begin(), edges_.end(), std::make_pair(std::min(a, b), std::max(a, b)));
+      edge_owner[it - edges_.begin()] = f;
+    }
+  // Per face, its owned vertices and edges (CSR, ascending).
+  auto group = [nf](const std::vector<int>& owner, std::vector<int>* start, std::vector<int>* items) {
+    start->assign(nf + 1, 0);
+    for (int o : owner)
+      if (o >= 0) ++(*start)[o + 1];
+    for (int f = 0; f < nf; ++f) (*start)[f + 1] += (*start)[f];
+    items->assign((*start)[nf], 0);
+    std::vector<int> fill(start->begin(), start->end() - 1);
+    for (int i = 0; i < static_cast<int>(owner.size()); ++i)
+      if (owner[i] >= 0) (*items)[fill[owner[i]]++] = i;
+  };
+  group(vertex_owner, &owned_start_, &owned_vertices_);
+  group(edge_owner, &owned_edge_start_, &owned_edges_);
 }
 
-// Sweep and prune: the boxes (grown by gap) sorted by their low end along the axis over which
-// the positions spread most; each box is paired with the following ones that start before it
-// ends and overlap it along the other two axes. Deterministic (ties broken by index).
-void CrossingResolver::OverlappingPairs(double gap, int num_queries) {
+void CrossingResolver::OverlappingPairs(double gap) {
   overlaps_.clear();
   const int n = static_cast<int>(boxes_.size());
   if (n == 0) return;
@@ -58,13 +83,11 @@ void CrossingResolver::OverlappingPairs(double gap, int num_queries) {
   const int num_cells = dims.prod();
 
   cell_start_.assign(num_cells + 1, 0);
-  const int first_inserted = num_queries;  // 0: all boxes against each other
   for (int i = 0; i < n; ++i) {
     for (int a = 0; a < 3; ++a) {
       lo_cell_[i][a] = index(boxes_[i].min()[a], a);
       hi_cell_[i][a] = index(boxes_[i].max()[a] + gap, a);
     }
-    if (i < first_inserted) continue;
     for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
       for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
         for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z) ++cell_start_[(x * dims[1] + y) * dims[2] + z + 1];
@@ -72,7 +95,7 @@ void CrossingResolver::OverlappingPairs(double gap, int num_queries) {
   for (int c = 0; c < num_cells; ++c) cell_start_[c + 1] += cell_start_[c];
   cell_entries_.resize(cell_start_[num_cells]);
   cell_fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
-  for (int i = first_inserted; i < n; ++i) {
+  for (int i = 0; i < n; ++i) {
     const Eigen::AlignedBox3d& b = boxes_[i];
     const Entry entry{{b.min().x(), b.min().y(), b.min().z()},
                       {b.max().x() + gap, b.max().y() + gap, b.max().z() + gap},
@@ -83,17 +106,22 @@ void CrossingResolver::OverlappingPairs(double gap, int num_queries) {
           cell_entries_[cell_fill_[(x * dims[1] + y) * dims[2] + z]++] = entry;
   }
   // Each overlapping pair is reported once: from its lower-indexed box (the query), in the cell holding the
-  // low corner of the two cell ranges' intersection. Only occupied cells are visited.
-  const int num_query = num_queries > 0 ? num_queries : n;
+  // low corner of the two cell ranges' intersection (along each axis, the query's or the entry's low
+  // cell, whichever is higher). Only occupied cells are visited.
   int count = 0;
-  for (int i = 0; i < num_query; ++i) {
+  for (int i = 0; i < n; ++i) {
     const double lo[3] = {boxes_[i].min().x(), boxes_[i].min().y(), boxes_[i].min().z()};
     const double hi[3] = {boxes_[i].max().x() + gap, boxes_[i].max().y() + gap, boxes_[i].max().z() + gap};
     const int cx = lo_cell_[i][0], cy = lo_cell_[i][1], cz = lo_cell_[i][2];
+#ifdef __SSE2__
+    const __m128d lo01 = _mm_loadu_pd(lo), hi01 = _mm_loadu_pd(hi);
+#endif
     for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
       for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
         for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z) {
           const int c = (x * dims[1] + y) * dims[2] + z;
+          // At the query's own low cell along an axis, any entry owns the pair along it.
+          const bool own_x = x == cx, own_y = y == cy, own_z = z == cz;
           // Branch-free: every entry is written, and kept only if it passes (the tests are
           // close to random, so branches would mostly mispredict).
           const int begin = cell_start_[c], end = cell_start_[c + 1];
@@ -103,9 +131,17 @@ void CrossingResolver::OverlappingPairs(double gap, int num_queries) {
           for (int p = end - 1; p >= begin; --p) {
             const Entry& e = cell_entries_[p];
             if (e.id <= i) break;
-            const bool keep = (std::max(cx, e.x) == x) & (std::max(cy, e.y) == y) &
-                              (std::max(cz, e.z) == z) & (e.lo[0] <= hi[0]) & (lo[0] <= e.hi[0]) &
-                              (e.lo[1] <= hi[1]) & (lo[1] <= e.hi[1]) & (e.lo[2] <= hi[2]) & (lo[2] <= e.hi[2]);
+            // Ownership: max(query low cell, entry low cell) == this cell along every axis (the
+            // cell is in both ranges, so it is at least both low cells).
+            const bool owned = (own_x | (e.x == x)) & (own_y | (e.y == y)) & (own_z | (e.z == z));
+#ifdef __SSE2__
+            const __m128d overlap01 = _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(e.lo), hi01),
+                                                 _mm_cmple_pd(lo01, _mm_loadu_pd(e.hi)));
+            const bool keep = owned & (_mm_movemask_pd(overlap01) == 3) & (e.lo[2] <= hi[2]) & (lo[2] <= e.hi[2]);
+#else
+            const bool keep = owned & (e.lo[0] <= hi[0]) & (lo[0] <= e.hi[0]) & (e.lo[1] <= hi[1]) &
+                              (lo[1] <= e.hi[1]) & (e.lo[2] <= hi[2]) & (lo[2] <= e.hi[2]);
+#endif
             out[count] = {i, e.id};
             count += keep;
           }
@@ -114,48 +150,50 @@ void CrossingResolver::OverlappingPairs(double gap, int num_queries) {
   overlaps_.resize(count);
 }
 
-// Edge pairs (no shared vertex) whose swept boxes (start and end positions) overlap within gap.
-void CrossingResolver::FindEdgeCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double gap) {
-  edge_candidates_.clear();
-  const int ne = static_cast<int>(edges_.size());
-  boxes_.resize(ne);
-  for (int e = 0; e < ne; ++e) {
-    boxes_[e].setEmpty();
-    for (int v : {edges_[e].first, edges_[e].second}) {
-      boxes_[e].extend(X0.row(v).transpose());
-      boxes_[e].extend(X1.row(v).transpose());
-    }
-  }
-  OverlappingPairs(gap, 0);
-  for (const auto& [i, j] : overlaps_) {
-    const int a = edges_[i].first, b = edges_[i].second, c = edges_[j].first, d = edges_[j].second;
-    if (c == a || c == b || d == a || d == b) continue;
-    edge_candidates_.emplace_back(i, j);
-  }
-}
-
-// Vertex-face pairs (vertex not of the face) whose swept boxes overlap within gap.
-void CrossingResolver::FindCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double gap) {
+// One broad phase for both kinds of pairs, over the faces' swept boxes only: each vertex and
+// each edge is owned by one face that contains it (whose swept box contains its own), so a
+// vertex-face or edge-edge pair whose swept boxes overlap within reach lies in a face pair whose
+// boxes overlap, and is found once, from the pair of its owners. This replaces two grid passes
+// (faces against vertices, edges against edges) that mostly reported neighbours in the sheet.
+void CrossingResolver::FindCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double reach) {
   candidates_.clear();
+  edge_candidates_.clear();
   const int nf = static_cast<int>(F_.rows()), nv = static_cast<int>(X1.rows());
-  boxes_.resize(nf + nv);
-  for (int f = 0; f < nf; ++f) {
-    boxes_[f].setEmpty();
-    for (int k = 0; k < 3; ++k) {
-      boxes_[f].extend(X0.row(F_(f, k)).transpose());
-      boxes_[f].extend(X1.row(F_(f, k)).transpose());
-    }
-  }
+  const int ne = static_cast<int>(edges_.size());
+  vertex_boxes_.resize(nv);
   for (int v = 0; v < nv; ++v) {
-    boxes_[nf + v].setEmpty();
-    boxes_[nf + v].extend(X0.row(v).transpose());
-    boxes_[nf + v].extend(X1.row(v).transpose());
+    vertex_boxes_[v].setEmpty();
+    vertex_boxes_[v].extend(X0.row(v).transpose());
+    vertex_boxes_[v].extend(X1.row(v).transpose());
   }
-  OverlappingPairs(gap, nf);  // faces against vertices
-  for (const auto& [i, j] : overlaps_) {
-    const int f = i, v = j - nf;  // i < j
-    if (F_(f, 0) == v || F_(f, 1) == v || F_(f, 2) == v) continue;
-    candidates_.push_back({v, f});
+  edge_boxes_.resize(ne);
+  for (int e = 0; e < ne; ++e) edge_boxes_[e] = vertex_boxes_[edges_[e].first].merged(vertex_boxes_[edges_[e].second]);
+  boxes_.resize(nf);
+  for (int f = 0; f < nf; ++f)
+    boxes_[f] = vertex_boxes_[F_(f, 0)].merged(vertex_boxes_[F_(f, 1)]).merged(vertex_boxes_[F_(f, 2)]);
+  OverlappingPairs(reach);
+  // Boxes overlap within reach (the grid's test, so the pairs are those of a direct search).
+  auto near = [reach](const Eigen::AlignedBox3d& a, const Eigen::AlignedBox3d& b) {
+    return (a.min().array() <= b.max().array() + reach).all() && (b.min().array() <= a.max().array() + reach).all();
+  };
+  auto incident = [this](int v, int f) { return F_(f, 0) == v || F_(f, 1) == v || F_(f, 2) == v; };
+  auto vertex_face = [&](int owner, int f) {
+    for (int k = owned_start_[owner]; k < owned_start_[owner + 1]; ++k) {
+      const int v = owned_vertices_[k];
+      if (!incident(v, f) && near(vertex_boxes_[v], boxes_[f])) candidates_.push_back({v, f});
+    }
+  };
+  for (const auto& [p, q] : overlaps_) {
+    vertex_face(p, q);
+    vertex_face(q, p);
+    for (int a = owned_edge_start_[p]; a < owned_edge_start_[p + 1]; ++a)
+      for (int b = owned_edge_start_[q]; b < owned_edge_start_[q + 1]; ++b) {
+        const int i = owned_edges_[a], j = owned_edges_[b];
+        const auto [ea, eb] = edges_[i];
+        const auto [ec, ed] = edges_[j];
+        if (ec == ea || ec == eb || ed == ea || ed == eb || !near(edge_boxes_[i], edge_boxes_[j])) continue;
+        edge_candidates_.emplace_back(std::min(i, j), std::max(i, j));
+      }
   }
 }
 
@@ -182,8 +220,8 @@ int CrossingResolver::SweepVertexFace(const Eigen::MatrixX3d& X0, double gap, Ei
                                       Eigen::MatrixX3d* V) {
   const Eigen::MatrixX3d& X1 = *X;
   int corrections = 0;
-  for (const Candidate& cand : candidates_) {
-    const int id[4] = {cand.vertex, F_(cand.face, 0), F_(cand.face, 1), F_(cand.face, 2)};
+  for (const auto& [vertex, face] : candidates_) {
+    const int id[4] = {vertex, F_(face, 0), F_(face, 1), F_(face, 2)};
     Eigen::Vector3d s[4], e[4];
     for (int k = 0; k < 4; ++k) {
       s[k] = X0.row(id[k]).transpose();
@@ -272,11 +310,12 @@ int CrossingResolver::SweepEdgeEdge(const Eigen::MatrixX3d& X0, double gap, Eige
   return corrections;
 }
 
-int CrossingResolver::Resolve(const Eigen::MatrixX3d& X0, double gap, int max_sweeps, Eigen::MatrixX3d* X,
-                              Eigen::MatrixX3d* V) {
+int CrossingResolver::Resolve(const Eigen::MatrixX3d& X0, double gap, double reach, int max_sweeps,
+                              Eigen::MatrixX3d* X, Eigen::MatrixX3d* V) {
+  candidates_.clear();
+  edge_candidates_.clear();
   if (!X->allFinite()) return 0;  // exploded: the simulator reports it
-  FindCandidates(X0, *X, gap);
-  FindEdgeCandidates(X0, *X, gap);
+  FindCandidates(X0, *X, std::max(gap, reach));
   int corrections = 0;
   for (int sweep = 0; sweep < max_sweeps; ++sweep) {
     const int n = SweepVertexFace(X0, gap, X, V) + SweepEdgeEdge(X0, gap, X, V);

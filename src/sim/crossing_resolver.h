@@ -39,16 +39,19 @@ class CrossingResolver {
   //   X    #V by 3 positions at the end of the step [m], corrected
   //   V    #V by 3 velocities [m/s], approaching normal velocity of corrected pairs removed
   // Returns the number of corrections made (a pair corrected in two sweeps counts twice).
-  int Resolve(const Eigen::MatrixX3d& X0, double gap, int max_sweeps, Eigen::MatrixX3d* X,
+  // reach: broad-phase distance (>= gap; less is raised to gap): pairs whose swept boxes come
+  // within it are tested. With reach >= a thickness h, vertex_face_candidates() holds every
+  // (non-incident) vertex-face pair within h at the end positions, so long as nothing was corrected.
+  int Resolve(const Eigen::MatrixX3d& X0, double gap, double reach, int max_sweeps, Eigen::MatrixX3d* X,
               Eigen::MatrixX3d* V);
 
+  // (vertex, face) pairs whose swept boxes came within reach in the last Resolve (each once).
+  const std::vector<std::pair<int, int>>& vertex_face_candidates() const { return candidates_; }
+
  private:
-  struct Candidate {
-    int vertex;
-    int face;
-  };
-  void FindCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double gap);
-  void FindEdgeCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double gap);
+  // Vertex-face pairs (vertex not of the face) into candidates_ and edge-edge pairs (no shared
+  // vertex) into edge_candidates_ whose swept boxes (start and end positions) overlap within reach.
+  void FindCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double reach);
   // One pass over the candidates; returns the corrections made.
   int SweepVertexFace(const Eigen::MatrixX3d& X0, double gap, Eigen::MatrixX3d* X, Eigen::MatrixX3d* V);
   int SweepEdgeEdge(const Eigen::MatrixX3d& X0, double gap, Eigen::MatrixX3d* X, Eigen::MatrixX3d* V);
@@ -58,16 +61,19 @@ class CrossingResolver {
             Eigen::MatrixX3d* V) const;
 
   // Pairs (i < j) of boxes_ that overlap when grown by gap, into overlaps_ (a uniform grid of
-  // about the mean box size, filled by counting sort). num_queries > 0: only pairs of a box
-  // i < num_queries with a box j >= num_queries; 0: all pairs.
-  void OverlappingPairs(double gap, int num_queries);
+  // about the mean box size, filled by counting sort).
+  void OverlappingPairs(double gap);
 
   Eigen::MatrixX3i F_;
   Eigen::VectorXd inverse_mass_;
   std::vector<std::pair<int, int>> edges_;            // unique edges (a < b)
-  std::vector<Candidate> candidates_;                 // vertex-face pairs
+  std::vector<std::pair<int, int>> candidates_;       // vertex-face pairs (vertex, face)
   std::vector<std::pair<int, int>> edge_candidates_;  // edge index pairs, no shared vertex
-  std::vector<Eigen::AlignedBox3d> boxes_;            // scratch: swept boxes
+  // Each vertex and edge is owned by one face holding it: per face f, its vertices are
+  // owned_vertices_[owned_start_[f] .. owned_start_[f + 1]), its edges (indices into edges_) likewise.
+  std::vector<int> owned_start_, owned_vertices_, owned_edge_start_, owned_edges_;
+  std::vector<Eigen::AlignedBox3d> boxes_;            // scratch: swept boxes of the faces
+  std::vector<Eigen::AlignedBox3d> vertex_boxes_, edge_boxes_;  // scratch: swept boxes
   std::vector<Eigen::Array3i> lo_cell_, hi_cell_;    // scratch: cell range of each box
   struct Entry {  // a box in a grid cell, with what the pair test needs (one cache line)
     double lo[3], hi[3];  // hi grown by gap

@@ -33,6 +33,27 @@ std::int64_t CellIndex(double c, double inv) { return static_cast<std::int64_t>(
 // while its pairs would be meaningless anyway: the simulator reports the exploded state itself.
 constexpr double kMaxCellsPerAxis = 32;
 
+// Vertices and faces beyond +-kFar cells (or non-finite) are left out: converting their cell
+// coordinate to an integer would overflow.
+constexpr double kFar = 1e15;
+
+// The exact test shared by Update and UpdateFromCandidates: is p within thickness of the plane of
+// face (a, b, c) with unit normal n (N = (b - a) x (c - a), nn = |N|^2), projecting inside the
+// face, and inside the face's box grown by thickness (lo, hi)? Sets *side (+1: on n's side).
+bool Near(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+          const Eigen::Vector3d& n, const Eigen::Vector3d& N, double nn, const Eigen::Vector3d& lo,
+          const Eigen::Vector3d& hi, double thickness, double* side) {
+  if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) return false;
+  const Eigen::Vector3d ap = p - a;
+  const double d = n.dot(ap);
+  if (std::abs(d) >= thickness) return false;
+  const double wb = ap.cross(c - a).dot(N) / nn;
+  const double wc = (b - a).cross(ap).dot(N) / nn;
+  if (wb < 0 || wc < 0 || wb + wc > 1) return false;
+  *side = d >= 0 ? 1.0 : -1.0;
+  return true;
+}
+
 }  // namespace
 
 VertexFaceProximity::VertexFaceProximity(const Eigen::MatrixX3i& F, int num_vertices, double cell_size)
@@ -54,7 +75,6 @@ void VertexFaceProximity::Update(const Eigen::MatrixX3d& X, double thickness) {
   // Insert in reverse so each bucket lists vertices in increasing order.
   // Vertices beyond +-kFar cells (or non-finite) are left out of the grid: converting their
   // cell coordinate to an integer would overflow, and no face they could be near is searched.
-  constexpr double kFar = 1e15;
   for (int i = num_vertices_ - 1; i >= 0; --i) {
     const Eigen::Vector3d c = X.row(i).transpose() * inv;
     if (!c.allFinite() || !(c.cwiseAbs().maxCoeff() < kFar)) {
@@ -90,14 +110,8 @@ void VertexFaceProximity::Update(const Eigen::MatrixX3d& X, double thickness) {
           const std::uint64_t key = CellKey(i, j, k);
           for (int vi = bucket_head_[Mix(key) & mask]; vi >= 0; vi = next_[vi]) {
             if (key_[vi] != key || vi == ia || vi == ib || vi == ic) continue;
-            const Eigen::Vector3d p = X.row(vi);
-            if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
-            const Eigen::Vector3d ap = p - a;
-            const double d = n.dot(ap);
-            if (std::abs(d) >= thickness) continue;
-            const double wb = ap.cross(c - a).dot(N) / nn;
-            const double wc = (b - a).cross(ap).dot(N) / nn;
-            if (wb < 0 || wc < 0 || wb + wc > 1) continue;
+            double side;
+            if (!Near(X.row(vi).transpose(), a, b, c, n, N, nn, lo, hi, thickness, &side)) continue;
             found_.push_back(vi);
           }
         }
@@ -109,6 +123,37 @@ void VertexFaceProximity::Update(const Eigen::MatrixX3d& X, double thickness) {
       pairs_.push_back({vi, f, d >= 0 ? 1.0 : -1.0});
     }
   }
+}
+
+void VertexFaceProximity::UpdateFromCandidates(const Eigen::MatrixX3d& X, double thickness,
+                                               const std::vector<std::pair<int, int>>& candidates) {
+  pairs_.clear();
+  scratch_.clear();
+  if (!(thickness > 0) || F_.rows() == 0) return;
+  const double inv = 1.0 / std::max(cell_size_, 2 * thickness);
+  for (const auto& [vi, f] : candidates) {
+    const int ia = F_(f, 0), ib = F_(f, 1), ic = F_(f, 2);
+    if (vi == ia || vi == ib || vi == ic) continue;
+    const Eigen::Vector3d a = X.row(ia), b = X.row(ib), c = X.row(ic);
+    const Eigen::Vector3d lo = a.cwiseMin(b).cwiseMin(c).array() - thickness;
+    const Eigen::Vector3d hi = a.cwiseMax(b).cwiseMax(c).array() + thickness;
+    // The faces Update skips (exploded or non-finite) are skipped here too.
+    if (!lo.allFinite() || !hi.allFinite() || !((hi - lo).maxCoeff() * inv <= kMaxCellsPerAxis) ||
+        !(lo.cwiseAbs().maxCoeff() * inv < kFar) || !(hi.cwiseAbs().maxCoeff() * inv < kFar))
+      continue;
+    const Eigen::Vector3d p = X.row(vi).transpose();
+    if (!(p.cwiseAbs().maxCoeff() * inv < kFar)) continue;  // also false for non-finite: left out, as in Update
+    const Eigen::Vector3d N = (b - a).cross(c - a);
+    const double nn = N.squaredNorm();
+    if (!(nn > 0)) continue;
+    const Eigen::Vector3d n = N / std::sqrt(nn);
+    double side;
+    if (Near(p, a, b, c, n, N, nn, lo, hi, thickness, &side)) scratch_.push_back({vi, f, side});
+  }
+  // Update's order: by face, then vertex.
+  std::sort(scratch_.begin(), scratch_.end(),
+            [](const Pair& p, const Pair& q) { return p.face != q.face ? p.face < q.face : p.vertex < q.vertex; });
+  pairs_.assign(scratch_.begin(), scratch_.end());
 }
 
 }  // namespace clothwind::sim

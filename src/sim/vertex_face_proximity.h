@@ -2,6 +2,7 @@
 #define CLOTHWIND_SIM_VERTEX_FACE_PROXIMITY_H_
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -32,6 +33,13 @@ class VertexFaceProximity {
   // axis (an exploded state, never a cloth's face: the cell is about an edge) are skipped.
   void Update(const Eigen::MatrixX3d& X, double thickness);
 
+  // The same pairs as Update (same order), looked for only among `candidates` (vertex, face)
+  // pairs, each listed at most once, that must include every pair within thickness (e.g. the
+  // crossing resolver's vertex-face candidates of the step that ended at X, with a broad-phase
+  // reach >= thickness). Saves Update's grid when such a list is at hand.
+  void UpdateFromCandidates(const Eigen::MatrixX3d& X, double thickness,
+                            const std::vector<std::pair<int, int>>& candidates);
+
   // Pairs found by the last Update.
   const std::vector<Pair>& pairs() const { return pairs_; }
 
@@ -44,6 +52,7 @@ class VertexFaceProximity {
   std::vector<std::uint64_t> key_; // per vertex: its cell key
   std::vector<Pair> pairs_;
   std::vector<int> found_;         // scratch: vertices found for one face
+  std::vector<Pair> scratch_;      // scratch: UpdateFromCandidates' pairs before sorting
 };
 
 }  // namespace clothwind::sim

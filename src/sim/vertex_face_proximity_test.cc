@@ -3,6 +3,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
+#include <algorithm>
 
 #include <gtest/gtest.h>
 
@@ -66,6 +69,42 @@ TEST(VertexFaceProximity, NonFiniteVertexIsIgnored) {
   VertexFaceProximity prox(s.F, 7, 0.05);
   prox.Update(s.X, 0.01);
   EXPECT_TRUE(prox.pairs().empty());
+}
+
+TEST(VertexFaceProximity, FromCandidatesEqualsUpdateGivenAllPairsAndOnlyLooksAmongThem) {
+  // A sheet of 6 x 6 vertices folded over itself (layers ~8 mm apart): pairs within the thickness.
+  const int n = 6;
+  Eigen::MatrixX3i F(2 * (n - 1) * (n - 1), 3);
+  int k = 0;
+  for (int i = 0; i + 1 < n; ++i)
+    for (int j = 0; j + 1 < n; ++j) {
+      const int a = i * n + j;
+      F.row(k++) << a, a + 1, a + n;
+      F.row(k++) << a + 1, a + n + 1, a + n;
+    }
+  Eigen::MatrixX3d X(n * n, 3);
+  for (int i = 0; i < n * n; ++i)
+    X.row(i) << (i / n >= n / 2 ? 0.05 * (n - 1 - i / n) + 0.01 : 0.05 * (i / n)) + 0.01 * std::sin(7.0 * i),
+        0.05 * (i % n) + 0.01 * std::cos(5.0 * i), (i / n >= n / 2 ? 0.008 : 0.0) + 0.002 * std::sin(3.0 * i);
+  const double thickness = 0.02;
+  VertexFaceProximity full(F, n * n, 0.05), filtered(F, n * n, 0.05);
+  full.Update(X, thickness);
+  ASSERT_GE(full.pairs().size(), 3u) << "the test needs pairs";
+  std::vector<std::pair<int, int>> all;  // every (vertex, face), in an order unlike Update's
+  for (int v = n * n - 1; v >= 0; --v)
+    for (int f = 0; f < F.rows(); ++f) all.emplace_back(v, f);
+  filtered.UpdateFromCandidates(X, thickness, all);
+  ASSERT_EQ(filtered.pairs().size(), full.pairs().size());
+  for (size_t i = 0; i < full.pairs().size(); ++i) {
+    EXPECT_EQ(filtered.pairs()[i].vertex, full.pairs()[i].vertex);
+    EXPECT_EQ(filtered.pairs()[i].face, full.pairs()[i].face);
+    EXPECT_EQ(filtered.pairs()[i].side, full.pairs()[i].side);
+  }
+  // Without the first pair among the candidates, that pair is not reported.
+  const auto first = std::make_pair(full.pairs()[0].vertex, full.pairs()[0].face);
+  all.erase(std::find(all.begin(), all.end(), first));
+  filtered.UpdateFromCandidates(X, thickness, all);
+  EXPECT_EQ(filtered.pairs().size(), full.pairs().size() - 1);
 }
 
 }  // namespace
