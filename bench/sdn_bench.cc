@@ -2,9 +2,10 @@
 // crop/resize/normalise + forward pass, for the SDN and the frame-stack baseline at several
 // widths and input sizes, on 1 and 2 threads (the goal: <= 50 ms per 30-frame clip on 2 cores
 // at the shipped size). Models are initialised in a temporary folder (speed does not depend on
-// the weights). Prints a table.
+// the weights). Prints a table. --model benches given trained models (e.g. the shipped
+// models/sdn.pt) instead of the initialised ones.
 //
-//   sdn_bench [--repeats N] [--quick]
+//   sdn_bench [--repeats N] [--quick] [--model PATH.pt ...]
 #include <time.h>
 
 #include <unistd.h>
@@ -48,17 +49,20 @@ struct Case {
 int main(int argc, char** argv) {
   int repeats = 20;
   bool quick = false;
+  std::vector<fs::path> given;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--quick")) quick = true;
+    else if (!std::strcmp(argv[i], "--model") && i + 1 < argc) given.push_back(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: sdn_bench [--repeats N] [--quick]\n");
+      std::fprintf(stderr, "usage: sdn_bench [--repeats N] [--quick] [--model PATH.pt ...]\n");
       return 2;
     }
   }
-  std::vector<Case> cases = {{"sdn", 16, 112, 30}, {"sdn", 32, 112, 30}, {"sdn", 64, 112, 30},
-                             {"resnet18", 64, 112, 30}, {"sdn", 64, 224, 30}};
+  std::vector<Case> cases = {{"sdn", 32, 64, 30},  {"sdn", 16, 112, 30},       {"sdn", 32, 112, 30},
+                             {"sdn", 64, 112, 30}, {"resnet18", 64, 112, 30}, {"sdn", 64, 224, 30}};
   if (quick) cases = {{"sdn", 16, 112, 30}, {"sdn", 64, 112, 30}};
+  if (!given.empty()) cases.clear();
   const fs::path dir = fs::temp_directory_path() / ("clothwind_sdn_bench_" + std::to_string(::getpid()));
   // A clip as the node receives it: 30 frames 300x300 of moving stripes.
   std::vector<cv::Mat> frames;
@@ -70,6 +74,7 @@ int main(int argc, char** argv) {
   }
   std::printf("%-28s %7s %10s %10s %10s %14s\n", "model", "threads", "mean [ms]", "p90 [ms]",
               "min [ms]", "cpu/clip [ms]");
+  std::vector<fs::path> models = given;
   for (const Case& c : cases) {
     cl::TrainOptions o;
     o.model.arch = c.arch;
@@ -79,9 +84,11 @@ int main(int argc, char** argv) {
     o.out = dir / (c.arch + std::to_string(c.width) + "_" + std::to_string(c.input_size));
     o.init_only = true;
     o.threads = 1;
-    const cl::TrainResult r = cl::Train(o);
+    models.push_back(cl::Train(o).model);
+  }
+  for (const fs::path& model : models) {
     for (int threads : {1, 2}) {
-      cl::Predictor p(r.model, threads, "cpu");
+      cl::Predictor p(model, threads, "cpu");
       p.PredictFrames(frames);  // warm-up, as the node does
       std::vector<double> ms;
       const double cpu0 = CpuMs();

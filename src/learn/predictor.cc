@@ -22,6 +22,10 @@ struct Predictor::Impl {
 
 Predictor::Predictor(const std::filesystem::path& weights, int threads, const std::string& device)
     : impl_(std::make_unique<Impl>()) {
+  // Flush denormals to zero: weight decay drives many weights and activations towards zero, and
+  // denormal floats made CPU training epochs 3x slower after ~10 epochs. Set before the intra-op
+  // threads exist: new threads inherit this thread's floating-point mode.
+  at::globalContext().setFlushDenormal(true);
   if (threads > 0) at::set_num_threads(threads);
   if (device == "cuda" && !torch::cuda::is_available()) {
     throw std::runtime_error("device cuda requested but libtorch finds no CUDA device");

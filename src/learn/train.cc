@@ -87,6 +87,10 @@ void SaveAtomically(T& object, const fs::path& path) {
 }  // namespace
 
 TrainResult Train(const TrainOptions& o) {
+  // Flush denormals to zero: weight decay drives many weights and activations towards zero, and
+  // denormal floats made CPU training epochs 3x slower after ~10 epochs. Set before the intra-op
+  // threads exist: new threads inherit this thread's floating-point mode.
+  at::globalContext().setFlushDenormal(true);
   if (o.threads > 0) at::set_num_threads(o.threads);
   if (o.device != "cpu" && o.device != "cuda" && o.device != "auto") {
     throw std::runtime_error("device must be cpu, cuda or auto, got \"" + o.device + "\"");
