@@ -194,5 +194,28 @@ TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
   EXPECT_THROW(p.PredictFrames(std::vector<cv::Mat>(29, frames[0])), std::invalid_argument);
 }
 
+// A float below FLT_MIN: with denormals flushed it becomes 0 when multiplied. volatile keeps the
+// compiler from folding the product at compile time.
+float DenormalProduct() {
+  volatile float tiny = 1e-39f, one = 1.0f;
+  return tiny * one;
+}
+
+TEST_F(TrainTest, TrainingAndInferenceFlushDenormals) {
+  // Denormal weights made CPU epochs several times slower late in training (docs/sdn.md).
+  at::globalContext().setFlushDenormal(false);
+  ASSERT_NE(DenormalProduct(), 0.0f);  // the check can see the difference
+  TrainOptions t;
+  t.model.width = 4;
+  t.model.input_size = 32;
+  t.out = *root_ / "denormal";
+  t.init_only = true;
+  const TrainResult r = Train(t);
+  EXPECT_EQ(DenormalProduct(), 0.0f);
+  at::globalContext().setFlushDenormal(false);
+  Predictor p(r.model, 1, "cpu");
+  EXPECT_EQ(DenormalProduct(), 0.0f);
+}
+
 }  // namespace
 }  // namespace clothwind::learn
