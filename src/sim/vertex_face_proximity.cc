@@ -37,6 +37,14 @@ constexpr double kMaxCellsPerAxis = 32;
 // coordinate to an integer would overflow.
 constexpr double kFar = 1e15;
 
+// Whether a face's grown box [lo, hi] can be put in a grid of cells 1/inv wide: finite, at most
+// kMaxCellsPerAxis cells across, within kFar cells of the origin. An exploded or non-finite face
+// is not, and both Update and UpdateFromCandidates skip it.
+bool FaceBoxUsable(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double inv) {
+  return lo.allFinite() && hi.allFinite() && (hi - lo).maxCoeff() * inv <= kMaxCellsPerAxis &&
+         lo.cwiseAbs().maxCoeff() * inv < kFar && hi.cwiseAbs().maxCoeff() * inv < kFar;
+}
+
 // The exact test shared by Update and UpdateFromCandidates: is p within thickness of the plane of
 // face (a, b, c) with unit normal n (N = (b - a) x (c - a), nn = |N|^2), projecting inside the
 // face, and inside the face's box grown by thickness (lo, hi)? Sets *side (+1: on n's side).
@@ -92,10 +100,7 @@ void VertexFaceProximity::Update(const Eigen::MatrixX3d& X, double thickness) {
     const Eigen::Vector3d a = X.row(ia), b = X.row(ib), c = X.row(ic);
     const Eigen::Vector3d lo = a.cwiseMin(b).cwiseMin(c).array() - thickness;
     const Eigen::Vector3d hi = a.cwiseMax(b).cwiseMax(c).array() + thickness;
-    // Exploded or non-finite face (see kMaxCellsPerAxis): skipped.
-    if (!lo.allFinite() || !hi.allFinite() || !((hi - lo).maxCoeff() * inv <= kMaxCellsPerAxis) ||
-        !(lo.cwiseAbs().maxCoeff() * inv < kFar) || !(hi.cwiseAbs().maxCoeff() * inv < kFar))
-      continue;
+    if (!FaceBoxUsable(lo, hi, inv)) continue;  // exploded or non-finite face (see kMaxCellsPerAxis)
     const Eigen::Vector3d N = (b - a).cross(c - a);
     const double nn = N.squaredNorm();
     if (!(nn > 0)) continue;
@@ -137,10 +142,7 @@ void VertexFaceProximity::UpdateFromCandidates(const Eigen::MatrixX3d& X, double
     const Eigen::Vector3d a = X.row(ia), b = X.row(ib), c = X.row(ic);
     const Eigen::Vector3d lo = a.cwiseMin(b).cwiseMin(c).array() - thickness;
     const Eigen::Vector3d hi = a.cwiseMax(b).cwiseMax(c).array() + thickness;
-    // The faces Update skips (exploded or non-finite) are skipped here too.
-    if (!lo.allFinite() || !hi.allFinite() || !((hi - lo).maxCoeff() * inv <= kMaxCellsPerAxis) ||
-        !(lo.cwiseAbs().maxCoeff() * inv < kFar) || !(hi.cwiseAbs().maxCoeff() * inv < kFar))
-      continue;
+    if (!FaceBoxUsable(lo, hi, inv)) continue;  // the faces Update skips are skipped here too
     const Eigen::Vector3d p = X.row(vi).transpose();
     if (!(p.cwiseAbs().maxCoeff() * inv < kFar)) continue;  // also false for non-finite: left out, as in Update
     const Eigen::Vector3d N = (b - a).cross(c - a);
