@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "sim/crossing_resolver.h"
+#include "sim/test_grid_faces.h"
 #include "sim/vertex_face_proximity.h"
 
 namespace clothwind::sim {
@@ -56,14 +57,7 @@ TEST(CrossingResolver, VertexFaceCandidatesCoverEveryPairWithinReach) {
   // A sheet folded over itself (two layers ~8 mm apart), jittered, moving a little at random:
   // every proximity pair at the end positions is a candidate.
   const int n = 8;
-  Eigen::MatrixX3i F(2 * (n - 1) * (n - 1), 3);
-  int k = 0;
-  for (int i = 0; i + 1 < n; ++i)
-    for (int j = 0; j + 1 < n; ++j) {
-      const int a = i * n + j;
-      F.row(k++) << a, a + 1, a + n;
-      F.row(k++) << a + 1, a + n + 1, a + n;
-    }
+  const Eigen::MatrixX3i F = GridFaces(n);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
   Eigen::MatrixX3d X0(n * n, 3);

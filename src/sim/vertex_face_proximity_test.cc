@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "sim/test_grid_faces.h"
 #include "sim/vertex_face_proximity.h"
 
 namespace clothwind::sim {
@@ -74,14 +75,7 @@ TEST(VertexFaceProximity, NonFiniteVertexIsIgnored) {
 TEST(VertexFaceProximity, FromCandidatesEqualsUpdateGivenAllPairsAndOnlyLooksAmongThem) {
   // A sheet of 6 x 6 vertices folded over itself (layers ~8 mm apart): pairs within the thickness.
   const int n = 6;
-  Eigen::MatrixX3i F(2 * (n - 1) * (n - 1), 3);
-  int k = 0;
-  for (int i = 0; i + 1 < n; ++i)
-    for (int j = 0; j + 1 < n; ++j) {
-      const int a = i * n + j;
-      F.row(k++) << a, a + 1, a + n;
-      F.row(k++) << a + 1, a + n + 1, a + n;
-    }
+  const Eigen::MatrixX3i F = GridFaces(n);
   Eigen::MatrixX3d X(n * n, 3);
   for (int i = 0; i < n * n; ++i)
     X.row(i) << (i / n >= n / 2 ? 0.05 * (n - 1 - i / n) + 0.01 : 0.05 * (i / n)) + 0.01 * std::sin(7.0 * i),
