@@ -22,6 +22,8 @@ struct MakeDatasetArgs {
   std::string shard = "0/1";
   std::string format = "jpg";
   double wind_min = -1, wind_max = -1;
+  // FlagSim material priors (SamplingRanges); < 0: the default.
+  double area_weight_spread = -1, bending_spread = -1, bending_jitter = -1;
   bool reindex = false;
   bool no_contact_sheet = false;
   std::string backgrounds;  // folder of images
@@ -54,10 +56,14 @@ int Run(MakeDatasetArgs& a) {
   ParseShard(a.shard, &o.shard, &o.shards);
   o.frame_ext = a.format == "jpeg" ? "jpg" : a.format;
   o.contact_sheet = !a.no_contact_sheet;
-  if (a.wind_min >= 0 || a.wind_max >= 0) {
+  if (a.wind_min >= 0 || a.wind_max >= 0 || a.area_weight_spread >= 0 || a.bending_spread >= 0 ||
+      a.bending_jitter >= 0) {
     data::SamplingRanges r = data::DefaultRanges(o.kind);
     if (a.wind_min >= 0) r.wind_min = a.wind_min;
     if (a.wind_max >= 0) r.wind_max = a.wind_max;
+    if (a.area_weight_spread >= 0) r.area_weight_factor = a.area_weight_spread;
+    if (a.bending_spread >= 0) r.bending_factor = a.bending_spread;
+    if (a.bending_jitter >= 0) r.bending_jitter = a.bending_jitter;
     o.ranges = r;
   }
   if (!a.backgrounds.empty()) {
@@ -132,6 +138,18 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
   sub->add_option("--jpeg-quality", a->o.jpeg_quality, "JPEG quality 1..100")->capture_default_str();
   sub->add_option("--wind-min", a->wind_min, "lowest wind speed [m/s] (default: flag 0, cloth 0)");
   sub->add_option("--wind-max", a->wind_max, "highest wind speed [m/s] (default: flag 10, cloth 5)");
+  // Why a narrow area weight: the wind's pressure balances the flag's weight, so the droop shows
+  // rho v^2 / (w g); a flag of unknown weight in [w/2, 2w] leaves v uncertain by a factor of 2
+  // (docs/datasets.md). A deployed flag can be weighed; its bending stiffness cannot easily.
+  sub->add_option("--area-weight-spread", a->area_weight_spread,
+                  "FlagSim: area weight = base x f, f log-uniform in [1/F, F] (default 2; 1 = the scene's)")
+      ->check(CLI::Range(1.0, 100.0));
+  sub->add_option("--bending-spread", a->bending_spread,
+                  "FlagSim: overall bending stiffness factor log-uniform in [1/G, G] (default 4)")
+      ->check(CLI::Range(1.0, 100.0));
+  sub->add_option("--bending-jitter", a->bending_jitter,
+                  "FlagSim: per-entry bending factor log-uniform in [1/H, H] (default 1.25)")
+      ->check(CLI::Range(1.0, 100.0));
   sub->add_option("--val", a->o.val_fraction, "fraction of simulations in the val split")->capture_default_str();
   sub->add_option("--test", a->o.test_fraction, "fraction of simulations in the test split")->capture_default_str();
   sub->add_option("--backgrounds", a->backgrounds, "folder of background images (default: procedural)");
