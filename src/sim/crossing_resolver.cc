@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
-#ifdef __SSE2__
-#include <emmintrin.h>
+#ifdef __SSE__
+#include <xmmintrin.h>
 #endif
 
 namespace clothwind::sim {
@@ -50,151 +51,242 @@ CrossingResolver::CrossingResolver(const Eigen::MatrixX3i& F, const Eigen::Vecto
   };
   group(vertex_owner, &owned_start_, &owned_vertices_);
   group(edge_owner, &owned_edge_start_, &owned_edges_);
-}
+  faces_.resize(nf);
+  for (int f = 0; f < nf; ++f) faces_[f] = {F_(f, 0), F_(f, 1), F_(f, 2)};
 
-void CrossingResolver::OverlappingPairs(double gap) {
-  overlaps_.clear();
-  const int n = static_cast<int>(boxes_.size());
-  if (n == 0) return;
-  Eigen::AlignedBox3d all;
-  all.setEmpty();
-  Eigen::Vector3d mean_size = Eigen::Vector3d::Zero();
-  for (const Eigen::AlignedBox3d& b : boxes_) {
-    if (!b.min().allFinite() || !b.max().allFinite()) return;  // exploded: the simulator reports it
-    all.extend(b);
-    mean_size += b.sizes();
-  }
-  // Cells about the mean box size, at most kMaxCells in all (an exploded state gets big cells).
-  constexpr double kMaxCells = 1 << 16;
-  const Eigen::Vector3d extent = all.sizes().array() + gap;
-  double cell = std::max(mean_size.maxCoeff() / n + gap, 1e-9);
-  while ((extent / cell).array().floor().matrix().prod() + 1 > kMaxCells ||
-         ((extent / cell).array() + 1).prod() > kMaxCells)
-    cell *= 2;
-  const double inv = 1.0 / cell;
-  Eigen::Array3i dims = ((extent * inv).array().floor() + 1).cast<int>();
-  const Eigen::Vector3d origin = all.min();
-  auto index = [&](double c, int axis) {
-    // c >= origin, so truncation is floor (std::floor is a library call without SSE4.1).
-    return std::min(static_cast<int>((c - origin[axis]) * inv), dims[axis] - 1);
-  };
-  lo_cell_.resize(n);
-  hi_cell_.resize(n);
-  const int num_cells = dims.prod();
-
-  cell_start_.assign(num_cells + 1, 0);
-  for (int i = 0; i < n; ++i) {
-    for (int a = 0; a < 3; ++a) {
-      lo_cell_[i][a] = index(boxes_[i].min()[a], a);
-      hi_cell_[i][a] = index(boxes_[i].max()[a] + gap, a);
-    }
-    for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
-      for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
-        for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z) ++cell_start_[(x * dims[1] + y) * dims[2] + z + 1];
-  }
-  for (int c = 0; c < num_cells; ++c) cell_start_[c + 1] += cell_start_[c];
-  cell_entries_.resize(cell_start_[num_cells]);
-  cell_fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
-  for (int i = 0; i < n; ++i) {
-    const Eigen::AlignedBox3d& b = boxes_[i];
-    const Entry entry{{b.min().x(), b.min().y(), b.min().z()},
-                      {b.max().x() + gap, b.max().y() + gap, b.max().z() + gap},
-                      i, lo_cell_[i][0], lo_cell_[i][1], lo_cell_[i][2]};
-    for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
-      for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
-        for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z)
-          cell_entries_[cell_fill_[(x * dims[1] + y) * dims[2] + z]++] = entry;
-  }
-  // Each overlapping pair is reported once: from its lower-indexed box (the query), in the cell holding the
-  // low corner of the two cell ranges' intersection (along each axis, the query's or the entry's low
-  // cell, whichever is higher). Only occupied cells are visited.
-  int count = 0;
-  for (int i = 0; i < n; ++i) {
-    const double lo[3] = {boxes_[i].min().x(), boxes_[i].min().y(), boxes_[i].min().z()};
-    const double hi[3] = {boxes_[i].max().x() + gap, boxes_[i].max().y() + gap, boxes_[i].max().z() + gap};
-    const int cx = lo_cell_[i][0], cy = lo_cell_[i][1], cz = lo_cell_[i][2];
-#ifdef __SSE2__
-    const __m128d lo01 = _mm_loadu_pd(lo), hi01 = _mm_loadu_pd(hi);
-#endif
-    for (int x = lo_cell_[i][0]; x <= hi_cell_[i][0]; ++x)
-      for (int y = lo_cell_[i][1]; y <= hi_cell_[i][1]; ++y)
-        for (int z = lo_cell_[i][2]; z <= hi_cell_[i][2]; ++z) {
-          const int c = (x * dims[1] + y) * dims[2] + z;
-          // At the query's own low cell along an axis, any entry owns the pair along it.
-          const bool own_x = x == cx, own_y = y == cy, own_z = z == cz;
-          // Branch-free: every entry is written, and kept only if it passes (the tests are
-          // close to random, so branches would mostly mispredict).
-          const int begin = cell_start_[c], end = cell_start_[c + 1];
-          if (overlaps_.size() < static_cast<size_t>(count + end - begin)) overlaps_.resize(2 * (count + end - begin));
-          std::pair<int, int>* out = overlaps_.data();
-          // Entries ascend by index: from the top down, stop at the first one not above i.
-          for (int p = end - 1; p >= begin; --p) {
-            const Entry& e = cell_entries_[p];
-            if (e.id <= i) break;
-            // Ownership: max(query low cell, entry low cell) == this cell along every axis (the
-            // cell is in both ranges, so it is at least both low cells).
-            const bool owned = (own_x | (e.x == x)) & (own_y | (e.y == y)) & (own_z | (e.z == z));
-#ifdef __SSE2__
-            const __m128d overlap01 = _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(e.lo), hi01),
-                                                 _mm_cmple_pd(lo01, _mm_loadu_pd(e.hi)));
-            const bool keep = owned & (_mm_movemask_pd(overlap01) == 3) & (e.lo[2] <= hi[2]) & (lo[2] <= e.hi[2]);
-#else
-            const bool keep = owned & (e.lo[0] <= hi[0]) & (lo[0] <= e.hi[0]) & (e.lo[1] <= hi[1]) &
-                              (lo[1] <= e.hi[1]) & (e.lo[2] <= hi[2]) & (lo[2] <= e.hi[2]);
-#endif
-            out[count] = {i, e.id};
-            count += keep;
-          }
+  // Faces sharing a vertex (p < q) and their owned-primitive pairs, as FindCandidates' grid
+  // would expand them (same exclusions), once for the fixed mesh.
+  std::vector<std::vector<int>> faces_of_vertex(nv);
+  for (int f = 0; f < nf; ++f)
+    for (int v : faces_[f]) faces_of_vertex[v].push_back(f);
+  auto incident = [this](int v, int f) { return faces_[f][0] == v || faces_[f][1] == v || faces_[f][2] == v; };
+  std::vector<int> neighbours;
+  for (int p = 0; p < nf; ++p) {
+    neighbours.clear();
+    for (int v : faces_[p])
+      for (int q : faces_of_vertex[v])
+        if (q > p) neighbours.push_back(q);
+    std::sort(neighbours.begin(), neighbours.end());
+    neighbours.erase(std::unique(neighbours.begin(), neighbours.end()), neighbours.end());
+    for (int q : neighbours) {
+      for (int k = owned_start_[p]; k < owned_start_[p + 1]; ++k)
+        if (!incident(owned_vertices_[k], q)) near_vertex_face_.emplace_back(owned_vertices_[k], q);
+      for (int k = owned_start_[q]; k < owned_start_[q + 1]; ++k)
+        if (!incident(owned_vertices_[k], p)) near_vertex_face_.emplace_back(owned_vertices_[k], p);
+      for (int a = owned_edge_start_[p]; a < owned_edge_start_[p + 1]; ++a)
+        for (int b = owned_edge_start_[q]; b < owned_edge_start_[q + 1]; ++b) {
+          const int i = owned_edges_[a], j = owned_edges_[b];
+          const auto [ea, eb] = edges_[i];
+          const auto [ec, ed] = edges_[j];
+          if (ec == ea || ec == eb || ed == ea || ed == eb) continue;
+          near_edge_edge_.emplace_back(std::min(i, j), std::max(i, j));
         }
+    }
   }
-  overlaps_.resize(count);
 }
 
-// One broad phase for both kinds of pairs, over the faces' swept boxes only: each vertex and
-// each edge is owned by one face that contains it (whose swept box contains its own), so a
-// vertex-face or edge-edge pair whose swept boxes overlap within reach lies in a face pair whose
-// boxes overlap, and is found once, from the pair of its owners. This replaces two grid passes
-// (faces against vertices, edges against edges) that mostly reported neighbours in the sheet.
+inline bool CrossingResolver::ShareVertex(int p, int q) const {
+  const std::array<int, 3>& a = faces_[p];
+  const std::array<int, 3>& b = faces_[q];
+  bool share = false;
+  for (int i = 0; i < 3; ++i) share |= (a[i] == b[0]) | (a[i] == b[1]) | (a[i] == b[2]);
+  return share;
+}
+
+namespace {
+
+// Boxes a and b overlap when grown by r (lane 3 of both is 0, so it always passes).
+inline bool BoxesNear(const float a_lo[4], const float a_hi[4], const float b_lo[4], const float b_hi[4], float r) {
+#ifdef __SSE__
+  const __m128 rr = _mm_set1_ps(r);
+  const __m128 m = _mm_and_ps(_mm_cmple_ps(_mm_load_ps(a_lo), _mm_add_ps(_mm_load_ps(b_hi), rr)),
+                              _mm_cmple_ps(_mm_load_ps(b_lo), _mm_add_ps(_mm_load_ps(a_hi), rr)));
+  return (_mm_movemask_ps(m) & 7) == 7;
+#else
+  bool near = true;
+  for (int k = 0; k < 3; ++k) near &= (a_lo[k] <= b_hi[k] + r) & (b_lo[k] <= a_hi[k] + r);
+  return near;
+#endif
+}
+
+}  // namespace
+
+// Sort and sweep along the axis over which the faces spread most: the faces stay nearly in order
+// from one step to the next, so an insertion sort of the previous order costs little, and each
+// face is tested against the faces after it whose intervals start within its own, four at a time.
+void CrossingResolver::OverlappingFarPairs(float gap) {
+  overlaps_.clear();
+  const int n = static_cast<int>(face_boxes_.size());
+  if (n == 0) return;
+  float lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = face_boxes_[0].lo[k];
+    hi[k] = face_boxes_[0].hi[k];
+  }
+  for (const Box& b : face_boxes_)
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(b.lo[k]) || !std::isfinite(b.hi[k])) return;  // exploded: the simulator reports it
+      lo[k] = std::min(lo[k], b.lo[k]);
+      hi[k] = std::max(hi[k], b.hi[k]);
+    }
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+  const int b_axis = (axis + 1) % 3, c_axis = (axis + 2) % 3;
+  if (static_cast<int>(sweep_order_.size()) != n) {
+    sweep_order_.resize(n);
+    for (int i = 0; i < n; ++i) sweep_order_[i] = i;
+  }
+  // Insertion sort by (low end along the axis, index): linear when nearly sorted.
+  auto key_less = [&](int a, int b) {
+    const float ka = face_boxes_[a].lo[axis], kb = face_boxes_[b].lo[axis];
+    return ka < kb || (ka == kb && a < b);
+  };
+  for (int i = 1; i < n; ++i) {
+    const int f = sweep_order_[i];
+    int j = i - 1;
+    while (j >= 0 && key_less(f, sweep_order_[j])) {
+      sweep_order_[j + 1] = sweep_order_[j];
+      --j;
+    }
+    sweep_order_[j + 1] = f;
+  }
+  // Structure of arrays in sweep order, padded by 3 boxes that end every sweep (+inf).
+  const int padded = n + 3;
+  for (auto* a : {&sweep_a_lo_, &sweep_a_hi_, &sweep_b_lo_, &sweep_b_hi_, &sweep_c_lo_, &sweep_c_hi_})
+    a->resize(padded);
+  for (int i = 0; i < n; ++i) {
+    const Box& b = face_boxes_[sweep_order_[i]];
+    sweep_a_lo_[i] = b.lo[axis];
+    sweep_a_hi_[i] = b.hi[axis] + gap;
+    sweep_b_lo_[i] = b.lo[b_axis];
+    sweep_b_hi_[i] = b.hi[b_axis] + gap;
+    sweep_c_lo_[i] = b.lo[c_axis];
+    sweep_c_hi_[i] = b.hi[c_axis] + gap;
+  }
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  for (int i = n; i < padded; ++i) {
+    sweep_a_lo_[i] = kInf;
+    sweep_a_hi_[i] = sweep_b_lo_[i] = sweep_b_hi_[i] = sweep_c_lo_[i] = sweep_c_hi_[i] = 0.0f;
+  }
+  for (int i = 0; i < n; ++i) {
+    const int fi = sweep_order_[i];
+    const float a_hi = sweep_a_hi_[i], b_lo = sweep_b_lo_[i], b_hi = sweep_b_hi_[i], c_lo = sweep_c_lo_[i],
+                c_hi = sweep_c_hi_[i];
+    // Boxes j > i start at or after box i along the axis; they overlap it there while they start
+    // before its (grown) high end. Across: both ways, each high end grown by gap.
+    for (int j = i + 1; j < n; j += 4) {
+#ifdef __SSE__
+      const __m128 starts = _mm_cmple_ps(_mm_loadu_ps(&sweep_a_lo_[j]), _mm_set1_ps(a_hi));
+      if (_mm_movemask_ps(starts) == 0) break;
+      const __m128 across = _mm_and_ps(
+          _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(&sweep_b_lo_[j]), _mm_set1_ps(b_hi)),
+                     _mm_cmple_ps(_mm_set1_ps(b_lo), _mm_loadu_ps(&sweep_b_hi_[j]))),
+          _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(&sweep_c_lo_[j]), _mm_set1_ps(c_hi)),
+                     _mm_cmple_ps(_mm_set1_ps(c_lo), _mm_loadu_ps(&sweep_c_hi_[j]))));
+      int mask = _mm_movemask_ps(_mm_and_ps(starts, across));
+#else
+      int mask = 0;
+      for (int l = 0; l < 4; ++l)
+        mask |= ((sweep_a_lo_[j + l] <= a_hi) & (sweep_b_lo_[j + l] <= b_hi) & (b_lo <= sweep_b_hi_[j + l]) &
+                 (sweep_c_lo_[j + l] <= c_hi) & (c_lo <= sweep_c_hi_[j + l]))
+                << l;
+      if (!(sweep_a_lo_[j] <= a_hi)) break;
+#endif
+      while (mask) {
+        const int l = __builtin_ctz(mask);
+        mask &= mask - 1;
+        if (j + l >= n) break;
+        const int fj = sweep_order_[j + l];
+        // Faces sharing a vertex are the fixed near lists' (see the constructor).
+        if (!ShareVertex(fi, fj)) overlaps_.emplace_back(std::min(fi, fj), std::max(fi, fj));
+      }
+    }
+  }
+  // The order is the sweep's: the same for the same states (deterministic), so no sort.
+}
+
+void CrossingResolver::ExpandFacePair(int p, int q, float reach) {
+  auto incident = [this](int v, int f) { return faces_[f][0] == v || faces_[f][1] == v || faces_[f][2] == v; };
+  auto vertex_face = [&](int owner, int f) {
+    const Box& fb = face_boxes_[f];
+    for (int k = owned_start_[owner]; k < owned_start_[owner + 1]; ++k) {
+      const int v = owned_vertices_[k];
+      if (!incident(v, f) && BoxesNear(vertex_boxes_[v].lo, vertex_boxes_[v].hi, fb.lo, fb.hi, reach))
+        candidates_.emplace_back(v, f);
+    }
+  };
+  vertex_face(p, q);
+  vertex_face(q, p);
+  for (int a = owned_edge_start_[p]; a < owned_edge_start_[p + 1]; ++a)
+    for (int b = owned_edge_start_[q]; b < owned_edge_start_[q + 1]; ++b) {
+      const int i = owned_edges_[a], j = owned_edges_[b];
+      const auto [ea, eb] = edges_[i];
+      const auto [ec, ed] = edges_[j];
+      if (ec == ea || ec == eb || ed == ea || ed == eb ||
+          !BoxesNear(edge_boxes_[i].lo, edge_boxes_[i].hi, edge_boxes_[j].lo, edge_boxes_[j].hi, reach))
+        continue;
+      edge_candidates_.emplace_back(std::min(i, j), std::max(i, j));
+    }
+}
+
+// Candidates come from the faces' swept boxes: each vertex and each edge is owned by one face that
+// contains it (whose swept box contains its own), so a vertex-face or edge-edge pair whose swept
+// boxes overlap within reach lies in a face pair whose boxes overlap, and is found once, from the
+// pair of its owners. Owner pairs that share a vertex always overlap; their primitive pairs are
+// fixed lists (near_vertex_face_, near_edge_edge_), tested box against box, and the grid only
+// looks for the others: where the sheet comes back onto itself.
 void CrossingResolver::FindCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double reach) {
   candidates_.clear();
   edge_candidates_.clear();
   const int nf = static_cast<int>(F_.rows()), nv = static_cast<int>(X1.rows());
   const int ne = static_cast<int>(edges_.size());
+  const float r = static_cast<float>(reach + kBoxPadding);
   vertex_boxes_.resize(nv);
   for (int v = 0; v < nv; ++v) {
-    vertex_boxes_[v].setEmpty();
-    vertex_boxes_[v].extend(X0.row(v).transpose());
-    vertex_boxes_[v].extend(X1.row(v).transpose());
-  }
-  edge_boxes_.resize(ne);
-  for (int e = 0; e < ne; ++e) edge_boxes_[e] = vertex_boxes_[edges_[e].first].merged(vertex_boxes_[edges_[e].second]);
-  boxes_.resize(nf);
-  for (int f = 0; f < nf; ++f)
-    boxes_[f] = vertex_boxes_[F_(f, 0)].merged(vertex_boxes_[F_(f, 1)]).merged(vertex_boxes_[F_(f, 2)]);
-  OverlappingPairs(reach);
-  // Boxes overlap within reach (the grid's test, so the pairs are those of a direct search).
-  auto near = [reach](const Eigen::AlignedBox3d& a, const Eigen::AlignedBox3d& b) {
-    return (a.min().array() <= b.max().array() + reach).all() && (b.min().array() <= a.max().array() + reach).all();
-  };
-  auto incident = [this](int v, int f) { return F_(f, 0) == v || F_(f, 1) == v || F_(f, 2) == v; };
-  auto vertex_face = [&](int owner, int f) {
-    for (int k = owned_start_[owner]; k < owned_start_[owner + 1]; ++k) {
-      const int v = owned_vertices_[k];
-      if (!incident(v, f) && near(vertex_boxes_[v], boxes_[f])) candidates_.push_back({v, f});
+    Box& b = vertex_boxes_[v];
+    for (int k = 0; k < 3; ++k) {
+      b.lo[k] = static_cast<float>(std::min(X0(v, k), X1(v, k)));
+      b.hi[k] = static_cast<float>(std::max(X0(v, k), X1(v, k)));
     }
-  };
-  for (const auto& [p, q] : overlaps_) {
-    vertex_face(p, q);
-    vertex_face(q, p);
-    for (int a = owned_edge_start_[p]; a < owned_edge_start_[p + 1]; ++a)
-      for (int b = owned_edge_start_[q]; b < owned_edge_start_[q + 1]; ++b) {
-        const int i = owned_edges_[a], j = owned_edges_[b];
-        const auto [ea, eb] = edges_[i];
-        const auto [ec, ed] = edges_[j];
-        if (ec == ea || ec == eb || ed == ea || ed == eb || !near(edge_boxes_[i], edge_boxes_[j])) continue;
-        edge_candidates_.emplace_back(std::min(i, j), std::max(i, j));
-      }
+    b.lo[3] = b.hi[3] = 0.0f;
   }
+  auto merge = [](const Box& a, const Box& b, Box* out) {
+#ifdef __SSE__
+    _mm_store_ps(out->lo, _mm_min_ps(_mm_load_ps(a.lo), _mm_load_ps(b.lo)));
+    _mm_store_ps(out->hi, _mm_max_ps(_mm_load_ps(a.hi), _mm_load_ps(b.hi)));
+#else
+    for (int k = 0; k < 4; ++k) {
+      out->lo[k] = std::min(a.lo[k], b.lo[k]);
+      out->hi[k] = std::max(a.hi[k], b.hi[k]);
+    }
+#endif
+  };
+  edge_boxes_.resize(ne);
+  for (int e = 0; e < ne; ++e) merge(vertex_boxes_[edges_[e].first], vertex_boxes_[edges_[e].second], &edge_boxes_[e]);
+  face_boxes_.resize(nf);
+  for (int f = 0; f < nf; ++f) {
+    merge(vertex_boxes_[faces_[f][0]], vertex_boxes_[faces_[f][1]], &face_boxes_[f]);
+    merge(face_boxes_[f], vertex_boxes_[faces_[f][2]], &face_boxes_[f]);
+  }
+  // Neighbours in the sheet: fixed lists (mostly rejected, so written branch-free).
+  candidates_.resize(near_vertex_face_.size());
+  int count = 0;
+  for (const auto& [v, f] : near_vertex_face_) {
+    candidates_[count] = {v, f};
+    count += BoxesNear(vertex_boxes_[v].lo, vertex_boxes_[v].hi, face_boxes_[f].lo, face_boxes_[f].hi, r);
+  }
+  candidates_.resize(count);
+  edge_candidates_.resize(near_edge_edge_.size());
+  count = 0;
+  for (const auto& [i, j] : near_edge_edge_) {
+    edge_candidates_[count] = {i, j};
+    count += BoxesNear(edge_boxes_[i].lo, edge_boxes_[i].hi, edge_boxes_[j].lo, edge_boxes_[j].hi, r);
+  }
+  edge_candidates_.resize(count);
+  // Faces apart in the sheet whose boxes meet.
+  OverlappingFarPairs(r);
+  for (const auto& [p, q] : overlaps_) ExpandFacePair(p, q, r);
 }
 
 bool CrossingResolver::Push(const int id[4], const double coef[4], const Eigen::Vector3d& n, double gap,

@@ -1,10 +1,12 @@
 // The crossing resolver puts back what passed through during a step, and its vertex-face
 // candidates cover every pair within the broad-phase reach at the end positions (the simulator
 // reuses them as the next step's proximity pairs).
+#include <cmath>
 #include <random>
 #include <set>
 #include <utility>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "sim/crossing_resolver.h"
@@ -81,6 +83,75 @@ TEST(CrossingResolver, VertexFaceCandidatesCoverEveryPairWithinReach) {
   ASSERT_GT(proximity.pairs().size(), 5u) << "the test needs pairs within reach";
   for (const auto& p : proximity.pairs())
     EXPECT_TRUE(candidates.count({p.vertex, p.face})) << "vertex " << p.vertex << ", face " << p.face;
+}
+
+// Swept boxes of points of X0 and X1 overlap when grown by reach (the broad phase's criterion).
+bool SweptBoxesNear(const std::vector<int>& a, const std::vector<int>& b, const Eigen::MatrixX3d& X0,
+                    const Eigen::MatrixX3d& X1, double reach) {
+  Eigen::AlignedBox3d ba, bb;
+  for (int i : a) ba.extend(X0.row(i).transpose()).extend(X1.row(i).transpose());
+  for (int i : b) bb.extend(X0.row(i).transpose()).extend(X1.row(i).transpose());
+  return (ba.min().array() <= bb.max().array() + reach).all() && (bb.min().array() <= ba.max().array() + reach).all();
+}
+
+TEST(CrossingResolver, CandidatesAreThePairsWhoseSweptBoxesMeetAsBruteForceFindsThem) {
+  // A sheet rolled into a tight spiral (layers 12 mm apart, so faces far apart in the sheet meet)
+  // and crumpled, moving at random: the candidates must be every vertex-face and edge-edge pair
+  // (no shared vertex) whose swept boxes come within reach, once each, and no pair farther than
+  // the reach plus the float padding: the neighbours-in-the-sheet lists and the sweep together
+  // equal a search over all pairs.
+  const int n = 12;
+  const Eigen::MatrixX3i F = GridFaces(n);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::MatrixX3d X0(n * n, 3);
+  for (int i = 0; i < n * n; ++i) {
+    const double s = 0.04 * (i / n), angle = s / 0.05;  // arc length along a spiral r = 0.05 + 0.012 angle / 2pi
+    const double r = 0.05 + 0.012 * angle / (2 * M_PI);
+    X0.row(i) << r * std::cos(angle) + 0.004 * u(rng), r * std::sin(angle) + 0.004 * u(rng),
+        0.04 * (i % n) + 0.004 * u(rng);
+  }
+  Eigen::MatrixX3d X1 = X0;
+  for (int i = 0; i < n * n; ++i) X1.row(i) += 0.006 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
+  const double reach = 0.01;
+  CrossingResolver resolver(F, Eigen::VectorXd::Ones(n * n));
+  Eigen::MatrixX3d X = X1, V = Eigen::MatrixX3d::Zero(n * n, 3);
+  resolver.Resolve(X0, 0.0, reach, 1, &X, &V);
+
+  std::set<std::pair<int, int>> expected_vf, expected_ee;
+  int far_pairs = 0;  // vertex-face pairs whose vertex is not on a face sharing a vertex with the face
+  for (int f = 0; f < F.rows(); ++f)
+    for (int v = 0; v < n * n; ++v) {
+      if (F(f, 0) == v || F(f, 1) == v || F(f, 2) == v) continue;
+      if (SweptBoxesNear({v}, {F(f, 0), F(f, 1), F(f, 2)}, X0, X1, reach)) {
+        expected_vf.insert({v, f});
+        far_pairs += std::abs(v / n - F(f, 0) / n) >= 3;  // rows apart in the sheet
+      }
+    }
+  const auto& edges = resolver.edges();
+  for (size_t i = 0; i < edges.size(); ++i)
+    for (size_t j = i + 1; j < edges.size(); ++j) {
+      const auto [a, b] = edges[i];
+      const auto [c, d] = edges[j];
+      if (a == c || a == d || b == c || b == d) continue;
+      if (SweptBoxesNear({a, b}, {c, d}, X0, X1, reach)) expected_ee.insert({static_cast<int>(i), static_cast<int>(j)});
+    }
+  ASSERT_GT(far_pairs, 20) << "the spiral's layers must meet for the test to see far pairs";
+
+  const auto& vf = resolver.vertex_face_candidates();
+  const auto& ee = resolver.edge_edge_candidates();
+  const std::set<std::pair<int, int>> got_vf(vf.begin(), vf.end()), got_ee(ee.begin(), ee.end());
+  EXPECT_EQ(got_vf.size(), vf.size()) << "each vertex-face pair once";
+  EXPECT_EQ(got_ee.size(), ee.size()) << "each edge pair once";
+  for (const auto& p : expected_vf) EXPECT_TRUE(got_vf.count(p)) << "missed vertex " << p.first << ", face " << p.second;
+  for (const auto& p : expected_ee) EXPECT_TRUE(got_ee.count(p)) << "missed edges " << p.first << ", " << p.second;
+  const double loose = reach + 2 * CrossingResolver::kBoxPadding;
+  for (const auto& [v, f] : got_vf)
+    EXPECT_TRUE(SweptBoxesNear({v}, {F(f, 0), F(f, 1), F(f, 2)}, X0, X1, loose)) << "vertex " << v << ", face " << f;
+  for (const auto& [i, j] : got_ee) {
+    EXPECT_LT(i, j);
+    EXPECT_TRUE(SweptBoxesNear({edges[i].first, edges[i].second}, {edges[j].first, edges[j].second}, X0, X1, loose));
+  }
 }
 
 }  // namespace
