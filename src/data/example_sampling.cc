@@ -14,7 +14,10 @@ namespace {
 enum Stream : uint64_t { kTheta = 1, kWind = 2, kFabric = 3, kSplit = 4, kView = 5, kCamera = 6 };
 
 double LogUniform(render::Rng& rng, double factor) {
-  if (factor <= 1.0) return 1.0;
+  if (factor <= 1.0) {
+    rng.Uniform();  // a draw all the same, so the later draws of the stream stay where they were
+    return 1.0;
+  }
   const double l = std::log(factor);
   return std::exp(rng.Uniform(-l, l));
 }

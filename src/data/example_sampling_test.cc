@@ -60,6 +60,35 @@ TEST(ExampleSamplingTest, FlagDrawsStayInTheirRangesAndCoverThem) {
   EXPECT_GT(std::abs(s.theta[1] / base[1] - s.theta[2] / base[2]), 1e-6);
 }
 
+TEST(ExampleSamplingTest, NarrowAreaWeightSpreadKeepsTheWeightAndLeavesOtherDrawsAlone) {
+  // A weighed flag (make-dataset --area-weight-spread 1.05): its weight stays within +-5 %, and
+  // the same simulation index keeps its wind and bending draws (separate random streams).
+  SamplingRanges weighed = DefaultRanges(render::SceneKind::kFlag);
+  weighed.area_weight_factor = 1.05;
+  const SamplingRanges wide = DefaultRanges(render::SceneKind::kFlag);
+  const sim::Theta base = BaseTheta();
+  double aw_lo = 1e9, aw_hi = -1e9;
+  for (int i = 0; i < 500; ++i) {
+    const SimulationSample a = SampleFlagSimulation(base, 5, i, weighed);
+    const SimulationSample b = SampleFlagSimulation(base, 5, i, wide);
+    const double aw = a.theta[0] / base[0];
+    aw_lo = std::min(aw_lo, aw);
+    aw_hi = std::max(aw_hi, aw);
+    EXPECT_EQ(a.theta[16], b.theta[16]) << "wind of simulation " << i;
+    // Bending draws come after the weight's in the same stream: the same values.
+    for (int k = 1; k <= 15; ++k) EXPECT_EQ(a.theta[k], b.theta[k]) << "bending " << k << " of simulation " << i;
+  }
+  EXPECT_GE(aw_lo, 1 / 1.05 - 1e-12);
+  EXPECT_LE(aw_hi, 1.05 + 1e-12);
+  EXPECT_LT(aw_lo, 0.96);
+  EXPECT_GT(aw_hi, 1.04);
+  // No spread at all: the scene's weight, and still the same bending draws.
+  weighed.area_weight_factor = 1.0;
+  const SimulationSample fixed = SampleFlagSimulation(base, 5, 3, weighed);
+  EXPECT_EQ(fixed.theta[0], base[0]);
+  EXPECT_EQ(fixed.theta[1], SampleFlagSimulation(base, 5, 3, wide).theta[1]);
+}
+
 TEST(ExampleSamplingTest, ClothDrawsFabricAreaWeightAndHorizontalWind) {
   std::vector<Fabric> fabrics(3);
   for (int f = 0; f < 3; ++f) {
