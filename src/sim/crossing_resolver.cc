@@ -19,22 +19,22 @@ constexpr double kInsideTolerance = 1e-2;
 }  // namespace
 
 CrossingResolver::CrossingResolver(const Eigen::MatrixX3i& F, const Eigen::VectorXd& inverse_mass)
-    : F_(F), inverse_mass_(inverse_mass) {
-  for (int f = 0; f < F_.rows(); ++f)
+    : inverse_mass_(inverse_mass) {
+  for (int f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) {
-      const int a = F_(f, k), b = F_(f, (k + 1) % 3);
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
       edges_.emplace_back(std::min(a, b), std::max(a, b));
     }
   std::sort(edges_.begin(), edges_.end());
   edges_.erase(std::unique(edges_.begin(), edges_.end()), edges_.end());
   // Owners (see FindCandidates): the lowest-indexed face holding the vertex or edge.
-  const int nf = static_cast<int>(F_.rows());
-  const int nv = nf > 0 ? F_.maxCoeff() + 1 : 0;
+  const int nf = static_cast<int>(F.rows());
+  const int nv = nf > 0 ? F.maxCoeff() + 1 : 0;
   std::vector<int> vertex_owner(nv, -1), edge_owner(edges_.size(), -1);
   for (int f = nf - 1; f >= 0; --f)
     for (int k = 0; k < 3; ++k) {
-      vertex_owner[F_(f, k)] = f;
-      const int a = F_(f, k), b = F_(f, (k + 1) % 3);
+      vertex_owner[F(f, k)] = f;
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
       const auto it = std::lower_bound(edges_.begin(), edges_.end(), std::make_pair(std::min(a, b), std::max(a, b)));
       edge_owner[it - edges_.begin()] = f;
     }
@@ -52,14 +52,13 @@ CrossingResolver::CrossingResolver(const Eigen::MatrixX3i& F, const Eigen::Vecto
   group(vertex_owner, &owned_start_, &owned_vertices_);
   group(edge_owner, &owned_edge_start_, &owned_edges_);
   faces_.resize(nf);
-  for (int f = 0; f < nf; ++f) faces_[f] = {F_(f, 0), F_(f, 1), F_(f, 2)};
+  for (int f = 0; f < nf; ++f) faces_[f] = {F(f, 0), F(f, 1), F(f, 2)};
 
   // Faces sharing a vertex (p < q) and their owned-primitive pairs, as FindCandidates' grid
   // would expand them (same exclusions), once for the fixed mesh.
   std::vector<std::vector<int>> faces_of_vertex(nv);
   for (int f = 0; f < nf; ++f)
     for (int v : faces_[f]) faces_of_vertex[v].push_back(f);
-  auto incident = [this](int v, int f) { return faces_[f][0] == v || faces_[f][1] == v || faces_[f][2] == v; };
   std::vector<int> neighbours;
   for (int p = 0; p < nf; ++p) {
     neighbours.clear();
@@ -68,21 +67,31 @@ CrossingResolver::CrossingResolver(const Eigen::MatrixX3i& F, const Eigen::Vecto
         if (q > p) neighbours.push_back(q);
     std::sort(neighbours.begin(), neighbours.end());
     neighbours.erase(std::unique(neighbours.begin(), neighbours.end()), neighbours.end());
-    for (int q : neighbours) {
-      for (int k = owned_start_[p]; k < owned_start_[p + 1]; ++k)
-        if (!incident(owned_vertices_[k], q)) near_vertex_face_.emplace_back(owned_vertices_[k], q);
-      for (int k = owned_start_[q]; k < owned_start_[q + 1]; ++k)
-        if (!incident(owned_vertices_[k], p)) near_vertex_face_.emplace_back(owned_vertices_[k], p);
-      for (int a = owned_edge_start_[p]; a < owned_edge_start_[p + 1]; ++a)
-        for (int b = owned_edge_start_[q]; b < owned_edge_start_[q + 1]; ++b) {
-          const int i = owned_edges_[a], j = owned_edges_[b];
-          const auto [ea, eb] = edges_[i];
-          const auto [ec, ed] = edges_[j];
-          if (ec == ea || ec == eb || ed == ea || ed == eb) continue;
-          near_edge_edge_.emplace_back(std::min(i, j), std::max(i, j));
-        }
-    }
+    for (int q : neighbours)
+      ForEachOwnedPair(
+          p, q, [this](int v, int f) { near_vertex_face_.emplace_back(v, f); },
+          [this](int i, int j) { near_edge_edge_.emplace_back(i, j); });
   }
+}
+
+template <class VertexFace, class EdgeEdge>
+void CrossingResolver::ForEachOwnedPair(int p, int q, VertexFace vertex_face, EdgeEdge edge_edge) const {
+  auto owned_vertices_against = [&](int owner, int f) {
+    const std::array<int, 3>& face = faces_[f];
+    for (int k = owned_start_[owner]; k < owned_start_[owner + 1]; ++k) {
+      const int v = owned_vertices_[k];
+      if (face[0] != v && face[1] != v && face[2] != v) vertex_face(v, f);
+    }
+  };
+  owned_vertices_against(p, q);
+  owned_vertices_against(q, p);
+  for (int a = owned_edge_start_[p]; a < owned_edge_start_[p + 1]; ++a)
+    for (int b = owned_edge_start_[q]; b < owned_edge_start_[q + 1]; ++b) {
+      const int i = owned_edges_[a], j = owned_edges_[b];
+      const auto [ea, eb] = edges_[i];
+      const auto [ec, ed] = edges_[j];
+      if (ec != ea && ec != eb && ed != ea && ed != eb) edge_edge(std::min(i, j), std::max(i, j));
+    }
 }
 
 inline bool CrossingResolver::ShareVertex(int p, int q) const {
@@ -207,39 +216,28 @@ void CrossingResolver::OverlappingFarPairs(float gap) {
 }
 
 void CrossingResolver::ExpandFacePair(int p, int q, float reach) {
-  auto incident = [this](int v, int f) { return faces_[f][0] == v || faces_[f][1] == v || faces_[f][2] == v; };
-  auto vertex_face = [&](int owner, int f) {
-    const Box& fb = face_boxes_[f];
-    for (int k = owned_start_[owner]; k < owned_start_[owner + 1]; ++k) {
-      const int v = owned_vertices_[k];
-      if (!incident(v, f) && BoxesNear(vertex_boxes_[v].lo, vertex_boxes_[v].hi, fb.lo, fb.hi, reach))
-        candidates_.emplace_back(v, f);
-    }
-  };
-  vertex_face(p, q);
-  vertex_face(q, p);
-  for (int a = owned_edge_start_[p]; a < owned_edge_start_[p + 1]; ++a)
-    for (int b = owned_edge_start_[q]; b < owned_edge_start_[q + 1]; ++b) {
-      const int i = owned_edges_[a], j = owned_edges_[b];
-      const auto [ea, eb] = edges_[i];
-      const auto [ec, ed] = edges_[j];
-      if (ec == ea || ec == eb || ed == ea || ed == eb ||
-          !BoxesNear(edge_boxes_[i].lo, edge_boxes_[i].hi, edge_boxes_[j].lo, edge_boxes_[j].hi, reach))
-        continue;
-      edge_candidates_.emplace_back(std::min(i, j), std::max(i, j));
-    }
+  ForEachOwnedPair(
+      p, q,
+      [&](int v, int f) {
+        if (BoxesNear(vertex_boxes_[v].lo, vertex_boxes_[v].hi, face_boxes_[f].lo, face_boxes_[f].hi, reach))
+          candidates_.emplace_back(v, f);
+      },
+      [&](int i, int j) {
+        if (BoxesNear(edge_boxes_[i].lo, edge_boxes_[i].hi, edge_boxes_[j].lo, edge_boxes_[j].hi, reach))
+          edge_candidates_.emplace_back(i, j);
+      });
 }
 
 // Candidates come from the faces' swept boxes: each vertex and each edge is owned by one face that
 // contains it (whose swept box contains its own), so a vertex-face or edge-edge pair whose swept
 // boxes overlap within reach lies in a face pair whose boxes overlap, and is found once, from the
 // pair of its owners. Owner pairs that share a vertex always overlap; their primitive pairs are
-// fixed lists (near_vertex_face_, near_edge_edge_), tested box against box, and the grid only
-// looks for the others: where the sheet comes back onto itself.
+// fixed lists (near_vertex_face_, near_edge_edge_), tested box against box, and the sort and
+// sweep only looks for the others: where the sheet comes back onto itself.
 void CrossingResolver::FindCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double reach) {
   candidates_.clear();
   edge_candidates_.clear();
-  const int nf = static_cast<int>(F_.rows()), nv = static_cast<int>(X1.rows());
+  const int nf = static_cast<int>(faces_.size()), nv = static_cast<int>(X1.rows());
   const int ne = static_cast<int>(edges_.size());
   const float r = static_cast<float>(reach + kBoxPadding);
   vertex_boxes_.resize(nv);
@@ -313,7 +311,7 @@ int CrossingResolver::SweepVertexFace(const Eigen::MatrixX3d& X0, double gap, Ei
   const Eigen::MatrixX3d& X1 = *X;
   int corrections = 0;
   for (const auto& [vertex, face] : candidates_) {
-    const int id[4] = {vertex, F_(face, 0), F_(face, 1), F_(face, 2)};
+    const int id[4] = {vertex, faces_[face][0], faces_[face][1], faces_[face][2]};
     Eigen::Vector3d s[4], e[4];
     for (int k = 0; k < 4; ++k) {
       s[k] = X0.row(id[k]).transpose();

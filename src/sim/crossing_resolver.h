@@ -24,7 +24,7 @@ namespace clothwind::sim {
 // approaching normal velocity (inelastic); both are shared among the four points by inverse
 // mass, so momentum and the centre of mass are kept. Sweeps repeat until nothing is left to
 // correct or `max_sweeps`. Candidates: the primitives of faces that share a vertex (fixed lists)
-// and of the faces' swept boxes that meet in a uniform grid, tested box against box.
+// and of faces whose swept boxes meet in a sort and sweep, tested box against box.
 // Deterministic. Buffers are reused.
 class CrossingResolver {
  public:
@@ -69,6 +69,10 @@ class CrossingResolver {
   // Vertex-face pairs (vertex not of the face) into candidates_ and edge-edge pairs (no shared
   // vertex) into edge_candidates_ whose swept boxes (start and end positions) overlap within reach.
   void FindCandidates(const Eigen::MatrixX3d& X0, const Eigen::MatrixX3d& X1, double reach);
+  // Calls vertex_face(v, f) for each vertex v owned by p or q and the other face f, v not of f,
+  // and edge_edge(i, j) (i < j) for each pair of edges owned by p and q with no shared vertex.
+  template <class VertexFace, class EdgeEdge>
+  void ForEachOwnedPair(int p, int q, VertexFace vertex_face, EdgeEdge edge_edge) const;
   // Appends the pairs of owned primitives of faces p and q whose boxes overlap within reach.
   void ExpandFacePair(int p, int q, float reach);
   // One pass over the candidates; returns the corrections made.
@@ -80,12 +84,11 @@ class CrossingResolver {
             Eigen::MatrixX3d* V) const;
 
   // Pairs (p < q) of face_boxes_ that overlap when grown by reach and share no vertex, into
-  // overlaps_ (sort and sweep), in face order.
+  // overlaps_ (sort and sweep), in sweep order.
   void OverlappingFarPairs(float reach);
   bool ShareVertex(int p, int q) const;
 
-  Eigen::MatrixX3i F_;
-  std::vector<std::array<int, 3>> faces_;              // F_ by rows
+  std::vector<std::array<int, 3>> faces_;             // the faces' vertex indices
   Eigen::VectorXd inverse_mass_;
   std::vector<std::pair<int, int>> edges_;            // unique edges (a < b)
   std::vector<std::pair<int, int>> candidates_;       // vertex-face pairs (vertex, face)
@@ -94,8 +97,8 @@ class CrossingResolver {
   // owned_vertices_[owned_start_[f] .. owned_start_[f + 1]), its edges (indices into edges_) likewise.
   std::vector<int> owned_start_, owned_vertices_, owned_edge_start_, owned_edges_;
   // The owned-primitive pairs of every two faces that share a vertex (neighbours in the sheet,
-  // whose boxes always touch), fixed with the mesh: tested directly each step instead of being
-  // rediscovered by the grid (they were ~90 % of its overlapping face pairs).
+  // whose boxes always touch), fixed with the mesh: box-tested each step instead of being found
+  // by the sweep (they are ~90 % of the overlapping face pairs).
   std::vector<std::pair<int, int>> near_vertex_face_;  // (vertex, face)
   std::vector<std::pair<int, int>> near_edge_edge_;    // (edge, edge), lower index first
   std::vector<Box> vertex_boxes_, edge_boxes_, face_boxes_;  // scratch: swept boxes
