@@ -40,6 +40,9 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
       ->check(CLI::Range(1, 512))
       ->capture_default_str();
   sub->add_option("--k", o.model.k, "SDN: spectral peaks per pixel")->check(CLI::Range(1, 64))->capture_default_str();
+  sub->add_flag("--include-dc", o.model.include_dc,
+                "SDN: the DC bin competes for the k peaks, signals not detrended (Algorithm 1 verbatim)");
+  sub->add_flag("--mean-map", o.model.mean_map, "SDN: add the clip's per-pixel temporal mean (the pose) as a channel");
   sub->add_option("--threads", o.threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--device", o.device, "cpu, cuda or auto (CUDA when libtorch finds one)")
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))

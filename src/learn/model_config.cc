@@ -8,12 +8,12 @@
 namespace clothwind::learn {
 
 int ModelConfig::TrunkInputChannels() const {
-  return arch == "sdn" ? 2 * k * channels : frames * channels;
+  return arch == "sdn" ? (2 * k + (mean_map ? 1 : 0)) * channels : frames * channels;
 }
 
 std::string ModelConfig::Name() const {
   std::ostringstream s;
-  if (arch == "sdn") s << "sdn-k" << k;
+  if (arch == "sdn") s << "sdn-k" << k << (include_dc ? "dc" : "") << (mean_map ? "m" : "");
   else s << arch;
   s << "-w" << width << "-" << input_size << "-" << frames << "f";
   return s.str();
@@ -29,6 +29,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
   return {{"format", "clothwind-model"}, {"version", 1},   {"arch", c.arch},
           {"frames", c.frames},          {"channels", c.channels},
           {"k", c.k},                    {"include_dc", c.include_dc},
+          {"mean_map", c.mean_map},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
           {"label_std", c.label_std}};
@@ -51,6 +52,8 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.channels = need("channels").get<int>();
     c.k = need("k").get<int>();
     c.include_dc = need("include_dc").get<bool>();
+    // Absent in models written before the mean map existed: they had none.
+    c.mean_map = j.contains("mean_map") ? j.at("mean_map").get<bool>() : false;
     c.frame_rate = need("frame_rate").get<double>();
     c.width = need("width").get<int>();
     c.input_size = need("input_size").get<int>();

@@ -15,16 +15,19 @@ struct ModelConfig {
   int frames = 30;           // N_t, input frames per clip
   int channels = 1;          // C, colour channels per frame (1: greyscale, as the seed)
   int k = 3;                 // SDN: spectral peaks kept per pixel (2kC trunk input channels)
-  bool include_dc = false;   // SDN: the DC bin among the candidate peaks
+  bool include_dc = false;   // SDN: the DC bin among the candidate peaks (no detrend)
+  bool mean_map = false;     // SDN: the clip's per-pixel temporal mean as C more trunk channels
   double frame_rate = 25.0;  // [Hz] of the clips the model reads
   int width = 64;            // ResNet-18 base width (64 as the original; 16 trains on a CPU)
   int input_size = 112;      // side of the square input [px] (224 as the seed, 112 for a CPU)
   double label_mean = 0.0;   // [m/s] the network regresses (v - label_mean) / label_std
   double label_std = 1.0;    // [m/s]
 
-  // Channels entering the ResNet trunk: 2kC for the SDN, N_t·C for the frame-stack baseline.
+  // Channels entering the ResNet trunk: 2kC (+C with mean_map) for the SDN, N_t·C for the
+  // frame-stack baseline.
   int TrunkInputChannels() const;
-  // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f".
+  // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("sdn-k3m-…" with mean_map,
+  // "sdn-k3dc-…" with include_dc).
   std::string Name() const;
   // Table 1's "input modality", e.g. "30x112x112".
   std::string Modality() const;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <fstream>
 #include <stdexcept>
@@ -91,7 +92,11 @@ at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
   }
   if (config_.arch == "sdn") {
     SpectralMaps maps = SpectralDecomposition(clips, config_.k, config_.frame_rate, config_.include_dc);
-    return at::cat({at::log1p(maps.power), maps.frequency * (2.0 / config_.frame_rate)}, 1);
+    std::vector<at::Tensor> parts = {at::log1p(maps.power), maps.frequency * (2.0 / config_.frame_rate)};
+    // The spectral maps see only motion; the mean image gives the trunk the flag's pose (its
+    // droop), which at low wind says more about the speed than its small oscillations.
+    if (config_.mean_map) parts.push_back(clips.mean(2));
+    return at::cat(parts, 1);
   }
   return clips.reshape({clips.size(0), clips.size(1) * clips.size(2), clips.size(3), clips.size(4)});
 }

@@ -25,7 +25,10 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, int k, double frame_rate
   // [N_b C H W, N_t]: one row per pixel signal.
   at::Tensor signals = x.permute({0, 1, 3, 4, 2}).reshape({-1, nt});
   at::Tensor window = at::hann_window(nt, /*periodic=*/true, x.options());
-  signals = signals - signals.mean(1, /*keepdim=*/true);
+  // Without the DC bin the pixel's mean is removed first (else it leaks through the Hann window
+  // into bin 1); with it, the signal is taken as it is (Algorithm 1 verbatim), so the DC bin
+  // carries the pixel's windowed mean brightness.
+  if (!include_dc) signals = signals - signals.mean(1, /*keepdim=*/true);
   at::Tensor spectrum = at::fft_rfft(signals * window, c10::nullopt, /*dim=*/1);
   at::Tensor periodogram = (at::real(spectrum).square() + at::imag(spectrum).square()) /
                            window.square().sum();

@@ -16,21 +16,22 @@ struct SpectralMaps {
 
 // The spectral decomposition of a batch of clips (Algorithm 1), batched on the input's device.
 //
-// Per pixel signal x_n (n = 0..N_t-1): the pixel's temporal mean is removed (a constant
-// detrend, as scipy.signal.periodogram does: otherwise a bright pixel's mean leaks through the
-// Hann window into bin 1), y_n = w_n (x_n - mean) with the periodic Hann window
+// Per pixel signal x_n (n = 0..N_t-1): unless include_dc, the pixel's temporal mean m is removed
+// (a constant detrend, as scipy.signal.periodogram does: otherwise a bright pixel's mean leaks
+// through the Hann window into bin 1); with include_dc, m = 0 and the signal is transformed as it
+// is (the seed's Algorithm 1). y_n = w_n (x_n - m) with the periodic Hann window
 // w_n = 0.5 - 0.5 cos(2π n / N_t); X_j = Σ_n y_n e^{-2πi jn/N_t} (one-sided, j = 0..N_t/2);
 // periodogram I_j = |X_j|² / Σ_n w_n²; the k largest I_j in descending order (the order of
 // exactly equal powers is unspecified) and their frequencies f_j = j · frame_rate / N_t.
-// The DC bin (j = 0) is excluded unless include_dc: it carries no motion, and a frequency map
-// of zeros says nothing.
+// The DC bin (j = 0) is excluded unless include_dc: it carries no motion, only the pixel's mean
+// brightness (squared), which is mostly the strongest bin and so takes one of the k slots.
 // Channel c·k + i of either map is the i-th strongest bin of input channel c.
 //
 // Inputs:
 //   x           [N_b, C, N_t, H, W] floating tensor (any device)
 //   k           number of bins to keep, 1 ≤ k ≤ number of candidate bins (N_t/2 or N_t/2+1)
 //   frame_rate  sampling rate of the clip [Hz] (25 for FlagSim)
-//   include_dc  keep the DC bin among the candidates
+//   include_dc  keep the DC bin among the candidates and do not detrend
 // Outputs:
 //   the two maps, each [N_b, kC, H, W], same dtype and device as x
 // Throws std::invalid_argument on a wrong rank, N_t < 2 or an impossible k.

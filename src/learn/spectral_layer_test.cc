@@ -21,12 +21,14 @@ struct Bin {
   int index;
 };
 
-// Periodogram of one signal by the textbook DFT after removing its mean, Hann window
-// w_n = 0.5 - 0.5 cos(2πn/N), normalised by Σ w_n².
+// Periodogram of one signal by the textbook DFT, Hann window w_n = 0.5 - 0.5 cos(2πn/N),
+// normalised by Σ w_n²; without the DC bin after removing the signal's mean.
 std::vector<Bin> NaivePeriodogram(std::vector<double> x, bool include_dc) {
   const int n = static_cast<int>(x.size());
   const double mean = std::accumulate(x.begin(), x.end(), 0.0) / n;
-  for (double& v : x) v -= mean;
+  if (!include_dc) {
+    for (double& v : x) v -= mean;
+  }
   std::vector<double> w(n);
   double w2 = 0;
   for (int i = 0; i < n; ++i) {
@@ -96,6 +98,27 @@ TEST(SpectralLayer, OscillatingPixelsGiveTheirFrequencyAndPower) {
   SpectralMaps dark = SpectralDecomposition(x - 100.0, 1, kFps);
   EXPECT_TRUE(at::allclose(dark.power, maps.power, 1e-9, 1e-9));
   EXPECT_TRUE(at::equal(dark.frequency, maps.frequency));
+}
+
+TEST(SpectralLayer, WithDcTheMeanBrightnessIsTheStrongestBin) {
+  // Algorithm 1 verbatim (include_dc): no detrend, so a pixel's mean m is bin 0 with
+  // |X_0| = m Σw = m N/2 and power (m N/2)² / (3N/8) = 2 m² N / 3, frequency 0; pixels of
+  // different brightness keep their order. Without DC the same clip is unaffected by m.
+  const int64_t nt = 30;
+  at::Tensor x = at::zeros({1, 1, nt, 1, 2}, at::kDouble);
+  for (int64_t t = 0; t < nt; ++t) {
+    const double wave = 0.2 * std::cos(2 * M_PI * 4 * t / nt);
+    x.index_put_({0, 0, t, 0, 0}, 3.0 + wave);
+    x.index_put_({0, 0, t, 0, 1}, -1.5 + wave);
+  }
+  SpectralMaps maps = SpectralDecomposition(x, 1, kFps, /*include_dc=*/true);
+  EXPECT_NEAR(maps.power.index({0, 0, 0, 0}).item<double>(), 2.0 * 9.0 * nt / 3.0, 1e-9);
+  EXPECT_NEAR(maps.power.index({0, 0, 0, 1}).item<double>(), 2.0 * 2.25 * nt / 3.0, 1e-9);
+  EXPECT_EQ(maps.frequency.index({0, 0, 0, 0}).item<double>(), 0.0);
+  SpectralMaps motion = SpectralDecomposition(x, 1, kFps, /*include_dc=*/false);
+  EXPECT_NEAR(motion.frequency.index({0, 0, 0, 0}).item<double>(), 4 * kFps / nt, 1e-12);
+  EXPECT_NEAR(motion.power.index({0, 0, 0, 0}).item<double>(),
+              motion.power.index({0, 0, 0, 1}).item<double>(), 1e-9);
 }
 
 void ExpectMatchesNaive(const at::Tensor& x, int k, bool include_dc) {

@@ -147,6 +147,39 @@ TEST_F(TrainTest, CheckpointRoundTripGivesIdenticalPredictions) {
   }
 }
 
+TEST(WindNet, OnlyTheMeanMapSeesAStillPose) {
+  // Two clips with the same motion on different still images: the detrended spectral maps are
+  // identical, so a plain SDN cannot tell them apart; with the mean map it can. The option
+  // survives the model.json round trip, and a model.json written before it existed loads
+  // without it.
+  ModelConfig c;
+  c.frames = 30;
+  c.k = 2;
+  c.width = 4;
+  c.input_size = 16;
+  at::manual_seed(5);
+  const at::Tensor motion = 0.1 * at::randn({1, 1, 30, 16, 16});
+  const at::Tensor still = at::randn({2, 1, 1, 16, 16});
+  const at::Tensor clips = motion + still;  // [2, 1, 30, 16, 16]
+  at::NoGradGuard no_grad;
+  WindNet plain(c);
+  plain->eval();
+  EXPECT_EQ(c.TrunkInputChannels(), 4);
+  const at::Tensor p = plain->forward(clips);
+  EXPECT_TRUE(at::allclose(p[0], p[1], 1e-4, 1e-5)) << p;
+  c.mean_map = true;
+  EXPECT_EQ(c.TrunkInputChannels(), 5);
+  EXPECT_EQ(c.Name(), "sdn-k2m-w4-16-30f");
+  WindNet posed(c);
+  posed->eval();
+  const at::Tensor q = posed->forward(clips);
+  EXPECT_FALSE(at::allclose(q[0], q[1], 1e-3, 1e-4)) << q;
+  EXPECT_TRUE(ModelConfigFromJson(ToJson(c), "x.json").mean_map);
+  nlohmann::json old = ToJson(c);
+  old.erase("mean_map");
+  EXPECT_FALSE(ModelConfigFromJson(old, "x.json").mean_map);
+}
+
 TEST_F(TrainTest, ResumeContinuesTheRun) {
   TrainOptions t = Options("sdn", "resume");
   t.epochs = 2;
