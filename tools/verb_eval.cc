@@ -13,7 +13,7 @@ namespace {
 
 struct EvalArgs {
   std::string model, data, split = "test", json, plot;
-  int threads = 2, batch = 8;
+  int threads = 2, batch = 8, windows = 1;
   std::string device = "auto";
 };
 
@@ -29,6 +29,10 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--plot", a->plot, "predicted-vs-true PNG (default: <model folder>/eval_<split>.png)");
   sub->add_option("--threads", a->threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--batch", a->batch, "clips per forward pass")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--windows", a->windows,
+                  "average this many evenly spaced frame windows per clip (1: the centred one, Table 1)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   sub->add_option("--device", a->device, "cpu, cuda or auto")
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
       ->capture_default_str();
@@ -39,7 +43,7 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     b.rate_unit = "clips/s";
     ProgressBar bar(b);
     const learn::EvalResult r = learn::Evaluate(a->model, a->data, a->split, a->threads, a->device, a->batch,
-                                                [&](int done, int total) { bar.Update(done, total); });
+                                                a->windows, [&](int done, int total) { bar.Update(done, total); });
     bar.Finish();
     std::cout << learn::EvalTable(r);
     const std::filesystem::path plot =

@@ -151,8 +151,31 @@ int ChooseFirstFrame(int num_frames, const SampleOptions& options, std::mt19937_
                              std::to_string(options.frames));
   }
   const int slack = num_frames - options.frames;
+  if (options.first_frame >= 0) {
+    if (options.first_frame > slack) {
+      throw std::runtime_error("window start " + std::to_string(options.first_frame) + " + " +
+                               std::to_string(options.frames) + " frames runs past the clip's " +
+                               std::to_string(num_frames));
+    }
+    return options.first_frame;
+  }
   if (!options.augment) return slack / 2;
   return std::uniform_int_distribution<int>(0, slack)(rng);
+}
+
+std::vector<int> EvenWindowStarts(int num_frames, int frames, int windows) {
+  if (windows < 1) throw std::invalid_argument("EvenWindowStarts: windows must be >= 1, got " + std::to_string(windows));
+  if (frames < 1 || num_frames < frames) {
+    throw std::invalid_argument("EvenWindowStarts: a clip of " + std::to_string(num_frames) + " frames has no window of " +
+                                std::to_string(frames));
+  }
+  const int slack = num_frames - frames;
+  if (windows == 1) return {slack / 2};
+  std::vector<int> starts;
+  for (int j = 0; j < windows; ++j) {
+    starts.push_back(static_cast<int>(std::lround(static_cast<double>(j) * slack / (windows - 1))));
+  }
+  return starts;
 }
 
 Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& options, std::mt19937_64& rng) {

@@ -49,6 +49,7 @@ struct SampleOptions {
   int frames = 30;        // N_t
   int input_size = 112;   // output side [px]
   bool augment = false;   // training: random temporal offset, multi-scale crop, flip
+  int first_frame = -1;   // >= 0: start the window here (evaluation over several windows)
   // Crop side as fractions of the frame's shorter side (multi-scale cropping, as TSN).
   std::vector<double> crop_scales = {1.0, 0.875, 0.75, 0.66};
 };
@@ -62,7 +63,8 @@ struct Sample {
   bool flipped = false;
 };
 
-// The frame window of a clip: uniformly random when augmenting, centred otherwise.
+// The frame window of a clip: options.first_frame when set, else uniformly random when augmenting,
+// centred otherwise. Throws std::runtime_error when the clip is too short for the window.
 int ChooseFirstFrame(int num_frames, const SampleOptions& options, std::mt19937_64& rng);
 
 // Turns greyscale frames (all of one size, count = options.frames) into a Sample: crop (random
@@ -70,6 +72,11 @@ int ChooseFirstFrame(int num_frames, const SampleOptions& options, std::mt19937_
 // otherwise), resize to input_size (area interpolation), flip horizontally with probability
 // 1/2 when augmenting, and normalise the whole clip to zero mean and unit standard deviation.
 Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& options, std::mt19937_64& rng);
+
+// The starts of `windows` evenly spaced frame windows of `frames` frames in a clip of `num_frames`:
+// the first at 0 and the last at num_frames - frames (one window: the centred one, as evaluation
+// takes). Throws std::invalid_argument for windows < 1 or a clip shorter than one window.
+std::vector<int> EvenWindowStarts(int num_frames, int frames, int windows);
 
 // LoadFrames + MakeSample for one example, deterministic in `seed`.
 Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed);

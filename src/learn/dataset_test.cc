@@ -185,6 +185,38 @@ TEST_F(DatasetTest, AugmentationShapesAndDeterminismBySeed) {
   EXPECT_FALSE(e1.flipped);
 }
 
+TEST_F(DatasetTest, ExplicitWindowStartsAreEvenlySpacedAndRespected) {
+  EXPECT_EQ(EvenWindowStarts(60, 30, 1), (std::vector<int>{15}));  // the centred window
+  EXPECT_EQ(EvenWindowStarts(60, 30, 2), (std::vector<int>{0, 30}));
+  EXPECT_EQ(EvenWindowStarts(60, 30, 3), (std::vector<int>{0, 15, 30}));
+  EXPECT_EQ(EvenWindowStarts(40, 30, 4), (std::vector<int>{0, 3, 7, 10}));
+  EXPECT_EQ(EvenWindowStarts(30, 30, 3), (std::vector<int>{0, 0, 0}));
+  EXPECT_THROW(EvenWindowStarts(60, 30, 0), std::invalid_argument);
+  EXPECT_THROW(EvenWindowStarts(20, 30, 1), std::invalid_argument);
+  // The dataset's clips have 40 frames: a window set at the centred start is the centred window;
+  // another start gives other frames, even when augmenting; one past the end is an error.
+  const ClipInfo clip = ReadDataset(*dir_).clips[0];
+  SampleOptions o;
+  o.frames = 30;
+  o.input_size = 32;
+  const Sample centred = LoadSample(clip, o, 0);
+  o.first_frame = 5;
+  EXPECT_EQ(LoadSample(clip, o, 0).pixels, centred.pixels);
+  o.first_frame = 0;
+  const Sample first = LoadSample(clip, o, 0);
+  EXPECT_EQ(first.first_frame, 0);
+  EXPECT_NE(first.pixels, centred.pixels);
+  o.augment = true;
+  for (uint64_t seed = 0; seed < 5; ++seed) EXPECT_EQ(LoadSample(clip, o, seed).first_frame, 0);
+  o.first_frame = 11;
+  try {
+    LoadSample(clip, o, 0);
+    ADD_FAILURE() << "a window past the clip's end was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("40"), std::string::npos) << e.what();
+  }
+}
+
 TEST(MakeSample, FlipMirrorsTheFrames) {
   // A horizontal ramp: the flipped sample is the mirror image of the unflipped one.
   std::vector<cv::Mat> frames;

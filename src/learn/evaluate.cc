@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <unistd.h>
 
 #include "learn/dataset.h"
@@ -37,31 +38,49 @@ Metrics ComputeMetrics(const std::vector<double>& truth, const std::vector<doubl
 }
 
 EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::string& split, int threads,
-                    const std::string& device, int batch, const std::function<void(int, int)>& progress) {
+                    const std::string& device, int batch, int windows, const std::function<void(int, int)>& progress) {
   const auto start = std::chrono::steady_clock::now();
+  if (windows < 1) throw std::invalid_argument("Evaluate: windows must be >= 1, got " + std::to_string(windows));
   Predictor predictor(model, threads, device);
   const std::vector<ClipInfo> clips = SelectSplit(ReadDataset(data), split);
   if (clips.empty()) throw std::runtime_error((data / "index.json").string() + ": no examples in split " + split);
   EvalResult r;
   r.config = predictor.config();
   r.split = split;
+  r.windows = windows;
   SampleOptions options;
   options.frames = r.config.frames;
   options.input_size = r.config.input_size;
   batch = std::max(1, batch);
   for (size_t i = 0; i < clips.size(); i += batch) {
-    std::vector<Sample> samples;
-    for (size_t j = i; j < std::min(clips.size(), i + batch); ++j) {
-      samples.push_back(LoadSample(clips[j], options, 0));
+    const size_t end = std::min(clips.size(), i + batch);
+    std::vector<double> sum(end - i, 0.0), sum_var(end - i, 0.0);
+    for (int w = 0; w < windows; ++w) {
+      std::vector<Sample> samples;
+      for (size_t j = i; j < end; ++j) {
+        SampleOptions o = options;
+        if (windows > 1) {
+          try {
+            o.first_frame = EvenWindowStarts(clips[j].num_frames, options.frames, windows)[w];
+          } catch (const std::invalid_argument& e) {
+            throw std::runtime_error(clips[j].name + ": " + e.what());
+          }
+        }
+        samples.push_back(LoadSample(clips[j], o, 0));
+      }
+      std::vector<const Sample*> pointers;
+      for (const Sample& s : samples) pointers.push_back(&s);
+      const std::vector<Prediction> predictions = predictor.Predict(pointers);
+      for (size_t j = 0; j < samples.size(); ++j) {
+        sum[j] += predictions[j].speed;
+        sum_var[j] += predictions[j].speed_std * predictions[j].speed_std;
+      }
     }
-    std::vector<const Sample*> pointers;
-    for (const Sample& s : samples) pointers.push_back(&s);
-    const std::vector<Prediction> predictions = predictor.Predict(pointers);
-    for (size_t j = 0; j < samples.size(); ++j) {
-      r.names.push_back(clips[i + j].name);
-      r.truth.push_back(clips[i + j].wind_speed);
-      r.predicted.push_back(predictions[j].speed);
-      r.predicted_std.push_back(predictions[j].speed_std);
+    for (size_t j = i; j < end; ++j) {
+      r.names.push_back(clips[j].name);
+      r.truth.push_back(clips[j].wind_speed);
+      r.predicted.push_back(sum[j - i] / windows);
+      r.predicted_std.push_back(std::sqrt(sum_var[j - i] / windows));
     }
     if (progress) progress(static_cast<int>(r.truth.size()), static_cast<int>(clips.size()));
   }
@@ -73,7 +92,7 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
 nlohmann::json EvalJson(const EvalResult& r) {
   return {{"rmse", r.metrics.rmse},    {"acc05", r.metrics.acc05},      {"count", r.metrics.count},
           {"model", r.config.Name()},  {"arch", r.config.arch},         {"modality", r.config.Modality()},
-          {"split", r.split},          {"seconds", r.seconds}};
+          {"split", r.split},          {"windows", r.windows},          {"seconds", r.seconds}};
 }
 
 std::string EvalTable(const EvalResult& r) {
@@ -85,7 +104,9 @@ std::string EvalTable(const EvalResult& r) {
     << "Acc@0.5\n";
   s << std::setw(width) << name << std::setw(18) << r.config.Modality()
     << std::setw(10) << std::fixed << std::setprecision(3) << r.metrics.rmse << r.metrics.acc05 << "\n";
-  s << "(" << r.metrics.count << " examples, split " << r.split << ")\n";
+  s << "(" << r.metrics.count << " examples, split " << r.split;
+  if (r.windows > 1) s << ", mean of " << r.windows << " frame windows per clip";
+  s << ")\n";
   return s.str();
 }
 

@@ -28,6 +28,7 @@ struct EvalResult {
   std::string split;
   std::vector<std::string> names;
   std::vector<double> truth, predicted, predicted_std;  // [m/s]
+  int windows = 1;  // frame windows averaged per clip
   Metrics metrics;
   double seconds = 0;  // wall time of the evaluation
 };
@@ -35,12 +36,16 @@ struct EvalResult {
 // Evaluates the model (model.pt + model.json) over one split of a dataset with the evaluation
 // preprocessing (centred frame window, centred square crop, no flip).
 // Inputs: threads  torch threads; device  cpu|cuda|auto; batch  clips per forward pass;
+//         windows  frame windows per clip (EvenWindowStarts; 1: the centred one, Table 1's
+//                  protocol): the clip's prediction is their mean speed and its std the root mean
+//                  of their variances (not divided by the count: the windows show one flag, so
+//                  their errors are not independent);
 //         progress  called after each batch with (done, total) (may be empty).
 EvalResult Evaluate(const std::filesystem::path& model, const std::filesystem::path& data, const std::string& split,
-                    int threads, const std::string& device, int batch,
+                    int threads, const std::string& device, int batch, int windows = 1,
                     const std::function<void(int, int)>& progress = {});
 
-// {"rmse": …, "acc05": …, "count": …} plus the model and split.
+// {"rmse": …, "acc05": …, "count": …} plus the model, split and windows.
 nlohmann::json EvalJson(const EvalResult& result);
 
 // Table 1's layout: header and one row ("Model  Input Modality  RMSE  Acc@0.5").

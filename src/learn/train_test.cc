@@ -92,6 +92,30 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
   EXPECT_DOUBLE_EQ(j["acc05"].get<double>(), again.acc05);
   EXPECT_EQ(j["count"].get<int>(), static_cast<int>(val.size()));
   for (double s : e.predicted_std) EXPECT_TRUE(std::isfinite(s) && s > 0);
+  // Several windows per clip: the mean of the predictions at the evenly spaced starts, and the
+  // root mean of their variances, clip by clip.
+  const EvalResult e3 = Evaluate(r.model, *root_ / "data", "val", 2, "cpu", 4, 3);
+  ASSERT_EQ(e3.predicted.size(), val.size());
+  EXPECT_EQ(EvalJson(e3)["windows"].get<int>(), 3);
+  Predictor predictor(r.model, 1, "cpu");
+  for (size_t i = 0; i < 3; ++i) {
+    const std::vector<int> starts = EvenWindowStarts(val[i].num_frames, predictor.config().frames, 3);
+    double sum = 0, sum_var = 0;
+    for (int start : starts) {
+      SampleOptions o;
+      o.frames = predictor.config().frames;
+      o.input_size = predictor.config().input_size;
+      o.first_frame = start;
+      const Sample sample = LoadSample(val[i], o, 0);
+      ASSERT_EQ(sample.first_frame, start);
+      const Prediction p = predictor.Predict({&sample}).front();
+      sum += p.speed;
+      sum_var += p.speed_std * p.speed_std;
+    }
+    EXPECT_EQ(e3.names[i], val[i].name);
+    EXPECT_NEAR(e3.predicted[i], sum / 3, 1e-4);
+    EXPECT_NEAR(e3.predicted_std[i], std::sqrt(sum_var / 3), 1e-4);
+  }
   // The plots are PNGs made by gnuplot (installed with the project's dependencies).
   EXPECT_EQ(r.plot_error, "");
   std::string error;

@@ -23,18 +23,22 @@ std::vector<EstimateRow> SortedByEnd(std::vector<EstimateRow> rows) {
 }
 
 std::string SummaryLine(const EstimateSummary& s) {
-  char line[320];
+  char line[480];
   std::snprintf(line, sizeof line,
                 "estimates: %d, %d with an anemometer label: RMSE %.3f m/s, Acc@0.5 %.3f, bias %+.3f m/s "
-                "(mean label %.3f m/s); latency mean %.1f ms, max %.1f ms",
-                s.count, s.compared, s.rmse, s.acc05, s.bias, s.mean_label, s.mean_latency * 1e3, s.max_latency * 1e3);
+                "(mean label %.3f m/s); latency mean %.1f ms, max %.1f ms\n"
+                "trailing %.0f s mean of the estimates against the label: RMSE %.3f m/s, Acc@0.5 %.3f, bias %+.3f m/s",
+                s.count, s.compared, s.rmse, s.acc05, s.bias, s.mean_label, s.mean_latency * 1e3, s.max_latency * 1e3,
+                s.window, s.window_rmse, s.window_acc05, s.window_bias);
   return line;
 }
 
 }  // namespace
 
-EstimateSummary SummariseEstimates(const std::vector<EstimateRow>& rows) {
+EstimateSummary SummariseEstimates(const std::vector<EstimateRow>& rows, double window) {
+  if (!(window > 0)) throw std::invalid_argument("SummariseEstimates: window must be > 0 s");
   EstimateSummary s;
+  s.window = window;
   s.count = static_cast<int>(rows.size());
   double se = 0, err = 0, label = 0, latency = 0;
   int within = 0;
@@ -57,6 +61,38 @@ EstimateSummary SummariseEstimates(const std::vector<EstimateRow>& rows) {
     s.acc05 = static_cast<double>(within) / s.compared;
     s.bias = err / s.compared;
     s.mean_label = label / s.compared;
+  }
+  // Trailing means: a sliding window over the rows in time order (finite estimates only).
+  const std::vector<EstimateRow> sorted = SortedByEnd(rows);
+  double wse = 0, werr = 0, sum = 0;
+  int wwithin = 0, wcompared = 0, in_window = 0;
+  size_t first = 0;
+  for (size_t i = 0; i < sorted.size(); ++i) {
+    if (std::isfinite(sorted[i].speed)) {
+      sum += sorted[i].speed;
+      ++in_window;
+    }
+    while (sorted[first].end <= sorted[i].end - window) {
+      if (std::isfinite(sorted[first].speed)) {
+        sum -= sorted[first].speed;
+        --in_window;
+      }
+      ++first;
+    }
+    // The rows `compared` counts: a finite estimate (so in_window > 0) and label.
+    if (!std::isfinite(sorted[i].speed) || !std::isfinite(sorted[i].reference)) continue;
+    ++wcompared;
+    const double e = sum / in_window - sorted[i].reference;
+    wse += e * e;
+    werr += e;
+    wwithin += std::fabs(e) <= 0.5;
+  }
+  if (wcompared == 0) {
+    s.window_rmse = s.window_acc05 = s.window_bias = kNaN;
+  } else {
+    s.window_rmse = std::sqrt(wse / wcompared);
+    s.window_acc05 = static_cast<double>(wwithin) / wcompared;
+    s.window_bias = werr / wcompared;
   }
   return s;
 }
@@ -91,7 +127,9 @@ nlohmann::json EstimateJson(const std::vector<EstimateRow>& rows) {
   const EstimateSummary s = SummariseEstimates(rows);
   return {{"estimates", list},       {"count", s.count},         {"compared", s.compared},
           {"rmse", Number(s.rmse)},  {"acc05", Number(s.acc05)}, {"bias", Number(s.bias)},
-          {"mean_label", Number(s.mean_label)}, {"mean_latency", s.mean_latency}, {"max_latency", s.max_latency}};
+          {"mean_label", Number(s.mean_label)}, {"mean_latency", s.mean_latency}, {"max_latency", s.max_latency},
+          {"window", s.window},      {"window_rmse", Number(s.window_rmse)},
+          {"window_acc05", Number(s.window_acc05)}, {"window_bias", Number(s.window_bias)}};
 }
 
 cv::Mat DrawEstimatePlot(const std::vector<EstimateRow>& rows, double t0, int width, int height) {

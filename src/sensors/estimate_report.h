@@ -32,10 +32,18 @@ struct EstimateSummary {
   double bias = 0;        // [m/s] mean of estimate - label; NaN when compared == 0
   double mean_label = 0;  // [m/s] mean of the labels compared; NaN when compared == 0
   double mean_latency = 0, max_latency = 0;  // [s] over all rows; 0 when there are none
+  // The same three metrics for the trailing mean of the estimates — at each labelled row, the
+  // mean speed of the rows whose `end` lies in (end - window, end] — against the row's label.
+  // The field protocol labels a clip with the anemometer's mean over the last minute, so one
+  // clip's estimate carries the gusts of its own 1.2 s while the label has averaged them out;
+  // the trailing mean compares like with like. Rows in the first `window` seconds average what
+  // there is. NaN when compared == 0.
+  double window = 60;     // [s]
+  double window_rmse = 0, window_acc05 = 0, window_bias = 0;
 };
 
-// Inputs: rows  in any order. Output: the summary above.
-EstimateSummary SummariseEstimates(const std::vector<EstimateRow>& rows);
+// Inputs: rows  in any order; window [s] of the trailing mean (> 0). Output: the summary above.
+EstimateSummary SummariseEstimates(const std::vector<EstimateRow>& rows, double window = 60);
 
 // A fixed-width table, one line per row sorted by `end`: sequence, time since t0, estimate ± std,
 // label, error; then one "estimates:" line with the summary.

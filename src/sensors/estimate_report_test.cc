@@ -29,11 +29,43 @@ TEST(EstimateReportTest, MetricsOverLabelledRowsOnly) {
   EXPECT_DOUBLE_EQ(s.max_latency, 0.050);
 }
 
+TEST(EstimateReportTest, TrailingMeanAveragesTheGustsOfSingleClips) {
+  // Estimates 6, 4, 6, 4 (given out of order) at 0, 1, 2, 3 s against a steady label of 5: every
+  // clip is 1 m/s off, but a 2 s trailing mean (this row and the one before) is exact from the
+  // second row on; the first row has only itself.
+  const std::vector<EstimateRow> rows = {
+      {3, 2.0, 6.0, 0.5, 5.0, 0.0}, {1, 0.0, 6.0, 0.5, 5.0, 0.0}, {4, 3.0, 4.0, 0.5, 5.0, 0.0}, {2, 1.0, 4.0, 0.5, 5.0, 0.0}};
+  const EstimateSummary s = SummariseEstimates(rows, 2.0);
+  EXPECT_DOUBLE_EQ(s.rmse, 1.0);
+  EXPECT_DOUBLE_EQ(s.window, 2.0);
+  EXPECT_DOUBLE_EQ(s.window_rmse, 0.5);  // sqrt((1 + 0 + 0 + 0) / 4)
+  EXPECT_DOUBLE_EQ(s.window_acc05, 0.75);
+  EXPECT_DOUBLE_EQ(s.window_bias, 0.25);
+  // A window of one spacing holds the row alone (it is open at its start): the per-clip figures.
+  const EstimateSummary one = SummariseEstimates(rows, 1.0);
+  EXPECT_DOUBLE_EQ(one.window_rmse, one.rmse);
+  EXPECT_DOUBLE_EQ(one.window_bias, one.bias);
+  // Rows without a label or estimate are left out as in the per-clip figures, and a NaN estimate
+  // does not poison the mean of its neighbours.
+  std::vector<EstimateRow> holes = rows;
+  holes.push_back({5, 3.5, kNaN, kNaN, 5.0, 0.0});
+  holes.push_back({6, 3.6, 5.0, 0.5, kNaN, 0.0});
+  const EstimateSummary h = SummariseEstimates(holes, 2.0);
+  EXPECT_EQ(h.compared, 4);
+  EXPECT_DOUBLE_EQ(h.window_rmse, 0.5);
+  EXPECT_THROW(SummariseEstimates(rows, 0.0), std::invalid_argument);
+  // The default window is the field protocol's minute, and the table and JSON carry the figures.
+  EXPECT_DOUBLE_EQ(SummariseEstimates(rows).window, 60.0);
+  EXPECT_NE(EstimateTable(rows, 0.0).find("trailing 60 s mean"), std::string::npos);
+  EXPECT_TRUE(EstimateJson(rows).contains("window_rmse"));
+}
+
 TEST(EstimateReportTest, NoLabelsGiveNaNNotZero) {
   const EstimateSummary s = SummariseEstimates({{1, 1.0, 2.0, 0.1, kNaN, 0.0}});
   EXPECT_EQ(s.compared, 0);
   EXPECT_TRUE(std::isnan(s.rmse));
   EXPECT_TRUE(std::isnan(s.acc05));
+  EXPECT_TRUE(std::isnan(s.window_rmse));
   EXPECT_TRUE(std::isnan(SummariseEstimates({}).rmse));
 }
 
