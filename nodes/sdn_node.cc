@@ -2,18 +2,24 @@
 // wind network (SDN or baseline, src/learn/) and publishes
 //   wind/estimate   clothwind/WindEstimate (speed, its std, clip stamps, anemometer reference,
 //                   latency, model name)
+//   wind/estimate_mean  clothwind/WindEstimate: the trailing mean of the estimates over
+//                   ~mean_window seconds of clip time (sensors/trailing_mean.h), published with
+//                   each estimate: the figure to hold against the anemometer's minute mean
 //   sdn/power       bgr8 Image: log power of each pixel's strongest spectral peak (inferno),
 //   sdn/frequency   bgr8 Image: its frequency, 0 .. Nyquist (jet); both for rviz, computed only
 //                   while someone subscribes, SDN models only.
 // Parameters: ~model (model.pt of a training run; model.json beside it), ~threads (2),
-// ~device (cpu | cuda | auto), ~queue_size (2 clips; older ones are dropped when the node lags).
+// ~device (cpu | cuda | auto), ~queue_size (2 clips; older ones are dropped when the node lags),
+// ~mean_window (60 s, the field protocol's label window).
 // Diagnostics: model, device, latency and rate; a malformed clip is an ERROR, not a crash. A
 // model that cannot be loaded is retried every 2 s (ERROR until it loads).
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <deque>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <image_transport/image_transport.h>
@@ -25,18 +31,20 @@
 
 #include "learn/predictor.h"
 #include "ros_bridge/sdn_conversions.h"
+#include "sensors/trailing_mean.h"
 
 namespace {
 
 class SdnNode {
  public:
-  SdnNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : transport_(nh) {
+  SdnNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : transport_(nh), trailing_(MeanWindow(pnh)) {
     pnh.param("model", model_path_, std::string());
     pnh.param("threads", threads_, 2);
     pnh.param("device", device_, std::string("cpu"));
     int queue_size = 2;
     pnh.param("queue_size", queue_size, 2);
     estimate_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate", 10);
+    mean_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate_mean", 10);
     power_pub_ = transport_.advertise("sdn/power", 1);
     frequency_pub_ = transport_.advertise("sdn/frequency", 1);
     updater_.setHardwareID("sdn:" + model_path_);
@@ -52,6 +60,16 @@ class SdnNode {
   }
 
  private:
+  static double MeanWindow(ros::NodeHandle& pnh) {
+    double window = 60.0;
+    pnh.param("mean_window", window, 60.0);
+    if (!(window > 0)) {
+      ROS_ERROR("sdn_node: ~mean_window must be > 0 s, got %g; using 60 s", window);
+      window = 60.0;
+    }
+    return window;
+  }
+
   void TryLoad() {
     try {
       if (model_path_.empty()) throw std::runtime_error("parameter ~model is not set");
@@ -88,7 +106,9 @@ class SdnNode {
       clothwind::learn::PeakMaps maps;
       const clothwind::learn::Prediction p = predictor_->PredictFrames(frames, want_maps ? &maps : nullptr);
       const double latency = std::chrono::duration<double>(std::chrono::steady_clock::now() - received).count();
-      estimate_pub_.publish(clothwind::ros_bridge::ToWindEstimate(*clip, p, latency, model_name_));
+      const clothwind::WindEstimate estimate = clothwind::ros_bridge::ToWindEstimate(*clip, p, latency, model_name_);
+      estimate_pub_.publish(estimate);
+      PublishMean(estimate);
       if (want_maps && !maps.power.empty()) PublishMaps(*clip, maps);
       ++estimates_;
       latencies_.push_back(latency);
@@ -102,6 +122,24 @@ class SdnNode {
       ROS_ERROR_THROTTLE(5.0, "sdn_node: %s", last_error_.c_str());
       updater_.force_update();
     }
+  }
+
+  // The trailing mean up to this estimate; its clip_start is the first frame of the oldest clip
+  // averaged, clip_end and the stamp those of this one.
+  void PublishMean(const clothwind::WindEstimate& estimate) {
+    const double end = estimate.clip_end.toSec();
+    if (!starts_.empty() && end < starts_.back().first) starts_.clear();  // time went back
+    trailing_.Add(end, estimate.speed, estimate.speed_std);
+    starts_.emplace_back(end, estimate.clip_start);
+    while (starts_.front().first < trailing_.Oldest()) starts_.pop_front();
+    clothwind::WindEstimate mean = estimate;
+    mean.clip_start = starts_.front().second;
+    mean.speed = trailing_.Mean();
+    mean.speed_std = trailing_.Std();
+    char model[64];
+    std::snprintf(model, sizeof model, " [trailing %.0f s mean of %zu clips]", trailing_.window(), trailing_.Count());
+    mean.model += model;
+    mean_pub_.publish(mean);
   }
 
   void PublishMaps(const clothwind::Clip& clip, const clothwind::learn::PeakMaps& maps) {
@@ -146,13 +184,15 @@ class SdnNode {
     stat.add("latency max [s]", max);
     stat.add("rate [clips/s]", rate);
     stat.add("estimates", estimates_);
+    stat.add("trailing mean [m/s]", trailing_.Mean());
+    stat.add("clips in the trailing mean", trailing_.Count());
     stat.add("malformed clips", errors_);
     stat.add("clips dropped (no model)", dropped_);
     stat.add("last error", last_error_);
   }
 
   image_transport::ImageTransport transport_;
-  ros::Publisher estimate_pub_;
+  ros::Publisher estimate_pub_, mean_pub_;
   image_transport::Publisher power_pub_, frequency_pub_;
   ros::Subscriber clip_sub_;
   diagnostic_updater::Updater updater_;
@@ -161,6 +201,8 @@ class SdnNode {
   int threads_ = 2;
   std::unique_ptr<clothwind::learn::Predictor> predictor_;
   std::deque<double> latencies_, stamps_;
+  clothwind::sensors::TrailingMean trailing_;
+  std::deque<std::pair<double, ros::Time>> starts_;  // (clip end [s], clip start) of the averaged clips
   uint64_t estimates_ = 0, errors_ = 0, dropped_ = 0;
   bool error_pending_ = false;
 };

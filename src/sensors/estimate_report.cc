@@ -8,6 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "sensors/trailing_mean.h"
 #include "sensors/wind_plot.h"
 
 namespace clothwind::sensors {
@@ -36,7 +37,6 @@ std::string SummaryLine(const EstimateSummary& s) {
 }  // namespace
 
 EstimateSummary SummariseEstimates(const std::vector<EstimateRow>& rows, double window) {
-  if (!(window > 0)) throw std::invalid_argument("SummariseEstimates: window must be > 0 s");
   EstimateSummary s;
   s.window = window;
   s.count = static_cast<int>(rows.size());
@@ -62,27 +62,16 @@ EstimateSummary SummariseEstimates(const std::vector<EstimateRow>& rows, double 
     s.bias = err / s.compared;
     s.mean_label = label / s.compared;
   }
-  // Trailing means: a sliding window over the rows in time order (finite estimates only).
-  const std::vector<EstimateRow> sorted = SortedByEnd(rows);
-  double wse = 0, werr = 0, sum = 0;
-  int wwithin = 0, wcompared = 0, in_window = 0;
-  size_t first = 0;
-  for (size_t i = 0; i < sorted.size(); ++i) {
-    if (std::isfinite(sorted[i].speed)) {
-      sum += sorted[i].speed;
-      ++in_window;
-    }
-    while (sorted[first].end <= sorted[i].end - window) {
-      if (std::isfinite(sorted[first].speed)) {
-        sum -= sorted[first].speed;
-        --in_window;
-      }
-      ++first;
-    }
-    // The rows `compared` counts: a finite estimate (so in_window > 0) and label.
-    if (!std::isfinite(sorted[i].speed) || !std::isfinite(sorted[i].reference)) continue;
+  // Trailing means, over the rows in time order.
+  TrailingMean trailing(window);
+  double wse = 0, werr = 0;
+  int wwithin = 0, wcompared = 0;
+  for (const EstimateRow& r : SortedByEnd(rows)) {
+    trailing.Add(r.end, r.speed);
+    // The rows `compared` counts: a finite estimate (so the mean is finite) and label.
+    if (!std::isfinite(r.speed) || !std::isfinite(r.reference)) continue;
     ++wcompared;
-    const double e = sum / in_window - sorted[i].reference;
+    const double e = trailing.Mean() - r.reference;
     wse += e * e;
     werr += e;
     wwithin += std::fabs(e) <= 0.5;

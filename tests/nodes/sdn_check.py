@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """rostest for sdn_node: publishes synthetic clips (one malformed) and checks the estimates,
-the diagnostics and the spectral images."""
+their trailing mean, the diagnostics and the spectral images."""
 import math
 import sys
 import threading
@@ -48,10 +48,12 @@ class SdnNodeTest(unittest.TestCase):
     def setUp(self):
         self.lock = threading.Lock()
         self.estimates = []
+        self.means = []
         self.statuses = []
         self.power = []
         self.frequency = []
         rospy.Subscriber("wind/estimate", WindEstimate, self.on_estimate, queue_size=100)
+        rospy.Subscriber("wind/estimate_mean", WindEstimate, lambda m: self.append(self.means, m), queue_size=100)
         rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics, queue_size=100)
         rospy.Subscriber("sdn/power", Image, lambda m: self.append(self.power, m), queue_size=10)
         rospy.Subscriber("sdn/frequency", Image, lambda m: self.append(self.frequency, m), queue_size=10)
@@ -98,13 +100,15 @@ class SdnNodeTest(unittest.TestCase):
                 bad.data = bad.data[:-5]  # wrong data length
                 self.pub.publish(bad)
             wind = float("nan") if i == 1 else 2.0 + i
-            clip = make_clip(i, start + rospy.Duration.from_sec(2.0 * i), size, frequency, wind)
+            # Each clip its own stripe frequency, so the estimates (and their means) differ.
+            clip = make_clip(i, start + rospy.Duration.from_sec(2.0 * i), size, frequency + 0.5 * i, wind)
             sent.append(clip)
             self.pub.publish(clip)
-        self.wait_for(lambda: len(self.estimates) >= n, 90, "%d estimates" % n)
+        self.wait_for(lambda: len(self.estimates) >= n and len(self.means) >= n, 90, "%d estimates and means" % n)
         rospy.sleep(1.0)
         with self.lock:
             estimates = list(self.estimates)
+            means = list(self.means)
         self.assertEqual(len(estimates), n, "one estimate per good clip, none for the malformed one")
         by_seq = {e.clip_sequence: e for e in estimates}
         self.assertEqual(sorted(by_seq), list(range(n)))
@@ -122,6 +126,24 @@ class SdnNodeTest(unittest.TestCase):
             self.assertTrue(math.isfinite(e.speed_std) and e.speed_std > 0)
             self.assertTrue(0 < e.latency < 30, e.latency)
             self.assertIn("sdn-k3", e.model)
+        # The trailing mean: one per estimate, stamped like it, over the clips that ended within
+        # ~mean_window seconds (clips end 2 s apart), its clip_start the oldest one's first frame.
+        window = rospy.get_param("~mean_window", 5.0)
+        self.assertEqual(len(means), n)
+        for m in means:
+            e = by_seq[m.clip_sequence]
+            self.assertEqual(m.header.stamp, e.header.stamp)
+            self.assertEqual(m.clip_end, e.clip_end)
+            inside = [o for o in estimates if m.clip_end - rospy.Duration.from_sec(window) < o.clip_end <= m.clip_end]
+            self.assertAlmostEqual(m.speed, sum(o.speed for o in inside) / len(inside), places=6)
+            self.assertAlmostEqual(m.speed_std, math.sqrt(sum(o.speed_std ** 2 for o in inside) / len(inside)), places=6)
+            self.assertEqual(m.clip_start, min(o.clip_start for o in inside))
+            self.assertIn("trailing %.0f s mean of %d clips" % (window, len(inside)), m.model)
+            if math.isnan(e.reference_speed):
+                self.assertTrue(math.isnan(m.reference_speed))
+            else:
+                self.assertEqual(m.reference_speed, e.reference_speed)
+        self.assertGreater(len(set(round(m.speed, 6) for m in means)), 1, "the means follow the estimates")
         # The malformed clip raised an ERROR naming the field, and the node carried on.
         self.wait_for(lambda: any(s.level == DiagnosticStatus.ERROR and "data" in s.message for s in self.statuses),
                       10, "an ERROR diagnostic for the malformed clip")
