@@ -1,7 +1,7 @@
 // wind_display_node: turns the latest wind estimate and anemometer readings into things rviz
 // shows (rviz cannot plot custom scalar messages), for launch/monitor.launch:
 //   monitor/wind_markers (visualization_msgs/MarkerArray): a view-facing text, two lines
-//     "estimate 3.4 ± 0.3 m/s" / "anemometer 3.2 m/s (60 s mean)", and an arrow along the
+//     "estimate 3.4 ± 0.3 m/s, 60 s mean 3.6" / "anemometer 3.2 m/s (60 s mean)", and an arrow along the
 //     anemometer's latest air velocity (REP 103: where the wind blows TO), 1 m per m/s, in the
 //     anemometer's frame (header.frame_id of anemometer/wind, so rviz needs no transform when its
 //     fixed frame is that frame);
@@ -115,7 +115,8 @@ class WindDisplayNode {
     text.scale.z = 0.6;  // [m] letter height
     text.color.r = text.color.g = text.color.b = 1.0;
     text.color.a = 1.0;
-    text.text = clothwind::sensors::WindSummaryText(est, est_std, mean, mean_window_);
+    const double est_mean = have_estimate_ ? estimates_.Mean(t_now, mean_window_) : std::nan("");
+    text.text = clothwind::sensors::WindSummaryText(est, est_std, mean, mean_window_, est_mean);
     const size_t bar = text.text.find(" | ");  // two lines: the 3-D view is narrow beside the images
     if (bar != std::string::npos) text.text.replace(bar, 3, "\n");
     array.markers.push_back(text);

@@ -71,12 +71,14 @@ double WindHistory::Mean(double t_now, double window, int* count) const {
   return n > 0 ? sum / n : std::numeric_limits<double>::quiet_NaN();
 }
 
-std::string WindSummaryText(double estimate, double estimate_std, double anemometer_mean, double window) {
+std::string WindSummaryText(double estimate, double estimate_std, double anemometer_mean, double window,
+                            double estimate_mean) {
   std::string text = "estimate ";
   if (std::isfinite(estimate)) {
     text += Format("%.1f", estimate);
     if (std::isfinite(estimate_std) && estimate_std > 0) text += Format(" \xC2\xB1 %.1f", estimate_std);
     text += " m/s";
+    if (std::isfinite(estimate_mean)) text += Format(", %.0f s mean", window) + Format(" %.1f", estimate_mean);
   } else {
     text += "--";
   }

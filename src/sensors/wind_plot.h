@@ -47,13 +47,17 @@ class WindHistory {
   std::deque<WindSample> samples_;
 };
 
-// The summary line, e.g. "estimate 3.4 ± 0.3 m/s | anemometer 3.2 m/s (60 s mean)"; a NaN
-// estimate or mean is written as "--", a NaN/zero std is left out.
+// The summary line, e.g. "estimate 3.4 ± 0.3 m/s, 60 s mean 3.6 | anemometer 3.2 m/s (60 s mean)";
+// a NaN estimate or anemometer mean is written as "--", a NaN/zero std and a NaN estimate mean
+// are left out.
 // Inputs:
 //   estimate, estimate_std  [m/s] latest estimate and its standard deviation
 //   anemometer_mean         [m/s] anemometer mean over the window
-//   window                  [s] the mean's window
-std::string WindSummaryText(double estimate, double estimate_std, double anemometer_mean, double window);
+//   window                  [s] the means' window
+//   estimate_mean           [m/s] the estimates' mean over the same window (what compares with
+//                           the anemometer's mean: one clip shows its own 1.2 s of gusts)
+std::string WindSummaryText(double estimate, double estimate_std, double anemometer_mean, double window,
+                            double estimate_mean = std::numeric_limits<double>::quiet_NaN());
 
 // Colours (BGR) of the plot's series; the legend and docs/monitor.md name them.
 const cv::Scalar kEstimateColour(0, 140, 255);   // orange line, with a pale ±std band

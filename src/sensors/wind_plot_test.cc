@@ -41,6 +41,9 @@ TEST(WindPlotTest, SummaryText) {
   EXPECT_EQ(WindSummaryText(3.42, 0.31, 3.18, 60), "estimate 3.4 \xC2\xB1 0.3 m/s | anemometer 3.2 m/s (60 s mean)");
   EXPECT_EQ(WindSummaryText(kNaN, kNaN, 2.0, 30), "estimate -- | anemometer 2.0 m/s (30 s mean)");
   EXPECT_EQ(WindSummaryText(1.0, kNaN, kNaN, 60), "estimate 1.0 m/s | anemometer -- (60 s mean)");
+  EXPECT_EQ(WindSummaryText(3.42, 0.31, 3.18, 60, 3.64),
+            "estimate 3.4 \xC2\xB1 0.3 m/s, 60 s mean 3.6 | anemometer 3.2 m/s (60 s mean)");
+  EXPECT_EQ(WindSummaryText(kNaN, kNaN, 2.0, 30, 2.5), "estimate -- | anemometer 2.0 m/s (30 s mean)");
 }
 
 TEST(WindPlotTest, SeriesDrawnAtTheirSpeeds) {
