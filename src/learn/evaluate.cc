@@ -37,6 +37,31 @@ Metrics ComputeMetrics(const std::vector<double>& truth, const std::vector<doubl
   return m;
 }
 
+std::vector<BandMetrics> ComputeBandMetrics(const std::vector<double>& truth, const std::vector<double>& predicted,
+                                            double width) {
+  if (truth.size() != predicted.size()) throw std::invalid_argument("ComputeBandMetrics: sizes differ");
+  if (!(width > 0)) throw std::invalid_argument("ComputeBandMetrics: width must be > 0, got " + std::to_string(width));
+  double top = 0;
+  for (double t : truth) top = std::max(top, t);
+  const int n = std::max(1, static_cast<int>(std::ceil(top / width)));
+  std::vector<std::vector<double>> t(n), p(n);
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const int b = std::clamp(static_cast<int>(std::floor(truth[i] / width)), 0, n - 1);
+    t[b].push_back(truth[i]);
+    p[b].push_back(predicted[i]);
+  }
+  std::vector<BandMetrics> bands(n);
+  for (int b = 0; b < n; ++b) {
+    bands[b].lo = b * width;
+    bands[b].hi = (b + 1) * width;
+    bands[b].metrics = ComputeMetrics(t[b], p[b]);
+    double sum = 0;
+    for (size_t i = 0; i < t[b].size(); ++i) sum += p[b][i] - t[b][i];
+    bands[b].bias = t[b].empty() ? std::numeric_limits<double>::quiet_NaN() : sum / t[b].size();
+  }
+  return bands;
+}
+
 EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::string& split, int threads,
                     const std::string& device, int batch, int windows, const std::function<void(int, int)>& progress) {
   const auto start = std::chrono::steady_clock::now();
@@ -85,14 +110,27 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
     if (progress) progress(static_cast<int>(r.truth.size()), static_cast<int>(clips.size()));
   }
   r.metrics = ComputeMetrics(r.truth, r.predicted);
+  r.bands = ComputeBandMetrics(r.truth, r.predicted, kEvalBandWidth);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
 
 nlohmann::json EvalJson(const EvalResult& r) {
-  return {{"rmse", r.metrics.rmse},    {"acc05", r.metrics.acc05},      {"count", r.metrics.count},
-          {"model", r.config.Name()},  {"arch", r.config.arch},         {"modality", r.config.Modality()},
-          {"split", r.split},          {"windows", r.windows},          {"seconds", r.seconds}};
+  nlohmann::json bands = nlohmann::json::array();
+  // An empty band has no figures: null, not NaN (which JSON lacks).
+  const auto number = [](double x) { return std::isnan(x) ? nlohmann::json(nullptr) : nlohmann::json(x); };
+  for (const BandMetrics& b : r.bands) {
+    bands.push_back({{"lo", b.lo},
+                     {"hi", b.hi},
+                     {"rmse", number(b.metrics.rmse)},
+                     {"acc05", number(b.metrics.acc05)},
+                     {"bias", number(b.bias)},
+                     {"count", b.metrics.count}});
+  }
+  return {{"rmse", r.metrics.rmse},   {"acc05", r.metrics.acc05}, {"count", r.metrics.count},
+          {"model", r.config.Name()}, {"arch", r.config.arch},    {"modality", r.config.Modality()},
+          {"split", r.split},         {"windows", r.windows},     {"seconds", r.seconds},
+          {"bands", bands}};
 }
 
 std::string EvalTable(const EvalResult& r) {
@@ -107,6 +145,12 @@ std::string EvalTable(const EvalResult& r) {
   s << "(" << r.metrics.count << " examples, split " << r.split;
   if (r.windows > 1) s << ", mean of " << r.windows << " frame windows per clip";
   s << ")\n";
+  for (const BandMetrics& b : r.bands) {
+    if (b.metrics.count == 0) continue;
+    s << std::setprecision(0) << "  true " << std::right << std::setw(2) << b.lo << "-" << std::left << std::setw(2)
+      << b.hi << " m/s: RMSE " << std::setprecision(3) << b.metrics.rmse << "  Acc@0.5 " << b.metrics.acc05
+      << "  bias " << std::showpos << b.bias << std::noshowpos << "  (" << b.metrics.count << ")\n";
+  }
   return s.str();
 }
 

@@ -23,6 +23,25 @@ struct Metrics {
 // Table 1's metrics of predictions against labels (same length; empty gives count 0, NaNs).
 Metrics ComputeMetrics(const std::vector<double>& truth, const std::vector<double>& predicted);
 
+// Table 1's metrics of the examples whose true speed lies in [lo, hi), plus their mean error:
+// where over the speed range a model errs, and which way (a regression falls back towards the
+// label mean at the ends of the range, so the top band's bias is negative).
+struct BandMetrics {
+  double lo = 0, hi = 0;  // [m/s] true speed range [lo, hi); the last band also holds hi itself
+  Metrics metrics;
+  double bias = 0;  // [m/s] mean of predicted - true (NaN when the band is empty)
+};
+
+// Splits [0, top] into bands of `width` m/s, top = width * ceil(max truth / width) (at least one
+// band), and returns every band's metrics in order, empty bands included (count 0, NaNs).
+// Inputs: truth, predicted  [n] m/s, same length; width > 0 [m/s].
+// Throws std::invalid_argument for sizes that differ or width <= 0.
+std::vector<BandMetrics> ComputeBandMetrics(const std::vector<double>& truth, const std::vector<double>& predicted,
+                                            double width);
+
+// Width of the speed bands `clothwind eval` reports [m/s]: five bands over FlagSim's 0-10 m/s.
+inline constexpr double kEvalBandWidth = 2.0;
+
 struct EvalResult {
   ModelConfig config;
   std::string split;
@@ -30,6 +49,7 @@ struct EvalResult {
   std::vector<double> truth, predicted, predicted_std;  // [m/s]
   int windows = 1;  // frame windows averaged per clip
   Metrics metrics;
+  std::vector<BandMetrics> bands;  // by true speed, kEvalBandWidth wide
   double seconds = 0;  // wall time of the evaluation
 };
 
@@ -45,10 +65,12 @@ EvalResult Evaluate(const std::filesystem::path& model, const std::filesystem::p
                     int threads, const std::string& device, int batch, int windows = 1,
                     const std::function<void(int, int)>& progress = {});
 
-// {"rmse": …, "acc05": …, "count": …} plus the model, split and windows.
+// {"rmse": …, "acc05": …, "count": …} plus the model, split, windows and "bands" (a list of
+// {"lo", "hi", "rmse", "acc05", "bias", "count"}; NaNs of empty bands as null).
 nlohmann::json EvalJson(const EvalResult& result);
 
-// Table 1's layout: header and one row ("Model  Input Modality  RMSE  Acc@0.5").
+// Table 1's layout: header and one row ("Model  Input Modality  RMSE  Acc@0.5"), then one line
+// per non-empty speed band (RMSE, Acc@0.5, bias, count).
 std::string EvalTable(const EvalResult& result);
 
 // Predicted against true wind speed, with the identity line and ±0.5 m/s band, as a PNG via
