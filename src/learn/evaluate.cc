@@ -22,18 +22,20 @@ Metrics ComputeMetrics(const std::vector<double>& truth, const std::vector<doubl
   Metrics m;
   m.count = static_cast<int>(truth.size());
   if (truth.empty()) {
-    m.rmse = m.acc05 = std::numeric_limits<double>::quiet_NaN();
+    m.rmse = m.acc05 = m.bias = std::numeric_limits<double>::quiet_NaN();
     return m;
   }
-  double se = 0;
+  double se = 0, sum = 0;
   int within = 0;
   for (size_t i = 0; i < truth.size(); ++i) {
     const double e = predicted[i] - truth[i];
     se += e * e;
+    sum += e;
     if (std::abs(e) <= 0.5) ++within;
   }
   m.rmse = std::sqrt(se / truth.size());
   m.acc05 = static_cast<double>(within) / truth.size();
+  m.bias = sum / truth.size();
   return m;
 }
 
@@ -55,9 +57,6 @@ std::vector<BandMetrics> ComputeBandMetrics(const std::vector<double>& truth, co
     bands[b].lo = b * width;
     bands[b].hi = (b + 1) * width;
     bands[b].metrics = ComputeMetrics(t[b], p[b]);
-    double sum = 0;
-    for (size_t i = 0; i < t[b].size(); ++i) sum += p[b][i] - t[b][i];
-    bands[b].bias = t[b].empty() ? std::numeric_limits<double>::quiet_NaN() : sum / t[b].size();
   }
   return bands;
 }
@@ -124,7 +123,7 @@ nlohmann::json EvalJson(const EvalResult& r) {
                      {"hi", b.hi},
                      {"rmse", number(b.metrics.rmse)},
                      {"acc05", number(b.metrics.acc05)},
-                     {"bias", number(b.bias)},
+                     {"bias", number(b.metrics.bias)},
                      {"count", b.metrics.count}});
   }
   return {{"rmse", r.metrics.rmse},   {"acc05", r.metrics.acc05}, {"count", r.metrics.count},
@@ -149,7 +148,7 @@ std::string EvalTable(const EvalResult& r) {
     if (b.metrics.count == 0) continue;
     s << std::setprecision(0) << "  true " << std::right << std::setw(2) << b.lo << "-" << std::left << std::setw(2)
       << b.hi << " m/s: RMSE " << std::setprecision(3) << b.metrics.rmse << "  Acc@0.5 " << b.metrics.acc05
-      << "  bias " << std::showpos << b.bias << std::noshowpos << "  (" << b.metrics.count << ")\n";
+      << "  bias " << std::showpos << b.metrics.bias << std::noshowpos << "  (" << b.metrics.count << ")\n";
   }
   return s.str();
 }

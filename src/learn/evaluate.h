@@ -17,19 +17,19 @@ namespace clothwind::learn {
 struct Metrics {
   double rmse = 0;   // [m/s] root mean squared error
   double acc05 = 0;  // fraction of examples with |pred - true| <= 0.5 m/s
+  double bias = 0;   // [m/s] mean of pred - true
   int count = 0;
 };
 
 // Table 1's metrics of predictions against labels (same length; empty gives count 0, NaNs).
 Metrics ComputeMetrics(const std::vector<double>& truth, const std::vector<double>& predicted);
 
-// Table 1's metrics of the examples whose true speed lies in [lo, hi), plus their mean error:
-// where over the speed range a model errs, and which way (a regression falls back towards the
-// label mean at the ends of the range, so the top band's bias is negative).
+// Table 1's metrics and the bias of the examples whose true speed lies in [lo, hi): where over
+// the speed range a model errs, and which way (a regression falls back towards the label mean at
+// the ends of the range, so the top band's bias is negative).
 struct BandMetrics {
   double lo = 0, hi = 0;  // [m/s] true speed range [lo, hi); the last band also holds hi itself
-  Metrics metrics;
-  double bias = 0;  // [m/s] mean of predicted - true (NaN when the band is empty)
+  Metrics metrics;        // NaN figures when the band is empty
 };
 
 // Splits [0, top] into bands of `width` m/s, top = width * ceil(max truth / width) (at least one

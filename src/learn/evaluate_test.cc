@@ -30,18 +30,18 @@ TEST(EvaluateTest, BandsSplitByTrueSpeedAndKeepEmptyBands) {
   EXPECT_EQ(b[0].metrics.count, 2);
   EXPECT_NEAR(b[0].metrics.rmse, std::sqrt((0.04 + 0.25) / 2), 1e-12);
   EXPECT_DOUBLE_EQ(b[0].metrics.acc05, 1.0);
-  EXPECT_NEAR(b[0].bias, -0.15, 1e-12);
+  EXPECT_NEAR(b[0].metrics.bias, -0.15, 1e-12);
   EXPECT_EQ(b[1].metrics.count, 1);
-  EXPECT_NEAR(b[1].bias, 0.6, 1e-12);
+  EXPECT_NEAR(b[1].metrics.bias, 0.6, 1e-12);
   EXPECT_DOUBLE_EQ(b[1].metrics.acc05, 0.0);
   for (int i : {2, 3}) {
     EXPECT_EQ(b[i].metrics.count, 0);
     EXPECT_TRUE(std::isnan(b[i].metrics.rmse));
-    EXPECT_TRUE(std::isnan(b[i].bias));
+    EXPECT_TRUE(std::isnan(b[i].metrics.bias));
   }
   EXPECT_EQ(b[4].metrics.count, 2);
   EXPECT_NEAR(b[4].metrics.rmse, std::sqrt(0.81 / 2), 1e-12);
-  EXPECT_NEAR(b[4].bias, -0.45, 1e-12);
+  EXPECT_NEAR(b[4].metrics.bias, -0.45, 1e-12);
   EXPECT_DOUBLE_EQ(b[4].metrics.acc05, 0.5);
 }
 
@@ -63,7 +63,7 @@ TEST(EvaluateTest, BandsRecombineIntoTheWholeSplit) {
     count += b.metrics.count;
     se += b.metrics.count * b.metrics.rmse * b.metrics.rmse;
     within += b.metrics.count * b.metrics.acc05;
-    bias += b.metrics.count * b.bias;
+    bias += b.metrics.count * b.metrics.bias;
   }
   EXPECT_EQ(count, all.count);
   EXPECT_NEAR(std::sqrt(se / count), all.rmse, 1e-9);
