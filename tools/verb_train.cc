@@ -1,4 +1,4 @@
-// clothwind train: trains the SDN or a ResNet-18 baseline of Table 1 on a dataset
+// clothwind train: trains the SDN or a baseline of Table 1 (ResNet-18, Yang et al.'s LSTM) on a dataset
 // (docs/dataset.md) with the seed's recipe; see docs/sdn.md.
 #include <iomanip>
 #include <iostream>
@@ -22,8 +22,10 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   auto args = std::make_shared<TrainArgs>();
   auto* sub = app.add_subcommand("train", "train the SDN or a ResNet-18 baseline (Table 1) on a dataset");
   learn::TrainOptions& o = args->o;
-  sub->add_option("--model", o.model.arch, "sdn (spectral layer + ResNet-18) or resnet18 (frames as channels)")
-      ->check(CLI::IsMember({"sdn", "resnet18"}))
+  sub->add_option("--model", o.model.arch,
+                  "sdn (spectral layer + ResNet-18), resnet18 (frames as channels) or lstm (Yang et al.: "
+                  "ResNet-18 per frame + LSTM)")
+      ->check(CLI::IsMember({"sdn", "resnet18", "lstm"}))
       ->capture_default_str();
   sub->add_option("--frames", args->frames, "input frames N_t (Table 1: 1, 10, 20 for resnet18; 20, 30 for sdn)")
       ->check(CLI::Range(1, 1000))
@@ -50,12 +52,16 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_flag("--resume", o.resume, "continue the run in --out from its last epoch");
   sub->add_flag("--init-only", o.init_only, "write an initialised (untrained) model and stop (tests, smoke runs)");
   sub->add_option("--lr", o.lr, "initial learning rate (Adam)")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--lr-schedule", o.lr_schedule,
+                  "step (the seed's: divide by 10 once) or cosine (from --lr down to 0 over the epochs)")
+      ->check(CLI::IsMember({"step", "cosine"}))
+      ->capture_default_str();
   sub->add_option("--lr-decay-epoch", o.lr_decay_epoch,
-                  "epochs at the initial rate before dividing it by 10 (-1: half the epochs, 20 of 40 as the seed)")
+                  "step: epochs at the initial rate before dividing it by 10 (-1: half the epochs, 20 of 40 as the seed)")
       ->capture_default_str();
   sub->add_option("--weight-decay", o.weight_decay, "Adam weight decay")->check(CLI::NonNegativeNumber)->capture_default_str();
-  sub->add_option("--grad-clip", o.grad_clip, "max gradient norm (0: off; the seed clips only its RNN baselines at 10)")
-      ->check(CLI::NonNegativeNumber)
+  sub->add_option("--grad-clip", o.grad_clip, "max gradient norm (0: off; -1: the seed's, 10 for lstm and off otherwise)")
+      ->check(CLI::Range(-1.0, 1e9))
       ->capture_default_str();
   sub->add_option("--seed", o.seed, "seed of initialisation, data order and augmentation")->capture_default_str();
   return [args]() {

@@ -134,7 +134,9 @@ nlohmann::json EvalJson(const EvalResult& r) {
 
 std::string EvalTable(const EvalResult& r) {
   std::ostringstream s;
-  const std::string model = r.config.arch == "sdn" ? "SDN" : "ResNet-18";
+  const std::string model = r.config.arch == "sdn"    ? "SDN"
+                            : r.config.arch == "lstm" ? "Yang et al."
+                                                      : "ResNet-18";
   const std::string name = model + " (" + r.config.Name() + ")";
   const int width = std::max<int>(28, static_cast<int>(name.size()) + 2);
   s << std::left << std::setw(width) << "Model" << std::setw(18) << "Input Modality" << std::setw(10) << "RMSE"

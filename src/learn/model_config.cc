@@ -8,8 +8,11 @@
 namespace clothwind::learn {
 
 int ModelConfig::TrunkInputChannels() const {
-  return arch == "sdn" ? (2 * k + (mean_map ? 1 : 0)) * channels : frames * channels;
+  if (arch == "sdn") return (2 * k + (mean_map ? 1 : 0)) * channels;
+  return arch == "lstm" ? channels : frames * channels;
 }
+
+bool IsKnownArch(const std::string& arch) { return arch == "sdn" || arch == "resnet18" || arch == "lstm"; }
 
 std::string ModelConfig::Name() const {
   std::ostringstream s;
@@ -62,8 +65,9 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(where + ": " + e.what());
   }
-  if (c.arch != "sdn" && c.arch != "resnet18") {
-    throw std::runtime_error(where + ": field \"arch\" must be \"sdn\" or \"resnet18\", got \"" + c.arch + "\"");
+  if (!IsKnownArch(c.arch)) {
+    throw std::runtime_error(where + ": field \"arch\" must be \"sdn\", \"resnet18\" or \"lstm\", got \"" +
+                             c.arch + "\"");
   }
   if (c.frames < 1 || c.channels < 1 || c.width < 1 || c.input_size < 16 || c.k < 1 ||
       !(c.frame_rate > 0) || !(c.label_std > 0)) {

@@ -11,7 +11,9 @@
 namespace clothwind::learn {
 
 struct ModelConfig {
-  std::string arch = "sdn";  // "sdn" (spectral layer + ResNet-18) or "resnet18" (frames as channels)
+  // "sdn" (spectral layer + ResNet-18), "resnet18" (frames as channels) or "lstm" (Yang et al.'s
+  // recurrent baseline: a ResNet-18 trunk per frame, an LSTM over the frames' features)
+  std::string arch = "sdn";
   int frames = 30;           // N_t, input frames per clip
   int channels = 1;          // C, colour channels per frame (1: greyscale, as the seed)
   int k = 3;                 // SDN: spectral peaks kept per pixel (2kC trunk input channels)
@@ -24,7 +26,7 @@ struct ModelConfig {
   double label_std = 1.0;    // [m/s]
 
   // Channels entering the ResNet trunk: 2kC (+C with mean_map) for the SDN, N_t·C for the
-  // frame-stack baseline.
+  // frame-stack baseline, C for the recurrent one (its trunk reads one frame at a time).
   int TrunkInputChannels() const;
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("sdn-k3m-…" with mean_map,
   // "sdn-k3dc-…" with include_dc).
@@ -32,6 +34,9 @@ struct ModelConfig {
   // Table 1's "input modality", e.g. "30x112x112".
   std::string Modality() const;
 };
+
+// True for an architecture this version builds ("sdn", "resnet18", "lstm").
+bool IsKnownArch(const std::string& arch);
 
 // JSON round trip; FromJson throws std::runtime_error naming the missing or invalid field
 // (`where` names the file for the message).

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <fstream>
@@ -67,7 +68,7 @@ at::Tensor ResNet18TrunkImpl::forward(const at::Tensor& x) {
 }
 
 WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
-  if (config.arch != "sdn" && config.arch != "resnet18") {
+  if (!IsKnownArch(config.arch)) {
     throw std::invalid_argument("WindNet: unknown architecture \"" + config.arch + "\"");
   }
   if (config.arch == "sdn") {
@@ -78,6 +79,11 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
     }
   }
   trunk_ = register_module("trunk", ResNet18Trunk(config.TrunkInputChannels(), config.width));
+  if (config.arch == "lstm") {
+    // Yang et al. read the last hidden state of an LSTM fed one CNN feature vector per frame.
+    const int features = trunk_->feature_size();
+    lstm_ = register_module("lstm", torch::nn::LSTM(torch::nn::LSTMOptions(features, features).batch_first(true)));
+  }
   head_ = register_module("head", torch::nn::Linear(trunk_->feature_size(), 2));
 }
 
@@ -98,11 +104,20 @@ at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
     if (config_.mean_map) parts.push_back(clips.mean(2));
     return at::cat(parts, 1);
   }
+  if (config_.arch == "lstm") {
+    return clips.transpose(1, 2).reshape({-1, clips.size(1), clips.size(3), clips.size(4)});
+  }
   return clips.reshape({clips.size(0), clips.size(1) * clips.size(2), clips.size(3), clips.size(4)});
 }
 
 at::Tensor WindNetImpl::forward(const at::Tensor& clips) {
-  at::Tensor out = head_->forward(trunk_->forward(TrunkInput(clips)));
+  at::Tensor features = trunk_->forward(TrunkInput(clips));
+  if (config_.arch == "lstm") {
+    // [N_b·N_t, F] -> [N_b, N_t, F] -> the LSTM's output after the last frame [N_b, F].
+    at::Tensor sequence = std::get<0>(lstm_->forward(features.reshape({clips.size(0), clips.size(2), -1})));
+    features = sequence.select(1, sequence.size(1) - 1);
+  }
+  at::Tensor out = head_->forward(features);
   return at::stack({out.select(1, 0), out.select(1, 1).clamp(-12.0, 8.0)}, 1);
 }
 

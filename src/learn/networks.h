@@ -1,6 +1,7 @@
 // The wind regression networks of Table 1 written with torch::nn: the SDN (spectral layer +
-// ResNet-18) and the ResNet-18 baseline that reads N_t frames stacked as channels. Both end in
-// a head predicting the (normalised) wind speed and its log variance.
+// ResNet-18), the ResNet-18 baseline that reads N_t frames stacked as channels, and the
+// recurrent baseline of Yang et al. (ICCV 2017: a CNN per frame, an LSTM over the frames). All
+// end in a head predicting the (normalised) wind speed and its log variance.
 #ifndef CLOTHWIND_LEARN_NETWORKS_H_
 #define CLOTHWIND_LEARN_NETWORKS_H_
 
@@ -12,6 +13,7 @@
 #include <torch/nn/modules/container/sequential.h>
 #include <torch/nn/modules/conv.h>
 #include <torch/nn/modules/linear.h>
+#include <torch/nn/modules/rnn.h>
 #include <torch/nn/pimpl.h>
 
 #include "learn/model_config.h"
@@ -62,14 +64,16 @@ class WindNetImpl : public torch::nn::Module {
   //   [N_b, 2]: column 0 the normalised speed (v - label_mean) / label_std, column 1 its log
   //   variance (normalised units), clamped to [-12, 8]
   at::Tensor forward(const at::Tensor& clips);
-  // The trunk's input image: the stacked spectral maps (SDN: log1p of the power, frequency
-  // divided by the Nyquist rate, so both are O(1)) or the frames as channels (baseline).
+  // The trunk's input images: the stacked spectral maps [N_b, 2kC, H, W] (SDN: log1p of the
+  // power, frequency divided by the Nyquist rate, so both are O(1)), the frames as channels
+  // [N_b, N_t·C, H, W] (resnet18), or every frame on its own [N_b·N_t, C, H, W] (lstm).
   at::Tensor TrunkInput(const at::Tensor& clips) const;
   const ModelConfig& config() const { return config_; }
 
  private:
   ModelConfig config_;
   ResNet18Trunk trunk_{nullptr};
+  torch::nn::LSTM lstm_{nullptr};  // lstm only: hidden size = the trunk's 8w features
   torch::nn::Linear head_{nullptr};
 };
 TORCH_MODULE(WindNet);

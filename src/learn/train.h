@@ -29,10 +29,11 @@ struct TrainOptions {
   int epochs = 40;
   int batch = 16;
   double lr = 1e-2;
-  int lr_decay_epoch = -1;           // epochs before lr /= lr_decay_factor; -1: epochs / 2
+  std::string lr_schedule = "step";  // "step" (the seed's) or "cosine" (see LearningRateAt)
+  int lr_decay_epoch = -1;           // step: epochs before lr /= lr_decay_factor; -1: epochs / 2
   double lr_decay_factor = 10;
   double weight_decay = 2e-3;
-  double grad_clip = 0;              // max gradient norm; 0: off (the seed clips only RNNs)
+  double grad_clip = -1;             // max gradient norm; 0: off; < 0: the seed's (10 for lstm, else off)
   int threads = 2;                   // torch intra-op threads
   std::string device = "auto";       // cpu | cuda | auto
   bool resume = false;               // continue from out/last.pt and out/state.json
@@ -49,6 +50,14 @@ struct TrainResult {
   std::string device;                // where it trained
   std::string plot_error;            // why the learning curve could not be drawn, if so
 };
+
+// The learning rate of 1-based `epoch` under options.lr_schedule:
+//   step    lr for epochs 1..D, lr / lr_decay_factor after (D = lr_decay_epoch, -1: epochs / 2)
+//   cosine  lr · (1 + cos(π (epoch − 1) / epochs)) / 2: lr at epoch 1, falling smoothly
+//           towards 0 at the last epoch, so fewer epochs are spent at a rate whose gradient
+//           noise holds the training error up (docs/sdn.md)
+// Throws std::invalid_argument for an unknown schedule.
+double LearningRateAt(const TrainOptions& options, int epoch);
 
 // Trains (or resumes) and writes to options.out:
 //   model.pt + model.json   best validation RMSE so far (what eval and sdn_node load)
