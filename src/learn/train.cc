@@ -158,6 +158,20 @@ TrainResult Train(const TrainOptions& o) {
     } catch (const nlohmann::json::exception& e) {
       throw std::runtime_error(state_path.string() + ": " + e.what());
     }
+    // A resumed run must keep the schedule it ran under: a cosine run resumed with other --epochs
+    // (or any run with another --lr, --lr-schedule or --lr-decay-epoch) would silently become a
+    // different run from the one its log describes.
+    for (const EpochRecord& e : result.log) {
+      const double expected = LearningRateAt(o, e.epoch);
+      if (std::abs(expected - e.lr) > 1e-9 * std::max(std::abs(e.lr), 1e-12)) {
+        std::ostringstream what;
+        what << state_path.string() << ": epoch " << e.epoch << " ran at learning rate " << e.lr
+             << ", but these options give " << expected << " there (--lr-schedule " << o.lr_schedule
+             << ", --epochs " << o.epochs << "); resume with the --lr, --lr-schedule, --epochs and "
+             << "--lr-decay-epoch the run started with";
+        throw std::runtime_error(what.str());
+      }
+    }
   }
   at::manual_seed(o.seed);
   WindNet net(config);

@@ -339,6 +339,23 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   const TrainResult redo = Train(u);
   EXPECT_NEAR(redo.log[2].train_loss, resumed.log[2].train_loss, 1e-5);
   EXPECT_NEAR(redo.log[2].val_rmse, resumed.log[2].val_rmse, 1e-5);
+
+  // Resuming under another schedule is refused before anything is written: epoch 2 ran at lr / 10
+  // (step), the cosine schedule over 4 epochs gives 0.85 lr there.
+  TrainOptions w = Options("sdn", "resume");
+  w.epochs = 4;
+  w.resume = true;
+  w.lr_schedule = "cosine";
+  const auto log_before = fs::last_write_time(*root_ / "resume" / "state.json");
+  try {
+    Train(w);
+    ADD_FAILURE() << "a resume under another schedule was accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("state.json: epoch 2 ran at learning rate"), std::string::npos) << what;
+    EXPECT_NE(what.find("--lr-schedule cosine"), std::string::npos) << what;
+  }
+  EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
 }
 
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
