@@ -15,6 +15,7 @@ struct EvalArgs {
   std::string model, data, split = "test", json, plot;
   int threads = 2, batch = 8, windows = 1;
   std::string device = "auto";
+  bool mirror = false;
 };
 
 VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
@@ -33,6 +34,8 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
                   "average this many evenly spaced frame windows per clip (1: the centred one, Table 1)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  sub->add_flag("--mirror", a->mirror,
+               "also predict each window's mirror image (horizontal flip) and average the two (Table 1: off)");
   sub->add_option("--device", a->device, "cpu, cuda or auto")
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
       ->capture_default_str();
@@ -43,7 +46,7 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     b.rate_unit = "clips/s";
     ProgressBar bar(b);
     const learn::EvalResult r = learn::Evaluate(a->model, a->data, a->split, a->threads, a->device, a->batch,
-                                                a->windows, [&](int done, int total) { bar.Update(done, total); });
+                                                a->windows, a->mirror, [&](int done, int total) { bar.Update(done, total); });
     bar.Finish();
     std::cout << learn::EvalTable(r);
     const std::filesystem::path plot =

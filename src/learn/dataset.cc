@@ -198,6 +198,7 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
     sample.flipped = std::uniform_int_distribution<int>(0, 1)(rng) == 1;
   } else {
     sample.crop = cv::Rect((w - side) / 2, (h - side) / 2, side, side);
+    sample.flipped = options.mirror;
   }
   const int s = options.input_size;
   sample.pixels.resize(static_cast<size_t>(options.frames) * s * s);

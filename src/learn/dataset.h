@@ -50,6 +50,7 @@ struct SampleOptions {
   int input_size = 112;   // output side [px]
   bool augment = false;   // training: random temporal offset, multi-scale crop, flip
   int first_frame = -1;   // >= 0: start the window here (evaluation over several windows)
+  bool mirror = false;    // not augmenting: flip horizontally (evaluation's mirror averaging)
   // Crop side as fractions of the frame's shorter side (multi-scale cropping, as TSN).
   std::vector<double> crop_scales = {1.0, 0.875, 0.75, 0.66};
 };
@@ -70,7 +71,7 @@ int ChooseFirstFrame(int num_frames, const SampleOptions& options, std::mt19937_
 // Turns greyscale frames (all of one size, count = options.frames) into a Sample: crop (random
 // multi-scale position and size when augmenting, the centred square of the shorter side
 // otherwise), resize to input_size (area interpolation), flip horizontally with probability
-// 1/2 when augmenting, and normalise the whole clip to zero mean and unit standard deviation.
+// 1/2 when augmenting (always when options.mirror and not augmenting), and normalise the whole clip to zero mean and unit standard deviation.
 Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& options, std::mt19937_64& rng);
 
 // The starts of `windows` evenly spaced frame windows of `frames` frames in a clip of `num_frames`:

@@ -183,6 +183,17 @@ TEST_F(DatasetTest, AugmentationShapesAndDeterminismBySeed) {
   EXPECT_EQ(e1.first_frame, 5);
   EXPECT_EQ(e1.crop, cv::Rect(0, 0, 48, 48));
   EXPECT_FALSE(e1.flipped);
+  // Evaluation's mirror option: the same window and crop, mirrored left to right.
+  o.mirror = true;
+  const Sample em = LoadSample(clip, o, 7);
+  EXPECT_TRUE(em.flipped);
+  EXPECT_EQ(em.crop, e1.crop);
+  const int side = o.input_size;
+  for (int t = 0; t < o.frames; t += 7)
+    for (int y = 0; y < side; y += 3)
+      for (int x = 0; x < side; ++x)
+        ASSERT_FLOAT_EQ(em.pixels[(t * side + y) * side + x], e1.pixels[(t * side + y) * side + side - 1 - x])
+            << t << " " << y;
 }
 
 TEST_F(DatasetTest, ExplicitWindowStartsAreEvenlySpacedAndRespected) {

@@ -62,7 +62,8 @@ std::vector<BandMetrics> ComputeBandMetrics(const std::vector<double>& truth, co
 }
 
 EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::string& split, int threads,
-                    const std::string& device, int batch, int windows, const std::function<void(int, int)>& progress) {
+                    const std::string& device, int batch, int windows, bool mirror,
+                    const std::function<void(int, int)>& progress) {
   const auto start = std::chrono::steady_clock::now();
   if (windows < 1) throw std::invalid_argument("Evaluate: windows must be >= 1, got " + std::to_string(windows));
   Predictor predictor(model, threads, device);
@@ -72,6 +73,8 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   r.config = predictor.config();
   r.split = split;
   r.windows = windows;
+  r.mirror = mirror;
+  const int passes = windows * (mirror ? 2 : 1);
   SampleOptions options;
   options.frames = r.config.frames;
   options.input_size = r.config.input_size;
@@ -79,10 +82,12 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   for (size_t i = 0; i < clips.size(); i += batch) {
     const size_t end = std::min(clips.size(), i + batch);
     std::vector<double> sum(end - i, 0.0), sum_var(end - i, 0.0);
-    for (int w = 0; w < windows; ++w) {
+    for (int pass = 0; pass < passes; ++pass) {
+      const int w = mirror ? pass / 2 : pass;
       std::vector<Sample> samples;
       for (size_t j = i; j < end; ++j) {
         SampleOptions o = options;
+        o.mirror = mirror && pass % 2 == 1;
         if (windows > 1) {
           try {
             o.first_frame = EvenWindowStarts(clips[j].num_frames, options.frames, windows)[w];
@@ -103,8 +108,8 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
     for (size_t j = i; j < end; ++j) {
       r.names.push_back(clips[j].name);
       r.truth.push_back(clips[j].wind_speed);
-      r.predicted.push_back(sum[j - i] / windows);
-      r.predicted_std.push_back(std::sqrt(sum_var[j - i] / windows));
+      r.predicted.push_back(sum[j - i] / passes);
+      r.predicted_std.push_back(std::sqrt(sum_var[j - i] / passes));
     }
     if (progress) progress(static_cast<int>(r.truth.size()), static_cast<int>(clips.size()));
   }
@@ -128,7 +133,8 @@ nlohmann::json EvalJson(const EvalResult& r) {
   }
   return {{"rmse", r.metrics.rmse},   {"acc05", r.metrics.acc05}, {"count", r.metrics.count},
           {"model", r.config.Name()}, {"arch", r.config.arch},    {"modality", r.config.Modality()},
-          {"split", r.split},         {"windows", r.windows},     {"seconds", r.seconds},
+          {"split", r.split},         {"windows", r.windows},     {"mirror", r.mirror},
+          {"seconds", r.seconds},
           {"bands", bands}};
 }
 
@@ -145,6 +151,7 @@ std::string EvalTable(const EvalResult& r) {
     << std::setw(10) << std::fixed << std::setprecision(3) << r.metrics.rmse << r.metrics.acc05 << "\n";
   s << "(" << r.metrics.count << " examples, split " << r.split;
   if (r.windows > 1) s << ", mean of " << r.windows << " frame windows per clip";
+  if (r.mirror) s << ", each averaged with its mirror image";
   s << ")\n";
   for (const BandMetrics& b : r.bands) {
     if (b.metrics.count == 0) continue;

@@ -47,7 +47,8 @@ struct EvalResult {
   std::string split;
   std::vector<std::string> names;
   std::vector<double> truth, predicted, predicted_std;  // [m/s]
-  int windows = 1;  // frame windows averaged per clip
+  int windows = 1;      // frame windows averaged per clip
+  bool mirror = false;  // each window averaged with its mirror image
   Metrics metrics;
   std::vector<BandMetrics> bands;  // by true speed, kEvalBandWidth wide
   double seconds = 0;  // wall time of the evaluation
@@ -60,12 +61,14 @@ struct EvalResult {
 //                  protocol): the clip's prediction is their mean speed and its std the root mean
 //                  of their variances (not divided by the count: the windows show one flag, so
 //                  their errors are not independent);
+//         mirror   also predict each window's mirror image (horizontal flip, as training's
+//                  augmentation: a flag seen from the other side) and average the two the same way;
 //         progress  called after each batch with (done, total) (may be empty).
 EvalResult Evaluate(const std::filesystem::path& model, const std::filesystem::path& data, const std::string& split,
-                    int threads, const std::string& device, int batch, int windows = 1,
+                    int threads, const std::string& device, int batch, int windows = 1, bool mirror = false,
                     const std::function<void(int, int)>& progress = {});
 
-// {"rmse": …, "acc05": …, "count": …} plus the model, split, windows and "bands" (a list of
+// {"rmse": …, "acc05": …, "count": …} plus the model, split, windows, mirror and "bands" (a list of
 // {"lo", "hi", "rmse", "acc05", "bias", "count"}; NaNs of empty bands as null).
 nlohmann::json EvalJson(const EvalResult& result);
 
