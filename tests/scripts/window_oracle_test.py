@@ -1,0 +1,89 @@
+#!/usr/bin/python3
+"""Unit tests of scripts/window-oracle's geometry and window features (no simulation needed)."""
+import importlib.machinery
+import importlib.util
+import os
+import unittest
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+_loader = importlib.machinery.SourceFileLoader('window_oracle', os.path.join(ROOT, 'scripts', 'window-oracle'))
+_spec = importlib.util.spec_from_loader('window_oracle', _loader)
+oracle = importlib.util.module_from_spec(_spec)
+_loader.exec_module(oracle)
+
+
+class MotionFeaturesTest(unittest.TestCase):
+    W, P, BINS = 30, 4, 6
+
+    def wave(self, bin_, lag):
+        """P points whose lateral y oscillates at DFT bin `bin_`, each `lag` rad behind the last."""
+        t = np.arange(self.W)
+        w = np.zeros((self.W, self.P, 3))
+        for p in range(self.P):
+            w[:, p, 1] = 0.3 * np.sin(2 * np.pi * bin_ * t / self.W - lag * (p - (self.P - 1)))
+            w[:, p, 2] = 1.0 + 0.1 * p + 0.05 * np.sin(2 * np.pi * bin_ * t / self.W - lag * (p - (self.P - 1)))
+        return w
+
+    def split(self, f):
+        p, b = self.P, self.BINS
+        mean, std = f[:3 * p].reshape(p, 3), f[3 * p:6 * p].reshape(p, 3)
+        power = f[6 * p:6 * p + 3 * b * p].reshape(b, p, 3)
+        rest = f[6 * p + 3 * b * p:]
+        re, im = rest[:len(rest) // 2].reshape(3, p, 2), rest[len(rest) // 2:].reshape(3, p, 2)
+        return mean, std, power, re + 1j * im
+
+    def test_periodogram_peaks_at_the_oscillation_bin(self):
+        for bin_ in (1, 2, 4):
+            _, _, power, _ = self.split(oracle.motion_features(self.wave(bin_, 0.4), self.BINS, 2))
+            np.testing.assert_array_equal(np.argmax(power[:, :, 1], axis=0) + 1, [bin_] * self.P)
+
+    def test_mean_and_std(self):
+        w = self.wave(2, 0.4)
+        mean, std, _, _ = self.split(oracle.motion_features(w, self.BINS, 2))
+        np.testing.assert_allclose(mean[:, 2], 1.0 + 0.1 * np.arange(self.P), atol=1e-12)
+        np.testing.assert_allclose(std[:, 1], 0.3 / np.sqrt(2), rtol=1e-9)
+
+    def test_phases_are_relative_to_the_reference_and_independent_of_the_start(self):
+        lag = 0.4
+        w = self.wave(2, lag)
+        _, _, _, rel = self.split(oracle.motion_features(w, self.BINS, 2))
+        # y (kept column 1 after deleting z) against the fly corner's z, in phase with it: the lag.
+        np.testing.assert_allclose(np.angle(rel[1, :, 1]), -lag * (np.arange(self.P) - (self.P - 1)), atol=1e-9)
+        shifted = np.concatenate([w[7:], w[:7]])  # the same periodic motion, started 7 frames later
+        _, _, _, rel2 = self.split(oracle.motion_features(shifted, self.BINS, 2))
+        np.testing.assert_allclose(rel2[1], rel[1], atol=1e-9)
+
+
+class ProjectTest(unittest.TestCase):
+    def flag(self):
+        """A flat 3 m x 2 m flag flying straight out along +x, hoist on the z axis."""
+        u, v = np.meshgrid(np.linspace(0, 3, 7), np.linspace(0, 2, 5))
+        return np.stack([u.ravel(), np.zeros(u.size), v.ravel()], axis=-1)[None]
+
+    def test_the_box_centre_is_the_image_centre_and_the_box_fits(self):
+        w = 3 * self.flag()  # 9 m x 6 m at 4-6 m: the field of view must widen past 45 deg to fit
+        box = (w.min(axis=(0, 1)), w.max(axis=(0, 1)))
+        for seed in range(20):
+            img, camera = oracle.project(np.array([[0.5 * (box[0] + box[1])]]), box, np.random.RandomState(seed))
+            np.testing.assert_allclose(img, 0.0, atol=1e-12)
+            img, camera = oracle.project(w, box, np.random.RandomState(seed))
+            self.assertLessEqual(np.abs(img).max(), 0.95 + 1e-9)
+            self.assertGreater(np.abs(img).max(), 0.95 - 1e-6)  # widened just enough
+            height, radius, angle, fov = camera
+            self.assertTrue(0.2 <= height <= 3 and 4 <= radius <= 6 and -15 <= angle <= 15 and fov > 45)
+
+    def test_a_camera_below_sees_lateral_motion_as_vertical(self):
+        # Looking up at the flag, moving it across the line of sight (y) moves it in the picture's
+        # vertical; a level camera would not. This is the ambiguity the image oracle measures.
+        w = self.flag()
+        box = (w.min(axis=(0, 1)), w.max(axis=(0, 1)))
+        swung = w + np.array([0.0, 0.3, 0.0])
+        a, _ = oracle.project(w, box, np.random.RandomState(3))
+        b, _ = oracle.project(swung, box, np.random.RandomState(3))
+        self.assertGreater(np.abs(b[..., 1] - a[..., 1]).mean(), 0.01)
+
+
+if __name__ == '__main__':
+    unittest.main()
