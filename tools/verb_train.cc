@@ -59,6 +59,12 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--lr-decay-epoch", o.lr_decay_epoch,
                   "step: epochs at the initial rate before dividing it by 10 (-1: half the epochs, 20 of 40 as the seed)")
       ->capture_default_str();
+  sub->add_option("--crop-scales", o.crop_scales,
+                  "training crop sides as fractions of the frame's shorter side, one drawn per clip "
+                  "(the seed's multi-scale crop: 1,0.875,0.75,0.66; 1 keeps the whole frame as eval does)")
+      ->delimiter(',')
+      ->check(CLI::Range(1e-3, 1.0))
+      ->capture_default_str();
   sub->add_option("--weight-decay", o.weight_decay, "Adam weight decay")->check(CLI::NonNegativeNumber)->capture_default_str();
   sub->add_option("--grad-clip", o.grad_clip, "max gradient norm (0: off; -1: the seed's, 10 for lstm and off otherwise)")
       ->check(CLI::Range(-1.0, 1e9))

@@ -1,5 +1,7 @@
 #include "learn/networks.h"
 
+#include "learn/weights_io.h"
+
 #include <cmath>
 #include <string>
 #include <tuple>
@@ -128,11 +130,8 @@ at::Tensor WindLoss(const at::Tensor& output, const at::Tensor& target) {
   return (residual2 + nll).mean();
 }
 
-void SaveWindNet(WindNet& net, const std::filesystem::path& weights) {
-  std::filesystem::path tmp = weights;
-  tmp += ".tmp" + std::to_string(::getpid());
-  torch::save(net, tmp.string());
-  std::filesystem::rename(tmp, weights);
+void SaveWindNet(WindNet& net, const std::filesystem::path& weights, WeightPrecision precision) {
+  SaveModuleWeights(*net, weights, precision);
   WriteFileAtomically(ConfigPathFor(weights), ToJson(net->config()).dump(2) + "\n");
 }
 
@@ -147,26 +146,11 @@ WindNet LoadWindNet(const std::filesystem::path& weights) {
     throw std::runtime_error(config_path.string() + ": not valid JSON: " + e.what());
   }
   WindNet net(ModelConfigFromJson(j, config_path.string()));
-  if (!std::filesystem::exists(weights)) throw std::runtime_error(weights.string() + ": no such file");
-  // torch::load replaces tensors whatever their shape: compare with the architecture's.
-  std::vector<std::pair<std::string, std::vector<int64_t>>> expected;
-  for (const auto& item : net->named_parameters()) expected.emplace_back(item.key(), item.value().sizes().vec());
-  for (const auto& item : net->named_buffers()) expected.emplace_back(item.key(), item.value().sizes().vec());
   try {
-    torch::load(net, weights.string(), at::Device(at::kCPU));
-    auto parameters = net->named_parameters();
-    auto buffers = net->named_buffers();
-    for (const auto& [name, sizes] : expected) {
-      const at::Tensor* t = parameters.find(name);
-      if (t == nullptr) t = buffers.find(name);
-      if (t == nullptr || t->sizes().vec() != sizes) {
-        throw std::runtime_error(weights.string() + ": tensor " + name + " does not have the shape that " +
-                                 config_path.string() + " implies (" + net->config().Name() + ")");
-      }
-    }
-  } catch (const c10::Error& e) {
-    throw std::runtime_error(weights.string() + ": does not hold the weights of a " + net->config().Name() +
-                             " network: " + e.what_without_backtrace());
+    LoadModuleWeights(*net, weights);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(std::string(e.what()) + " (" + config_path.string() + " describes a " +
+                             net->config().Name() + " network)");
   }
   net->eval();
   return net;

@@ -18,6 +18,7 @@
 
 #include "learn/model_config.h"
 #include "learn/spectral_layer.h"
+#include "learn/weights_io.h"
 
 namespace clothwind::learn {
 
@@ -84,12 +85,15 @@ TORCH_MODULE(WindNet);
 // Inputs: output [N_b, 2] of WindNet, target [N_b] normalised speeds. Output: scalar loss.
 at::Tensor WindLoss(const at::Tensor& output, const at::Tensor& target);
 
-// Saves the network's parameters and buffers (torch::save) to `weights` and its ModelConfig
-// to ConfigPathFor(weights), both atomically (temporary file, then rename).
-void SaveWindNet(WindNet& net, const std::filesystem::path& weights);
+// Saves the network's parameters and buffers to `weights` (torch::save's layout; parameters
+// in float16 when asked: half the file, for the shipped model) and its ModelConfig to
+// ConfigPathFor(weights), both atomically (temporary file, then rename).
+void SaveWindNet(WindNet& net, const std::filesystem::path& weights,
+                 WeightPrecision precision = WeightPrecision::kFloat32);
 
-// Loads a network saved by SaveWindNet (config from the JSON beside the weights), in eval mode
-// on the CPU. Throws std::runtime_error naming the file that is missing or does not match.
+// Loads a network saved by SaveWindNet in either precision (config from the JSON beside the
+// weights) as float32, in eval mode on the CPU. Throws std::runtime_error naming the file
+// that is missing or does not match, and the tensor.
 WindNet LoadWindNet(const std::filesystem::path& weights);
 
 }  // namespace clothwind::learn

@@ -111,6 +111,12 @@ TrainResult Train(const TrainOptions& o) {
     throw std::runtime_error("device cuda requested but libtorch finds no CUDA device");
   }
   if (o.epochs < 1 || o.batch < 1) throw std::runtime_error("epochs and batch must be at least 1");
+  if (o.crop_scales.empty()) throw std::runtime_error("crop_scales: expected at least one scale in (0, 1]");
+  for (double s : o.crop_scales) {
+    if (!(s > 0 && s <= 1)) {
+      throw std::runtime_error("crop_scales: each scale must lie in (0, 1], got " + std::to_string(s));
+    }
+  }
   if (o.lr_schedule != "step" && o.lr_schedule != "cosine") {
     throw std::runtime_error("lr schedule must be step or cosine, got \"" + o.lr_schedule + "\"");
   }
@@ -172,6 +178,16 @@ TrainResult Train(const TrainOptions& o) {
         throw std::runtime_error(what.str());
       }
     }
+    // Runs from before crop_scales was recorded used the seed's scales (the default).
+    const std::vector<double> ran_with =
+        state.contains("crop_scales") ? state["crop_scales"].get<std::vector<double>>()
+                                      : TrainOptions().crop_scales;
+    if (ran_with != o.crop_scales) {
+      throw std::runtime_error(state_path.string() + ": the run trained with crop scales " +
+                               nlohmann::json(ran_with).dump() + ", these options give " +
+                               nlohmann::json(o.crop_scales).dump() +
+                               "; resume with the --crop-scales the run started with");
+    }
   }
   at::manual_seed(o.seed);
   WindNet net(config);
@@ -199,6 +215,7 @@ TrainResult Train(const TrainOptions& o) {
   train_options.frames = val_options.frames = config.frames;
   train_options.input_size = val_options.input_size = config.input_size;
   train_options.augment = true;
+  train_options.crop_scales = o.crop_scales;
   // The seed clips gradients (max norm 10) for its recurrent models only.
   const double grad_clip = o.grad_clip >= 0 ? o.grad_clip : (config.arch == "lstm" ? 10.0 : 0.0);
   const float mean = static_cast<float>(config.label_mean), inv_std = static_cast<float>(1.0 / config.label_std);
@@ -289,6 +306,7 @@ TrainResult Train(const TrainOptions& o) {
     nlohmann::json log = nlohmann::json::array();
     for (const EpochRecord& e : result.log) log.push_back(EpochJson(e));
     state = {{"epoch", epoch}, {"model", ToJson(config)}, {"log", log}, {"seed", o.seed},
+             {"crop_scales", o.crop_scales},
              {"best_val_rmse", result.best_val_rmse}};
     WriteFileAtomically(state_path, state.dump(2));
     WriteFileAtomically(o.out / "log.tsv", LogTsv(result.log));

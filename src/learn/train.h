@@ -33,6 +33,10 @@ struct TrainOptions {
   int lr_decay_epoch = -1;           // step: epochs before lr /= lr_decay_factor; -1: epochs / 2
   double lr_decay_factor = 10;
   double weight_decay = 2e-3;
+  // Multi-scale random crop (the seed's, after TSN): side of each training crop as a fraction of
+  // the frame's shorter side, one drawn per clip. Evaluation always takes the whole square, so
+  // scales below 1 also train on zoomed views that the test never shows.
+  std::vector<double> crop_scales = {1.0, 0.875, 0.75, 0.66};
   double grad_clip = -1;             // max gradient norm; 0: off; < 0: the seed's (10 for lstm, else off)
   int threads = 2;                   // torch intra-op threads
   std::string device = "auto";       // cpu | cuda | auto

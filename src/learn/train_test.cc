@@ -379,6 +379,37 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
     EXPECT_NE(what.find("--lr-schedule cosine"), std::string::npos) << what;
   }
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
+
+  // So is a resume with other crop scales: its augmentation would differ from the log's epochs.
+  TrainOptions x = Options("sdn", "resume");
+  x.epochs = 3;  // the schedule it ran under
+  x.resume = true;
+  x.crop_scales = {1.0};
+  try {
+    Train(x);
+    ADD_FAILURE() << "a resume with other crop scales was accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("state.json: the run trained with crop scales [1.0,0.875,0.75,0.66]"),
+              std::string::npos) << what;
+    EXPECT_NE(what.find("--crop-scales"), std::string::npos) << what;
+  }
+  EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
+}
+
+TEST_F(TrainTest, CropScalesOutsideTheFrameAreRefused) {
+  for (const std::vector<double>& scales : {std::vector<double>{}, {1.0, 0.0}, {1.2}}) {
+    TrainOptions t = Options("sdn", "bad_scales");
+    t.epochs = 1;
+    t.crop_scales = scales;
+    try {
+      Train(t);
+      ADD_FAILURE() << "crop scales " << nlohmann::json(scales).dump() << " were accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("crop_scales"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(*root_ / "bad_scales" / "state.json"));
+  }
 }
 
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {

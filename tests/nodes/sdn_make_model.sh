@@ -5,11 +5,16 @@
 #     an initialised (untrained) model: its estimates are meaningless, for plumbing tests;
 #   sdn_make_model.sh <model.pt> --toy <dataset dir> [train options...] -- <command...>
 #     makes the toy dataset (clothwind make-toy-dataset: stripes at f = 1 + 0.5 v Hz) and trains
-#     on it, for tests that check the estimates themselves.
+#     on it, for tests that check the estimates themselves;
+#   sdn_make_model.sh <model.pt> --toy <dataset dir> --half [train options...] -- <command...>
+#     the same, trained beside <model.pt> (full/) and exported to it in float16 (clothwind
+#     export-model), so the node serves a model as models/sdn.pt is shipped.
 set -euo pipefail
 model="$1"; shift
 toy=""
 if [ "${1:-}" = "--toy" ]; then toy="$2"; shift 2; fi
+half=0
+if [ "${1:-}" = "--half" ]; then half=1; shift; fi
 opts=()
 while [ $# -gt 0 ] && [ "$1" != "--" ]; do opts+=("$1"); shift; done
 [ $# -gt 0 ] && shift  # the "--"
@@ -18,7 +23,12 @@ source "$(dirname "$0")/clothwind_cli.sh"
 if [ ! -f "$model" ] || [ "$cli" -nt "$model" ] || [ "$0" -nt "$model" ]; then
   if [ -n "$toy" ]; then
     "$cli" make-toy-dataset --out "$toy" --clips 100 --frames 60 --size 32 --seed 1 >&2
-    "$cli" train --data "$toy" --out "$(dirname "$model")" "${opts[@]}" >&2
+    if [ "$half" = 1 ]; then
+      "$cli" train --data "$toy" --out "$(dirname "$model")/full" "${opts[@]}" >&2
+      "$cli" export-model --model "$(dirname "$model")/full/model.pt" --out "$model" --precision float16 >&2
+    else
+      "$cli" train --data "$toy" --out "$(dirname "$model")" "${opts[@]}" >&2
+    fi
   else
     "$cli" train --init-only --out "$(dirname "$model")" "${opts[@]}" >&2
   fi
