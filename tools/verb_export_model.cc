@@ -1,11 +1,15 @@
-// clothwind export-model: rewrites a trained model (model.pt + model.json) for shipping, with its
+// clothwind export-model: rewrites a trained model (model.pt + model.json) for shipping: its
 // parameters in float16 (half the file; every weight rounded once, batch-norm statistics kept in
-// float32). LoadWindNet, eval and sdn_node read either precision and compute in float32.
+// float32), and with --calibrate-std its predicted standard deviation scaled so that errors on
+// the validation split are one std rms (ModelConfig::std_scale). LoadWindNet, eval and sdn_node
+// read either precision and compute in float32.
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <memory>
 
+#include "learn/evaluate.h"
 #include "learn/networks.h"
 #include "learn/weights_io.h"
 #include "verb_registry.h"
@@ -14,17 +18,24 @@ namespace clothwind::tools {
 namespace {
 
 struct ExportArgs {
-  std::string model, out, precision = "float16";
+  std::string model, out, precision = "float16", calibrate_data;
+  int threads = 2;
 };
 
 VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()> {
   auto a = std::make_shared<ExportArgs>();
   auto* sub = app.add_subcommand("export-model",
-                                 "rewrite a trained model (model.pt + model.json) in float16 for shipping");
+                                 "rewrite a trained model (model.pt + model.json) for shipping: float16 "
+                                 "weights, optionally a std calibrated on the validation split");
   sub->add_option("--model", a->model, "trained model.pt (model.json beside it)")->required();
   sub->add_option("--out", a->out, "output .pt (its .json is written beside it)")->required();
   sub->add_option("--precision", a->precision, "precision of the parameters in the file")
       ->check(CLI::IsMember({"float16", "float32"}))
+      ->capture_default_str();
+  sub->add_option("--calibrate-std", a->calibrate_data,
+                  "dataset folder whose val split sets the std's scale (errors one std rms)");
+  sub->add_option("--threads", a->threads, "torch threads for the calibration")
+      ->check(CLI::Range(1, 256))
       ->capture_default_str();
   return [a]() {
     if (std::filesystem::exists(a->out) && std::filesystem::equivalent(a->model, a->out)) {
@@ -32,11 +43,24 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
       return 2;
     }
     learn::WindNet net = learn::LoadWindNet(a->model);
+    std::cout << std::fixed << std::setprecision(3);
+    if (!a->calibrate_data.empty()) {
+      const learn::EvalResult r = learn::Evaluate(a->model, a->calibrate_data, "val", a->threads, "cpu", 16);
+      const double k = learn::CalibrationScale(r);
+      learn::EvalResult calibrated = r;
+      for (double& s : calibrated.predicted_std) s *= k;
+      const double one = learn::StdCoverage(r, 1), two = learn::StdCoverage(r, 2);
+      const double one_k = learn::StdCoverage(calibrated, 1), two_k = learn::StdCoverage(calibrated, 2);
+      std::cout << "std calibration on " << r.truth.size() << " val clips: scale " << k << " (errors within 1 / 2 std: "
+                << one << " / " << two << " before, " << one_k << " / " << two_k << " after)\n";
+      net->set_std_scale(net->config().std_scale * k);
+    }
     learn::SaveWindNet(net, a->out, learn::ParseWeightPrecision(a->precision));
     const double in_mb = std::filesystem::file_size(a->model) / 1e6;
     const double out_mb = std::filesystem::file_size(a->out) / 1e6;
-    std::cout << std::fixed << std::setprecision(1) << "wrote " << a->out << " (" << net->config().Name()
-              << ", " << a->precision << "): " << out_mb << " MB from " << in_mb << " MB\n";
+    std::cout << std::setprecision(1) << "wrote " << a->out << " (" << net->config().Name() << ", " << a->precision
+              << ", std scale " << std::setprecision(3) << net->config().std_scale << std::setprecision(1)
+              << "): " << out_mb << " MB from " << in_mb << " MB\n";
     return 0;
   };
 });

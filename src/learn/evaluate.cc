@@ -17,6 +17,33 @@
 namespace clothwind::learn {
 namespace fs = std::filesystem;
 
+double CalibrationScale(const EvalResult& result) {
+  const size_t n = result.truth.size();
+  if (n == 0 || result.predicted.size() != n || result.predicted_std.size() != n) {
+    throw std::invalid_argument("CalibrationScale: needs truth, predicted and predicted_std of one length >= 1");
+  }
+  double sum = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!(result.predicted_std[i] > 0)) {
+      const std::string name = i < result.names.size() ? result.names[i] : "example " + std::to_string(i);
+      throw std::invalid_argument("CalibrationScale: predicted std of " + name + " is not positive");
+    }
+    const double z = (result.predicted[i] - result.truth[i]) / result.predicted_std[i];
+    sum += z * z;
+  }
+  return std::sqrt(sum / n);
+}
+
+double StdCoverage(const EvalResult& result, double multiple) {
+  const size_t n = std::min(result.truth.size(), result.predicted_std.size());
+  if (n == 0) return std::numeric_limits<double>::quiet_NaN();
+  size_t within = 0;
+  for (size_t i = 0; i < n; ++i) {
+    within += std::abs(result.predicted[i] - result.truth[i]) <= multiple * result.predicted_std[i];
+  }
+  return static_cast<double>(within) / n;
+}
+
 Metrics ComputeMetrics(const std::vector<double>& truth, const std::vector<double>& predicted) {
   if (truth.size() != predicted.size()) throw std::invalid_argument("ComputeMetrics: sizes differ");
   Metrics m;
@@ -135,6 +162,7 @@ nlohmann::json EvalJson(const EvalResult& r) {
           {"model", r.config.Name()}, {"arch", r.config.arch},    {"modality", r.config.Modality()},
           {"split", r.split},         {"windows", r.windows},     {"mirror", r.mirror},
           {"seconds", r.seconds},
+          {"std_within_1", number(StdCoverage(r, 1))}, {"std_within_2", number(StdCoverage(r, 2))},
           {"bands", bands}};
 }
 
@@ -153,6 +181,10 @@ std::string EvalTable(const EvalResult& r) {
   if (r.windows > 1) s << ", mean of " << r.windows << " frame windows per clip";
   if (r.mirror) s << ", each averaged with its mirror image";
   s << ")\n";
+  if (!r.predicted_std.empty()) {
+    s << "  predicted std: errors within 1 std " << StdCoverage(r, 1) << ", within 2 std " << StdCoverage(r, 2)
+      << " (calibrated: 0.683, 0.954)\n";
+  }
   for (const BandMetrics& b : r.bands) {
     if (b.metrics.count == 0) continue;
     s << std::setprecision(0) << "  true " << std::right << std::setw(2) << b.lo << "-" << std::left << std::setw(2)

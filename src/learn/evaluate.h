@@ -80,6 +80,18 @@ std::string EvalTable(const EvalResult& result);
 // gnuplot (written atomically). Returns false (and says why in *error) if gnuplot fails.
 bool PlotPredictions(const EvalResult& result, const std::filesystem::path& png, std::string* error);
 
+// The factor k by which predicted standard deviations must be multiplied so that the errors,
+// measured in them, have unit root mean square: k = sqrt(mean(((predicted - truth) / std)^2)).
+// k > 1: the model is over-confident. Fitted on a validation split, it calibrates the std
+// (ModelConfig::std_scale) without touching the speeds.
+// Inputs: result  truth, predicted, predicted_std [n] (std > 0), n >= 1.
+// Throws std::invalid_argument for an empty result or a std that is not positive.
+double CalibrationScale(const EvalResult& result);
+
+// Fraction of the examples whose error is at most `multiple` predicted stds (a calibrated
+// Gaussian std gives 0.683 at 1 and 0.954 at 2). Inputs as CalibrationScale; NaN when empty.
+double StdCoverage(const EvalResult& result, double multiple);
+
 // One line of the training log per epoch.
 struct EpochRecord {
   int epoch = 0;

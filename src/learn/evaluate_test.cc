@@ -21,6 +21,27 @@ TEST(EvaluateTest, MetricsOfAHandWorkedExample) {
   EXPECT_THROW(ComputeMetrics({1.0}, {}), std::invalid_argument);
 }
 
+TEST(EvaluateTest, CalibrationScaleMakesErrorsUnitInTheirStd) {
+  // Errors +1, -2, +2 against stds 1, 1, 2: z = 1, -2, 1, so k = sqrt((1 + 4 + 1) / 3).
+  EvalResult r;
+  r.truth = {1.0, 5.0, 3.0};
+  r.predicted = {2.0, 3.0, 5.0};
+  r.predicted_std = {1.0, 1.0, 2.0};
+  const double k = CalibrationScale(r);
+  EXPECT_NEAR(k, std::sqrt(2.0), 1e-12);
+  // Multiplying every std by k calibrates: the factor of the result is 1.
+  for (double& s : r.predicted_std) s *= k;
+  EXPECT_NEAR(CalibrationScale(r), 1.0, 1e-12);
+  // |e| / std = 1, 2, 1 before calibration: two within 1 std (inclusive), all within 2.
+  for (double& s : r.predicted_std) s /= k;
+  EXPECT_DOUBLE_EQ(StdCoverage(r, 1), 2.0 / 3);
+  EXPECT_DOUBLE_EQ(StdCoverage(r, 2), 1.0);
+  EXPECT_TRUE(std::isnan(StdCoverage(EvalResult{}, 1)));
+  r.predicted_std[1] = 0;
+  EXPECT_THROW(CalibrationScale(r), std::invalid_argument);
+  EXPECT_THROW(CalibrationScale(EvalResult{}), std::invalid_argument);
+}
+
 TEST(EvaluateTest, BandsSplitByTrueSpeedAndKeepEmptyBands) {
   const std::vector<BandMetrics> b =
       ComputeBandMetrics({0.5, 1.5, 3.0, 9.9, 10.0}, {0.7, 1.0, 3.6, 9.0, 10.0}, 2.0);

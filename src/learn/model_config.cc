@@ -35,7 +35,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"mean_map", c.mean_map},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
-          {"label_std", c.label_std}};
+          {"label_std", c.label_std},    {"std_scale", c.std_scale}};
 }
 
 ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& where) {
@@ -62,6 +62,8 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.input_size = need("input_size").get<int>();
     c.label_mean = need("label_mean").get<double>();
     c.label_std = need("label_std").get<double>();
+    // Absent in models written before calibration existed: the std as trained.
+    c.std_scale = j.contains("std_scale") ? j.at("std_scale").get<double>() : 1.0;
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(where + ": " + e.what());
   }
@@ -70,9 +72,9 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
                              c.arch + "\"");
   }
   if (c.frames < 1 || c.channels < 1 || c.width < 1 || c.input_size < 16 || c.k < 1 ||
-      !(c.frame_rate > 0) || !(c.label_std > 0)) {
+      !(c.frame_rate > 0) || !(c.label_std > 0) || !(c.std_scale > 0)) {
     throw std::runtime_error(where + ": frames, channels, width, k must be >= 1, input_size >= 16, "
-                             "frame_rate and label_std > 0");
+                             "frame_rate, label_std and std_scale > 0");
   }
   return c;
 }

@@ -24,6 +24,10 @@ struct ModelConfig {
   int input_size = 112;      // side of the square input [px] (224 as the seed, 112 for a CPU)
   double label_mean = 0.0;   // [m/s] the network regresses (v - label_mean) / label_std
   double label_std = 1.0;    // [m/s]
+  // Factor on the predicted standard deviation, fitted on the validation split after training
+  // (clothwind export-model --calibrate-std; CalibrationScale): a network that fits its training
+  // clips better than new ones learns a variance that is too small for new ones. 1: as trained.
+  double std_scale = 1.0;
 
   // Channels entering the ResNet trunk: 2kC (+C with mean_map) for the SDN, N_t·C for the
   // frame-stack baseline, C for the recurrent one (its trunk reads one frame at a time).

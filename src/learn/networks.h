@@ -70,6 +70,8 @@ class WindNetImpl : public torch::nn::Module {
   // [N_b, N_t·C, H, W] (resnet18), or every frame on its own [N_b·N_t, C, H, W] (lstm).
   at::Tensor TrunkInput(const at::Tensor& clips) const;
   const ModelConfig& config() const { return config_; }
+  // Sets the calibration factor of the predicted std (no weight depends on it).
+  void set_std_scale(double scale) { config_.std_scale = scale; }
 
  private:
   ModelConfig config_;

@@ -185,6 +185,12 @@ TEST_F(TrainTest, CheckpointRoundTripGivesIdenticalPredictions) {
   const ModelConfig& c = loaded->config();
   EXPECT_NEAR(p.speed, c.label_mean + c.label_std * a[1][0].item<double>(), 1e-5);
   EXPECT_NEAR(p.speed_std, c.label_std * std::exp(0.5 * a[1][1].item<double>()), 1e-5);
+  // A calibrated copy scales the std and nothing else.
+  loaded->set_std_scale(1.5);
+  SaveWindNet(loaded, *root_ / "roundtrip" / "calibrated.pt");
+  const Prediction q = Predictor(*root_ / "roundtrip" / "calibrated.pt", 2, "cpu").Predict({&s})[0];
+  EXPECT_NEAR(q.speed, p.speed, 1e-9);
+  EXPECT_NEAR(q.speed_std, 1.5 * p.speed_std, 1e-9);
   // A model.json that does not match the weights is refused, naming the file.
   nlohmann::json j = nlohmann::json::parse(std::ifstream(*root_ / "roundtrip" / "copy.json"));
   j["width"] = 16;
@@ -228,6 +234,14 @@ TEST(WindNet, OnlyTheMeanMapSeesAStillPose) {
   nlohmann::json old = ToJson(c);
   old.erase("mean_map");
   EXPECT_FALSE(ModelConfigFromJson(old, "x.json").mean_map);
+  // The std calibration round-trips, is 1 for models from before it, and must be positive.
+  c.std_scale = 1.25;
+  EXPECT_DOUBLE_EQ(ModelConfigFromJson(ToJson(c), "x.json").std_scale, 1.25);
+  old.erase("std_scale");
+  EXPECT_DOUBLE_EQ(ModelConfigFromJson(old, "x.json").std_scale, 1.0);
+  nlohmann::json bad = ToJson(c);
+  bad["std_scale"] = 0.0;
+  EXPECT_THROW(ModelConfigFromJson(bad, "x.json"), std::runtime_error);
 }
 
 TEST(LearningRate, StepAndCosineSchedules) {

@@ -8,7 +8,8 @@
 #     on it, for tests that check the estimates themselves;
 #   sdn_make_model.sh <model.pt> --toy <dataset dir> --half [train options...] -- <command...>
 #     the same, trained beside <model.pt> (full/) and exported to it in float16 (clothwind
-#     export-model), so the node serves a model as models/sdn.pt is shipped.
+#     export-model, std calibrated on the toy val split), so the node serves a model as
+#     models/sdn.pt is shipped.
 set -euo pipefail
 model="$1"; shift
 toy=""
@@ -25,7 +26,8 @@ if [ ! -f "$model" ] || [ "$cli" -nt "$model" ] || [ "$0" -nt "$model" ]; then
     "$cli" make-toy-dataset --out "$toy" --clips 100 --frames 60 --size 32 --seed 1 >&2
     if [ "$half" = 1 ]; then
       "$cli" train --data "$toy" --out "$(dirname "$model")/full" "${opts[@]}" >&2
-      "$cli" export-model --model "$(dirname "$model")/full/model.pt" --out "$model" --precision float16 >&2
+      "$cli" export-model --model "$(dirname "$model")/full/model.pt" --out "$model" --precision float16 \
+        --calibrate-std "$toy" >&2
     else
       "$cli" train --data "$toy" --out "$(dirname "$model")" "${opts[@]}" >&2
     fi
