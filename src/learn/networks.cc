@@ -1,7 +1,5 @@
 #include "learn/networks.h"
 
-#include "learn/weights_io.h"
-
 #include <cmath>
 #include <string>
 #include <tuple>
@@ -9,10 +7,8 @@
 
 #include <fstream>
 #include <stdexcept>
-#include <unistd.h>
 
 #include <ATen/ATen.h>
-#include <torch/serialize.h>
 
 namespace clothwind::learn {
 namespace {

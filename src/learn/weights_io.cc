@@ -2,12 +2,13 @@
 
 #include <sstream>
 #include <stdexcept>
-#include <unistd.h>
 
 #include <ATen/ATen.h>
 #include <c10/util/Exception.h>
 #include <torch/serialize/input-archive.h>
 #include <torch/serialize/output-archive.h>
+
+#include "learn/model_config.h"
 
 namespace clothwind::learn {
 namespace {
@@ -94,10 +95,9 @@ void SaveModuleWeights(const torch::nn::Module& module, const std::filesystem::p
                        WeightPrecision precision) {
   torch::serialize::OutputArchive archive;
   Write(module, "", precision, archive);
-  std::filesystem::path tmp = path;
-  tmp += ".tmp" + std::to_string(::getpid());
-  archive.save_to(tmp.string());
-  std::filesystem::rename(tmp, path);
+  std::ostringstream bytes;
+  archive.save_to(bytes);
+  WriteFileAtomically(path, bytes.str());
 }
 
 WeightPrecision LoadModuleWeights(torch::nn::Module& module, const std::filesystem::path& path) {
