@@ -44,6 +44,13 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--k", o.model.k, "SDN: spectral peaks per pixel")->check(CLI::Range(1, 64))->capture_default_str();
   sub->add_flag("--include-dc", o.model.include_dc,
                 "SDN: the DC bin competes for the k peaks, signals not detrended (Algorithm 1 verbatim)");
+  sub->add_option("--dft-size", o.model.dft_size,
+                  "SDN: DFT length, the windowed signal zero-padded to it (0: N_t, Algorithm 1; 120 samples a "
+                  "30-frame clip's spectrum every 0.21 Hz instead of 0.83)")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  sub->add_flag("--local-peaks", o.model.local_peaks,
+                "SDN: keep the k strongest local maxima of each pixel's periodogram, not the k strongest bins");
   sub->add_flag("--mean-map", o.model.mean_map, "SDN: add the clip's per-pixel temporal mean (the pose) as a channel");
   sub->add_option("--threads", o.threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--device", o.device, "cpu, cuda or auto (CUDA when libtorch finds one)")

@@ -12,11 +12,30 @@ int ModelConfig::TrunkInputChannels() const {
   return arch == "lstm" ? channels : frames * channels;
 }
 
+SpectralOptions ModelConfig::Spectral() const {
+  SpectralOptions o;
+  o.k = k;
+  o.frame_rate = frame_rate;
+  o.include_dc = include_dc;
+  o.dft_size = dft_size;
+  o.local_peaks = local_peaks;
+  return o;
+}
+
+int ModelConfig::SpectralCandidates() const {
+  const int length = dft_size == 0 ? frames : dft_size;
+  return length / 2 + (include_dc ? 1 : 0);
+}
+
 bool IsKnownArch(const std::string& arch) { return arch == "sdn" || arch == "resnet18" || arch == "lstm"; }
 
 std::string ModelConfig::Name() const {
   std::ostringstream s;
-  if (arch == "sdn") s << "sdn-k" << k << (include_dc ? "dc" : "") << (mean_map ? "m" : "");
+  if (arch == "sdn") {
+    s << "sdn-k" << k << (include_dc ? "dc" : "") << (mean_map ? "m" : "");
+    if (dft_size != 0) s << "d" << dft_size;
+    if (local_peaks) s << "p";
+  }
   else s << arch;
   s << "-w" << width << "-" << input_size << "-" << frames << "f";
   return s.str();
@@ -32,7 +51,8 @@ nlohmann::json ToJson(const ModelConfig& c) {
   return {{"format", "clothwind-model"}, {"version", 1},   {"arch", c.arch},
           {"frames", c.frames},          {"channels", c.channels},
           {"k", c.k},                    {"include_dc", c.include_dc},
-          {"mean_map", c.mean_map},
+          {"mean_map", c.mean_map},      {"dft_size", c.dft_size},
+          {"local_peaks", c.local_peaks},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
           {"label_std", c.label_std},    {"std_scale", c.std_scale}};
@@ -57,6 +77,9 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.include_dc = need("include_dc").get<bool>();
     // Absent in models written before the mean map existed: they had none.
     c.mean_map = j.contains("mean_map") ? j.at("mean_map").get<bool>() : false;
+    // Absent in models written before padding and peak picking existed: Algorithm 1's bins.
+    c.dft_size = j.contains("dft_size") ? j.at("dft_size").get<int>() : 0;
+    c.local_peaks = j.contains("local_peaks") ? j.at("local_peaks").get<bool>() : false;
     c.frame_rate = need("frame_rate").get<double>();
     c.width = need("width").get<int>();
     c.input_size = need("input_size").get<int>();
@@ -75,6 +98,10 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
       !(c.frame_rate > 0) || !(c.label_std > 0) || !(c.std_scale > 0)) {
     throw std::runtime_error(where + ": frames, channels, width, k must be >= 1, input_size >= 16, "
                              "frame_rate, label_std and std_scale > 0");
+  }
+  if (c.dft_size != 0 && c.dft_size < c.frames) {
+    throw std::runtime_error(where + ": field \"dft_size\" must be 0 or at least \"frames\" (" +
+                             std::to_string(c.frames) + "), got " + std::to_string(c.dft_size));
   }
   return c;
 }

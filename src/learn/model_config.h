@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "learn/spectral_layer.h"
+
 namespace clothwind::learn {
 
 struct ModelConfig {
@@ -19,6 +21,8 @@ struct ModelConfig {
   int k = 3;                 // SDN: spectral peaks kept per pixel (2kC trunk input channels)
   bool include_dc = false;   // SDN: the DC bin among the candidate peaks (no detrend)
   bool mean_map = false;     // SDN: the clip's per-pixel temporal mean as C more trunk channels
+  int dft_size = 0;          // SDN: DFT length, zero-padded beyond N_t (0: N_t; SpectralOptions)
+  bool local_peaks = false;  // SDN: the k strongest local maxima instead of the k strongest bins
   double frame_rate = 25.0;  // [Hz] of the clips the model reads
   int width = 64;            // ResNet-18 base width (64 as the original; 16 trains on a CPU)
   int input_size = 112;      // side of the square input [px] (224 as the seed, 112 for a CPU)
@@ -29,11 +33,16 @@ struct ModelConfig {
   // clips better than new ones learns a variance that is too small for new ones. 1: as trained.
   double std_scale = 1.0;
 
+  // The spectral layer's options for this model (k, frame rate, DC, DFT length, peaks).
+  SpectralOptions Spectral() const;
+  // Frequency bins the spectral layer offers this model (what k may be at most).
+  int SpectralCandidates() const;
+
   // Channels entering the ResNet trunk: 2kC (+C with mean_map) for the SDN, N_t·C for the
   // frame-stack baseline, C for the recurrent one (its trunk reads one frame at a time).
   int TrunkInputChannels() const;
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("sdn-k3m-…" with mean_map,
-  // "sdn-k3dc-…" with include_dc).
+  // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks).
   std::string Name() const;
   // Table 1's "input modality", e.g. "30x112x112".
   std::string Modality() const;

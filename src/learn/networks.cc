@@ -70,10 +70,13 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
     throw std::invalid_argument("WindNet: unknown architecture \"" + config.arch + "\"");
   }
   if (config.arch == "sdn") {
-    const int candidates = config.frames / 2 + (config.include_dc ? 1 : 0);
-    if (config.frames < 2 || config.k < 1 || config.k > candidates) {
-      throw std::invalid_argument("WindNet: an SDN on " + std::to_string(config.frames) + " frames offers " +
-                                  std::to_string(candidates) + " frequency bins, k = " + std::to_string(config.k));
+    const int candidates = config.SpectralCandidates();
+    if (config.frames < 2 || config.k < 1 || config.k > candidates ||
+        (config.dft_size != 0 && config.dft_size < config.frames)) {
+      throw std::invalid_argument("WindNet: an SDN on " + std::to_string(config.frames) + " frames (DFT length " +
+                                  std::to_string(config.dft_size == 0 ? config.frames : config.dft_size) +
+                                  ") offers " + std::to_string(candidates) + " frequency bins, k = " +
+                                  std::to_string(config.k));
     }
   }
   trunk_ = register_module("trunk", ResNet18Trunk(config.TrunkInputChannels(), config.width));
@@ -95,7 +98,7 @@ at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
                                                   : std::string()));
   }
   if (config_.arch == "sdn") {
-    SpectralMaps maps = SpectralDecomposition(clips, config_.k, config_.frame_rate, config_.include_dc);
+    SpectralMaps maps = SpectralDecomposition(clips, config_.Spectral());
     std::vector<at::Tensor> parts = {at::log1p(maps.power), maps.frequency * (2.0 / config_.frame_rate)};
     // The spectral maps see only motion; the mean image gives the trunk the flag's pose (its
     // droop), which at low wind says more about the speed than its small oscillations.

@@ -94,7 +94,9 @@ Prediction Predictor::PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps
   const ModelConfig& c = config();
   if (maps != nullptr && c.arch == "sdn") {
     at::Tensor clip = at::from_blob(sample.pixels.data(), {1, 1, c.frames, c.input_size, c.input_size}, at::kFloat);
-    SpectralMaps m = SpectralDecomposition(clip, 1, c.frame_rate, c.include_dc);
+    SpectralOptions strongest = c.Spectral();
+    strongest.k = 1;
+    SpectralMaps m = SpectralDecomposition(clip, strongest);
     maps->power = cv::Mat(c.input_size, c.input_size, CV_32F);
     maps->frequency = cv::Mat(c.input_size, c.input_size, CV_32F);
     std::copy_n(m.power.contiguous().data_ptr<float>(), m.power.numel(), maps->power.ptr<float>());

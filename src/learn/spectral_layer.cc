@@ -1,5 +1,6 @@
 #include "learn/spectral_layer.h"
 
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -8,18 +9,35 @@
 namespace clothwind::learn {
 
 SpectralMaps SpectralDecomposition(const at::Tensor& x, int k, double frame_rate, bool include_dc) {
+  SpectralOptions options;
+  options.k = k;
+  options.frame_rate = frame_rate;
+  options.include_dc = include_dc;
+  return SpectralDecomposition(x, options);
+}
+
+SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& options) {
+  const int k = options.k;
+  const double frame_rate = options.frame_rate;
+  const bool include_dc = options.include_dc;
   if (x.dim() != 5) {
     throw std::invalid_argument("SpectralDecomposition: expected a [N_b, C, N_t, H, W] tensor, got " +
                                 std::to_string(x.dim()) + " dimensions");
   }
   const int64_t nb = x.size(0), c = x.size(1), nt = x.size(2), h = x.size(3), w = x.size(4);
   if (nt < 2) throw std::invalid_argument("SpectralDecomposition: N_t must be at least 2");
+  if (options.dft_size != 0 && options.dft_size < nt) {
+    throw std::invalid_argument("SpectralDecomposition: dft_size = " + std::to_string(options.dft_size) +
+                                " is shorter than the clip's N_t = " + std::to_string(nt) +
+                                " (0 or at least N_t expected)");
+  }
+  const int64_t length = options.dft_size == 0 ? nt : options.dft_size;
   const int64_t first = include_dc ? 0 : 1;
-  const int64_t candidates = nt / 2 + 1 - first;
+  const int64_t candidates = length / 2 + 1 - first;
   if (k < 1 || k > candidates) {
     throw std::invalid_argument("SpectralDecomposition: k = " + std::to_string(k) + " but N_t = " +
-                                std::to_string(nt) + " offers " + std::to_string(candidates) +
-                                " frequency bins");
+                                std::to_string(nt) + " (DFT length " + std::to_string(length) + ") offers " +
+                                std::to_string(candidates) + " frequency bins");
   }
   if (!(frame_rate > 0)) throw std::invalid_argument("SpectralDecomposition: frame_rate must be > 0");
   // [N_b C H W, N_t]: one row per pixel signal.
@@ -29,12 +47,30 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, int k, double frame_rate
   // into bin 1); with it, the signal is taken as it is (Algorithm 1 verbatim), so the DC bin
   // carries the pixel's windowed mean brightness.
   if (!include_dc) signals = signals - signals.mean(1, /*keepdim=*/true);
-  at::Tensor spectrum = at::fft_rfft(signals * window, c10::nullopt, /*dim=*/1);
+  at::Tensor spectrum = at::fft_rfft(signals * window, length, /*dim=*/1);
   at::Tensor periodogram = (at::real(spectrum).square() + at::imag(spectrum).square()) /
                            window.square().sum();
   periodogram = periodogram.narrow(1, first, candidates);
-  auto [power, bin] = at::topk(periodogram, k, /*dim=*/1, /*largest=*/true, /*sorted=*/true);
-  at::Tensor frequency = (bin + first).to(x.scalar_type()) * (frame_rate / static_cast<double>(nt));
+  at::Tensor ranked = periodogram;
+  if (options.local_peaks) {
+    // A bin is a peak when no neighbour is higher (>= on the left, > on the right, so a flat
+    // top counts once); beyond the ends the spectrum counts as -infinity.
+    at::Tensor pad = at::full({periodogram.size(0), 1}, -std::numeric_limits<double>::infinity(),
+                              periodogram.options());
+    at::Tensor left = at::cat({pad, periodogram.narrow(1, 0, candidates - 1)}, 1);
+    at::Tensor right = at::cat({periodogram.narrow(1, 1, candidates - 1), pad}, 1);
+    at::Tensor is_peak = periodogram.ge(left).logical_and(periodogram.gt(right));
+    ranked = at::where(is_peak, periodogram, at::full_like(periodogram, -1.0));
+  }
+  auto [score, bin] = at::topk(ranked, k, /*dim=*/1, /*largest=*/true, /*sorted=*/true);
+  at::Tensor power = periodogram.gather(1, bin);
+  at::Tensor frequency = (bin + first).to(x.scalar_type()) * (frame_rate / static_cast<double>(length));
+  if (options.local_peaks) {
+    // Slots no peak filled (score -1), and peaks of a still pixel (power 0), read as no motion.
+    at::Tensor missing = score.le(0);
+    power = power.masked_fill(missing, 0.0);
+    frequency = frequency.masked_fill(missing, 0.0);
+  }
   auto to_map = [&](const at::Tensor& t) {
     return t.reshape({nb, c, h, w, k}).permute({0, 1, 4, 2, 3}).reshape({nb, c * k, h, w});
   };

@@ -8,6 +8,24 @@
 
 namespace clothwind::learn {
 
+// How the layer reads each pixel's spectrum (beyond Algorithm 1's k, frame rate and DC choice).
+struct SpectralOptions {
+  int k = 3;                // bins (or peaks) kept per pixel
+  double frame_rate = 25.0; // [Hz] sampling rate of the clip (25 for FlagSim)
+  bool include_dc = false;  // keep the DC bin among the candidates and do not detrend
+  // DFT length L >= N_t (0: L = N_t, Algorithm 1). L > N_t zero-pads the windowed signal, which
+  // samples the same spectrum every frame_rate / L Hz instead of every frame_rate / N_t: a
+  // 30-frame clip's bins are 0.83 Hz apart, coarse beside a flag's flapping frequency, which
+  // grows with the wind. The periodogram's scale is unchanged (normalised by sum w_n^2).
+  int dft_size = 0;
+  // Keep the k strongest local maxima of the periodogram (I_j >= I_{j-1} and I_j > I_{j+1}; the
+  // ends count when higher than their one neighbour) instead of the k strongest bins: on a padded
+  // DFT the strongest bins all sit on the main peak's lobe, so bins would repeat one peak k
+  // times. A pixel with fewer than k peaks of positive power gets power 0 and frequency 0 in the
+  // missing slots.
+  bool local_peaks = false;
+};
+
 // Power and frequency maps of a batch of clips.
 struct SpectralMaps {
   at::Tensor power;      // [N_b, kC, H, W] periodogram of the selected bins (unit: input² )
@@ -37,6 +55,12 @@ struct SpectralMaps {
 // Throws std::invalid_argument on a wrong rank, N_t < 2 or an impossible k.
 SpectralMaps SpectralDecomposition(const at::Tensor& x, int k, double frame_rate,
                                    bool include_dc = false);
+
+// The same with SpectralOptions: options.dft_size = L pads each windowed signal with zeros to L
+// samples, so X_j = sum_n y_n e^{-2 pi i jn/L}, j = 0..L/2, and f_j = j frame_rate / L; with
+// options.local_peaks only local maxima compete for the k slots. The defaults are Algorithm 1.
+// Inputs/outputs as above; throws std::invalid_argument also for dft_size in (0, N_t).
+SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& options);
 
 // Algorithm 1's output as one image: [power, frequency] concatenated along channels,
 // [N_b, 2kC, H, W].

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include <ATen/ATen.h>
@@ -22,8 +23,11 @@ struct Bin {
 };
 
 // Periodogram of one signal by the textbook DFT, Hann window w_n = 0.5 - 0.5 cos(2πn/N),
-// normalised by Σ w_n²; without the DC bin after removing the signal's mean.
-std::vector<Bin> NaivePeriodogram(std::vector<double> x, bool include_dc) {
+// normalised by Σ w_n²; without the DC bin after removing the signal's mean. length > N: the DFT
+// of the windowed signal followed by length - N zeros. local_peaks: only bins no neighbour
+// exceeds (left >=, right >) are returned. Sorted by descending power.
+std::vector<Bin> NaivePeriodogram(std::vector<double> x, bool include_dc, int length = 0,
+                                  bool local_peaks = false) {
   const int n = static_cast<int>(x.size());
   const double mean = std::accumulate(x.begin(), x.end(), 0.0) / n;
   if (!include_dc) {
@@ -35,14 +39,24 @@ std::vector<Bin> NaivePeriodogram(std::vector<double> x, bool include_dc) {
     w[i] = 0.5 - 0.5 * std::cos(2 * M_PI * i / n);
     w2 += w[i] * w[i];
   }
+  const int l = length == 0 ? n : length;
   std::vector<Bin> bins;
-  for (int j = include_dc ? 0 : 1; j <= n / 2; ++j) {
+  for (int j = include_dc ? 0 : 1; j <= l / 2; ++j) {
     double re = 0, im = 0;
     for (int i = 0; i < n; ++i) {
-      re += w[i] * x[i] * std::cos(2 * M_PI * j * i / n);
-      im -= w[i] * x[i] * std::sin(2 * M_PI * j * i / n);
+      re += w[i] * x[i] * std::cos(2 * M_PI * j * i / l);
+      im -= w[i] * x[i] * std::sin(2 * M_PI * j * i / l);
     }
     bins.push_back({(re * re + im * im) / w2, j});
+  }
+  if (local_peaks) {
+    std::vector<Bin> peaks;
+    for (size_t i = 0; i < bins.size(); ++i) {
+      const bool left_ok = i == 0 || bins[i].power >= bins[i - 1].power;
+      const bool right_ok = i + 1 == bins.size() || bins[i].power > bins[i + 1].power;
+      if (left_ok && right_ok) peaks.push_back(bins[i]);
+    }
+    bins = peaks;
   }
   std::stable_sort(bins.begin(), bins.end(), [](const Bin& a, const Bin& b) { return a.power > b.power; });
   return bins;
@@ -149,6 +163,87 @@ TEST(SpectralLayer, TopKMatchesNaiveDftForRandomSignals) {
   ExpectMatchesNaive(RandomClip(1, 1, 10, 3, 3, 4), 5, false);  // every candidate bin
 }
 
+// A pixel oscillating at `hz` with amplitude `amplitude` (plus `second` at `hz2`), N_t frames.
+at::Tensor Oscillation(int nt, double hz, double amplitude, double hz2 = 0, double second = 0) {
+  at::Tensor x = at::zeros({1, 1, nt, 1, 1}, at::kDouble);
+  for (int n = 0; n < nt; ++n) {
+    const double t = n / kFps;
+    x.index_put_({0, 0, n, 0, 0}, amplitude * std::sin(2 * M_PI * hz * t + 0.3) +
+                                      second * std::sin(2 * M_PI * hz2 * t + 1.1));
+  }
+  return x;
+}
+
+TEST(SpectralLayer, ZeroPaddedDftMatchesNaiveDft) {
+  for (const auto& [nt, length, k, peaks] :
+       std::vector<std::tuple<int, int, int, bool>>{{30, 120, 3, false}, {31, 64, 2, false},
+                                                    {30, 120, 3, true}, {20, 20, 2, true}}) {
+    at::Tensor x = RandomClip(2, 1, nt, 2, 3, 10 + nt + length);
+    SpectralOptions o;
+    o.k = k;
+    o.dft_size = length;
+    o.local_peaks = peaks;
+    SpectralMaps maps = SpectralDecomposition(x, o);
+    ASSERT_EQ(maps.power.sizes(), (at::IntArrayRef{2, k, 2, 3}));
+    for (int64_t b = 0; b < 2; ++b)
+      for (int64_t y = 0; y < 2; ++y)
+        for (int64_t xx = 0; xx < 3; ++xx) {
+          const auto naive = NaivePeriodogram(PixelSignal(x, b, 0, y, xx), false, length, peaks);
+          ASSERT_GE(naive.size(), static_cast<size_t>(k));  // random signals have many peaks
+          for (int i = 0; i < k; ++i) {
+            EXPECT_NEAR(maps.power.index({b, i, y, xx}).item<double>(), naive[i].power,
+                        1e-9 * (1 + naive[i].power)) << "N_t " << nt << " L " << length << " slot " << i;
+            EXPECT_NEAR(maps.frequency.index({b, i, y, xx}).item<double>(), naive[i].index * kFps / length, 1e-12)
+                << "N_t " << nt << " L " << length << " slot " << i;
+          }
+        }
+  }
+}
+
+TEST(SpectralLayer, PaddingResolvesAFrequencyBetweenBins) {
+  // 2.9 Hz over 30 frames at 25 fps: the bins are 0.83 Hz apart (2.50, 3.33), so the unpadded
+  // layer is 0.4 Hz off; padded to 240 samples (0.10 Hz apart) the peak lands within a bin.
+  const double hz = 2.9;
+  at::Tensor x = Oscillation(30, hz, 1.0);
+  const double coarse = SpectralDecomposition(x, 1, kFps).frequency.item<double>();
+  EXPECT_GT(std::abs(coarse - hz), 0.35);
+  SpectralOptions o;
+  o.k = 1;
+  o.dft_size = 240;
+  SpectralMaps fine = SpectralDecomposition(x, o);
+  EXPECT_NEAR(fine.frequency.item<double>(), hz, kFps / 240);
+  // The peak power does not depend on the padding when the tone sits on a bin (1.25 Hz: bin 3
+  // unpadded, bin 24 of 240).
+  at::Tensor on_bin = Oscillation(60, 1.25, 2.0);
+  const double unpadded = SpectralDecomposition(on_bin, 1, kFps).power.item<double>();
+  o.dft_size = 480;
+  SpectralMaps padded = SpectralDecomposition(on_bin, o);
+  EXPECT_NEAR(padded.frequency.item<double>(), 1.25, 1e-12);
+  EXPECT_NEAR(padded.power.item<double>(), unpadded, 1e-9 * unpadded);
+}
+
+TEST(SpectralLayer, LocalPeaksFindTheSecondToneThatBinsMiss) {
+  // Tones at 2.5 Hz (amplitude 1) and 7.5 Hz (0.5) over 60 frames, padded to 240: the three
+  // strongest bins all sit on the 2.5 Hz lobe, the two strongest peaks are the two tones, with
+  // powers a factor 4 apart (amplitude squared).
+  at::Tensor x = Oscillation(60, 2.5, 1.0, 7.5, 0.5);
+  SpectralOptions o;
+  o.k = 2;
+  o.dft_size = 240;
+  SpectralMaps bins = SpectralDecomposition(x, o);
+  EXPECT_NEAR(bins.frequency.index({0, 1, 0, 0}).item<double>(), 2.5, 0.3);
+  o.local_peaks = true;
+  SpectralMaps peaks = SpectralDecomposition(x, o);
+  EXPECT_NEAR(peaks.frequency.index({0, 0, 0, 0}).item<double>(), 2.5, 1e-12);
+  EXPECT_NEAR(peaks.frequency.index({0, 1, 0, 0}).item<double>(), 7.5, 1e-12);
+  EXPECT_NEAR(peaks.power.index({0, 0, 0, 0}).item<double>() / peaks.power.index({0, 1, 0, 0}).item<double>(),
+              4.0, 0.05);
+  // A still pixel has no peak: every slot reads power 0 at 0 Hz.
+  SpectralMaps still = SpectralDecomposition(at::ones({1, 1, 60, 1, 1}, at::kDouble), o);
+  EXPECT_EQ(still.power.abs().max().item<double>(), 0.0);
+  EXPECT_EQ(still.frequency.abs().max().item<double>(), 0.0);
+}
+
 TEST(SpectralLayer, FloatInputAgreesWithDouble) {
   at::Tensor x = RandomClip(1, 1, 30, 4, 4, 5);
   SpectralMaps d = SpectralDecomposition(x, 2, kFps);
@@ -188,6 +283,15 @@ TEST(SpectralLayer, RejectsBadShapesAndK) {
   EXPECT_NO_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), 15, kFps));
   EXPECT_NO_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), 16, kFps, true));
   EXPECT_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), 0, kFps), std::invalid_argument);
+  SpectralOptions short_dft;
+  short_dft.k = 1;
+  short_dft.dft_size = 20;  // shorter than the 30 frames
+  EXPECT_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), short_dft), std::invalid_argument);
+  short_dft.dft_size = 120;
+  short_dft.k = 60;  // 120 samples offer 60 bins without DC
+  EXPECT_NO_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), short_dft));
+  short_dft.k = 61;
+  EXPECT_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), short_dft), std::invalid_argument);
 }
 
 TEST(SpectralLayer, IsDifferentiableWithRespectToTheClip) {

@@ -244,6 +244,53 @@ TEST(WindNet, OnlyTheMeanMapSeesAStillPose) {
   EXPECT_THROW(ModelConfigFromJson(bad, "x.json"), std::runtime_error);
 }
 
+TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
+  ModelConfig c;
+  c.arch = "sdn";
+  c.k = 2;
+  c.width = 4;
+  c.input_size = 16;
+  c.dft_size = 120;
+  c.local_peaks = true;
+  EXPECT_EQ(c.Name(), "sdn-k2d120p-w4-16-30f");
+  EXPECT_EQ(c.SpectralCandidates(), 60);
+  const ModelConfig back = ModelConfigFromJson(ToJson(c), "x.json");
+  EXPECT_EQ(back.dft_size, 120);
+  EXPECT_TRUE(back.local_peaks);
+  // Models from before the options read as Algorithm 1's bins.
+  nlohmann::json old = ToJson(c);
+  old.erase("dft_size");
+  old.erase("local_peaks");
+  EXPECT_EQ(ModelConfigFromJson(old, "x.json").dft_size, 0);
+  EXPECT_FALSE(ModelConfigFromJson(old, "x.json").local_peaks);
+  // A DFT shorter than the clip is refused by field name, by the file and by the network.
+  nlohmann::json bad = ToJson(c);
+  bad["dft_size"] = 20;
+  try {
+    ModelConfigFromJson(bad, "run/model.json");
+    ADD_FAILURE() << "dft_size 20 < 30 frames accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("run/model.json: field \"dft_size\""), std::string::npos) << e.what();
+  }
+  ModelConfig short_dft = c;
+  short_dft.dft_size = 20;
+  EXPECT_THROW(WindNet{short_dft}, std::invalid_argument);
+  // The options reach the layer: the same weights read a clip differently with and without them.
+  at::manual_seed(3);
+  const at::Tensor clips = at::randn({1, 1, 30, 16, 16});
+  at::NoGradGuard no_grad;
+  WindNet padded(c);
+  padded->eval();
+  ModelConfig plain_config = c;
+  plain_config.dft_size = 0;
+  plain_config.local_peaks = false;
+  WindNet plain(plain_config);
+  plain->eval();
+  torch::OrderedDict<std::string, at::Tensor> from = padded->named_parameters();
+  for (auto& p : plain->named_parameters()) p.value().copy_(from[p.key()]);
+  EXPECT_FALSE(at::allclose(padded->forward(clips), plain->forward(clips), 1e-4, 1e-5));
+}
+
 TEST(LearningRate, StepAndCosineSchedules) {
   TrainOptions o;
   o.epochs = 40;
