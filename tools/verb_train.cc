@@ -51,6 +51,12 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
       ->capture_default_str();
   sub->add_flag("--local-peaks", o.model.local_peaks,
                 "SDN: keep the k strongest local maxima of each pixel's periodogram, not the k strongest bins");
+  sub->add_option("--dropout", o.model.dropout, "dropout probability on the pooled features (training only)")
+      ->check(CLI::Range(0.0, 0.95))
+      ->capture_default_str();
+  sub->add_flag("--phase-steps", o.model.phase_steps,
+                "SDN: add the strongest peak's phase step to the right and lower neighbour (cos, sin): a "
+                "travelling wave's wavenumber");
   sub->add_flag("--mean-map", o.model.mean_map, "SDN: add the clip's per-pixel temporal mean (the pose) as a channel");
   sub->add_option("--threads", o.threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--device", o.device, "cpu, cuda or auto (CUDA when libtorch finds one)")

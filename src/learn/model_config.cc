@@ -8,7 +8,7 @@
 namespace clothwind::learn {
 
 int ModelConfig::TrunkInputChannels() const {
-  if (arch == "sdn") return (2 * k + (mean_map ? 1 : 0)) * channels;
+  if (arch == "sdn") return (2 * k + (mean_map ? 1 : 0) + (phase_steps ? 4 : 0)) * channels;
   return arch == "lstm" ? channels : frames * channels;
 }
 
@@ -19,6 +19,7 @@ SpectralOptions ModelConfig::Spectral() const {
   o.include_dc = include_dc;
   o.dft_size = dft_size;
   o.local_peaks = local_peaks;
+  o.phase_steps = phase_steps;
   return o;
 }
 
@@ -35,6 +36,7 @@ std::string ModelConfig::Name() const {
     s << "sdn-k" << k << (include_dc ? "dc" : "") << (mean_map ? "m" : "");
     if (dft_size != 0) s << "d" << dft_size;
     if (local_peaks) s << "p";
+    if (phase_steps) s << "s";
   }
   else s << arch;
   s << "-w" << width << "-" << input_size << "-" << frames << "f";
@@ -52,7 +54,8 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"frames", c.frames},          {"channels", c.channels},
           {"k", c.k},                    {"include_dc", c.include_dc},
           {"mean_map", c.mean_map},      {"dft_size", c.dft_size},
-          {"local_peaks", c.local_peaks},
+          {"local_peaks", c.local_peaks},  {"phase_steps", c.phase_steps},
+          {"dropout", c.dropout},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
           {"label_std", c.label_std},    {"std_scale", c.std_scale}};
@@ -80,6 +83,8 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     // Absent in models written before padding and peak picking existed: Algorithm 1's bins.
     c.dft_size = j.contains("dft_size") ? j.at("dft_size").get<int>() : 0;
     c.local_peaks = j.contains("local_peaks") ? j.at("local_peaks").get<bool>() : false;
+    c.phase_steps = j.contains("phase_steps") ? j.at("phase_steps").get<bool>() : false;
+    c.dropout = j.contains("dropout") ? j.at("dropout").get<double>() : 0.0;
     c.frame_rate = need("frame_rate").get<double>();
     c.width = need("width").get<int>();
     c.input_size = need("input_size").get<int>();
@@ -98,6 +103,9 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
       !(c.frame_rate > 0) || !(c.label_std > 0) || !(c.std_scale > 0)) {
     throw std::runtime_error(where + ": frames, channels, width, k must be >= 1, input_size >= 16, "
                              "frame_rate, label_std and std_scale > 0");
+  }
+  if (!(c.dropout >= 0 && c.dropout < 1)) {
+    throw std::runtime_error(where + ": field \"dropout\" must be in [0, 1), got " + std::to_string(c.dropout));
   }
   if (c.dft_size != 0 && c.dft_size < c.frames) {
     throw std::runtime_error(where + ": field \"dft_size\" must be 0 or at least \"frames\" (" +

@@ -23,6 +23,8 @@ struct ModelConfig {
   bool mean_map = false;     // SDN: the clip's per-pixel temporal mean as C more trunk channels
   int dft_size = 0;          // SDN: DFT length, zero-padded beyond N_t (0: N_t; SpectralOptions)
   bool local_peaks = false;  // SDN: the k strongest local maxima instead of the k strongest bins
+  bool phase_steps = false;
+  double dropout = 0.0;      // dropout probability on the trunk's pooled features while training  // SDN: 4C more channels, the strongest peak's phase step to the neighbours
   double frame_rate = 25.0;  // [Hz] of the clips the model reads
   int width = 64;            // ResNet-18 base width (64 as the original; 16 trains on a CPU)
   int input_size = 112;      // side of the square input [px] (224 as the seed, 112 for a CPU)
@@ -42,7 +44,7 @@ struct ModelConfig {
   // frame-stack baseline, C for the recurrent one (its trunk reads one frame at a time).
   int TrunkInputChannels() const;
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("sdn-k3m-…" with mean_map,
-  // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks).
+  // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps).
   std::string Name() const;
   // Table 1's "input modality", e.g. "30x112x112".
   std::string Modality() const;

@@ -103,6 +103,7 @@ at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
     // The spectral maps see only motion; the mean image gives the trunk the flag's pose (its
     // droop), which at low wind says more about the speed than its small oscillations.
     if (config_.mean_map) parts.push_back(clips.mean(2));
+    if (config_.phase_steps) parts.push_back(maps.phase);
     return at::cat(parts, 1);
   }
   if (config_.arch == "lstm") {
@@ -118,6 +119,9 @@ at::Tensor WindNetImpl::forward(const at::Tensor& clips) {
     at::Tensor sequence = std::get<0>(lstm_->forward(features.reshape({clips.size(0), clips.size(2), -1})));
     features = sequence.select(1, sequence.size(1) - 1);
   }
+  // Dropout on the pooled features, in training only: the SDN fits its training clips better
+  // than new ones (docs/sdn.md), and the head is where one feature can memorise a simulation.
+  if (config_.dropout > 0) features = at::dropout(features, config_.dropout, is_training());
   at::Tensor out = head_->forward(features);
   return at::stack({out.select(1, 0), out.select(1, 1).clamp(-12.0, 8.0)}, 1);
 }

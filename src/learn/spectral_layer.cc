@@ -2,11 +2,47 @@
 
 #include <limits>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 #include <string>
 
 #include <ATen/ATen.h>
 
 namespace clothwind::learn {
+
+namespace {
+
+// SpectralMaps::phase from the one-sided spectra [N_b C H W, F] (complex) and each pixel's
+// strongest bin [N_b C H W, 1] (index into F).
+at::Tensor PhaseSteps(const at::Tensor& spectrum, const at::Tensor& bin, int64_t nb, int64_t c, int64_t h,
+                      int64_t w) {
+  const int64_t f = spectrum.size(1);
+  at::Tensor re = at::real(spectrum).reshape({nb, c, h, w, f});
+  at::Tensor im = at::imag(spectrum).reshape({nb, c, h, w, f});
+  at::Tensor index = bin.reshape({nb, c, h, w, 1});
+  const double eps = 1e-6 * (re.square() + im.square()).mean().item<double>() + 1e-30;
+  // One step along spatial dimension `dim` (2: y, down; 3: x, right): pixel p's bin read at p and
+  // at its neighbour, then their normalised cross product.
+  auto step = [&](int64_t dim) {
+    const int64_t n = dim == 2 ? h : w;
+    if (n < 2) return std::make_pair(at::zeros({nb, c, h, w}, re.options()), at::zeros({nb, c, h, w}, re.options()));
+    at::Tensor idx = index.narrow(dim, 0, n - 1);
+    at::Tensor ar = re.narrow(dim, 0, n - 1).gather(4, idx), ai = im.narrow(dim, 0, n - 1).gather(4, idx);
+    at::Tensor br = re.narrow(dim, 1, n - 1).gather(4, idx), bi = im.narrow(dim, 1, n - 1).gather(4, idx);
+    at::Tensor norm = at::sqrt((ar.square() + ai.square()) * (br.square() + bi.square())) + eps;
+    at::Tensor cos = ((ar * br + ai * bi) / norm).squeeze(4);
+    at::Tensor sin = ((ai * br - ar * bi) / norm).squeeze(4);
+    // Pad the missing last row/column with zeros.
+    std::vector<int64_t> pad = dim == 3 ? std::vector<int64_t>{0, 1} : std::vector<int64_t>{0, 0, 0, 1};
+    return std::make_pair(at::constant_pad_nd(cos, pad, 0.0), at::constant_pad_nd(sin, pad, 0.0));
+  };
+  auto [rc, rs] = step(3);
+  auto [dc, ds] = step(2);
+  // [N_b, C, 4, H, W] -> [N_b, 4C, H, W], channel 4c + (0..3).
+  return at::stack({rc, rs, dc, ds}, 2).reshape({nb, 4 * c, h, w});
+}
+
+}  // namespace
 
 SpectralMaps SpectralDecomposition(const at::Tensor& x, int k, double frame_rate, bool include_dc) {
   SpectralOptions options;
@@ -74,7 +110,9 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
   auto to_map = [&](const at::Tensor& t) {
     return t.reshape({nb, c, h, w, k}).permute({0, 1, 4, 2, 3}).reshape({nb, c * k, h, w});
   };
-  return {to_map(power), to_map(frequency)};
+  SpectralMaps maps{to_map(power), to_map(frequency), at::Tensor()};
+  if (options.phase_steps) maps.phase = PhaseSteps(spectrum, bin.narrow(1, 0, 1) + first, nb, c, h, w);
+  return maps;
 }
 
 at::Tensor StackSpectralMaps(const SpectralMaps& maps) {

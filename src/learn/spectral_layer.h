@@ -24,12 +24,24 @@ struct SpectralOptions {
   // times. A pixel with fewer than k peaks of positive power gets power 0 and frequency 0 in the
   // missing slots.
   bool local_peaks = false;
+  // Also return SpectralMaps::phase: how the strongest peak's phase changes to the next pixel.
+  // The spectral maps say how fast each pixel moves, not where its motion is in its cycle; a
+  // wave travelling along the flag shows as a steady phase step between neighbours (its
+  // wavenumber), and the step, unlike the phase itself, does not depend on when the clip began.
+  bool phase_steps = false;
 };
 
 // Power and frequency maps of a batch of clips.
 struct SpectralMaps {
   at::Tensor power;      // [N_b, kC, H, W] periodogram of the selected bins (unit: input² )
   at::Tensor frequency;  // [N_b, kC, H, W] their frequencies [Hz]
+  // With SpectralOptions::phase_steps, else undefined: [N_b, 4C, H, W], per input channel c the
+  // channels 4c..4c+3 = cos, sin of the step to the right (x+1), cos, sin of the step down (y+1):
+  // with X(p) the DFT of pixel p at p's strongest selected bin, and X(q) that of the neighbour q
+  // at the same bin, X(p)·conj(X(q)) / (|X(p)||X(q)| + ε), ε = 1e-6 · the clip's mean |X|²
+  // (so still pixels read ~0). A wave e^{i(ωt − κx)} reads (cos κ, sin κ). The last column's
+  // right step and the last row's down step are 0.
+  at::Tensor phase;
 };
 
 // The spectral decomposition of a batch of clips (Algorithm 1), batched on the input's device.

@@ -244,6 +244,57 @@ TEST(SpectralLayer, LocalPeaksFindTheSecondToneThatBinsMiss) {
   EXPECT_EQ(still.frequency.abs().max().item<double>(), 0.0);
 }
 
+// A wave cos(2π f t − κx x − κy y + φ0) over an h × w image, N_t frames.
+at::Tensor TravellingWave(int nt, int h, int w, double hz, double kx, double ky, double phi0) {
+  at::Tensor x = at::zeros({1, 1, nt, h, w}, at::kDouble);
+  auto a = x.accessor<double, 5>();
+  for (int n = 0; n < nt; ++n)
+    for (int y = 0; y < h; ++y)
+      for (int xx = 0; xx < w; ++xx) a[0][0][n][y][xx] = std::cos(2 * M_PI * hz * n / kFps - kx * xx - ky * y + phi0);
+  return x;
+}
+
+TEST(SpectralLayer, PhaseStepsReadATravellingWavesWavenumber) {
+  // 2.5 Hz is bin 3 of 30 frames, so every pixel's strongest bin is the wave's.
+  const double kx = 0.4, ky = -0.25;
+  SpectralOptions o;
+  o.k = 2;
+  o.phase_steps = true;
+  SpectralMaps maps = SpectralDecomposition(TravellingWave(30, 4, 5, 2.5, kx, ky, 0.7), o);
+  ASSERT_EQ(maps.phase.sizes(), (at::IntArrayRef{1, 4, 4, 5}));
+  auto ph = maps.phase.accessor<double, 4>();
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 5; ++x) {
+      if (x < 4) {
+        EXPECT_NEAR(ph[0][0][y][x], std::cos(kx), 1e-6) << y << "," << x;
+        EXPECT_NEAR(ph[0][1][y][x], std::sin(kx), 1e-6) << y << "," << x;
+      } else {
+        EXPECT_EQ(ph[0][0][y][x], 0.0);  // no right neighbour
+        EXPECT_EQ(ph[0][1][y][x], 0.0);
+      }
+      if (y < 3) {
+        EXPECT_NEAR(ph[0][2][y][x], std::cos(ky), 1e-6) << y << "," << x;
+        EXPECT_NEAR(ph[0][3][y][x], std::sin(ky), 1e-6) << y << "," << x;
+      } else {
+        EXPECT_EQ(ph[0][2][y][x], 0.0);
+        EXPECT_EQ(ph[0][3][y][x], 0.0);
+      }
+    }
+  // The step does not depend on when the clip began (the wave's phase at t = 0), nor on a padded
+  // DFT, but the wave going the other way flips the sine.
+  o.dft_size = 120;
+  SpectralMaps later = SpectralDecomposition(TravellingWave(30, 4, 5, 2.5, kx, ky, 2.9), o);
+  EXPECT_TRUE(at::allclose(later.phase, maps.phase, 1e-6, 1e-6));
+  SpectralMaps back = SpectralDecomposition(TravellingWave(30, 4, 5, 2.5, -kx, ky, 0.7), o);
+  EXPECT_NEAR(back.phase.index({0, 1, 0, 0}).item<double>(), -std::sin(kx), 1e-6);
+  // Still pixels read no step; without the option there is no phase map.
+  at::Tensor still = TravellingWave(30, 4, 5, 2.5, kx, ky, 0.7);
+  still.narrow(4, 0, 2).zero_();
+  SpectralMaps half = SpectralDecomposition(still, o);
+  EXPECT_LT(half.phase.narrow(3, 0, 1).abs().max().item<double>(), 1e-3);
+  EXPECT_FALSE(SpectralDecomposition(still, 2, kFps).phase.defined());
+}
+
 TEST(SpectralLayer, FloatInputAgreesWithDouble) {
   at::Tensor x = RandomClip(1, 1, 30, 4, 4, 5);
   SpectralMaps d = SpectralDecomposition(x, 2, kFps);

@@ -289,6 +289,39 @@ TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
   torch::OrderedDict<std::string, at::Tensor> from = padded->named_parameters();
   for (auto& p : plain->named_parameters()) p.value().copy_(from[p.key()]);
   EXPECT_FALSE(at::allclose(padded->forward(clips), plain->forward(clips), 1e-4, 1e-5));
+  // Phase steps add 4C trunk channels, round-trip, and default to off in older files.
+  c.phase_steps = true;
+  EXPECT_EQ(c.TrunkInputChannels(), 8);
+  EXPECT_EQ(c.Name(), "sdn-k2d120ps-w4-16-30f");
+  EXPECT_TRUE(ModelConfigFromJson(ToJson(c), "x.json").phase_steps);
+  EXPECT_FALSE(ModelConfigFromJson(old, "x.json").phase_steps);
+  WindNet stepped(c);
+  stepped->eval();
+  EXPECT_EQ(stepped->forward(clips).sizes(), (at::IntArrayRef{1, 2}));
+}
+
+TEST(ModelConfig, DropoutActsInTrainingOnlyAndRoundTrips) {
+  ModelConfig c;
+  c.arch = "sdn";
+  c.k = 2;
+  c.width = 4;
+  c.input_size = 16;
+  c.dropout = 0.5;
+  EXPECT_DOUBLE_EQ(ModelConfigFromJson(ToJson(c), "x.json").dropout, 0.5);
+  nlohmann::json old = ToJson(c);
+  old.erase("dropout");
+  EXPECT_DOUBLE_EQ(ModelConfigFromJson(old, "x.json").dropout, 0.0);
+  nlohmann::json bad = ToJson(c);
+  bad["dropout"] = 1.0;
+  EXPECT_THROW(ModelConfigFromJson(bad, "x.json"), std::runtime_error);
+  at::manual_seed(4);
+  const at::Tensor clips = at::randn({2, 1, 30, 16, 16});
+  at::NoGradGuard no_grad;
+  WindNet net(c);
+  net->train();
+  EXPECT_FALSE(at::allclose(net->forward(clips), net->forward(clips)));  // a new mask each time
+  net->eval();
+  EXPECT_TRUE(at::equal(net->forward(clips), net->forward(clips)));
 }
 
 TEST(LearningRate, StepAndCosineSchedules) {
