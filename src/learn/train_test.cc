@@ -32,6 +32,17 @@ double LabelStd(const std::vector<ClipInfo>& clips) {
   return std::sqrt(v / clips.size());
 }
 
+// The smallest SDN the network tests build: k = 2 peaks, width 4, 16 px, 30 frames.
+ModelConfig TinySdn() {
+  ModelConfig c;
+  c.arch = "sdn";
+  c.frames = 30;
+  c.k = 2;
+  c.width = 4;
+  c.input_size = 16;
+  return c;
+}
+
 class TrainTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -208,11 +219,7 @@ TEST(WindNet, OnlyTheMeanMapSeesAStillPose) {
   // identical, so a plain SDN cannot tell them apart; with the mean map it can. The option
   // survives the model.json round trip, and a model.json written before it existed loads
   // without it.
-  ModelConfig c;
-  c.frames = 30;
-  c.k = 2;
-  c.width = 4;
-  c.input_size = 16;
+  ModelConfig c = TinySdn();
   at::manual_seed(5);
   const at::Tensor motion = 0.1 * at::randn({1, 1, 30, 16, 16});
   const at::Tensor still = at::randn({2, 1, 1, 16, 16});
@@ -245,11 +252,7 @@ TEST(WindNet, OnlyTheMeanMapSeesAStillPose) {
 }
 
 TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
-  ModelConfig c;
-  c.arch = "sdn";
-  c.k = 2;
-  c.width = 4;
-  c.input_size = 16;
+  ModelConfig c = TinySdn();
   c.dft_size = 120;
   c.local_peaks = true;
   EXPECT_EQ(c.Name(), "sdn-k2d120p-w4-16-30f");
@@ -301,11 +304,7 @@ TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
 }
 
 TEST(ModelConfig, DropoutActsInTrainingOnlyAndRoundTrips) {
-  ModelConfig c;
-  c.arch = "sdn";
-  c.k = 2;
-  c.width = 4;
-  c.input_size = 16;
+  ModelConfig c = TinySdn();
   c.dropout = 0.5;
   EXPECT_DOUBLE_EQ(ModelConfigFromJson(ToJson(c), "x.json").dropout, 0.5);
   nlohmann::json old = ToJson(c);
