@@ -24,8 +24,7 @@ SpectralOptions ModelConfig::Spectral() const {
 }
 
 int ModelConfig::SpectralCandidates() const {
-  const int length = dft_size == 0 ? frames : dft_size;
-  return length / 2 + (include_dc ? 1 : 0);
+  return DftLength() / 2 + (include_dc ? 1 : 0);
 }
 
 bool IsKnownArch(const std::string& arch) { return arch == "sdn" || arch == "resnet18" || arch == "lstm"; }

@@ -37,6 +37,8 @@ struct ModelConfig {
 
   // The spectral layer's options for this model (k, frame rate, DC, DFT length, peaks).
   SpectralOptions Spectral() const;
+  // The spectral layer's DFT length: dft_size, or N_t when it is 0.
+  int DftLength() const { return dft_size == 0 ? frames : dft_size; }
   // Frequency bins the spectral layer offers this model (what k may be at most).
   int SpectralCandidates() const;
 

@@ -72,9 +72,9 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
   if (config.arch == "sdn") {
     const int candidates = config.SpectralCandidates();
     if (config.frames < 2 || config.k < 1 || config.k > candidates ||
-        (config.dft_size != 0 && config.dft_size < config.frames)) {
+        config.DftLength() < config.frames) {
       throw std::invalid_argument("WindNet: an SDN on " + std::to_string(config.frames) + " frames (DFT length " +
-                                  std::to_string(config.dft_size == 0 ? config.frames : config.dft_size) +
+                                  std::to_string(config.DftLength()) +
                                   ") offers " + std::to_string(candidates) + " frequency bins, k = " +
                                   std::to_string(config.k));
     }

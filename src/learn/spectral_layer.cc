@@ -99,12 +99,13 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
     ranked = at::where(is_peak, periodogram, at::full_like(periodogram, -1.0));
   }
   auto [score, bin] = at::topk(ranked, k, /*dim=*/1, /*largest=*/true, /*sorted=*/true);
-  at::Tensor power = periodogram.gather(1, bin);
+  // topk's values are the selected bins' powers (a non-peak's -1 only where no peak was left).
+  at::Tensor power = score;
   at::Tensor frequency = (bin + first).to(x.scalar_type()) * (frame_rate / static_cast<double>(length));
   if (options.local_peaks) {
     // Slots no peak filled (score -1), and peaks of a still pixel (power 0), read as no motion.
     at::Tensor missing = score.le(0);
-    power = power.masked_fill(missing, 0.0);
+    power = score.masked_fill(missing, 0.0);
     frequency = frequency.masked_fill(missing, 0.0);
   }
   auto to_map = [&](const at::Tensor& t) {
