@@ -7,7 +7,6 @@
 // CPU time is per thread (CLOCK_THREAD_CPUTIME_ID), so the per-core figures hold on a machine
 // shared with other work; the wall-clock run shows what the machine delivered at the time.
 
-#include <time.h>
 
 #include <chrono>
 #include <cstdio>
@@ -21,6 +20,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <unistd.h>
 
+#include "bench_clock.h"
 #include "data/cloth_animation.h"
 #include "data/dataset_generator.h"
 #include "data/example_sampling.h"
@@ -35,11 +35,7 @@ namespace cr = clothwind::render;
 namespace cs = clothwind::sim;
 
 namespace {
-double ThreadCpuS() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
+using clothwind::bench::ThreadCpuSeconds;
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -89,27 +85,27 @@ int main(int argc, char** argv) {
   cs::SimulateOptions so;
   const int first = static_cast<int>(std::lround(warmup / base.scene.frame_time));
   so.duration = (first + frames - 1) * base.scene.frame_time;
-  double t0 = ThreadCpuS();
+  double t0 = ThreadCpuSeconds();
   const cs::Trajectory traj = cs::SimulateTrajectory(setup, s.theta, so);
-  const double sim_s = ThreadCpuS() - t0;
+  const double sim_s = ThreadCpuSeconds() - t0;
   const cd::ClothAnimation anim = cd::AnimationFromTrajectory(traj, first, frames);
 
   cr::RenderParams zeta = cd::SampleView(kind, s.seed, 0, 1);
   if (samples > 0) zeta.samples = samples;
   cr::RenderOptions ro;
   ro.threads = 1;
-  t0 = ThreadCpuS();
+  t0 = ThreadCpuSeconds();
   cr::Renderer renderer(zeta, ro);
   const std::vector<cv::Mat> images = cd::RenderAnimation(&renderer, anim, 0.0, frames, 25.0);
-  const double render_s = ThreadCpuS() - t0;
-  t0 = ThreadCpuS();
+  const double render_s = ThreadCpuSeconds() - t0;
+  t0 = ThreadCpuSeconds();
   size_t bytes = 0;
   for (const auto& im : images) {
     std::vector<uint8_t> buf;
     cv::imencode(".jpg", im, buf, {cv::IMWRITE_JPEG_QUALITY, 95});
     bytes += buf.size();
   }
-  const double jpeg_s = ThreadCpuS() - t0;
+  const double jpeg_s = ThreadCpuSeconds() - t0;
 
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   std::printf("dataset_bench: %s, %d vertices, %d faces, %.1f s warm-up + %d frames (%.1f s simulated, "

@@ -5,10 +5,7 @@
 //
 // --write DIR also saves the frames of the all-threads run as PNG (to look at them).
 
-#include <time.h>
-
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -17,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_clock.h"
 #include "render/render_params.h"
 #include "render/renderer.h"
 #include "render/sensor_model.h"
@@ -25,18 +23,8 @@
 namespace cr = clothwind::render;
 
 namespace {
-// CPU time of the whole process [ms]: on a shared machine wall time overstates the cost.
-double CpuMs() {
-  timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-double NowMs() {
-  return std::chrono::duration<double, std::milli>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
+using clothwind::bench::ProcessCpuMs;
+using clothwind::bench::WallMs;
 
 struct Timing {
   double wall_ms, cpu_ms;  // per frame, setup included
@@ -47,11 +35,11 @@ struct Timing {
 Timing RunClip(const cr::RenderParams& p, int threads, int frames, const std::string& write_dir) {
   // Everything a clip costs: textures, backdrop, static geometry and the first frame's cache
   // of static radiance are built inside the timed region.
-  const double t0 = NowMs(), c0 = CpuMs();
+  const double t0 = WallMs(), c0 = ProcessCpuMs();
   cr::RenderOptions o;
   o.threads = threads;
   cr::Renderer r(p, o);
-  const double setup = CpuMs() - c0;
+  const double setup = ProcessCpuMs() - c0;
   const double w = p.mesh_width, h = p.MeshRestHeight();
   for (int i = 0; i < frames; ++i) {
     const cr::ClothMesh m = p.scene == cr::SceneKind::kFlag
@@ -64,7 +52,7 @@ Timing RunClip(const cr::RenderParams& p, int threads, int frames, const std::st
       cr::WriteFrameAtomic(write_dir + name, frame);
     }
   }
-  return {(NowMs() - t0) / frames, (CpuMs() - c0) / frames, setup};
+  return {(WallMs() - t0) / frames, (ProcessCpuMs() - c0) / frames, setup};
 }
 }  // namespace
 

@@ -6,12 +6,10 @@
 // models/sdn.pt) instead of the initialised ones.
 //
 //   sdn_bench [--repeats N] [--quick] [--model PATH.pt ...]
-#include <time.h>
 
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
@@ -21,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_clock.h"
 #include "learn/predictor.h"
 #include "learn/train.h"
 
@@ -29,15 +28,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-double CpuMs() {
-  timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-double NowMs() {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+using clothwind::bench::ProcessCpuMs;
+using clothwind::bench::WallMs;
 
 struct Case {
   std::string arch;
@@ -91,13 +83,13 @@ int main(int argc, char** argv) {
       cl::Predictor p(model, threads, "cpu");
       p.PredictFrames(frames);  // warm-up, as the node does
       std::vector<double> ms;
-      const double cpu0 = CpuMs();
+      const double cpu0 = ProcessCpuMs();
       for (int i = 0; i < repeats; ++i) {
-        const double t0 = NowMs();
+        const double t0 = WallMs();
         p.PredictFrames(frames);
-        ms.push_back(NowMs() - t0);
+        ms.push_back(WallMs() - t0);
       }
-      const double cpu = (CpuMs() - cpu0) / repeats;
+      const double cpu = (ProcessCpuMs() - cpu0) / repeats;
       std::sort(ms.begin(), ms.end());
       double mean = 0;
       for (double m : ms) mean += m;

@@ -7,7 +7,6 @@
 //             [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N (0 = off)]
 // Default scene: $CLOTHWIND_SHARED_DIR/arcsim/conf/flag.json (ArcSim's own, so the comparison is
 // like for like), else config/scenes/flag.json under $CLOTHWIND_SOURCE_DIR or the working dir.
-#include <time.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -18,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_clock.h"
 #include "sim/flag_metrics.h"
 #include "sim/simulate.h"
 
@@ -44,12 +44,7 @@ double ArcSimWallPerSimSecond(double wind) {
   return it == figures.end() ? 0.0 : it->second;
 }
 
-// CPU time of this thread [s]: on a shared machine wall time also counts other jobs' load.
-double ThreadCpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
+using clothwind::bench::ThreadCpuSeconds;
 
 }  // namespace
 
