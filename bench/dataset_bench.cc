@@ -7,8 +7,6 @@
 // CPU time is per thread (CLOCK_THREAD_CPUTIME_ID), so the per-core figures hold on a machine
 // shared with other work; the wall-clock run shows what the machine delivered at the time.
 
-
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -34,9 +32,8 @@ namespace cd = clothwind::data;
 namespace cr = clothwind::render;
 namespace cs = clothwind::sim;
 
-namespace {
 using clothwind::bench::ThreadCpuSeconds;
-}  // namespace
+using clothwind::bench::WallMs;
 
 int main(int argc, char** argv) {
   std::string kind_name = "flag";
@@ -136,9 +133,9 @@ int main(int argc, char** argv) {
   o.max_edge = max_edge;
   o.samples = samples;
   o.contact_sheet = false;
-  const auto w0 = std::chrono::steady_clock::now();
+  const double w0 = WallMs();
   const cd::DatasetSummary sum = cd::GenerateDataset(o);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  const double wall = (WallMs() - w0) * 1e-3;  // [s]
   std::printf("make-dataset run: %lld simulations x %d views = %lld clips in %.1f s wall on %d jobs: "
               "%.1f clips/min (worker time: simulate %.1f s, render %.1f s, write %.1f s)\n",
               static_cast<long long>(sum.simulated), views, static_cast<long long>(sum.examples_written), wall,
