@@ -4,13 +4,13 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "render/random.h"
+#include "common/random.h"
 
 namespace clothwind::data {
 
 namespace {
 // Standard normal from two uniforms (Box-Muller): fixed by the seed on every platform.
-double Gaussian(render::Rng& rng) {
+double Gaussian(Rng& rng) {
   const double u1 = std::max(rng.Uniform(), 1e-300), u2 = rng.Uniform();
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
@@ -21,7 +21,7 @@ std::vector<sensors::SyntheticReading> SimulateAnemometer(const sim::WindField& 
                                                           double start_time, double duration) {
   if (!(p.rate > 0 && p.sample_dt > 0 && p.distance_constant > 0 && p.vane_tau > 0 && duration > 0))
     throw std::invalid_argument("anemometer model: rate, sample_dt, distance_constant, vane_tau and duration must be > 0");
-  render::Rng rng(render::HashSeed(p.seed, 0xa4e3));
+  Rng rng(HashSeed(p.seed, 0xa4e3));
   const double interval = 1.0 / p.rate;
   const int per_interval = std::max(1, static_cast<int>(std::lround(interval / p.sample_dt)));
   const double dt = interval / per_interval;

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "render/random.h"
+#include "common/random.h"
 
 namespace clothwind::data {
 namespace {
@@ -13,7 +13,7 @@ namespace {
 // draw to one part never shifts another.
 enum Stream : uint64_t { kTheta = 1, kWind = 2, kFabric = 3, kSplit = 4, kView = 5, kCamera = 6 };
 
-double LogUniform(render::Rng& rng, double factor) {
+double LogUniform(Rng& rng, double factor) {
   if (factor <= 1.0) {
     rng.Uniform();  // a draw all the same, so the later draws of the stream stay where they were
     return 1.0;
@@ -42,7 +42,7 @@ SamplingRanges DefaultRanges(render::SceneKind kind) {
 
 uint64_t SimulationSeed(uint64_t global_seed, int64_t index) {
   if (index < 0) throw std::invalid_argument("simulation index must be >= 0");
-  return render::HashSeed(global_seed, static_cast<uint64_t>(index), 0x5eedda7aULL);
+  return HashSeed(global_seed, static_cast<uint64_t>(index), 0x5eedda7aULL);
 }
 
 SimulationSample SampleFlagSimulation(const sim::Theta& base, uint64_t global_seed, int64_t index,
@@ -52,13 +52,13 @@ SimulationSample SampleFlagSimulation(const sim::Theta& base, uint64_t global_se
   s.index = index;
   s.seed = SimulationSeed(global_seed, index);
   s.fabric = "camel-ponte-roma";
-  render::Rng rng(render::HashSeed(s.seed, kTheta));
+  Rng rng(HashSeed(s.seed, kTheta));
   s.theta = base;
   s.theta[sim::kAreaWeightIndex] = base[sim::kAreaWeightIndex] * LogUniform(rng, ranges.area_weight_factor);
   const double stiffness = LogUniform(rng, ranges.bending_factor);
   for (int k = 0; k < 15; ++k)
     s.theta[sim::kBendingIndex + k] = base[sim::kBendingIndex + k] * stiffness * LogUniform(rng, ranges.bending_jitter);
-  render::Rng wind(render::HashSeed(s.seed, kWind));
+  Rng wind(HashSeed(s.seed, kWind));
   s.theta[sim::kWindSpeedIndex] = wind.Uniform(ranges.wind_min, ranges.wind_max);
   s.wind_velocity = Eigen::Vector3d(s.theta[sim::kWindSpeedIndex], 0, 0);
   return s;
@@ -71,15 +71,15 @@ SimulationSample SampleClothSimulation(const std::vector<Fabric>& fabrics, uint6
   SimulationSample s;
   s.index = index;
   s.seed = SimulationSeed(global_seed, index);
-  render::Rng pick(render::HashSeed(s.seed, kFabric));
+  Rng pick(HashSeed(s.seed, kFabric));
   s.fabric_index = pick.UniformInt(static_cast<int>(fabrics.size()));
   const Fabric& f = fabrics[s.fabric_index];
   s.fabric = f.name;
-  render::Rng rng(render::HashSeed(s.seed, kTheta));
+  Rng rng(HashSeed(s.seed, kTheta));
   s.theta[sim::kAreaWeightIndex] = rng.Uniform(ranges.cloth_area_weight_min, ranges.cloth_area_weight_max);
   for (int d = 0; d < 3; ++d)
     for (int c = 0; c < 5; ++c) s.theta[sim::kBendingIndex + 5 * d + c] = f.material.bending[d][c];
-  render::Rng wind(render::HashSeed(s.seed, kWind));
+  Rng wind(HashSeed(s.seed, kWind));
   const double speed = wind.Uniform(ranges.wind_min, ranges.wind_max);
   const double azimuth = wind.Uniform(-M_PI, M_PI);
   s.theta[sim::kWindSpeedIndex] = speed;
@@ -93,13 +93,13 @@ render::RenderParams SampleView(render::SceneKind kind, uint64_t simulation_seed
     throw std::invalid_argument("view " + std::to_string(view) + " of " + std::to_string(views) +
                                 ": expected 0 <= view < views");
   render::RenderParams p =
-      render::SampleRenderParams(kind, render::HashSeed(simulation_seed, kView), background_images);
+      render::SampleRenderParams(kind, HashSeed(simulation_seed, kView), background_images);
   const bool flag = kind == render::SceneKind::kFlag;
-  render::Rng cam(render::HashSeed(simulation_seed, kCamera, static_cast<uint64_t>(view)));
+  Rng cam(HashSeed(simulation_seed, kCamera, static_cast<uint64_t>(view)));
   if (view > 0) {  // the same scene seen from elsewhere (ranges of Table 2)
     p.camera_height = flag ? cam.Uniform(0.2, 3) : cam.Uniform(0.5, 2);
     p.camera_radius = flag ? cam.Uniform(4, 6) : cam.Uniform(1, 2.5);
-    p.seed = render::HashSeed(p.seed, static_cast<uint64_t>(view));
+    p.seed = HashSeed(p.seed, static_cast<uint64_t>(view));
   }
   const double half = flag ? 15.0 : 5.0;
   p.camera_angle_deg = -half + 2 * half * (view + cam.Uniform()) / views;
@@ -109,7 +109,7 @@ render::RenderParams SampleView(render::SceneKind kind, uint64_t simulation_seed
 std::string SplitOf(uint64_t simulation_seed, double val_fraction, double test_fraction) {
   if (!(val_fraction >= 0 && test_fraction >= 0 && val_fraction + test_fraction <= 1))
     throw std::invalid_argument("split fractions: expected val, test >= 0 and val + test <= 1");
-  render::Rng rng(render::HashSeed(simulation_seed, kSplit));
+  Rng rng(HashSeed(simulation_seed, kSplit));
   const double u = rng.Uniform();
   if (u < test_fraction) return "test";
   if (u < test_fraction + val_fraction) return "val";

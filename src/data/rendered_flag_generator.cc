@@ -6,7 +6,7 @@
 
 #include "data/cloth_animation.h"
 #include "data/paths.h"
-#include "render/random.h"
+#include "common/random.h"
 #include "sim/scene.h"
 #include "sim/scene_builder.h"
 
@@ -29,7 +29,7 @@ RenderedFlagGenerator::RenderedFlagGenerator(const sensors::SyntheticSessionOpti
   render::ValidateRenderParams(zeta_);
 
   sim::TurbulenceParams turbulence = options.turbulence;
-  turbulence.seed = render::HashSeed(session.seed, 0x7e4b);
+  turbulence.seed = HashSeed(session.seed, 0x7e4b);
   field_ = std::make_shared<SessionWindField>(std::make_shared<sensors::SyntheticWind>(session),
                                               session.direction_from, turbulence,
                                               std::max(session.wind_base, 0.5));
@@ -89,7 +89,7 @@ std::vector<sensors::SyntheticReading> RenderedFlagGenerator::AnemometerReadings
   p.rate = session_.anemometer_rate;
   p.latency = session_.anemometer_latency;
   p.direction_from = session_.direction_from;
-  p.seed = render::HashSeed(session_.seed, 0xa7e);
+  p.seed = HashSeed(session_.seed, 0xa7e);
   return SimulateAnemometer(*field_, p, session_.start_time, session_.duration);
 }
 

@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "render/noise.h"
-#include "render/random.h"
+#include "common/random.h"
 
 namespace clothwind::render {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "render/random.h"
+#include "common/random.h"
 
 namespace clothwind::render {
 

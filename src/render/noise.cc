@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "render/random.h"
+#include "common/random.h"
 
 namespace clothwind::render {
 

@@ -8,7 +8,7 @@
 
 #include "render/fabric_patterns.h"
 #include "render/flag_designs.h"
-#include "render/random.h"
+#include "common/random.h"
 
 namespace clothwind::render {
 

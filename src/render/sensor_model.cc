@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "render/color.h"
-#include "render/random.h"
+#include "common/random.h"
 
 namespace clothwind::render {
 

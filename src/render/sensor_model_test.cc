@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
-#include "render/random.h"
+#include "common/random.h"
 #include "render/renderer.h"
 
 namespace clothwind::render {

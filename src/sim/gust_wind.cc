@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "sim/random.h"
+#include "common/random.h"
 
 namespace clothwind::sim {
 
@@ -22,7 +22,7 @@ GustWind::GustWind(const GustParams& p, const Eigen::Vector3d& mean_velocity)
     throw std::invalid_argument("gust amplitude must be finite, spread in [0, 1]");
   }
   if (p.rate == 0.0 || p.amplitude == 0.0) return;
-  SplitMix64 g(p.seed);
+  Rng g(p.seed);
   double t = 0.0;
   while (true) {
     t += -std::log(1.0 - g.Uniform()) / p.rate;  // exponential inter-arrival

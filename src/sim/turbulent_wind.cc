@@ -6,7 +6,7 @@
 
 #include <Eigen/Geometry>
 
-#include "sim/random.h"
+#include "common/random.h"
 
 namespace clothwind::sim {
 namespace {
@@ -14,7 +14,7 @@ namespace {
 // k_e L_u for the von Kármán spectrum: sqrt(pi) Gamma(5/6) / Gamma(1/3).
 double KeTimesL() { return std::sqrt(M_PI) * std::tgamma(5.0 / 6.0) / std::tgamma(1.0 / 3.0); }
 
-Eigen::Vector3d RandomUnit(SplitMix64& g) {
+Eigen::Vector3d RandomUnit(Rng& g) {
   const double z = g.Uniform(-1.0, 1.0);
   const double phi = g.Uniform(0.0, 2.0 * M_PI);
   const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
@@ -54,7 +54,7 @@ TurbulentWind::TurbulentWind(const TurbulenceParams& p, const Eigen::Vector3d& m
   // energy; above, the k^-5/3 tail is scales far below a flag's size (L_u/270 ~ cm).
   const double ke = KeTimesL() / p.length_scale;
   const double lo = std::log(0.1 * ke), hi = std::log(200.0 * ke);
-  SplitMix64 g(p.seed);
+  Rng g(p.seed);
   const int n = p.modes;
   std::vector<Eigen::Vector3d> raw(n), wavevector(n);
   std::vector<double> phase(n);

@@ -1,6 +1,6 @@
 #include "sim/wind_spec.h"
 
-#include "sim/random.h"
+#include "common/random.h"
 
 namespace clothwind::sim {
 

@@ -1,38 +1,41 @@
-#ifndef CLOTHWIND_RENDER_RANDOM_H_
-#define CLOTHWIND_RENDER_RANDOM_H_
+#ifndef CLOTHWIND_COMMON_RANDOM_H_
+#define CLOTHWIND_COMMON_RANDOM_H_
 
 #include <cstdint>
 #include <initializer_list>
 
-namespace clothwind::render {
+namespace clothwind {
 
-// Seeded generator (SplitMix64) whose stream is fixed by the seed alone on every platform:
-// render parameters, textures and pixel samples must be reproducible from a seed, and the
-// <random> distributions are implementation-defined.
+// Seeded generator (SplitMix64, Steele, Lea and Flood 2014) whose stream is fixed by the seed
+// alone on every platform and standard library: wind fields, render parameters, textures, pixel
+// samples and dataset splits must be reproducible from a seed, and the <random> distributions are
+// implementation-defined. The simulator and the renderer share this one generator, so a dataset
+// made today equals one made from the same seeds a year ago.
 class Rng {
  public:
   explicit Rng(uint64_t seed) : state_(seed) {}
 
+  // The next 64 random bits.
   uint64_t Next() {
     uint64_t z = (state_ += 0x9e3779b97f4a7c15ULL);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
     return z ^ (z >> 31);
   }
-  // Uniform in [0, 1).
+  // Uniform in [0, 1), from the top 53 bits.
   double Uniform() { return static_cast<double>(Next() >> 11) * 0x1.0p-53; }
   // Uniform in [a, b).
   double Uniform(double a, double b) { return a + (b - a) * Uniform(); }
   // Uniform integer in [0, n); n > 0.
   int UniformInt(int n) { return static_cast<int>(Uniform() * n) % n; }
-  // Uniform float in [0, 1) for per-pixel sampling.
+  // Uniform float in [0, 1) from the top 24 bits, for per-pixel sampling.
   float UniformF() { return static_cast<float>(Next() >> 40) * 0x1.0p-24f; }
 
  private:
   uint64_t state_;
 };
 
-// Mixes several integers into one seed: pixel samples are drawn from Rng(HashSeed(seed, x, y,
+// Mixes up to four integers into one seed: pixel samples are drawn from Rng(HashSeed(seed, x, y,
 // frame)) so an image does not depend on how rows are shared among threads.
 inline uint64_t HashSeed(uint64_t a, uint64_t b = 0, uint64_t c = 0, uint64_t d = 0) {
   uint64_t h = a * 0x9e3779b97f4a7c15ULL;
@@ -44,6 +47,12 @@ inline uint64_t HashSeed(uint64_t a, uint64_t b = 0, uint64_t c = 0, uint64_t d 
   return h;
 }
 
-}  // namespace clothwind::render
+// Derives the seed of sub-stream `stream` (e.g. gusts and turbulence from one --seed).
+inline uint64_t DeriveSeed(uint64_t seed, uint64_t stream) {
+  Rng g(seed ^ (0xd1b54a32d192ed03ULL * (stream + 1)));
+  return g.Next();
+}
 
-#endif  // CLOTHWIND_RENDER_RANDOM_H_
+}  // namespace clothwind
+
+#endif  // CLOTHWIND_COMMON_RANDOM_H_
