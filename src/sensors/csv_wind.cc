@@ -9,18 +9,6 @@
 namespace clothwind::sensors {
 namespace {
 
-std::vector<std::string> Split(const std::string& s) {
-  std::vector<std::string> out;
-  size_t start = 0;
-  while (true) {
-    const size_t next = s.find(',', start);
-    out.push_back(TrimSpaces(s.substr(start, next == std::string::npos ? std::string::npos : next - start)));
-    if (next == std::string::npos) break;
-    start = next + 1;
-  }
-  return out;
-}
-
 bool IsHeader(const std::string& record) {
   std::string t = TrimSpaces(record);
   for (char& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -31,7 +19,7 @@ bool IsHeader(const std::string& record) {
 
 bool LooksLikeCsvWind(const std::string& record) {
   if (IsHeader(record)) return true;
-  const std::vector<std::string> f = Split(record);
+  const std::vector<std::string> f = SplitCommas(record, true);
   if (f.size() < 2 || f.size() > 3 || f[0].empty()) return false;
   for (char c : record) {
     if (!(std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+' || c == 'e' ||
@@ -48,7 +36,7 @@ ParseResult ParseCsvWind(const std::string& record) {
     r.error = "CSV header line";
     return r;
   }
-  const std::vector<std::string> f = Split(record);
+  const std::vector<std::string> f = SplitCommas(record, true);
   if (f.size() < 2 || f.size() > 3) {
     r.error = "CSV: expected 'speed,direction[,gust]', got " + std::to_string(f.size()) + " fields";
     return r;

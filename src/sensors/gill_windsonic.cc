@@ -28,18 +28,6 @@ bool GillSpeedUnit(const std::string& f, SpeedUnit* unit) {
   return true;
 }
 
-std::vector<std::string> SplitCommas(const std::string& s) {
-  std::vector<std::string> out;
-  size_t start = 0;
-  while (true) {
-    const size_t next = s.find(',', start);
-    out.push_back(TrimSpaces(s.substr(start, next == std::string::npos ? std::string::npos : next - start)));
-    if (next == std::string::npos) break;
-    start = next + 1;
-  }
-  return out;
-}
-
 }  // namespace
 
 uint8_t GillChecksum(const std::string& body) {
@@ -86,7 +74,7 @@ ParseResult ParseGillWindSonic(const std::string& record) {
     std::snprintf(msg, sizeof(msg), "checksum mismatch: record says %02X, computed %02X", expected, actual);
     return Fail(ParseStatus::kChecksumError, msg);
   }
-  std::vector<std::string> f = SplitCommas(body);
+  std::vector<std::string> f = SplitCommas(body, true);
   if (!f.empty() && f.back().empty()) f.pop_back();  // the trailing comma before ETX
   // node, a, b, units, [speed of sound, temperature on other Gill models,] status
   if (f.size() < 5) return Fail(ParseStatus::kMalformed, "expected at least 5 fields, got " + std::to_string(f.size()));

@@ -222,15 +222,7 @@ bool SplitNmeaSentence(const std::string& record, NmeaSentence* out, ParseResult
     out->type = address.substr(2);
   }
   out->fields.clear();
-  if (comma != std::string::npos) {
-    size_t start = comma + 1;
-    while (true) {
-      const size_t next = body.find(',', start);
-      out->fields.push_back(body.substr(start, next == std::string::npos ? std::string::npos : next - start));
-      if (next == std::string::npos) break;
-      start = next + 1;
-    }
-  }
+  if (comma != std::string::npos) out->fields = SplitCommas(body.substr(comma + 1), false);
   return true;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <utility>
 
 namespace clothwind::sensors {
 
@@ -12,6 +13,19 @@ std::string TrimSpaces(const std::string& s) {
   if (b == std::string::npos) return "";
   const size_t e = s.find_last_not_of(" \t");
   return s.substr(b, e - b + 1);
+}
+
+std::vector<std::string> SplitCommas(const std::string& s, bool trim_spaces) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (true) {
+    const size_t next = s.find(',', start);
+    std::string field = s.substr(start, next == std::string::npos ? std::string::npos : next - start);
+    out.push_back(trim_spaces ? TrimSpaces(field) : std::move(field));
+    if (next == std::string::npos) break;
+    start = next + 1;
+  }
+  return out;
 }
 
 bool ParseOptionalNumber(const std::string& field, double* value, std::string* error) {

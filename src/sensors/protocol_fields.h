@@ -4,6 +4,7 @@
 #define CLOTHWIND_SENSORS_PROTOCOL_FIELDS_H_
 
 #include <string>
+#include <vector>
 
 namespace clothwind::sensors {
 
@@ -18,6 +19,14 @@ bool ParseOptionalNumber(const std::string& field, double* value, std::string* e
 
 // Removes leading and trailing spaces and tabs.
 std::string TrimSpaces(const std::string& s);
+
+// Splits a record at every comma: "a,,b" gives {"a", "", "b"} and "" gives {""}, so field
+// positions stay those of the protocol even where a field is empty.
+// Inputs:
+//   s            the record (without framing, e.g. no '$' or checksum)
+//   trim_spaces  whether to strip spaces and tabs around each field
+// Returns the fields, one more than the number of commas.
+std::vector<std::string> SplitCommas(const std::string& s, bool trim_spaces);
 
 }  // namespace clothwind::sensors
 
