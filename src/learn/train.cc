@@ -37,7 +37,7 @@ struct Batch {
 // Clips read at once while a batch loads. Loading is bound by file reads, not decoding, once the
 // dataset outgrows the page cache (flagsim-e5's 9.6 GB on the 24 GiB VM, whose cache the host
 // trims): one reader keeps one read in flight and left 37 % of the CPU idle there, four 20 %
-// (eight no less: the rest is the training step's own serial parts and the system's reads).
+// (eight no less).
 // Each clip's sample depends only on its own seed, so a batch is the same for any number of readers.
 constexpr int kBatchReaders = 4;
 
