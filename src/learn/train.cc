@@ -7,6 +7,7 @@
 #include <future>
 #include <iomanip>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <sstream>
@@ -23,6 +24,7 @@
 #include <torch/serialize.h>
 
 #include "learn/dataset.h"
+#include "learn/frame_cache.h"
 #include "learn/networks.h"
 
 namespace clothwind::learn {
@@ -42,10 +44,10 @@ struct Batch {
 constexpr int kBatchReaders = 4;
 
 // Loads clips indices[begin, end) of `clips` as one batch, clip i augmented with seed
-// seed_base + indices[i].
+// seed_base + indices[i], its frames from `cache` when given (a cache of these same clips).
 // Outputs: clips [end - begin, 1, N_t, S, S] float, speeds [end - begin] m/s.
 Batch LoadBatch(const std::vector<ClipInfo>& clips, const std::vector<size_t>& indices, size_t begin, size_t end,
-                const SampleOptions& options, uint64_t seed_base) {
+                const SampleOptions& options, uint64_t seed_base, FrameCache* cache) {
   const int64_t n = static_cast<int64_t>(end - begin), s = options.input_size;
   Batch b{at::empty({n, 1, options.frames, s, s}), at::empty({n}, at::kFloat)};
   float* pixels = b.clips.data_ptr<float>();
@@ -54,7 +56,8 @@ Batch LoadBatch(const std::vector<ClipInfo>& clips, const std::vector<size_t>& i
   auto load = [&](int64_t first, int64_t last) {
     for (int64_t i = first; i < last; ++i) {
       const size_t clip = indices[begin + static_cast<size_t>(i)];
-      Sample sample = LoadSample(clips[clip], options, seed_base + clip);
+      Sample sample = cache ? LoadSample(*cache, clip, options, seed_base + clip)
+                            : LoadSample(clips[clip], options, seed_base + clip);
       if (static_cast<int64_t>(sample.pixels.size()) != clip_floats)
         throw std::logic_error("LoadBatch: sample of " + std::to_string(sample.pixels.size()) +
                                " values, expected " + std::to_string(clip_floats));
@@ -240,6 +243,17 @@ TrainResult Train(const TrainOptions& o) {
   train_options.input_size = val_options.input_size = config.input_size;
   train_options.augment = true;
   train_options.crop_scales = o.crop_scales;
+  std::unique_ptr<FrameCache> train_cache, val_cache;
+  if (o.cache_frames) {
+    std::string why;
+    for (const ClipInfo& c : train) {
+      if (!FrameCache::Exact(train_options, c, &why)) {
+        throw std::runtime_error("--cache-frames would change the training samples: " + why);
+      }
+    }
+    train_cache = std::make_unique<FrameCache>(train, config.input_size);
+    val_cache = std::make_unique<FrameCache>(val, config.input_size);
+  }
   // The seed clips gradients (max norm 10) for its recurrent models only.
   const double grad_clip = o.grad_clip >= 0 ? o.grad_clip : (config.arch == "lstm" ? 10.0 : 0.0);
   const float mean = static_cast<float>(config.label_mean), inv_std = static_cast<float>(1.0 / config.label_std);
@@ -267,7 +281,7 @@ TrainResult Train(const TrainOptions& o) {
     size_t seen = 0;
     auto load = [&](size_t b) {
       return std::async(std::launch::async, LoadBatch, std::cref(train), std::cref(order), b,
-                        std::min(usable, b + o.batch), std::cref(train_options), seed_base);
+                        std::min(usable, b + o.batch), std::cref(train_options), seed_base, train_cache.get());
     };
     std::future<Batch> next = load(0);
     for (int step = 0; step < steps; ++step) {
@@ -299,7 +313,7 @@ TrainResult Train(const TrainOptions& o) {
       std::vector<double> truth, predicted;
       double val_loss = 0;
       for (size_t b = 0; b < all.size(); b += o.batch) {
-        Batch batch = LoadBatch(val, all, b, std::min(all.size(), b + o.batch), val_options, 0);
+        Batch batch = LoadBatch(val, all, b, std::min(all.size(), b + o.batch), val_options, 0, val_cache.get());
         at::Tensor y = (batch.speeds - mean) * inv_std;
         at::Tensor out = net->forward(batch.clips.to(device)).to(at::kCPU);
         val_loss += WindLoss(out, y).item<double>() * y.size(0);

@@ -42,6 +42,10 @@ struct TrainOptions {
   std::string device = "auto";       // cpu | cuda | auto
   bool resume = false;               // continue from out/last.pt and out/state.json
   bool init_only = false;            // write an initialised (untrained) model and stop
+  // Keep every frame decoded and resized in memory after its first read (learn/frame_cache.h):
+  // the same samples, without rereading a dataset larger than the page cache each epoch.
+  // Needs crop_scales = {1} and square frames; costs clips x frames x input_size^2 bytes.
+  bool cache_frames = false;
   uint64_t seed = 1;
   std::function<void(const TrainProgress&)> progress;  // after each batch (may be empty)
   std::function<void(const EpochRecord&)> epoch_done;  // after each epoch (may be empty)

@@ -1,0 +1,83 @@
+#include "learn/frame_cache.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+namespace clothwind::learn {
+
+FrameCache::FrameCache(const std::vector<ClipInfo>& clips, int input_size)
+    : clips_(clips), input_size_(input_size) {
+  if (input_size < 1) throw std::invalid_argument("FrameCache: input size must be >= 1");
+  slots_.reserve(clips.size());
+  for (size_t i = 0; i < clips.size(); ++i) slots_.push_back(std::make_unique<Slot>());
+}
+
+bool FrameCache::Exact(const SampleOptions& options, const ClipInfo& clip, std::string* why) {
+  if (!options.augment) return true;  // evaluation: always the centre square
+  for (double s : options.crop_scales) {
+    if (s != 1.0) {
+      if (why) *why = "training crop scale " + std::to_string(s) + " (the cache holds whole squares: use --crop-scales 1)";
+      return false;
+    }
+  }
+  if (clip.width != clip.height) {
+    if (why) {
+      *why = clip.name + ": frames are " + std::to_string(clip.width) + "x" + std::to_string(clip.height) +
+             ", and a training crop slides along a non-square frame";
+    }
+    return false;
+  }
+  return true;
+}
+
+std::vector<cv::Mat> FrameCache::Frames(size_t index, int first, int count) {
+  const ClipInfo& clip = clips_.at(index);
+  Slot& slot = *slots_[index];
+  std::lock_guard<std::mutex> lock(slot.mutex);
+  if (first < 0 || count < 1 || first + count > clip.num_frames) {
+    return LoadFrames(clip, first, count);  // throws the error a direct read gives
+  }
+  const size_t plane = static_cast<size_t>(input_size_) * input_size_;
+  if (slot.pixels.empty()) {
+    slot.pixels.resize(static_cast<size_t>(clip.num_frames) * plane);
+    slot.loaded.assign(static_cast<size_t>(clip.num_frames), false);
+    bytes_ += slot.pixels.size();
+  }
+  std::vector<cv::Mat> out;
+  out.reserve(static_cast<size_t>(count));
+  for (int t = first; t < first + count; ++t) {
+    // A header over the clip's buffer: no copy, and valid as long as the cache.
+    cv::Mat held(input_size_, input_size_, CV_8UC1, slot.pixels.data() + static_cast<size_t>(t) * plane);
+    if (!slot.loaded[static_cast<size_t>(t)]) {
+      const cv::Mat frame = LoadFrames(clip, t, 1)[0];
+      const int side = std::min(frame.cols, frame.rows);
+      const cv::Rect square((frame.cols - side) / 2, (frame.rows - side) / 2, side, side);
+      // The interpolation MakeSample picks for a crop of this side; writes into `held` in place.
+      cv::resize(frame(square), held, held.size(), 0, 0, side >= input_size_ ? cv::INTER_AREA : cv::INTER_LINEAR);
+      slot.loaded[static_cast<size_t>(t)] = true;
+      ++frames_held_;
+    }
+    out.push_back(held);  // MakeSample only reads it
+  }
+  return out;
+}
+
+Sample LoadSample(FrameCache& cache, size_t index, const SampleOptions& options, uint64_t seed) {
+  if (options.input_size != cache.input_size()) {
+    throw std::invalid_argument("LoadSample: input size " + std::to_string(options.input_size) +
+                                " but the frame cache holds " + std::to_string(cache.input_size()) + " px");
+  }
+  const ClipInfo& clip = cache.clip(index);
+  // The same draws in the same order as LoadSample(clip, ...): the window, then MakeSample's crop
+  // scale, offsets (both 0 on a whole square) and flip; resizing S to S is a copy in OpenCV.
+  std::mt19937_64 rng(seed);
+  const int first = ChooseFirstFrame(clip.num_frames, options, rng);
+  Sample sample = MakeSample(cache.Frames(index, first, options.frames), options, rng);
+  sample.first_frame = first;
+  sample.wind_speed = static_cast<float>(clip.wind_speed);
+  return sample;
+}
+
+}  // namespace clothwind::learn

@@ -1,0 +1,166 @@
+#include "learn/frame_cache.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <future>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "learn/train.h"
+
+namespace clothwind::learn {
+namespace {
+namespace fs = std::filesystem;
+
+class FrameCacheTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::temp_directory_path() / ("clothwind_frame_cache_" + std::to_string(::getpid())));
+    ToyDatasetOptions o;
+    o.clips = 6;
+    o.frames = 40;
+    o.size = 48;
+    WriteToyDataset(*dir_, o);
+    clips_ = new std::vector<ClipInfo>(ReadDataset(*dir_).clips);
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete clips_;
+    delete dir_;
+  }
+  static SampleOptions Training() {
+    SampleOptions o;
+    o.frames = 20;
+    o.input_size = 32;  // 48 -> 32: INTER_AREA, as FlagSim's 128 -> 64
+    o.augment = true;
+    o.crop_scales = {1.0};
+    return o;
+  }
+  static void ExpectSameSample(const Sample& direct, const Sample& cached) {
+    EXPECT_EQ(direct.first_frame, cached.first_frame);
+    EXPECT_EQ(direct.flipped, cached.flipped);
+    EXPECT_EQ(direct.wind_speed, cached.wind_speed);
+    ASSERT_EQ(direct.pixels.size(), cached.pixels.size());
+    EXPECT_EQ(direct.pixels, cached.pixels);  // bit for bit
+  }
+  static fs::path* dir_;
+  static std::vector<ClipInfo>* clips_;
+};
+fs::path* FrameCacheTest::dir_ = nullptr;
+std::vector<ClipInfo>* FrameCacheTest::clips_ = nullptr;
+
+TEST_F(FrameCacheTest, TrainingSamplesEqualTheFilesBitForBitOnFirstAndLaterReads) {
+  FrameCache cache(*clips_, 32);
+  const SampleOptions o = Training();
+  ASSERT_TRUE(FrameCache::Exact(o, (*clips_)[0], nullptr));
+  int flipped = 0;
+  std::set<int> starts;
+  for (int pass = 0; pass < 2; ++pass) {  // pass 0 fills the cache, pass 1 reads it
+    for (size_t i = 0; i < clips_->size(); ++i) {
+      for (uint64_t seed = 1; seed <= 4; ++seed) {
+        const Sample direct = LoadSample((*clips_)[i], o, seed * 1000 + i);
+        ExpectSameSample(direct, LoadSample(cache, i, o, seed * 1000 + i));
+        flipped += direct.flipped;
+        starts.insert(direct.first_frame);
+      }
+    }
+  }
+  // The draws did vary, so equality covers flips and temporal offsets, not one fixed window.
+  EXPECT_GT(flipped, 0);
+  EXPECT_GT(starts.size(), 3u);
+}
+
+TEST_F(FrameCacheTest, EvaluationSamplesEqualTheFilesWithAndWithoutMirror) {
+  FrameCache cache(*clips_, 32);
+  SampleOptions o = Training();
+  o.augment = false;
+  for (bool mirror : {false, true}) {
+    o.mirror = mirror;
+    for (int first : {-1, 0, 20}) {
+      o.first_frame = first;
+      for (size_t i = 0; i < clips_->size(); ++i) ExpectSameSample(LoadSample((*clips_)[i], o, 7), LoadSample(cache, i, o, 7));
+    }
+  }
+}
+
+TEST_F(FrameCacheTest, HoldsEachFrameOnceAndOnlyTheFramesRead) {
+  FrameCache cache(*clips_, 32);
+  EXPECT_EQ(cache.bytes(), 0u);
+  cache.Frames(0, 5, 10);
+  EXPECT_EQ(cache.frames_held(), 10u);
+  EXPECT_EQ(cache.bytes(), 40u * 32 * 32);  // the clip's 40 frames, allocated at once
+  cache.Frames(0, 10, 10);  // 5 of these are held already
+  EXPECT_EQ(cache.frames_held(), 15u);
+  const std::vector<cv::Mat> frames = cache.Frames(0, 5, 15);
+  EXPECT_EQ(cache.frames_held(), 15u);
+  EXPECT_EQ(cache.bytes(), 40u * 32 * 32);
+  cache.Frames(3, 0, 1);
+  EXPECT_EQ(cache.bytes(), 80u * 32 * 32);
+  ASSERT_EQ(frames.size(), 15u);
+  EXPECT_EQ(frames[0].cols, 32);
+  EXPECT_EQ(frames[0].rows, 32);
+  EXPECT_EQ(frames[0].type(), CV_8UC1);
+}
+
+TEST_F(FrameCacheTest, ThreadsFillingOneCacheGetWhatOneThreadGets) {
+  FrameCache shared(*clips_, 32), serial(*clips_, 32);
+  const SampleOptions o = Training();
+  std::vector<std::future<std::vector<Sample>>> parts;
+  for (int t = 0; t < 4; ++t) {
+    parts.push_back(std::async(std::launch::async, [&, t] {
+      std::vector<Sample> out;
+      for (size_t i = 0; i < clips_->size(); ++i) out.push_back(LoadSample(shared, i, o, 100 * t + i));
+      return out;
+    }));
+  }
+  for (int t = 0; t < 4; ++t) {
+    const std::vector<Sample> got = parts[t].get();
+    for (size_t i = 0; i < clips_->size(); ++i) ExpectSameSample(LoadSample(serial, i, o, 100 * t + i), got[i]);
+  }
+  EXPECT_EQ(shared.bytes(), serial.bytes());
+  EXPECT_EQ(shared.frames_held(), serial.frames_held());
+}
+
+TEST_F(FrameCacheTest, SaysWhenItWouldChangeTheSamples) {
+  SampleOptions o = Training();
+  std::string why;
+  o.crop_scales = {1.0, 0.75};
+  EXPECT_FALSE(FrameCache::Exact(o, (*clips_)[0], &why));
+  EXPECT_THAT(why, ::testing::HasSubstr("--crop-scales 1"));
+  o.crop_scales = {1.0};
+  ClipInfo wide = (*clips_)[0];
+  wide.width = 64;
+  EXPECT_FALSE(FrameCache::Exact(o, wide, &why));
+  EXPECT_THAT(why, ::testing::HasSubstr("64x48"));
+  o.augment = false;  // evaluation takes the centre square of any frame
+  EXPECT_TRUE(FrameCache::Exact(o, wide, &why));
+
+  FrameCache cache(*clips_, 24);
+  EXPECT_THROW(LoadSample(cache, 0, Training(), 1), std::invalid_argument);  // 32 px asked of a 24 px cache
+  EXPECT_THROW(cache.Frames(0, 30, 20), std::runtime_error);                 // past the clip's 40 frames
+}
+
+TEST_F(FrameCacheTest, TrainingRefusesTheCacheWithTheSeedsMultiScaleCrops) {
+  TrainOptions o;
+  o.data = *dir_;
+  o.out = *dir_ / "run";
+  o.model.frames = 20;
+  o.model.input_size = 32;
+  o.epochs = 1;
+  o.cache_frames = true;  // with the default crop scales 1, 0.875, 0.75, 0.66
+  try {
+    Train(o);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("--cache-frames"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("--crop-scales 1"));
+  }
+}
+
+}  // namespace
+}  // namespace clothwind::learn
