@@ -5,6 +5,7 @@
 
 #include "learn/evaluate.h"
 #include "learn/model_config.h"
+#include "learn/view_breakdown.h"
 #include "progress_bar.h"
 #include "verb_registry.h"
 
@@ -16,6 +17,7 @@ struct EvalArgs {
   int threads = 2, batch = 8, windows = 1;
   std::string device = "auto";
   bool mirror = false;
+  bool by_view = false;
 };
 
 VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
@@ -36,6 +38,9 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       ->capture_default_str();
   sub->add_flag("--mirror", a->mirror,
                "also predict each window's mirror image (horizontal flip) and average the two (Table 1: off)");
+  sub->add_flag("--by-view", a->by_view,
+               "also break the errors down by the clips' views (camera elevation, angle, distance; texture), "
+               "read from each simulated clip's label.json");
   sub->add_option("--device", a->device, "cpu, cuda or auto")
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
       ->capture_default_str();
@@ -49,6 +54,12 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
                                                 a->windows, a->mirror, [&](int done, int total) { bar.Update(done, total); });
     bar.Finish();
     std::cout << learn::EvalTable(r);
+    nlohmann::json json = learn::EvalJson(r);
+    if (a->by_view) {
+      const learn::ViewBreakdown breakdown = learn::BreakDownByView(r);
+      std::cout << learn::ViewBreakdownTable(breakdown);
+      json["by_view"] = learn::ViewBreakdownJson(breakdown);
+    }
     const std::filesystem::path plot =
         a->plot.empty() ? std::filesystem::path(a->model).parent_path() / ("eval_" + a->split + ".png")
                         : std::filesystem::path(a->plot);
@@ -59,7 +70,7 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       std::cerr << "plot not drawn: " << error << "\n";
     }
     if (!a->json.empty()) {
-      learn::WriteFileAtomically(a->json, learn::EvalJson(r).dump(2) + "\n");
+      learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
       std::cout << "json: " << a->json << "\n";
     }
     return 0;

@@ -132,7 +132,9 @@ TEST(ExampleSamplingTest, ViewsShareTheSceneAndSpreadTheCameraAngle) {
     EXPECT_GE(p.camera_radius, 4.0);
     EXPECT_LT(p.camera_radius, 6.0);
     EXPECT_NO_THROW(render::ValidateRenderParams(p));
-    if (v > 0) EXPECT_NE(p.seed, v0.seed);
+    if (v > 0) {
+      EXPECT_NE(p.seed, v0.seed);
+    }
   }
   const render::RenderParams c = SampleView(render::SceneKind::kCloth, seed, 1, 2);
   EXPECT_GE(c.camera_angle_deg, 0.0);

@@ -134,6 +134,7 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
     }
     for (size_t j = i; j < end; ++j) {
       r.names.push_back(clips[j].name);
+      r.dirs.push_back(clips[j].dir);
       r.truth.push_back(clips[j].wind_speed);
       r.predicted.push_back(sum[j - i] / passes);
       r.predicted_std.push_back(std::sqrt(sum_var[j - i] / passes));
@@ -146,23 +147,27 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   return r;
 }
 
+namespace {
+// An empty group has no figures: null, not NaN (which JSON lacks).
+nlohmann::json Number(double x) { return std::isnan(x) ? nlohmann::json(nullptr) : nlohmann::json(x); }
+}  // namespace
+
+nlohmann::json MetricsJson(const Metrics& m) {
+  return {{"rmse", Number(m.rmse)}, {"acc05", Number(m.acc05)}, {"bias", Number(m.bias)}, {"count", m.count}};
+}
+
 nlohmann::json EvalJson(const EvalResult& r) {
   nlohmann::json bands = nlohmann::json::array();
-  // An empty band has no figures: null, not NaN (which JSON lacks).
-  const auto number = [](double x) { return std::isnan(x) ? nlohmann::json(nullptr) : nlohmann::json(x); };
   for (const BandMetrics& b : r.bands) {
-    bands.push_back({{"lo", b.lo},
-                     {"hi", b.hi},
-                     {"rmse", number(b.metrics.rmse)},
-                     {"acc05", number(b.metrics.acc05)},
-                     {"bias", number(b.metrics.bias)},
-                     {"count", b.metrics.count}});
+    nlohmann::json band = {{"lo", b.lo}, {"hi", b.hi}};
+    band.update(MetricsJson(b.metrics));
+    bands.push_back(band);
   }
   return {{"rmse", r.metrics.rmse},   {"acc05", r.metrics.acc05}, {"count", r.metrics.count},
           {"model", r.config.Name()}, {"arch", r.config.arch},    {"modality", r.config.Modality()},
           {"split", r.split},         {"windows", r.windows},     {"mirror", r.mirror},
           {"seconds", r.seconds},
-          {"std_within_1", number(StdCoverage(r, 1))}, {"std_within_2", number(StdCoverage(r, 2))},
+          {"std_within_1", Number(StdCoverage(r, 1))}, {"std_within_2", Number(StdCoverage(r, 2))},
           {"bands", bands}};
 }
 

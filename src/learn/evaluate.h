@@ -46,6 +46,7 @@ struct EvalResult {
   ModelConfig config;
   std::string split;
   std::vector<std::string> names;
+  std::vector<std::filesystem::path> dirs;  // each example's folder (frames, label.json)
   std::vector<double> truth, predicted, predicted_std;  // [m/s]
   int windows = 1;      // frame windows averaged per clip
   bool mirror = false;  // each window averaged with its mirror image
@@ -67,6 +68,9 @@ struct EvalResult {
 EvalResult Evaluate(const std::filesystem::path& model, const std::filesystem::path& data, const std::string& split,
                     int threads, const std::string& device, int batch, int windows = 1, bool mirror = false,
                     const std::function<void(int, int)>& progress = {});
+
+// {"rmse", "acc05", "bias", "count"} of one group of examples; NaN figures (an empty group) as null.
+nlohmann::json MetricsJson(const Metrics& metrics);
 
 // {"rmse": …, "acc05": …, "count": …} plus the model, split, windows, mirror and "bands" (a list of
 // {"lo", "hi", "rmse", "acc05", "bias", "count"}; NaNs of empty bands as null).

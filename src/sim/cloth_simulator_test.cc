@@ -153,8 +153,12 @@ TEST(ClothSimulatorTest, EnergyDoesNotGrowWithoutInput) {
     // Strain limiting moves positions and adds the move / dt to the velocities (as ArcSim does),
     // which may add a trace of kinetic energy in a step.
     // Explicit bending is not strictly dissipative either (a trace, at sharp folds).
-    if (variant == 0) EXPECT_EQ(increases, 0);
-    if (variant == 1 || variant == 3) EXPECT_LT(worst_increase, 1e-3 * scale);
+    if (variant == 0) {
+      EXPECT_EQ(increases, 0);
+    }
+    if (variant == 1 || variant == 3) {
+      EXPECT_LT(worst_increase, 1e-3 * scale);
+    }
     EXPECT_LT(highest, e0 + 1e-4 * scale);
     EXPECT_LT(previous, e0 - 0.05 * scale);
   }

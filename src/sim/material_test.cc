@@ -139,7 +139,7 @@ TEST(MaterialTest, EveryArcSimMaterialLoadsWithSaneValues) {
     G(1, 1) = 0.05;
     EXPECT_GT(m.StretchingStiffness(G)[2], 0);
     for (double curv : {0.0, 5.0, 50.0})
-      for (const Eigen::Vector2d du : {Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 1), Eigen::Vector2d(0, 1)}) {
+      for (const Eigen::Vector2d& du : {Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 1), Eigen::Vector2d(0, 1)}) {
         const double kb = m.BendingStiffness(curv, du);
         EXPECT_GE(kb, 0);
         EXPECT_LT(kb, 1e-2);  // N m: cloth ~1e-5, paper 4e-4

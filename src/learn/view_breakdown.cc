@@ -1,0 +1,160 @@
+#include "learn/view_breakdown.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace clothwind::learn {
+namespace fs = std::filesystem;
+
+namespace {
+
+double ZetaNumber(const nlohmann::json& zeta, const char* field, const fs::path& file) {
+  if (!zeta.contains(field) || !zeta[field].is_number()) {
+    throw std::runtime_error(file.string() + ": zeta." + field + " is missing or not a number");
+  }
+  return zeta[field].get<double>();
+}
+
+nlohmann::json BinsJson(const std::vector<BinMetrics>& bins) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const BinMetrics& b : bins) {
+    nlohmann::json bin = {{"lo", b.lo}, {"hi", b.hi}};
+    bin.update(MetricsJson(b.metrics));
+    out.push_back(bin);
+  }
+  return out;
+}
+
+void MetricsColumns(std::ostream& s, const Metrics& m) {
+  s << std::fixed << std::setprecision(3) << "RMSE " << m.rmse << "  Acc@0.5 " << m.acc05 << "  bias "
+    << std::showpos << m.bias << std::noshowpos << "  (" << m.count << ")\n";
+}
+
+void BinsTable(std::ostream& s, const std::string& heading, const std::vector<BinMetrics>& bins, int digits,
+               const std::string& unit) {
+  s << "  by " << heading << ":\n";
+  for (const BinMetrics& b : bins) {
+    std::ostringstream range;
+    range << std::fixed << std::setprecision(digits) << b.lo << "-" << b.hi << " " << unit;
+    s << "    " << std::left << std::setw(14) << range.str() << std::right;
+    MetricsColumns(s, b.metrics);
+  }
+}
+
+}  // namespace
+
+ClipView ReadClipView(const fs::path& label_json) {
+  std::ifstream in(label_json);
+  if (!in) throw std::runtime_error(label_json.string() + ": cannot be read");
+  nlohmann::json label;
+  try {
+    label = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(label_json.string() + ": not JSON: " + e.what());
+  }
+  if (!label.contains("zeta") || !label["zeta"].is_object()) {
+    throw std::runtime_error(label_json.string() +
+                             ": no zeta object (the rendering parameters of a simulated clip; a real clip has none)");
+  }
+  const nlohmann::json& z = label["zeta"];
+  const double aspect = ZetaNumber(z, "mesh_aspect_ratio", label_json);
+  if (!(aspect > 0)) throw std::runtime_error(label_json.string() + ": zeta.mesh_aspect_ratio must be > 0");
+  const double centre = ZetaNumber(z, "mesh_height", label_json) + ZetaNumber(z, "mesh_width", label_json) / aspect / 2;
+  ClipView v;
+  v.radius_m = ZetaNumber(z, "camera_radius", label_json);
+  v.elevation_deg = std::atan2(centre - ZetaNumber(z, "camera_height", label_json), v.radius_m) * 180.0 / M_PI;
+  v.angle_deg = std::abs(ZetaNumber(z, "camera_angle_deg", label_json));
+  if (!z.contains("texture_name") || !z["texture_name"].is_string()) {
+    throw std::runtime_error(label_json.string() + ": zeta.texture_name is missing or not a string");
+  }
+  v.texture = z["texture_name"].get<std::string>();
+  return v;
+}
+
+std::vector<BinMetrics> ComputeBinnedMetrics(const std::vector<double>& key, const std::vector<double>& truth,
+                                             const std::vector<double>& predicted, double width) {
+  if (key.size() != truth.size() || truth.size() != predicted.size()) {
+    throw std::invalid_argument("ComputeBinnedMetrics: key, truth and predicted differ in size");
+  }
+  if (!(width > 0)) throw std::invalid_argument("ComputeBinnedMetrics: width must be > 0, got " + std::to_string(width));
+  if (key.empty()) return {};
+  const double origin = width * std::floor(*std::min_element(key.begin(), key.end()) / width);
+  std::map<long, std::pair<std::vector<double>, std::vector<double>>> bins;  // bin index -> truth, predicted
+  for (size_t i = 0; i < key.size(); ++i) {
+    auto& [t, p] = bins[static_cast<long>(std::floor((key[i] - origin) / width))];
+    t.push_back(truth[i]);
+    p.push_back(predicted[i]);
+  }
+  std::vector<BinMetrics> out;
+  for (const auto& [index, tp] : bins) {
+    out.push_back({origin + index * width, origin + (index + 1) * width, ComputeMetrics(tp.first, tp.second)});
+  }
+  return out;
+}
+
+ViewBreakdown BreakDownByView(const EvalResult& result, const std::vector<ClipView>& views) {
+  const size_t n = result.truth.size();
+  if (views.size() != n || result.predicted.size() != n) {
+    throw std::invalid_argument("BreakDownByView: " + std::to_string(views.size()) + " views for " +
+                                std::to_string(n) + " examples");
+  }
+  std::vector<double> elevation, angle, radius;
+  std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> by_texture;
+  for (size_t i = 0; i < n; ++i) {
+    elevation.push_back(views[i].elevation_deg);
+    angle.push_back(views[i].angle_deg);
+    radius.push_back(views[i].radius_m);
+    by_texture[views[i].texture].first.push_back(result.truth[i]);
+    by_texture[views[i].texture].second.push_back(result.predicted[i]);
+  }
+  ViewBreakdown b;
+  b.elevation = ComputeBinnedMetrics(elevation, result.truth, result.predicted, kElevationBin);
+  b.angle = ComputeBinnedMetrics(angle, result.truth, result.predicted, kAngleBin);
+  b.radius = ComputeBinnedMetrics(radius, result.truth, result.predicted, kRadiusBin);
+  for (const auto& [name, tp] : by_texture) b.texture.push_back({name, ComputeMetrics(tp.first, tp.second)});
+  std::stable_sort(b.texture.begin(), b.texture.end(),
+                   [](const NamedMetrics& x, const NamedMetrics& y) { return x.metrics.rmse > y.metrics.rmse; });
+  return b;
+}
+
+ViewBreakdown BreakDownByView(const EvalResult& result) {
+  if (result.dirs.size() != result.truth.size()) {
+    throw std::invalid_argument("BreakDownByView: the evaluation lists no folder for some examples");
+  }
+  std::vector<ClipView> views;
+  for (const fs::path& dir : result.dirs) views.push_back(ReadClipView(dir / "label.json"));
+  return BreakDownByView(result, views);
+}
+
+nlohmann::json ViewBreakdownJson(const ViewBreakdown& b) {
+  nlohmann::json textures = nlohmann::json::array();
+  for (const NamedMetrics& t : b.texture) {
+    nlohmann::json entry = {{"name", t.name}};
+    entry.update(MetricsJson(t.metrics));
+    textures.push_back(entry);
+  }
+  return {{"camera_elevation_deg", BinsJson(b.elevation)},
+          {"camera_angle_deg", BinsJson(b.angle)},
+          {"camera_radius_m", BinsJson(b.radius)},
+          {"texture", textures}};
+}
+
+std::string ViewBreakdownTable(const ViewBreakdown& b) {
+  std::ostringstream s;
+  BinsTable(s, "camera elevation (to the mesh's centre at rest)", b.elevation, 0, "deg");
+  BinsTable(s, "camera angle off side-on, either side", b.angle, 0, "deg");
+  BinsTable(s, "camera distance", b.radius, 1, "m");
+  s << "  by texture, worst first:\n";
+  for (const NamedMetrics& t : b.texture) {
+    s << "    " << std::left << std::setw(24) << t.name << std::right;
+    MetricsColumns(s, t.metrics);
+  }
+  return s.str();
+}
+
+}  // namespace clothwind::learn
