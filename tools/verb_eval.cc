@@ -55,10 +55,17 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     bar.Finish();
     std::cout << learn::EvalTable(r);
     nlohmann::json json = learn::EvalJson(r);
+    // A clip without a view (a real one) must not cost the evaluation: the figures, plot and JSON
+    // are still written, and the run then fails saying why the breakdown is missing.
+    std::string by_view_error;
     if (a->by_view) {
-      const learn::ViewBreakdown breakdown = learn::BreakDownByView(r);
-      std::cout << learn::ViewBreakdownTable(breakdown);
-      json["by_view"] = learn::ViewBreakdownJson(breakdown);
+      try {
+        const learn::ViewBreakdown breakdown = learn::BreakDownByView(r);
+        std::cout << learn::ViewBreakdownTable(breakdown);
+        json["by_view"] = learn::ViewBreakdownJson(breakdown);
+      } catch (const std::exception& e) {
+        by_view_error = e.what();
+      }
     }
     const std::filesystem::path plot =
         a->plot.empty() ? std::filesystem::path(a->model).parent_path() / ("eval_" + a->split + ".png")
@@ -72,6 +79,10 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     if (!a->json.empty()) {
       learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
       std::cout << "json: " << a->json << "\n";
+    }
+    if (!by_view_error.empty()) {
+      std::cerr << "clothwind eval: --by-view: " << by_view_error << "\n";
+      return 1;
     }
     return 0;
   };

@@ -19,6 +19,7 @@
 #include "learn/evaluate.h"
 #include "learn/networks.h"
 #include "learn/predictor.h"
+#include "learn/view_breakdown.h"
 
 namespace clothwind::learn {
 namespace {
@@ -106,6 +107,16 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
   EXPECT_DOUBLE_EQ(j["acc05"].get<double>(), again.acc05);
   EXPECT_EQ(j["count"].get<int>(), static_cast<int>(val.size()));
   for (double s : e.predicted_std) EXPECT_TRUE(std::isfinite(s) && s > 0);
+  // Each example's folder comes with it, for the breakdown by view; the toy clips have no
+  // rendering parameters, so that breakdown refuses them by their label file.
+  ASSERT_EQ(e.dirs.size(), e.truth.size());
+  for (const fs::path& d : e.dirs) EXPECT_TRUE(fs::exists(d / "label.json")) << d;
+  try {
+    BreakDownByView(e);
+    ADD_FAILURE() << "toy clips were broken down by view";
+  } catch (const std::runtime_error& err) {
+    EXPECT_NE(std::string(err.what()).find("label.json: no zeta"), std::string::npos) << err.what();
+  }
   // Several windows per clip: the mean of the predictions at the evenly spaced starts, and the
   // root mean of their variances, clip by clip.
   const EvalResult e3 = Evaluate(r.model, *root_ / "data", "val", 2, "cpu", 4, 3);
