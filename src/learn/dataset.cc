@@ -15,8 +15,6 @@
 
 namespace clothwind::learn {
 namespace fs = std::filesystem;
-namespace {
-
 nlohmann::json ReadJson(const fs::path& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path.string() + ": cannot open");
@@ -26,6 +24,8 @@ nlohmann::json ReadJson(const fs::path& path) {
     throw std::runtime_error(path.string() + ": not valid JSON: " + e.what());
   }
 }
+
+namespace {
 
 template <typename T>
 T Field(const nlohmann::json& j, const char* key, const fs::path& file, const char* expected) {
@@ -197,7 +197,7 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
     sample.crop = cv::Rect(x, y, crop, crop);
     sample.flipped = std::uniform_int_distribution<int>(0, 1)(rng) == 1;
   } else {
-    sample.crop = cv::Rect((w - side) / 2, (h - side) / 2, side, side);
+    sample.crop = CentreSquare(w, h);
     sample.flipped = options.mirror;
   }
   const int s = options.input_size;
@@ -210,8 +210,7 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
                                   std::to_string(h) + " mono8");
     }
     cv::Mat resized;
-    cv::resize(f(sample.crop), resized, cv::Size(s, s), 0, 0,
-               sample.crop.width >= s ? cv::INTER_AREA : cv::INTER_LINEAR);
+    ResizeCrop(f, sample.crop, s, resized);
     if (sample.flipped) cv::flip(resized, resized, 1);
     cv::Mat out(s, s, CV_32F, sample.pixels.data() + static_cast<size_t>(t) * s * s);
     resized.convertTo(out, CV_32F);
@@ -227,13 +226,26 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
   return sample;
 }
 
-Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed) {
+cv::Rect CentreSquare(int width, int height) {
+  const int side = std::min(width, height);
+  return cv::Rect((width - side) / 2, (height - side) / 2, side, side);
+}
+
+void ResizeCrop(const cv::Mat& frame, const cv::Rect& crop, int side, cv::Mat& out) {
+  cv::resize(frame(crop), out, cv::Size(side, side), 0, 0, crop.width >= side ? cv::INTER_AREA : cv::INTER_LINEAR);
+}
+
+Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed, const FrameReader& read) {
   std::mt19937_64 rng(seed);
   const int first = ChooseFirstFrame(clip.num_frames, options, rng);
-  Sample sample = MakeSample(LoadFrames(clip, first, options.frames), options, rng);
+  Sample sample = MakeSample(read(first, options.frames), options, rng);
   sample.first_frame = first;
   sample.wind_speed = static_cast<float>(clip.wind_speed);
   return sample;
+}
+
+Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed) {
+  return LoadSample(clip, options, seed, [&clip](int first, int count) { return LoadFrames(clip, first, count); });
 }
 
 std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions& o) {

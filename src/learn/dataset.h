@@ -6,10 +6,12 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
 namespace clothwind::learn {
@@ -31,6 +33,9 @@ struct Dataset {
   std::string kind;  // "flag", "cloth" or "real"
   std::vector<ClipInfo> clips;
 };
+
+// Parses a JSON file. Throws std::runtime_error naming the file when it cannot be opened or parsed.
+nlohmann::json ReadJson(const std::filesystem::path& path);
 
 // Reads DIR/index.json and every listed DIR/<name>/label.json (frames are read lazily).
 // Throws std::runtime_error naming the file and the field that is missing or wrong.
@@ -68,6 +73,14 @@ struct Sample {
 // centred otherwise. Throws std::runtime_error when the clip is too short for the window.
 int ChooseFirstFrame(int num_frames, const SampleOptions& options, std::mt19937_64& rng);
 
+// The centred square of the shorter side of a width x height frame: evaluation's crop.
+cv::Rect CentreSquare(int width, int height);
+
+// Resizes frame(crop) to side x side into `out` (area interpolation when shrinking, linear when
+// enlarging), as MakeSample does for every frame. An `out` already side x side of the frame's type
+// is written in place.
+void ResizeCrop(const cv::Mat& frame, const cv::Rect& crop, int side, cv::Mat& out);
+
 // Turns greyscale frames (all of one size, count = options.frames) into a Sample: crop (random
 // multi-scale position and size when augmenting, the centred square of the shorter side
 // otherwise), resize to input_size (area interpolation), flip horizontally with probability
@@ -79,7 +92,14 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
 // takes). Throws std::invalid_argument for windows < 1 or a clip shorter than one window.
 std::vector<int> EvenWindowStarts(int num_frames, int frames, int windows);
 
-// LoadFrames + MakeSample for one example, deterministic in `seed`.
+// Frames first..first+count-1 of a clip, from wherever they are held (LoadFrames: the files).
+using FrameReader = std::function<std::vector<cv::Mat>(int first, int count)>;
+
+// ChooseFirstFrame + `read` + MakeSample for one example, deterministic in `seed`: the window,
+// crop and flip are drawn from one generator in that order, whatever supplies the frames.
+Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed, const FrameReader& read);
+
+// LoadSample with the frames read from the clip's files (LoadFrames).
 Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed);
 
 // A synthetic dataset in the docs/dataset.md format whose content is a known function of the

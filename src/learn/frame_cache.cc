@@ -1,9 +1,6 @@
 #include "learn/frame_cache.h"
 
-#include <algorithm>
 #include <stdexcept>
-
-#include <opencv2/imgproc.hpp>
 
 namespace clothwind::learn {
 
@@ -52,10 +49,8 @@ std::vector<cv::Mat> FrameCache::Frames(size_t index, int first, int count) {
     cv::Mat held(input_size_, input_size_, CV_8UC1, slot.pixels.data() + static_cast<size_t>(t) * plane);
     if (!slot.loaded[static_cast<size_t>(t)]) {
       const cv::Mat frame = LoadFrames(clip, t, 1)[0];
-      const int side = std::min(frame.cols, frame.rows);
-      const cv::Rect square((frame.cols - side) / 2, (frame.rows - side) / 2, side, side);
-      // The interpolation MakeSample picks for a crop of this side; writes into `held` in place.
-      cv::resize(frame(square), held, held.size(), 0, 0, side >= input_size_ ? cv::INTER_AREA : cv::INTER_LINEAR);
+      // MakeSample's own crop and resize, written into `held` in place.
+      ResizeCrop(frame, CentreSquare(frame.cols, frame.rows), input_size_, held);
       slot.loaded[static_cast<size_t>(t)] = true;
       ++frames_held_;
     }
@@ -69,15 +64,9 @@ Sample LoadSample(FrameCache& cache, size_t index, const SampleOptions& options,
     throw std::invalid_argument("LoadSample: input size " + std::to_string(options.input_size) +
                                 " but the frame cache holds " + std::to_string(cache.input_size()) + " px");
   }
-  const ClipInfo& clip = cache.clip(index);
-  // The same draws in the same order as LoadSample(clip, ...): the window, then MakeSample's crop
-  // scale, offsets (both 0 on a whole square) and flip; resizing S to S is a copy in OpenCV.
-  std::mt19937_64 rng(seed);
-  const int first = ChooseFirstFrame(clip.num_frames, options, rng);
-  Sample sample = MakeSample(cache.Frames(index, first, options.frames), options, rng);
-  sample.first_frame = first;
-  sample.wind_speed = static_cast<float>(clip.wind_speed);
-  return sample;
+  // MakeSample's crop offsets are 0 on a whole square, and resizing S to S is a copy in OpenCV.
+  return LoadSample(cache.clip(index), options, seed,
+                    [&cache, index](int first, int count) { return cache.Frames(index, first, count); });
 }
 
 }  // namespace clothwind::learn

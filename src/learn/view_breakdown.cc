@@ -2,11 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <map>
 #include <sstream>
 #include <stdexcept>
+
+#include "learn/dataset.h"
 
 namespace clothwind::learn {
 namespace fs = std::filesystem;
@@ -49,14 +50,7 @@ void BinsTable(std::ostream& s, const std::string& heading, const std::vector<Bi
 }  // namespace
 
 ClipView ReadClipView(const fs::path& label_json) {
-  std::ifstream in(label_json);
-  if (!in) throw std::runtime_error(label_json.string() + ": cannot be read");
-  nlohmann::json label;
-  try {
-    label = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(label_json.string() + ": not JSON: " + e.what());
-  }
+  const nlohmann::json label = ReadJson(label_json);
   if (!label.contains("zeta") || !label["zeta"].is_object()) {
     throw std::runtime_error(label_json.string() +
                              ": no zeta object (the rendering parameters of a simulated clip; a real clip has none)");
