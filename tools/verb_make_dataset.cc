@@ -24,6 +24,9 @@ struct MakeDatasetArgs {
   double wind_min = -1, wind_max = -1;
   // FlagSim material priors (SamplingRanges); < 0: the default.
   double area_weight_spread = -1, bending_spread = -1, bending_jitter = -1;
+  // Camera ranges "MIN:MAX" [m] and half-range [deg]; empty / < 0: Table 2's.
+  std::string camera_height, camera_radius;
+  double camera_angle = -1;
   bool reindex = false;
   bool no_contact_sheet = false;
   std::string backgrounds;  // folder of images
@@ -45,6 +48,20 @@ void ParseShard(const std::string& text, int* shard, int* shards) {
     throw std::invalid_argument("--shard " + text + ": expected 0 <= i < N");
 }
 
+// "MIN:MAX" -> (min, max), for the option named `option`.
+void ParseRange(const std::string& option, const std::string& text, double* lo, double* hi) {
+  const auto colon = text.find(':');
+  try {
+    if (colon == std::string::npos) throw std::invalid_argument(text);
+    size_t a = 0, b = 0;
+    *lo = std::stod(text.substr(0, colon), &a);
+    *hi = std::stod(text.substr(colon + 1), &b);
+    if (a != colon || b != text.size() - colon - 1) throw std::invalid_argument(text);
+  } catch (const std::exception&) {
+    throw std::invalid_argument(option + ": expected MIN:MAX in metres (e.g. 5.1:6.1), got '" + text + "'");
+  }
+}
+
 int Run(MakeDatasetArgs& a) {
   data::DatasetOptions& o = a.o;
   if (a.reindex) {
@@ -57,13 +74,19 @@ int Run(MakeDatasetArgs& a) {
   o.frame_ext = a.format == "jpeg" ? "jpg" : a.format;
   o.contact_sheet = !a.no_contact_sheet;
   if (a.wind_min >= 0 || a.wind_max >= 0 || a.area_weight_spread >= 0 || a.bending_spread >= 0 ||
-      a.bending_jitter >= 0) {
+      a.bending_jitter >= 0 || !a.camera_height.empty() || !a.camera_radius.empty() || a.camera_angle >= 0) {
     data::SamplingRanges r = data::DefaultRanges(o.kind);
     if (a.wind_min >= 0) r.wind_min = a.wind_min;
     if (a.wind_max >= 0) r.wind_max = a.wind_max;
     if (a.area_weight_spread >= 0) r.area_weight_factor = a.area_weight_spread;
     if (a.bending_spread >= 0) r.bending_factor = a.bending_spread;
     if (a.bending_jitter >= 0) r.bending_jitter = a.bending_jitter;
+    if (!a.camera_height.empty())
+      ParseRange("--camera-height", a.camera_height, &r.camera.height_min, &r.camera.height_max);
+    if (!a.camera_radius.empty())
+      ParseRange("--camera-radius", a.camera_radius, &r.camera.radius_min, &r.camera.radius_max);
+    if (a.camera_angle >= 0) r.camera.angle_max_deg = a.camera_angle;
+    render::ValidateCameraRanges(r.camera);
     o.ranges = r;
   }
   if (!a.backgrounds.empty()) {
@@ -150,6 +173,15 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
   sub->add_option("--bending-jitter", a->bending_jitter,
                   "FlagSim: per-entry bending factor log-uniform in [1/H, H] (default 1.25)")
       ->check(CLI::Range(1.0, 100.0));
+  // Why: Table 2's cameras look up at the flag from 0.2-3 m; a site's own camera (say on a roof,
+  // level with the flag) is better served by a dataset drawn around where it stands.
+  sub->add_option("--camera-height", a->camera_height,
+                  "camera height above the ground MIN:MAX [m] (default: flag 0.2:3, cloth 0.5:2)");
+  sub->add_option("--camera-radius", a->camera_radius,
+                  "camera distance to the mesh's centre MIN:MAX [m] (default: flag 4:6, cloth 1:2.5)");
+  sub->add_option("--camera-angle", a->camera_angle,
+                  "camera angle off side-on, +-DEG (default: flag 15, cloth 5)")
+      ->check(CLI::Range(0.0, 89.9));
   sub->add_option("--val", a->o.val_fraction, "fraction of simulations in the val split")->capture_default_str();
   sub->add_option("--test", a->o.test_fraction, "fraction of simulations in the test split")->capture_default_str();
   sub->add_option("--backgrounds", a->backgrounds, "folder of background images (default: procedural)");

@@ -174,6 +174,17 @@ nlohmann::json RangesJson(const SamplingRanges& r) {
           {"cloth_area_weight_max", r.cloth_area_weight_max}};
 }
 
+// The dataset's settings record the cameras only where they differ from Table 2's, so the
+// datasets made before cameras were an option keep their settings and resume as they were.
+nlohmann::json RangesJson(const SamplingRanges& r, render::SceneKind kind) {
+  nlohmann::json j = RangesJson(r);
+  if (r.camera != render::TableTwoCameraRanges(kind))
+    j["camera"] = {{"height", {r.camera.height_min, r.camera.height_max}},
+                   {"radius", {r.camera.radius_min, r.camera.radius_max}},
+                   {"angle_max_deg", r.camera.angle_max_deg}};
+  return j;
+}
+
 nlohmann::json IndexHeader(const DatasetOptions& o, const nlohmann::json& settings) {
   return {{"format", "clothwind-dataset"},
           {"version", kFormatVersion},
@@ -238,7 +249,7 @@ nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<st
           {"jpeg_quality", o.jpeg_quality},
           {"val_fraction", o.val_fraction},
           {"test_fraction", o.test_fraction},
-          {"ranges", RangesJson(o.ranges ? *o.ranges : DefaultRanges(o.kind))},
+          {"ranges", RangesJson(o.ranges ? *o.ranges : DefaultRanges(o.kind), o.kind)},
           {"scene", fs::path(scene_path).filename().string()},
           {"fabrics", fabric_names},
           {"background_images", backgrounds},
@@ -329,7 +340,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
         const std::string name = ExampleName(o.kind, i, v);
         if (fs::exists(fs::path(o.out) / name / "label.json")) continue;
         t0 = Clock::now();
-        render::RenderParams zeta = SampleView(o.kind, s.seed, v, o.views, o.background_images);
+        render::RenderParams zeta = SampleView(o.kind, s.seed, v, o.views, o.background_images, prep.ranges.camera);
         if (o.samples > 0) zeta.samples = o.samples;
         zeta.width = zeta.height = o.size;
         zeta.fps = o.fps;

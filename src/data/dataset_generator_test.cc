@@ -225,6 +225,35 @@ TEST_F(DatasetGeneratorTest, RefusesToMixSettingsInOneFolder) {
   EXPECT_EQ(s.examples_in_index, 4);
 }
 
+TEST_F(DatasetGeneratorTest, OtherCamerasAreRecordedAndNotMixedIn) {
+  // Table 2's cameras leave the settings as they were before cameras were an option (so older
+  // datasets resume); other ranges are recorded, and a resume with others is refused.
+  DatasetOptions o = Tiny((root_ / "cameras").string());
+  EXPECT_FALSE(DatasetSettingsJson(o, {})["ranges"].contains("camera"));
+  SamplingRanges r = DefaultRanges(render::SceneKind::kFlag);
+  r.camera.height_min = 5.1, r.camera.height_max = 6.1;
+  o.ranges = r;
+  const nlohmann::json camera = DatasetSettingsJson(o, {})["ranges"]["camera"];
+  EXPECT_EQ(camera["height"], nlohmann::json::array({5.1, 6.1}));
+  EXPECT_EQ(camera["radius"], nlohmann::json::array({4.0, 6.0}));
+  EXPECT_EQ(camera["angle_max_deg"], 15.0);
+  o.count = 1;
+  EXPECT_EQ(GenerateDataset(o).examples_written, 1);
+  const auto label = ReadLabel((root_ / "cameras" / "flag-000000-v0" / "label.json").string());
+  const auto table = ReadLabel((Ref() / "flag-000000-v0" / "label.json").string());
+  EXPECT_GE(label["zeta"]["camera_height"].get<double>(), 5.1);
+  EXPECT_LE(label["zeta"]["camera_height"].get<double>(), 6.1);
+  EXPECT_EQ(label["theta"], table["theta"]);
+  EXPECT_EQ(label["zeta"]["texture_name"], table["zeta"]["texture_name"]);
+  o.ranges.reset();
+  try {
+    GenerateDataset(o);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("dataset.ranges"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(DatasetGeneratorTest, ViewsRenderOneSimulationFromSeveralCameras) {
   DatasetOptions o = Tiny((root_ / "views").string());
   o.count = 1;

@@ -30,6 +30,7 @@ void CheckRanges(const SamplingRanges& r) {
     throw std::invalid_argument("sampling ranges: expected 0 < cloth area weight min <= max");
   if (!(r.area_weight_factor >= 1 && r.bending_factor >= 1 && r.bending_jitter >= 1))
     throw std::invalid_argument("sampling ranges: perturbation factors must be >= 1");
+  render::ValidateCameraRanges(r.camera);
 }
 
 }  // namespace
@@ -37,6 +38,7 @@ void CheckRanges(const SamplingRanges& r) {
 SamplingRanges DefaultRanges(render::SceneKind kind) {
   SamplingRanges r;
   if (kind == render::SceneKind::kCloth) r.wind_max = 5.0;
+  r.camera = render::TableTwoCameraRanges(kind);
   return r;
 }
 
@@ -89,19 +91,25 @@ SimulationSample SampleClothSimulation(const std::vector<Fabric>& fabrics, uint6
 
 render::RenderParams SampleView(render::SceneKind kind, uint64_t simulation_seed, int view,
                                 int views, const std::vector<std::string>& background_images) {
+  return SampleView(kind, simulation_seed, view, views, background_images,
+                    render::TableTwoCameraRanges(kind));
+}
+
+render::RenderParams SampleView(render::SceneKind kind, uint64_t simulation_seed, int view,
+                                int views, const std::vector<std::string>& background_images,
+                                const render::CameraRanges& camera) {
   if (views < 1 || view < 0 || view >= views)
     throw std::invalid_argument("view " + std::to_string(view) + " of " + std::to_string(views) +
                                 ": expected 0 <= view < views");
-  render::RenderParams p =
-      render::SampleRenderParams(kind, HashSeed(simulation_seed, kView), background_images);
-  const bool flag = kind == render::SceneKind::kFlag;
+  render::RenderParams p = render::SampleRenderParams(kind, HashSeed(simulation_seed, kView),
+                                                      background_images, camera);
   Rng cam(HashSeed(simulation_seed, kCamera, static_cast<uint64_t>(view)));
-  if (view > 0) {  // the same scene seen from elsewhere (ranges of Table 2)
-    p.camera_height = flag ? cam.Uniform(0.2, 3) : cam.Uniform(0.5, 2);
-    p.camera_radius = flag ? cam.Uniform(4, 6) : cam.Uniform(1, 2.5);
+  if (view > 0) {  // the same scene seen from elsewhere
+    p.camera_height = cam.Uniform(camera.height_min, camera.height_max);
+    p.camera_radius = cam.Uniform(camera.radius_min, camera.radius_max);
     p.seed = HashSeed(p.seed, static_cast<uint64_t>(view));
   }
-  const double half = flag ? 15.0 : 5.0;
+  const double half = camera.angle_max_deg;
   p.camera_angle_deg = -half + 2 * half * (view + cam.Uniform()) / views;
   return p;
 }

@@ -31,6 +31,8 @@ struct SamplingRanges {
   // al.'s fabrics, 0.1-0.4); bending is the fabric's own (the paper keeps it fixed).
   double cloth_area_weight_min = 0.1;
   double cloth_area_weight_max = 0.4;
+  // Where the cameras stand (render::CameraRanges; DefaultRanges gives Table 2's of the kind).
+  render::CameraRanges camera;
 };
 
 // The default ranges of a dataset kind (FlagSim: wind 0-10 m/s; ClothSim: wind 0-5 m/s).
@@ -74,9 +76,16 @@ SimulationSample SampleClothSimulation(const std::vector<Fabric>& fabrics, uint6
 // backdrop, texture) and move the camera: new height and radius, and an angle stratified over
 // the Table 2 range (view v of K draws from the v-th of K equal parts of [-15, 15] deg for
 // flags, [-5, 5] for cloth) so the views show different apparent wind directions.
-// Inputs: kind; simulation_seed; view in [0, views); views >= 1; background_images (may be empty).
+// With `camera`, heights, radii and angles are drawn from its ranges instead of Table 2's (the
+// angle still stratified, over [-angle_max, angle_max]); every other draw stays the same, so a
+// dataset with other cameras shows the same simulations, scenes and textures.
+// Inputs: kind; simulation_seed; view in [0, views); views >= 1; background_images (may be
+//   empty); camera  (default TableTwoCameraRanges(kind)).
 render::RenderParams SampleView(render::SceneKind kind, uint64_t simulation_seed, int view,
                                 int views, const std::vector<std::string>& background_images = {});
+render::RenderParams SampleView(render::SceneKind kind, uint64_t simulation_seed, int view,
+                                int views, const std::vector<std::string>& background_images,
+                                const render::CameraRanges& camera);
 
 // Which split a simulation belongs to, from a hash of its seed: "test" with probability
 // test_fraction, "val" with val_fraction, else "train". All views of a simulation share it (no

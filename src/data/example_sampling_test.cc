@@ -143,6 +143,34 @@ TEST(ExampleSamplingTest, ViewsShareTheSceneAndSpreadTheCameraAngle) {
   EXPECT_THROW(SampleView(render::SceneKind::kFlag, seed, 3, 3), std::invalid_argument);
 }
 
+TEST(ExampleSamplingTest, OtherCamerasSeeTheSameScene) {
+  // Two datasets of one seed that differ only in their camera ranges show the same scenes: the
+  // controlled comparison docs/sdn.md makes between Table 2's cameras and level ones.
+  const uint64_t seed = SimulationSeed(1, 9);
+  const int views = 4;
+  render::CameraRanges level;
+  level.height_min = 5.1, level.height_max = 6.1;
+  level.angle_max_deg = 8;
+  for (int v = 0; v < views; ++v) {
+    const render::RenderParams table = SampleView(render::SceneKind::kFlag, seed, v, views);
+    render::RenderParams p = SampleView(render::SceneKind::kFlag, seed, v, views, {}, level);
+    EXPECT_GE(p.camera_height, 5.1);
+    EXPECT_LE(p.camera_height, 6.1);
+    EXPECT_GE(p.camera_angle_deg, -8.0 + 4.0 * v);  // stratified over [-8, 8]
+    EXPECT_LT(p.camera_angle_deg, -4.0 + 4.0 * v);
+    EXPECT_DOUBLE_EQ(p.camera_radius, table.camera_radius);  // radius range unchanged
+    p.camera_height = table.camera_height;
+    p.camera_angle_deg = table.camera_angle_deg;
+    EXPECT_EQ(render::ToJson(p), render::ToJson(table));
+  }
+  SamplingRanges r = DefaultRanges(render::SceneKind::kFlag);
+  EXPECT_TRUE(r.camera == render::TableTwoCameraRanges(render::SceneKind::kFlag));
+  EXPECT_TRUE(DefaultRanges(render::SceneKind::kCloth).camera ==
+              render::TableTwoCameraRanges(render::SceneKind::kCloth));
+  r.camera.height_max = 0.1;  // below its min
+  EXPECT_THROW(SampleFlagSimulation(sim::Theta::Zero(), 1, 0, r), std::invalid_argument);
+}
+
 TEST(ExampleSamplingTest, SplitsFollowTheFractions) {
   int counts[3] = {0, 0, 0};
   const int n = 20000;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "render/camera.h"
@@ -21,8 +22,46 @@ SceneKind SceneKindFromName(const std::string& name) {
                               "', expected 'flag' or 'cloth'");
 }
 
+bool CameraRanges::operator==(const CameraRanges& o) const {
+  return height_min == o.height_min && height_max == o.height_max && radius_min == o.radius_min &&
+         radius_max == o.radius_max && angle_max_deg == o.angle_max_deg;
+}
+
+CameraRanges TableTwoCameraRanges(SceneKind kind) {
+  CameraRanges r;
+  if (kind == SceneKind::kCloth) {
+    r.height_min = 0.5, r.height_max = 2.0;
+    r.radius_min = 1.0, r.radius_max = 2.5;
+    r.angle_max_deg = 5.0;
+  }
+  return r;
+}
+
+void ValidateCameraRanges(const CameraRanges& r) {
+  const auto check = [](bool ok, const std::string& field, double lo, double hi, const std::string& expected) {
+    if (!ok) {
+      std::ostringstream m;
+      m << "camera ranges: " << field << " is [" << lo << ", " << hi << "], expected " << expected;
+      throw std::invalid_argument(m.str());
+    }
+  };
+  check(r.height_min > 0 && r.height_max >= r.height_min, "camera height", r.height_min, r.height_max,
+        "0 < min <= max [m]");
+  check(r.radius_min > 0 && r.radius_max >= r.radius_min, "camera radius", r.radius_min, r.radius_max,
+        "0 < min <= max [m]");
+  check(r.angle_max_deg >= 0 && r.angle_max_deg < 90, "camera angle", -r.angle_max_deg, r.angle_max_deg,
+        "a half-range in [0, 90) deg");
+}
+
 RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
                                 const std::vector<std::string>& background_images) {
+  return SampleRenderParams(kind, seed, background_images, TableTwoCameraRanges(kind));
+}
+
+RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
+                                const std::vector<std::string>& background_images,
+                                const CameraRanges& camera) {
+  ValidateCameraRanges(camera);
   Rng rng(HashSeed(seed, 0x2e7a));
   RenderParams p;
   p.scene = kind;
@@ -40,9 +79,9 @@ RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
   p.sky_strength = rng.Uniform(0.7, 1.3);
   p.texture_seed = rng.Next();
   if (kind == SceneKind::kFlag) {
-    p.camera_height = rng.Uniform(0.2, 3);
-    p.camera_radius = rng.Uniform(4, 6);
-    p.camera_angle_deg = rng.Uniform(-15, 15);
+    p.camera_height = rng.Uniform(camera.height_min, camera.height_max);
+    p.camera_radius = rng.Uniform(camera.radius_min, camera.radius_max);
+    p.camera_angle_deg = rng.Uniform(-camera.angle_max_deg, camera.angle_max_deg);
     p.camera_fov_deg = 45.0;
     p.mesh_height = 4.6;
     p.mesh_width = 3.0;
@@ -50,9 +89,9 @@ RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
     p.texture_kind = "flag";
     p.texture_name = FlagDesignName(static_cast<FlagDesign>(rng.UniformInt(kNumFlagDesigns)));
   } else {
-    p.camera_height = rng.Uniform(0.5, 2);
-    p.camera_radius = rng.Uniform(1, 2.5);
-    p.camera_angle_deg = rng.Uniform(-5, 5);
+    p.camera_height = rng.Uniform(camera.height_min, camera.height_max);
+    p.camera_radius = rng.Uniform(camera.radius_min, camera.radius_max);
+    p.camera_angle_deg = rng.Uniform(-camera.angle_max_deg, camera.angle_max_deg);
     p.camera_fov_deg = 45.0;
     p.mesh_height = 2.0;
     p.mesh_width = 1.0;

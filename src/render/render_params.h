@@ -75,11 +75,35 @@ struct RenderParams {
   double MeshRestHeight() const { return mesh_width / mesh_aspect_ratio; }
 };
 
-// Draws ζ from the ranges of seed Table 2 for the given scene kind.
+// Where a dataset's cameras stand: ζ's camera_height ~ U(height_min, height_max),
+// camera_radius ~ U(radius_min, radius_max), camera_angle_deg ~ U(-angle_max_deg, angle_max_deg).
+// Table 2's ranges by default; narrower or other ranges let a dataset match one site's camera
+// (docs/datasets.md, "Cameras"). Lengths in metres, angles in degrees.
+struct CameraRanges {
+  double height_min = 0.2, height_max = 3.0;  // [m] above the ground
+  double radius_min = 4.0, radius_max = 6.0;  // [m] horizontal distance to the mesh's centre
+  double angle_max_deg = 15.0;                // [deg] off the side-on view, either way
+  bool operator==(const CameraRanges& o) const;
+  bool operator!=(const CameraRanges& o) const { return !(*this == o); }
+};
+
+// Table 2's camera ranges: flag height 0.2-3, radius 4-6, angle ±15; cloth 0.5-2, 1-2.5, ±5.
+CameraRanges TableTwoCameraRanges(SceneKind kind);
+
+// Throws std::invalid_argument naming the field ("camera height", ...) unless
+// 0 < min <= max for height and radius and 0 <= angle_max_deg < 90.
+void ValidateCameraRanges(const CameraRanges& r);
+
+// Draws ζ from the ranges of seed Table 2 for the given scene kind, the camera from `camera`
+// (default: TableTwoCameraRanges(kind)). The camera's draws take the same places in the random
+// stream whatever its ranges, so two datasets of one seed differ only in their cameras.
 // Inputs: kind; seed  everything drawn follows from it; background_images  candidate files
-//   (one is picked by seed); empty means procedural backdrops.
+//   (one is picked by seed); empty means procedural backdrops; camera  validated ranges.
 RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
                                 const std::vector<std::string>& background_images = {});
+RenderParams SampleRenderParams(SceneKind kind, uint64_t seed,
+                                const std::vector<std::string>& background_images,
+                                const CameraRanges& camera);
 
 // JSON round trip (for label.json). FromJson requires every field and names the one that is
 // missing or of the wrong type (std::invalid_argument).

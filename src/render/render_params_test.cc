@@ -70,6 +70,53 @@ TEST(RenderParams, SamplesStayInTableTwoRanges) {
   }
 }
 
+TEST(RenderParams, CamerasComeFromTheGivenRangesAndNothingElseMoves) {
+  CameraRanges level;  // a camera on a roof, level with the flag's centre (5.6 m)
+  level.height_min = 5.1, level.height_max = 6.1;
+  level.radius_min = 8, level.radius_max = 9;
+  level.angle_max_deg = 3;
+  for (uint64_t seed = 0; seed < 200; ++seed) {
+    const RenderParams table = SampleRenderParams(SceneKind::kFlag, seed);
+    EXPECT_EQ(ToJson(table), ToJson(SampleRenderParams(SceneKind::kFlag, seed, {},
+                                                       TableTwoCameraRanges(SceneKind::kFlag))));
+    RenderParams p = SampleRenderParams(SceneKind::kFlag, seed, {}, level);
+    EXPECT_GE(p.camera_height, 5.1); EXPECT_LE(p.camera_height, 6.1);
+    EXPECT_GE(p.camera_radius, 8); EXPECT_LE(p.camera_radius, 9);
+    EXPECT_GE(p.camera_angle_deg, -3); EXPECT_LE(p.camera_angle_deg, 3);
+    // The same place in the stream: the same fraction of each range.
+    EXPECT_NEAR((p.camera_height - 5.1) / 1.0, (table.camera_height - 0.2) / 2.8, 1e-12);
+    // Everything else (sun, backdrop, texture) is the Table 2 draw's.
+    p.camera_height = table.camera_height;
+    p.camera_radius = table.camera_radius;
+    p.camera_angle_deg = table.camera_angle_deg;
+    EXPECT_EQ(ToJson(p), ToJson(table));
+  }
+  const RenderParams c = SampleRenderParams(SceneKind::kCloth, 3, {}, TableTwoCameraRanges(SceneKind::kCloth));
+  EXPECT_EQ(ToJson(c), ToJson(SampleRenderParams(SceneKind::kCloth, 3)));
+}
+
+TEST(RenderParams, BadCameraRangesNameTheRange) {
+  const auto message = [](const CameraRanges& r) {
+    try {
+      ValidateCameraRanges(r);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CameraRanges r;
+  r.height_min = 3, r.height_max = 2;
+  EXPECT_NE(message(r).find("camera height is [3, 2], expected 0 < min <= max"), std::string::npos) << message(r);
+  r = CameraRanges();
+  r.radius_min = 0;
+  EXPECT_NE(message(r).find("camera radius"), std::string::npos) << message(r);
+  r = CameraRanges();
+  r.angle_max_deg = 90;
+  EXPECT_NE(message(r).find("camera angle"), std::string::npos) << message(r);
+  EXPECT_EQ(message(CameraRanges()), "no error");
+  EXPECT_THROW(SampleRenderParams(SceneKind::kFlag, 1, {}, r), std::invalid_argument);
+}
+
 TEST(RenderParams, SameSeedSameParamsOtherSeedOther) {
   EXPECT_EQ(ToJson(SampleRenderParams(SceneKind::kFlag, 5)),
             ToJson(SampleRenderParams(SceneKind::kFlag, 5)));
