@@ -32,34 +32,36 @@ struct MakeDatasetArgs {
   std::string backgrounds;  // folder of images
 };
 
+// "A<sep>B" -> (a, b) with `parse` (std::stoi, std::stod, ...) taking each part whole; false if
+// the text is not of that form.
+template <typename T, typename Parse>
+bool ParsePair(const std::string& text, char sep, Parse parse, T* a, T* b) {
+  const auto at = text.find(sep);
+  if (at == std::string::npos) return false;
+  try {
+    size_t na = 0, nb = 0;
+    *a = parse(text.substr(0, at), &na);
+    *b = parse(text.substr(at + 1), &nb);
+    return na == at && nb == text.size() - at - 1;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
 // "i/N" -> (i, N).
 void ParseShard(const std::string& text, int* shard, int* shards) {
-  const auto slash = text.find('/');
-  try {
-    if (slash == std::string::npos) throw std::invalid_argument(text);
-    size_t a = 0, b = 0;
-    *shard = std::stoi(text.substr(0, slash), &a);
-    *shards = std::stoi(text.substr(slash + 1), &b);
-    if (a != slash || b != text.size() - slash - 1) throw std::invalid_argument(text);
-  } catch (const std::exception&) {
+  const auto stoi = [](const std::string& t, size_t* n) { return std::stoi(t, n); };
+  if (!ParsePair(text, '/', stoi, shard, shards))
     throw std::invalid_argument("--shard: expected i/N (e.g. 3/8), got '" + text + "'");
-  }
   if (*shards < 1 || *shard < 0 || *shard >= *shards)
     throw std::invalid_argument("--shard " + text + ": expected 0 <= i < N");
 }
 
 // "MIN:MAX" -> (min, max), for the option named `option`.
 void ParseRange(const std::string& option, const std::string& text, double* lo, double* hi) {
-  const auto colon = text.find(':');
-  try {
-    if (colon == std::string::npos) throw std::invalid_argument(text);
-    size_t a = 0, b = 0;
-    *lo = std::stod(text.substr(0, colon), &a);
-    *hi = std::stod(text.substr(colon + 1), &b);
-    if (a != colon || b != text.size() - colon - 1) throw std::invalid_argument(text);
-  } catch (const std::exception&) {
+  const auto stod = [](const std::string& t, size_t* n) { return std::stod(t, n); };
+  if (!ParsePair(text, ':', stod, lo, hi))
     throw std::invalid_argument(option + ": expected MIN:MAX in metres (e.g. 5.1:6.1), got '" + text + "'");
-  }
 }
 
 int Run(MakeDatasetArgs& a) {
@@ -86,7 +88,6 @@ int Run(MakeDatasetArgs& a) {
     if (!a.camera_radius.empty())
       ParseRange("--camera-radius", a.camera_radius, &r.camera.radius_min, &r.camera.radius_max);
     if (a.camera_angle >= 0) r.camera.angle_max_deg = a.camera_angle;
-    render::ValidateCameraRanges(r.camera);
     o.ranges = r;
   }
   if (!a.backgrounds.empty()) {

@@ -119,6 +119,7 @@ Prepared Prepare(const DatasetOptions& o) {
   p.base_theta = sim::SceneTheta(p.setup);
   p.scene_name = fs::path(scene_path).filename().string();
   p.ranges = o.ranges ? *o.ranges : DefaultRanges(o.kind);
+  ValidateRanges(p.ranges);  // once, before any simulation, not per worker
   if (o.kind == render::SceneKind::kCloth)
     p.fabrics = LoadFabrics(o.materials_dir.empty() ? DefaultMaterialsDir() : o.materials_dir,
                             scene_path, o.exclude_fabrics);
@@ -164,20 +165,16 @@ void WriteExample(const std::string& out, const std::string& name, const std::ve
   }
 }
 
-nlohmann::json RangesJson(const SamplingRanges& r) {
-  return {{"wind_min", r.wind_min},
-          {"wind_max", r.wind_max},
-          {"area_weight_factor", r.area_weight_factor},
-          {"bending_factor", r.bending_factor},
-          {"bending_jitter", r.bending_jitter},
-          {"cloth_area_weight_min", r.cloth_area_weight_min},
-          {"cloth_area_weight_max", r.cloth_area_weight_max}};
-}
-
 // The dataset's settings record the cameras only where they differ from Table 2's, so the
 // datasets made before cameras were an option keep their settings and resume as they were.
 nlohmann::json RangesJson(const SamplingRanges& r, render::SceneKind kind) {
-  nlohmann::json j = RangesJson(r);
+  nlohmann::json j{{"wind_min", r.wind_min},
+                   {"wind_max", r.wind_max},
+                   {"area_weight_factor", r.area_weight_factor},
+                   {"bending_factor", r.bending_factor},
+                   {"bending_jitter", r.bending_jitter},
+                   {"cloth_area_weight_min", r.cloth_area_weight_min},
+                   {"cloth_area_weight_max", r.cloth_area_weight_max}};
   if (r.camera != render::TableTwoCameraRanges(kind))
     j["camera"] = {{"height", {r.camera.height_min, r.camera.height_max}},
                    {"radius", {r.camera.radius_min, r.camera.radius_max}},

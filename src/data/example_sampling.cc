@@ -22,7 +22,9 @@ double LogUniform(Rng& rng, double factor) {
   return std::exp(rng.Uniform(-l, l));
 }
 
-void CheckRanges(const SamplingRanges& r) {
+}  // namespace
+
+void ValidateRanges(const SamplingRanges& r) {
   if (!(r.wind_min >= 0 && r.wind_max >= r.wind_min))
     throw std::invalid_argument("sampling ranges: expected 0 <= wind_min <= wind_max, got " +
                                 std::to_string(r.wind_min) + ", " + std::to_string(r.wind_max));
@@ -32,8 +34,6 @@ void CheckRanges(const SamplingRanges& r) {
     throw std::invalid_argument("sampling ranges: perturbation factors must be >= 1");
   render::ValidateCameraRanges(r.camera);
 }
-
-}  // namespace
 
 SamplingRanges DefaultRanges(render::SceneKind kind) {
   SamplingRanges r;
@@ -49,7 +49,7 @@ uint64_t SimulationSeed(uint64_t global_seed, int64_t index) {
 
 SimulationSample SampleFlagSimulation(const sim::Theta& base, uint64_t global_seed, int64_t index,
                                       const SamplingRanges& ranges) {
-  CheckRanges(ranges);
+  ValidateRanges(ranges);
   SimulationSample s;
   s.index = index;
   s.seed = SimulationSeed(global_seed, index);
@@ -68,7 +68,7 @@ SimulationSample SampleFlagSimulation(const sim::Theta& base, uint64_t global_se
 
 SimulationSample SampleClothSimulation(const std::vector<Fabric>& fabrics, uint64_t global_seed,
                                        int64_t index, const SamplingRanges& ranges) {
-  CheckRanges(ranges);
+  ValidateRanges(ranges);
   if (fabrics.empty()) throw std::invalid_argument("ClothSim needs at least one fabric");
   SimulationSample s;
   s.index = index;

@@ -38,6 +38,10 @@ struct SamplingRanges {
 // The default ranges of a dataset kind (FlagSim: wind 0-10 m/s; ClothSim: wind 0-5 m/s).
 SamplingRanges DefaultRanges(render::SceneKind kind);
 
+// Throws std::invalid_argument naming the range unless 0 <= wind_min <= wind_max, the factors
+// are >= 1, the cloth area weights 0 < min <= max and the cameras valid (ValidateCameraRanges).
+void ValidateRanges(const SamplingRanges& r);
+
 // One fabric of ClothSim.
 struct Fabric {
   std::string name;       // file stem, e.g. "gray-interlock"
