@@ -119,7 +119,9 @@ Prepared Prepare(const DatasetOptions& o) {
   p.base_theta = sim::SceneTheta(p.setup);
   p.scene_name = fs::path(scene_path).filename().string();
   p.ranges = o.ranges ? *o.ranges : DefaultRanges(o.kind);
-  ValidateRanges(p.ranges);  // once, before any simulation, not per worker
+  // Before any folder is made: a bad range fails the run here instead of failing every simulation
+  // (the samplers check again, cheaply, for callers that use them directly).
+  ValidateRanges(p.ranges);
   if (o.kind == render::SceneKind::kCloth)
     p.fabrics = LoadFabrics(o.materials_dir.empty() ? DefaultMaterialsDir() : o.materials_dir,
                             scene_path, o.exclude_fabrics);
