@@ -57,6 +57,11 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_flag("--phase-steps", o.model.phase_steps,
                 "SDN: add the strongest peak's phase step to the right and lower neighbour (cos, sin): a "
                 "travelling wave's wavenumber");
+  sub->add_option("--spectral-pool", o.model.spectral_pool,
+                  "SDN: average-pool the spectral maps by this factor before the trunk (--input-size 128 "
+                  "--spectral-pool 2: 128-px spectra, a 64-px trunk's cost)")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
   sub->add_flag("--mean-map", o.model.mean_map, "SDN: add the clip's per-pixel temporal mean (the pose) as a channel");
   sub->add_option("--threads", o.threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--device", o.device, "cpu, cuda or auto (CUDA when libtorch finds one)")

@@ -36,6 +36,7 @@ std::string ModelConfig::Name() const {
     if (dft_size != 0) s << "d" << dft_size;
     if (local_peaks) s << "p";
     if (phase_steps) s << "s";
+    if (spectral_pool != 1) s << "/" << spectral_pool;
   }
   else s << arch;
   s << "-w" << width << "-" << input_size << "-" << frames << "f";
@@ -54,7 +55,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"k", c.k},                    {"include_dc", c.include_dc},
           {"mean_map", c.mean_map},      {"dft_size", c.dft_size},
           {"local_peaks", c.local_peaks},  {"phase_steps", c.phase_steps},
-          {"dropout", c.dropout},
+          {"spectral_pool", c.spectral_pool}, {"dropout", c.dropout},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
           {"label_std", c.label_std},    {"std_scale", c.std_scale}};
@@ -83,6 +84,7 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.dft_size = j.contains("dft_size") ? j.at("dft_size").get<int>() : 0;
     c.local_peaks = j.contains("local_peaks") ? j.at("local_peaks").get<bool>() : false;
     c.phase_steps = j.contains("phase_steps") ? j.at("phase_steps").get<bool>() : false;
+    c.spectral_pool = j.contains("spectral_pool") ? j.at("spectral_pool").get<int>() : 1;
     c.dropout = j.contains("dropout") ? j.at("dropout").get<double>() : 0.0;
     c.frame_rate = need("frame_rate").get<double>();
     c.width = need("width").get<int>();
@@ -105,6 +107,12 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
   }
   if (!(c.dropout >= 0 && c.dropout < 1)) {
     throw std::runtime_error(where + ": field \"dropout\" must be in [0, 1), got " + std::to_string(c.dropout));
+  }
+  if (c.spectral_pool < 1 || c.input_size % c.spectral_pool != 0 ||
+      (c.spectral_pool != 1 && c.arch != "sdn")) {
+    throw std::runtime_error(where + ": field \"spectral_pool\" must be >= 1, divide \"input_size\" (" +
+                             std::to_string(c.input_size) + ") and be 1 unless \"arch\" is \"sdn\", got " +
+                             std::to_string(c.spectral_pool));
   }
   if (c.dft_size != 0 && c.dft_size < c.frames) {
     throw std::runtime_error(where + ": field \"dft_size\" must be 0 or at least \"frames\" (" +

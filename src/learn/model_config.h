@@ -23,8 +23,12 @@ struct ModelConfig {
   bool mean_map = false;     // SDN: the clip's per-pixel temporal mean as C more trunk channels
   int dft_size = 0;          // SDN: DFT length, zero-padded beyond N_t (0: N_t; SpectralOptions)
   bool local_peaks = false;  // SDN: the k strongest local maxima instead of the k strongest bins
-  bool phase_steps = false;
-  double dropout = 0.0;      // dropout probability on the trunk's pooled features while training  // SDN: 4C more channels, the strongest peak's phase step to the neighbours
+  bool phase_steps = false;  // SDN: 4C more channels, the strongest peak's phase step to the neighbours
+  // SDN: the spectral maps are computed on the input_size clip and average-pooled by this factor
+  // before the trunk, so fine texture's motion reaches a trunk that costs what input_size /
+  // spectral_pool would (1: no pooling). input_size must be a multiple of it.
+  int spectral_pool = 1;
+  double dropout = 0.0;      // dropout probability on the trunk's pooled features while training
   double frame_rate = 25.0;  // [Hz] of the clips the model reads
   int width = 64;            // ResNet-18 base width (64 as the original; 16 trains on a CPU)
   int input_size = 112;      // side of the square input [px] (224 as the seed, 112 for a CPU)
@@ -46,7 +50,8 @@ struct ModelConfig {
   // frame-stack baseline, C for the recurrent one (its trunk reads one frame at a time).
   int TrunkInputChannels() const;
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("sdn-k3m-…" with mean_map,
-  // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps).
+  // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps,
+  // "…s/2-" with spectral_pool 2).
   std::string Name() const;
   // Table 1's "input modality", e.g. "30x112x112".
   std::string Modality() const;

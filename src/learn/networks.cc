@@ -79,6 +79,12 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
                                   std::to_string(config.k));
     }
   }
+  if (config.spectral_pool < 1 || config.input_size % config.spectral_pool != 0 ||
+      (config.spectral_pool != 1 && config.arch != "sdn")) {
+    throw std::invalid_argument("WindNet: spectral_pool " + std::to_string(config.spectral_pool) +
+                                " must be >= 1, divide the input size " + std::to_string(config.input_size) +
+                                " and be 1 unless the model is an SDN");
+  }
   trunk_ = register_module("trunk", ResNet18Trunk(config.TrunkInputChannels(), config.width));
   if (config.arch == "lstm") {
     // Yang et al. read the last hidden state of an LSTM fed one CNN feature vector per frame.
@@ -104,7 +110,13 @@ at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
     // droop), which at low wind says more about the speed than its small oscillations.
     if (config_.mean_map) parts.push_back(clips.mean(2));
     if (config_.phase_steps) parts.push_back(maps.phase);
-    return at::cat(parts, 1);
+    at::Tensor maps_in = at::cat(parts, 1);
+    // Pooling after the per-pixel spectra, not before: a stripe's edge that moves by less than a
+    // pooled pixel still shows its power here, where downsampling the frames first blurs it away.
+    if (config_.spectral_pool > 1) {
+      maps_in = at::avg_pool2d(maps_in, {config_.spectral_pool, config_.spectral_pool});
+    }
+    return maps_in;
   }
   if (config_.arch == "lstm") {
     return clips.transpose(1, 2).reshape({-1, clips.size(1), clips.size(3), clips.size(4)});

@@ -67,7 +67,8 @@ class WindNetImpl : public torch::nn::Module {
   at::Tensor forward(const at::Tensor& clips);
   // The trunk's input images: the stacked spectral maps [N_b, 2kC, H, W] (SDN: log1p of the
   // power, frequency divided by the Nyquist rate, so both are O(1)), the frames as channels
-  // [N_b, N_t·C, H, W] (resnet18), or every frame on its own [N_b·N_t, C, H, W] (lstm).
+  // [N_b, N_t·C, H, W] (resnet18), or every frame on its own [N_b·N_t, C, H, W] (lstm). An SDN
+  // with spectral_pool p > 1 returns its maps average-pooled to [N_b, ·, H/p, W/p].
   at::Tensor TrunkInput(const at::Tensor& clips) const;
   const ModelConfig& config() const { return config_; }
   // Sets the calibration factor of the predicted std (no weight depends on it).

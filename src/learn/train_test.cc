@@ -314,6 +314,57 @@ TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
   EXPECT_EQ(stepped->forward(clips).sizes(), (at::IntArrayRef{1, 2}));
 }
 
+TEST(ModelConfig, SpectralPoolKeepsMotionThatDownsamplingTheFramesErases) {
+  // A checkerboard flickering at 5 Hz: every 2x2 block sums to zero, so averaging the frames
+  // down to half size first leaves no motion at all, while the spectra of the full-size clip,
+  // pooled afterwards, keep its power. The pooled trunk input is the average pool of the
+  // unpooled one, channel for channel.
+  ModelConfig c = TinySdn();
+  c.input_size = 32;
+  c.spectral_pool = 2;
+  EXPECT_EQ(c.Name(), "sdn-k2/2-w4-32-30f");
+  const at::Tensor t = at::arange(30, at::kDouble).to(at::kFloat) / 25.0;
+  const at::Tensor x = at::arange(32).view({1, 32}), y = at::arange(32).view({32, 1});
+  const at::Tensor checker = ((x + y).remainder(2) * 2 - 1).to(at::kFloat);  // [32, 32] of +-1
+  const at::Tensor clip =
+      (at::sin(2 * M_PI * 5.0 * t).view({30, 1, 1}) * checker).view({1, 1, 30, 32, 32});
+  at::NoGradGuard no_grad;
+  WindNet pooled(c);
+  const at::Tensor pooled_in = pooled->TrunkInput(clip);
+  EXPECT_EQ(pooled_in.sizes(), (at::IntArrayRef{1, 4, 16, 16}));
+  ModelConfig full = c;
+  full.spectral_pool = 1;
+  WindNet unpooled(full);
+  EXPECT_TRUE(at::allclose(pooled_in, at::avg_pool2d(unpooled->TrunkInput(clip), {2, 2}), 1e-5, 1e-6));
+  ModelConfig half = full;
+  half.input_size = 16;
+  WindNet small(half);
+  const at::Tensor small_in = small->TrunkInput(at::avg_pool3d(clip, {1, 2, 2}));
+  // Channels 0..k-1 are log1p(power): the strongest peak's power, on average over the image.
+  EXPECT_GT(pooled_in.select(1, 0).mean().item<double>(), 1.0);
+  EXPECT_LT(small_in.select(1, 0).mean().item<double>(), 1e-6);
+  // Round trip, the default for older files, and refusals by field name.
+  EXPECT_EQ(ModelConfigFromJson(ToJson(c), "x.json").spectral_pool, 2);
+  nlohmann::json old = ToJson(c);
+  old.erase("spectral_pool");
+  EXPECT_EQ(ModelConfigFromJson(old, "x.json").spectral_pool, 1);
+  nlohmann::json bad = ToJson(c);
+  bad["spectral_pool"] = 3;  // 32 px do not pool by 3
+  try {
+    ModelConfigFromJson(bad, "run/model.json");
+    ADD_FAILURE() << "spectral_pool 3 on 32 px accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("run/model.json: field \"spectral_pool\""), std::string::npos) << e.what();
+  }
+  ModelConfig odd = c;
+  odd.spectral_pool = 3;
+  EXPECT_THROW(WindNet{odd}, std::invalid_argument);
+  ModelConfig stacked = c;
+  stacked.arch = "resnet18";
+  stacked.frames = 10;
+  EXPECT_THROW(WindNet{stacked}, std::invalid_argument);
+}
+
 TEST(ModelConfig, DropoutActsInTrainingOnlyAndRoundTrips) {
   ModelConfig c = TinySdn();
   c.dropout = 0.5;
