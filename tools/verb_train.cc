@@ -57,6 +57,11 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_flag("--phase-steps", o.model.phase_steps,
                 "SDN: add the strongest peak's phase step to the right and lower neighbour (cos, sin): a "
                 "travelling wave's wavenumber");
+  sub->add_option("--phase-step-far", o.model.phase_step_far,
+                  "SDN with --phase-steps: also the phase step over this many pixels (0: none; a long wave's "
+                  "wavenumber above one pixel's phase noise)")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
   sub->add_option("--spectral-pool", o.model.spectral_pool,
                   "SDN: average-pool the spectral maps by this factor before the trunk (--input-size 128 "
                   "--spectral-pool 2: 128-px spectra, a 64-px trunk's cost)")

@@ -8,7 +8,10 @@
 namespace clothwind::learn {
 
 int ModelConfig::TrunkInputChannels() const {
-  if (arch == "sdn") return (2 * k + (mean_map ? 1 : 0) + (phase_steps ? 4 : 0)) * channels;
+  if (arch == "sdn") {
+    return (2 * k + (mean_map ? 1 : 0) + (phase_steps ? 4 : 0) + (phase_steps && phase_step_far > 1 ? 4 : 0)) *
+           channels;
+  }
   return arch == "lstm" ? channels : frames * channels;
 }
 
@@ -20,6 +23,7 @@ SpectralOptions ModelConfig::Spectral() const {
   o.dft_size = dft_size;
   o.local_peaks = local_peaks;
   o.phase_steps = phase_steps;
+  o.phase_step_far = phase_step_far;
   return o;
 }
 
@@ -36,6 +40,7 @@ std::string ModelConfig::Name() const {
     if (dft_size != 0) s << "d" << dft_size;
     if (local_peaks) s << "p";
     if (phase_steps) s << "s";
+    if (phase_steps && phase_step_far > 1) s << phase_step_far;
     if (spectral_pool != 1) s << "/" << spectral_pool;
   }
   else s << arch;
@@ -55,6 +60,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"k", c.k},                    {"include_dc", c.include_dc},
           {"mean_map", c.mean_map},      {"dft_size", c.dft_size},
           {"local_peaks", c.local_peaks},  {"phase_steps", c.phase_steps},
+          {"phase_step_far", c.phase_step_far},
           {"spectral_pool", c.spectral_pool}, {"dropout", c.dropout},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
@@ -84,6 +90,7 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.dft_size = j.contains("dft_size") ? j.at("dft_size").get<int>() : 0;
     c.local_peaks = j.contains("local_peaks") ? j.at("local_peaks").get<bool>() : false;
     c.phase_steps = j.contains("phase_steps") ? j.at("phase_steps").get<bool>() : false;
+    c.phase_step_far = j.contains("phase_step_far") ? j.at("phase_step_far").get<int>() : 0;
     c.spectral_pool = j.contains("spectral_pool") ? j.at("spectral_pool").get<int>() : 1;
     c.dropout = j.contains("dropout") ? j.at("dropout").get<double>() : 0.0;
     c.frame_rate = need("frame_rate").get<double>();
@@ -107,6 +114,10 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
   }
   if (!(c.dropout >= 0 && c.dropout < 1)) {
     throw std::runtime_error(where + ": field \"dropout\" must be in [0, 1), got " + std::to_string(c.dropout));
+  }
+  if (c.phase_step_far < 0 || c.phase_step_far == 1 || (c.phase_step_far > 1 && !c.phase_steps)) {
+    throw std::runtime_error(where + ": field \"phase_step_far\" must be 0, or at least 2 with \"phase_steps\", got " +
+                             std::to_string(c.phase_step_far));
   }
   if (c.spectral_pool < 1 || c.input_size % c.spectral_pool != 0 ||
       (c.spectral_pool != 1 && c.arch != "sdn")) {

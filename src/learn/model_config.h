@@ -24,6 +24,7 @@ struct ModelConfig {
   int dft_size = 0;          // SDN: DFT length, zero-padded beyond N_t (0: N_t; SpectralOptions)
   bool local_peaks = false;  // SDN: the k strongest local maxima instead of the k strongest bins
   bool phase_steps = false;  // SDN: 4C more channels, the strongest peak's phase step to the neighbours
+  int phase_step_far = 0;    // SDN with phase_steps: 4C more, the step over this many pixels (0: none)
   // SDN: the spectral maps are computed on the input_size clip and average-pooled by this factor
   // before the trunk, so fine texture's motion reaches a trunk that costs what input_size /
   // spectral_pool would (1: no pooling). input_size must be a multiple of it.
@@ -51,7 +52,7 @@ struct ModelConfig {
   int TrunkInputChannels() const;
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("sdn-k3m-…" with mean_map,
   // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps,
-  // "…s/2-" with spectral_pool 2).
+  // "…s4-" with phase_step_far 4, "…s/2-" with spectral_pool 2).
   std::string Name() const;
   // Table 1's "input modality", e.g. "30x112x112".
   std::string Modality() const;

@@ -12,28 +12,29 @@ namespace clothwind::learn {
 
 namespace {
 
-// SpectralMaps::phase from the one-sided spectra [N_b C H W, F] (complex) and each pixel's
-// strongest bin [N_b C H W, 1] (index into F).
+// Phase steps over `distance` pixels from the one-sided spectra [N_b C H W, F] (complex) and each
+// pixel's strongest bin [N_b C H W, 1] (index into F): [N_b, 4C, H, W] (SpectralMaps::phase).
 at::Tensor PhaseSteps(const at::Tensor& spectrum, const at::Tensor& bin, int64_t nb, int64_t c, int64_t h,
-                      int64_t w) {
+                      int64_t w, int64_t distance) {
   const int64_t f = spectrum.size(1);
   at::Tensor re = at::real(spectrum).reshape({nb, c, h, w, f});
   at::Tensor im = at::imag(spectrum).reshape({nb, c, h, w, f});
   at::Tensor index = bin.reshape({nb, c, h, w, 1});
   const double eps = 1e-6 * (re.square() + im.square()).mean().item<double>() + 1e-30;
   // One step along spatial dimension `dim` (2: y, down; 3: x, right): pixel p's bin read at p and
-  // at its neighbour, then their normalised cross product.
+  // at the pixel `distance` further, then their normalised cross product.
+  const int64_t d = distance;
   auto step = [&](int64_t dim) {
     const int64_t n = dim == 2 ? h : w;
-    if (n < 2) return std::make_pair(at::zeros({nb, c, h, w}, re.options()), at::zeros({nb, c, h, w}, re.options()));
-    at::Tensor idx = index.narrow(dim, 0, n - 1);
-    at::Tensor ar = re.narrow(dim, 0, n - 1).gather(4, idx), ai = im.narrow(dim, 0, n - 1).gather(4, idx);
-    at::Tensor br = re.narrow(dim, 1, n - 1).gather(4, idx), bi = im.narrow(dim, 1, n - 1).gather(4, idx);
+    if (n <= d) return std::make_pair(at::zeros({nb, c, h, w}, re.options()), at::zeros({nb, c, h, w}, re.options()));
+    at::Tensor idx = index.narrow(dim, 0, n - d);
+    at::Tensor ar = re.narrow(dim, 0, n - d).gather(4, idx), ai = im.narrow(dim, 0, n - d).gather(4, idx);
+    at::Tensor br = re.narrow(dim, d, n - d).gather(4, idx), bi = im.narrow(dim, d, n - d).gather(4, idx);
     at::Tensor norm = at::sqrt((ar.square() + ai.square()) * (br.square() + bi.square())) + eps;
     at::Tensor cos = ((ar * br + ai * bi) / norm).squeeze(4);
     at::Tensor sin = ((ai * br - ar * bi) / norm).squeeze(4);
-    // Pad the missing last row/column with zeros.
-    std::vector<int64_t> pad = dim == 3 ? std::vector<int64_t>{0, 1} : std::vector<int64_t>{0, 0, 0, 1};
+    // Pad the missing last rows/columns with zeros.
+    std::vector<int64_t> pad = dim == 3 ? std::vector<int64_t>{0, d} : std::vector<int64_t>{0, 0, 0, d};
     return std::make_pair(at::constant_pad_nd(cos, pad, 0.0), at::constant_pad_nd(sin, pad, 0.0));
   };
   auto [rc, rs] = step(3);
@@ -76,6 +77,10 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
                                 std::to_string(candidates) + " frequency bins");
   }
   if (!(frame_rate > 0)) throw std::invalid_argument("SpectralDecomposition: frame_rate must be > 0");
+  if (options.phase_step_far < 0 || options.phase_step_far == 1 || (options.phase_step_far > 1 && !options.phase_steps)) {
+    throw std::invalid_argument("SpectralDecomposition: phase_step_far = " + std::to_string(options.phase_step_far) +
+                                " (0, or a distance of at least 2 pixels with phase_steps, expected)");
+  }
   // [N_b C H W, N_t]: one row per pixel signal.
   at::Tensor signals = x.permute({0, 1, 3, 4, 2}).reshape({-1, nt});
   at::Tensor window = at::hann_window(nt, /*periodic=*/true, x.options());
@@ -112,7 +117,13 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
     return t.reshape({nb, c, h, w, k}).permute({0, 1, 4, 2, 3}).reshape({nb, c * k, h, w});
   };
   SpectralMaps maps{to_map(power), to_map(frequency), at::Tensor()};
-  if (options.phase_steps) maps.phase = PhaseSteps(spectrum, bin.narrow(1, 0, 1) + first, nb, c, h, w);
+  if (options.phase_steps) {
+    const at::Tensor strongest = bin.narrow(1, 0, 1) + first;
+    maps.phase = PhaseSteps(spectrum, strongest, nb, c, h, w, 1);
+    if (options.phase_step_far > 1) {
+      maps.phase = at::cat({maps.phase, PhaseSteps(spectrum, strongest, nb, c, h, w, options.phase_step_far)}, 1);
+    }
+  }
   return maps;
 }
 

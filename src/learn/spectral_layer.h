@@ -29,6 +29,10 @@ struct SpectralOptions {
   // wave travelling along the flag shows as a steady phase step between neighbours (its
   // wavenumber), and the step, unlike the phase itself, does not depend on when the clip began.
   bool phase_steps = false;
+  // With phase_steps, also the step over this many pixels (0: none; else >= 2). A long wave
+  // turns by only a few degrees between neighbours, within the noise of one pixel's phase; over
+  // several pixels the same wave turns further, so its wavenumber reads above that noise.
+  int phase_step_far = 0;
 };
 
 // Power and frequency maps of a batch of clips.
@@ -40,7 +44,9 @@ struct SpectralMaps {
   // with X(p) the DFT of pixel p at p's strongest selected bin, and X(q) that of the neighbour q
   // at the same bin, X(p)·conj(X(q)) / (|X(p)||X(q)| + ε), ε = 1e-6 · the clip's mean |X|²
   // (so still pixels read ~0). A wave e^{i(ωt − κx)} reads (cos κ, sin κ). The last column's
-  // right step and the last row's down step are 0.
+  // right step and the last row's down step are 0. With phase_step_far = D, [N_b, 8C, H, W]:
+  // channels 4C + 4c..4C + 4c+3 are the same steps to x+D and y+D (a wave reads (cos κD, sin κD)),
+  // 0 in the last D columns / rows.
   at::Tensor phase;
 };
 

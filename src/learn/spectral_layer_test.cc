@@ -295,6 +295,35 @@ TEST(SpectralLayer, PhaseStepsReadATravellingWavesWavenumber) {
   EXPECT_FALSE(SpectralDecomposition(still, 2, kFps).phase.defined());
 }
 
+TEST(SpectralLayer, FarPhaseStepsTurnByTheWavenumberTimesTheDistance) {
+  // Over 3 pixels the same wave turns by 3κ: channels 4..7 read (cos 3κx, sin 3κx, cos 3κy,
+  // sin 3κy) where the pixel 3 further exists, 0 elsewhere; channels 0..3 are the near steps.
+  const double kx = 0.15, ky = -0.1;
+  SpectralOptions o;
+  o.k = 2;
+  o.phase_steps = true;
+  o.phase_step_far = 3;
+  const at::Tensor wave = TravellingWave(30, 5, 6, 2.5, kx, ky, 0.7);
+  SpectralMaps maps = SpectralDecomposition(wave, o);
+  ASSERT_EQ(maps.phase.sizes(), (at::IntArrayRef{1, 8, 5, 6}));
+  o.phase_step_far = 0;
+  EXPECT_TRUE(at::allclose(maps.phase.narrow(1, 0, 4), SpectralDecomposition(wave, o).phase, 1e-12, 1e-12));
+  auto ph = maps.phase.accessor<double, 4>();
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 6; ++x) {
+      EXPECT_NEAR(ph[0][4][y][x], x < 3 ? std::cos(3 * kx) : 0.0, 1e-6) << y << "," << x;
+      EXPECT_NEAR(ph[0][5][y][x], x < 3 ? std::sin(3 * kx) : 0.0, 1e-6) << y << "," << x;
+      EXPECT_NEAR(ph[0][6][y][x], y < 2 ? std::cos(3 * ky) : 0.0, 1e-6) << y << "," << x;
+      EXPECT_NEAR(ph[0][7][y][x], y < 2 ? std::sin(3 * ky) : 0.0, 1e-6) << y << "," << x;
+    }
+  // A distance of 1 repeats the near steps, and far steps need the near ones: both refused.
+  o.phase_step_far = 1;
+  EXPECT_THROW(SpectralDecomposition(wave, o), std::invalid_argument);
+  o.phase_step_far = 3;
+  o.phase_steps = false;
+  EXPECT_THROW(SpectralDecomposition(wave, o), std::invalid_argument);
+}
+
 TEST(SpectralLayer, FloatInputAgreesWithDouble) {
   at::Tensor x = RandomClip(1, 1, 30, 4, 4, 5);
   SpectralMaps d = SpectralDecomposition(x, 2, kFps);

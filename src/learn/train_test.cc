@@ -312,6 +312,27 @@ TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
   WindNet stepped(c);
   stepped->eval();
   EXPECT_EQ(stepped->forward(clips).sizes(), (at::IntArrayRef{1, 2}));
+  // Far phase steps add 4C more, round-trip, default to none in older files, and are refused
+  // without the near ones, by field name in a file and by the network.
+  c.phase_step_far = 4;
+  EXPECT_EQ(c.TrunkInputChannels(), 12);
+  EXPECT_EQ(c.Name(), "sdn-k2d120ps4-w4-16-30f");
+  EXPECT_EQ(ModelConfigFromJson(ToJson(c), "x.json").phase_step_far, 4);
+  EXPECT_EQ(ModelConfigFromJson(old, "x.json").phase_step_far, 0);
+  WindNet far(c);
+  far->eval();
+  EXPECT_EQ(far->forward(clips).sizes(), (at::IntArrayRef{1, 2}));
+  nlohmann::json no_near = ToJson(c);
+  no_near["phase_steps"] = false;
+  try {
+    ModelConfigFromJson(no_near, "run/model.json");
+    ADD_FAILURE() << "phase_step_far without phase_steps accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("run/model.json: field \"phase_step_far\""), std::string::npos) << e.what();
+  }
+  ModelConfig bad_far = c;
+  bad_far.phase_step_far = 1;
+  EXPECT_THROW(WindNet{bad_far}, std::invalid_argument);
 }
 
 TEST(ModelConfig, SpectralPoolKeepsMotionThatDownsamplingTheFramesErases) {
