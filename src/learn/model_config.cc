@@ -9,8 +9,8 @@ namespace clothwind::learn {
 
 int ModelConfig::TrunkInputChannels() const {
   if (arch == "sdn") {
-    return (2 * k + (mean_map ? 1 : 0) + (phase_steps ? 4 : 0) + (phase_steps && phase_step_far > 1 ? 4 : 0)) *
-           channels;
+    const int phase = phase_steps ? (phase_step_far > 1 ? 8 : 4) : 0;
+    return (2 * k + (mean_map ? 1 : 0) + phase) * channels;
   }
   return arch == "lstm" ? channels : frames * channels;
 }
@@ -29,6 +29,14 @@ SpectralOptions ModelConfig::Spectral() const {
 
 int ModelConfig::SpectralCandidates() const {
   return DftLength() / 2 + (include_dc ? 1 : 0);
+}
+
+bool ModelConfig::PhaseStepFarIsValid() const {
+  return phase_step_far == 0 || (phase_step_far >= 2 && phase_steps);
+}
+
+bool ModelConfig::SpectralPoolIsValid() const {
+  return spectral_pool >= 1 && input_size % spectral_pool == 0 && (spectral_pool == 1 || arch == "sdn");
 }
 
 bool IsKnownArch(const std::string& arch) { return arch == "sdn" || arch == "resnet18" || arch == "lstm"; }
@@ -115,12 +123,11 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
   if (!(c.dropout >= 0 && c.dropout < 1)) {
     throw std::runtime_error(where + ": field \"dropout\" must be in [0, 1), got " + std::to_string(c.dropout));
   }
-  if (c.phase_step_far < 0 || c.phase_step_far == 1 || (c.phase_step_far > 1 && !c.phase_steps)) {
+  if (!c.PhaseStepFarIsValid()) {
     throw std::runtime_error(where + ": field \"phase_step_far\" must be 0, or at least 2 with \"phase_steps\", got " +
                              std::to_string(c.phase_step_far));
   }
-  if (c.spectral_pool < 1 || c.input_size % c.spectral_pool != 0 ||
-      (c.spectral_pool != 1 && c.arch != "sdn")) {
+  if (!c.SpectralPoolIsValid()) {
     throw std::runtime_error(where + ": field \"spectral_pool\" must be >= 1, divide \"input_size\" (" +
                              std::to_string(c.input_size) + ") and be 1 unless \"arch\" is \"sdn\", got " +
                              std::to_string(c.spectral_pool));

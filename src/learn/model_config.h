@@ -46,6 +46,10 @@ struct ModelConfig {
   int DftLength() const { return dft_size == 0 ? frames : dft_size; }
   // Frequency bins the spectral layer offers this model (what k may be at most).
   int SpectralCandidates() const;
+  // phase_step_far is 0, or a distance of at least 2 pixels with phase_steps on.
+  bool PhaseStepFarIsValid() const;
+  // spectral_pool is >= 1, divides input_size, and is 1 unless the model is an SDN.
+  bool SpectralPoolIsValid() const;
 
   // Channels entering the ResNet trunk: 2kC (+C with mean_map) for the SDN, N_t·C for the
   // frame-stack baseline, C for the recurrent one (its trunk reads one frame at a time).

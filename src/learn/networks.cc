@@ -79,13 +79,11 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
                                   std::to_string(config.k));
     }
   }
-  if (config.phase_step_far < 0 || config.phase_step_far == 1 ||
-      (config.phase_step_far > 1 && (!config.phase_steps || config.arch != "sdn"))) {
+  if (!config.PhaseStepFarIsValid() || (config.phase_step_far != 0 && config.arch != "sdn")) {
     throw std::invalid_argument("WindNet: phase_step_far " + std::to_string(config.phase_step_far) +
                                 " must be 0, or a distance of at least 2 pixels on an SDN with phase steps");
   }
-  if (config.spectral_pool < 1 || config.input_size % config.spectral_pool != 0 ||
-      (config.spectral_pool != 1 && config.arch != "sdn")) {
+  if (!config.SpectralPoolIsValid()) {
     throw std::invalid_argument("WindNet: spectral_pool " + std::to_string(config.spectral_pool) +
                                 " must be >= 1, divide the input size " + std::to_string(config.input_size) +
                                 " and be 1 unless the model is an SDN");

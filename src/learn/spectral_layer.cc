@@ -12,19 +12,20 @@ namespace clothwind::learn {
 
 namespace {
 
-// Phase steps over `distance` pixels from the one-sided spectra [N_b C H W, F] (complex) and each
-// pixel's strongest bin [N_b C H W, 1] (index into F): [N_b, 4C, H, W] (SpectralMaps::phase).
+// Phase steps over each of `distances` pixels from the one-sided spectra [N_b C H W, F] (complex)
+// and each pixel's strongest bin [N_b C H W, 1] (index into F): [N_b, 4C·#distances, H, W]
+// (SpectralMaps::phase), one 4C block per distance in order. The spectrum is split and its
+// scale ε found once for all distances.
 at::Tensor PhaseSteps(const at::Tensor& spectrum, const at::Tensor& bin, int64_t nb, int64_t c, int64_t h,
-                      int64_t w, int64_t distance) {
+                      int64_t w, const std::vector<int64_t>& distances) {
   const int64_t f = spectrum.size(1);
   at::Tensor re = at::real(spectrum).reshape({nb, c, h, w, f});
   at::Tensor im = at::imag(spectrum).reshape({nb, c, h, w, f});
   at::Tensor index = bin.reshape({nb, c, h, w, 1});
   const double eps = 1e-6 * (re.square() + im.square()).mean().item<double>() + 1e-30;
   // One step along spatial dimension `dim` (2: y, down; 3: x, right): pixel p's bin read at p and
-  // at the pixel `distance` further, then their normalised cross product.
-  const int64_t d = distance;
-  auto step = [&](int64_t dim) {
+  // at the pixel d further, then their normalised cross product.
+  auto step = [&](int64_t dim, int64_t d) {
     const int64_t n = dim == 2 ? h : w;
     if (n <= d) return std::make_pair(at::zeros({nb, c, h, w}, re.options()), at::zeros({nb, c, h, w}, re.options()));
     at::Tensor idx = index.narrow(dim, 0, n - d);
@@ -37,10 +38,14 @@ at::Tensor PhaseSteps(const at::Tensor& spectrum, const at::Tensor& bin, int64_t
     std::vector<int64_t> pad = dim == 3 ? std::vector<int64_t>{0, d} : std::vector<int64_t>{0, 0, 0, d};
     return std::make_pair(at::constant_pad_nd(cos, pad, 0.0), at::constant_pad_nd(sin, pad, 0.0));
   };
-  auto [rc, rs] = step(3);
-  auto [dc, ds] = step(2);
-  // [N_b, C, 4, H, W] -> [N_b, 4C, H, W], channel 4c + (0..3).
-  return at::stack({rc, rs, dc, ds}, 2).reshape({nb, 4 * c, h, w});
+  std::vector<at::Tensor> blocks;
+  for (const int64_t d : distances) {
+    auto [rc, rs] = step(3, d);
+    auto [dc, ds] = step(2, d);
+    // [N_b, C, 4, H, W] -> [N_b, 4C, H, W], channel 4c + (0..3).
+    blocks.push_back(at::stack({rc, rs, dc, ds}, 2).reshape({nb, 4 * c, h, w}));
+  }
+  return blocks.size() == 1 ? blocks[0] : at::cat(blocks, 1);
 }
 
 }  // namespace
@@ -118,11 +123,9 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
   };
   SpectralMaps maps{to_map(power), to_map(frequency), at::Tensor()};
   if (options.phase_steps) {
-    const at::Tensor strongest = bin.narrow(1, 0, 1) + first;
-    maps.phase = PhaseSteps(spectrum, strongest, nb, c, h, w, 1);
-    if (options.phase_step_far > 1) {
-      maps.phase = at::cat({maps.phase, PhaseSteps(spectrum, strongest, nb, c, h, w, options.phase_step_far)}, 1);
-    }
+    std::vector<int64_t> distances = {1};
+    if (options.phase_step_far > 1) distances.push_back(options.phase_step_far);
+    maps.phase = PhaseSteps(spectrum, bin.narrow(1, 0, 1) + first, nb, c, h, w, distances);
   }
   return maps;
 }
