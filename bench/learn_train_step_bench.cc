@@ -3,9 +3,12 @@
 // clips of 30 frames, for the input sizes and spectral pooling the SDN trains with. Why: the
 // layer has no weights but runs on every pixel of every frame, so at a larger input it can
 // cost as much as the trunk it feeds (docs/sdn.md, "Spectra of the full frame"). Prints a table
-// of wall and process-CPU milliseconds (medians over --repeats).
+// of wall and process-CPU milliseconds (medians over --repeats). With --device cuda the clips,
+// network and optimiser live on the GPU and each timed call ends in a device synchronisation, so
+// wall time is the GPU's (scripts/device-check runs it so on a lent GPU machine).
 //
-//   learn_train_step_bench [--repeats N] [--threads T] [--batch B]
+//   learn_train_step_bench [--repeats N] [--threads T] [--batch B] [--device cpu|cuda]
+//                          [--cases SIZE:POOL,...]   (default 64:1,96:1,128:2,128:1)
 
 #include <algorithm>
 #include <cstdio>
@@ -14,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include <torch/cuda.h>
 #include <torch/torch.h>
 
 #include "bench_clock.h"
@@ -35,14 +39,35 @@ struct Timing {
   double wall_ms, cpu_ms;
 };
 
-// Median wall and CPU time of `repeats` calls of f (after one warm-up call).
+// Parses "64:1,128:2" into cases; false on anything else.
+bool ParseCases(const std::string& text, std::vector<Case>* cases) {
+  cases->clear();
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t end = std::min(text.find(',', start), text.size());
+    int size = 0, pool = 0;
+    char tail = 0;
+    if (std::sscanf(text.substr(start, end - start).c_str(), "%d:%d%c", &size, &pool, &tail) != 2 || size < 8 ||
+        pool < 1 || size % pool != 0) {
+      return false;
+    }
+    cases->push_back({size, pool});
+    start = end + 1;
+  }
+  return !cases->empty();
+}
+
+// Median wall and CPU time of `repeats` calls of f (after one warm-up call); on a GPU each call
+// waits for the device, since kernels run asynchronously.
 template <typename F>
-Timing Measure(int repeats, F&& f) {
+Timing Measure(int repeats, bool cuda, F&& f) {
   f();
+  if (cuda) torch::cuda::synchronize();
   std::vector<double> wall, cpu;
   for (int r = 0; r < repeats; ++r) {
     const double w0 = WallMs(), c0 = ProcessCpuMs();
     f();
+    if (cuda) torch::cuda::synchronize();
     wall.push_back(WallMs() - w0);
     cpu.push_back(ProcessCpuMs() - c0);
   }
@@ -55,20 +80,33 @@ Timing Measure(int repeats, F&& f) {
 
 int main(int argc, char** argv) {
   int repeats = 10, threads = 2, batch = 16;
-  for (int i = 1; i < argc; ++i) {
+  std::string device_name = "cpu";
+  std::vector<Case> cases = {{64, 1}, {96, 1}, {128, 2}, {128, 1}};
+  bool ok = true;
+  for (int i = 1; i < argc && ok; ++i) {
     if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--batch") && i + 1 < argc) batch = std::max(1, std::atoi(argv[++i]));
-    else {
-      std::fprintf(stderr, "usage: learn_train_step_bench [--repeats N] [--threads T] [--batch B]\n");
-      return 2;
-    }
+    else if (!std::strcmp(argv[i], "--device") && i + 1 < argc) device_name = argv[++i];
+    else if (!std::strcmp(argv[i], "--cases") && i + 1 < argc) ok = ParseCases(argv[++i], &cases);
+    else ok = false;
   }
+  if (!ok || (device_name != "cpu" && device_name != "cuda")) {
+    std::fprintf(stderr,
+                 "usage: learn_train_step_bench [--repeats N] [--threads T] [--batch B] [--device cpu|cuda]\n"
+                 "                              [--cases SIZE:POOL,...]  (SIZE >= 8, divisible by POOL >= 1)\n");
+    return 2;
+  }
+  const bool cuda = device_name == "cuda";
+  if (cuda && !torch::cuda::is_available()) {
+    std::fprintf(stderr, "learn_train_step_bench: --device cuda, but libtorch finds no CUDA device\n");
+    return 1;
+  }
+  const at::Device device = cuda ? at::Device(at::kCUDA) : at::Device(at::kCPU);
   at::set_num_threads(threads);
   at::globalContext().setFlushDenormal(true);
-  const std::vector<Case> cases = {{64, 1}, {96, 1}, {128, 2}, {128, 1}};
-  std::printf("SDN training step, batch %d x 30 frames, width 48, k 3, phase steps, %d thread(s), median of %d\n",
-              batch, threads, repeats);
+  std::printf("SDN training step on %s, batch %d x 30 frames, width 48, k 3, phase steps, %d thread(s), median of %d\n",
+              device_name.c_str(), batch, threads, repeats);
   std::printf("%-6s %-5s | %-17s | %-17s | %-17s\n", "input", "pool", "layer wall/cpu ms", "trunk input ms",
               "whole step ms");
   for (const Case& c : cases) {
@@ -82,19 +120,20 @@ int main(int argc, char** argv) {
     config.spectral_pool = c.spectral_pool;
     at::manual_seed(1);
     cl::WindNet net(config);
+    net->to(device);
     net->train();
     torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(1e-3).weight_decay(1e-4));
-    const at::Tensor clips = at::randn({batch, 1, 30, c.input_size, c.input_size});
-    const at::Tensor target = at::randn({batch});
-    const Timing layer = Measure(repeats, [&] {
+    const at::Tensor clips = at::randn({batch, 1, 30, c.input_size, c.input_size}).to(device);
+    const at::Tensor target = at::randn({batch}).to(device);
+    const Timing layer = Measure(repeats, cuda, [&] {
       at::NoGradGuard no_grad;
       cl::SpectralDecomposition(clips, config.Spectral());
     });
-    const Timing input = Measure(repeats, [&] {
+    const Timing input = Measure(repeats, cuda, [&] {
       at::NoGradGuard no_grad;
       net->TrunkInput(clips);
     });
-    const Timing step = Measure(repeats, [&] {
+    const Timing step = Measure(repeats, cuda, [&] {
       adam.zero_grad();
       cl::WindLoss(net->forward(clips), target).backward();
       adam.step();

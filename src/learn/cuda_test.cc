@@ -1,0 +1,161 @@
+// The spectral layer, the SDN and the shipped model on a CUDA device against the CPU. The layer
+// and networks are written with device-agnostic ATen calls, so they should give the CPU's
+// answer on a GPU up to rounding; this is the check that nothing in them (a window, a padding
+// tensor, an index) is made on the CPU and silently copied, or fails on CUDA. Each test skips
+// where libtorch finds no CUDA device (Debian's libtorch is built without CUDA, so CI skips
+// them); scripts/device-check builds and runs them on a GPU machine.
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <ATen/ATen.h>
+#include <ATen/Context.h>
+#include <gtest/gtest.h>
+#include <torch/cuda.h>
+
+#include "learn/networks.h"
+#include "learn/spectral_layer.h"
+
+namespace clothwind::learn {
+namespace {
+
+#define SKIP_WITHOUT_CUDA()                                                        \
+  if (!torch::cuda::is_available()) {                                             \
+    GTEST_SKIP() << "libtorch finds no CUDA device (a CPU-only build or no GPU)";  \
+  }
+
+// Relative difference ‖a − b‖ / ‖b‖ of two tensors on any devices, in double on the CPU.
+double RelativeDifference(const at::Tensor& a, const at::Tensor& b) {
+  const at::Tensor da = a.detach().to(at::kCPU).to(at::kDouble), db = b.detach().to(at::kCPU).to(at::kDouble);
+  return (da - db).norm().item<double>() / std::max(db.norm().item<double>(), 1e-300);
+}
+
+// A clip of travelling waves plus noise, [nb, 1, nt, h, w]: every pixel has a clear strongest
+// peak (so the ranking of bins is not decided by rounding), and neighbours differ in phase.
+at::Tensor WaveClip(int64_t nb, int64_t nt, int64_t h, int64_t w, at::ScalarType type, uint64_t seed) {
+  at::manual_seed(seed);
+  const at::Tensor t = at::arange(nt, at::kDouble).view({1, 1, nt, 1, 1}) / 25.0;
+  const at::Tensor x = at::arange(w, at::kDouble).view({1, 1, 1, 1, w});
+  const at::Tensor y = at::arange(h, at::kDouble).view({1, 1, 1, h, 1});
+  const at::Tensor f = 1.0 + 4.0 * at::rand({nb, 1, 1, 1, 1}, at::kDouble);  // [Hz]
+  at::Tensor clip = at::sin(2 * M_PI * f * t - 0.3 * x - 0.1 * y) +
+                    0.3 * at::sin(2 * M_PI * 2.7 * f * t + 0.2 * x) +
+                    0.05 * at::randn({nb, 1, nt, h, w}, at::kDouble);
+  return clip.to(type);
+}
+
+TEST(Cuda, SpectralLayerMatchesTheCpuWithEveryOption) {
+  SKIP_WITHOUT_CUDA();
+  // Double precision on both devices: the ranking of bins then cannot differ by rounding, so
+  // frequencies must agree exactly and powers to double rounding.
+  const at::Tensor clip = at::cat({WaveClip(2, 30, 12, 16, at::kDouble, 1),
+                                   at::randn({1, 1, 30, 12, 16}, at::kDouble)});
+  for (const bool padded : {false, true}) {
+    SpectralOptions o;
+    o.k = 3;
+    o.phase_steps = true;
+    o.phase_step_far = 4;
+    if (padded) {
+      o.dft_size = 64;
+      o.local_peaks = true;
+    }
+    const SpectralMaps cpu = SpectralDecomposition(clip, o);
+    const SpectralMaps gpu = SpectralDecomposition(clip.to(at::kCUDA), o);
+    ASSERT_TRUE(gpu.power.is_cuda()) << "the maps stay on the input's device";
+    ASSERT_TRUE(gpu.phase.is_cuda());
+    EXPECT_EQ(gpu.power.sizes(), cpu.power.sizes());
+    EXPECT_LT(RelativeDifference(gpu.power, cpu.power), 1e-10) << "padded " << padded;
+    EXPECT_TRUE(at::equal(gpu.frequency.to(at::kCPU), cpu.frequency)) << "padded " << padded;
+    EXPECT_LT(RelativeDifference(gpu.phase, cpu.phase), 1e-9) << "padded " << padded;
+  }
+}
+
+TEST(Cuda, SpectralLayerInFloatAgreesWithDoubleOnTheGpu) {
+  SKIP_WITHOUT_CUDA();
+  // The training precision on the GPU against double on the CPU: cuFFT's float rounding must
+  // stay as small as pocketfft's (spectral_layer_test's FloatInputAgreesWithDouble bound).
+  const at::Tensor clip = WaveClip(2, 30, 10, 10, at::kDouble, 2);
+  const SpectralMaps ref = SpectralDecomposition(clip, 3, 25.0);
+  const SpectralMaps gpu = SpectralDecomposition(clip.to(at::kFloat).to(at::kCUDA), 3, 25.0);
+  EXPECT_EQ(gpu.power.scalar_type(), at::kFloat);
+  EXPECT_LT(RelativeDifference(gpu.power, ref.power), 1e-5);
+  EXPECT_TRUE(at::allclose(gpu.frequency.to(at::kCPU).to(at::kDouble), ref.frequency, 1e-6, 1e-6));
+}
+
+// A small SDN of every option the shipped models use, in the given mode.
+ModelConfig SmallSdn() {
+  ModelConfig config;
+  config.arch = "sdn";
+  config.frames = 30;
+  config.k = 3;
+  config.width = 8;
+  config.input_size = 32;
+  config.phase_steps = true;
+  config.spectral_pool = 2;
+  return config;
+}
+
+TEST(Cuda, SdnForwardAndGradientsMatchTheCpu) {
+  SKIP_WITHOUT_CUDA();
+  // TF32 would round convolution inputs to 10 mantissa bits (errors ~1e-3); the comparison is
+  // of the same float32 arithmetic on two devices.
+  at::globalContext().setAllowTF32CuDNN(false);
+  at::globalContext().setAllowTF32CuBLAS(false);
+  at::manual_seed(3);
+  WindNet net(SmallSdn());
+  net->train();  // batch statistics, as in training
+  const at::Tensor clip = WaveClip(4, 30, 32, 32, at::kFloat, 4);
+  const at::Tensor target = at::randn({4});
+
+  auto step = [&](const at::Device& device) {
+    net->to(device);
+    net->zero_grad();
+    const at::Tensor out = net->forward(clip.to(device));
+    WindLoss(out, target.to(device)).backward();
+    std::vector<at::Tensor> grads;
+    for (const auto& p : net->parameters()) grads.push_back(p.grad().to(at::kCPU).clone());
+    return std::make_pair(out.detach().to(at::kCPU), grads);
+  };
+  // Batch norm's running statistics move with every training forward, so each device starts
+  // from the same copy of them.
+  std::vector<at::Tensor> buffers;
+  for (const auto& b : net->buffers()) buffers.push_back(b.clone());
+  const auto [cpu_out, cpu_grads] = step(at::kCPU);
+  {
+    at::NoGradGuard no_grad;
+    const auto now = net->buffers();
+    for (size_t i = 0; i < now.size(); ++i) now[i].copy_(buffers[i]);
+  }
+  const auto [gpu_out, gpu_grads] = step(at::kCUDA);
+  EXPECT_LT(RelativeDifference(gpu_out, cpu_out), 1e-4);
+  ASSERT_EQ(gpu_grads.size(), cpu_grads.size());
+  for (size_t i = 0; i < cpu_grads.size(); ++i) {
+    EXPECT_LT(RelativeDifference(gpu_grads[i], cpu_grads[i]), 1e-3) << "parameter " << i;
+  }
+}
+
+TEST(Cuda, ShippedModelGivesTheSameEstimateOnTheGpu) {
+  SKIP_WITHOUT_CUDA();
+  const char* source = std::getenv("CLOTHWIND_SOURCE_DIR");
+  ASSERT_NE(source, nullptr) << "CLOTHWIND_SOURCE_DIR is set by CTest and scripts/device-check";
+  at::globalContext().setAllowTF32CuDNN(false);
+  at::globalContext().setAllowTF32CuBLAS(false);
+  WindNet net = LoadWindNet(std::filesystem::path(source) / "models/sdn.pt");
+  const ModelConfig& config = net->config();
+  at::Tensor clip = WaveClip(8, config.frames, config.input_size, config.input_size, at::kFloat, 5);
+  // Per-clip normalisation, as the dataset reader and the Predictor apply it.
+  clip = (clip - clip.mean({1, 2, 3, 4}, true)) / clip.std({1, 2, 3, 4}, true, true);
+  at::NoGradGuard no_grad;
+  const at::Tensor cpu = net->forward(clip);
+  net->to(at::kCUDA);
+  const at::Tensor gpu = net->forward(clip.to(at::kCUDA)).to(at::kCPU);
+  // Column 0 in m/s: the estimate a user reads.
+  const at::Tensor speed_difference = (gpu.select(1, 0) - cpu.select(1, 0)).abs() * config.label_std;
+  EXPECT_LT(speed_difference.max().item<double>(), 1e-3) << "m/s";
+  EXPECT_LT((gpu.select(1, 1) - cpu.select(1, 1)).abs().max().item<double>(), 1e-3) << "log variance";
+}
+
+}  // namespace
+}  // namespace clothwind::learn
