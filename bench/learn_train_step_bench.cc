@@ -7,7 +7,7 @@
 // network and optimiser live on the GPU and each timed call ends in a device synchronisation, so
 // wall time is the GPU's (scripts/device-check runs it so on a lent GPU machine).
 //
-//   learn_train_step_bench [--repeats N] [--threads T] [--batch B] [--device cpu|cuda]
+//   learn_train_step_bench [--repeats N] [--threads T] [--batch B] [--width W] [--device cpu|cuda]
 //                          [--cases SIZE:POOL,...]   (default 64:1,96:1,128:2,128:1)
 
 #include <algorithm>
@@ -79,7 +79,7 @@ Timing Measure(int repeats, bool cuda, F&& f) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int repeats = 10, threads = 2, batch = 16;
+  int repeats = 10, threads = 2, batch = 16, width = 48;
   std::string device_name = "cpu";
   std::vector<Case> cases = {{64, 1}, {96, 1}, {128, 2}, {128, 1}};
   bool ok = true;
@@ -87,13 +87,14 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--batch") && i + 1 < argc) batch = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--width") && i + 1 < argc) width = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--device") && i + 1 < argc) device_name = argv[++i];
     else if (!std::strcmp(argv[i], "--cases") && i + 1 < argc) ok = ParseCases(argv[++i], &cases);
     else ok = false;
   }
   if (!ok || (device_name != "cpu" && device_name != "cuda")) {
     std::fprintf(stderr,
-                 "usage: learn_train_step_bench [--repeats N] [--threads T] [--batch B] [--device cpu|cuda]\n"
+                 "usage: learn_train_step_bench [--repeats N] [--threads T] [--batch B] [--width W] [--device cpu|cuda]\n"
                  "                              [--cases SIZE:POOL,...]  (SIZE >= 8, divisible by POOL >= 1)\n");
     return 2;
   }
@@ -105,8 +106,8 @@ int main(int argc, char** argv) {
   const at::Device device = cuda ? at::Device(at::kCUDA) : at::Device(at::kCPU);
   at::set_num_threads(threads);
   at::globalContext().setFlushDenormal(true);
-  std::printf("SDN training step on %s, batch %d x 30 frames, width 48, k 3, phase steps, %d thread(s), median of %d\n",
-              device_name.c_str(), batch, threads, repeats);
+  std::printf("SDN training step on %s, batch %d x 30 frames, width %d, k 3, phase steps, %d thread(s), median of %d\n",
+              device_name.c_str(), batch, width, threads, repeats);
   std::printf("%-6s %-5s | %-17s | %-17s | %-17s\n", "input", "pool", "layer wall/cpu ms", "trunk input ms",
               "whole step ms");
   for (const Case& c : cases) {
@@ -114,7 +115,7 @@ int main(int argc, char** argv) {
     config.arch = "sdn";
     config.frames = 30;
     config.k = 3;
-    config.width = 48;
+    config.width = width;
     config.phase_steps = true;
     config.input_size = c.input_size;
     config.spectral_pool = c.spectral_pool;
