@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,8 @@
 #include <ATen/Context.h>
 #include <gtest/gtest.h>
 #include <torch/cuda.h>
+#include <torch/optim/adam.h>
+#include <torch/serialize.h>
 
 #include "learn/networks.h"
 #include "learn/spectral_layer.h"
@@ -155,6 +158,58 @@ TEST(Cuda, ShippedModelGivesTheSameEstimateOnTheGpu) {
   const at::Tensor speed_difference = (gpu.select(1, 0) - cpu.select(1, 0)).abs() * config.label_std;
   EXPECT_LT(speed_difference.max().item<double>(), 1e-3) << "m/s";
   EXPECT_LT((gpu.select(1, 1) - cpu.select(1, 1)).abs().max().item<double>(), 1e-3) << "log variance";
+}
+
+TEST(Cuda, ANetworkTrainedOnTheGpuSavesAndLoadsOnTheCpu) {
+  SKIP_WITHOUT_CUDA();
+  // A model trained on a GPU ships as a file the CPU nodes load (models/README.md): SaveWindNet
+  // must gather the CUDA tensors, and LoadWindNet must give the trained network's answer on
+  // the CPU. With CLOTHWIND_CUDA_TEST_KEEP=DIR the model and a clip with its expected output
+  // stay in DIR, so that another libtorch (Debian's, on the CPU machine) can be checked too.
+  at::globalContext().setAllowTF32CuDNN(false);
+  at::globalContext().setAllowTF32CuBLAS(false);
+  at::manual_seed(6);
+  WindNet net(SmallSdn());
+  net->to(at::kCUDA);
+  net->train();
+  torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(1e-2));
+  const at::Tensor clip = WaveClip(4, 30, 32, 32, at::kFloat, 7);
+  for (int step = 0; step < 3; ++step) {  // moves the weights and batch norm's statistics
+    adam.zero_grad();
+    WindLoss(net->forward(clip.to(at::kCUDA)), at::randn({4}).to(at::kCUDA)).backward();
+    adam.step();
+  }
+  net->eval();
+  at::Tensor expected;
+  {
+    at::NoGradGuard no_grad;
+    expected = net->forward(clip.to(at::kCUDA)).to(at::kCPU);
+  }
+  const char* keep = std::getenv("CLOTHWIND_CUDA_TEST_KEEP");
+  const std::filesystem::path dir =
+      keep ? std::filesystem::path(keep) : std::filesystem::temp_directory_path() / "clothwind_cuda_test";
+  std::filesystem::create_directories(dir);
+  SaveWindNet(net, dir / "gpu-trained.pt");
+  WindNet loaded = LoadWindNet(dir / "gpu-trained.pt");
+  ASSERT_TRUE(loaded->parameters().front().is_cpu());
+  at::NoGradGuard no_grad;
+  EXPECT_LT(RelativeDifference(loaded->forward(clip), expected), 1e-4);
+  if (keep) torch::save(std::vector<at::Tensor>{clip, expected}, (dir / "gpu-trained-io.pt").string());
+}
+
+TEST(Cuda, ANetworkKeptFromAGpuGivesItsAnswerHere) {
+  // The other half of the test above, on any machine: with CLOTHWIND_CUDA_TEST_FROM=DIR (a
+  // CLOTHWIND_CUDA_TEST_KEEP folder brought back from a GPU machine, written by its libtorch),
+  // this libtorch must load the model and give the output the GPU gave.
+  const char* from = std::getenv("CLOTHWIND_CUDA_TEST_FROM");
+  if (!from) GTEST_SKIP() << "CLOTHWIND_CUDA_TEST_FROM names no folder kept from a GPU machine";
+  const std::filesystem::path dir(from);
+  WindNet loaded = LoadWindNet(dir / "gpu-trained.pt");
+  std::vector<at::Tensor> io;
+  torch::load(io, (dir / "gpu-trained-io.pt").string());
+  ASSERT_EQ(io.size(), 2u) << dir / "gpu-trained-io.pt" << ": expected the clip and the GPU's output";
+  at::NoGradGuard no_grad;
+  EXPECT_LT(RelativeDifference(loaded->forward(io[0]), io[1]), 1e-4);
 }
 
 }  // namespace
