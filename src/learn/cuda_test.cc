@@ -35,6 +35,14 @@ double RelativeDifference(const at::Tensor& a, const at::Tensor& b) {
   return (da - db).norm().item<double>() / std::max(db.norm().item<double>(), 1e-300);
 }
 
+// Turns off TF32, which libtorch allows in cuDNN's convolutions by default: it rounds their
+// inputs to 10 mantissa bits (errors ~1e-3), and the comparisons here are of the same float32
+// arithmetic on two devices.
+void UseFullFloat32() {
+  at::globalContext().setAllowTF32CuDNN(false);
+  at::globalContext().setAllowTF32CuBLAS(false);
+}
+
 // A clip of travelling waves plus noise, [nb, 1, nt, h, w]: every pixel has a clear strongest
 // peak (so the ranking of bins is not decided by rounding), and neighbours differ in phase.
 at::Tensor WaveClip(int64_t nb, int64_t nt, int64_t h, int64_t w, at::ScalarType type, uint64_t seed) {
@@ -87,7 +95,7 @@ TEST(Cuda, SpectralLayerInFloatAgreesWithDoubleOnTheGpu) {
   EXPECT_TRUE(at::allclose(gpu.frequency.to(at::kCPU).to(at::kDouble), ref.frequency, 1e-6, 1e-6));
 }
 
-// A small SDN of every option the shipped models use, in the given mode.
+// A small SDN with the shipped model's phase steps, and spectral pooling.
 ModelConfig SmallSdn() {
   ModelConfig config;
   config.arch = "sdn";
@@ -102,10 +110,7 @@ ModelConfig SmallSdn() {
 
 TEST(Cuda, SdnForwardAndGradientsMatchTheCpu) {
   SKIP_WITHOUT_CUDA();
-  // TF32 would round convolution inputs to 10 mantissa bits (errors ~1e-3); the comparison is
-  // of the same float32 arithmetic on two devices.
-  at::globalContext().setAllowTF32CuDNN(false);
-  at::globalContext().setAllowTF32CuBLAS(false);
+  UseFullFloat32();
   at::manual_seed(3);
   WindNet net(SmallSdn());
   net->train();  // batch statistics, as in training
@@ -143,8 +148,7 @@ TEST(Cuda, ShippedModelGivesTheSameEstimateOnTheGpu) {
   SKIP_WITHOUT_CUDA();
   const char* source = std::getenv("CLOTHWIND_SOURCE_DIR");
   ASSERT_NE(source, nullptr) << "CLOTHWIND_SOURCE_DIR is set by CTest and scripts/device-check";
-  at::globalContext().setAllowTF32CuDNN(false);
-  at::globalContext().setAllowTF32CuBLAS(false);
+  UseFullFloat32();
   WindNet net = LoadWindNet(std::filesystem::path(source) / "models/sdn.pt");
   const ModelConfig& config = net->config();
   at::Tensor clip = WaveClip(8, config.frames, config.input_size, config.input_size, at::kFloat, 5);
@@ -166,8 +170,7 @@ TEST(Cuda, ANetworkTrainedOnTheGpuSavesAndLoadsOnTheCpu) {
   // must gather the CUDA tensors, and LoadWindNet must give the trained network's answer on
   // the CPU. With CLOTHWIND_CUDA_TEST_KEEP=DIR the model and a clip with its expected output
   // stay in DIR, so that another libtorch (Debian's, on the CPU machine) can be checked too.
-  at::globalContext().setAllowTF32CuDNN(false);
-  at::globalContext().setAllowTF32CuBLAS(false);
+  UseFullFloat32();
   at::manual_seed(6);
   WindNet net(SmallSdn());
   net->to(at::kCUDA);
