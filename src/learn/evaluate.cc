@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <malloc.h>
 #include <unistd.h>
 
 #include "learn/dataset.h"
@@ -140,6 +141,10 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
       r.predicted_std.push_back(std::sqrt(sum_var[j - i] / passes));
     }
     if (progress) progress(static_cast<int>(r.truth.size()), static_cast<int>(clips.size()));
+    // Hand the batch's freed pages back to the system. Without this glibc's heap kept them:
+    // evaluating 1228 clips of 128-px frames peaked at 9.0 GB resident (7 MB a clip), and e5's
+    // 4792 test clips were killed for memory; with it the peak is 0.37 GB at the same speed.
+    ::malloc_trim(0);
   }
   r.metrics = ComputeMetrics(r.truth, r.predicted);
   r.bands = ComputeBandMetrics(r.truth, r.predicted, kEvalBandWidth);
