@@ -1,13 +1,14 @@
-// The spectral layer, the SDN and the shipped model on a CUDA device against the CPU. The layer
+// The spectral layer, the SDN and the shipped model on a CUDA device against the CPU, and a
+// network trained on the GPU loaded on the CPU (also by another libtorch). The layer
 // and networks are written with device-agnostic ATen calls, so they should give the CPU's
 // answer on a GPU up to rounding; this is the check that nothing in them (a window, a padding
 // tensor, an index) is made on the CPU and silently copied, or fails on CUDA. Each test skips
 // where libtorch finds no CUDA device (Debian's libtorch is built without CUDA, so CI skips
 // them); scripts/device-check builds and runs them on a GPU machine.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
