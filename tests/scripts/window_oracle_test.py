@@ -66,9 +66,9 @@ class ProjectTest(unittest.TestCase):
         w = 3 * self.flag()  # 9 m x 6 m at 4-6 m: the field of view must widen past 45 deg to fit
         box = (w.min(axis=(0, 1)), w.max(axis=(0, 1)))
         for seed in range(20):
-            img, camera = oracle.project(np.array([[0.5 * (box[0] + box[1])]]), box, np.random.RandomState(seed))
+            img, camera = oracle.project(np.array([[0.5 * (box[0] + box[1])]]), box, np.random.RandomState(seed), 'clip')
             np.testing.assert_allclose(img, 0.0, atol=1e-12)
-            img, camera = oracle.project(w, box, np.random.RandomState(seed))
+            img, camera = oracle.project(w, box, np.random.RandomState(seed), 'clip')
             self.assertLessEqual(np.abs(img).max(), 0.95 + 1e-9)
             self.assertGreater(np.abs(img).max(), 0.95 - 1e-6)  # widened just enough
             height, radius, angle, fov = camera
@@ -80,9 +80,40 @@ class ProjectTest(unittest.TestCase):
         w = self.flag()
         box = (w.min(axis=(0, 1)), w.max(axis=(0, 1)))
         swung = w + np.array([0.0, 0.3, 0.0])
-        a, _ = oracle.project(w, box, np.random.RandomState(3))
-        b, _ = oracle.project(swung, box, np.random.RandomState(3))
-        self.assertGreater(np.abs(b[..., 1] - a[..., 1]).mean(), 0.01)
+        for framing in ('clip', 'fixed'):
+            a, _ = oracle.project(w, box, np.random.RandomState(3), framing)
+            b, _ = oracle.project(swung, box, np.random.RandomState(3), framing)
+            self.assertGreater(np.abs(b[..., 1] - a[..., 1]).mean(), 0.01)
+
+    def test_fixed_framing_aims_at_the_rest_centre_as_the_datasets_camera(self):
+        # make-dataset's camera (render/camera.cc MeshCentre, PlaceCamera) looks at the flying
+        # flag's rest centre (w/2, 0, h/2) above the mast foot with a 45 deg field of view,
+        # whatever the clip: that point is the picture's centre for every camera drawn.
+        centre = np.array([[[1.5, 0.0, 1.0]]])
+        drooping = self.flag() - np.array([0.0, 0.0, 0.7])  # a clip whose own box is elsewhere
+        box = (drooping.min(axis=(0, 1)), drooping.max(axis=(0, 1)))
+        for seed in range(20):
+            img, camera = oracle.project(centre, box, np.random.RandomState(seed), 'fixed')
+            np.testing.assert_allclose(img, 0.0, atol=1e-12)
+            self.assertEqual(camera[3], 45.0)
+
+    def test_only_fixed_framing_shows_where_the_flag_hangs(self):
+        # A flag drooping 0.4 m lower moves down in the fixed picture; framed on its own box, its
+        # box centre stays the picture's centre, so the droop's height is lost.
+        w = self.flag()
+        low = w - np.array([0.0, 0.0, 0.4])
+        for seed in range(10):
+            boxes = [(x.min(axis=(0, 1)), x.max(axis=(0, 1))) for x in (w, low)]
+            centres = [0.5 * (b[0] + b[1])[None, None] for b in boxes]
+            fixed = [oracle.project(c, b, np.random.RandomState(seed), 'fixed')[0] for c, b in zip(centres, boxes)]
+            clip = [oracle.project(c, b, np.random.RandomState(seed), 'clip')[0] for c, b in zip(centres, boxes)]
+            self.assertGreater(fixed[1][..., 1].item() - fixed[0][..., 1].item(), 0.05)  # image y is down
+            np.testing.assert_allclose(clip[0], clip[1], atol=1e-12)
+
+    def test_fixed_framing_clamps_what_leaves_the_picture(self):
+        far = self.flag() + np.array([0.0, 0.0, -8.0])  # far below the frame's bottom edge
+        img, _ = oracle.project(far, (far.min(axis=(0, 1)), far.max(axis=(0, 1))), np.random.RandomState(1), 'fixed')
+        np.testing.assert_allclose(img[..., 1], 1.0)
 
 
 if __name__ == '__main__':
