@@ -67,6 +67,9 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                   "--spectral-pool 2: 128-px spectra, a 64-px trunk's cost)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
+  sub->add_flag_callback("--no-stem-pool", [args] { args->o.model.stem_pool = false; },
+                "leave out the trunk's max pool after its stem: its stages see twice the resolution, at "
+                "about four times their cost");
   sub->add_flag("--mean-map", o.model.mean_map, "SDN: add the clip's per-pixel temporal mean (the pose) as a channel");
   sub->add_option("--threads", o.threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--device", o.device, "cpu, cuda or auto (CUDA when libtorch finds one)")

@@ -52,6 +52,7 @@ std::string ModelConfig::Name() const {
     if (spectral_pool != 1) s << "/" << spectral_pool;
   }
   else s << arch;
+  if (!stem_pool) s << "-np";
   s << "-w" << width << "-" << input_size << "-" << frames << "f";
   return s.str();
 }
@@ -69,7 +70,8 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"mean_map", c.mean_map},      {"dft_size", c.dft_size},
           {"local_peaks", c.local_peaks},  {"phase_steps", c.phase_steps},
           {"phase_step_far", c.phase_step_far},
-          {"spectral_pool", c.spectral_pool}, {"dropout", c.dropout},
+          {"spectral_pool", c.spectral_pool}, {"stem_pool", c.stem_pool},
+          {"dropout", c.dropout},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
           {"label_std", c.label_std},    {"std_scale", c.std_scale}};
@@ -100,6 +102,8 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.phase_steps = j.contains("phase_steps") ? j.at("phase_steps").get<bool>() : false;
     c.phase_step_far = j.contains("phase_step_far") ? j.at("phase_step_far").get<int>() : 0;
     c.spectral_pool = j.contains("spectral_pool") ? j.at("spectral_pool").get<int>() : 1;
+    // Absent in models written before the option existed: they pooled after the stem.
+    c.stem_pool = j.contains("stem_pool") ? j.at("stem_pool").get<bool>() : true;
     c.dropout = j.contains("dropout") ? j.at("dropout").get<double>() : 0.0;
     c.frame_rate = need("frame_rate").get<double>();
     c.width = need("width").get<int>();

@@ -29,6 +29,10 @@ struct ModelConfig {
   // before the trunk, so fine texture's motion reaches a trunk that costs what input_size /
   // spectral_pool would (1: no pooling). input_size must be a multiple of it.
   int spectral_pool = 1;
+  // The trunk's 3×3 stride-2 max pool after its stem, as ResNet-18's. At 64 px the stem and the
+  // pool leave 16 px for the first stage; without the pool the stages keep 32 px, at about four
+  // times their cost (a small input's detail is what the pool throws away).
+  bool stem_pool = true;
   double dropout = 0.0;      // dropout probability on the trunk's pooled features while training
   double frame_rate = 25.0;  // [Hz] of the clips the model reads
   int width = 64;            // ResNet-18 base width (64 as the original; 16 trains on a CPU)

@@ -37,7 +37,7 @@ at::Tensor BasicBlockImpl::forward(const at::Tensor& x) {
   return at::relu(y + (shortcut_ ? shortcut_->forward(x) : x));
 }
 
-ResNet18TrunkImpl::ResNet18TrunkImpl(int in_channels, int width) {
+ResNet18TrunkImpl::ResNet18TrunkImpl(int in_channels, int width, bool stem_pool) : stem_pool_(stem_pool) {
   stem_ = register_module("stem", Conv(in_channels, width, 7, 2));
   stem_bn_ = register_module("stem_bn", torch::nn::BatchNorm2d(width));
   torch::nn::Sequential stages;
@@ -58,11 +58,14 @@ ResNet18TrunkImpl::ResNet18TrunkImpl(int in_channels, int width) {
   }
 }
 
-at::Tensor ResNet18TrunkImpl::forward(const at::Tensor& x) {
+at::Tensor ResNet18TrunkImpl::FeatureMap(const at::Tensor& x) {
   at::Tensor y = at::relu(stem_bn_->forward(stem_->forward(x)));
-  y = at::max_pool2d(y, {3, 3}, {2, 2}, {1, 1});
-  y = stages_->forward(y);
-  return at::adaptive_avg_pool2d(y, {1, 1}).flatten(1);
+  if (stem_pool_) y = at::max_pool2d(y, {3, 3}, {2, 2}, {1, 1});
+  return stages_->forward(y);
+}
+
+at::Tensor ResNet18TrunkImpl::forward(const at::Tensor& x) {
+  return at::adaptive_avg_pool2d(FeatureMap(x), {1, 1}).flatten(1);
 }
 
 WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
@@ -88,7 +91,7 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
                                 " must be >= 1, divide the input size " + std::to_string(config.input_size) +
                                 " and be 1 unless the model is an SDN");
   }
-  trunk_ = register_module("trunk", ResNet18Trunk(config.TrunkInputChannels(), config.width));
+  trunk_ = register_module("trunk", ResNet18Trunk(config.TrunkInputChannels(), config.width, config.stem_pool));
   if (config.arch == "lstm") {
     // Yang et al. read the last hidden state of an LSTM fed one CNN feature vector per frame.
     const int features = trunk_->feature_size();

@@ -40,16 +40,22 @@ TORCH_MODULE(BasicBlock);
 // (widths w, 2w, 4w, 8w; stride 2 from the second stage), global average pooling.
 class ResNet18TrunkImpl : public torch::nn::Module {
  public:
-  // in_channels  channels of the input image; width  w, the first stage's width (64 originally)
-  ResNet18TrunkImpl(int in_channels, int width);
-  // x [N_b, in_channels, H, W] -> features [N_b, 8w]
+  // in_channels  channels of the input image; width  w, the first stage's width (64 originally);
+  // stem_pool  the 3×3 stride-2 max pool after the stem (ResNet-18's; false: the stages see twice
+  // the resolution)
+  ResNet18TrunkImpl(int in_channels, int width, bool stem_pool = true);
+  // x [N_b, in_channels, H, W] -> features [N_b, 8w]: FeatureMap averaged over its pixels
   at::Tensor forward(const at::Tensor& x);
+  // x [N_b, in_channels, H, W] -> the last stage's map [N_b, 8w, ⌈H/32⌉, ⌈W/32⌉] (⌈H/16⌉, ⌈W/16⌉
+  // without the stem pool)
+  at::Tensor FeatureMap(const at::Tensor& x);
   int feature_size() const { return features_; }
 
  private:
   torch::nn::Conv2d stem_{nullptr};
   torch::nn::BatchNorm2d stem_bn_{nullptr};
   torch::nn::Sequential stages_{nullptr};
+  bool stem_pool_ = true;
   int features_ = 0;
 };
 TORCH_MODULE(ResNet18Trunk);

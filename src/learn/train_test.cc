@@ -381,6 +381,37 @@ TEST(ModelConfig, SpectralPoolKeepsMotionThatDownsamplingTheFramesErases) {
   EXPECT_THROW(WindNet{stacked}, std::invalid_argument);
 }
 
+TEST(ModelConfig, WithoutTheStemPoolTheTrunkKeepsTwiceTheResolution) {
+  // At 64 px ResNet-18's stem (stride 2) and max pool leave 16 px for the first stage and 2 px
+  // at the last; without the pool the stages run at 32 px and end at 4 px.
+  at::NoGradGuard no_grad;
+  const at::Tensor x = at::randn({2, 3, 64, 64});
+  ResNet18Trunk pooled(3, 4), unpooled(3, 4, /*stem_pool=*/false);
+  EXPECT_EQ(pooled->FeatureMap(x).sizes(), (at::IntArrayRef{2, 32, 2, 2}));
+  EXPECT_EQ(unpooled->FeatureMap(x).sizes(), (at::IntArrayRef{2, 32, 4, 4}));
+  EXPECT_TRUE(at::allclose(unpooled->forward(x), unpooled->FeatureMap(x).mean({2, 3})));
+  // The same weights with and without the pool give other features: the option reaches the net.
+  {
+    auto from = pooled->named_parameters(), to = unpooled->named_parameters();
+    for (const auto& p : from) to[p.key()].copy_(p.value());
+    auto from_b = pooled->named_buffers(), to_b = unpooled->named_buffers();
+    for (const auto& b : from_b) to_b[b.key()].copy_(b.value());
+  }
+  EXPECT_TRUE(at::equal(unpooled->named_parameters()["stem.weight"], pooled->named_parameters()["stem.weight"]));
+  EXPECT_FALSE(at::allclose(unpooled->forward(x), pooled->forward(x)));
+  // The whole network: name, round trip, the default for older files, and an estimate.
+  ModelConfig c = TinySdn();
+  c.stem_pool = false;
+  EXPECT_EQ(c.Name(), "sdn-k2-np-w4-16-30f");
+  EXPECT_FALSE(ModelConfigFromJson(ToJson(c), "x.json").stem_pool);
+  nlohmann::json old = ToJson(c);
+  old.erase("stem_pool");
+  EXPECT_TRUE(ModelConfigFromJson(old, "x.json").stem_pool);
+  WindNet net(c);
+  net->eval();
+  EXPECT_EQ(net->forward(at::randn({3, 1, 30, 16, 16})).sizes(), (at::IntArrayRef{3, 2}));
+}
+
 TEST(ModelConfig, DropoutActsInTrainingOnlyAndRoundTrips) {
   ModelConfig c = TinySdn();
   c.dropout = 0.5;
