@@ -44,6 +44,12 @@ ModelConfig TinySdn() {
   return c;
 }
 
+// Copies `from`'s parameters into `to`, which has the same parameter names and shapes.
+void CopyParameters(torch::nn::Module& from, torch::nn::Module& to) {
+  torch::OrderedDict<std::string, at::Tensor> source = from.named_parameters();
+  for (auto& p : to.named_parameters()) p.value().copy_(source[p.key()]);
+}
+
 // Expects ModelConfigFromJson to refuse `j` read as "run/model.json", naming the file and `field`.
 void ExpectFieldRefused(const nlohmann::json& j, const std::string& field) {
   try {
@@ -305,8 +311,7 @@ TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
   plain_config.local_peaks = false;
   WindNet plain(plain_config);
   plain->eval();
-  torch::OrderedDict<std::string, at::Tensor> from = padded->named_parameters();
-  for (auto& p : plain->named_parameters()) p.value().copy_(from[p.key()]);
+  CopyParameters(*padded, *plain);
   EXPECT_FALSE(at::allclose(padded->forward(clips), plain->forward(clips), 1e-4, 1e-5));
   // Phase steps add 4C trunk channels, round-trip, and default to off in older files.
   c.phase_steps = true;
@@ -391,12 +396,8 @@ TEST(ModelConfig, WithoutTheStemPoolTheTrunkKeepsTwiceTheResolution) {
   EXPECT_EQ(unpooled->FeatureMap(x).sizes(), (at::IntArrayRef{2, 32, 4, 4}));
   EXPECT_TRUE(at::allclose(unpooled->forward(x), unpooled->FeatureMap(x).mean({2, 3})));
   // The same weights with and without the pool give other features: the option reaches the net.
-  {
-    auto from = pooled->named_parameters(), to = unpooled->named_parameters();
-    for (const auto& p : from) to[p.key()].copy_(p.value());
-    auto from_b = pooled->named_buffers(), to_b = unpooled->named_buffers();
-    for (const auto& b : from_b) to_b[b.key()].copy_(b.value());
-  }
+  // (In training mode batch norm reads the batch's statistics, so the buffers need no copy.)
+  CopyParameters(*pooled, *unpooled);
   EXPECT_TRUE(at::equal(unpooled->named_parameters()["stem.weight"], pooled->named_parameters()["stem.weight"]));
   EXPECT_FALSE(at::allclose(unpooled->forward(x), pooled->forward(x)));
   // The whole network: name, round trip, the default for older files, and an estimate.
