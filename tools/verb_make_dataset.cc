@@ -157,7 +157,9 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
   sub->add_option("--samples", a->o.samples, "anti-aliasing samples per pixel (0: zeta's default, 4)")
       ->capture_default_str();
   sub->add_option("--size", a->o.size, "frame width = height [px]")->capture_default_str();
-  sub->add_option("--format", a->format, "frame format")->check(CLI::IsMember({"jpg", "jpeg", "png"}))
+  sub->add_option("--format", a->format,
+                  "frame format (pgm: 8-bit grey as the SDN reads it, lossless, readable without an image codec)")
+      ->check(CLI::IsMember({"jpg", "jpeg", "png", "pgm"}))
       ->capture_default_str();
   sub->add_option("--jpeg-quality", a->o.jpeg_quality, "JPEG quality 1..100")->capture_default_str();
   sub->add_option("--wind-min", a->wind_min, "lowest wind speed [m/s] (default: flag 0, cloth 0)");

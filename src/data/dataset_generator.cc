@@ -13,6 +13,7 @@
 #include <thread>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
@@ -55,7 +56,8 @@ void ValidateOptions(const DatasetOptions& o) {
   Check(o.fps > 0, "--fps must be > 0");
   Check(o.samples >= 0, "--samples must be >= 0");
   Check(o.size >= 16 && o.size <= 4096, "--size must be in 16..4096 px");
-  Check(o.frame_ext == "jpg" || o.frame_ext == "png", "frame format must be jpg or png");
+  Check(o.frame_ext == "jpg" || o.frame_ext == "png" || o.frame_ext == "pgm",
+        "frame format must be jpg, png or pgm");
   Check(o.jpeg_quality >= 1 && o.jpeg_quality <= 100, "--jpeg-quality must be in 1..100");
   Check(o.max_edge >= 0, "--max-edge must be >= 0 m");
 }
@@ -152,10 +154,13 @@ void WriteExample(const std::string& out, const std::string& name, const std::ve
   try {
     std::vector<int> params;
     if (o.frame_ext == "jpg") params = {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality};
+    cv::Mat grey;
     for (size_t k = 0; k < images.size(); ++k) {
       char file[32];
       std::snprintf(file, sizeof(file), "%03zu.%s", k, o.frame_ext.c_str());
-      if (!cv::imwrite((tmp / file).string(), images[k], params))
+      // PGM holds one channel: the grey the SDN reads (cv::imread's IMREAD_GRAYSCALE weights).
+      if (o.frame_ext == "pgm") cv::cvtColor(images[k], grey, cv::COLOR_BGR2GRAY);
+      if (!cv::imwrite((tmp / file).string(), o.frame_ext == "pgm" ? grey : images[k], params))
         throw std::runtime_error("cannot write " + (tmp / file).string());
     }
     sim::WriteFileAtomically((tmp / "label.json").string(), label.dump(2) + "\n");

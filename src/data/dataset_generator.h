@@ -45,7 +45,7 @@ struct DatasetOptions {
   // renders a 60-frame clip in ~0.6 s on one core instead of ~1 s (docs/datasets.md).
   int samples = 2;
   int size = 300;              // frame width = height [px]
-  std::string frame_ext = "jpg";  // "jpg" | "png"
+  std::string frame_ext = "jpg";  // "jpg" | "png" | "pgm" (one grey channel)
   int jpeg_quality = 95;
   double val_fraction = 0.1, test_fraction = 0.2;
   std::vector<std::string> background_images;  // empty: procedural backdrops

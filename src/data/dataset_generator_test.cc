@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "data/dataset_index.h"
 #include "data/paths.h"
@@ -315,6 +316,41 @@ TEST_F(DatasetGeneratorTest, ReindexMergesFoldersCopiedFromOtherMachines) {
   EXPECT_THROW(ReindexDataset(real.string()), std::runtime_error);
 }
 
+// PGM frames are the grey of the colour frames, exactly: one channel, the weights of
+// cv::IMREAD_GRAYSCALE, nothing lost (PNG as the lossless colour reference).
+TEST_F(DatasetGeneratorTest, PgmFramesHoldTheGreyOfTheColourFrames) {
+  DatasetOptions png = Tiny((root_ / "png").string());
+  png.count = 1;
+  png.frame_ext = "png";
+  DatasetOptions pgm = png;
+  pgm.out = (root_ / "pgm").string();
+  pgm.frame_ext = "pgm";
+  ASSERT_TRUE(GenerateDataset(png).errors.empty());
+  ASSERT_TRUE(GenerateDataset(pgm).errors.empty());
+  const std::string name = ExampleName(render::SceneKind::kFlag, 0, 0);
+  const nlohmann::json label = ReadLabel((fs::path(pgm.out) / name / "label.json").string());
+  EXPECT_EQ(label["encoding"], "mono8");
+  EXPECT_EQ(label["frame_pattern"], "%03d.pgm");
+  for (int f = 0; f < pgm.frames; ++f) {
+    char file[16];
+    std::snprintf(file, sizeof(file), "%03d", f);
+    const cv::Mat colour = cv::imread((fs::path(png.out) / name / (std::string(file) + ".png")).string(),
+                                      cv::IMREAD_UNCHANGED);
+    const cv::Mat grey = cv::imread((fs::path(pgm.out) / name / (std::string(file) + ".pgm")).string(),
+                                    cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(colour.channels(), 3) << file;
+    ASSERT_EQ(grey.channels(), 1) << file;
+    ASSERT_EQ(grey.type(), CV_8UC1) << file;
+    cv::Mat expected;
+    cv::cvtColor(colour, expected, cv::COLOR_BGR2GRAY);
+    EXPECT_EQ(cv::norm(grey, expected, cv::NORM_INF), 0) << file;
+    // Not a blank picture: the flag and the sky differ.
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(grey, &lo, &hi);
+    EXPECT_GT(hi - lo, 30) << file;
+  }
+}
+
 TEST(DatasetOptionsTest, BadOptionsAreRejected) {
   DatasetOptions o;
   o.out = "/tmp/never";
@@ -324,6 +360,9 @@ TEST(DatasetOptionsTest, BadOptionsAreRejected) {
   EXPECT_THROW(GenerateDataset(o), std::invalid_argument);
   o.shard = 0;
   o.views = 0;
+  EXPECT_THROW(GenerateDataset(o), std::invalid_argument);
+  o.views = 1;
+  o.frame_ext = "ppm";
   EXPECT_THROW(GenerateDataset(o), std::invalid_argument);
 }
 

@@ -31,7 +31,7 @@ nlohmann::json SimExampleLabel(const std::string& name, const SimulationSample& 
   j["frame_rate"] = info.frame_rate;
   j["width"] = zeta.width;
   j["height"] = zeta.height;
-  j["encoding"] = "rgb8";
+  j["encoding"] = info.frame_ext == "pgm" ? "mono8" : "rgb8";
   j["frame_pattern"] = "%03d." + info.frame_ext;
   j["wind_speed"] = s.theta[sim::kWindSpeedIndex];
   j["theta"] = theta;

@@ -24,7 +24,7 @@ struct ClipInfo {
   std::string split;           // "train" | "val" | "test"
   int num_frames = 60;
   double frame_rate = 25.0;    // [Hz]
-  std::string frame_ext = "jpg";  // "jpg" | "png"
+  std::string frame_ext = "jpg";  // "jpg" | "png" | "pgm" (one grey channel)
   std::string scene;           // scene file name (no folders: labels must not depend on the machine)
   double max_edge = 0.0;       // mesh resolution [m]
   int vertices = 0, faces = 0;
