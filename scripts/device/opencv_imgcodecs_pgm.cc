@@ -1,0 +1,104 @@
+// A stand-in for OpenCV's imgcodecs on a lent GPU machine (scripts/device-train), built into a
+// library with imgcodecs' file name. Debian's imgcodecs needs GDAL, OpenEXR, GDCM and ~140
+// libraries in all (181 MB), far over what may travel to that machine (64 MiB), while a FlagSim
+// made with `make-dataset --format pgm` needs only binary PGM. So this reads and writes binary
+// PGM (P5, 8-bit) and refuses every other format with an error naming the file; nothing else of
+// clothwind runs there.
+//
+// The functions are those clothwind's libraries call (nm -D --undefined-only), and those Debian's
+// libtorch loads through its own OpenCV (for `--check` here), declared by OpenCV's own header so
+// their symbols match. Not part of the product: it never builds in CI
+// except through `scripts/device-train --check`.
+#include <cctype>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace cv {
+namespace {
+
+bool IsPgm(const std::string& filename) {
+  const size_t dot = filename.rfind('.');
+  return dot != std::string::npos && filename.substr(dot) == ".pgm";
+}
+
+[[noreturn]] void Refuse(const std::string& what) {
+  throw std::runtime_error(what + ": this machine's stand-in for OpenCV's imgcodecs reads and writes "
+                           "binary PGM only (make the dataset with --format pgm)");
+}
+
+// The next header token of a PGM stream, skipping white space and '#' comments.
+std::string Token(std::istream& in) {
+  std::string token;
+  while (in) {
+    const int c = in.get();
+    if (c == '#') {
+      std::string comment;
+      std::getline(in, comment);
+    } else if (std::isspace(c) || c == EOF) {
+      if (!token.empty()) return token;
+    } else {
+      token.push_back(static_cast<char>(c));
+    }
+  }
+  return token;
+}
+
+}  // namespace
+
+// Reads a binary PGM (P5, maxval <= 255): one channel, or three equal ones with IMREAD_COLOR as
+// the real imread gives them. Empty Mat if the file cannot be read, as imread.
+Mat imread(const String& filename, int flags) {
+  if (!IsPgm(filename)) Refuse("imread " + filename);
+  std::ifstream in(filename, std::ios::binary);
+  if (!in) return Mat();
+  if (Token(in) != "P5") return Mat();
+  int width = 0, height = 0, maxval = 0;
+  try {
+    width = std::stoi(Token(in));
+    height = std::stoi(Token(in));
+    maxval = std::stoi(Token(in));
+  } catch (const std::exception&) {
+    return Mat();
+  }
+  if (width <= 0 || height <= 0 || maxval <= 0 || maxval > 255) return Mat();
+  Mat grey(height, width, CV_8UC1);
+  in.read(reinterpret_cast<char*>(grey.data), static_cast<std::streamsize>(grey.total()));
+  if (in.gcount() != static_cast<std::streamsize>(grey.total())) return Mat();
+  if (flags == IMREAD_COLOR) {
+    Mat colour;
+    cvtColor(grey, colour, COLOR_GRAY2BGR);
+    return colour;
+  }
+  return grey;
+}
+
+// Writes an 8-bit single-channel image as binary PGM.
+bool imwrite(const String& filename, InputArray img, const std::vector<int>& /*params*/) {
+  if (!IsPgm(filename)) Refuse("imwrite " + filename);
+  const Mat m = img.getMat();
+  if (m.type() != CV_8UC1) Refuse("imwrite " + filename + " (not an 8-bit grey image)");
+  std::ofstream out(filename, std::ios::binary);
+  if (!out) return false;
+  out << "P5\n" << m.cols << " " << m.rows << "\n255\n";
+  for (int y = 0; y < m.rows; ++y) out.write(m.ptr<char>(y), m.cols);
+  return static_cast<bool>(out);
+}
+
+bool haveImageReader(const String& filename) { return IsPgm(filename); }
+bool haveImageWriter(const String& filename) { return IsPgm(filename); }
+
+Mat imdecode(InputArray /*buf*/, int /*flags*/) { Refuse("imdecode"); }
+Mat imdecode(InputArray /*buf*/, int /*flags*/, Mat* /*dst*/) { Refuse("imdecode"); }
+
+bool imencode(const String& ext, InputArray /*img*/, std::vector<uchar>& /*buf*/,
+              const std::vector<int>& /*params*/) {
+  Refuse("imencode " + ext);
+}
+
+}  // namespace cv
