@@ -116,5 +116,50 @@ class ProjectTest(unittest.TestCase):
         np.testing.assert_allclose(img[..., 1], 1.0)
 
 
+
+class ClipWindowsTest(unittest.TestCase):
+    """--clip-windows reads a simulation as FlagSim clips: one camera per clip, K windows each."""
+
+    def args(self, k):
+        class A:
+            pass
+        a = A()
+        a.seed, a.window, a.clip, a.clip_windows, a.warmup = 1, 30, 60, k, 0.0
+        a.coords, a.framing, a.camera_known, a.features, a.bins = 'image', 'fixed', True, 'shape', 6
+        return a
+
+    def loaded(self, frames=180, points=4):
+        t = np.arange(frames)[:, None, None]
+        pts = np.zeros((frames, points, 3))
+        pts[:, :, 0] = np.linspace(0.5, 3.0, points)
+        pts[:, :, 2] = -0.5 + 0.1 * np.sin(0.3 * t[:, :, 0])
+        return 0.04, pts, pts
+
+    def test_window_starts_are_those_of_clothwind_eval(self):
+        # learn::EvenWindowStarts (dataset_test.cc): {15}, {0, 30}, {0, 15, 30}, {0, 3, 7, 10}.
+        self.assertEqual(oracle.clip_window_starts(0, 60, 30, 1), [15])
+        self.assertEqual(oracle.clip_window_starts(0, 60, 30, 2), [0, 30])
+        self.assertEqual(oracle.clip_window_starts(60, 60, 30, 3), [60, 75, 90])
+        self.assertEqual(oracle.clip_window_starts(0, 40, 30, 4), [0, 3, 7, 10])
+
+    def test_the_windows_of_a_clip_share_its_camera_and_clips_do_not(self):
+        clips = oracle.clip_windows_of(0, self.loaded(), self.args(3))
+        self.assertEqual([c for c, _ in clips], [0, 60, 120])
+        cameras = [[f[-4:] for f in feats] for _, feats in clips]
+        for per_clip in cameras:
+            self.assertEqual(len(per_clip), 3)
+            for cam in per_clip[1:]:
+                np.testing.assert_array_equal(cam, per_clip[0])
+        self.assertFalse(np.allclose(cameras[0][0], cameras[1][0]))
+        # The windows themselves differ (the flag moves between them).
+        self.assertFalse(np.allclose(clips[0][1][0], clips[0][1][1]))
+
+    def test_a_clips_estimate_is_the_mean_of_its_windows(self):
+        errors = oracle.clip_errors([(0, 0)] * 3 + [(1, 0)] * 3, [2.0] * 3 + [5.0] * 3,
+                                    [2.3, 2.6, 1.9, 5.0, 4.4, 4.6])
+        np.testing.assert_allclose([t for t, _ in errors], [2.0, 5.0])
+        np.testing.assert_allclose([e for _, e in errors], [0.2667, -0.3333], atol=1e-3)
+
+
 if __name__ == '__main__':
     unittest.main()
