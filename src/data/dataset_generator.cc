@@ -292,6 +292,11 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
     if (i >= 0 && i % o.shards == o.shard) fs::remove_all(e.path());
   }
 
+  // The index is written before the first simulation too: a run killed midway (or stopped by a
+  // time limit) leaves a folder that says what it is, so a rerun with other settings is still
+  // refused, and `make-dataset --reindex` lists the examples it finished.
+  WriteIndex(o.out, BuildIndex(o.out, IndexHeader(o, settings)));
+
   // This shard's simulations that still miss a view.
   std::vector<int64_t> todo;
   for (int64_t i = o.shard; i < o.count; i += o.shards) {

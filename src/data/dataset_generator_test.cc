@@ -316,6 +316,30 @@ TEST_F(DatasetGeneratorTest, ReindexMergesFoldersCopiedFromOtherMachines) {
   EXPECT_THROW(ReindexDataset(real.string()), std::runtime_error);
 }
 
+// A run stopped after its first simulation (killed, or timed out) has already written the
+// dataset's header: a rerun with other settings is refused, --reindex lists what was finished,
+// and resuming ends where one uninterrupted run does.
+TEST_F(DatasetGeneratorTest, AStoppedRunLeavesAnIndexThatReindexCompletes) {
+  const fs::path dir = root_ / "stopped";
+  DatasetOptions o = Tiny(dir.string());
+  o.jobs = 1;
+  bool had_index = false;
+  const auto stop = [&](const DatasetProgress&) {
+    had_index = fs::exists(dir / "index.json");
+    throw std::runtime_error("stopped");
+  };
+  EXPECT_THROW(GenerateDataset(o, stop), std::runtime_error);
+  EXPECT_TRUE(had_index);
+  DatasetOptions other = o;
+  other.size = 32;
+  EXPECT_THROW(GenerateDataset(other), std::runtime_error);
+  EXPECT_EQ(ReindexDataset(dir.string(), false), 1);
+  const nlohmann::json index = ReadIndex(dir.string());
+  EXPECT_EQ(index["dataset"], ReadIndex(Ref().string())["dataset"]);
+  GenerateDataset(Tiny(dir.string()));
+  EXPECT_EQ(Files(dir), Files(Ref()));
+}
+
 // PGM frames are the grey of the colour frames, exactly: one channel, the weights of
 // cv::IMREAD_GRAYSCALE, nothing lost (PNG as the lossless colour reference).
 TEST_F(DatasetGeneratorTest, PgmFramesHoldTheGreyOfTheColourFrames) {
