@@ -292,10 +292,11 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
     if (i >= 0 && i % o.shards == o.shard) fs::remove_all(e.path());
   }
 
-  // The index is written before the first simulation too: a run killed midway (or stopped by a
-  // time limit) leaves a folder that says what it is, so a rerun with other settings is still
-  // refused, and `make-dataset --reindex` lists the examples it finished.
-  WriteIndex(o.out, BuildIndex(o.out, IndexHeader(o, settings)));
+  // A new folder gets its index's header before the first simulation: a run killed midway (or
+  // stopped by a time limit) leaves a folder that says what it is, so a rerun with other settings
+  // is still refused, and `make-dataset --reindex` lists the examples it finished. (A folder that
+  // has an index keeps it until the end, which rebuilds it from the folders present.)
+  if (ReadIndex(o.out).is_null()) WriteIndex(o.out, IndexHeader(o, settings));
 
   // This shard's simulations that still miss a view.
   std::vector<int64_t> todo;
