@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 
 #include "learn/model_config.h"
 
@@ -178,11 +179,38 @@ std::vector<int> EvenWindowStarts(int num_frames, int frames, int windows) {
   return starts;
 }
 
-Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& options, std::mt19937_64& rng) {
+cv::Mat FrameFlow(const cv::Mat& previous, const cv::Mat& next) {
+  if (previous.type() != CV_8UC1 || next.type() != CV_8UC1 || previous.size() != next.size() || previous.empty()) {
+    throw std::invalid_argument("FrameFlow: two non-empty mono8 images of one size expected");
+  }
+  // One instance per thread: DIS keeps scratch buffers between calls and is not thread-safe.
+  thread_local cv::Ptr<cv::DISOpticalFlow> dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
+  cv::Mat flow;
+  dis->calc(previous, next, flow);
+  return flow;
+}
+
+cv::Mat FrameFlow16(const cv::Mat& previous, const cv::Mat& next) {
+  cv::Mat steps;
+  FrameFlow(previous, next).convertTo(steps, CV_16SC2, kFlowSteps);
+  return steps;
+}
+
+std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames) {
+  std::vector<cv::Mat> flows(frames.empty() ? 0 : frames.size() - 1);
+  for (size_t t = 1; t < frames.size(); ++t) {
+    FrameFlow16(frames[t - 1], frames[t]).convertTo(flows[t - 1], CV_32FC2, 1.0 / kFlowSteps);
+  }
+  return flows;
+}
+
+Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& options, std::mt19937_64& rng,
+                  const std::vector<cv::Mat>* flows) {
   if (static_cast<int>(frames.size()) != options.frames || frames.empty()) {
     throw std::invalid_argument("MakeSample: " + std::to_string(frames.size()) + " frames given, " +
                                 std::to_string(options.frames) + " expected");
   }
+  if (options.flow && options.frames < 2) throw std::invalid_argument("MakeSample: flow needs at least 2 frames");
   const int w = frames[0].cols, h = frames[0].rows;
   const int side = std::min(w, h);
   Sample sample;
@@ -201,7 +229,11 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
     sample.flipped = options.mirror;
   }
   const int s = options.input_size;
-  sample.pixels.resize(static_cast<size_t>(options.frames) * s * s);
+  const size_t plane = static_cast<size_t>(s) * s;
+  const size_t grey = static_cast<size_t>(options.frames) * plane;
+  sample.channels = options.flow ? 3 : 1;
+  sample.pixels.resize(grey * sample.channels);
+  std::vector<cv::Mat> resized(options.frames);
   double sum = 0, sum2 = 0;
   for (int t = 0; t < options.frames; ++t) {
     const cv::Mat& f = frames[t];
@@ -209,20 +241,53 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
       throw std::invalid_argument("MakeSample: frame " + std::to_string(t) + " is not " + std::to_string(w) + "x" +
                                   std::to_string(h) + " mono8");
     }
-    cv::Mat resized;
-    ResizeCrop(f, sample.crop, s, resized);
-    if (sample.flipped) cv::flip(resized, resized, 1);
-    cv::Mat out(s, s, CV_32F, sample.pixels.data() + static_cast<size_t>(t) * s * s);
-    resized.convertTo(out, CV_32F);
+    ResizeCrop(f, sample.crop, s, resized[t]);
+    cv::Mat shown;
+    if (sample.flipped) {
+      cv::flip(resized[t], shown, 1);
+    } else {
+      shown = resized[t];
+    }
+    cv::Mat out(s, s, CV_32F, sample.pixels.data() + static_cast<size_t>(t) * plane);
+    shown.convertTo(out, CV_32F);
     const cv::Scalar m = cv::sum(out);
     sum += m[0];
     sum2 += out.dot(out);
   }
-  const double n = static_cast<double>(sample.pixels.size());
+  const double n = static_cast<double>(grey);
   const double mean = sum / n;
   const double std = std::sqrt(std::max(sum2 / n - mean * mean, 0.0));
   const float inv = static_cast<float>(1.0 / std::max(std, 1e-3));
-  for (float& p : sample.pixels) p = (p - static_cast<float>(mean)) * inv;
+  for (size_t i = 0; i < grey; ++i) sample.pixels[i] = (sample.pixels[i] - static_cast<float>(mean)) * inv;
+  if (options.flow) {
+    std::vector<cv::Mat> computed;
+    if (flows == nullptr) {
+      // Flow of the frames as the network sees them, before the flip (which then mirrors it).
+      computed = WindowFlows(resized);
+      flows = &computed;
+    } else if (static_cast<int>(flows->size()) != options.frames - 1 || w != s || h != s) {
+      throw std::invalid_argument("MakeSample: " + std::to_string(flows->size()) + " flows of " +
+                                  std::to_string(options.frames - 1) + " expected, on frames of the input size");
+    }
+    for (int t = 0; t < options.frames; ++t) {
+      const cv::Mat& f = (*flows)[static_cast<size_t>(std::max(t - 1, 0))];
+      if (f.type() != CV_32FC2 || f.rows != s || f.cols != s) {
+        throw std::invalid_argument("MakeSample: flow " + std::to_string(t) + " is not " + std::to_string(s) +
+                                    "x" + std::to_string(s) + " CV_32FC2");
+      }
+      cv::Mat xy[2];
+      cv::split(f, xy);
+      if (sample.flipped) {
+        cv::flip(xy[0], xy[0], 1);
+        cv::flip(xy[1], xy[1], 1);
+        xy[0] = -xy[0];  // mirrored, a motion to the right is one to the left
+      }
+      for (int c = 0; c < 2; ++c) {
+        cv::Mat out(s, s, CV_32F, sample.pixels.data() + grey * (1 + c) + static_cast<size_t>(t) * plane);
+        xy[c].copyTo(out);
+      }
+    }
+  }
   return sample;
 }
 
@@ -235,10 +300,13 @@ void ResizeCrop(const cv::Mat& frame, const cv::Rect& crop, int side, cv::Mat& o
   cv::resize(frame(crop), out, cv::Size(side, side), 0, 0, crop.width >= side ? cv::INTER_AREA : cv::INTER_LINEAR);
 }
 
-Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed, const FrameReader& read) {
+Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed, const FrameReader& read,
+                  const FlowReader& read_flows) {
   std::mt19937_64 rng(seed);
   const int first = ChooseFirstFrame(clip.num_frames, options, rng);
-  Sample sample = MakeSample(read(first, options.frames), options, rng);
+  std::vector<cv::Mat> flows;
+  if (options.flow && read_flows) flows = read_flows(first, options.frames);
+  Sample sample = MakeSample(read(first, options.frames), options, rng, flows.empty() ? nullptr : &flows);
   sample.first_frame = first;
   sample.wind_speed = static_cast<float>(clip.wind_speed);
   return sample;

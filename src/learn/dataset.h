@@ -49,20 +49,26 @@ std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& spl
 // other than the label's.
 std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count);
 
-// How a clip becomes a network input [frames, input_size, input_size] (C = 1, greyscale).
+// How a clip becomes a network input [C, frames, input_size, input_size]: C = 1 (greyscale, as
+// the seed) or, with `flow`, C = 3 (greyscale, then the optical flow's x and y components).
 struct SampleOptions {
   int frames = 30;        // N_t
   int input_size = 112;   // output side [px]
   bool augment = false;   // training: random temporal offset, multi-scale crop, flip
   int first_frame = -1;   // >= 0: start the window here (evaluation over several windows)
   bool mirror = false;    // not augmenting: flip horizontally (evaluation's mirror averaging)
+  bool flow = false;      // two more channels: each frame's optical flow from the one before (FrameFlow)
   // Crop side as fractions of the frame's shorter side (multi-scale cropping, as TSN).
   std::vector<double> crop_scales = {1.0, 0.875, 0.75, 0.66};
 };
 
 // A network input with the augmentation that produced it (for tests and logs).
 struct Sample {
-  std::vector<float> pixels;  // frames x input_size x input_size, per-clip zero mean, unit std
+  // C x frames x input_size x input_size. Channel 0: grey, per-clip zero mean and unit std.
+  // Channels 1, 2 (options.flow): flow x (right) and y (down) [input pixels per frame], unnormalised:
+  // how far the cloth moves is the measurement, so it keeps its scale.
+  std::vector<float> pixels;
+  int channels = 1;           // C
   float wind_speed = 0;       // [m/s]
   int first_frame = 0;        // temporal offset used
   cv::Rect crop;              // square crop taken from the frames [px]
@@ -81,11 +87,36 @@ cv::Rect CentreSquare(int width, int height);
 // is written in place.
 void ResizeCrop(const cv::Mat& frame, const cv::Rect& crop, int side, cv::Mat& out);
 
+// Dense optical flow from `previous` to `next` (DIS, OpenCV's medium preset), why: the intensity
+// spectra read texture, not motion — a stripe running along the wind changes few pixels as a
+// wave travels down it — while the flow is how far each pixel's content moved whatever it shows.
+// Inputs: two CV_8UC1 images of one size H x W. Output: H x W CV_32FC2, (dx, dy) [px] per pixel
+// of `previous`. DIS reads a sub-pixel shift of a textured image to ~0.05 px (test
+// FrameFlowReadsAKnownShift). Throws std::invalid_argument for images of other types or sizes.
+cv::Mat FrameFlow(const cv::Mat& previous, const cv::Mat& next);
+
+// Flow is kept on a grid of 1/kFlowSteps px (far finer than DIS reads it), so that a cache can
+// hold it in 16 bits per component and still give exactly the samples computed afresh.
+constexpr double kFlowSteps = 256;
+// FrameFlow(previous, next) as CV_16SC2 in steps of 1/kFlowSteps px (rounded, saturated).
+cv::Mat FrameFlow16(const cv::Mat& previous, const cv::Mat& next);
+
+// The flow channels of a window of T frames: T - 1 flows between consecutive frames (flows[i] from
+// frame i to frame i + 1; FrameFlow16 as CV_32FC2 [px]), as a Sample holds them: frame t's flow is
+// the one that arrives at it (flows[t - 1]) and frame 0, which has none, repeats frame 1's (the
+// spectral layer's Hann window gives the first sample zero weight).
+std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames);
+
 // Turns greyscale frames (all of one size, count = options.frames) into a Sample: crop (random
 // multi-scale position and size when augmenting, the centred square of the shorter side
 // otherwise), resize to input_size (area interpolation), flip horizontally with probability
 // 1/2 when augmenting (always when options.mirror and not augmenting), and normalise the whole clip to zero mean and unit standard deviation.
-Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& options, std::mt19937_64& rng);
+// With options.flow, the flow of the resized frames (WindowFlows) follows as channels 1 and 2,
+// flipped with the frames (mirrored, x negated). `flows`, when given, are those T - 1 flows
+// already computed (a cache's): only for frames that are already input_size squares, whose crop
+// is then the whole frame.
+Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& options, std::mt19937_64& rng,
+                  const std::vector<cv::Mat>* flows = nullptr);
 
 // The starts of `windows` evenly spaced frame windows of `frames` frames in a clip of `num_frames`:
 // the first at 0 and the last at num_frames - frames (one window: the centred one, as evaluation
@@ -94,10 +125,15 @@ std::vector<int> EvenWindowStarts(int num_frames, int frames, int windows);
 
 // Frames first..first+count-1 of a clip, from wherever they are held (LoadFrames: the files).
 using FrameReader = std::function<std::vector<cv::Mat>(int first, int count)>;
+// The count - 1 flows between frames first..first+count-1 (WindowFlows of those frames), from
+// wherever they are held.
+using FlowReader = std::function<std::vector<cv::Mat>(int first, int count)>;
 
 // ChooseFirstFrame + `read` + MakeSample for one example, deterministic in `seed`: the window,
 // crop and flip are drawn from one generator in that order, whatever supplies the frames.
-Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed, const FrameReader& read);
+// `read_flows`, when set and options.flow, supplies the window's flows (see MakeSample).
+Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed, const FrameReader& read,
+                  const FlowReader& read_flows = nullptr);
 
 // LoadSample with the frames read from the clip's files (LoadFrames).
 Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed);

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace clothwind::learn {
 namespace {
@@ -255,6 +256,103 @@ TEST(MakeSample, FlipMirrorsTheFrames) {
       for (int x = 0; x < 16; ++x)
         EXPECT_FLOAT_EQ(mirrored.pixels[(t * 16 + y) * 16 + x], plain.pixels[(t * 16 + y) * 16 + 15 - x]);
   EXPECT_LT(plain.pixels[0], plain.pixels[15]);  // the ramp rises left to right unflipped
+}
+
+// A smooth random texture, as a flag's print and shading look to the flow at 64 px.
+cv::Mat Texture(int side, uint64_t seed) {
+  cv::Mat noise(side, side, CV_32F);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(noise, noise, cv::Size(0, 0), 1.5);
+  cv::normalize(noise, noise, 20, 235, cv::NORM_MINMAX);
+  cv::Mat out;
+  noise.convertTo(out, CV_8U);
+  return out;
+}
+
+// `image` moved by (dx, dy) [px] (bilinear; edges reflected).
+cv::Mat Shifted(const cv::Mat& image, double dx, double dy) {
+  const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
+  cv::Mat out;
+  cv::warpAffine(image, out, m, image.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  return out;
+}
+
+// Mean of one channel of a CV_32FC2 flow over its interior (a border of 8 px left out: there the
+// reflected edge does not move as the texture does).
+double InteriorMean(const cv::Mat& flow, int channel) {
+  cv::Mat c;
+  cv::extractChannel(flow(cv::Rect(8, 8, flow.cols - 16, flow.rows - 16)), c, channel);
+  return cv::mean(c)[0];
+}
+
+TEST(FrameFlow, ReadsAKnownShift) {
+  const cv::Mat a = Texture(64, 3);
+  for (const cv::Point2d shift : {cv::Point2d(0, 0), cv::Point2d(0.4, -0.3), cv::Point2d(1.5, 0.8), cv::Point2d(-2.5, 0)}) {
+    const cv::Mat flow = FrameFlow(a, Shifted(a, shift.x, shift.y));
+    ASSERT_EQ(flow.type(), CV_32FC2);
+    ASSERT_EQ(flow.size(), a.size());
+    EXPECT_NEAR(InteriorMean(flow, 0), shift.x, 0.1) << shift;
+    EXPECT_NEAR(InteriorMean(flow, 1), shift.y, 0.1) << shift;
+  }
+  // The 16-bit form is the same flow on a 1/256 px grid.
+  const cv::Mat b = Shifted(a, 0.7, 0.2);
+  const cv::Mat f = FrameFlow(a, b), f16 = FrameFlow16(a, b);
+  ASSERT_EQ(f16.type(), CV_16SC2);
+  cv::Mat back;
+  f16.convertTo(back, CV_32FC2, 1.0 / kFlowSteps);
+  EXPECT_LE(cv::norm(back, f, cv::NORM_INF), 0.5 / kFlowSteps + 1e-6);
+  EXPECT_THROW(FrameFlow(a, cv::Mat(32, 32, CV_8UC1, cv::Scalar(0))), std::invalid_argument);
+  EXPECT_THROW(FrameFlow(a, cv::Mat(64, 64, CV_32F, cv::Scalar(0))), std::invalid_argument);
+}
+
+TEST(MakeSample, FlowChannelsFollowTheMotionAndTheFlip) {
+  // A texture running right at 1 px and down at 0.5 px per frame, seen whole at its own size.
+  const cv::Mat texture = Texture(48, 5);
+  std::vector<cv::Mat> frames;
+  for (int t = 0; t < 6; ++t) frames.push_back(Shifted(texture, 1.0 * t, 0.5 * t));
+  SampleOptions o;
+  o.frames = 6;
+  o.input_size = 48;
+  o.flow = true;
+  std::mt19937_64 rng(0);
+  const Sample s = MakeSample(frames, o, rng);
+  ASSERT_EQ(s.channels, 3);
+  const size_t plane = 48 * 48, grey = 6 * plane;
+  ASSERT_EQ(s.pixels.size(), 3 * grey);
+  // Channel 0 is the grey sample without flow, unchanged.
+  SampleOptions no_flow = o;
+  no_flow.flow = false;
+  const Sample g = MakeSample(frames, no_flow, rng);
+  EXPECT_EQ(g.channels, 1);
+  EXPECT_TRUE(std::equal(g.pixels.begin(), g.pixels.end(), s.pixels.begin()));
+  auto flow_at = [](const Sample& sample, int channel, int t) {
+    return cv::Mat(48, 48, CV_32F, const_cast<float*>(sample.pixels.data()) + (6 * channel + t) * 48 * 48).clone();
+  };
+  const cv::Rect inner(8, 8, 32, 32);
+  for (int t = 0; t < 6; ++t) {
+    EXPECT_NEAR(cv::mean(flow_at(s, 1, t)(inner))[0], 1.0, 0.1) << "x, frame " << t;
+    EXPECT_NEAR(cv::mean(flow_at(s, 2, t)(inner))[0], 0.5, 0.1) << "y, frame " << t;
+  }
+  // Frame 0 has no flow arriving at it: it repeats frame 1's.
+  EXPECT_EQ(cv::norm(flow_at(s, 1, 0), flow_at(s, 1, 1), cv::NORM_INF), 0.0);
+  // Mirrored: the same flow field mirrored, its x component negated (the motion runs left).
+  o.mirror = true;
+  const Sample m = MakeSample(frames, o, rng);
+  ASSERT_TRUE(m.flipped);
+  for (int t = 0; t < 6; ++t) {
+    cv::Mat x = flow_at(s, 1, t), y = flow_at(s, 2, t);
+    cv::flip(x, x, 1);
+    cv::flip(y, y, 1);
+    EXPECT_EQ(cv::norm(flow_at(m, 1, t), -x, cv::NORM_INF), 0.0) << t;
+    EXPECT_EQ(cv::norm(flow_at(m, 2, t), y, cv::NORM_INF), 0.0) << t;
+  }
+  // Flows handed in are used as they are, and must match the window.
+  const std::vector<cv::Mat> given = WindowFlows(frames);
+  o.mirror = false;
+  EXPECT_EQ(MakeSample(frames, o, rng, &given).pixels, s.pixels);
+  const std::vector<cv::Mat> short_by_one(given.begin() + 1, given.end());
+  EXPECT_THROW(MakeSample(frames, o, rng, &short_by_one), std::invalid_argument);
 }
 
 }  // namespace

@@ -30,9 +30,36 @@ bool FrameCache::Exact(const SampleOptions& options, const ClipInfo& clip, std::
 }
 
 std::vector<cv::Mat> FrameCache::Frames(size_t index, int first, int count) {
-  const ClipInfo& clip = clips_.at(index);
-  Slot& slot = *slots_[index];
+  Slot& slot = *slots_.at(index);
   std::lock_guard<std::mutex> lock(slot.mutex);
+  return FramesLocked(index, slot, first, count);
+}
+
+std::vector<cv::Mat> FrameCache::Flows(size_t index, int first, int count) {
+  Slot& slot = *slots_.at(index);
+  std::lock_guard<std::mutex> lock(slot.mutex);
+  const std::vector<cv::Mat> frames = FramesLocked(index, slot, first, count);  // checks the range
+  const int frames_in_clip = clips_[index].num_frames;
+  const size_t plane = static_cast<size_t>(input_size_) * input_size_ * 2;
+  if (slot.flow.empty()) {
+    slot.flow.resize(static_cast<size_t>(frames_in_clip) * plane);
+    slot.flow_loaded.assign(static_cast<size_t>(frames_in_clip), false);
+    flow_bytes_ += slot.flow.size() * sizeof(int16_t);
+  }
+  std::vector<cv::Mat> flows(frames.size() - 1);
+  for (int t = first + 1; t < first + count; ++t) {
+    cv::Mat held(input_size_, input_size_, CV_16SC2, slot.flow.data() + static_cast<size_t>(t) * plane);
+    if (!slot.flow_loaded[static_cast<size_t>(t)]) {
+      FrameFlow16(frames[t - 1 - first], frames[t - first]).copyTo(held);
+      slot.flow_loaded[static_cast<size_t>(t)] = true;
+    }
+    held.convertTo(flows[t - 1 - first], CV_32FC2, 1.0 / kFlowSteps);
+  }
+  return flows;
+}
+
+std::vector<cv::Mat> FrameCache::FramesLocked(size_t index, Slot& slot, int first, int count) {
+  const ClipInfo& clip = clips_.at(index);
   if (first < 0 || count < 1 || first + count > clip.num_frames) {
     return LoadFrames(clip, first, count);  // throws the error a direct read gives
   }
@@ -65,8 +92,9 @@ Sample LoadSample(FrameCache& cache, size_t index, const SampleOptions& options,
                                 " but the frame cache holds " + std::to_string(cache.input_size()) + " px");
   }
   // MakeSample's crop offsets are 0 on a whole square, and resizing S to S is a copy in OpenCV.
-  return LoadSample(cache.clip(index), options, seed,
-                    [&cache, index](int first, int count) { return cache.Frames(index, first, count); });
+  return LoadSample(
+      cache.clip(index), options, seed, [&cache, index](int first, int count) { return cache.Frames(index, first, count); },
+      [&cache, index](int first, int count) { return cache.Flows(index, first, count); });
 }
 
 }  // namespace clothwind::learn

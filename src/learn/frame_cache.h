@@ -9,6 +9,7 @@
 #define CLOTHWIND_LEARN_FRAME_CACHE_H_
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -40,6 +41,11 @@ class FrameCache {
   // Throws what LoadFrames throws for a missing or malformed frame.
   std::vector<cv::Mat> Frames(size_t index, int first, int count);
 
+  // WindowFlows of frames first..first+count-1 of clip `index` (count - 1 CV_32FC2 images of
+  // S x S), computing and keeping (16 bits per component, FrameFlow16) the flows not yet held.
+  // Equal to WindowFlows(Frames(index, first, count)). Safe to call from several threads.
+  std::vector<cv::Mat> Flows(size_t index, int first, int count);
+
   const ClipInfo& clip(size_t index) const { return clips_.at(index); }
   int input_size() const { return input_size_; }
   size_t size() const { return slots_.size(); }
@@ -47,6 +53,8 @@ class FrameCache {
   // clips x frames x S^2), and how many frames of them have been decoded.
   size_t bytes() const { return bytes_.load(); }
   size_t frames_held() const { return frames_held_.load(); }
+  // Flow bytes allocated now: num_frames x S^2 x 4 for every clip whose flow was read.
+  size_t flow_bytes() const { return flow_bytes_.load(); }
 
  private:
   // One allocation per clip, not one per frame: 4 KB frames kept between the JPEG decoder's
@@ -56,18 +64,24 @@ class FrameCache {
     std::mutex mutex;
     std::vector<uint8_t> pixels;  // num_frames x S x S, allocated at the first read
     std::vector<bool> loaded;     // per frame
+    std::vector<int16_t> flow;    // num_frames x S x S x 2: frame t's flow from frame t - 1 (t >= 1)
+    std::vector<bool> flow_loaded;
   };
+  // Frames() with the slot's mutex already held.
+  std::vector<cv::Mat> FramesLocked(size_t index, Slot& slot, int first, int count);
   const std::vector<ClipInfo>& clips_;
   int input_size_;
   std::vector<std::unique_ptr<Slot>> slots_;
   std::atomic<size_t> bytes_{0};
   std::atomic<size_t> frames_held_{0};
+  std::atomic<size_t> flow_bytes_{0};
 };
 
 // LoadSample for example `index` of the cache's clips, its frames from the cache: pixels, window,
 // flip and speed equal to LoadSample(clips[index], options, seed)'s whenever FrameCache::Exact
 // holds (sample.crop is then the whole S x S cached square, not the square in the file's pixels).
 // Throws std::invalid_argument when options.input_size is not the cache's.
+// With options.flow, the flows come from the cache as well (FrameCache::Flows).
 Sample LoadSample(FrameCache& cache, size_t index, const SampleOptions& options, uint64_t seed);
 
 }  // namespace clothwind::learn

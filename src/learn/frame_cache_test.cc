@@ -126,6 +126,37 @@ TEST_F(FrameCacheTest, ThreadsFillingOneCacheGetWhatOneThreadGets) {
   EXPECT_EQ(shared.frames_held(), serial.frames_held());
 }
 
+TEST_F(FrameCacheTest, FlowSamplesEqualTheFilesBitForBitAndAreComputedOnce) {
+  FrameCache cache(*clips_, 32);
+  SampleOptions o = Training();
+  o.flow = true;
+  int flipped = 0;
+  for (int pass = 0; pass < 2; ++pass) {  // pass 0 fills the cache, pass 1 reads it
+    for (size_t i = 0; i < clips_->size(); ++i) {
+      for (uint64_t seed = 1; seed <= 3; ++seed) {
+        const Sample direct = LoadSample((*clips_)[i], o, seed * 1000 + i);
+        ASSERT_EQ(direct.channels, 3);
+        ExpectSameSample(direct, LoadSample(cache, i, o, seed * 1000 + i));
+        flipped += direct.flipped;
+      }
+    }
+  }
+  EXPECT_GT(flipped, 0);
+  SampleOptions eval = o;
+  eval.augment = false;
+  for (bool mirror : {false, true}) {
+    eval.mirror = mirror;
+    for (size_t i = 0; i < clips_->size(); ++i) ExpectSameSample(LoadSample((*clips_)[i], eval, 7), LoadSample(cache, i, eval, 7));
+  }
+  // One allocation per clip read, of 16 bits x 2 components per pixel and frame.
+  EXPECT_EQ(cache.flow_bytes(), clips_->size() * 40u * 32 * 32 * 4);
+  // Flows of a window equal WindowFlows of its frames.
+  const std::vector<cv::Mat> flows = cache.Flows(2, 3, 10);
+  const std::vector<cv::Mat> fresh = WindowFlows(cache.Frames(2, 3, 10));
+  ASSERT_EQ(flows.size(), 9u);
+  for (size_t t = 0; t < flows.size(); ++t) EXPECT_EQ(cv::norm(flows[t], fresh[t], cv::NORM_INF), 0.0) << t;
+}
+
 TEST_F(FrameCacheTest, SaysWhenItWouldChangeTheSamples) {
   SampleOptions o = Training();
   std::string why;

@@ -52,6 +52,7 @@ std::string ModelConfig::Name() const {
     if (spectral_pool != 1) s << "/" << spectral_pool;
   }
   else s << arch;
+  if (flow) s << "-flow";
   if (!stem_pool) s << "-np";
   s << "-w" << width << "-" << input_size << "-" << frames << "f";
   return s.str();
@@ -59,13 +60,17 @@ std::string ModelConfig::Name() const {
 
 std::string ModelConfig::Modality() const {
   std::ostringstream s;
-  s << frames * channels << "x" << input_size << "x" << input_size;
+  if (flow) {
+    s << frames << "x" << channels << "x" << input_size << "x" << input_size;
+  } else {
+    s << frames * channels << "x" << input_size << "x" << input_size;
+  }
   return s.str();
 }
 
 nlohmann::json ToJson(const ModelConfig& c) {
   return {{"format", "clothwind-model"}, {"version", 1},   {"arch", c.arch},
-          {"frames", c.frames},          {"channels", c.channels},
+          {"frames", c.frames},          {"channels", c.channels}, {"flow", c.flow},
           {"k", c.k},                    {"include_dc", c.include_dc},
           {"mean_map", c.mean_map},      {"dft_size", c.dft_size},
           {"local_peaks", c.local_peaks},  {"phase_steps", c.phase_steps},
@@ -92,6 +97,8 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.arch = need("arch").get<std::string>();
     c.frames = need("frames").get<int>();
     c.channels = need("channels").get<int>();
+    // Absent in models written before flow channels existed: greyscale only.
+    c.flow = j.contains("flow") ? j.at("flow").get<bool>() : false;
     c.k = need("k").get<int>();
     c.include_dc = need("include_dc").get<bool>();
     // Absent in models written before the mean map existed: they had none.
@@ -123,6 +130,10 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
       !(c.frame_rate > 0) || !(c.label_std > 0) || !(c.std_scale > 0)) {
     throw std::runtime_error(where + ": frames, channels, width, k must be >= 1, input_size >= 16, "
                              "frame_rate, label_std and std_scale > 0");
+  }
+  if (c.channels != c.ChannelsForInput()) {
+    throw std::runtime_error(where + ": field \"channels\" must be " + std::to_string(c.ChannelsForInput()) +
+                             (c.flow ? " (grey and flow x, y)" : " (grey)") + ", got " + std::to_string(c.channels));
   }
   if (!(c.dropout >= 0 && c.dropout < 1)) {
     throw std::runtime_error(where + ": field \"dropout\" must be in [0, 1), got " + std::to_string(c.dropout));

@@ -17,7 +17,10 @@ struct ModelConfig {
   // recurrent baseline: a ResNet-18 trunk per frame, an LSTM over the frames' features)
   std::string arch = "sdn";
   int frames = 30;           // N_t, input frames per clip
-  int channels = 1;          // C, colour channels per frame (1: greyscale, as the seed)
+  int channels = 1;          // C, channels per frame: 1 (greyscale, as the seed), 3 with flow
+  // Each frame's optical flow from the one before as two more channels (SampleOptions::flow):
+  // the spectral layer then reads how far the cloth moves, not only how its texture flickers.
+  bool flow = false;
   int k = 3;                 // SDN: spectral peaks kept per pixel (2kC trunk input channels)
   bool include_dc = false;   // SDN: the DC bin among the candidate peaks (no detrend)
   bool mean_map = false;     // SDN: the clip's per-pixel temporal mean as C more trunk channels
@@ -58,11 +61,13 @@ struct ModelConfig {
   // Channels entering the ResNet trunk: 2kC (+C with mean_map) for the SDN, N_t·C for the
   // frame-stack baseline, C for the recurrent one (its trunk reads one frame at a time).
   int TrunkInputChannels() const;
-  // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("sdn-k3m-…" with mean_map,
+  // The channels per frame that `flow` implies (1 or 3).
+  int ChannelsForInput() const { return flow ? 3 : 1; }
+  // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("…-flow-…" with flow, "sdn-k3m-…" with mean_map,
   // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps,
   // "…s4-" with phase_step_far 4, "…s/2-" with spectral_pool 2).
   std::string Name() const;
-  // Table 1's "input modality", e.g. "30x112x112".
+  // Table 1's "input modality", e.g. "30x112x112" ("30x3x64x64" with flow's three channels).
   std::string Modality() const;
 };
 

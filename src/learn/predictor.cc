@@ -48,8 +48,8 @@ std::string Predictor::device() const { return impl_->device.is_cuda() ? "cuda" 
 std::vector<Prediction> Predictor::Predict(const std::vector<const Sample*>& samples) {
   if (samples.empty()) return {};
   const ModelConfig& c = config();
-  const int64_t per = static_cast<int64_t>(c.frames) * c.input_size * c.input_size;
-  at::Tensor batch = at::empty({static_cast<int64_t>(samples.size()), 1, c.frames, c.input_size, c.input_size});
+  const int64_t per = static_cast<int64_t>(c.channels) * c.frames * c.input_size * c.input_size;
+  at::Tensor batch = at::empty({static_cast<int64_t>(samples.size()), c.channels, c.frames, c.input_size, c.input_size});
   for (size_t i = 0; i < samples.size(); ++i) {
     if (static_cast<int64_t>(samples[i]->pixels.size()) != per) {
       throw std::invalid_argument("Predictor: sample " + std::to_string(i) + " has " +
@@ -83,6 +83,7 @@ Sample Predictor::Prepare(const std::vector<cv::Mat>& frames) const {
   SampleOptions options;
   options.frames = c.frames;
   options.input_size = c.input_size;
+  options.flow = c.flow;
   std::vector<cv::Mat> last(frames.end() - c.frames, frames.end());
   std::mt19937_64 unused(0);
   return MakeSample(last, options, unused);
@@ -93,6 +94,7 @@ Prediction Predictor::PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps
   Prediction p = Predict({&sample})[0];
   const ModelConfig& c = config();
   if (maps != nullptr && c.arch == "sdn") {
+    // The grey channel's maps (channel 0; flow channels, when the model has them, follow it).
     at::Tensor clip = at::from_blob(sample.pixels.data(), {1, 1, c.frames, c.input_size, c.input_size}, at::kFloat);
     SpectralOptions strongest = c.Spectral();
     strongest.k = 1;

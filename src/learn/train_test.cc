@@ -615,6 +615,49 @@ TEST_F(TrainTest, CropScalesOutsideTheFrameAreRefused) {
   }
 }
 
+TEST_F(TrainTest, FlowChannelsTrainRoundTripAndAreRefusedWhenInconsistent) {
+  TrainOptions t = Options("sdn", "flow");
+  t.model.flow = true;
+  t.model.phase_steps = true;
+  t.epochs = 1;
+  const TrainResult r = Train(t);
+  Predictor p(r.model, 1, "cpu");
+  EXPECT_TRUE(p.config().flow);
+  EXPECT_EQ(p.config().channels, 3);
+  EXPECT_NE(p.config().Name().find("-flow"), std::string::npos) << p.config().Name();
+  EXPECT_EQ(p.config().Modality(), "30x3x32x32");
+  // (2k + 4 phase) channels per input channel reach the trunk.
+  EXPECT_EQ(p.config().TrunkInputChannels(), (2 * 3 + 4) * 3);
+  const Dataset dataset = ReadDataset(*root_ / "data");
+  SampleOptions o;
+  o.frames = 30;
+  o.input_size = 32;
+  o.flow = true;
+  const Sample sample = LoadSample(dataset.clips[0], o, 0);
+  const Prediction a = p.Predict({&sample}).front();
+  EXPECT_TRUE(std::isfinite(a.speed));
+  // The node's path (Prepare: the last N_t frames) builds the same three channels.
+  const std::vector<cv::Mat> frames = LoadFrames(dataset.clips[0], 15, 30);
+  EXPECT_EQ(p.Prepare(frames).pixels.size(), 3u * 30 * 32 * 32);
+  // Flow carries what the grey channel does not: zeroing it changes the estimate.
+  Sample no_motion = sample;
+  std::fill(no_motion.pixels.begin() + 30 * 32 * 32, no_motion.pixels.end(), 0.0f);
+  EXPECT_GT(std::abs(p.Predict({&no_motion}).front().speed - a.speed), 1e-4);
+  // A grey-only sample is refused by a flow model, and a model file whose channels disagree with
+  // its flow field is refused by name.
+  o.flow = false;
+  const Sample grey = LoadSample(dataset.clips[0], o, 0);
+  EXPECT_THROW(p.Predict({&grey}), std::invalid_argument);
+  nlohmann::json j = ToJson(p.config());
+  j["channels"] = 1;
+  ExpectFieldRefused(j, "channels");
+  // Older model files have no "flow" field: greyscale.
+  ModelConfig old;
+  nlohmann::json without = ToJson(old);
+  without.erase("flow");
+  EXPECT_FALSE(ModelConfigFromJson(without, "old/model.json").flow);
+}
+
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
   TrainOptions t;
   t.model.arch = "sdn";
