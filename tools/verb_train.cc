@@ -73,6 +73,10 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_flag("--flow", o.model.flow,
                 "each frame's optical flow from the one before (DIS) as two more input channels: what "
                 "moves, whatever the flag's design shows (docs/sdn.md)");
+  sub->add_option("--flow-size", o.model.flow_size,
+                  "with --flow: compute the flow on the crop resized to this side [px], then bring it to "
+                  "--input-size (0: at --input-size)")
+      ->check(CLI::NonNegativeNumber);
   sub->add_flag("--mean-map", o.model.mean_map, "SDN: add the clip's per-pixel temporal mean (the pose) as a channel");
   sub->add_option("--threads", o.threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--device", o.device, "cpu, cuda or auto (CUDA when libtorch finds one)")

@@ -190,18 +190,32 @@ cv::Mat FrameFlow(const cv::Mat& previous, const cv::Mat& next) {
   return flow;
 }
 
-cv::Mat FrameFlow16(const cv::Mat& previous, const cv::Mat& next) {
-  cv::Mat steps;
-  FrameFlow(previous, next).convertTo(steps, CV_16SC2, kFlowSteps);
-  return steps;
+std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames, const cv::Rect& crop, int flow_side, int side) {
+  if (flow_side < 1 || side < 1) throw std::invalid_argument("WindowFlows: sides must be >= 1");
+  std::vector<cv::Mat> flows(frames.empty() ? 0 : frames.size() - 1);
+  cv::Mat previous, next;
+  for (size_t t = 0; t < frames.size(); ++t) {
+    ResizeCrop(frames[t], crop, flow_side, next);
+    if (t > 0) {
+      cv::Mat flow = FrameFlow(previous, next);
+      if (flow_side != side) {
+        cv::Mat resized;
+        cv::resize(flow, resized, cv::Size(side, side), 0, 0, flow_side > side ? cv::INTER_AREA : cv::INTER_LINEAR);
+        flow = resized * (static_cast<double>(side) / flow_side);
+      }
+      cv::Mat steps;
+      flow.convertTo(steps, CV_16SC2, kFlowSteps);
+      steps.convertTo(flows[t - 1], CV_32FC2, 1.0 / kFlowSteps);
+    }
+    std::swap(previous, next);
+  }
+  return flows;
 }
 
 std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames) {
-  std::vector<cv::Mat> flows(frames.empty() ? 0 : frames.size() - 1);
-  for (size_t t = 1; t < frames.size(); ++t) {
-    FrameFlow16(frames[t - 1], frames[t]).convertTo(flows[t - 1], CV_32FC2, 1.0 / kFlowSteps);
-  }
-  return flows;
+  if (frames.empty()) return {};
+  const int side = frames[0].cols;
+  return WindowFlows(frames, cv::Rect(0, 0, side, frames[0].rows), side, side);
 }
 
 Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& options, std::mt19937_64& rng,
@@ -263,7 +277,7 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
     std::vector<cv::Mat> computed;
     if (flows == nullptr) {
       // Flow of the frames as the network sees them, before the flip (which then mirrors it).
-      computed = WindowFlows(resized);
+      computed = WindowFlows(frames, sample.crop, options.flow_size > 0 ? options.flow_size : s, s);
       flows = &computed;
     } else if (static_cast<int>(flows->size()) != options.frames - 1 || w != s || h != s) {
       throw std::invalid_argument("MakeSample: " + std::to_string(flows->size()) + " flows of " +

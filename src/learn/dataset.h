@@ -58,6 +58,9 @@ struct SampleOptions {
   int first_frame = -1;   // >= 0: start the window here (evaluation over several windows)
   bool mirror = false;    // not augmenting: flip horizontally (evaluation's mirror averaging)
   bool flow = false;      // two more channels: each frame's optical flow from the one before (FrameFlow)
+  // Side [px] the crop is resized to for the flow, which is then resized to input_size and
+  // scaled with it (0: input_size). A finer flow reads the cloth's sub-pixel motion more exactly.
+  int flow_size = 0;
   // Crop side as fractions of the frame's shorter side (multi-scale cropping, as TSN).
   std::vector<double> crop_scales = {1.0, 0.875, 0.75, 0.66};
 };
@@ -98,13 +101,17 @@ cv::Mat FrameFlow(const cv::Mat& previous, const cv::Mat& next);
 // Flow is kept on a grid of 1/kFlowSteps px (far finer than DIS reads it), so that a cache can
 // hold it in 16 bits per component and still give exactly the samples computed afresh.
 constexpr double kFlowSteps = 256;
-// FrameFlow(previous, next) as CV_16SC2 in steps of 1/kFlowSteps px (rounded, saturated).
-cv::Mat FrameFlow16(const cv::Mat& previous, const cv::Mat& next);
 
 // The flow channels of a window of T frames: T - 1 flows between consecutive frames (flows[i] from
-// frame i to frame i + 1; FrameFlow16 as CV_32FC2 [px]), as a Sample holds them: frame t's flow is
-// the one that arrives at it (flows[t - 1]) and frame 0, which has none, repeats frame 1's (the
-// spectral layer's Hann window gives the first sample zero weight).
+// frame i to frame i + 1), as a Sample holds them: frame t's flow is the one that arrives at it
+// (flows[t - 1]) and frame 0, which has none, repeats frame 1's (the spectral layer's Hann window
+// gives the first sample zero weight).
+// Inputs: frames, T mono8 images of one size; crop, the square of them the sample shows; flow_side,
+// the side the crop is resized to for FrameFlow; side, the sample's input size.
+// Output: T - 1 side x side CV_32FC2 flows [input px per frame]: FrameFlow at flow_side, resized
+// to side (area) and scaled by side / flow_side, on the 1/kFlowSteps grid.
+std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames, const cv::Rect& crop, int flow_side, int side);
+// The same for frames that are already the sample's squares (crop: all of them; flow_side = side).
 std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames);
 
 // Turns greyscale frames (all of one size, count = options.frames) into a Sample: crop (random

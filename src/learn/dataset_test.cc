@@ -295,13 +295,22 @@ TEST(FrameFlow, ReadsAKnownShift) {
     EXPECT_NEAR(InteriorMean(flow, 0), shift.x, 0.1) << shift;
     EXPECT_NEAR(InteriorMean(flow, 1), shift.y, 0.1) << shift;
   }
-  // The 16-bit form is the same flow on a 1/256 px grid.
+  // A window's flows are the same flow on a 1/256 px grid.
   const cv::Mat b = Shifted(a, 0.7, 0.2);
-  const cv::Mat f = FrameFlow(a, b), f16 = FrameFlow16(a, b);
-  ASSERT_EQ(f16.type(), CV_16SC2);
-  cv::Mat back;
-  f16.convertTo(back, CV_32FC2, 1.0 / kFlowSteps);
-  EXPECT_LE(cv::norm(back, f, cv::NORM_INF), 0.5 / kFlowSteps + 1e-6);
+  const cv::Mat f = FrameFlow(a, b), grid = WindowFlows({a, b})[0];
+  EXPECT_LE(cv::norm(grid, f, cv::NORM_INF), 0.5 / kFlowSteps + 1e-6);
+  cv::Mat steps = grid * kFlowSteps, rounded;
+  steps.convertTo(rounded, CV_16SC2);
+  rounded.convertTo(rounded, CV_32FC2);
+  EXPECT_EQ(cv::norm(steps, rounded, cv::NORM_INF), 0.0);
+  // Computed on a finer image and brought to the input's size, the flow keeps the input's units:
+  // the same texture at twice the size, shifted twice as far, reads the same shift.
+  cv::Mat big;
+  cv::resize(a, big, cv::Size(128, 128), 0, 0, cv::INTER_LINEAR);
+  const std::vector<cv::Mat> fine = WindowFlows({big, Shifted(big, 1.6, -1.0)}, cv::Rect(0, 0, 128, 128), 128, 64);
+  ASSERT_EQ(fine[0].size(), cv::Size(64, 64));
+  EXPECT_NEAR(InteriorMean(fine[0], 0), 0.8, 0.1);
+  EXPECT_NEAR(InteriorMean(fine[0], 1), -0.5, 0.1);
   EXPECT_THROW(FrameFlow(a, cv::Mat(32, 32, CV_8UC1, cv::Scalar(0))), std::invalid_argument);
   EXPECT_THROW(FrameFlow(a, cv::Mat(64, 64, CV_32F, cv::Scalar(0))), std::invalid_argument);
 }

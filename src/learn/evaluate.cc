@@ -107,6 +107,7 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   options.frames = r.config.frames;
   options.input_size = r.config.input_size;
   options.flow = r.config.flow;
+  options.flow_size = r.config.flow_size;
   batch = std::max(1, batch);
   for (size_t i = 0; i < clips.size(); i += batch) {
     const size_t end = std::min(clips.size(), i + batch);

@@ -35,22 +35,38 @@ std::vector<cv::Mat> FrameCache::Frames(size_t index, int first, int count) {
   return FramesLocked(index, slot, first, count);
 }
 
-std::vector<cv::Mat> FrameCache::Flows(size_t index, int first, int count) {
+std::vector<cv::Mat> FrameCache::Flows(size_t index, int first, int count, int flow_side) {
+  if (flow_side == 0) flow_side = input_size_;
+  int expected = 0;
+  if (!flow_side_.compare_exchange_strong(expected, flow_side) && expected != flow_side) {
+    throw std::invalid_argument("FrameCache: flow computed at " + std::to_string(flow_side) + " px asked of a cache holding " +
+                                std::to_string(expected) + " px flow");
+  }
   Slot& slot = *slots_.at(index);
   std::lock_guard<std::mutex> lock(slot.mutex);
   const std::vector<cv::Mat> frames = FramesLocked(index, slot, first, count);  // checks the range
-  const int frames_in_clip = clips_[index].num_frames;
+  const ClipInfo& clip = clips_[index];
   const size_t plane = static_cast<size_t>(input_size_) * input_size_ * 2;
   if (slot.flow.empty()) {
-    slot.flow.resize(static_cast<size_t>(frames_in_clip) * plane);
-    slot.flow_loaded.assign(static_cast<size_t>(frames_in_clip), false);
+    slot.flow.resize(static_cast<size_t>(clip.num_frames) * plane);
+    slot.flow_loaded.assign(static_cast<size_t>(clip.num_frames), false);
     flow_bytes_ += slot.flow.size() * sizeof(int16_t);
+  }
+  // A flow finer than the input needs the files' frames; read them once for the whole window.
+  std::vector<cv::Mat> files;
+  for (int t = first + 1; t < first + count && files.empty() && flow_side != input_size_; ++t) {
+    if (!slot.flow_loaded[static_cast<size_t>(t)]) files = LoadFrames(clip, first, count);
   }
   std::vector<cv::Mat> flows(frames.size() - 1);
   for (int t = first + 1; t < first + count; ++t) {
     cv::Mat held(input_size_, input_size_, CV_16SC2, slot.flow.data() + static_cast<size_t>(t) * plane);
     if (!slot.flow_loaded[static_cast<size_t>(t)]) {
-      FrameFlow16(frames[t - 1 - first], frames[t - first]).copyTo(held);
+      const int i = t - first;
+      const std::vector<cv::Mat> pair = files.empty() ? std::vector<cv::Mat>{frames[i - 1], frames[i]}
+                                                      : std::vector<cv::Mat>{files[i - 1], files[i]};
+      const cv::Rect crop = CentreSquare(pair[0].cols, pair[0].rows);
+      WindowFlows(pair, crop, files.empty() ? input_size_ : flow_side, input_size_)[0].convertTo(held, CV_16SC2,
+                                                                                                kFlowSteps);
       slot.flow_loaded[static_cast<size_t>(t)] = true;
     }
     held.convertTo(flows[t - 1 - first], CV_32FC2, 1.0 / kFlowSteps);
@@ -94,7 +110,7 @@ Sample LoadSample(FrameCache& cache, size_t index, const SampleOptions& options,
   // MakeSample's crop offsets are 0 on a whole square, and resizing S to S is a copy in OpenCV.
   return LoadSample(
       cache.clip(index), options, seed, [&cache, index](int first, int count) { return cache.Frames(index, first, count); },
-      [&cache, index](int first, int count) { return cache.Flows(index, first, count); });
+      [&cache, index, &options](int first, int count) { return cache.Flows(index, first, count, options.flow_size); });
 }
 
 }  // namespace clothwind::learn

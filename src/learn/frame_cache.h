@@ -42,9 +42,11 @@ class FrameCache {
   std::vector<cv::Mat> Frames(size_t index, int first, int count);
 
   // WindowFlows of frames first..first+count-1 of clip `index` (count - 1 CV_32FC2 images of
-  // S x S), computing and keeping (16 bits per component, FrameFlow16) the flows not yet held.
-  // Equal to WindowFlows(Frames(index, first, count)). Safe to call from several threads.
-  std::vector<cv::Mat> Flows(size_t index, int first, int count);
+  // S x S) with the flow computed at flow_side (0: S), computing and keeping (16 bits per
+  // component) the flows not yet held. Equal to WindowFlows(files' frames, centre square,
+  // flow_side, S). A cache holds one flow_side: another throws std::invalid_argument. Safe to call
+  // from several threads.
+  std::vector<cv::Mat> Flows(size_t index, int first, int count, int flow_side = 0);
 
   const ClipInfo& clip(size_t index) const { return clips_.at(index); }
   int input_size() const { return input_size_; }
@@ -75,6 +77,7 @@ class FrameCache {
   std::atomic<size_t> bytes_{0};
   std::atomic<size_t> frames_held_{0};
   std::atomic<size_t> flow_bytes_{0};
+  std::atomic<int> flow_side_{0};  // the flow side held (0: none yet)
 };
 
 // LoadSample for example `index` of the cache's clips, its frames from the cache: pixels, window,

@@ -150,6 +150,18 @@ TEST_F(FrameCacheTest, FlowSamplesEqualTheFilesBitForBitAndAreComputedOnce) {
   }
   // One allocation per clip read, of 16 bits x 2 components per pixel and frame.
   EXPECT_EQ(cache.flow_bytes(), clips_->size() * 40u * 32 * 32 * 4);
+  // A flow computed on the files' 48-px frames, brought to 32 px, is cached alike; one cache holds
+  // one flow size.
+  FrameCache fine(*clips_, 32);
+  SampleOptions fine_options = o;
+  fine_options.flow_size = 48;
+  for (size_t i = 0; i < clips_->size(); ++i) {
+    const Sample direct = LoadSample((*clips_)[i], fine_options, 5 + i);
+    ExpectSameSample(direct, LoadSample(fine, i, fine_options, 5 + i));
+    ExpectSameSample(direct, LoadSample(fine, i, fine_options, 5 + i));
+    EXPECT_NE(direct.pixels, LoadSample((*clips_)[i], o, 5 + i).pixels);  // the flow differs
+  }
+  EXPECT_THROW(LoadSample(fine, 0, o, 1), std::invalid_argument);
   // Flows of a window equal WindowFlows of its frames.
   const std::vector<cv::Mat> flows = cache.Flows(2, 3, 10);
   const std::vector<cv::Mat> fresh = WindowFlows(cache.Frames(2, 3, 10));

@@ -53,6 +53,7 @@ std::string ModelConfig::Name() const {
   }
   else s << arch;
   if (flow) s << "-flow";
+  if (flow && flow_size != 0) s << flow_size;
   if (!stem_pool) s << "-np";
   s << "-w" << width << "-" << input_size << "-" << frames << "f";
   return s.str();
@@ -70,7 +71,7 @@ std::string ModelConfig::Modality() const {
 
 nlohmann::json ToJson(const ModelConfig& c) {
   return {{"format", "clothwind-model"}, {"version", 1},   {"arch", c.arch},
-          {"frames", c.frames},          {"channels", c.channels}, {"flow", c.flow},
+          {"frames", c.frames},          {"channels", c.channels}, {"flow", c.flow}, {"flow_size", c.flow_size},
           {"k", c.k},                    {"include_dc", c.include_dc},
           {"mean_map", c.mean_map},      {"dft_size", c.dft_size},
           {"local_peaks", c.local_peaks},  {"phase_steps", c.phase_steps},
@@ -99,6 +100,7 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.channels = need("channels").get<int>();
     // Absent in models written before flow channels existed: greyscale only.
     c.flow = j.contains("flow") ? j.at("flow").get<bool>() : false;
+    c.flow_size = j.contains("flow_size") ? j.at("flow_size").get<int>() : 0;
     c.k = need("k").get<int>();
     c.include_dc = need("include_dc").get<bool>();
     // Absent in models written before the mean map existed: they had none.
@@ -134,6 +136,10 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
   if (c.channels != c.ChannelsForInput()) {
     throw std::runtime_error(where + ": field \"channels\" must be " + std::to_string(c.ChannelsForInput()) +
                              (c.flow ? " (grey and flow x, y)" : " (grey)") + ", got " + std::to_string(c.channels));
+  }
+  if (c.flow_size != 0 && (!c.flow || c.flow_size < 16)) {
+    throw std::runtime_error(where + ": field \"flow_size\" must be 0, or at least 16 with \"flow\", got " +
+                             std::to_string(c.flow_size));
   }
   if (!(c.dropout >= 0 && c.dropout < 1)) {
     throw std::runtime_error(where + ": field \"dropout\" must be in [0, 1), got " + std::to_string(c.dropout));

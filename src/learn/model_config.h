@@ -21,6 +21,9 @@ struct ModelConfig {
   // Each frame's optical flow from the one before as two more channels (SampleOptions::flow):
   // the spectral layer then reads how far the cloth moves, not only how its texture flickers.
   bool flow = false;
+  // With flow: the side [px] the flow is computed at before it is resized to input_size (0:
+  // input_size; SampleOptions::flow_size).
+  int flow_size = 0;
   int k = 3;                 // SDN: spectral peaks kept per pixel (2kC trunk input channels)
   bool include_dc = false;   // SDN: the DC bin among the candidate peaks (no detrend)
   bool mean_map = false;     // SDN: the clip's per-pixel temporal mean as C more trunk channels

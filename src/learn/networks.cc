@@ -91,6 +91,10 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
                                 " must be >= 1, divide the input size " + std::to_string(config.input_size) +
                                 " and be 1 unless the model is an SDN");
   }
+  if (config.flow_size != 0 && (!config.flow || config.flow_size < 16)) {
+    throw std::invalid_argument("WindNet: flow_size " + std::to_string(config.flow_size) +
+                                " must be 0, or at least 16 on a model with flow");
+  }
   trunk_ = register_module("trunk", ResNet18Trunk(config.TrunkInputChannels(), config.width, config.stem_pool));
   if (config.arch == "lstm") {
     // Yang et al. read the last hidden state of an LSTM fed one CNN feature vector per frame.

@@ -84,6 +84,7 @@ Sample Predictor::Prepare(const std::vector<cv::Mat>& frames) const {
   options.frames = c.frames;
   options.input_size = c.input_size;
   options.flow = c.flow;
+  options.flow_size = c.flow_size;
   std::vector<cv::Mat> last(frames.end() - c.frames, frames.end());
   std::mt19937_64 unused(0);
   return MakeSample(last, options, unused);

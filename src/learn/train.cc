@@ -242,6 +242,7 @@ TrainResult Train(const TrainOptions& o) {
   train_options.frames = val_options.frames = config.frames;
   train_options.input_size = val_options.input_size = config.input_size;
   train_options.flow = val_options.flow = config.flow;
+  train_options.flow_size = val_options.flow_size = config.flow_size;
   train_options.augment = true;
   train_options.crop_scales = o.crop_scales;
   std::unique_ptr<FrameCache> train_cache, val_cache;

@@ -651,6 +651,9 @@ TEST_F(TrainTest, FlowChannelsTrainRoundTripAndAreRefusedWhenInconsistent) {
   nlohmann::json j = ToJson(p.config());
   j["channels"] = 1;
   ExpectFieldRefused(j, "channels");
+  j = ToJson(p.config());
+  j["flow_size"] = 8;
+  ExpectFieldRefused(j, "flow_size");
   // Older model files have no "flow" field: greyscale.
   ModelConfig old;
   nlohmann::json without = ToJson(old);
