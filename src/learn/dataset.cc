@@ -247,7 +247,6 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
   const size_t grey = static_cast<size_t>(options.frames) * plane;
   sample.channels = options.flow ? 3 : 1;
   sample.pixels.resize(grey * sample.channels);
-  std::vector<cv::Mat> resized(options.frames);
   double sum = 0, sum2 = 0;
   for (int t = 0; t < options.frames; ++t) {
     const cv::Mat& f = frames[t];
@@ -255,15 +254,11 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
       throw std::invalid_argument("MakeSample: frame " + std::to_string(t) + " is not " + std::to_string(w) + "x" +
                                   std::to_string(h) + " mono8");
     }
-    ResizeCrop(f, sample.crop, s, resized[t]);
-    cv::Mat shown;
-    if (sample.flipped) {
-      cv::flip(resized[t], shown, 1);
-    } else {
-      shown = resized[t];
-    }
+    cv::Mat resized;
+    ResizeCrop(f, sample.crop, s, resized);
+    if (sample.flipped) cv::flip(resized, resized, 1);
     cv::Mat out(s, s, CV_32F, sample.pixels.data() + static_cast<size_t>(t) * plane);
-    shown.convertTo(out, CV_32F);
+    resized.convertTo(out, CV_32F);
     const cv::Scalar m = cv::sum(out);
     sum += m[0];
     sum2 += out.dot(out);

@@ -61,12 +61,12 @@ std::vector<cv::Mat> FrameCache::Flows(size_t index, int first, int count, int f
   for (int t = first + 1; t < first + count; ++t) {
     cv::Mat held(input_size_, input_size_, CV_16SC2, slot.flow.data() + static_cast<size_t>(t) * plane);
     if (!slot.flow_loaded[static_cast<size_t>(t)]) {
+      // At the input size the cached squares are what MakeSample would crop and resize.
+      const std::vector<cv::Mat>& source = flow_side == input_size_ ? frames : files;
       const int i = t - first;
-      const std::vector<cv::Mat> pair = files.empty() ? std::vector<cv::Mat>{frames[i - 1], frames[i]}
-                                                      : std::vector<cv::Mat>{files[i - 1], files[i]};
-      const cv::Rect crop = CentreSquare(pair[0].cols, pair[0].rows);
-      WindowFlows(pair, crop, files.empty() ? input_size_ : flow_side, input_size_)[0].convertTo(held, CV_16SC2,
-                                                                                                kFlowSteps);
+      const std::vector<cv::Mat> pair = {source[i - 1], source[i]};
+      WindowFlows(pair, CentreSquare(pair[0].cols, pair[0].rows), flow_side, input_size_)[0].convertTo(
+          held, CV_16SC2, kFlowSteps);
       slot.flow_loaded[static_cast<size_t>(t)] = true;
     }
     held.convertTo(flows[t - 1 - first], CV_32FC2, 1.0 / kFlowSteps);
