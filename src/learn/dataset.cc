@@ -245,7 +245,7 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
   const int s = options.input_size;
   const size_t plane = static_cast<size_t>(s) * s;
   const size_t grey = static_cast<size_t>(options.frames) * plane;
-  sample.channels = options.flow ? 3 : 1;
+  sample.channels = options.channels();
   sample.pixels.resize(grey * sample.channels);
   double sum = 0, sum2 = 0;
   for (int t = 0; t < options.frames; ++t) {

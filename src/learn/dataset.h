@@ -63,6 +63,8 @@ struct SampleOptions {
   int flow_size = 0;
   // Crop side as fractions of the frame's shorter side (multi-scale cropping, as TSN).
   std::vector<double> crop_scales = {1.0, 0.875, 0.75, 0.66};
+  // C, the channels per frame of the samples these options make: 1 (grey), 3 with flow.
+  int channels() const { return flow ? 3 : 1; }
 };
 
 // A network input with the augmentation that produced it (for tests and logs).

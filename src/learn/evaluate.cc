@@ -103,11 +103,7 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   r.windows = windows;
   r.mirror = mirror;
   const int passes = windows * (mirror ? 2 : 1);
-  SampleOptions options;
-  options.frames = r.config.frames;
-  options.input_size = r.config.input_size;
-  options.flow = r.config.flow;
-  options.flow_size = r.config.flow_size;
+  const SampleOptions options = r.config.Sampling();
   batch = std::max(1, batch);
   for (size_t i = 0; i < clips.size(); i += batch) {
     const size_t end = std::min(clips.size(), i + batch);

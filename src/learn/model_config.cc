@@ -39,6 +39,15 @@ bool ModelConfig::SpectralPoolIsValid() const {
   return spectral_pool >= 1 && input_size % spectral_pool == 0 && (spectral_pool == 1 || arch == "sdn");
 }
 
+SampleOptions ModelConfig::Sampling() const {
+  SampleOptions o;
+  o.frames = frames;
+  o.input_size = input_size;
+  o.flow = flow;
+  o.flow_size = flow_size;
+  return o;
+}
+
 bool IsKnownArch(const std::string& arch) { return arch == "sdn" || arch == "resnet18" || arch == "lstm"; }
 
 std::string ModelConfig::Name() const {
@@ -137,7 +146,7 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     throw std::runtime_error(where + ": field \"channels\" must be " + std::to_string(c.ChannelsForInput()) +
                              (c.flow ? " (grey and flow x, y)" : " (grey)") + ", got " + std::to_string(c.channels));
   }
-  if (c.flow_size != 0 && (!c.flow || c.flow_size < 16)) {
+  if (!c.FlowSizeIsValid()) {
     throw std::runtime_error(where + ": field \"flow_size\" must be 0, or at least 16 with \"flow\", got " +
                              std::to_string(c.flow_size));
   }

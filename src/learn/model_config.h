@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "learn/dataset.h"
 #include "learn/spectral_layer.h"
 
 namespace clothwind::learn {
@@ -64,8 +65,13 @@ struct ModelConfig {
   // Channels entering the ResNet trunk: 2kC (+C with mean_map) for the SDN, N_t·C for the
   // frame-stack baseline, C for the recurrent one (its trunk reads one frame at a time).
   int TrunkInputChannels() const;
-  // The channels per frame that `flow` implies (1 or 3).
-  int ChannelsForInput() const { return flow ? 3 : 1; }
+  // How a clip becomes this model's input: frames, input size and flow set, no augmentation
+  // (evaluation's and the node's; training adds its augmentation to these).
+  SampleOptions Sampling() const;
+  // The channels per frame that `flow` implies (1 or 3): Sampling().channels().
+  int ChannelsForInput() const { return Sampling().channels(); }
+  // flow_size is 0, or a side of at least 16 px on a model with flow.
+  bool FlowSizeIsValid() const { return flow_size == 0 || (flow && flow_size >= 16); }
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("…-flow-…" with flow, "sdn-k3m-…" with mean_map,
   // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps,
   // "…s4-" with phase_step_far 4, "…s/2-" with spectral_pool 2).

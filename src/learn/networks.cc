@@ -91,7 +91,7 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
                                 " must be >= 1, divide the input size " + std::to_string(config.input_size) +
                                 " and be 1 unless the model is an SDN");
   }
-  if (config.flow_size != 0 && (!config.flow || config.flow_size < 16)) {
+  if (!config.FlowSizeIsValid()) {
     throw std::invalid_argument("WindNet: flow_size " + std::to_string(config.flow_size) +
                                 " must be 0, or at least 16 on a model with flow");
   }

@@ -80,11 +80,7 @@ Sample Predictor::Prepare(const std::vector<cv::Mat>& frames) const {
       throw std::invalid_argument("clip frames must be non-empty mono8 images of one size");
     }
   }
-  SampleOptions options;
-  options.frames = c.frames;
-  options.input_size = c.input_size;
-  options.flow = c.flow;
-  options.flow_size = c.flow_size;
+  const SampleOptions options = c.Sampling();
   std::vector<cv::Mat> last(frames.end() - c.frames, frames.end());
   std::mt19937_64 unused(0);
   return MakeSample(last, options, unused);

@@ -45,11 +45,11 @@ constexpr int kBatchReaders = 4;
 
 // Loads clips indices[begin, end) of `clips` as one batch, clip i augmented with seed
 // seed_base + indices[i], its frames from `cache` when given (a cache of these same clips).
-// Outputs: clips [end - begin, C, N_t, S, S] float (C = 3 with options.flow, else 1), speeds [end - begin] m/s.
+// Outputs: clips [end - begin, C, N_t, S, S] float (C = options.channels()), speeds [end - begin] m/s.
 Batch LoadBatch(const std::vector<ClipInfo>& clips, const std::vector<size_t>& indices, size_t begin, size_t end,
                 const SampleOptions& options, uint64_t seed_base, FrameCache* cache) {
   const int64_t n = static_cast<int64_t>(end - begin), s = options.input_size;
-  Batch b{at::empty({n, options.flow ? 3 : 1, options.frames, s, s}), at::empty({n}, at::kFloat)};
+  Batch b{at::empty({n, options.channels(), options.frames, s, s}), at::empty({n}, at::kFloat)};
   float* pixels = b.clips.data_ptr<float>();
   float* speeds = b.speeds.data_ptr<float>();
   const int64_t clip_floats = n > 0 ? b.clips.numel() / n : 0;
@@ -238,11 +238,8 @@ TrainResult Train(const TrainOptions& o) {
 
   result.best_val_rmse = std::numeric_limits<double>::infinity();
   for (const EpochRecord& e : result.log) result.best_val_rmse = std::min(result.best_val_rmse, e.val_rmse);
-  SampleOptions train_options, val_options;
-  train_options.frames = val_options.frames = config.frames;
-  train_options.input_size = val_options.input_size = config.input_size;
-  train_options.flow = val_options.flow = config.flow;
-  train_options.flow_size = val_options.flow_size = config.flow_size;
+  const SampleOptions val_options = config.Sampling();
+  SampleOptions train_options = config.Sampling();
   train_options.augment = true;
   train_options.crop_scales = o.crop_scales;
   std::unique_ptr<FrameCache> train_cache, val_cache;
