@@ -1,5 +1,6 @@
 #include "learn/frame_cache.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace clothwind::learn {
@@ -53,10 +54,10 @@ std::vector<cv::Mat> FrameCache::Flows(size_t index, int first, int count, int f
     flow_bytes_ += slot.flow.size() * sizeof(int16_t);
   }
   // A flow finer than the input needs the files' frames; read them once for the whole window.
-  std::vector<cv::Mat> files;
-  for (int t = first + 1; t < first + count && files.empty() && flow_side != input_size_; ++t) {
-    if (!slot.flow_loaded[static_cast<size_t>(t)]) files = LoadFrames(clip, first, count);
-  }
+  const auto loaded = slot.flow_loaded.begin();
+  const bool missing = std::find(loaded + first + 1, loaded + first + count, false) != loaded + first + count;
+  const std::vector<cv::Mat> files =
+      missing && flow_side != input_size_ ? LoadFrames(clip, first, count) : std::vector<cv::Mat>{};
   std::vector<cv::Mat> flows(frames.size() - 1);
   for (int t = first + 1; t < first + count; ++t) {
     cv::Mat held(input_size_, input_size_, CV_16SC2, slot.flow.data() + static_cast<size_t>(t) * plane);
