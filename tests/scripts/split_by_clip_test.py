@@ -1,0 +1,99 @@
+#!/usr/bin/python3
+"""Tests of scripts/split-by-clip on a toy dataset: links, splits drawn per clip, refusals."""
+import json
+import os
+import subprocess
+import tempfile
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SCRIPT = os.path.join(ROOT, 'scripts', 'split-by-clip')
+
+
+def make_dataset(folder, sims, views=4):
+    """A clothwind-dataset index whose splits are per simulation, as make-dataset writes them."""
+    clips = []
+    for s in range(sims):
+        split = ('train', 'train', 'val', 'test')[s % 4]
+        for v in range(views):
+            name = f'flag-{s:06d}-v{v}'
+            os.makedirs(os.path.join(folder, name))
+            for f in ('000.jpg', 'label.json'):
+                with open(os.path.join(folder, name, f), 'w') as out:
+                    out.write(name)
+            clips.append({'name': name, 'wind_speed': 0.01 * s, 'split': split, 'simulation': s, 'view': v})
+    index = {'format': 'clothwind-dataset', 'version': 1, 'count': sims,
+             'dataset': {'val_fraction': 0.1, 'test_fraction': 0.2}, 'clips': clips}
+    with open(os.path.join(folder, 'index.json'), 'w') as out:
+        json.dump(index, out)
+    return index
+
+
+def run(*args):
+    return subprocess.run([SCRIPT, *args], capture_output=True, text=True)
+
+
+class SplitByClipTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.src = os.path.join(self.tmp.name, 'src')
+        self.source_index = make_dataset(self.src, sims=250)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def resplit(self, name='dst'):
+        dst = os.path.join(self.tmp.name, name)
+        r = run(self.src, dst)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(dst, 'index.json')) as f:
+            return dst, json.load(f)
+
+    def test_splits_are_drawn_per_clip_with_the_source_fractions(self):
+        _, index = self.resplit()
+        self.assertEqual(index['dataset']['split_by'], 'clip')
+        splits = [c['split'] for c in index['clips']]
+        self.assertEqual(len(splits), 1000)
+        # Binomial(1000, p) counts: 5 standard deviations either side.
+        self.assertLess(abs(splits.count('test') - 200), 5 * 12.7)
+        self.assertLess(abs(splits.count('val') - 100), 5 * 9.5)
+        # Per clip, not per simulation: many simulations' views straddle splits.
+        by_sim = {}
+        for c in index['clips']:
+            by_sim.setdefault(c['simulation'], set()).add(c['split'])
+        self.assertGreater(sum(len(s) > 1 for s in by_sim.values()), 100)
+        # Everything but the split is the source's.
+        for old, new in zip(self.source_index['clips'], index['clips']):
+            self.assertEqual({k: v for k, v in old.items() if k != 'split'},
+                             {k: v for k, v in new.items() if k != 'split'})
+
+    def test_the_draw_is_reproducible(self):
+        _, a = self.resplit('a')
+        _, b = self.resplit('b')
+        self.assertEqual([c['split'] for c in a['clips']], [c['split'] for c in b['clips']])
+
+    def test_examples_are_hard_links_of_the_source(self):
+        dst, _ = self.resplit()
+        for f in ('000.jpg', 'label.json'):
+            a = os.stat(os.path.join(self.src, 'flag-000007-v2', f))
+            b = os.stat(os.path.join(dst, 'flag-000007-v2', f))
+            self.assertEqual((a.st_dev, a.st_ino), (b.st_dev, b.st_ino))
+        self.assertFalse(os.path.exists(dst + '.tmp'))
+
+    def test_refuses_an_existing_destination_and_a_bad_index(self):
+        dst, _ = self.resplit()
+        r = run(self.src, dst)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn('exists', r.stderr)
+        bad = os.path.join(self.tmp.name, 'bad')
+        os.makedirs(bad)
+        with open(os.path.join(bad, 'index.json'), 'w') as f:
+            json.dump({'format': 'something-else', 'clips': []}, f)
+        r = run(bad, os.path.join(self.tmp.name, 'out'))
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn('index.json', r.stderr)
+        self.assertIn('clothwind-dataset', r.stderr)
+
+
+if __name__ == '__main__':
+    unittest.main()
