@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Tests of scripts/split-by-clip on a toy dataset: links, splits drawn per clip, refusals."""
+"""Tests of scripts/dataset-variant on a toy dataset: per-clip splits, fewer training views, links,
+refusals."""
 import json
 import os
 import subprocess
@@ -7,14 +8,14 @@ import tempfile
 import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SCRIPT = os.path.join(ROOT, 'scripts', 'split-by-clip')
+SCRIPT = os.path.join(ROOT, 'scripts', 'dataset-variant')
 
 
 def make_dataset(folder, sims, views=4):
     """A clothwind-dataset index whose splits are per simulation, as make-dataset writes them."""
     clips = []
     for s in range(sims):
-        split = ('train', 'train', 'val', 'test')[s % 4]
+        split = ('train', 'train', 'val', 'test')[(s // 4) % 4]
         for v in range(views):
             name = f'flag-{s:06d}-v{v}'
             os.makedirs(os.path.join(folder, name))
@@ -23,7 +24,7 @@ def make_dataset(folder, sims, views=4):
                     out.write(name)
             clips.append({'name': name, 'wind_speed': 0.01 * s, 'split': split, 'simulation': s, 'view': v})
     index = {'format': 'clothwind-dataset', 'version': 1, 'count': sims,
-             'dataset': {'val_fraction': 0.1, 'test_fraction': 0.2}, 'clips': clips}
+             'dataset': {'views': views, 'val_fraction': 0.1, 'test_fraction': 0.2}, 'clips': clips}
     with open(os.path.join(folder, 'index.json'), 'w') as out:
         json.dump(index, out)
     return index
@@ -33,7 +34,7 @@ def run(*args):
     return subprocess.run([SCRIPT, *args], capture_output=True, text=True)
 
 
-class SplitByClipTest(unittest.TestCase):
+class DatasetVariantTest(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
         self.src = os.path.join(self.tmp.name, 'src')
@@ -42,16 +43,16 @@ class SplitByClipTest(unittest.TestCase):
     def tearDown(self):
         self.tmp.cleanup()
 
-    def resplit(self, name='dst'):
+    def resplit(self, name='dst', change=('--split-by-clip',)):
         dst = os.path.join(self.tmp.name, name)
-        r = run(self.src, dst)
+        r = run(self.src, dst, *change)
         self.assertEqual(r.returncode, 0, r.stderr)
         with open(os.path.join(dst, 'index.json')) as f:
             return dst, json.load(f)
 
     def test_splits_are_drawn_per_clip_with_the_source_fractions(self):
         _, index = self.resplit()
-        self.assertEqual(index['dataset']['split_by'], 'clip')
+        self.assertEqual(index['dataset']['variant'], 'split_by_clip')
         splits = [c['split'] for c in index['clips']]
         self.assertEqual(len(splits), 1000)
         # Binomial(1000, p) counts: 5 standard deviations either side.
@@ -80,19 +81,45 @@ class SplitByClipTest(unittest.TestCase):
             self.assertEqual((a.st_dev, a.st_ino), (b.st_dev, b.st_ino))
         self.assertFalse(os.path.exists(dst + '.tmp'))
 
-    def test_refuses_an_existing_destination_and_a_bad_index(self):
+    def test_train_views_keeps_n_views_of_each_training_simulation_in_rotation(self):
+        dst, index = self.resplit(change=('--train-views', '1'))
+        self.assertEqual(index['dataset']['variant'], 'train_views_1')
+        train = [c for c in index['clips'] if c['split'] == 'train']
+        sims = [c['simulation'] for c in train]
+        self.assertEqual(len(sims), len(set(sims)))  # one view each
+        self.assertEqual(len(sims), sum((s // 4) % 4 < 2 for s in range(250)))  # every training simulation
+        # Views rotate with the simulation, so each camera-angle stratum keeps a quarter.
+        self.assertEqual({c['view'] for c in train}, {0, 1, 2, 3})
+        for c in train:
+            self.assertEqual(c['view'], c['simulation'] % 4)
+        # val and test keep all their views; dropped training views are not copied.
+        for split in ('val', 'test'):
+            self.assertEqual(sum(c['split'] == split for c in index['clips']),
+                             sum(c['split'] == split for c in self.source_index['clips']))
+        self.assertFalse(os.path.exists(os.path.join(dst, 'flag-000000-v1')))
+        self.assertTrue(os.path.exists(os.path.join(dst, 'flag-000008-v3')))  # a val simulation
+        _, index3 = self.resplit('three', ('--train-views', '3'))
+        self.assertEqual(sum(c['split'] == 'train' for c in index3['clips']), 3 * len(sims))
+
+    def test_refuses_an_existing_destination_a_bad_index_and_bad_options(self):
         dst, _ = self.resplit()
-        r = run(self.src, dst)
+        r = run(self.src, dst, '--split-by-clip')
         self.assertNotEqual(r.returncode, 0)
         self.assertIn('exists', r.stderr)
         bad = os.path.join(self.tmp.name, 'bad')
         os.makedirs(bad)
         with open(os.path.join(bad, 'index.json'), 'w') as f:
             json.dump({'format': 'something-else', 'clips': []}, f)
-        r = run(bad, os.path.join(self.tmp.name, 'out'))
+        r = run(bad, os.path.join(self.tmp.name, 'out'), '--split-by-clip')
         self.assertNotEqual(r.returncode, 0)
         self.assertIn('index.json', r.stderr)
         self.assertIn('clothwind-dataset', r.stderr)
+        r = run(self.src, os.path.join(self.tmp.name, 'out'), '--train-views', '5')
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn('--train-views must be in [1, 4]', r.stderr)
+        r = run(self.src, os.path.join(self.tmp.name, 'out'))  # no change named
+        self.assertNotEqual(r.returncode, 0)
+        self.assertFalse(os.path.exists(os.path.join(self.tmp.name, 'out')))
 
 
 if __name__ == '__main__':
