@@ -117,6 +117,11 @@ class DatasetVariantTest(unittest.TestCase):
         r = run(self.src, os.path.join(self.tmp.name, 'out'), '--train-views', '5')
         self.assertNotEqual(r.returncode, 0)
         self.assertIn('--train-views must be in [1, 4]', r.stderr)
+        os.makedirs(os.path.join(self.tmp.name, 'busy.tmp'))  # another run's, or a killed one's
+        r = run(self.src, os.path.join(self.tmp.name, 'busy'), '--split-by-clip')
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn('busy.tmp: exists', r.stderr)
+        self.assertFalse(os.path.exists(os.path.join(self.tmp.name, 'busy')))
         r = run(self.src, os.path.join(self.tmp.name, 'out'))  # no change named
         self.assertNotEqual(r.returncode, 0)
         self.assertFalse(os.path.exists(os.path.join(self.tmp.name, 'out')))
