@@ -2,7 +2,7 @@
 // becomes (pooled or not), and the whole step (forward, loss, backward, Adam), per batch of 16
 // clips of 30 frames, for the input sizes and spectral pooling the SDN trains with. Why: the
 // layer has no weights but runs on every pixel of every frame, so at a larger input it can
-// cost as much as the trunk it feeds (docs/sdn.md, "Spectra of the full frame"). Prints a table
+// cost as much as the trunk it feeds (docs/sdn-experiments.md, "Spectra of the full frame"). Prints a table
 // of wall and process-CPU milliseconds (medians over --repeats). With --device cuda the clips,
 // network and optimiser live on the GPU and each timed call ends in a device synchronisation, so
 // wall time is the GPU's (scripts/device-check runs it so on a lent GPU machine).

@@ -145,7 +145,7 @@ TEST(ExampleSamplingTest, ViewsShareTheSceneAndSpreadTheCameraAngle) {
 
 TEST(ExampleSamplingTest, OtherCamerasSeeTheSameScene) {
   // Two datasets of one seed that differ only in their camera ranges show the same scenes: the
-  // controlled comparison docs/sdn.md makes between Table 2's cameras and level ones.
+  // controlled comparison docs/sdn-experiments.md makes between Table 2's cameras and level ones.
   const uint64_t seed = SimulationSeed(1, 9);
   const int views = 4;
   render::CameraRanges level;

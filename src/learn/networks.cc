@@ -142,7 +142,7 @@ at::Tensor WindNetImpl::forward(const at::Tensor& clips) {
     features = sequence.select(1, sequence.size(1) - 1);
   }
   // Dropout on the pooled features, in training only: the SDN fits its training clips better
-  // than new ones (docs/sdn.md), and the head is where one feature can memorise a simulation.
+  // than new ones (docs/sdn-experiments.md), and the head is where one feature can memorise a simulation.
   if (config_.dropout > 0) features = at::dropout(features, config_.dropout, is_training());
   at::Tensor out = head_->forward(features);
   return at::stack({out.select(1, 0), out.select(1, 1).clamp(-12.0, 8.0)}, 1);

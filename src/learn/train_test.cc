@@ -689,7 +689,7 @@ float DenormalProduct() {
 }
 
 TEST_F(TrainTest, TrainingAndInferenceFlushDenormals) {
-  // Denormal weights made CPU epochs several times slower late in training (docs/sdn.md).
+  // Denormal weights made CPU epochs several times slower late in training (docs/sdn-experiments.md).
   at::globalContext().setFlushDenormal(false);
   ASSERT_NE(DenormalProduct(), 0.0f);  // the check can see the difference
   TrainOptions t;
