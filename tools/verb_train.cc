@@ -62,6 +62,9 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                   "wavenumber above one pixel's phase noise)")
       ->check(CLI::Range(0, 64))
       ->capture_default_str();
+  sub->add_flag("--mode-shape", o.model.mode_shape,
+                "SDN: add each pixel's amplitude at the clip's dominant frequency relative to the pixel that moves "
+                "most (real, imaginary): the whole flag's wave at once, its wavelength as stripes");
   sub->add_option("--spectral-pool", o.model.spectral_pool,
                   "SDN: average-pool the spectral maps by this factor before the trunk (--input-size 128 "
                   "--spectral-pool 2: 128-px spectra, a 64-px trunk's cost)")

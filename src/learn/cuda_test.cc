@@ -69,6 +69,7 @@ TEST(Cuda, SpectralLayerMatchesTheCpuWithEveryOption) {
     o.k = 3;
     o.phase_steps = true;
     o.phase_step_far = 4;
+    o.mode_shape = true;
     if (padded) {
       o.dft_size = 64;
       o.local_peaks = true;
@@ -81,6 +82,7 @@ TEST(Cuda, SpectralLayerMatchesTheCpuWithEveryOption) {
     EXPECT_LT(RelativeDifference(gpu.power, cpu.power), 1e-10) << "padded " << padded;
     EXPECT_TRUE(at::equal(gpu.frequency.to(at::kCPU), cpu.frequency)) << "padded " << padded;
     EXPECT_LT(RelativeDifference(gpu.phase, cpu.phase), 1e-9) << "padded " << padded;
+    EXPECT_LT(RelativeDifference(gpu.mode, cpu.mode), 1e-9) << "padded " << padded;
   }
 }
 

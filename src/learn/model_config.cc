@@ -10,7 +10,7 @@ namespace clothwind::learn {
 int ModelConfig::TrunkInputChannels() const {
   if (arch == "sdn") {
     const int phase = phase_steps ? (phase_step_far > 1 ? 8 : 4) : 0;
-    return (2 * k + (mean_map ? 1 : 0) + phase) * channels;
+    return (2 * k + (mean_map ? 1 : 0) + phase + (mode_shape ? 2 : 0)) * channels;
   }
   return arch == "lstm" ? channels : frames * channels;
 }
@@ -24,6 +24,7 @@ SpectralOptions ModelConfig::Spectral() const {
   o.local_peaks = local_peaks;
   o.phase_steps = phase_steps;
   o.phase_step_far = phase_step_far;
+  o.mode_shape = mode_shape;
   return o;
 }
 
@@ -58,6 +59,7 @@ std::string ModelConfig::Name() const {
     if (local_peaks) s << "p";
     if (phase_steps) s << "s";
     if (phase_steps && phase_step_far > 1) s << phase_step_far;
+    if (mode_shape) s << "o";
     if (spectral_pool != 1) s << "/" << spectral_pool;
   }
   else s << arch;
@@ -84,7 +86,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"k", c.k},                    {"include_dc", c.include_dc},
           {"mean_map", c.mean_map},      {"dft_size", c.dft_size},
           {"local_peaks", c.local_peaks},  {"phase_steps", c.phase_steps},
-          {"phase_step_far", c.phase_step_far},
+          {"phase_step_far", c.phase_step_far}, {"mode_shape", c.mode_shape},
           {"spectral_pool", c.spectral_pool}, {"stem_pool", c.stem_pool},
           {"dropout", c.dropout},
           {"frame_rate", c.frame_rate},  {"width", c.width},
@@ -119,6 +121,7 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.local_peaks = j.contains("local_peaks") ? j.at("local_peaks").get<bool>() : false;
     c.phase_steps = j.contains("phase_steps") ? j.at("phase_steps").get<bool>() : false;
     c.phase_step_far = j.contains("phase_step_far") ? j.at("phase_step_far").get<int>() : 0;
+    c.mode_shape = j.contains("mode_shape") ? j.at("mode_shape").get<bool>() : false;
     c.spectral_pool = j.contains("spectral_pool") ? j.at("spectral_pool").get<int>() : 1;
     // Absent in models written before the option existed: they pooled after the stem.
     c.stem_pool = j.contains("stem_pool") ? j.at("stem_pool").get<bool>() : true;
@@ -156,6 +159,9 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
   if (!c.PhaseStepFarIsValid()) {
     throw std::runtime_error(where + ": field \"phase_step_far\" must be 0, or at least 2 with \"phase_steps\", got " +
                              std::to_string(c.phase_step_far));
+  }
+  if (c.mode_shape && c.arch != "sdn") {
+    throw std::runtime_error(where + ": field \"mode_shape\" is for \"arch\" \"sdn\" only, got \"" + c.arch + "\"");
   }
   if (!c.SpectralPoolIsValid()) {
     throw std::runtime_error(where + ": field \"spectral_pool\" must be >= 1, divide \"input_size\" (" +

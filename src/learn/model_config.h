@@ -32,6 +32,8 @@ struct ModelConfig {
   bool local_peaks = false;  // SDN: the k strongest local maxima instead of the k strongest bins
   bool phase_steps = false;  // SDN: 4C more channels, the strongest peak's phase step to the neighbours
   int phase_step_far = 0;    // SDN with phase_steps: 4C more, the step over this many pixels (0: none)
+  bool mode_shape = false;   // SDN: 2C more, each pixel's amplitude at the clip's dominant frequency
+                             // relative to the pixel that moves most (SpectralOptions::mode_shape)
   // SDN: the spectral maps are computed on the input_size clip and average-pooled by this factor
   // before the trunk, so fine texture's motion reaches a trunk that costs what input_size /
   // spectral_pool would (1: no pooling). input_size must be a multiple of it.
@@ -62,7 +64,8 @@ struct ModelConfig {
   // spectral_pool is >= 1, divides input_size, and is 1 unless the model is an SDN.
   bool SpectralPoolIsValid() const;
 
-  // Channels entering the ResNet trunk: 2kC (+C with mean_map) for the SDN, N_t·C for the
+  // Channels entering the ResNet trunk: 2kC (+C with mean_map, +4C or 8C with phase steps, +2C
+  // with mode_shape) for the SDN, N_t·C for the
   // frame-stack baseline, C for the recurrent one (its trunk reads one frame at a time).
   int TrunkInputChannels() const;
   // How a clip becomes this model's input: frames, input size and flow set, no augmentation
@@ -74,7 +77,7 @@ struct ModelConfig {
   bool FlowSizeIsValid() const { return flow_size == 0 || (flow && flow_size >= 16); }
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("…-flow-…" with flow, "sdn-k3m-…" with mean_map,
   // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps,
-  // "…s4-" with phase_step_far 4, "…s/2-" with spectral_pool 2).
+  // "…s4-" with phase_step_far 4, "…o-" with mode_shape, "…s/2-" with spectral_pool 2).
   std::string Name() const;
   // Table 1's "input modality", e.g. "30x112x112" ("30x3x64x64" with flow's three channels).
   std::string Modality() const;

@@ -86,6 +86,9 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
     throw std::invalid_argument("WindNet: phase_step_far " + std::to_string(config.phase_step_far) +
                                 " must be 0, or a distance of at least 2 pixels on an SDN with phase steps");
   }
+  if (config.mode_shape && config.arch != "sdn") {
+    throw std::invalid_argument("WindNet: mode_shape is an SDN option, not for " + config.arch);
+  }
   if (!config.SpectralPoolIsValid()) {
     throw std::invalid_argument("WindNet: spectral_pool " + std::to_string(config.spectral_pool) +
                                 " must be >= 1, divide the input size " + std::to_string(config.input_size) +
@@ -120,6 +123,7 @@ at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
     // droop), which at low wind says more about the speed than its small oscillations.
     if (config_.mean_map) parts.push_back(clips.mean(2));
     if (config_.phase_steps) parts.push_back(maps.phase);
+    if (config_.mode_shape) parts.push_back(maps.mode);
     at::Tensor maps_in = at::cat(parts, 1);
     // Pooling after the per-pixel spectra, not before: a stripe's edge that moves by less than a
     // pooled pixel still shows its power here, where downsampling the frames first blurs it away.

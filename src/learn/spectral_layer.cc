@@ -48,6 +48,28 @@ at::Tensor PhaseSteps(const at::Tensor& spectrum, const at::Tensor& bin, int64_t
   return blocks.size() == 1 ? blocks[0] : at::cat(blocks, 1);
 }
 
+// The clip's dominant mode (SpectralMaps::mode) from the one-sided spectra [N_b C H W, F]
+// (complex) and the candidate bins' periodogram [N_b C H W, candidates], whose bin 0 is spectrum
+// bin `first`: [N_b, 2C, H, W].
+at::Tensor ModeShape(const at::Tensor& spectrum, const at::Tensor& periodogram, int64_t first, int64_t nb,
+                     int64_t c, int64_t h, int64_t w) {
+  const int64_t f = spectrum.size(1), candidates = periodogram.size(1);
+  // j*: the bin with the most power over the whole image, per example and channel.
+  at::Tensor dominant = periodogram.reshape({nb, c, h * w, candidates}).sum(2).argmax(2) + first;  // [nb, c]
+  at::Tensor index = dominant.reshape({nb, c, 1, 1}).expand({nb, c, h * w, 1});
+  at::Tensor re = at::real(spectrum).reshape({nb, c, h * w, f}).gather(3, index).squeeze(3);  // [nb, c, hw]
+  at::Tensor im = at::imag(spectrum).reshape({nb, c, h * w, f}).gather(3, index).squeeze(3);
+  at::Tensor amplitude2 = re.square() + im.square();
+  at::Tensor reference = amplitude2.argmax(2, /*keepdim=*/true);  // p*, [nb, c, 1]
+  at::Tensor rr = re.gather(2, reference), ri = im.gather(2, reference);
+  // |R| · rms, with a floor so a still clip reads zeros instead of 0/0.
+  at::Tensor scale = at::sqrt(rr.square() + ri.square()) * at::sqrt(amplitude2.mean(2, /*keepdim=*/true)) + 1e-30;
+  at::Tensor real = (re * rr + im * ri) / scale;
+  at::Tensor imag = (im * rr - re * ri) / scale;
+  // [nb, c, 2, hw] -> [nb, 2c, h, w], channel 2c + (0, 1).
+  return at::stack({real, imag}, 2).reshape({nb, 2 * c, h, w});
+}
+
 }  // namespace
 
 SpectralMaps SpectralDecomposition(const at::Tensor& x, int k, double frame_rate, bool include_dc) {
@@ -121,12 +143,13 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
   auto to_map = [&](const at::Tensor& t) {
     return t.reshape({nb, c, h, w, k}).permute({0, 1, 4, 2, 3}).reshape({nb, c * k, h, w});
   };
-  SpectralMaps maps{to_map(power), to_map(frequency), at::Tensor()};
+  SpectralMaps maps{to_map(power), to_map(frequency), at::Tensor(), at::Tensor()};
   if (options.phase_steps) {
     std::vector<int64_t> distances = {1};
     if (options.phase_step_far > 1) distances.push_back(options.phase_step_far);
     maps.phase = PhaseSteps(spectrum, bin.narrow(1, 0, 1) + first, nb, c, h, w, distances);
   }
+  if (options.mode_shape) maps.mode = ModeShape(spectrum, periodogram, first, nb, c, h, w);
   return maps;
 }
 

@@ -33,6 +33,12 @@ struct SpectralOptions {
   // turns by only a few degrees between neighbours, within the noise of one pixel's phase; over
   // several pixels the same wave turns further, so its wavenumber reads above that noise.
   int phase_step_far = 0;
+  // Also return SpectralMaps::mode: every pixel's complex amplitude at the clip's dominant
+  // frequency, relative to the phase of the pixel that moves most. Phase steps read the wave
+  // between neighbours, where a wave as long as the flag turns by less than one pixel's phase
+  // noise; against one reference the whole flag's phase ramp shows at once, as stripes whose
+  // spacing is the wavelength (with the frequency, the wave's speed, which grows with the wind).
+  bool mode_shape = false;
 };
 
 // Power and frequency maps of a batch of clips.
@@ -48,6 +54,15 @@ struct SpectralMaps {
   // channels 4C + 4c..4C + 4c+3 are the same steps to x+D and y+D (a wave reads (cos κD, sin κD)),
   // 0 in the last D columns / rows.
   at::Tensor phase;
+  // With SpectralOptions::mode_shape, else undefined: [N_b, 2C, H, W], per input channel c the
+  // channels 2c, 2c+1 = real and imaginary part of X(p)·conj(R) / (|R| · rms), where X(p) is
+  // pixel p's DFT at the clip's dominant bin j* (the candidate bin of largest periodogram summed
+  // over all H·W pixels of that channel), R = X(p*) at the pixel p* of largest |X(p)|, and
+  // rms = sqrt(mean_p |X(p)|²) (plus 1e-30). So p* reads (|X(p*)|/rms, 0), a still pixel (0, 0),
+  // a wave A(p) e^{i(ωt − κ·p)} at its bin reads A(p)/rms · e^{−iκ·(p − p*)}, whatever the clip's
+  // start time. A per-clip feature: unlike the other maps it changes when a crop removes p* or
+  // much of the motion (it still commutes with flips, and with crops that keep p* and the rms).
+  at::Tensor mode;
 };
 
 // The spectral decomposition of a batch of clips (Algorithm 1), batched on the input's device.

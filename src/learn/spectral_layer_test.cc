@@ -324,6 +324,85 @@ TEST(SpectralLayer, FarPhaseStepsTurnByTheWavenumberTimesTheDistance) {
   EXPECT_THROW(SpectralDecomposition(wave, o), std::invalid_argument);
 }
 
+// A wave of amplitude A(x, y) = 1 + 0.1x + 0.05y (largest at the last pixel) plus an optional
+// second tone of frequency hz2 and amplitude a2 on the first row's first two pixels.
+at::Tensor ShapedWave(int h, int w, double kx, double ky, double phi0, double hz2 = 0, double a2 = 0) {
+  at::Tensor x = TravellingWave(30, h, w, 2.5, kx, ky, phi0);
+  auto a = x.accessor<double, 5>();
+  for (int n = 0; n < 30; ++n)
+    for (int y = 0; y < h; ++y)
+      for (int xx = 0; xx < w; ++xx) {
+        a[0][0][n][y][xx] *= 1 + 0.1 * xx + 0.05 * y;
+        if (y == 0 && xx < 2) a[0][0][n][y][xx] += a2 * std::sin(2 * M_PI * hz2 * n / kFps);
+      }
+  return x;
+}
+
+TEST(SpectralLayer, ModeShapeReadsTheWavesPhaseRampAgainstTheStrongestPixel) {
+  // 2.5 Hz is bin 3 of 30 frames: every pixel's DFT there is A(p)·e^{i(φ0 − κ·p)} times one
+  // constant, so the map is A(p)/rms(A) · e^{−iκ·(p − p*)} with p* the last pixel (4, 5).
+  const int h = 5, w = 6;
+  const double kx = 0.4, ky = -0.25;
+  SpectralOptions o;
+  o.k = 2;
+  o.mode_shape = true;
+  SpectralMaps maps = SpectralDecomposition(ShapedWave(h, w, kx, ky, 0.7), o);
+  ASSERT_EQ(maps.mode.sizes(), (at::IntArrayRef{1, 2, h, w}));
+  double sum_a2 = 0;
+  for (int y = 0; y < h; ++y)
+    for (int xx = 0; xx < w; ++xx) sum_a2 += std::pow(1 + 0.1 * xx + 0.05 * y, 2);
+  const double rms = std::sqrt(sum_a2 / (h * w));
+  auto m = maps.mode.accessor<double, 4>();
+  for (int y = 0; y < h; ++y)
+    for (int xx = 0; xx < w; ++xx) {
+      const double amplitude = (1 + 0.1 * xx + 0.05 * y) / rms;
+      const double angle = -(kx * (xx - (w - 1)) + ky * (y - (h - 1)));
+      EXPECT_NEAR(m[0][0][y][xx], amplitude * std::cos(angle), 1e-9) << y << "," << xx;
+      EXPECT_NEAR(m[0][1][y][xx], amplitude * std::sin(angle), 1e-9) << y << "," << xx;
+    }
+  // Not when the clip began, nor a constant brightness, nor a padded DFT (2.5 Hz is on its grid
+  // too) changes it; a flip mirrors it.
+  EXPECT_TRUE(at::allclose(SpectralDecomposition(ShapedWave(h, w, kx, ky, 2.9), o).mode, maps.mode, 1e-9, 1e-9));
+  EXPECT_TRUE(at::allclose(SpectralDecomposition(ShapedWave(h, w, kx, ky, 0.7) + 3.0, o).mode, maps.mode, 1e-9, 1e-9));
+  SpectralOptions padded = o;
+  padded.dft_size = 60;
+  EXPECT_TRUE(at::allclose(SpectralDecomposition(ShapedWave(h, w, kx, ky, 0.7), padded).mode, maps.mode, 1e-9, 1e-9));
+  EXPECT_TRUE(at::allclose(SpectralDecomposition(ShapedWave(h, w, kx, ky, 0.7).flip({4}), o).mode,
+                           maps.mode.flip({3}), 1e-12, 1e-12));
+  // The wave going the other way along x turns the ramp the other way.
+  SpectralMaps back = SpectralDecomposition(ShapedWave(h, w, -kx, ky, 0.7), o);
+  EXPECT_NEAR(back.mode.index({0, 1, h - 1, 0}).item<double>(),
+              -m[0][1][h - 1][0], 1e-9);
+  // Without the option there is no mode map; a still clip reads zeros, not 0/0.
+  EXPECT_FALSE(SpectralDecomposition(ShapedWave(h, w, kx, ky, 0.7), 2, kFps).mode.defined());
+  SpectralMaps still = SpectralDecomposition(at::full({1, 1, 30, h, w}, 2.0, at::kDouble), o);
+  EXPECT_EQ(still.mode.abs().max().item<double>(), 0.0);
+}
+
+TEST(SpectralLayer, ModeShapeFollowsTheToneWithTheMostPowerOverTheImage) {
+  // A 5 Hz tone (bin 6) on two pixels: weaker over the image than the wave, it leaves the map as
+  // it was; four times stronger per pixel than the wave's largest, it carries more power over
+  // the image than the wave and the map shows it instead (zero where it is absent).
+  const int h = 5, w = 6;
+  SpectralOptions o;
+  o.k = 2;
+  o.mode_shape = true;
+  const at::Tensor base = SpectralDecomposition(ShapedWave(h, w, 0.4, -0.25, 0.7), o).mode;
+  EXPECT_TRUE(at::allclose(SpectralDecomposition(ShapedWave(h, w, 0.4, -0.25, 0.7, 5.0, 1.0), o).mode, base,
+                           1e-9, 1e-9));
+  at::Tensor tone = SpectralDecomposition(ShapedWave(h, w, 0.4, -0.25, 0.7, 5.0, 8.0), o).mode;
+  // The two tone pixels in phase: both read (√(h·w/2), 0) against each other; all others 0.
+  const double expected = std::sqrt(h * w / 2.0);
+  EXPECT_NEAR(tone.index({0, 0, 0, 0}).item<double>(), expected, 1e-9);
+  EXPECT_NEAR(tone.index({0, 0, 0, 1}).item<double>(), expected, 1e-9);
+  EXPECT_LT(tone.narrow(2, 1, h - 1).abs().max().item<double>(), 1e-9);
+  // Batched clips are decomposed each on its own.
+  at::Tensor both = SpectralDecomposition(
+      at::cat({ShapedWave(h, w, 0.4, -0.25, 0.7), ShapedWave(h, w, 0.4, -0.25, 0.7, 5.0, 8.0)}, 0), o).mode;
+  EXPECT_TRUE(at::allclose(both.narrow(0, 0, 1), base, 1e-12, 1e-12));
+  EXPECT_TRUE(at::allclose(both.narrow(0, 1, 1), tone, 1e-12, 1e-12));
+}
+
 TEST(SpectralLayer, FloatInputAgreesWithDouble) {
   at::Tensor x = RandomClip(1, 1, 30, 4, 4, 5);
   SpectralMaps d = SpectralDecomposition(x, 2, kFps);

@@ -338,6 +338,26 @@ TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
   ModelConfig bad_far = c;
   bad_far.phase_step_far = 1;
   EXPECT_THROW(WindNet{bad_far}, std::invalid_argument);
+  // The mode shape adds 2C, round-trips, defaults to off in older files, reaches the trunk's
+  // input (its last two channels are the layer's mode map), and is an SDN's option only.
+  c.mode_shape = true;
+  EXPECT_EQ(c.TrunkInputChannels(), 14);
+  EXPECT_EQ(c.Name(), "sdn-k2d120ps4o-w4-16-30f");
+  EXPECT_TRUE(ModelConfigFromJson(ToJson(c), "x.json").mode_shape);
+  EXPECT_FALSE(ModelConfigFromJson(old, "x.json").mode_shape);
+  WindNet moded(c);
+  moded->eval();
+  EXPECT_EQ(moded->forward(clips).sizes(), (at::IntArrayRef{1, 2}));
+  EXPECT_TRUE(at::allclose(moded->TrunkInput(clips).narrow(1, 12, 2), SpectralDecomposition(clips, c.Spectral()).mode));
+  nlohmann::json baseline = ToJson(c);
+  baseline["arch"] = "resnet18";
+  baseline["phase_step_far"] = 0;
+  baseline["phase_steps"] = false;
+  ExpectFieldRefused(baseline, "mode_shape");
+  ModelConfig bad_mode = TinySdn();
+  bad_mode.arch = "resnet18";
+  bad_mode.mode_shape = true;
+  EXPECT_THROW(WindNet{bad_mode}, std::invalid_argument);
 }
 
 TEST(ModelConfig, SpectralPoolKeepsMotionThatDownsamplingTheFramesErases) {
