@@ -1,0 +1,47 @@
+# The "Levers at a glance" table of docs/sdn.md as a picture: every measured change to the SDN,
+# its control's test RMSE and its own (one window), coloured by verdict. Figures and commands
+# behind each row: docs/sdn-experiments.md. Regenerate from the repository root with
+#   gnuplot docs/sdn_levers.gp
+# Columns: row, control [m/s], change [m/s], verdict (0 shipped, 1 no lever, 2 not a product
+# figure: other cameras or a leaky split), label.
+$levers << EOD
+1 0.599 0.526 0 "weight decay 1e-4, width 48 (e2)"
+2 0.526 0.467 0 "whole frames, no multi-scale crop (e2)"
+3 0.467 0.439 0 "phase steps (e2)"
+4 0.439 0.380 0 "1500 → 6000 simulations (e2 test)"
+5 0.599 0.598 1 "mirror test-time augmentation (e2)"
+6 0.439 0.444 1 "far phase step (e2)"
+7 0.439 0.434 1 "optical flow at 128 px (e2)"
+8 0.463 0.454 1 "mode shape (e2)"
+9 0.463 0.460 1 "known fabric (e2 simulations)"
+10 0.414 0.412 1 "no stem pool (e3)"
+11 0.414 0.407 1 "128-px spectra pooled (e3)"
+12 0.383 0.373 1 "width 64 (e5)"
+13 0.383 0.377 1 "60 frames at once (e5)"
+14 0.383 0.380 1 "26 epochs (e5)"
+15 0.383 0.365 1 "96-px input, validation tied (e5)"
+16 0.565 0.541 1 "224 px on a GPU (800 simulations)"
+17 0.435 0.411 1 "1 view of 4× the simulations (e5)"
+18 0.411 0.383 1 "1 → 4 views, training grown (e5)"
+19 0.439 0.359 2 "cameras level with the flag (e2 simulations)"
+20 0.456 0.384 2 "split per clip, a leak (same clips)"
+EOD
+set terminal pngcairo size 1000,640 font "DejaVu Sans,10"
+set output "docs/sdn_levers.png"
+set title "What each measured change did to the SDN's test RMSE (one window; arrow: control → change)"
+set xlabel "test RMSE [m/s]"
+set xrange [0.15:0.62]
+set yrange [20.7:0.3]
+set ytics out nomirror
+set grid xtics
+unset key
+set arrow from 0.25, graph 0 to 0.25, graph 1 nohead dt 2 lw 2 lc rgb "#c00000"
+set label "issue's target 0.25" at 0.252, 20.4 tc rgb "#c00000"
+set arrow from 0.18, graph 0 to 0.18, graph 1 nohead dt 3 lw 1.5 lc rgb "#404040"
+set label "paper 0.180" at 0.182, 20.4 tc rgb "#404040"
+set label "shipped" at graph 0.80, 0.16 tc rgb "#2e8b57"
+set label "no lever (a tie)" at graph 0.80, 0.12 tc rgb "#808080"
+set label "not a product figure" at graph 0.80, 0.08 tc rgb "#e07000"
+colour(c) = c == 0 ? 0x2e8b57 : (c == 1 ? 0x808080 : 0xe07000)
+plot $levers using 2:1:($3-$2):(0):(colour($4)):ytic(5) with vectors head filled size 0.008,20 lw 2 lc rgb variable, \
+     $levers using 2:1:(colour($4)) with points pt 7 ps 0.8 lc rgb variable
