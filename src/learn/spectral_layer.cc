@@ -108,6 +108,11 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
     throw std::invalid_argument("SpectralDecomposition: phase_step_far = " + std::to_string(options.phase_step_far) +
                                 " (0, or a distance of at least 2 pixels with phase_steps, expected)");
   }
+  if (options.mode_shape && include_dc) {
+    // Undetrended, a pixel's mean brightness leaks through the Hann window into bin 1 and the
+    // still image would be the "dominant mode".
+    throw std::invalid_argument("SpectralDecomposition: mode_shape needs the detrended spectrum (include_dc off)");
+  }
   // [N_b C H W, N_t]: one row per pixel signal.
   at::Tensor signals = x.permute({0, 1, 3, 4, 2}).reshape({-1, nt});
   at::Tensor window = at::hann_window(nt, /*periodic=*/true, x.options());

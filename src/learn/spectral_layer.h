@@ -60,7 +60,8 @@ struct SpectralMaps {
   // over all H·W pixels of that channel), R = X(p*) at the pixel p* of largest |X(p)|, and
   // rms = sqrt(mean_p |X(p)|²) (plus 1e-30). So p* reads (|X(p*)|/rms, 0), a still pixel (0, 0),
   // a wave A(p) e^{i(ωt − κ·p)} at its bin reads A(p)/rms · e^{−iκ·(p − p*)}, whatever the clip's
-  // start time. A per-clip feature: unlike the other maps it changes when a crop removes p* or
+  // start time. Refused with include_dc (undetrended, the still image would be the mode).
+  // A per-clip feature: unlike the other maps it changes when a crop removes p* or
   // much of the motion (it still commutes with flips, and with crops that keep p* and the rms).
   at::Tensor mode;
 };

@@ -364,6 +364,10 @@ TEST(SpectralLayer, ModeShapeReadsTheWavesPhaseRampAgainstTheStrongestPixel) {
   // too) changes it; a flip mirrors it.
   EXPECT_TRUE(at::allclose(SpectralDecomposition(ShapedWave(h, w, kx, ky, 2.9), o).mode, maps.mode, 1e-9, 1e-9));
   EXPECT_TRUE(at::allclose(SpectralDecomposition(ShapedWave(h, w, kx, ky, 0.7) + 3.0, o).mode, maps.mode, 1e-9, 1e-9));
+  // Undetrended (include_dc) a bright still pixel's mean would be the mode: refused.
+  SpectralOptions with_dc = o;
+  with_dc.include_dc = true;
+  EXPECT_THROW(SpectralDecomposition(ShapedWave(h, w, kx, ky, 0.7), with_dc), std::invalid_argument);
   SpectralOptions padded = o;
   padded.dft_size = 60;
   EXPECT_TRUE(at::allclose(SpectralDecomposition(ShapedWave(h, w, kx, ky, 0.7), padded).mode, maps.mode, 1e-9, 1e-9));

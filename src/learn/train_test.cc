@@ -354,9 +354,15 @@ TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
   baseline["phase_step_far"] = 0;
   baseline["phase_steps"] = false;
   ExpectFieldRefused(baseline, "mode_shape");
+  nlohmann::json undetrended = ToJson(c);
+  undetrended["include_dc"] = true;
+  ExpectFieldRefused(undetrended, "mode_shape");
   ModelConfig bad_mode = TinySdn();
   bad_mode.arch = "resnet18";
   bad_mode.mode_shape = true;
+  EXPECT_THROW(WindNet{bad_mode}, std::invalid_argument);
+  bad_mode.arch = "sdn";
+  bad_mode.include_dc = true;
   EXPECT_THROW(WindNet{bad_mode}, std::invalid_argument);
 }
 
