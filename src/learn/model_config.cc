@@ -160,7 +160,7 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     throw std::runtime_error(where + ": field \"phase_step_far\" must be 0, or at least 2 with \"phase_steps\", got " +
                              std::to_string(c.phase_step_far));
   }
-  if (c.mode_shape && (c.arch != "sdn" || c.include_dc)) {
+  if (!c.ModeShapeIsValid()) {
     throw std::runtime_error(where + ": field \"mode_shape\" is for \"arch\" \"sdn\" without \"include_dc\" only, got \"" +
                              c.arch + "\"" + (c.include_dc ? " with \"include_dc\"" : ""));
   }

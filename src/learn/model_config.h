@@ -61,6 +61,9 @@ struct ModelConfig {
   int SpectralCandidates() const;
   // phase_step_far is 0, or a distance of at least 2 pixels with phase_steps on.
   bool PhaseStepFarIsValid() const;
+  // mode_shape is off, or on an SDN without include_dc (undetrended, the still image would be
+  // the dominant mode; SpectralOptions::mode_shape).
+  bool ModeShapeIsValid() const { return !mode_shape || (arch == "sdn" && !include_dc); }
   // spectral_pool is >= 1, divides input_size, and is 1 unless the model is an SDN.
   bool SpectralPoolIsValid() const;
 

@@ -60,6 +60,13 @@ void ExpectFieldRefused(const nlohmann::json& j, const std::string& field) {
   }
 }
 
+// A network built from `config` reads `clips` [1, C, N_t, H, W] into one (speed, log variance) pair.
+void ExpectOneEstimatePerClip(const ModelConfig& config, const at::Tensor& clips) {
+  WindNet net(config);
+  net->eval();
+  EXPECT_EQ(net->forward(clips).sizes(), (at::IntArrayRef{1, 2})) << config.Name();
+}
+
 class TrainTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -319,9 +326,7 @@ TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
   EXPECT_EQ(c.Name(), "sdn-k2d120ps-w4-16-30f");
   EXPECT_TRUE(ModelConfigFromJson(ToJson(c), "x.json").phase_steps);
   EXPECT_FALSE(ModelConfigFromJson(old, "x.json").phase_steps);
-  WindNet stepped(c);
-  stepped->eval();
-  EXPECT_EQ(stepped->forward(clips).sizes(), (at::IntArrayRef{1, 2}));
+  ExpectOneEstimatePerClip(c, clips);
   // Far phase steps add 4C more, round-trip, default to none in older files, and are refused
   // without the near ones, by field name in a file and by the network.
   c.phase_step_far = 4;
@@ -329,9 +334,7 @@ TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
   EXPECT_EQ(c.Name(), "sdn-k2d120ps4-w4-16-30f");
   EXPECT_EQ(ModelConfigFromJson(ToJson(c), "x.json").phase_step_far, 4);
   EXPECT_EQ(ModelConfigFromJson(old, "x.json").phase_step_far, 0);
-  WindNet far(c);
-  far->eval();
-  EXPECT_EQ(far->forward(clips).sizes(), (at::IntArrayRef{1, 2}));
+  ExpectOneEstimatePerClip(c, clips);
   nlohmann::json no_near = ToJson(c);
   no_near["phase_steps"] = false;
   ExpectFieldRefused(no_near, "phase_step_far");
@@ -345,10 +348,8 @@ TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
   EXPECT_EQ(c.Name(), "sdn-k2d120ps4o-w4-16-30f");
   EXPECT_TRUE(ModelConfigFromJson(ToJson(c), "x.json").mode_shape);
   EXPECT_FALSE(ModelConfigFromJson(old, "x.json").mode_shape);
-  WindNet moded(c);
-  moded->eval();
-  EXPECT_EQ(moded->forward(clips).sizes(), (at::IntArrayRef{1, 2}));
-  EXPECT_TRUE(at::allclose(moded->TrunkInput(clips).narrow(1, 12, 2), SpectralDecomposition(clips, c.Spectral()).mode));
+  ExpectOneEstimatePerClip(c, clips);
+  EXPECT_TRUE(at::allclose(WindNet(c)->TrunkInput(clips).narrow(1, 12, 2), SpectralDecomposition(clips, c.Spectral()).mode));
   nlohmann::json baseline = ToJson(c);
   baseline["arch"] = "resnet18";
   baseline["phase_step_far"] = 0;
