@@ -8,11 +8,12 @@
 namespace clothwind::learn {
 
 int ModelConfig::TrunkInputChannels() const {
+  const int coords = coord_maps ? 2 : 0;
   if (arch == "sdn") {
     const int phase = phase_steps ? (phase_step_far > 1 ? 8 : 4) : 0;
-    return (2 * k + (mean_map ? 1 : 0) + phase + (mode_shape ? 2 : 0)) * channels;
+    return (2 * k + (mean_map ? 1 : 0) + phase + (mode_shape ? 2 : 0)) * channels + coords;
   }
-  return arch == "lstm" ? channels : frames * channels;
+  return (arch == "lstm" ? channels : frames * channels) + coords;
 }
 
 SpectralOptions ModelConfig::Spectral() const {
@@ -66,6 +67,7 @@ std::string ModelConfig::Name() const {
   if (flow) s << "-flow";
   if (flow && flow_size != 0) s << flow_size;
   if (!stem_pool) s << "-np";
+  if (coord_maps) s << "-xy";
   s << "-w" << width << "-" << input_size << "-" << frames << "f";
   return s.str();
 }
@@ -88,6 +90,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"local_peaks", c.local_peaks},  {"phase_steps", c.phase_steps},
           {"phase_step_far", c.phase_step_far}, {"mode_shape", c.mode_shape},
           {"spectral_pool", c.spectral_pool}, {"stem_pool", c.stem_pool},
+          {"coord_maps", c.coord_maps},
           {"dropout", c.dropout},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
@@ -125,6 +128,8 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.spectral_pool = j.contains("spectral_pool") ? j.at("spectral_pool").get<int>() : 1;
     // Absent in models written before the option existed: they pooled after the stem.
     c.stem_pool = j.contains("stem_pool") ? j.at("stem_pool").get<bool>() : true;
+    // Absent in models written before the option existed: no coordinate channels.
+    c.coord_maps = j.contains("coord_maps") ? j.at("coord_maps").get<bool>() : false;
     c.dropout = j.contains("dropout") ? j.at("dropout").get<double>() : 0.0;
     c.frame_rate = need("frame_rate").get<double>();
     c.width = need("width").get<int>();

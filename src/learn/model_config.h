@@ -42,6 +42,10 @@ struct ModelConfig {
   // pool leave 16 px for the first stage; without the pool the stages keep 32 px, at about four
   // times their cost (a small input's detail is what the pool throws away).
   bool stem_pool = true;
+  // Two more trunk channels, each pixel's column and row scaled to [-1, 1] (CoordConv): with the
+  // camera aimed at the flag's rest centre, where in the frame the flag moves says how far it
+  // droops, and convolutions followed by average pooling see where only through the zero padding.
+  bool coord_maps = false;
   double dropout = 0.0;      // dropout probability on the trunk's pooled features while training
   double frame_rate = 25.0;  // [Hz] of the clips the model reads
   int width = 64;            // ResNet-18 base width (64 as the original; 16 trains on a CPU)
@@ -68,8 +72,8 @@ struct ModelConfig {
   bool SpectralPoolIsValid() const;
 
   // Channels entering the ResNet trunk: 2kC (+C with mean_map, +4C or 8C with phase steps, +2C
-  // with mode_shape) for the SDN, N_t·C for the
-  // frame-stack baseline, C for the recurrent one (its trunk reads one frame at a time).
+  // with mode_shape) for the SDN, N_t·C for the frame-stack baseline, C for the recurrent one
+  // (its trunk reads one frame at a time); +2 with coord_maps for every architecture.
   int TrunkInputChannels() const;
   // How a clip becomes this model's input: frames, input size and flow set, no augmentation
   // (evaluation's and the node's; training adds its augmentation to these).
@@ -80,7 +84,8 @@ struct ModelConfig {
   bool FlowSizeIsValid() const { return flow_size == 0 || (flow && flow_size >= 16); }
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("…-flow-…" with flow, "sdn-k3m-…" with mean_map,
   // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps,
-  // "…s4-" with phase_step_far 4, "…o-" with mode_shape, "…s/2-" with spectral_pool 2).
+  // "…s4-" with phase_step_far 4, "…o-" with mode_shape, "…s/2-" with spectral_pool 2, "…-xy-" with
+  // coord_maps).
   std::string Name() const;
   // Table 1's "input modality", e.g. "30x112x112" ("30x3x64x64" with flow's three channels).
   std::string Modality() const;

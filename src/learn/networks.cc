@@ -130,12 +130,24 @@ at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
     if (config_.spectral_pool > 1) {
       maps_in = at::avg_pool2d(maps_in, {config_.spectral_pool, config_.spectral_pool});
     }
-    return maps_in;
+    return WithCoordMaps(maps_in);
   }
   if (config_.arch == "lstm") {
-    return clips.transpose(1, 2).reshape({-1, clips.size(1), clips.size(3), clips.size(4)});
+    return WithCoordMaps(clips.transpose(1, 2).reshape({-1, clips.size(1), clips.size(3), clips.size(4)}));
   }
-  return clips.reshape({clips.size(0), clips.size(1) * clips.size(2), clips.size(3), clips.size(4)});
+  return WithCoordMaps(clips.reshape({clips.size(0), clips.size(1) * clips.size(2), clips.size(3), clips.size(4)}));
+}
+
+at::Tensor WindNetImpl::WithCoordMaps(const at::Tensor& images) const {
+  if (!config_.coord_maps) return images;
+  const int64_t n = images.size(0), h = images.size(2), w = images.size(3);
+  // Pixel centres: column j of W reads -1 + (2j + 1) / W, so the image centre reads 0 at any size.
+  const auto options = images.options();
+  const at::Tensor column = (at::arange(w, options) * 2 + 1) / static_cast<double>(w) - 1;
+  const at::Tensor row = (at::arange(h, options) * 2 + 1) / static_cast<double>(h) - 1;
+  const at::Tensor x = column.view({1, 1, 1, w}).expand({n, 1, h, w});
+  const at::Tensor y = row.view({1, 1, h, 1}).expand({n, 1, h, w});
+  return at::cat({images, x, y}, 1);
 }
 
 at::Tensor WindNetImpl::forward(const at::Tensor& clips) {

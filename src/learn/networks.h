@@ -75,12 +75,17 @@ class WindNetImpl : public torch::nn::Module {
   // power, frequency divided by the Nyquist rate, so both are O(1)), the frames as channels
   // [N_b, N_t·C, H, W] (resnet18), or every frame on its own [N_b·N_t, C, H, W] (lstm). An SDN
   // with spectral_pool p > 1 returns its maps average-pooled to [N_b, ·, H/p, W/p].
+  // With coord_maps every architecture's images get two more channels last: the column and the
+  // row of each pixel centre, scaled to (-1, 1).
   at::Tensor TrunkInput(const at::Tensor& clips) const;
   const ModelConfig& config() const { return config_; }
   // Sets the calibration factor of the predicted std (no weight depends on it).
   void set_std_scale(double scale) { config_.std_scale = scale; }
 
  private:
+  // images [N, ch, H, W] -> [N, ch + 2, H, W] with coord_maps (column, row), else unchanged.
+  at::Tensor WithCoordMaps(const at::Tensor& images) const;
+
   ModelConfig config_;
   ResNet18Trunk trunk_{nullptr};
   torch::nn::LSTM lstm_{nullptr};  // lstm only: hidden size = the trunk's 8w features

@@ -440,6 +440,54 @@ TEST(ModelConfig, WithoutTheStemPoolTheTrunkKeepsTwiceTheResolution) {
   EXPECT_EQ(net->forward(at::randn({3, 1, 30, 16, 16})).sizes(), (at::IntArrayRef{3, 2}));
 }
 
+TEST(ModelConfig, CoordMapsAreEachPixelsColumnAndRowAfterEveryArchitecturesImages) {
+  at::manual_seed(5);
+  const at::Tensor clips = at::randn({2, 1, 30, 16, 16});
+  at::NoGradGuard no_grad;
+  // The column map at pixel centres, (2j + 1) / 16 - 1: -15/16 ... 15/16, the centre at 0.
+  const at::Tensor column = (at::arange(16, at::kFloat) * 2 + 1) / 16.0 - 1;
+  for (const std::string arch : {"sdn", "resnet18", "lstm"}) {
+    ModelConfig plain = TinySdn();
+    plain.arch = arch;
+    ModelConfig c = plain;
+    c.coord_maps = true;
+    EXPECT_EQ(c.TrunkInputChannels(), plain.TrunkInputChannels() + 2) << arch;
+    EXPECT_NE(c.Name().find("-xy-"), std::string::npos) << c.Name();
+    const at::Tensor with = WindNet(c)->TrunkInput(clips), without = WindNet(plain)->TrunkInput(clips);
+    const int64_t ch = without.size(1);
+    ASSERT_EQ(with.size(1), ch + 2) << arch;
+    // The images themselves are unchanged, and come first (the stem's weights for them keep
+    // their place).
+    EXPECT_TRUE(at::equal(with.narrow(1, 0, ch), without)) << arch;
+    // Every image (the lstm's every frame) gets the same column and row maps.
+    const at::Tensor x = with.select(1, ch), y = with.select(1, ch + 1);
+    EXPECT_TRUE(at::allclose(x, column.view({1, 1, 16}).expand_as(x))) << arch;
+    EXPECT_TRUE(at::allclose(y, column.view({1, 16, 1}).expand_as(y))) << arch;
+    ExpectOneEstimatePerClip(c, clips.narrow(0, 0, 1));
+  }
+  // Pooled spectra get maps at the pooled size, centred as well.
+  ModelConfig pooled = TinySdn();
+  pooled.input_size = 32;
+  pooled.spectral_pool = 2;
+  pooled.coord_maps = true;
+  const at::Tensor input = WindNet(pooled)->TrunkInput(at::randn({1, 1, 30, 32, 32}));
+  EXPECT_EQ(input.sizes(), (at::IntArrayRef{1, pooled.TrunkInputChannels(), 16, 16}));
+  EXPECT_TRUE(at::allclose(input.select(1, input.size(1) - 2).select(1, 3), column));
+  // The maps reach the estimate: with their stem weights zeroed the same network reads otherwise.
+  ModelConfig c = TinySdn();
+  c.coord_maps = true;
+  WindNet net(c);
+  net->eval();
+  const at::Tensor before = net->forward(clips);
+  net->named_parameters()["trunk.stem.weight"].narrow(1, c.TrunkInputChannels() - 2, 2).zero_();
+  EXPECT_FALSE(at::allclose(net->forward(clips), before, 1e-5, 1e-6));
+  // Round trip, and off in older files.
+  EXPECT_TRUE(ModelConfigFromJson(ToJson(c), "x.json").coord_maps);
+  nlohmann::json old = ToJson(c);
+  old.erase("coord_maps");
+  EXPECT_FALSE(ModelConfigFromJson(old, "x.json").coord_maps);
+}
+
 TEST(ModelConfig, DropoutActsInTrainingOnlyAndRoundTrips) {
   ModelConfig c = TinySdn();
   c.dropout = 0.5;
