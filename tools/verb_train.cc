@@ -74,7 +74,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                 "leave out the trunk's max pool after its stem: its stages see twice the resolution, at "
                 "about four times their cost");
   sub->add_flag("--coord-maps", o.model.coord_maps,
-                "give the trunk each pixel's column and row in [-1, 1] as two more channels (CoordConv): where "
+                "give the trunk each pixel's column and row in (-1, 1) as two more channels (CoordConv): where "
                 "in the frame the flag moves, which average pooling otherwise sees only through the padding");
   sub->add_flag("--flow", o.model.flow,
                 "each frame's optical flow from the one before (DIS) as two more input channels: what "

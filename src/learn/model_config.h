@@ -42,7 +42,7 @@ struct ModelConfig {
   // pool leave 16 px for the first stage; without the pool the stages keep 32 px, at about four
   // times their cost (a small input's detail is what the pool throws away).
   bool stem_pool = true;
-  // Two more trunk channels, each pixel's column and row scaled to [-1, 1] (CoordConv): with the
+  // Two more trunk channels, each pixel's column and row scaled to (-1, 1) (CoordConv): with the
   // camera aimed at the flag's rest centre, where in the frame the flag moves says how far it
   // droops, and convolutions followed by average pooling see where only through the zero padding.
   bool coord_maps = false;
