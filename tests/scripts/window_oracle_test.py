@@ -126,6 +126,7 @@ class ClipWindowsTest(unittest.TestCase):
         a = A()
         a.seed, a.window, a.clip, a.clip_windows, a.warmup = 1, 30, 60, k, 0.0
         a.coords, a.framing, a.camera_known, a.features, a.bins = 'image', 'fixed', True, 'shape', 6
+        a.track_noise, a.track_size = 0.0, 64
         return a
 
     def loaded(self, frames=180, points=4):
@@ -153,6 +154,26 @@ class ClipWindowsTest(unittest.TestCase):
         self.assertFalse(np.allclose(cameras[0][0], cameras[1][0]))
         # The windows themselves differ (the flag moves between them).
         self.assertFalse(np.allclose(clips[0][1][0], clips[0][1][1]))
+
+    def test_track_noise_is_pixels_of_the_frame_and_repeats_with_the_camera(self):
+        # Shape features are the window-mean image positions (then the camera): jitter of sigma
+        # pixels per frame moves a mean of W frames by sigma / sqrt(W), in image units 2 / size.
+        a, loaded = self.args(1), self.loaded(frames=40, points=400)
+        a.camera_known = False
+        clean = oracle.window_features(loaded, a, 0, False, [1, 0, 0, 0])
+        a.track_noise, a.track_size = 2.0, 64
+        noisy = oracle.window_features(loaded, a, 0, False, [1, 0, 0, 0])
+        expected = 2.0 * 2.0 / 64 / np.sqrt(a.window)
+        self.assertAlmostEqual(np.std(noisy - clean) / expected, 1.0, delta=0.1)
+        self.assertAlmostEqual(np.mean(noisy - clean) / expected, 0.0, delta=0.1)
+        # Deterministic for one camera seed, other jitter for another.
+        np.testing.assert_array_equal(noisy, oracle.window_features(loaded, a, 0, False, [1, 0, 0, 0]))
+        quiet = self.args(1)
+        quiet.camera_known = False
+        jitter = noisy - clean
+        other = (oracle.window_features(loaded, a, 0, False, [1, 0, 5, 0]) -
+                 oracle.window_features(loaded, quiet, 0, False, [1, 0, 5, 0]))
+        self.assertLess(abs(np.corrcoef(jitter, other)[0, 1]), 0.2)
 
     def test_a_clips_estimate_is_the_mean_of_its_windows(self):
         errors = oracle.clip_errors([(0, 0)] * 3 + [(1, 0)] * 3, [2.0] * 3 + [5.0] * 3,
