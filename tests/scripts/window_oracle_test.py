@@ -175,6 +175,15 @@ class ClipWindowsTest(unittest.TestCase):
                  oracle.window_features(loaded, quiet, 0, False, [1, 0, 5, 0]))
         self.assertLess(abs(np.corrcoef(jitter, other)[0, 1]), 0.2)
 
+    def test_train_seconds_keep_the_windows_inside_the_first_seconds(self):
+        # 180 frames at 25 Hz, no warm-up: 2.4 s are frames 0-59, whose 30-frame windows every 5
+        # frames start at 0 ... 30 (7); without the limit they run to 150 (31).
+        a, loaded = self.args(1), self.loaded()
+        self.assertEqual(len(oracle.windows_of(0, loaded, a, 5, False, 2.4)), 7)
+        self.assertEqual(len(oracle.windows_of(0, loaded, a, 5, False)), 31)
+        np.testing.assert_array_equal(oracle.windows_of(0, loaded, a, 5, False, 2.4)[6],
+                                      oracle.windows_of(0, loaded, a, 5, False)[6])
+
     def test_a_clips_estimate_is_the_mean_of_its_windows(self):
         errors = oracle.clip_errors([(0, 0)] * 3 + [(1, 0)] * 3, [2.0] * 3 + [5.0] * 3,
                                     [2.3, 2.6, 1.9, 5.0, 4.4, 4.6])
