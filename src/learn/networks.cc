@@ -116,6 +116,10 @@ at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
                                                         " N_t=" + std::to_string(clips.size(2))
                                                   : std::string()));
   }
+  return WithCoordMaps(ArchImages(clips));
+}
+
+at::Tensor WindNetImpl::ArchImages(const at::Tensor& clips) const {
   if (config_.arch == "sdn") {
     SpectralMaps maps = SpectralDecomposition(clips, config_.Spectral());
     std::vector<at::Tensor> parts = {at::log1p(maps.power), maps.frequency * (2.0 / config_.frame_rate)};
@@ -130,12 +134,12 @@ at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
     if (config_.spectral_pool > 1) {
       maps_in = at::avg_pool2d(maps_in, {config_.spectral_pool, config_.spectral_pool});
     }
-    return WithCoordMaps(maps_in);
+    return maps_in;
   }
   if (config_.arch == "lstm") {
-    return WithCoordMaps(clips.transpose(1, 2).reshape({-1, clips.size(1), clips.size(3), clips.size(4)}));
+    return clips.transpose(1, 2).reshape({-1, clips.size(1), clips.size(3), clips.size(4)});
   }
-  return WithCoordMaps(clips.reshape({clips.size(0), clips.size(1) * clips.size(2), clips.size(3), clips.size(4)}));
+  return clips.reshape({clips.size(0), clips.size(1) * clips.size(2), clips.size(3), clips.size(4)});
 }
 
 at::Tensor WindNetImpl::WithCoordMaps(const at::Tensor& images) const {

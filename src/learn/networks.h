@@ -83,6 +83,8 @@ class WindNetImpl : public torch::nn::Module {
   void set_std_scale(double scale) { config_.std_scale = scale; }
 
  private:
+  // TrunkInput without the coordinate maps: the architecture's own images of checked clips.
+  at::Tensor ArchImages(const at::Tensor& clips) const;
   // images [N, ch, H, W] -> [N, ch + 2, H, W] with coord_maps (column, row), else unchanged.
   at::Tensor WithCoordMaps(const at::Tensor& images) const;
 
