@@ -30,6 +30,7 @@ struct MakeDatasetArgs {
   bool reindex = false;
   bool no_contact_sheet = false;
   std::string backgrounds;  // folder of images
+  std::string tracks;       // "COLSxROWS"
 };
 
 // "A<sep>B" -> (a, b) with `parse` (std::stoi, std::stod, ...) taking each part whole; false if
@@ -75,6 +76,7 @@ int Run(MakeDatasetArgs& a) {
   ParseShard(a.shard, &o.shard, &o.shards);
   o.frame_ext = a.format == "jpeg" ? "jpg" : a.format;
   o.contact_sheet = !a.no_contact_sheet;
+  if (!a.tracks.empty()) o.tracks = data::ParseTrackGrid("--tracks", a.tracks);
   if (a.wind_min >= 0 || a.wind_max >= 0 || a.area_weight_spread >= 0 || a.bending_spread >= 0 ||
       a.bending_jitter >= 0 || !a.camera_height.empty() || !a.camera_radius.empty() || a.camera_angle >= 0) {
     data::SamplingRanges r = data::DefaultRanges(o.kind);
@@ -123,7 +125,10 @@ int Run(MakeDatasetArgs& a) {
               static_cast<long long>(s.examples_written));
   std::printf("  wall %.1f s on %d jobs; worker time: simulate %.1f s, render %.1f s, write %.1f s\n",
               s.wall_seconds, s.jobs, s.simulate_seconds, s.render_seconds, s.write_seconds);
-  if (s.examples_written > 0) {
+  if (s.examples_written > 0 && o.add_tracks) {
+    std::printf("  per example: %.2f s of worker time (a simulation's replay shared by its views)\n",
+                busy / s.examples_written);
+  } else if (s.examples_written > 0) {
     std::printf("  per example: %.2f s of worker time (render %.1f ms/frame); %.1f clips/min overall\n",
                 busy / s.examples_written, 1e3 * s.render_seconds / (s.examples_written * o.frames),
                 60.0 * s.examples_written / s.wall_seconds);
@@ -191,6 +196,13 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
   sub->add_flag("--reindex", a->reindex,
                 "only rebuild index.json and the contact sheet from the example folders (merge shards)");
   sub->add_flag("--no-contact-sheet", a->no_contact_sheet, "skip contact_sheet.png");
+  sub->add_option("--tracks", a->tracks,
+                  "also write each example's tracks.json: where a COLSxROWS grid of the cloth's material "
+                  "points is in each frame (e.g. 8x6; training's --aux-tracks reads them)");
+  sub->add_flag("--add-tracks", a->o.add_tracks,
+                "render nothing: give the examples already in --out their tracks.json (needs --tracks and "
+                "the options the dataset was made with; each replayed simulation is checked against "
+                "its stored frames)");
   return [a] {
     if (!a->reindex && a->o.count <= 0) throw std::invalid_argument("--count N (N >= 1) is required");
     return Run(*a);

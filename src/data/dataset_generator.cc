@@ -60,6 +60,7 @@ void ValidateOptions(const DatasetOptions& o) {
         "frame format must be jpg, png or pgm");
   Check(o.jpeg_quality >= 1 && o.jpeg_quality <= 100, "--jpeg-quality must be in 1..100");
   Check(o.max_edge >= 0, "--max-edge must be >= 0 m");
+  Check(!o.add_tracks || o.tracks, "--add-tracks needs the grid of the tracks (--tracks COLSxROWS)");
 }
 
 std::string TempPrefix(const std::string& name) { return "." + name + ".tmp-"; }
@@ -148,7 +149,7 @@ void CheckFinite(const sim::Trajectory& t) {
 
 // Writes one example: frames and label.json into a temporary folder, renamed into place.
 void WriteExample(const std::string& out, const std::string& name, const std::vector<cv::Mat>& images,
-                  const nlohmann::json& label, const DatasetOptions& o) {
+                  const nlohmann::json& label, const nlohmann::json& tracks, const DatasetOptions& o) {
   const fs::path tmp = fs::path(out) / TempDirName(name);
   fs::create_directory(tmp);
   try {
@@ -163,6 +164,7 @@ void WriteExample(const std::string& out, const std::string& name, const std::ve
       if (!cv::imwrite((tmp / file).string(), o.frame_ext == "pgm" ? grey : images[k], params))
         throw std::runtime_error("cannot write " + (tmp / file).string());
     }
+    if (!tracks.is_null()) sim::WriteFileAtomically((tmp / "tracks.json").string(), tracks.dump() + "\n");
     sim::WriteFileAtomically((tmp / "label.json").string(), label.dump(2) + "\n");
     fs::rename(tmp, fs::path(out) / name);
   } catch (...) {
@@ -170,6 +172,31 @@ void WriteExample(const std::string& out, const std::string& name, const std::ve
     fs::remove_all(tmp, ec);
     throw;
   }
+}
+
+// --add-tracks: throws unless `rendered` (the example's last frame rendered again from its replayed
+// simulation) matches the stored one within kMaxReplayGreyDifference.
+void CheckReplay(const fs::path& example, int last_frame, const std::string& ext, const cv::Mat& rendered) {
+  char file[32];
+  std::snprintf(file, sizeof(file), "%03d.%s", last_frame, ext.c_str());
+  const fs::path path = example / file;
+  const cv::Mat stored = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+  if (stored.empty()) throw std::runtime_error("cannot read " + path.string());
+  cv::Mat grey;
+  cv::cvtColor(rendered, grey, cv::COLOR_BGR2GRAY);
+  if (stored.size() != grey.size())
+    throw std::runtime_error(path.string() + " is " + std::to_string(stored.cols) + "x" +
+                             std::to_string(stored.rows) + " px, the dataset's settings render " +
+                             std::to_string(grey.cols) + "x" + std::to_string(grey.rows));
+  cv::Mat diff;
+  cv::absdiff(stored, grey, diff);
+  const double mean = cv::mean(diff)[0];
+  if (mean > kMaxReplayGreyDifference)
+    throw std::runtime_error(path.string() + " differs from the replayed simulation's frame by " +
+                             std::to_string(mean) + " grey levels on average (at most " +
+                             std::to_string(kMaxReplayGreyDifference) +
+                             " expected): the example was made by another simulator or renderer, so no "
+                             "tracks are added to it");
 }
 
 // The dataset's settings record the cameras only where they differ from Table 2's, so the
@@ -240,7 +267,7 @@ nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<st
   const std::string scene_path = o.scene.empty() ? DefaultScenePath(o.kind) : o.scene;
   nlohmann::json backgrounds = nlohmann::json::array();
   for (const auto& b : o.background_images) backgrounds.push_back(fs::path(b).filename().string());
-  return {{"kind", render::SceneKindName(o.kind)},
+  nlohmann::json settings = {{"kind", render::SceneKindName(o.kind)},
           {"seed", o.seed},
           {"views", o.views},
           {"frames", o.frames},
@@ -258,6 +285,8 @@ nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<st
           {"fabrics", fabric_names},
           {"background_images", backgrounds},
           {"generator_version", kGeneratorVersion}};
+  if (o.tracks) settings["tracks"] = {o.tracks->cols, o.tracks->rows};
+  return settings;
 }
 
 int64_t ReindexDataset(const std::string& dir, bool contact_sheet) {
@@ -278,7 +307,17 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   const Prepared prep = Prepare(o);
   const nlohmann::json settings = DatasetSettingsJson(o, FabricNames(prep.fabrics));
   fs::create_directories(o.out);
-  CheckCompatible(o.out, settings);
+  if (o.add_tracks) {
+    if (ReadIndex(o.out).is_null())
+      throw std::runtime_error("--add-tracks: " + (fs::path(o.out) / "index.json").string() +
+                               " not found: tracks are added to a dataset made before");
+    // The examples were made without tracks: every other setting must be theirs.
+    nlohmann::json made = settings;
+    made.erase("tracks");
+    CheckCompatible(o.out, made);
+  } else {
+    CheckCompatible(o.out, settings);
+  }
 
   DatasetSummary summary;
   summary.jobs = o.jobs > 0 ? o.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -298,13 +337,18 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   // has an index keeps it until the end, which rebuilds it from the folders present.)
   if (ReadIndex(o.out).is_null()) WriteIndex(o.out, IndexHeader(o, settings));
 
-  // This shard's simulations that still miss a view.
+  // This shard's simulations that still miss a view (--add-tracks: a view's tracks).
+  auto has = [&](int64_t i, int v, const char* file) {
+    return fs::exists(fs::path(o.out) / ExampleName(o.kind, i, v) / file);
+  };
+  auto view_done = [&](int64_t i, int v) {
+    return o.add_tracks ? !has(i, v, "label.json") || has(i, v, "tracks.json") : has(i, v, "label.json");
+  };
   std::vector<int64_t> todo;
   for (int64_t i = o.shard; i < o.count; i += o.shards) {
     ++summary.assigned;
     bool complete = true;
-    for (int v = 0; v < o.views && complete; ++v)
-      complete = fs::exists(fs::path(o.out) / ExampleName(o.kind, i, v) / "label.json");
+    for (int v = 0; v < o.views && complete; ++v) complete = view_done(i, v);
     if (complete) ++summary.skipped;
     else todo.push_back(i);
   }
@@ -348,7 +392,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
       info.warmup = first_frame * frame_time;
       for (int v = 0; v < o.views; ++v) {
         const std::string name = ExampleName(o.kind, i, v);
-        if (fs::exists(fs::path(o.out) / name / "label.json")) continue;
+        if (view_done(i, v)) continue;
         t0 = Clock::now();
         render::RenderParams zeta = SampleView(o.kind, s.seed, v, o.views, o.background_images, prep.ranges.camera);
         if (o.samples > 0) zeta.samples = o.samples;
@@ -357,11 +401,24 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
         render::RenderOptions ro;
         ro.threads = 1;  // parallel over simulations instead
         render::Renderer renderer(zeta, ro);
+        const nlohmann::json tracks = o.tracks ? TracksJson(ProjectTracks(anim, zeta, *o.tracks, o.frames)) : nullptr;
+        if (o.add_tracks) {
+          const int last_frame = o.frames - 1;
+          CheckReplay(fs::path(o.out) / name, last_frame, o.frame_ext,
+                      RenderAnimation(&renderer, anim, last_frame / o.fps, 1, o.fps)[0]);
+          render_s += Seconds(t0);
+          t0 = Clock::now();
+          sim::WriteFileAtomically((fs::path(o.out) / name / "tracks.json").string(), tracks.dump() + "\n");
+          write_s += Seconds(t0);
+          ++written;
+          last = name;
+          continue;
+        }
         const std::vector<cv::Mat> images = RenderAnimation(&renderer, anim, 0.0, o.frames, o.fps);
         render_s += Seconds(t0);
         t0 = Clock::now();
         info.view = v;
-        WriteExample(o.out, name, images, SimExampleLabel(name, s, zeta, info), o);
+        WriteExample(o.out, name, images, SimExampleLabel(name, s, zeta, info), tracks, o);
         write_s += Seconds(t0);
         ++written;
         last = name;

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "data/clip_tracks.h"
 #include "data/example_sampling.h"
 #include "render/render_params.h"
 
@@ -51,7 +52,21 @@ struct DatasetOptions {
   std::vector<std::string> background_images;  // empty: procedural backdrops
 
   bool contact_sheet = true;   // write DIR/contact_sheet.png at the end
+
+  // Each example also gets tracks.json: where this grid of the cloth's material points is in
+  // each frame (data/clip_tracks.h), recorded in the settings as "tracks": [cols, rows].
+  std::optional<TrackGrid> tracks;
+  // With `tracks`: render nothing new, but give every example already in DIR that lacks it its
+  // tracks.json, from its simulation run again. The run checks each replay against the example's
+  // stored last frame (kMaxReplayGreyDifference) so that tracks never describe other frames.
+  bool add_tracks = false;
 };
+
+// The mean absolute difference [grey levels of 255] allowed between an example's stored last
+// frame and the same frame rendered again from its replayed simulation (--add-tracks). Frames
+// rendered from one simulation differ only by JPEG's loss: 0.3-0.7 on flagsim-e2's 128-px frames
+// at quality 95, where the clip's frame before (the cloth 40 ms earlier) already differs by 3.
+constexpr double kMaxReplayGreyDifference = 1.5;
 
 // Progress after each simulation (called from worker threads, serialised by the generator).
 struct DatasetProgress {
@@ -66,7 +81,7 @@ struct DatasetSummary {
   int64_t assigned = 0;          // simulations of this shard
   int64_t skipped = 0;           // already complete (all views present)
   int64_t simulated = 0;         // simulations run now
-  int64_t examples_written = 0;  // example folders written now
+  int64_t examples_written = 0;  // example folders written now (--add-tracks: tracks.json files)
   int64_t failed = 0;            // simulations that failed (see errors)
   int64_t examples_in_index = 0; // examples in DIR/index.json after this run (all shards)
   std::vector<std::string> errors;

@@ -1,0 +1,108 @@
+#include "learn/track_targets.h"
+
+#include <cmath>
+#include <complex>
+#include <stdexcept>
+#include <string>
+
+#include "learn/dataset.h"
+
+namespace clothwind::learn {
+
+Tracks ReadTracks(const std::filesystem::path& file) {
+  const nlohmann::json j = ReadJson(file);
+  const std::string where = file.string() + ": field ";
+  auto need = [&](const char* key) -> const nlohmann::json& {
+    if (!j.contains(key)) throw std::runtime_error(where + "'" + key + "' is missing");
+    return j[key];
+  };
+  if (j.value("format", "") != "clothwind-tracks")
+    throw std::runtime_error(where + "'format' must be \"clothwind-tracks\"");
+  if (j.value("version", 0) != 1) throw std::runtime_error(where + "'version' must be 1");
+  Tracks t;
+  try {
+    const auto grid = need("grid").get<std::vector<int>>();
+    if (grid.size() != 2 || grid[0] < 1 || grid[1] < 1)
+      throw std::runtime_error(where + "'grid' must be [cols, rows] of positive integers");
+    t.cols = grid[0];
+    t.rows = grid[1];
+    t.width = need("width").get<int>();
+    t.height = need("height").get<int>();
+    const nlohmann::json& xy = need("xy");
+    if (!xy.is_array() || xy.empty()) throw std::runtime_error(where + "'xy' must be a non-empty array of frames");
+    t.frames = static_cast<int>(xy.size());
+    t.xy.reserve(static_cast<size_t>(t.frames) * 2 * t.points());
+    for (int k = 0; k < t.frames; ++k) {
+      if (!xy[k].is_array() || static_cast<int>(xy[k].size()) != 2 * t.points())
+        throw std::runtime_error(where + "'xy[" + std::to_string(k) + "]' must hold " +
+                                 std::to_string(2 * t.points()) + " coordinates (x, y of each grid point)");
+      for (const auto& value : xy[k]) t.xy.push_back(value.get<float>());
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(file.string() + ": " + e.what());
+  }
+  return t;
+}
+
+std::vector<float> TrackTargets(const Tracks& tracks, int first, int frames, const cv::Rect& crop, int source_side,
+                                bool flipped) {
+  if (first < 0 || frames < 2 || first + frames > tracks.frames)
+    throw std::invalid_argument("TrackTargets: window " + std::to_string(first) + "+" + std::to_string(frames) +
+                                " outside tracks of " + std::to_string(tracks.frames) + " frames");
+  if (tracks.width != tracks.height || crop.width != crop.height || crop.width < 1 || source_side < 1)
+    throw std::invalid_argument("TrackTargets: expected square frames and crops");
+  const int points = tracks.points();
+  const double scale = static_cast<double>(source_side) / tracks.width;
+  std::vector<double> hann(frames);
+  double hann_sum = 0;
+  for (int t = 0; t < frames; ++t) hann_sum += hann[t] = 0.5 - 0.5 * std::cos(2 * M_PI * t / frames);
+  std::vector<float> out;
+  out.reserve(static_cast<size_t>(points) * kTargetsPerPoint);
+  std::vector<double> series(frames);
+  for (int p = 0; p < points; ++p) {
+    std::vector<float> means, amplitudes;
+    for (int c = 0; c < 2; ++c) {
+      const double origin = c == 0 ? crop.x : crop.y;
+      double mean = 0;
+      for (int t = 0; t < frames; ++t) {
+        const double pixel = tracks.xy[(static_cast<size_t>(first + t) * points + p) * 2 + c] * scale;
+        double unit = 2.0 * (pixel - origin) / crop.width - 1.0;
+        if (c == 0 && flipped) unit = -unit;
+        mean += series[t] = unit;
+      }
+      mean /= frames;
+      means.push_back(static_cast<float>(mean));
+      for (int j = 1; j <= kTrackBins; ++j) {
+        std::complex<double> sum = 0;
+        for (int t = 0; t < frames; ++t)
+          sum += hann[t] * (series[t] - mean) * std::polar(1.0, -2 * M_PI * j * t / frames);
+        amplitudes.push_back(static_cast<float>(std::log(1e-4 + std::abs(sum) / hann_sum)));
+      }
+    }
+    out.insert(out.end(), means.begin(), means.end());
+    out.insert(out.end(), amplitudes.begin(), amplitudes.end());
+  }
+  return out;
+}
+
+TargetScale ScaleOf(const std::vector<std::vector<float>>& targets) {
+  TargetScale s;
+  if (targets.empty()) return s;
+  const size_t n = targets[0].size();
+  std::vector<double> sum(n, 0), sum2(n, 0);
+  for (const auto& row : targets) {
+    if (row.size() != n) throw std::invalid_argument("ScaleOf: rows of different lengths");
+    for (size_t i = 0; i < n; ++i) {
+      sum[i] += row[i];
+      sum2[i] += static_cast<double>(row[i]) * row[i];
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const double mean = sum[i] / targets.size(), var = sum2[i] / targets.size() - mean * mean;
+    s.mean.push_back(static_cast<float>(mean));
+    s.std.push_back(var > 1e-12 ? static_cast<float>(std::sqrt(var)) : 1.0f);
+  }
+  return s;
+}
+
+}  // namespace clothwind::learn

@@ -1,0 +1,162 @@
+#include "learn/track_targets.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace clothwind::learn {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Tracks of a cols x rows grid on size x size frames; point p at x(p, t), y(p, t).
+template <typename X, typename Y>
+Tracks MakeTracks(int cols, int rows, int size, int frames, X x, Y y) {
+  Tracks t;
+  t.cols = cols;
+  t.rows = rows;
+  t.width = t.height = size;
+  t.frames = frames;
+  for (int k = 0; k < frames; ++k)
+    for (int p = 0; p < cols * rows; ++p) {
+      t.xy.push_back(static_cast<float>(x(p, k)));
+      t.xy.push_back(static_cast<float>(y(p, k)));
+    }
+  return t;
+}
+
+// Index of a point's target: 0, 1 the u, v means; 2 + j - 1 u's bin j; 2 + kTrackBins + j - 1 v's.
+int UMean(int p) { return p * kTargetsPerPoint; }
+int VMean(int p) { return p * kTargetsPerPoint + 1; }
+int UBin(int p, int j) { return p * kTargetsPerPoint + 1 + j; }
+int VBin(int p, int j) { return p * kTargetsPerPoint + 1 + kTrackBins + j; }
+
+TEST(TrackTargetsTest, ASinusoidReadsHalfItsAmplitudeAtItsBinAQuarterNextToItAndNothingElsewhere) {
+  // Point 0 swings 3 px left-right at bin 2 of a 30-frame window about the frame's centre;
+  // point 1 stands 32 px below the centre.
+  const int T = 30;
+  const Tracks t = MakeTracks(
+      1, 2, 128, 60, [&](int p, int k) { return p == 0 ? 64.0 + 3.0 * std::sin(2 * M_PI * 2 * k / T) : 64.0; },
+      [](int p, int) { return p == 0 ? 64.0 : 96.0; });
+  const std::vector<float> y = TrackTargets(t, 0, T, cv::Rect(0, 0, 128, 128), 128, false);
+  ASSERT_EQ(y.size(), 2u * kTargetsPerPoint);
+  EXPECT_NEAR(y[UMean(0)], 0.0, 1e-6);
+  EXPECT_NEAR(y[VMean(0)], 0.0, 1e-6);
+  EXPECT_NEAR(y[VMean(1)], 0.5, 1e-6);
+  const double amplitude = 2.0 * 3.0 / 128;  // 3 px in units of half the frame
+  EXPECT_NEAR(y[UBin(0, 2)], std::log(1e-4 + amplitude / 2), 1e-4);
+  // The Hann window's spectrum is (1/2, -1/4, -1/4) at bins (0, ±1): the neighbours read half as much.
+  EXPECT_NEAR(y[UBin(0, 1)], std::log(1e-4 + amplitude / 4), 1e-4);
+  EXPECT_NEAR(y[UBin(0, 3)], std::log(1e-4 + amplitude / 4), 1e-4);
+  for (int j = 1; j <= kTrackBins; ++j) {
+    if (j > 3) {
+      EXPECT_LT(y[UBin(0, j)], std::log(2e-4)) << j;  // nothing leaks further
+    }
+    EXPECT_NEAR(y[VBin(0, j)], std::log(1e-4), 1e-6) << j;       // no vertical motion
+    EXPECT_NEAR(y[UBin(1, j)], std::log(1e-4), 1e-6) << j;
+  }
+}
+
+TEST(TrackTargetsTest, FlippingNegatesTheHorizontalMeansAndKeepsTheMotion) {
+  const Tracks t = MakeTracks(
+      2, 2, 128, 40, [](int p, int k) { return 20.0 + 25 * p + 2.0 * std::cos(0.7 * k + p); },
+      [](int p, int k) { return 50.0 + 10 * p + std::sin(0.3 * k); });
+  const std::vector<float> a = TrackTargets(t, 5, 30, cv::Rect(0, 0, 128, 128), 128, false);
+  const std::vector<float> b = TrackTargets(t, 5, 30, cv::Rect(0, 0, 128, 128), 128, true);
+  for (int p = 0; p < 4; ++p) {
+    EXPECT_NEAR(b[UMean(p)], -a[UMean(p)], 1e-6);
+    EXPECT_NEAR(b[VMean(p)], a[VMean(p)], 1e-6);
+    for (int j = 1; j <= kTrackBins; ++j) {
+      EXPECT_NEAR(b[UBin(p, j)], a[UBin(p, j)], 1e-5);
+      EXPECT_NEAR(b[VBin(p, j)], a[VBin(p, j)], 1e-5);
+    }
+  }
+}
+
+TEST(TrackTargetsTest, PositionsAreInTheCropAndInTheFramesTheCropWasTakenFrom) {
+  // A point fixed at (96, 64) px of a 128-px frame.
+  const Tracks t = MakeTracks(1, 2, 128, 30, [](int, int) { return 96.0; }, [](int, int) { return 64.0; });
+  // The crop's right edge: u = 1, v = 0 at the crop's centre row.
+  std::vector<float> y = TrackTargets(t, 0, 30, cv::Rect(32, 32, 64, 64), 128, false);
+  EXPECT_NEAR(y[UMean(0)], 1.0, 1e-6);
+  EXPECT_NEAR(y[VMean(0)], 0.0, 1e-6);
+  // A frame cache's 64-px squares of the same frames: the point is at (48, 32) of them.
+  y = TrackTargets(t, 0, 30, cv::Rect(0, 0, 64, 64), 64, false);
+  EXPECT_NEAR(y[UMean(0)], 0.5, 1e-6);
+  EXPECT_NEAR(y[VMean(0)], 0.0, 1e-6);
+}
+
+TEST(TrackTargetsTest, TheWindowIsTheSamplesFrames) {
+  // A point that stands still until frame 30 and then oscillates: window 0 shows no motion,
+  // window 30 the oscillation.
+  const Tracks t = MakeTracks(
+      1, 2, 128, 60, [](int, int k) { return k < 30 ? 64.0 : 64.0 + 4 * std::sin(2 * M_PI * k / 10); },
+      [](int, int) { return 64.0; });
+  const std::vector<float> still = TrackTargets(t, 0, 30, cv::Rect(0, 0, 128, 128), 128, false);
+  const std::vector<float> moving = TrackTargets(t, 30, 30, cv::Rect(0, 0, 128, 128), 128, false);
+  EXPECT_NEAR(still[UBin(0, 3)], std::log(1e-4), 1e-6);
+  EXPECT_GT(moving[UBin(0, 3)], std::log(0.02));
+  EXPECT_THROW(TrackTargets(t, 31, 30, cv::Rect(0, 0, 128, 128), 128, false), std::invalid_argument);
+}
+
+TEST(TrackTargetsTest, ScaleStandardisesEachTargetAndLeavesAConstantOneAtStdOne) {
+  const TargetScale s = ScaleOf({{1, 5, 2}, {3, 5, 4}, {5, 5, 9}});
+  ASSERT_EQ(s.mean.size(), 3u);
+  EXPECT_FLOAT_EQ(s.mean[0], 3);
+  EXPECT_NEAR(s.std[0], std::sqrt(8.0 / 3), 1e-6);
+  EXPECT_FLOAT_EQ(s.mean[1], 5);
+  EXPECT_FLOAT_EQ(s.std[1], 1);
+  EXPECT_FLOAT_EQ(s.mean[2], 5);
+}
+
+class TracksFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override { path_ = fs::temp_directory_path() / ("cw_tracks_" + std::to_string(::getpid()) + ".json"); }
+  void TearDown() override { fs::remove(path_); }
+  void Write(const nlohmann::json& j) { std::ofstream(path_) << j.dump(); }
+  fs::path path_;
+};
+
+TEST_F(TracksFileTest, ReadsTheGridAndFramesMakeDatasetWrites) {
+  Write({{"format", "clothwind-tracks"}, {"version", 1}, {"grid", {1, 2}}, {"width", 128}, {"height", 128},
+         {"vertices", {3, 7}}, {"xy", {{1.5, 2.5, 3.5, 4.5}, {1.25, 2.25, 3.25, 4.25}, {0, 0, 0, 0}}}});
+  const Tracks t = ReadTracks(path_);
+  EXPECT_EQ(t.points(), 2);
+  EXPECT_EQ(t.frames, 3);
+  EXPECT_EQ(t.width, 128);
+  ASSERT_EQ(t.xy.size(), 12u);
+  EXPECT_FLOAT_EQ(t.xy[4], 1.25);  // frame 1, point 0, x
+  EXPECT_FLOAT_EQ(t.xy[7], 4.25);  // frame 1, point 1, y
+}
+
+TEST_F(TracksFileTest, ErrorsNameTheFileAndTheField) {
+  auto message = [&](const nlohmann::json& j) {
+    Write(j);
+    try {
+      ReadTracks(path_);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const nlohmann::json good = {{"format", "clothwind-tracks"}, {"version", 1}, {"grid", {1, 2}},
+                               {"width", 8}, {"height", 8}, {"xy", {{1, 2, 3, 4}}}};
+  nlohmann::json j = good;
+  j["xy"][0].erase(3);
+  std::string m = message(j);
+  EXPECT_NE(m.find(path_.string()), std::string::npos) << m;
+  EXPECT_NE(m.find("xy[0]"), std::string::npos) << m;
+  j = good;
+  j.erase("width");
+  EXPECT_NE(message(j).find("'width'"), std::string::npos);
+  j = good;
+  j["format"] = "clothwind-dataset";
+  EXPECT_NE(message(j).find("'format'"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace clothwind::learn
