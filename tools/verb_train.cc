@@ -93,6 +93,12 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                 "keep every frame decoded at the input size in memory after its first read: the same samples, "
                 "no rereading of a dataset larger than the page cache (needs --crop-scales 1; clips x frames x "
                 "size^2 bytes, 4.7 GB for flagsim-e5 at 64 px)");
+  sub->add_option("--aux-tracks", o.aux_tracks,
+                  "weight of an auxiliary loss (0: off): a second head regresses each clip's grid of material "
+                  "points (position and low-frequency motion, from the dataset's tracks.json: make-dataset "
+                  "--tracks); the wind estimate does not read it")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   sub->add_flag("--init-only", o.init_only, "write an initialised (untrained) model and stop (tests, smoke runs)");
   sub->add_option("--lr", o.lr, "initial learning rate (Adam)")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--lr-schedule", o.lr_schedule,
@@ -138,8 +144,9 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
       if (bar) bar->Finish();
       std::cout << std::fixed << std::setprecision(4) << "epoch " << e.epoch << "/" << o.epochs << "  lr " << e.lr
                 << "  train loss " << e.train_loss << " rmse " << e.train_rmse << "  val loss " << e.val_loss
-                << " rmse " << e.val_rmse << " acc@0.5 " << e.val_acc05 << "  " << std::setprecision(1)
-                << e.seconds << " s" << std::endl;
+                << " rmse " << e.val_rmse << " acc@0.5 " << e.val_acc05;
+      if (o.aux_tracks > 0) std::cout << "  aux loss " << e.train_aux_loss;
+      std::cout << "  " << std::setprecision(1) << e.seconds << " s" << std::endl;
     };
     const learn::TrainResult r = learn::Train(o);
     if (o.init_only) {

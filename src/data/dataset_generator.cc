@@ -306,11 +306,11 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   const auto start = Clock::now();
   const Prepared prep = Prepare(o);
   const nlohmann::json settings = DatasetSettingsJson(o, FabricNames(prep.fabrics));
+  if (o.add_tracks && ReadIndex(o.out).is_null())
+    throw std::runtime_error("--add-tracks: " + (fs::path(o.out) / "index.json").string() +
+                             " not found: tracks are added to a dataset made before");
   fs::create_directories(o.out);
   if (o.add_tracks) {
-    if (ReadIndex(o.out).is_null())
-      throw std::runtime_error("--add-tracks: " + (fs::path(o.out) / "index.json").string() +
-                               " not found: tracks are added to a dataset made before");
     // The examples were made without tracks: every other setting must be theirs.
     nlohmann::json made = settings;
     made.erase("tracks");

@@ -375,6 +375,82 @@ TEST_F(DatasetGeneratorTest, PgmFramesHoldTheGreyOfTheColourFrames) {
   }
 }
 
+TEST_F(DatasetGeneratorTest, AddTracksGivesADatasetTheTracksItWouldHaveBeenMadeWith) {
+  ASSERT_TRUE(reference_.errors.empty());
+  // Made with tracks: the same frames as the reference, and a tracks.json per example.
+  DatasetOptions with = Tiny((root_ / "with-tracks").string());
+  with.tracks = TrackGrid{4, 3};
+  const DatasetSummary made = GenerateDataset(with);
+  ASSERT_TRUE(made.errors.empty()) << made.errors[0];
+  // The reference, made without, given its tracks afterwards.
+  const fs::path added = root_ / "added-tracks";
+  fs::copy(Ref(), added, fs::copy_options::recursive);
+  DatasetOptions add = Tiny(added.string());
+  add.tracks = TrackGrid{4, 3};
+  add.add_tracks = true;
+  const DatasetSummary s = GenerateDataset(add);
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  EXPECT_EQ(s.examples_written, 3);
+  for (int i = 0; i < 3; ++i) {
+    const std::string name = ExampleName(render::SceneKind::kFlag, i, 0);
+    const std::string tracks = Bytes(root_ / "with-tracks" / name / "tracks.json");
+    const nlohmann::json j = nlohmann::json::parse(tracks);
+    EXPECT_EQ(j["grid"], nlohmann::json({4, 3})) << name;
+    EXPECT_EQ(j["xy"].size(), 6u) << name;
+    EXPECT_EQ(Bytes(added / name / "tracks.json"), tracks) << name;
+    for (int k = 0; k < 6; ++k) {
+      char frame[16];
+      std::snprintf(frame, sizeof(frame), "%03d.jpg", k);
+      EXPECT_EQ(Bytes(root_ / "with-tracks" / name / frame), Bytes(Ref() / name / frame)) << name << frame;
+      EXPECT_EQ(Bytes(added / name / frame), Bytes(Ref() / name / frame)) << name << frame;
+    }
+  }
+  EXPECT_EQ(ReadIndex(added.string())["dataset"]["tracks"], nlohmann::json({4, 3}));
+  EXPECT_EQ(ReadIndex((root_ / "with-tracks").string())["dataset"]["tracks"], nlohmann::json({4, 3}));
+  // Again: nothing left to do.
+  EXPECT_EQ(GenerateDataset(add).simulated, 0);
+}
+
+TEST_F(DatasetGeneratorTest, AddTracksRefusesAnExampleWhoseFramesItsReplayDoesNotShow) {
+  ASSERT_TRUE(reference_.errors.empty());
+  const fs::path dir = root_ / "tampered";
+  fs::copy(Ref(), dir, fs::copy_options::recursive);
+  // Example 1's last frame mirrored: the cloth is not where its simulation puts it.
+  const fs::path last = dir / ExampleName(render::SceneKind::kFlag, 1, 0) / "005.jpg";
+  cv::Mat image = cv::imread(last.string());
+  cv::flip(image, image, 1);
+  ASSERT_TRUE(cv::imwrite(last.string(), image));
+  DatasetOptions add = Tiny(dir.string());
+  add.tracks = TrackGrid{4, 3};
+  add.add_tracks = true;
+  const DatasetSummary s = GenerateDataset(add);
+  ASSERT_EQ(s.failed, 1);
+  EXPECT_NE(s.errors[0].find(last.string()), std::string::npos) << s.errors[0];
+  EXPECT_NE(s.errors[0].find("grey levels"), std::string::npos) << s.errors[0];
+  EXPECT_FALSE(fs::exists(last.parent_path() / "tracks.json"));
+  EXPECT_TRUE(fs::exists(dir / ExampleName(render::SceneKind::kFlag, 0, 0) / "tracks.json"));
+  EXPECT_TRUE(fs::exists(dir / ExampleName(render::SceneKind::kFlag, 2, 0) / "tracks.json"));
+  // Other settings than the dataset's are refused before anything runs.
+  add.seed = 2;
+  EXPECT_THROW(GenerateDataset(add), std::runtime_error);
+}
+
+TEST(DatasetOptionsTest, AddTracksNeedsAGridAndADataset) {
+  DatasetOptions o;
+  o.out = (fs::temp_directory_path() / ("clothwind_no_dataset_" + std::to_string(::getpid()))).string();
+  o.count = 1;
+  o.add_tracks = true;
+  EXPECT_THROW(GenerateDataset(o), std::invalid_argument);
+  o.tracks = TrackGrid{};
+  try {
+    GenerateDataset(o);
+    ADD_FAILURE() << "an empty folder has no dataset";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("--add-tracks"), std::string::npos) << e.what();
+  }
+  fs::remove_all(o.out);
+}
+
 TEST(DatasetOptionsTest, BadOptionsAreRejected) {
   DatasetOptions o;
   o.out = "/tmp/never";

@@ -104,6 +104,7 @@ struct EpochRecord {
   double train_rmse = 0, val_rmse = 0;  // [m/s]
   double val_acc05 = 0;
   double seconds = 0;                   // wall time of the epoch
+  double train_aux_loss = 0;            // AuxLoss over the epoch (0 without auxiliary targets)
 };
 
 // Training and validation RMSE per epoch as a PNG via gnuplot (atomically).

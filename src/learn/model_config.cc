@@ -91,7 +91,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"phase_step_far", c.phase_step_far}, {"mode_shape", c.mode_shape},
           {"spectral_pool", c.spectral_pool}, {"stem_pool", c.stem_pool},
           {"coord_maps", c.coord_maps},
-          {"dropout", c.dropout},
+          {"dropout", c.dropout},        {"aux_outputs", c.aux_outputs},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
           {"label_std", c.label_std},    {"std_scale", c.std_scale}};
@@ -131,6 +131,9 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     // Absent in models written before the option existed: no coordinate channels.
     c.coord_maps = j.contains("coord_maps") ? j.at("coord_maps").get<bool>() : false;
     c.dropout = j.contains("dropout") ? j.at("dropout").get<double>() : 0.0;
+    // Absent in models written before auxiliary targets existed: no second head.
+    c.aux_outputs = j.contains("aux_outputs") ? j.at("aux_outputs").get<int>() : 0;
+    if (c.aux_outputs < 0) throw std::runtime_error(where + ": field \"aux_outputs\" must be >= 0");
     c.frame_rate = need("frame_rate").get<double>();
     c.width = need("width").get<int>();
     c.input_size = need("input_size").get<int>();

@@ -47,6 +47,10 @@ struct ModelConfig {
   // droops, and convolutions followed by average pooling see where only through the zero padding.
   bool coord_maps = false;
   double dropout = 0.0;      // dropout probability on the trunk's pooled features while training
+  // Training only: a second head on the trunk's pooled features with this many outputs, which
+  // training fits to the clip's track targets (learn/track_targets.h, --aux-tracks); 0: none.
+  // The wind estimate never reads it, so a model with one predicts as one without.
+  int aux_outputs = 0;
   double frame_rate = 25.0;  // [Hz] of the clips the model reads
   int width = 64;            // ResNet-18 base width (64 as the original; 16 trains on a CPU)
   int input_size = 112;      // side of the square input [px] (224 as the seed, 112 for a CPU)

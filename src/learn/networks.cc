@@ -105,6 +105,9 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
     lstm_ = register_module("lstm", torch::nn::LSTM(torch::nn::LSTMOptions(features, features).batch_first(true)));
   }
   head_ = register_module("head", torch::nn::Linear(trunk_->feature_size(), 2));
+  if (config.aux_outputs < 0) throw std::invalid_argument("WindNet: aux_outputs must be >= 0");
+  if (config.aux_outputs > 0)
+    aux_head_ = register_module("aux_head", torch::nn::Linear(trunk_->feature_size(), config.aux_outputs));
 }
 
 at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
@@ -154,7 +157,9 @@ at::Tensor WindNetImpl::WithCoordMaps(const at::Tensor& images) const {
   return at::cat({images, x, y}, 1);
 }
 
-at::Tensor WindNetImpl::forward(const at::Tensor& clips) {
+at::Tensor WindNetImpl::forward(const at::Tensor& clips) { return ForwardWithAux(clips).wind; }
+
+WindNetImpl::Outputs WindNetImpl::ForwardWithAux(const at::Tensor& clips) {
   at::Tensor features = trunk_->forward(TrunkInput(clips));
   if (config_.arch == "lstm") {
     // [N_b·N_t, F] -> [N_b, N_t, F] -> the LSTM's output after the last frame [N_b, F].
@@ -163,9 +168,14 @@ at::Tensor WindNetImpl::forward(const at::Tensor& clips) {
   }
   // Dropout on the pooled features, in training only: the SDN fits its training clips better
   // than new ones (docs/sdn-experiments.md), and the head is where one feature can memorise a simulation.
+  Outputs outputs;
+  // The auxiliary head reads the features before dropout: it describes the clip, it does not
+  // memorise a simulation.
+  if (aux_head_) outputs.aux = aux_head_->forward(features);
   if (config_.dropout > 0) features = at::dropout(features, config_.dropout, is_training());
   at::Tensor out = head_->forward(features);
-  return at::stack({out.select(1, 0), out.select(1, 1).clamp(-12.0, 8.0)}, 1);
+  outputs.wind = at::stack({out.select(1, 0), out.select(1, 1).clamp(-12.0, 8.0)}, 1);
+  return outputs;
 }
 
 at::Tensor WindLoss(const at::Tensor& output, const at::Tensor& target) {
@@ -174,6 +184,8 @@ at::Tensor WindLoss(const at::Tensor& output, const at::Tensor& target) {
   at::Tensor nll = 0.5 * (log_var + residual2.detach() * at::exp(-log_var));
   return (residual2 + nll).mean();
 }
+
+at::Tensor AuxLoss(const at::Tensor& aux, const at::Tensor& target) { return (aux - target).square().mean(); }
 
 void SaveWindNet(WindNet& net, const std::filesystem::path& weights, WeightPrecision precision) {
   SaveModuleWeights(*net, weights, precision);

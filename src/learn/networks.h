@@ -71,6 +71,12 @@ class WindNetImpl : public torch::nn::Module {
   //   [N_b, 2]: column 0 the normalised speed (v - label_mean) / label_std, column 1 its log
   //   variance (normalised units), clamped to [-12, 8]
   at::Tensor forward(const at::Tensor& clips);
+  // forward's output and, with config.aux_outputs > 0, the auxiliary head's [N_b, aux_outputs]
+  // (standardised track targets; undefined without the head), from one pass through the trunk.
+  struct Outputs {
+    at::Tensor wind, aux;
+  };
+  Outputs ForwardWithAux(const at::Tensor& clips);
   // The trunk's input images: the stacked spectral maps [N_b, 2kC, H, W] (SDN: log1p of the
   // power, frequency divided by the Nyquist rate, so both are O(1)), the frames as channels
   // [N_b, N_t·C, H, W] (resnet18), or every frame on its own [N_b·N_t, C, H, W] (lstm). An SDN
@@ -92,6 +98,7 @@ class WindNetImpl : public torch::nn::Module {
   ResNet18Trunk trunk_{nullptr};
   torch::nn::LSTM lstm_{nullptr};  // lstm only: hidden size = the trunk's 8w features
   torch::nn::Linear head_{nullptr};
+  torch::nn::Linear aux_head_{nullptr};  // aux_outputs > 0 only
 };
 TORCH_MODULE(WindNet);
 
@@ -100,6 +107,10 @@ TORCH_MODULE(WindNet);
 // the variance head cannot slow down the regression (normalised units).
 // Inputs: output [N_b, 2] of WindNet, target [N_b] normalised speeds. Output: scalar loss.
 at::Tensor WindLoss(const at::Tensor& output, const at::Tensor& target);
+
+// The auxiliary loss: mean squared error of the auxiliary head's outputs [N_b, A] against the
+// standardised targets [N_b, A] (each target then weighs about 1 whatever its units).
+at::Tensor AuxLoss(const at::Tensor& aux, const at::Tensor& target);
 
 // Saves the network's parameters and buffers to `weights` (torch::save's layout; parameters
 // in float16 when asked: half the file, for the shipped model) and its ModelConfig to

@@ -26,6 +26,7 @@
 #include "learn/dataset.h"
 #include "learn/frame_cache.h"
 #include "learn/networks.h"
+#include "learn/track_targets.h"
 
 namespace clothwind::learn {
 namespace fs = std::filesystem;
@@ -34,7 +35,46 @@ namespace {
 struct Batch {
   at::Tensor clips;   // [B, 1, N_t, S, S]
   at::Tensor speeds;  // [B] [m/s]
+  at::Tensor aux;     // [B, A] standardised track targets (undefined without them)
 };
+
+// What --aux-tracks needs for the training clips: each clip's tracks, and the targets' scale.
+struct AuxTargets {
+  std::vector<Tracks> tracks;  // one per training clip, in its order
+  TargetScale scale;
+  int outputs() const { return static_cast<int>(scale.mean.size()); }
+};
+
+// Reads every clip's tracks.json and scales the targets by those of the clips' evaluation
+// windows, as they are and mirrored (the training windows' augmentations). Throws
+// std::runtime_error naming the first clip without tracks, or with tracks that do not fit it.
+AuxTargets ReadAuxTargets(const std::vector<ClipInfo>& clips, const SampleOptions& options) {
+  AuxTargets aux;
+  aux.tracks.resize(clips.size());
+  std::vector<std::vector<float>> eval_targets;
+  for (size_t i = 0; i < clips.size(); ++i) {
+    const ClipInfo& c = clips[i];
+    const fs::path file = c.dir / "tracks.json";
+    if (!fs::exists(file))
+      throw std::runtime_error(file.string() + " not found: --aux-tracks trains on a dataset made with "
+                               "`clothwind make-dataset --tracks COLSxROWS` (or given them by --add-tracks)");
+    aux.tracks[i] = ReadTracks(file);
+    const Tracks& t = aux.tracks[i];
+    if (t.frames != c.num_frames || t.width != c.width || t.height != c.height ||
+        (i > 0 && t.points() != aux.tracks[0].points()))
+      throw std::runtime_error(file.string() + ": " + std::to_string(t.frames) + " frames of " +
+                               std::to_string(t.width) + "x" + std::to_string(t.height) + " px and " +
+                               std::to_string(t.points()) + " points, expected the clip's " +
+                               std::to_string(c.num_frames) + " frames of " + std::to_string(c.width) + "x" +
+                               std::to_string(c.height) + (i > 0 ? " and the other clips' grid" : ""));
+    const int first = (c.num_frames - options.frames) / 2;
+    const cv::Rect whole = CentreSquare(c.width, c.height);
+    for (bool flipped : {false, true})
+      eval_targets.push_back(TrackTargets(t, first, options.frames, whole, c.width, flipped));
+  }
+  aux.scale = ScaleOf(eval_targets);
+  return aux;
+}
 
 // Clips read at once while a batch loads. Loading is bound by file reads, not decoding, once the
 // dataset outgrows the page cache (flagsim-e5's 9.6 GB on the 24 GiB VM, whose cache the host
@@ -46,10 +86,12 @@ constexpr int kBatchReaders = 4;
 // Loads clips indices[begin, end) of `clips` as one batch, clip i augmented with seed
 // seed_base + indices[i], its frames from `cache` when given (a cache of these same clips).
 // Outputs: clips [end - begin, C, N_t, S, S] float (C = options.channels()), speeds [end - begin] m/s.
+// With `aux`, the batch also holds each sample's standardised track targets, for its window, crop and flip.
 Batch LoadBatch(const std::vector<ClipInfo>& clips, const std::vector<size_t>& indices, size_t begin, size_t end,
-                const SampleOptions& options, uint64_t seed_base, FrameCache* cache) {
+                const SampleOptions& options, uint64_t seed_base, FrameCache* cache, const AuxTargets* aux) {
   const int64_t n = static_cast<int64_t>(end - begin), s = options.input_size;
-  Batch b{at::empty({n, options.channels(), options.frames, s, s}), at::empty({n}, at::kFloat)};
+  Batch b{at::empty({n, options.channels(), options.frames, s, s}), at::empty({n}, at::kFloat), at::Tensor()};
+  if (aux) b.aux = at::empty({n, aux->outputs()}, at::kFloat);
   float* pixels = b.clips.data_ptr<float>();
   float* speeds = b.speeds.data_ptr<float>();
   const int64_t clip_floats = n > 0 ? b.clips.numel() / n : 0;
@@ -63,6 +105,14 @@ Batch LoadBatch(const std::vector<ClipInfo>& clips, const std::vector<size_t>& i
                                " values, expected " + std::to_string(clip_floats));
       std::copy(sample.pixels.begin(), sample.pixels.end(), pixels + i * clip_floats);
       speeds[i] = static_cast<float>(sample.wind_speed);
+      if (aux) {
+        // A cache's crops are of its input_size squares; the files' of the clip's own frames.
+        const int source_side = cache ? options.input_size : clips[clip].width;
+        const std::vector<float> y =
+            TrackTargets(aux->tracks[clip], sample.first_frame, options.frames, sample.crop, source_side, sample.flipped);
+        float* row = b.aux.data_ptr<float>() + i * aux->outputs();
+        for (int k = 0; k < aux->outputs(); ++k) row[k] = (y[k] - aux->scale.mean[k]) / aux->scale.std[k];
+      }
     }
   };
   const int64_t readers = std::min<int64_t>(kBatchReaders, n);
@@ -77,7 +127,7 @@ Batch LoadBatch(const std::vector<ClipInfo>& clips, const std::vector<size_t>& i
 nlohmann::json EpochJson(const EpochRecord& e) {
   return {{"epoch", e.epoch},         {"lr", e.lr},           {"train_loss", e.train_loss},
           {"val_loss", e.val_loss},   {"train_rmse", e.train_rmse}, {"val_rmse", e.val_rmse},
-          {"val_acc05", e.val_acc05}, {"seconds", e.seconds}};
+          {"val_acc05", e.val_acc05}, {"seconds", e.seconds}, {"train_aux_loss", e.train_aux_loss}};
 }
 
 EpochRecord EpochFromJson(const nlohmann::json& j) {
@@ -90,15 +140,17 @@ EpochRecord EpochFromJson(const nlohmann::json& j) {
   e.val_rmse = j.at("val_rmse").get<double>();
   e.val_acc05 = j.at("val_acc05").get<double>();
   e.seconds = j.at("seconds").get<double>();
+  e.train_aux_loss = j.value("train_aux_loss", 0.0);  // absent in runs from before auxiliary targets
   return e;
 }
 
 std::string LogTsv(const std::vector<EpochRecord>& log) {
   std::ostringstream s;
-  s << "epoch\tlr\ttrain_loss\tval_loss\ttrain_rmse\tval_rmse\tval_acc05\tseconds\n" << std::setprecision(6);
+  s << "epoch\tlr\ttrain_loss\tval_loss\ttrain_rmse\tval_rmse\tval_acc05\tseconds\ttrain_aux_loss\n"
+    << std::setprecision(6);
   for (const EpochRecord& e : log) {
     s << e.epoch << "\t" << e.lr << "\t" << e.train_loss << "\t" << e.val_loss << "\t" << e.train_rmse << "\t"
-      << e.val_rmse << "\t" << e.val_acc05 << "\t" << e.seconds << "\n";
+      << e.val_rmse << "\t" << e.val_acc05 << "\t" << e.seconds << "\t" << e.train_aux_loss << "\n";
   }
   return s.str();
 }
@@ -216,6 +268,24 @@ TrainResult Train(const TrainOptions& o) {
                                "; resume with the --crop-scales the run started with");
     }
   }
+  // Auxiliary track targets: read (and their head sized) before the network is built.
+  if (!(o.aux_tracks >= 0)) throw std::runtime_error("aux_tracks: the loss weight must be >= 0");
+  const double ran_aux = o.resume ? state.value("aux_tracks", 0.0) : o.aux_tracks;
+  if (ran_aux != o.aux_tracks) {
+    throw std::runtime_error(state_path.string() + ": the run trained with --aux-tracks " + std::to_string(ran_aux) +
+                             ", these options give " + std::to_string(o.aux_tracks) +
+                             "; resume with the --aux-tracks the run started with");
+  }
+  std::unique_ptr<AuxTargets> aux;
+  if (o.aux_tracks > 0 && !train.empty()) {
+    aux = std::make_unique<AuxTargets>(ReadAuxTargets(train, config.Sampling()));
+    if (o.resume && config.aux_outputs != aux->outputs()) {
+      throw std::runtime_error(state_path.string() + ": the run's auxiliary head has " +
+                               std::to_string(config.aux_outputs) + " outputs, the dataset's tracks give " +
+                               std::to_string(aux->outputs()));
+    }
+    config.aux_outputs = aux->outputs();
+  }
   at::manual_seed(o.seed);
   WindNet net(config);
   torch::optim::Adam optimizer(net->parameters(), torch::optim::AdamOptions(o.lr).weight_decay(o.weight_decay));
@@ -276,11 +346,12 @@ TrainResult Train(const TrainOptions& o) {
     if (usable % o.batch == 1 && usable > 1) --usable;
     const int steps = static_cast<int>((usable + o.batch - 1) / o.batch);
     net->train();
-    double loss_sum = 0, se_sum = 0;
+    double loss_sum = 0, se_sum = 0, aux_sum = 0;
     size_t seen = 0;
     auto load = [&](size_t b) {
       return std::async(std::launch::async, LoadBatch, std::cref(train), std::cref(order), b,
-                        std::min(usable, b + o.batch), std::cref(train_options), seed_base, train_cache.get());
+                        std::min(usable, b + o.batch), std::cref(train_options), seed_base, train_cache.get(),
+                        aux.get());
     };
     std::future<Batch> next = load(0);
     for (int step = 0; step < steps; ++step) {
@@ -289,8 +360,14 @@ TrainResult Train(const TrainOptions& o) {
       if (following < usable) next = load(following);  // decode the next batch while this one trains
       at::Tensor x = batch.clips.to(device), y = ((batch.speeds - mean) * inv_std).to(device);
       optimizer.zero_grad();
-      at::Tensor out = net->forward(x);
+      const WindNetImpl::Outputs outputs = net->ForwardWithAux(x);
+      const at::Tensor& out = outputs.wind;
       at::Tensor loss = WindLoss(out, y);
+      if (aux) {
+        at::Tensor aux_loss = AuxLoss(outputs.aux, batch.aux.to(device));
+        aux_sum += aux_loss.item<double>() * x.size(0);
+        loss = loss + o.aux_tracks * aux_loss;
+      }
       loss.backward();
       if (grad_clip > 0) torch::nn::utils::clip_grad_norm_(net->parameters(), grad_clip);
       optimizer.step();
@@ -302,6 +379,7 @@ TrainResult Train(const TrainOptions& o) {
     }
     record.train_loss = loss_sum / std::max<size_t>(seen, 1);
     record.train_rmse = std::sqrt(se_sum / std::max<size_t>(seen, 1));
+    record.train_aux_loss = aux_sum / std::max<size_t>(seen, 1);
 
     // Validation: evaluation preprocessing, no augmentation.
     net->eval();
@@ -312,7 +390,8 @@ TrainResult Train(const TrainOptions& o) {
       std::vector<double> truth, predicted;
       double val_loss = 0;
       for (size_t b = 0; b < all.size(); b += o.batch) {
-        Batch batch = LoadBatch(val, all, b, std::min(all.size(), b + o.batch), val_options, 0, val_cache.get());
+        Batch batch =
+            LoadBatch(val, all, b, std::min(all.size(), b + o.batch), val_options, 0, val_cache.get(), nullptr);
         at::Tensor y = (batch.speeds - mean) * inv_std;
         at::Tensor out = net->forward(batch.clips.to(device)).to(at::kCPU);
         val_loss += WindLoss(out, y).item<double>() * y.size(0);
@@ -343,7 +422,7 @@ TrainResult Train(const TrainOptions& o) {
     nlohmann::json log = nlohmann::json::array();
     for (const EpochRecord& e : result.log) log.push_back(EpochJson(e));
     state = {{"epoch", epoch}, {"model", ToJson(config)}, {"log", log}, {"seed", o.seed},
-             {"crop_scales", o.crop_scales},
+             {"crop_scales", o.crop_scales}, {"aux_tracks", o.aux_tracks},
              {"best_val_rmse", result.best_val_rmse}};
     WriteFileAtomically(state_path, state.dump(2));
     WriteFileAtomically(o.out / "log.tsv", LogTsv(result.log));

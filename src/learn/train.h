@@ -46,6 +46,10 @@ struct TrainOptions {
   // the same samples, without rereading a dataset larger than the page cache each epoch.
   // Needs crop_scales = {1} and square frames; costs clips x frames x input_size^2 bytes.
   bool cache_frames = false;
+  // Weight of the auxiliary loss (0: off): a second head regresses each training sample's
+  // standardised track targets (learn/track_targets.h) from the dataset's tracks.json files, and
+  // training minimises WindLoss + aux_tracks · AuxLoss. Every training clip needs its tracks.
+  double aux_tracks = 0;
   uint64_t seed = 1;
   std::function<void(const TrainProgress&)> progress;  // after each batch (may be empty)
   std::function<void(const EpochRecord&)> epoch_done;  // after each epoch (may be empty)
