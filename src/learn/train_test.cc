@@ -19,6 +19,7 @@
 #include "learn/evaluate.h"
 #include "learn/networks.h"
 #include "learn/predictor.h"
+#include "learn/track_targets.h"
 #include "learn/view_breakdown.h"
 
 namespace clothwind::learn {
@@ -508,6 +509,40 @@ TEST(ModelConfig, DropoutActsInTrainingOnlyAndRoundTrips) {
   EXPECT_TRUE(at::equal(net->forward(clips), net->forward(clips)));
 }
 
+TEST(ModelConfig, TheAuxiliaryHeadTrainsTheTrunkAndNotTheWindHeadAndRoundTrips) {
+  ModelConfig c = TinySdn();
+  c.aux_outputs = 5;
+  EXPECT_EQ(ModelConfigFromJson(ToJson(c), "x.json").aux_outputs, 5);
+  nlohmann::json old = ToJson(c);
+  old.erase("aux_outputs");
+  EXPECT_EQ(ModelConfigFromJson(old, "x.json").aux_outputs, 0);
+  nlohmann::json bad = ToJson(c);
+  bad["aux_outputs"] = -1;
+  ExpectFieldRefused(bad, "aux_outputs");
+
+  at::manual_seed(5);
+  const at::Tensor clips = at::randn({3, 1, 30, 16, 16});
+  WindNet net(c);
+  net->eval();  // batch norm's running statistics: the same numbers from both calls
+  const WindNetImpl::Outputs out = net->ForwardWithAux(clips);
+  ASSERT_EQ(out.aux.sizes(), (at::IntArrayRef{3, 5}));
+  EXPECT_TRUE(at::equal(out.wind, net->forward(clips)));
+  // The auxiliary loss reaches the trunk, not the wind head.
+  AuxLoss(out.aux, at::zeros({3, 5})).backward();
+  for (const auto& p : net->named_parameters()) {
+    const bool has = p.value().grad().defined() && p.value().grad().abs().sum().item<double>() > 0;
+    if (p.key().rfind("head.", 0) == 0) {
+      EXPECT_FALSE(has) << p.key();
+    } else if (p.key().rfind("trunk.stem.", 0) == 0 || p.key().rfind("aux_head.", 0) == 0) {
+      EXPECT_TRUE(has) << p.key();
+    }
+  }
+  // Without the option there is no second head.
+  WindNet plain(TinySdn());
+  EXPECT_FALSE(plain->ForwardWithAux(clips).aux.defined());
+  for (const auto& p : plain->named_parameters()) EXPECT_EQ(p.key().rfind("aux_head", 0), std::string::npos);
+}
+
 TEST(LearningRate, StepAndCosineSchedules) {
   TrainOptions o;
   o.epochs = 40;
@@ -734,6 +769,63 @@ TEST_F(TrainTest, FlowChannelsTrainRoundTripAndAreRefusedWhenInconsistent) {
   nlohmann::json without = ToJson(old);
   without.erase("flow");
   EXPECT_FALSE(ModelConfigFromJson(without, "old/model.json").flow);
+}
+
+// Gives every clip of the dataset in `dir` a tracks.json: a 2x2 grid whose points swing 1.5 px
+// across at the clip's stripe frequency (1 + 0.5 v Hz, ToyDatasetOptions' defaults).
+void WriteToyTracks(const fs::path& dir) {
+  for (const ClipInfo& c : ReadDataset(dir).clips) {
+    const double f = 1.0 + 0.5 * c.wind_speed;
+    nlohmann::json xy = nlohmann::json::array();
+    for (int k = 0; k < c.num_frames; ++k) {
+      nlohmann::json row = nlohmann::json::array();
+      for (int p = 0; p < 4; ++p) {
+        row.push_back(8.0 + 16 * (p / 2) + 1.5 * std::sin(2 * M_PI * f * k / c.frame_rate + p));
+        row.push_back(8.0 + 16 * (p % 2));
+      }
+      xy.push_back(row);
+    }
+    std::ofstream(c.dir / "tracks.json") << nlohmann::json{{"format", "clothwind-tracks"}, {"version", 1},
+                                                           {"grid", {2, 2}}, {"width", c.width},
+                                                           {"height", c.height}, {"xy", xy}}.dump();
+  }
+}
+
+TEST_F(TrainTest, AuxTracksTrainASecondHeadOnTheClipsTracks) {
+  // A dataset without tracks is refused, naming the file it lacks.
+  TrainOptions t = Options("sdn", "aux");
+  t.epochs = 6;
+  t.aux_tracks = 1.0;
+  try {
+    Train(t);
+    ADD_FAILURE() << "--aux-tracks trained without tracks";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("tracks.json not found"), std::string::npos) << e.what();
+  }
+  fs::copy(*root_ / "data", *root_ / "data_tracks", fs::copy_options::recursive);
+  WriteToyTracks(*root_ / "data_tracks");
+  t.data = *root_ / "data_tracks";
+  const TrainResult r = Train(t);
+  ASSERT_EQ(r.log.size(), 6u);
+  // The head regresses what the targets hold: its loss (about 1 per standardised target at the
+  // start) falls as it learns the swing's frequency, which the spectral maps show (the means of
+  // a swing cut at any phase stay partly unpredictable).
+  EXPECT_GT(r.log[0].train_aux_loss, 0.0);
+  EXPECT_LT(r.log[5].train_aux_loss, 0.6 * r.log[0].train_aux_loss);  // 0.96 -> 0.42 measured
+  EXPECT_LT(r.best_val_rmse, LabelStd(SelectSplit(ReadDataset(t.data), "val")));
+  const WindNet net = LoadWindNet(r.model);
+  EXPECT_EQ(net->config().aux_outputs, 4 * kTargetsPerPoint);
+  // Resuming under another weight would make another run than the log's.
+  TrainOptions again = t;
+  again.epochs = 7;
+  again.resume = true;
+  again.aux_tracks = 0.5;
+  try {
+    Train(again);
+    ADD_FAILURE() << "a resume with another --aux-tracks was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("--aux-tracks"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
