@@ -60,6 +60,9 @@ struct DatasetOptions {
   // tracks.json, from its simulation run again. The run checks each replay against the example's
   // stored last frame (kMaxReplayGreyDifference) so that tracks never describe other frames.
   bool add_tracks = false;
+  // With add_tracks: only the examples of this split ("train", "val" or "test"; "": all). Training's
+  // auxiliary loss reads the training split's tracks alone, and a replay costs ~40 % of a new example.
+  std::string add_tracks_split;
 };
 
 // The mean absolute difference [grey levels of 255] allowed between an example's stored last

@@ -406,6 +406,23 @@ TEST_F(DatasetGeneratorTest, AddTracksGivesADatasetTheTracksItWouldHaveBeenMadeW
     }
   }
   EXPECT_EQ(ReadIndex(added.string())["dataset"]["tracks"], nlohmann::json({4, 3}));
+  // --split: only that split's simulations are replayed.
+  const fs::path some = root_ / "split-tracks";
+  fs::copy(Ref(), some, fs::copy_options::recursive);
+  DatasetOptions train_only = add;
+  train_only.out = some.string();
+  train_only.add_tracks_split = "train";
+  const DatasetSummary t = GenerateDataset(train_only);
+  ASSERT_TRUE(t.errors.empty()) << t.errors[0];
+  int trained = 0;
+  const nlohmann::json index = ReadIndex(some.string());
+  for (const auto& clip : index["clips"]) {
+    const bool is_train = clip["split"] == "train";
+    trained += is_train;
+    EXPECT_EQ(fs::exists(some / clip["name"].get<std::string>() / "tracks.json"), is_train) << clip["name"];
+  }
+  EXPECT_EQ(t.examples_written, trained);
+  EXPECT_GT(trained, 0);
   EXPECT_EQ(ReadIndex((root_ / "with-tracks").string())["dataset"]["tracks"], nlohmann::json({4, 3}));
   // Again: nothing left to do.
   EXPECT_EQ(GenerateDataset(add).simulated, 0);
