@@ -1,0 +1,80 @@
+#!/usr/bin/python3
+"""Tests of scripts/plot-tracks on a tiny example: a picture per frame named, refusals naming the file."""
+import json
+import os
+import struct
+import subprocess
+import tempfile
+import unittest
+import zlib
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SCRIPT = os.path.join(ROOT, 'scripts', 'plot-tracks')
+
+
+def write_png(path, width, height, grey):
+    """An 8-bit RGB PNG of one grey level (the standard library's zlib, no image module)."""
+    def chunk(kind, data):
+        return struct.pack('>I', len(data)) + kind + data + struct.pack('>I', zlib.crc32(kind + data))
+    rows = b''.join(b'\x00' + bytes([grey, grey, grey]) * width for _ in range(height))
+    with open(path, 'wb') as f:
+        f.write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', width, height, 8, 2, 0, 0, 0)) +
+                chunk(b'IDAT', zlib.compress(rows)) + chunk(b'IEND', b''))
+
+
+def png_size(path):
+    with open(path, 'rb') as f:
+        head = f.read(24)
+    assert head[:8] == b'\x89PNG\r\n\x1a\n', path
+    return struct.unpack('>II', head[16:24])
+
+
+class PlotTracksTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.example = os.path.join(self.tmp.name, 'flag-000000-v0')
+        os.makedirs(self.example)
+        for k in range(4):
+            write_png(os.path.join(self.example, f'{k:03d}.png'), 32, 32, 40 * k)
+        self.tracks = {'format': 'clothwind-tracks', 'version': 1, 'grid': [1, 2], 'width': 32, 'height': 32,
+                       'vertices': [0, 1], 'xy': [[10 + k, 8, 10 + k, 24] for k in range(4)]}
+        self.write_tracks()
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def write_tracks(self):
+        with open(os.path.join(self.example, 'tracks.json'), 'w') as f:
+            json.dump(self.tracks, f)
+
+    def run_script(self, *args):
+        return subprocess.run([SCRIPT, self.example, *args], capture_output=True, text=True)
+
+    def test_one_panel_per_frame(self):
+        out = os.path.join(self.tmp.name, 'a.png')
+        r = self.run_script(out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(png_size(out), (900, 330))  # first, middle, last: three 300-px panels
+        r = self.run_script(out, '--frames', '2,3')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(png_size(out), (600, 330))
+
+    def test_refusals_name_what_is_wrong(self):
+        out = os.path.join(self.tmp.name, 'b.png')
+        r = self.run_script(out, '--frames', '0,4')
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn('frame 4 outside 0..3', r.stderr)
+        self.tracks['format'] = 'clothwind-dataset'
+        self.write_tracks()
+        r = self.run_script(out)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("tracks.json: field 'format'", r.stderr)
+        os.remove(os.path.join(self.example, 'tracks.json'))
+        r = self.run_script(out)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn(os.path.join(self.example, 'tracks.json'), r.stderr)
+        self.assertFalse(os.path.exists(out))
+
+
+if __name__ == '__main__':
+    unittest.main()
