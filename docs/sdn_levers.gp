@@ -15,34 +15,36 @@ $levers << EOD
 8 0.463 0.454 1 "mode shape (e2)"
 9 0.463 0.452 1 "coordinate maps (e2)"
 10 0.463 0.460 1 "known fabric (e2 simulations)"
-11 0.414 0.412 1 "no stem pool (e3)"
-12 0.414 0.407 1 "128-px spectra pooled (e3)"
-13 0.383 0.373 1 "width 64 (e5)"
-14 0.383 0.377 1 "60 frames at once (e5)"
-15 0.383 0.380 1 "26 epochs (e5)"
-16 0.383 0.365 1 "96-px input, validation tied (e5)"
-17 0.565 0.541 1 "224 px on a GPU (800 simulations)"
-18 0.435 0.411 1 "1 view of 4× the simulations (e5)"
-19 0.411 0.383 1 "1 → 4 views, training grown (e5)"
-20 0.439 0.359 2 "cameras level with the flag (e2 simulations)"
-21 0.456 0.384 2 "split per clip, a leak (same clips)"
+11 0.463 0.420 1 "auxiliary track head (e2, 2 seeds)"
+12 0.398 0.392 1 "auxiliary track head (e5, 10 epochs)"
+13 0.414 0.412 1 "no stem pool (e3)"
+14 0.414 0.407 1 "128-px spectra pooled (e3)"
+15 0.383 0.373 1 "width 64 (e5)"
+16 0.383 0.377 1 "60 frames at once (e5)"
+17 0.383 0.380 1 "26 epochs (e5)"
+18 0.383 0.365 1 "96-px input, validation tied (e5)"
+19 0.565 0.541 1 "224 px on a GPU (800 simulations)"
+20 0.435 0.411 1 "1 view of 4× the simulations (e5)"
+21 0.411 0.383 1 "1 → 4 views, training grown (e5)"
+22 0.439 0.359 2 "cameras level with the flag (e2 simulations)"
+23 0.456 0.384 2 "split per clip, a leak (same clips)"
 EOD
-set terminal pngcairo size 1000,640 font "DejaVu Sans,10"
+set terminal pngcairo size 1000,690 font "DejaVu Sans,10"
 set output "docs/sdn_levers.png"
 set title "What each measured change did to the SDN's test RMSE (one window; arrow: control → change)"
 set xlabel "test RMSE [m/s]"
 set xrange [0.15:0.62]
-set yrange [21.7:0.3]
+set yrange [23.7:0.3]
 set ytics out nomirror
 set grid xtics
 unset key
 set arrow from 0.25, graph 0 to 0.25, graph 1 nohead dt 2 lw 2 lc rgb "#c00000"
-set label "issue's target 0.25" at 0.252, 21.4 tc rgb "#c00000"
+set label "issue's target 0.25" at 0.252, 23.4 tc rgb "#c00000"
 set arrow from 0.18, graph 0 to 0.18, graph 1 nohead dt 3 lw 1.5 lc rgb "#404040"
-set label "paper 0.180" at 0.182, 21.4 tc rgb "#404040"
-set label "shipped" at graph 0.80, 0.16 tc rgb "#2e8b57"
-set label "no lever (a tie)" at graph 0.80, 0.12 tc rgb "#808080"
-set label "not a product figure" at graph 0.80, 0.08 tc rgb "#e07000"
+set label "paper 0.180" at 0.182, 23.4 tc rgb "#404040"
+set label "shipped" at graph 0.74, 0.16 tc rgb "#2e8b57"
+set label "no lever (a tie, or e2 only)" at graph 0.74, 0.12 tc rgb "#808080"
+set label "not a product figure" at graph 0.74, 0.08 tc rgb "#e07000"
 colour(c) = c == 0 ? 0x2e8b57 : (c == 1 ? 0x808080 : 0xe07000)
 plot $levers using 2:1:($3-$2):(0):(colour($4)):ytic(5) with vectors head filled size 0.008,20 lw 2 lc rgb variable, \
      $levers using 2:1:(colour($4)) with points pt 7 ps 0.8 lc rgb variable
