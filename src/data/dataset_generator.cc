@@ -239,7 +239,10 @@ void CheckCompatible(const std::string& dir, const nlohmann::json& settings) {
       throw std::runtime_error((fs::path(dir) / "index.json").string() + ": field 'dataset." + it.key() +
                                "' is " + (old.contains(it.key()) ? old[it.key()].dump() : "missing") +
                                " but this run asks for " + it.value().dump() +
-                               " (resume with the same settings, or use another --out)");
+                               (it.key() == "tracks" && !old.contains("tracks")
+                                    ? " (the examples there were made without tracks: give them theirs with "
+                                      "--add-tracks, then resume with --tracks)"
+                                    : " (resume with the same settings, or use another --out)"));
   }
 }
 

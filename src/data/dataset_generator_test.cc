@@ -426,6 +426,19 @@ TEST_F(DatasetGeneratorTest, AddTracksGivesADatasetTheTracksItWouldHaveBeenMadeW
   EXPECT_EQ(ReadIndex((root_ / "with-tracks").string())["dataset"]["tracks"], nlohmann::json({4, 3}));
   // Again: nothing left to do.
   EXPECT_EQ(GenerateDataset(add).simulated, 0);
+  // Resuming a dataset made without tracks with --tracks alone would leave its examples without:
+  // refused, pointing at --add-tracks.
+  const fs::path plain = root_ / "plain-resumed-with-tracks";
+  fs::copy(Ref(), plain, fs::copy_options::recursive);
+  DatasetOptions resume = Tiny(plain.string());
+  resume.tracks = TrackGrid{4, 3};
+  try {
+    GenerateDataset(resume);
+    ADD_FAILURE() << "a dataset without tracks was resumed with --tracks";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("'dataset.tracks'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--add-tracks"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(DatasetGeneratorTest, AddTracksRefusesAnExampleWhoseFramesItsReplayDoesNotShow) {

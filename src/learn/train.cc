@@ -69,8 +69,12 @@ AuxTargets ReadAuxTargets(const std::vector<ClipInfo>& clips, const SampleOption
                                std::to_string(c.height) + (i > 0 ? " and the other clips' grid" : ""));
     const int first = (c.num_frames - options.frames) / 2;
     const cv::Rect whole = CentreSquare(c.width, c.height);
-    for (bool flipped : {false, true})
-      eval_targets.push_back(TrackTargets(t, first, options.frames, whole, c.width, flipped));
+    try {
+      for (bool flipped : {false, true})
+        eval_targets.push_back(TrackTargets(t, first, options.frames, whole, c.width, flipped));
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(file.string() + ": " + e.what());
+    }
   }
   aux.scale = ScaleOf(eval_targets);
   return aux;
