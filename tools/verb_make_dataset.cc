@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "common/parse_pair.h"
 #include "data/dataset_generator.h"
 #include "progress_bar.h"
 #include "verb_registry.h"
@@ -32,22 +33,6 @@ struct MakeDatasetArgs {
   std::string backgrounds;  // folder of images
   std::string tracks;       // "COLSxROWS"
 };
-
-// "A<sep>B" -> (a, b) with `parse` (std::stoi, std::stod, ...) taking each part whole; false if
-// the text is not of that form.
-template <typename T, typename Parse>
-bool ParsePair(const std::string& text, char sep, Parse parse, T* a, T* b) {
-  const auto at = text.find(sep);
-  if (at == std::string::npos) return false;
-  try {
-    size_t na = 0, nb = 0;
-    *a = parse(text.substr(0, at), &na);
-    *b = parse(text.substr(at + 1), &nb);
-    return na == at && nb == text.size() - at - 1;
-  } catch (const std::exception&) {
-    return false;
-  }
-}
 
 // "i/N" -> (i, N).
 void ParseShard(const std::string& text, int* shard, int* shards) {

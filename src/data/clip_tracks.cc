@@ -3,25 +3,15 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/parse_pair.h"
 #include "render/camera.h"
 
 namespace clothwind::data {
 
 TrackGrid ParseTrackGrid(const std::string& option, const std::string& text) {
   TrackGrid g;
-  const auto x = text.find('x');
-  bool ok = x != std::string::npos;
-  try {
-    size_t a = 0, b = 0;
-    if (ok) {
-      g.cols = std::stoi(text.substr(0, x), &a);
-      g.rows = std::stoi(text.substr(x + 1), &b);
-      ok = a == x && b == text.size() - x - 1;
-    }
-  } catch (const std::exception&) {
-    ok = false;
-  }
-  if (!ok || g.cols < 1 || g.rows < 2)
+  const auto stoi = [](const std::string& t, size_t* n) { return std::stoi(t, n); };
+  if (!ParsePair(text, 'x', stoi, &g.cols, &g.rows) || g.cols < 1 || g.rows < 2)
     throw std::invalid_argument(option + ": expected COLSxROWS with COLS >= 1 and ROWS >= 2 (e.g. 8x6), got '" +
                                 text + "'");
   return g;

@@ -418,16 +418,13 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
           render_s += Seconds(t0);
           t0 = Clock::now();
           sim::WriteFileAtomically((fs::path(o.out) / name / "tracks.json").string(), tracks.dump() + "\n");
-          write_s += Seconds(t0);
-          ++written;
-          last = name;
-          continue;
+        } else {
+          const std::vector<cv::Mat> images = RenderAnimation(&renderer, anim, 0.0, o.frames, o.fps);
+          render_s += Seconds(t0);
+          t0 = Clock::now();
+          info.view = v;
+          WriteExample(o.out, name, images, SimExampleLabel(name, s, zeta, info), tracks, o);
         }
-        const std::vector<cv::Mat> images = RenderAnimation(&renderer, anim, 0.0, o.frames, o.fps);
-        render_s += Seconds(t0);
-        t0 = Clock::now();
-        info.view = v;
-        WriteExample(o.out, name, images, SimExampleLabel(name, s, zeta, info), tracks, o);
         write_s += Seconds(t0);
         ++written;
         last = name;
