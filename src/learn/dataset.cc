@@ -79,6 +79,13 @@ Dataset ReadDataset(const fs::path& dir) {
                                "].name must be a folder name, got \"" + clip.name + "\"");
     }
     clip.dir = dir / clip.name;
+    if (entry.contains("simulation")) {
+      clip.simulation = Field<int>(entry, "simulation", index_path, "a simulation index >= 0");
+      if (clip.simulation < 0) {
+        throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
+                                 "].simulation must be >= 0, got " + std::to_string(clip.simulation));
+      }
+    }
     const fs::path label_path = clip.dir / "label.json";
     const nlohmann::json label = ReadJson(label_path);
     clip.wind_speed = Field<double>(label, "wind_speed", label_path, "a number [m/s]");

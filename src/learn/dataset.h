@@ -21,6 +21,7 @@ struct ClipInfo {
   std::string name;
   std::filesystem::path dir;   // folder of its frames and label.json
   std::string split;           // "train", "val" or "test"
+  int simulation = -1;         // index.json's "simulation" (a simulated dataset's views share it); -1: none
   double wind_speed = 0;       // regression target [m/s]
   int num_frames = 0;
   double frame_rate = 25;      // [Hz]

@@ -67,6 +67,7 @@ TEST_F(DatasetTest, ReadsIndexLabelsAndFrames) {
     EXPECT_DOUBLE_EQ(c.frame_rate, 25);
     EXPECT_GE(c.wind_speed, 0);
     EXPECT_LE(c.wind_speed, 10);
+    EXPECT_EQ(c.simulation, -1);  // the toy index names no simulations
     per_split[c.split == "train" ? 0 : c.split == "val" ? 1 : 2]++;
   }
   EXPECT_EQ(SelectSplit(d, "all").size(), 10u);
@@ -131,10 +132,26 @@ TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
     expect_error(d, (d / "toy-00005" / "000.jpg").string(), "48x30");
   }
   {
+    const fs::path d = Copy("simulation");
+    EditJson(d / "index.json", [](nlohmann::json& j) { j["clips"][6]["simulation"] = -2; });
+    expect_error(d, (d / "index.json").string(), "clips[6].simulation must be >= 0, got -2");
+  }
+  {
     const fs::path d = Copy("json");
     std::ofstream(d / "toy-00000" / "label.json") << "{ not json";
     expect_error(d, (d / "toy-00000" / "label.json").string(), "not valid JSON");
   }
+}
+
+TEST_F(DatasetTest, ReadsEachClipsSimulation) {
+  // A simulated dataset's index names each clip's simulation; its views share it.
+  const fs::path d = Copy("simulations");
+  EditJson(d / "index.json", [](nlohmann::json& j) {
+    for (size_t i = 0; i < j["clips"].size(); ++i) j["clips"][i]["simulation"] = static_cast<int>(i / 2);
+  });
+  const Dataset dataset = ReadDataset(d);
+  ASSERT_EQ(dataset.clips.size(), 10u);
+  for (size_t i = 0; i < dataset.clips.size(); ++i) EXPECT_EQ(dataset.clips[i].simulation, static_cast<int>(i / 2));
 }
 
 double Mean(const std::vector<float>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); }

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <malloc.h>
@@ -89,6 +90,47 @@ std::vector<BandMetrics> ComputeBandMetrics(const std::vector<double>& truth, co
   return bands;
 }
 
+SimulationMetrics ComputeSimulationMetrics(const std::vector<double>& truth, const std::vector<double>& predicted,
+                                           const std::vector<int>& simulation) {
+  if (truth.size() != predicted.size() || truth.size() != simulation.size()) {
+    throw std::invalid_argument("ComputeSimulationMetrics: truth, predicted and simulation sizes differ");
+  }
+  struct Group {
+    double truth = 0, sum = 0;
+    int count = 0;
+  };
+  std::map<int, Group> groups;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    if (simulation[i] < 0) continue;
+    Group& g = groups[simulation[i]];
+    if (g.count > 0 && std::abs(g.truth - truth[i]) > 1e-9) {
+      throw std::invalid_argument("ComputeSimulationMetrics: simulation " + std::to_string(simulation[i]) +
+                                  " has clips of two winds, " + std::to_string(g.truth) + " and " +
+                                  std::to_string(truth[i]) + " m/s");
+    }
+    g.truth = truth[i];
+    g.sum += predicted[i];
+    ++g.count;
+  }
+  SimulationMetrics m;
+  m.simulations = static_cast<int>(groups.size());
+  if (groups.empty()) {
+    m.rmse = m.scatter = std::numeric_limits<double>::quiet_NaN();
+    return m;
+  }
+  double se = 0, scatter = 0;
+  for (const auto& [id, g] : groups) se += std::pow(g.sum / g.count - g.truth, 2);
+  for (size_t i = 0; i < truth.size(); ++i) {
+    if (simulation[i] < 0) continue;
+    const Group& g = groups.at(simulation[i]);
+    scatter += std::pow(predicted[i] - g.sum / g.count, 2);
+    ++m.clips;
+  }
+  m.rmse = std::sqrt(se / groups.size());
+  m.scatter = std::sqrt(scatter / m.clips);
+  return m;
+}
+
 EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::string& split, int threads,
                     const std::string& device, int batch, int windows, bool mirror,
                     const std::function<void(int, int)>& progress) {
@@ -135,6 +177,7 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
       r.names.push_back(clips[j].name);
       r.dirs.push_back(clips[j].dir);
       r.truth.push_back(clips[j].wind_speed);
+      r.simulations.push_back(clips[j].simulation);
       r.predicted.push_back(sum[j - i] / passes);
       r.predicted_std.push_back(std::sqrt(sum_var[j - i] / passes));
     }
@@ -146,6 +189,7 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   }
   r.metrics = ComputeMetrics(r.truth, r.predicted);
   r.bands = ComputeBandMetrics(r.truth, r.predicted, kEvalBandWidth);
+  r.per_simulation = ComputeSimulationMetrics(r.truth, r.predicted, r.simulations);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
@@ -171,7 +215,13 @@ nlohmann::json EvalJson(const EvalResult& r) {
           {"split", r.split},         {"windows", r.windows},     {"mirror", r.mirror},
           {"seconds", r.seconds},
           {"std_within_1", Number(StdCoverage(r, 1))}, {"std_within_2", Number(StdCoverage(r, 2))},
-          {"bands", bands}};
+          {"bands", bands},
+          {"per_simulation", r.per_simulation.simulations == 0
+                                 ? nlohmann::json(nullptr)
+                                 : nlohmann::json{{"rmse", r.per_simulation.rmse},
+                                                  {"scatter", r.per_simulation.scatter},
+                                                  {"simulations", r.per_simulation.simulations},
+                                                  {"clips", r.per_simulation.clips}}}};
 }
 
 std::string EvalTable(const EvalResult& r) {
@@ -198,6 +248,11 @@ std::string EvalTable(const EvalResult& r) {
     s << std::setprecision(0) << "  true " << std::right << std::setw(2) << b.lo << "-" << std::left << std::setw(2)
       << b.hi << " m/s: RMSE " << std::setprecision(3) << b.metrics.rmse << "  Acc@0.5 " << b.metrics.acc05
       << "  bias " << std::showpos << b.metrics.bias << std::noshowpos << "  (" << b.metrics.count << ")\n";
+  }
+  const SimulationMetrics& ps = r.per_simulation;
+  if (ps.simulations > 0) {
+    s << std::setprecision(3) << "  per simulation (mean of its clips): RMSE " << ps.rmse << "; views scatter "
+      << ps.scatter << "  (" << ps.simulations << " simulations, " << ps.clips << " clips)\n";
   }
   return s.str();
 }

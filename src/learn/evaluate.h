@@ -39,6 +39,26 @@ struct BandMetrics {
 std::vector<BandMetrics> ComputeBandMetrics(const std::vector<double>& truth, const std::vector<double>& predicted,
                                             double width);
 
+// How a split's error divides between what the clips of one simulation share and how they scatter
+// around it. A FlagSim simulation is seen by several cameras (views), each its own clip with the
+// simulation's one wind: an error every view makes is in the simulation (its flag's motion, its
+// material), one that changes from view to view is in the camera.
+struct SimulationMetrics {
+  double rmse = 0;     // [m/s] rms over simulations of (mean prediction of its clips - its wind)
+  double scatter = 0;  // [m/s] rms over clips of (prediction - its simulation's mean prediction)
+  int simulations = 0;
+  int clips = 0;       // clips from a simulation (those with simulation id -1 are left out)
+};
+
+// Inputs: truth, predicted [n] m/s; simulation [n] each clip's simulation id (>= 0), or -1 for a
+//         clip from no simulation (a recorded one), which is left out.
+// Output: the metrics above; NaN rmse and scatter when no clip has an id. When every simulation
+//         has the same number of clips, rmse^2 + scatter^2 is the clips' mean squared error.
+// Throws std::invalid_argument for sizes that differ, or for clips of one simulation whose truths
+// differ (a simulation has one wind).
+SimulationMetrics ComputeSimulationMetrics(const std::vector<double>& truth, const std::vector<double>& predicted,
+                                           const std::vector<int>& simulation);
+
 // Width of the speed bands `clothwind eval` reports [m/s]: five bands over FlagSim's 0-10 m/s.
 inline constexpr double kEvalBandWidth = 2.0;
 
@@ -48,10 +68,12 @@ struct EvalResult {
   std::vector<std::string> names;
   std::vector<std::filesystem::path> dirs;  // each example's folder (frames, label.json)
   std::vector<double> truth, predicted, predicted_std;  // [m/s]
+  std::vector<int> simulations;  // each clip's simulation id (ClipInfo::simulation; -1: none)
   int windows = 1;      // frame windows averaged per clip
   bool mirror = false;  // each window averaged with its mirror image
   Metrics metrics;
   std::vector<BandMetrics> bands;  // by true speed, kEvalBandWidth wide
+  SimulationMetrics per_simulation;  // simulations == 0 for a dataset without simulation ids
   double seconds = 0;  // wall time of the evaluation
 };
 
@@ -72,12 +94,13 @@ EvalResult Evaluate(const std::filesystem::path& model, const std::filesystem::p
 // {"rmse", "acc05", "bias", "count"} of one group of examples; NaN figures (an empty group) as null.
 nlohmann::json MetricsJson(const Metrics& metrics);
 
-// {"rmse": …, "acc05": …, "count": …} plus the model, split, windows, mirror and "bands" (a list of
-// {"lo", "hi", "rmse", "acc05", "bias", "count"}; NaNs of empty bands as null).
+// {"rmse": …, "acc05": …, "count": …} plus the model, split, windows, mirror, "bands" (a list of
+// {"lo", "hi", "rmse", "acc05", "bias", "count"}; NaNs of empty bands as null) and
+// "per_simulation" ({"rmse", "scatter", "simulations", "clips"}; null without simulation ids).
 nlohmann::json EvalJson(const EvalResult& result);
 
 // Table 1's layout: header and one row ("Model  Input Modality  RMSE  Acc@0.5"), then one line
-// per non-empty speed band (RMSE, Acc@0.5, bias, count).
+// per non-empty speed band (RMSE, Acc@0.5, bias, count) and one for the per-simulation split.
 std::string EvalTable(const EvalResult& result);
 
 // Predicted against true wind speed, with the identity line and ±0.5 m/s band, as a PNG via

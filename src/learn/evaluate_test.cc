@@ -1,10 +1,11 @@
-// Table 1's metrics and their split by true wind speed, checked against figures worked out by
-// hand and against the whole-split metrics they must recombine into.
+// Table 1's metrics and their split by true wind speed and by simulation, checked against figures
+// worked out by hand and against the whole-split metrics they must recombine into.
 #include "learn/evaluate.h"
 
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -119,6 +120,86 @@ TEST(EvaluateTest, JsonAndTableCarryTheBands) {
   EXPECT_NE(table.find("true  0-2  m/s: RMSE 0.381"), std::string::npos) << table;
   EXPECT_NE(table.find("bias -1.000  (1)"), std::string::npos) << table;
   EXPECT_EQ(table.find(" 2-4 "), std::string::npos) << table;  // empty bands are not printed
+}
+
+TEST(EvaluateTest, PerSimulationSplitOfAHandWorkedExample) {
+  // Simulation 0 (2 m/s): views read 2.5 and 1.5, mean 2.0: no shared error, each view 0.5 off it.
+  // Simulation 1 (4 m/s): both views read 5: a shared error of 1, no scatter. The recorded clip
+  // (-1) is left out.
+  const SimulationMetrics m =
+      ComputeSimulationMetrics({2.0, 2.0, 4.0, 4.0, 7.0}, {2.5, 1.5, 5.0, 5.0, 0.0}, {0, 0, 1, 1, -1});
+  EXPECT_EQ(m.simulations, 2);
+  EXPECT_EQ(m.clips, 4);
+  EXPECT_NEAR(m.rmse, std::sqrt((0.0 + 1.0) / 2), 1e-12);
+  EXPECT_NEAR(m.scatter, std::sqrt((0.25 + 0.25 + 0 + 0) / 4), 1e-12);
+  // No simulation ids: nothing to split.
+  const SimulationMetrics none = ComputeSimulationMetrics({1.0, 2.0}, {1.0, 2.0}, {-1, -1});
+  EXPECT_EQ(none.simulations, 0);
+  EXPECT_TRUE(std::isnan(none.rmse));
+  EXPECT_TRUE(std::isnan(none.scatter));
+}
+
+TEST(EvaluateTest, PerSimulationAndScatterRecombineIntoTheClipsError) {
+  // Four views a simulation: each clip's squared error is its simulation's shared error squared
+  // plus its own deviation squared plus a cross term that sums to zero over the views, so
+  // rmse^2 + scatter^2 is the clips' mean squared error.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> speed(0.0, 10.0);
+  std::normal_distribution<double> shared(0.1, 0.4), view(0.0, 0.2);
+  std::vector<double> truth, predicted;
+  std::vector<int> simulation;
+  for (int s = 0; s < 301; ++s) {
+    const double wind = speed(rng), offset = shared(rng);
+    for (int v = 0; v < 4; ++v) {
+      truth.push_back(wind);
+      predicted.push_back(wind + offset + view(rng));
+      simulation.push_back(s);
+    }
+  }
+  const SimulationMetrics m = ComputeSimulationMetrics(truth, predicted, simulation);
+  EXPECT_EQ(m.simulations, 301);
+  EXPECT_EQ(m.clips, 1204);
+  const double clip_rmse = ComputeMetrics(truth, predicted).rmse;
+  EXPECT_NEAR(m.rmse * m.rmse + m.scatter * m.scatter, clip_rmse * clip_rmse, 1e-9);
+  // And each part is the one drawn: the shared error's rms sqrt(0.1^2 + 0.4^2 + 0.2^2/4) (the
+  // views' mean keeps a quarter of their variance), the scatter 0.2 sqrt(3/4).
+  EXPECT_NEAR(m.rmse, std::sqrt(0.01 + 0.16 + 0.01), 0.05);
+  EXPECT_NEAR(m.scatter, 0.2 * std::sqrt(0.75), 0.012);
+}
+
+TEST(EvaluateTest, PerSimulationRefusesBadInput) {
+  EXPECT_THROW(ComputeSimulationMetrics({1.0}, {1.0, 2.0}, {0, 0}), std::invalid_argument);
+  EXPECT_THROW(ComputeSimulationMetrics({1.0, 2.0}, {1.0, 2.0}, {0}), std::invalid_argument);
+  try {
+    ComputeSimulationMetrics({3.0, 3.5}, {3.0, 3.0}, {7, 7});
+    ADD_FAILURE() << "two winds in one simulation";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("simulation 7 has clips of two winds"), std::string::npos) << e.what();
+  }
+}
+
+TEST(EvaluateTest, JsonAndTableCarryThePerSimulationSplit) {
+  EvalResult r;
+  r.split = "test";
+  r.truth = {2.0, 2.0, 4.0, 4.0};
+  r.predicted = {2.5, 1.5, 5.0, 5.0};
+  r.simulations = {0, 0, 1, 1};
+  r.metrics = ComputeMetrics(r.truth, r.predicted);
+  r.bands = ComputeBandMetrics(r.truth, r.predicted, kEvalBandWidth);
+  r.per_simulation = ComputeSimulationMetrics(r.truth, r.predicted, r.simulations);
+  const nlohmann::json j = EvalJson(r);
+  EXPECT_NEAR(j["per_simulation"]["rmse"].get<double>(), std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(j["per_simulation"]["scatter"].get<double>(), std::sqrt(0.125), 1e-12);
+  EXPECT_EQ(j["per_simulation"]["simulations"].get<int>(), 2);
+  const std::string table = EvalTable(r);
+  EXPECT_NE(table.find("per simulation (mean of its clips): RMSE 0.707; views scatter 0.354  (2 simulations, 4 clips)"),
+            std::string::npos)
+      << table;
+  // A recorded dataset has no simulations: null, and no line.
+  r.simulations = {-1, -1, -1, -1};
+  r.per_simulation = ComputeSimulationMetrics(r.truth, r.predicted, r.simulations);
+  EXPECT_TRUE(EvalJson(r)["per_simulation"].is_null());
+  EXPECT_EQ(EvalTable(r).find("per simulation"), std::string::npos);
 }
 
 }  // namespace
