@@ -1,8 +1,9 @@
 // clothwind export-model: rewrites a trained model (model.pt + model.json) for shipping: its
 // parameters in float16 (half the file; every weight rounded once, batch-norm statistics kept in
 // float32), and with --calibrate-std its predicted standard deviation scaled so that errors on
-// the validation split are one std rms (ModelConfig::std_scale). LoadWindNet, eval and sdn_node
-// read either precision and compute in float32.
+// the validation split are one std rms (ModelConfig::std_scale). An auxiliary head (train
+// --aux-tracks) is dropped. LoadWindNet, eval and sdn_node read either precision and compute in
+// float32.
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -43,6 +44,11 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
       return 2;
     }
     learn::WindNet net = learn::LoadWindNet(a->model);
+    // A head trained beside the wind's (--aux-tracks) only shaped the trunk: no estimate reads it.
+    if (net->config().aux_outputs > 0) {
+      std::cout << "dropping the auxiliary head (" << net->config().aux_outputs << " outputs): no estimate reads it\n";
+      net = learn::WithoutAuxHead(net);
+    }
     std::cout << std::fixed << std::setprecision(3);
     if (!a->calibrate_data.empty()) {
       const learn::EvalResult r = learn::Evaluate(a->model, a->calibrate_data, "val", a->threads, "cpu", 16);

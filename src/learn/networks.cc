@@ -192,6 +192,19 @@ void SaveWindNet(WindNet& net, const std::filesystem::path& weights, WeightPreci
   WriteFileAtomically(ConfigPathFor(weights), ToJson(net->config()).dump(2) + "\n");
 }
 
+WindNet WithoutAuxHead(WindNet& net) {
+  ModelConfig config = net->config();
+  config.aux_outputs = 0;
+  WindNet stripped(config);
+  torch::NoGradGuard no_grad;
+  const auto from_parameters = net->named_parameters();
+  const auto from_buffers = net->named_buffers();
+  for (auto& p : stripped->named_parameters()) p.value().copy_(from_parameters[p.key()].to(torch::kCPU));
+  for (auto& b : stripped->named_buffers()) b.value().copy_(from_buffers[b.key()].to(torch::kCPU));
+  stripped->eval();
+  return stripped;
+}
+
 WindNet LoadWindNet(const std::filesystem::path& weights) {
   const std::filesystem::path config_path = ConfigPathFor(weights);
   std::ifstream in(config_path);

@@ -118,6 +118,12 @@ at::Tensor AuxLoss(const at::Tensor& aux, const at::Tensor& target);
 void SaveWindNet(WindNet& net, const std::filesystem::path& weights,
                  WeightPrecision precision = WeightPrecision::kFloat32);
 
+// The same network without its auxiliary head (ModelConfig::aux_outputs 0), for shipping: the head
+// is a training aid that no estimate reads. Every other parameter and buffer is copied, so
+// forward() gives the same output. A network without the head is returned as a copy.
+// Inputs: net  a WindNet (any config). Output: a new WindNet in eval mode on the CPU.
+WindNet WithoutAuxHead(WindNet& net);
+
 // Loads a network saved by SaveWindNet in either precision (config from the JSON beside the
 // weights) as float32, in eval mode on the CPU. Throws std::runtime_error naming the file
 // that is missing or does not match, and the tensor.

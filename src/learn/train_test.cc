@@ -537,6 +537,15 @@ TEST(ModelConfig, TheAuxiliaryHeadTrainsTheTrunkAndNotTheWindHeadAndRoundTrips) 
       EXPECT_TRUE(has) << p.key();
     }
   }
+  // Shipping drops the head: the same wind from the same weights, without the head's.
+  WindNet stripped = WithoutAuxHead(net);
+  EXPECT_EQ(stripped->config().aux_outputs, 0);
+  EXPECT_FALSE(stripped->ForwardWithAux(clips).aux.defined());
+  EXPECT_TRUE(at::equal(stripped->forward(clips), net->forward(clips)));
+  int64_t before = 0, after = 0;
+  for (const auto& p : net->parameters()) before += p.numel();
+  for (const auto& p : stripped->parameters()) after += p.numel();
+  EXPECT_EQ(before - after, 5 * (8 * c.width + 1));  // the head: 5 x (8w features + bias)
   // Without the option there is no second head.
   WindNet plain(TinySdn());
   EXPECT_FALSE(plain->ForwardWithAux(clips).aux.defined());
