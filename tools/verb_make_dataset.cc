@@ -188,8 +188,9 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
                 "render nothing: give the examples already in --out their tracks.json (needs --tracks and "
                 "the options the dataset was made with; each replayed simulation is checked against "
                 "its stored frames)");
-  sub->add_option("--split", a->o.add_tracks_split,
-                  "with --add-tracks: only this split's examples (train: what --aux-tracks reads)")
+  sub->add_option("--split", a->o.split,
+                  "only this split's simulations, as the whole dataset has them (test: to evaluate a model "
+                  "without making its training data; with --add-tracks, train: what --aux-tracks reads)")
       ->check(CLI::IsMember({"train", "val", "test"}));
   return [a] {
     if (!a->reindex && a->o.count <= 0) throw std::invalid_argument("--count N (N >= 1) is required");

@@ -61,9 +61,8 @@ void ValidateOptions(const DatasetOptions& o) {
   Check(o.jpeg_quality >= 1 && o.jpeg_quality <= 100, "--jpeg-quality must be in 1..100");
   Check(o.max_edge >= 0, "--max-edge must be >= 0 m");
   Check(!o.add_tracks || o.tracks, "--add-tracks needs the grid of the tracks (--tracks COLSxROWS)");
-  Check(o.add_tracks_split.empty() || (o.add_tracks &&
-        (o.add_tracks_split == "train" || o.add_tracks_split == "val" || o.add_tracks_split == "test")),
-        "--split must be train, val or test, and goes with --add-tracks");
+  Check(o.split.empty() || o.split == "train" || o.split == "val" || o.split == "test",
+        "--split must be train, val or test");
 }
 
 std::string TempPrefix(const std::string& name) { return "." + name + ".tmp-"; }
@@ -352,8 +351,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   };
   std::vector<int64_t> todo;
   for (int64_t i = o.shard; i < o.count; i += o.shards) {
-    if (!o.add_tracks_split.empty() &&
-        SplitOf(SimulationSeed(o.seed, i), o.val_fraction, o.test_fraction) != o.add_tracks_split)
+    if (!o.split.empty() && SplitOf(SimulationSeed(o.seed, i), o.val_fraction, o.test_fraction) != o.split)
       continue;
     ++summary.assigned;
     bool complete = true;

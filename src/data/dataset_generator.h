@@ -60,9 +60,12 @@ struct DatasetOptions {
   // tracks.json, from its simulation run again. The run checks each replay against the example's
   // stored last frame (kMaxReplayGreyDifference) so that tracks never describe other frames.
   bool add_tracks = false;
-  // With add_tracks: only the examples of this split ("train", "val" or "test"; "": all). Training's
-  // auxiliary loss reads the training split's tracks alone, and a replay costs ~40 % of a new example.
-  std::string add_tracks_split;
+  // Only the simulations of this split ("train", "val" or "test"; "": all), each exactly as the whole
+  // dataset would make it (a simulation's split comes from its seed alone). Making: a model is
+  // evaluated on a test split without the hours of its training split; a later run without it
+  // completes the dataset. With add_tracks: training's auxiliary loss reads the training split's
+  // tracks alone, and a replay costs ~40 % of a new example.
+  std::string split;
 };
 
 // The mean absolute difference [grey levels of 255] allowed between an example's stored last

@@ -184,6 +184,46 @@ TEST_F(DatasetGeneratorTest, BlownUpSimulationIsRecordedAsFailedAndWritesNothing
     EXPECT_FALSE(entry.is_directory()) << "example folder written: " << entry.path();
 }
 
+TEST_F(DatasetGeneratorTest, OneSplitIsTheWholeDatasetsExamplesOfThatSplitAndResumesToIt) {
+  // The reference's simulations fall into more than one split, so one split is a proper part.
+  const nlohmann::json ref_index = ReadIndex(Ref().string());
+  std::map<std::string, int> per_split;
+  for (const auto& clip : ref_index["clips"]) ++per_split[clip["split"].get<std::string>()];
+  ASSERT_GE(per_split.size(), 2u) << ref_index["clips"].dump();
+  const std::string split = ref_index["clips"][0]["split"];
+
+  const fs::path dir = root_ / ("only-" + split);
+  DatasetOptions o = Tiny(dir.string());
+  o.split = split;
+  const DatasetSummary s = GenerateDataset(o);
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  EXPECT_EQ(s.assigned, per_split[split]);
+  EXPECT_EQ(s.examples_written, per_split[split]);
+  // Its index lists the reference's examples of that split, and each is the reference's byte for byte.
+  const nlohmann::json index = ReadIndex(dir.string());
+  nlohmann::json expected = nlohmann::json::array();
+  for (const auto& clip : ref_index["clips"])
+    if (clip["split"] == split) expected.push_back(clip);
+  EXPECT_EQ(index["clips"], expected);
+  for (const auto& clip : expected) {
+    const std::string name = clip["name"];
+    for (const auto& [file, bytes] : Files(Ref() / name)) EXPECT_EQ(Bytes(dir / name / file), bytes) << name << "/" << file;
+  }
+  // A run without --split completes it into the whole dataset, redoing nothing.
+  const DatasetSummary rest = GenerateDataset(Tiny(dir.string()));
+  EXPECT_EQ(rest.skipped, per_split[split]);
+  EXPECT_EQ(rest.examples_written, 3 - per_split[split]);
+  EXPECT_EQ(Files(dir), Files(Ref()));
+  // A split that is not one is refused by name.
+  o.split = "validation";
+  try {
+    GenerateDataset(o);
+    ADD_FAILURE() << "--split validation was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--split must be train, val or test"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(DatasetGeneratorTest, ShardsTogetherEqualOneRun) {
   const fs::path dir = root_ / "shards";
   int64_t total = 0;
@@ -411,7 +451,7 @@ TEST_F(DatasetGeneratorTest, AddTracksGivesADatasetTheTracksItWouldHaveBeenMadeW
   fs::copy(Ref(), some, fs::copy_options::recursive);
   DatasetOptions train_only = add;
   train_only.out = some.string();
-  train_only.add_tracks_split = "train";
+  train_only.split = "train";
   const DatasetSummary t = GenerateDataset(train_only);
   ASSERT_TRUE(t.errors.empty()) << t.errors[0];
   int trained = 0;
