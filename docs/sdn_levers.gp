@@ -17,7 +17,7 @@ $levers << EOD
 10 0.463 0.460 1 "known fabric (e2 simulations)"
 11 0.463 0.420 1 "auxiliary track head (e2, 2 seeds)"
 12 0.398 0.392 1 "auxiliary track head (e5, 10 epochs)"
-13 0.383 0.355 0 "auxiliary track head (e5, 20 epochs, 2 seeds)"
+13 0.383 0.354 0 "auxiliary track head (e5, 20 epochs, 2 seeds)"
 14 0.414 0.412 1 "no stem pool (e3)"
 15 0.414 0.407 1 "128-px spectra pooled (e3)"
 16 0.383 0.373 1 "width 64 (e5)"
