@@ -5,6 +5,7 @@
 #include <memory>
 #include <sstream>
 
+#include "learn/track_targets.h"
 #include "learn/train.h"
 #include "progress_bar.h"
 #include "verb_registry.h"
@@ -98,6 +99,11 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                   "points (position and low-frequency motion, from the dataset's tracks.json: make-dataset "
                   "--tracks); the wind estimate does not read it")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  sub->add_option("--aux-phases", o.aux_phase_bins,
+                  "with --aux-tracks: the auxiliary head also regresses each point's motion phase relative to a "
+                  "fly corner's at DFT bins 1..N (0: none), the flag's travelling wave")
+      ->check(CLI::Range(0, learn::kTrackBins))
       ->capture_default_str();
   sub->add_flag("--init-only", o.init_only, "write an initialised (untrained) model and stop (tests, smoke runs)");
   sub->add_option("--lr", o.lr, "initial learning rate (Adam)")->check(CLI::PositiveNumber)->capture_default_str();

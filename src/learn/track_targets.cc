@@ -45,19 +45,24 @@ Tracks ReadTracks(const std::filesystem::path& file) {
 }
 
 std::vector<float> TrackTargets(const Tracks& tracks, int first, int frames, const cv::Rect& crop, int source_side,
-                                bool flipped) {
+                                bool flipped, int phase_bins) {
   if (first < 0 || frames < 2 || first + frames > tracks.frames)
     throw std::invalid_argument("TrackTargets: window " + std::to_string(first) + "+" + std::to_string(frames) +
                                 " outside tracks of " + std::to_string(tracks.frames) + " frames");
   if (tracks.width != tracks.height || crop.width != crop.height || crop.width < 1 || source_side < 1)
     throw std::invalid_argument("TrackTargets: expected square frames and crops");
+  if (phase_bins < 0 || phase_bins > kTrackBins)
+    throw std::invalid_argument("TrackTargets: phase_bins must be in [0, " + std::to_string(kTrackBins) + "], got " +
+                                std::to_string(phase_bins));
   const int points = tracks.points();
   const double scale = static_cast<double>(source_side) / tracks.width;
   std::vector<double> hann(frames);
   double hann_sum = 0;
   for (int t = 0; t < frames; ++t) hann_sum += hann[t] = 0.5 - 0.5 * std::cos(2 * M_PI * t / frames);
+  // spectrum[(p * 2 + c) * kTrackBins + j - 1]: coordinate c of point p at bin j, / Σ w_t.
+  std::vector<std::complex<double>> spectrum(static_cast<size_t>(points) * 2 * kTrackBins);
   std::vector<float> out;
-  out.reserve(static_cast<size_t>(points) * kTargetsPerPoint);
+  out.reserve(TrackTargetCount(points, phase_bins));
   std::vector<double> series(frames);
   for (int p = 0; p < points; ++p) {
     std::vector<float> means, amplitudes;
@@ -76,12 +81,26 @@ std::vector<float> TrackTargets(const Tracks& tracks, int first, int frames, con
         std::complex<double> sum = 0;
         for (int t = 0; t < frames; ++t)
           sum += hann[t] * (series[t] - mean) * std::polar(1.0, -2 * M_PI * j * t / frames);
+        spectrum[(static_cast<size_t>(p) * 2 + c) * kTrackBins + j - 1] = sum / hann_sum;
         amplitudes.push_back(static_cast<float>(std::log(1e-4 + std::abs(sum) / hann_sum)));
       }
     }
     out.insert(out.end(), means.begin(), means.end());
     out.insert(out.end(), amplitudes.begin(), amplitudes.end());
   }
+  const size_t reference = (static_cast<size_t>(points - 1) * 2 + 1) * kTrackBins;  // the last point's v
+  for (int p = 0; p < points; ++p)
+    for (int j = 1; j <= phase_bins; ++j) {
+      const std::complex<double> r = spectrum[reference + j - 1];
+      const std::complex<double> unrotate = std::abs(r) > 1e-12 ? std::conj(r) / std::abs(r) : 1.0;
+      for (int c = 0; c < 2; ++c) {
+        const std::complex<double> x = spectrum[(static_cast<size_t>(p) * 2 + c) * kTrackBins + j - 1];
+        const double amplitude = std::abs(x);
+        const std::complex<double> z = amplitude > 1e-12 ? x / amplitude * unrotate * std::sqrt(amplitude) : 0.0;
+        out.push_back(static_cast<float>(z.real()));
+        out.push_back(static_cast<float>(z.imag()));
+      }
+    }
   return out;
 }
 

@@ -33,18 +33,33 @@ Tracks ReadTracks(const std::filesystem::path& file);
 constexpr int kTrackBins = 5;
 // Targets per point: for each image coordinate, its window mean and its log amplitude at each bin.
 constexpr int kTargetsPerPoint = 2 * (1 + kTrackBins);
+// Phase targets per point and phase bin (TrackTargets' phase_bins): u's and v's (re, im).
+constexpr int kPhaseTargetsPerPointAndBin = 4;
+
+// How many targets TrackTargets returns for `points` points and `phase_bins` phase bins.
+inline int TrackTargetCount(int points, int phase_bins) {
+  return points * (kTargetsPerPoint + kPhaseTargetsPerPointAndBin * phase_bins);
+}
 
 // The targets of one sample, for the window, crop and flip that made it (learn::Sample).
 // Inputs: tracks; first, frames  the sample's window; crop  the square it shows, in pixels of
 //   frames of side `source_side` (the clip's own frames, or a frame cache's resized squares;
 //   the tracks, given for tracks.width, are scaled to it); flipped  whether it was mirrored.
-// Output: points · kTargetsPerPoint values, point-major; per point (u, v) means, then u's and v's
+// Output: TrackTargetCount(points, phase_bins) values: first points · kTargetsPerPoint, point-major; per point (u, v) means, then u's and v's
 //   log(1e-4 + A_j) for j = 1..kTrackBins. u, v: position in the sample scaled to [-1, 1]
 //   (u right, negated when flipped; v down); A_j = |Σ_t w_t (u_t - ū) e^{-2πi jt/T}| / Σ_t w_t,
 //   w the periodic Hann window (the spectral layer's), so a sinusoid of amplitude a at bin j reads a / 2.
-// Throws std::invalid_argument when the window is outside the tracks or the frames are not square.
+//   With phase_bins = B > 0 (at most kTrackBins), B · 4 values per point follow all points' blocks,
+//   point-major, then bin-major: for j = 1..B, u's then v's (re, im) of
+//   sqrt(A_j) · e^{i(φ_j - ψ_j)}, where φ_j is the coordinate's phase at bin j and ψ_j the phase of
+//   the last point's v there (a fly corner, docs/datasets.md "Tracks"; ψ_j = 0 where it does not
+//   move). Relative phases are what the window oracle reads a travelling wave by, and they do not
+//   depend on when the window starts; the sqrt(A_j) weight fades them out where a point hardly moves
+//   and its phase is noise.
+// Throws std::invalid_argument when the window is outside the tracks, the frames are not square or
+// phase_bins is outside [0, kTrackBins].
 std::vector<float> TrackTargets(const Tracks& tracks, int first, int frames, const cv::Rect& crop, int source_side,
-                                bool flipped);
+                                bool flipped, int phase_bins = 0);
 
 // Per-target mean and standard deviation over `targets` (rows of one length), to standardise
 // the targets so that each weighs about as much in the loss whatever its units. A constant target

@@ -103,6 +103,60 @@ TEST(TrackTargetsTest, TheWindowIsTheSamplesFrames) {
   EXPECT_THROW(TrackTargets(t, 31, 30, cv::Rect(0, 0, 128, 128), 128, false), std::invalid_argument);
 }
 
+// Index of point p's phase target at bin j (of `bins`): coordinate c (0 u, 1 v), part 0 re, 1 im.
+int Phase(int points, int bins, int p, int j, int c, int part) {
+  return points * kTargetsPerPoint + (p * bins + j - 1) * kPhaseTargetsPerPointAndBin + c * 2 + part;
+}
+
+// A wave travelling from hoist to fly at bin 2 of a 30-frame window: point p's u lags the fly
+// corner's v by 0.6 · (points - 1 - p) rad; its amplitude grows with p.
+Tracks TravellingWave(int frames) {
+  const int points = 4, T = 30;
+  return MakeTracks(
+      2, 2, 128, frames,
+      [&](int p, int k) { return 40.0 + 15 * p + (1 + p) * std::cos(2 * M_PI * 2 * k / T - 0.6 * (points - 1 - p)); },
+      [&](int p, int k) { return 60.0 + (p == points - 1 ? 4.0 * std::cos(2 * M_PI * 2 * k / T) : 0.0); });
+}
+
+TEST(TrackTargetsTest, PhaseTargetsReadAPointsPhaseAgainstTheFlyCornerWeightedByTheSqrtOfItsAmplitude) {
+  const Tracks t = TravellingWave(60);
+  const int points = 4, bins = 3;
+  const std::vector<float> y = TrackTargets(t, 0, 30, cv::Rect(0, 0, 128, 128), 128, false, bins);
+  ASSERT_EQ(y.size(), static_cast<size_t>(TrackTargetCount(points, bins)));
+  // The amplitude and mean targets are those without phases.
+  const std::vector<float> plain = TrackTargets(t, 0, 30, cv::Rect(0, 0, 128, 128), 128, false);
+  for (size_t i = 0; i < plain.size(); ++i) EXPECT_EQ(y[i], plain[i]) << i;
+  for (int p = 0; p < points; ++p) {
+    // A cosine of amplitude a px reads a / 2 at its bin in units of half the frame (2 / 128 per px).
+    const double amplitude = (1 + p) * 2.0 / 128 / 2, lag = -0.6 * (points - 1 - p);
+    EXPECT_NEAR(y[Phase(points, bins, p, 2, 0, 0)], std::sqrt(amplitude) * std::cos(lag), 1e-4) << p;
+    EXPECT_NEAR(y[Phase(points, bins, p, 2, 0, 1)], std::sqrt(amplitude) * std::sin(lag), 1e-4) << p;
+  }
+  // The reference itself: its v at phase 0; the other points' v do not move.
+  EXPECT_NEAR(y[Phase(points, bins, 3, 2, 1, 0)], std::sqrt(4.0 * 2 / 128 / 2), 1e-4);
+  EXPECT_NEAR(y[Phase(points, bins, 3, 2, 1, 1)], 0.0, 1e-6);
+  EXPECT_EQ(y[Phase(points, bins, 0, 2, 1, 0)], 0.0f);
+  EXPECT_EQ(y[Phase(points, bins, 0, 2, 1, 1)], 0.0f);
+}
+
+TEST(TrackTargetsTest, PhaseTargetsDoNotDependOnWhenTheWindowStartsAndFlipWithTheHorizontalMotion) {
+  const Tracks t = TravellingWave(60);
+  const int points = 4, bins = 2;
+  const cv::Rect whole(0, 0, 128, 128);
+  const std::vector<float> a = TrackTargets(t, 0, 30, whole, 128, false, bins);
+  const std::vector<float> b = TrackTargets(t, 11, 30, whole, 128, false, bins);  // 11 frames later, not a whole period
+  const std::vector<float> m = TrackTargets(t, 11, 30, whole, 128, true, bins);
+  for (int p = 0; p < points; ++p)
+    for (int part = 0; part < 2; ++part) {
+      const int u = Phase(points, bins, p, 2, 0, part), v = Phase(points, bins, p, 2, 1, part);
+      EXPECT_NEAR(b[u], a[u], 1e-5) << p;
+      EXPECT_NEAR(m[u], -a[u], 1e-5) << p;  // mirrored: u and with it its phasor change sign
+      EXPECT_NEAR(m[v], a[v], 1e-5) << p;
+    }
+  EXPECT_THROW(TrackTargets(t, 0, 30, whole, 128, false, kTrackBins + 1), std::invalid_argument);
+  EXPECT_THROW(TrackTargets(t, 0, 30, whole, 128, false, -1), std::invalid_argument);
+}
+
 TEST(TrackTargetsTest, ScaleStandardisesEachTargetAndLeavesAConstantOneAtStdOne) {
   const TargetScale s = ScaleOf({{1, 5, 2}, {3, 5, 4}, {5, 5, 9}});
   ASSERT_EQ(s.mean.size(), 3u);

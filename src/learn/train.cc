@@ -41,6 +41,7 @@ struct Batch {
 // What --aux-tracks needs for the training clips: each clip's tracks, and the targets' scale.
 struct AuxTargets {
   std::vector<Tracks> tracks;  // one per training clip, in its order
+  int phase_bins = 0;          // TrackTargets' phase_bins (TrainOptions::aux_phase_bins)
   TargetScale scale;
   int outputs() const { return static_cast<int>(scale.mean.size()); }
 };
@@ -48,8 +49,9 @@ struct AuxTargets {
 // Reads every clip's tracks.json and scales the targets by those of the clips' evaluation
 // windows, as they are and mirrored (the training windows' augmentations). Throws
 // std::runtime_error naming the first clip without tracks, or with tracks that do not fit it.
-AuxTargets ReadAuxTargets(const std::vector<ClipInfo>& clips, const SampleOptions& options) {
+AuxTargets ReadAuxTargets(const std::vector<ClipInfo>& clips, const SampleOptions& options, int phase_bins) {
   AuxTargets aux;
+  aux.phase_bins = phase_bins;
   aux.tracks.resize(clips.size());
   std::vector<std::vector<float>> eval_targets;
   for (size_t i = 0; i < clips.size(); ++i) {
@@ -71,7 +73,7 @@ AuxTargets ReadAuxTargets(const std::vector<ClipInfo>& clips, const SampleOption
     const cv::Rect whole = CentreSquare(c.width, c.height);
     try {
       for (bool flipped : {false, true})
-        eval_targets.push_back(TrackTargets(t, first, options.frames, whole, c.width, flipped));
+        eval_targets.push_back(TrackTargets(t, first, options.frames, whole, c.width, flipped, phase_bins));
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(file.string() + ": " + e.what());
     }
@@ -113,7 +115,8 @@ Batch LoadBatch(const std::vector<ClipInfo>& clips, const std::vector<size_t>& i
         // A cache's crops are of its input_size squares; the files' of the clip's own frames.
         const int source_side = cache ? options.input_size : clips[clip].width;
         const std::vector<float> y =
-            TrackTargets(aux->tracks[clip], sample.first_frame, options.frames, sample.crop, source_side, sample.flipped);
+            TrackTargets(aux->tracks[clip], sample.first_frame, options.frames, sample.crop, source_side, sample.flipped,
+                         aux->phase_bins);
         float* row = b.aux.data_ptr<float>() + i * aux->outputs();
         for (int k = 0; k < aux->outputs(); ++k) row[k] = (y[k] - aux->scale.mean[k]) / aux->scale.std[k];
       }
@@ -280,9 +283,18 @@ TrainResult Train(const TrainOptions& o) {
                              ", these options give " + std::to_string(o.aux_tracks) +
                              "; resume with the --aux-tracks the run started with");
   }
+  if (o.aux_phase_bins < 0 || o.aux_phase_bins > kTrackBins || (o.aux_phase_bins > 0 && o.aux_tracks <= 0))
+    throw std::runtime_error("aux_phase_bins: must be in [0, " + std::to_string(kTrackBins) +
+                             "], and above 0 only with an auxiliary loss (--aux-tracks W > 0)");
+  const int ran_phases = o.resume ? state.value("aux_phase_bins", 0) : o.aux_phase_bins;
+  if (ran_phases != o.aux_phase_bins) {
+    throw std::runtime_error(state_path.string() + ": the run trained with --aux-phases " + std::to_string(ran_phases) +
+                             ", these options give " + std::to_string(o.aux_phase_bins) +
+                             "; resume with the --aux-phases the run started with");
+  }
   std::unique_ptr<AuxTargets> aux;
   if (o.aux_tracks > 0 && !train.empty()) {
-    aux = std::make_unique<AuxTargets>(ReadAuxTargets(train, config.Sampling()));
+    aux = std::make_unique<AuxTargets>(ReadAuxTargets(train, config.Sampling(), o.aux_phase_bins));
     if (o.resume && config.aux_outputs != aux->outputs()) {
       throw std::runtime_error(state_path.string() + ": the run's auxiliary head has " +
                                std::to_string(config.aux_outputs) + " outputs, the dataset's tracks give " +
@@ -427,6 +439,7 @@ TrainResult Train(const TrainOptions& o) {
     for (const EpochRecord& e : result.log) log.push_back(EpochJson(e));
     state = {{"epoch", epoch}, {"model", ToJson(config)}, {"log", log}, {"seed", o.seed},
              {"crop_scales", o.crop_scales}, {"aux_tracks", o.aux_tracks},
+             {"aux_phase_bins", o.aux_phase_bins},
              {"best_val_rmse", result.best_val_rmse}};
     WriteFileAtomically(state_path, state.dump(2));
     WriteFileAtomically(o.out / "log.tsv", LogTsv(result.log));

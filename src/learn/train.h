@@ -50,6 +50,9 @@ struct TrainOptions {
   // standardised track targets (learn/track_targets.h) from the dataset's tracks.json files, and
   // training minimises WindLoss + aux_tracks · AuxLoss. Every training clip needs its tracks.
   double aux_tracks = 0;
+  // With aux_tracks > 0: also regress each point's phase relative to a fly corner's at DFT bins
+  // 1..aux_phase_bins (TrackTargets' phase_bins; 0: none), the travelling wave the oracle reads.
+  int aux_phase_bins = 0;
   uint64_t seed = 1;
   std::function<void(const TrainProgress&)> progress;  // after each batch (may be empty)
   std::function<void(const EpochRecord&)> epoch_done;  // after each epoch (may be empty)

@@ -835,6 +835,32 @@ TEST_F(TrainTest, AuxTracksTrainASecondHeadOnTheClipsTracks) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("--aux-tracks"), std::string::npos) << e.what();
   }
+  // Phase targets widen the head by 4 per point and phase bin; they need the auxiliary loss, and
+  // a resume keeps the count the run started with.
+  TrainOptions phases = t;
+  phases.out = *root_ / "aux_phases";
+  phases.epochs = 1;
+  phases.aux_phase_bins = 2;
+  EXPECT_EQ(LoadWindNet(Train(phases).model)->config().aux_outputs, TrackTargetCount(4, 2));
+  TrainOptions other = phases;
+  other.epochs = 2;
+  other.resume = true;
+  other.aux_phase_bins = 3;
+  try {
+    Train(other);
+    ADD_FAILURE() << "a resume with another --aux-phases was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("--aux-phases 2"), std::string::npos) << e.what();
+  }
+  TrainOptions without = phases;
+  without.out = *root_ / "aux_phases_alone";
+  without.aux_tracks = 0;
+  try {
+    Train(without);
+    ADD_FAILURE() << "phase targets without the auxiliary loss were accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("aux_phase_bins"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
