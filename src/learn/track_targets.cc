@@ -95,8 +95,8 @@ std::vector<float> TrackTargets(const Tracks& tracks, int first, int frames, con
       const std::complex<double> unrotate = std::abs(r) > 1e-12 ? std::conj(r) / std::abs(r) : 1.0;
       for (int c = 0; c < 2; ++c) {
         const std::complex<double> x = spectrum[(static_cast<size_t>(p) * 2 + c) * kTrackBins + j - 1];
-        const double amplitude = std::abs(x);
-        const std::complex<double> z = amplitude > 1e-12 ? x / amplitude * unrotate * std::sqrt(amplitude) : 0.0;
+        const double amplitude = std::abs(x);  // x / |x| · sqrt|x|, rotated to the reference's phase
+        const std::complex<double> z = amplitude > 1e-12 ? x * unrotate / std::sqrt(amplitude) : 0.0;
         out.push_back(static_cast<float>(z.real()));
         out.push_back(static_cast<float>(z.imag()));
       }

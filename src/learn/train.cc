@@ -115,8 +115,8 @@ Batch LoadBatch(const std::vector<ClipInfo>& clips, const std::vector<size_t>& i
         // A cache's crops are of its input_size squares; the files' of the clip's own frames.
         const int source_side = cache ? options.input_size : clips[clip].width;
         const std::vector<float> y =
-            TrackTargets(aux->tracks[clip], sample.first_frame, options.frames, sample.crop, source_side, sample.flipped,
-                         aux->phase_bins);
+            TrackTargets(aux->tracks[clip], sample.first_frame, options.frames, sample.crop, source_side,
+                         sample.flipped, aux->phase_bins);
         float* row = b.aux.data_ptr<float>() + i * aux->outputs();
         for (int k = 0; k < aux->outputs(); ++k) row[k] = (y[k] - aux->scale.mean[k]) / aux->scale.std[k];
       }
@@ -168,6 +168,16 @@ void SaveAtomically(T& object, const fs::path& path) {
   tmp += ".tmp";
   torch::save(object, tmp.string());
   fs::rename(tmp, path);
+}
+
+// On a resume, refuses an option whose value differs from the one the run started with (`ran`,
+// from its state.json at state_path), naming the flag.
+template <typename T>
+void RefuseChangedOnResume(const fs::path& state_path, const std::string& flag, T ran, T given) {
+  if (ran == given) return;
+  throw std::runtime_error(state_path.string() + ": the run trained with " + flag + " " + std::to_string(ran) +
+                           ", these options give " + std::to_string(given) + "; resume with the " + flag +
+                           " the run started with");
 }
 
 }  // namespace
@@ -277,21 +287,11 @@ TrainResult Train(const TrainOptions& o) {
   }
   // Auxiliary track targets: read (and their head sized) before the network is built.
   if (!(o.aux_tracks >= 0)) throw std::runtime_error("aux_tracks: the loss weight must be >= 0");
-  const double ran_aux = o.resume ? state.value("aux_tracks", 0.0) : o.aux_tracks;
-  if (ran_aux != o.aux_tracks) {
-    throw std::runtime_error(state_path.string() + ": the run trained with --aux-tracks " + std::to_string(ran_aux) +
-                             ", these options give " + std::to_string(o.aux_tracks) +
-                             "; resume with the --aux-tracks the run started with");
-  }
+  if (o.resume) RefuseChangedOnResume(state_path, "--aux-tracks", state.value("aux_tracks", 0.0), o.aux_tracks);
   if (o.aux_phase_bins < 0 || o.aux_phase_bins > kTrackBins || (o.aux_phase_bins > 0 && o.aux_tracks <= 0))
     throw std::runtime_error("aux_phase_bins: must be in [0, " + std::to_string(kTrackBins) +
                              "], and above 0 only with an auxiliary loss (--aux-tracks W > 0)");
-  const int ran_phases = o.resume ? state.value("aux_phase_bins", 0) : o.aux_phase_bins;
-  if (ran_phases != o.aux_phase_bins) {
-    throw std::runtime_error(state_path.string() + ": the run trained with --aux-phases " + std::to_string(ran_phases) +
-                             ", these options give " + std::to_string(o.aux_phase_bins) +
-                             "; resume with the --aux-phases the run started with");
-  }
+  if (o.resume) RefuseChangedOnResume(state_path, "--aux-phases", state.value("aux_phase_bins", 0), o.aux_phase_bins);
   std::unique_ptr<AuxTargets> aux;
   if (o.aux_tracks > 0 && !train.empty()) {
     aux = std::make_unique<AuxTargets>(ReadAuxTargets(train, config.Sampling(), o.aux_phase_bins));

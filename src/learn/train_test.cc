@@ -61,6 +61,18 @@ void ExpectFieldRefused(const nlohmann::json& j, const std::string& field) {
   }
 }
 
+// Expects Train(o) to refuse, with a message holding every one of `words`; `accepted` says what
+// was wrongly accepted.
+void ExpectTrainRefused(const TrainOptions& o, const std::string& accepted, const std::vector<std::string>& words) {
+  try {
+    Train(o);
+    ADD_FAILURE() << accepted;
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    for (const std::string& w : words) EXPECT_NE(what.find(w), std::string::npos) << what;
+  }
+}
+
 // A network built from `config` reads `clips` [1, C, N_t, H, W] into one (speed, log variance) pair.
 void ExpectOneEstimatePerClip(const ModelConfig& config, const at::Tensor& clips) {
   WindNet net(config);
@@ -583,12 +595,7 @@ TEST_F(TrainTest, CosineScheduleIsWhatTrainingUses) {
   for (int e = 1; e <= 3; ++e) EXPECT_DOUBLE_EQ(r.log[e - 1].lr, LearningRateAt(t, e)) << e;
   t.lr_schedule = "warm";
   t.out = *root_ / "cosine_bad";
-  try {
-    Train(t);
-    ADD_FAILURE() << "unknown schedule accepted";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("warm"), std::string::npos) << e.what();
-  }
+  ExpectTrainRefused(t, "unknown schedule accepted", {"warm"});
 }
 
 // Clips whose whole image flickers at f = 1 + 0.5 v Hz (25 fps) with a random phase, on a random
@@ -692,14 +699,8 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   w.resume = true;
   w.lr_schedule = "cosine";
   const auto log_before = fs::last_write_time(*root_ / "resume" / "state.json");
-  try {
-    Train(w);
-    ADD_FAILURE() << "a resume under another schedule was accepted";
-  } catch (const std::runtime_error& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("state.json: epoch 2 ran at learning rate"), std::string::npos) << what;
-    EXPECT_NE(what.find("--lr-schedule cosine"), std::string::npos) << what;
-  }
+  ExpectTrainRefused(w, "a resume under another schedule was accepted",
+                     {"state.json: epoch 2 ran at learning rate", "--lr-schedule cosine"});
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
 
   // So is a resume with other crop scales: its augmentation would differ from the log's epochs.
@@ -707,15 +708,8 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   x.epochs = 3;  // the schedule it ran under
   x.resume = true;
   x.crop_scales = {1.0};
-  try {
-    Train(x);
-    ADD_FAILURE() << "a resume with other crop scales was accepted";
-  } catch (const std::runtime_error& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("state.json: the run trained with crop scales [1.0,0.875,0.75,0.66]"),
-              std::string::npos) << what;
-    EXPECT_NE(what.find("--crop-scales"), std::string::npos) << what;
-  }
+  ExpectTrainRefused(x, "a resume with other crop scales was accepted",
+                     {"state.json: the run trained with crop scales [1.0,0.875,0.75,0.66]", "--crop-scales"});
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
 }
 
@@ -724,12 +718,7 @@ TEST_F(TrainTest, CropScalesOutsideTheFrameAreRefused) {
     TrainOptions t = Options("sdn", "bad_scales");
     t.epochs = 1;
     t.crop_scales = scales;
-    try {
-      Train(t);
-      ADD_FAILURE() << "crop scales " << nlohmann::json(scales).dump() << " were accepted";
-    } catch (const std::runtime_error& e) {
-      EXPECT_NE(std::string(e.what()).find("crop_scales"), std::string::npos) << e.what();
-    }
+    ExpectTrainRefused(t, "crop scales " + nlohmann::json(scales).dump() + " were accepted", {"crop_scales"});
     EXPECT_FALSE(fs::exists(*root_ / "bad_scales" / "state.json"));
   }
 }
@@ -805,12 +794,7 @@ TEST_F(TrainTest, AuxTracksTrainASecondHeadOnTheClipsTracks) {
   TrainOptions t = Options("sdn", "aux");
   t.epochs = 6;
   t.aux_tracks = 1.0;
-  try {
-    Train(t);
-    ADD_FAILURE() << "--aux-tracks trained without tracks";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("tracks.json not found"), std::string::npos) << e.what();
-  }
+  ExpectTrainRefused(t, "--aux-tracks trained without tracks", {"tracks.json not found"});
   fs::copy(*root_ / "data", *root_ / "data_tracks", fs::copy_options::recursive);
   WriteToyTracks(*root_ / "data_tracks");
   t.data = *root_ / "data_tracks";
@@ -829,12 +813,7 @@ TEST_F(TrainTest, AuxTracksTrainASecondHeadOnTheClipsTracks) {
   again.epochs = 7;
   again.resume = true;
   again.aux_tracks = 0.5;
-  try {
-    Train(again);
-    ADD_FAILURE() << "a resume with another --aux-tracks was accepted";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("--aux-tracks"), std::string::npos) << e.what();
-  }
+  ExpectTrainRefused(again, "a resume with another --aux-tracks was accepted", {"--aux-tracks"});
   // Phase targets widen the head by 4 per point and phase bin; they need the auxiliary loss, and
   // a resume keeps the count the run started with.
   TrainOptions phases = t;
@@ -846,21 +825,11 @@ TEST_F(TrainTest, AuxTracksTrainASecondHeadOnTheClipsTracks) {
   other.epochs = 2;
   other.resume = true;
   other.aux_phase_bins = 3;
-  try {
-    Train(other);
-    ADD_FAILURE() << "a resume with another --aux-phases was accepted";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("--aux-phases 2"), std::string::npos) << e.what();
-  }
+  ExpectTrainRefused(other, "a resume with another --aux-phases was accepted", {"--aux-phases 2"});
   TrainOptions without = phases;
   without.out = *root_ / "aux_phases_alone";
   without.aux_tracks = 0;
-  try {
-    Train(without);
-    ADD_FAILURE() << "phase targets without the auxiliary loss were accepted";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("aux_phase_bins"), std::string::npos) << e.what();
-  }
+  ExpectTrainRefused(without, "phase targets without the auxiliary loss were accepted", {"aux_phase_bins"});
 }
 
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
