@@ -7,8 +7,11 @@
 // network and optimiser live on the GPU and each timed call ends in a device synchronisation, so
 // wall time is the GPU's (scripts/device-check runs it so on a lent GPU machine).
 //
+// Freed memory is kept for reuse as `clothwind train` keeps it (learn/heap_reuse.h); --glibc-heap
+// leaves glibc's defaults, to measure what that saves.
+//
 //   learn_train_step_bench [--repeats N] [--threads T] [--batch B] [--width W] [--device cpu|cuda]
-//                          [--cases SIZE:POOL,...]   (default 64:1,96:1,128:2,128:1)
+//                          [--cases SIZE:POOL,...] [--glibc-heap]   (default cases 64:1,96:1,128:2,128:1)
 
 #include <algorithm>
 #include <cstdio>
@@ -21,6 +24,7 @@
 #include <torch/torch.h>
 
 #include "bench_clock.h"
+#include "learn/heap_reuse.h"
 #include "learn/networks.h"
 #include "learn/spectral_layer.h"
 
@@ -82,9 +86,10 @@ int main(int argc, char** argv) {
   int repeats = 10, threads = 2, batch = 16, width = 48;
   std::string device_name = "cpu";
   std::vector<Case> cases = {{64, 1}, {96, 1}, {128, 2}, {128, 1}};
-  bool ok = true;
+  bool ok = true, glibc_heap = false;
   for (int i = 1; i < argc && ok; ++i) {
-    if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
+    if (!std::strcmp(argv[i], "--glibc-heap")) glibc_heap = true;
+    else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--batch") && i + 1 < argc) batch = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--width") && i + 1 < argc) width = std::max(1, std::atoi(argv[++i]));
@@ -95,9 +100,10 @@ int main(int argc, char** argv) {
   if (!ok || (device_name != "cpu" && device_name != "cuda")) {
     std::fprintf(stderr,
                  "usage: learn_train_step_bench [--repeats N] [--threads T] [--batch B] [--width W] [--device cpu|cuda]\n"
-                 "                              [--cases SIZE:POOL,...]  (SIZE >= 8, divisible by POOL >= 1)\n");
+                 "                              [--cases SIZE:POOL,...] [--glibc-heap]  (SIZE >= 8, divisible by POOL >= 1)\n");
     return 2;
   }
+  if (!glibc_heap) cl::KeepFreedHeapForReuse();
   const bool cuda = device_name == "cuda";
   if (cuda && !torch::cuda::is_available()) {
     std::fprintf(stderr, "learn_train_step_bench: --device cuda, but libtorch finds no CUDA device\n");
@@ -106,8 +112,9 @@ int main(int argc, char** argv) {
   const at::Device device = cuda ? at::Device(at::kCUDA) : at::Device(at::kCPU);
   at::set_num_threads(threads);
   at::globalContext().setFlushDenormal(true);
-  std::printf("SDN training step on %s, batch %d x 30 frames, width %d, k 3, phase steps, %d thread(s), median of %d\n",
-              device_name.c_str(), batch, width, threads, repeats);
+  std::printf("SDN training step on %s, batch %d x 30 frames, width %d, k 3, phase steps, %d thread(s), median of %d, %s\n",
+              device_name.c_str(), batch, width, threads, repeats,
+              glibc_heap ? "glibc's default heap" : "freed heap kept for reuse");
   std::printf("%-6s %-5s | %-17s | %-17s | %-17s\n", "input", "pool", "layer wall/cpu ms", "trunk input ms",
               "whole step ms");
   for (const Case& c : cases) {

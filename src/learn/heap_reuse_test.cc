@@ -1,0 +1,79 @@
+#include "learn/heap_reuse.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <climits>
+#include <cstdlib>
+
+#include <gtest/gtest.h>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+namespace clothwind::learn {
+namespace {
+
+constexpr size_t kBlock = size_t{8} << 20;  // about one batch of 16 64-px 30-frame clips in float
+constexpr int kRounds = 20;
+
+long MinorFaults() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_minflt;
+}
+
+// Allocates kBlock bytes, writes one byte a page (as a tensor's first use does) and frees it,
+// kRounds times; returns the page faults that took.
+long FaultsOfAllocateTouchFree() {
+  const long page = sysconf(_SC_PAGESIZE);
+  const long before = MinorFaults();
+  for (int r = 0; r < kRounds; ++r) {
+    volatile char* block = static_cast<volatile char*>(std::malloc(kBlock));
+    if (block == nullptr) return -1;
+    for (size_t i = 0; i < kBlock; i += page) block[i] = static_cast<char>(r);
+    std::free(const_cast<char*>(block));
+  }
+  return MinorFaults() - before;
+}
+
+long PagesPerBlock() { return static_cast<long>(kBlock) / sysconf(_SC_PAGESIZE); }
+
+#if defined(__GLIBC__)
+// The control: with glibc's initial thresholds fixed (so they cannot adapt), every round maps
+// the block afresh and faults all its pages again. Skipped where transparent huge pages back
+// such a mapping in 2-MiB faults, which hides the count.
+TEST(HeapReuseTest, SmallThresholdsFaultTheSameBlockAgainEveryRound) {
+  ASSERT_EQ(mallopt(M_MMAP_THRESHOLD, 128 << 10), 1);
+  ASSERT_EQ(mallopt(M_TRIM_THRESHOLD, 128 << 10), 1);
+  const long faults = FaultsOfAllocateTouchFree();
+  ASSERT_GE(faults, 0);
+  if (faults < kRounds * 4) GTEST_SKIP() << "huge pages back the block: " << faults << " faults";
+  EXPECT_GE(faults, kRounds * PagesPerBlock() / 2) << "pages per block " << PagesPerBlock();
+}
+#endif
+
+TEST(HeapReuseTest, FreedBlocksAreReusedWithoutFaultingTheirPagesAgain) {
+#if !defined(__GLIBC__)
+  GTEST_SKIP() << "glibc's mallopt only";
+#endif
+  ASSERT_TRUE(KeepFreedHeapForReuse());
+  FaultsOfAllocateTouchFree();  // the heap grows once
+  const long faults = FaultsOfAllocateTouchFree();
+  ASSERT_GE(faults, 0);
+  // Twenty rounds fault fewer pages than one block has: the freed block is handed back as it is.
+  EXPECT_LT(faults, PagesPerBlock()) << kRounds << " rounds of " << PagesPerBlock() << " pages";
+}
+
+TEST(HeapReuseTest, RefusesThresholdsGlibcCannotTake) {
+#if !defined(__GLIBC__)
+  GTEST_SKIP() << "glibc's mallopt only";
+#endif
+  EXPECT_FALSE(KeepFreedHeapForReuse(size_t{INT_MAX} + 1));  // mallopt takes an int
+  EXPECT_FALSE(KeepFreedHeapForReuse(size_t{32} << 20, size_t{INT_MAX} + 1));
+  EXPECT_TRUE(KeepFreedHeapForReuse());  // the defaults are within both
+}
+
+}  // namespace
+}  // namespace clothwind::learn
