@@ -1,0 +1,116 @@
+#!/usr/bin/python3
+"""Tests of scripts/track-spectrum on tracks of known motion: a sine's frequency and amplitude come
+back, the window and split are the ones asked for, and bad input is refused naming what is wrong."""
+import json
+import math
+import os
+import struct
+import subprocess
+import tempfile
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SCRIPT = os.path.join(ROOT, 'scripts', 'track-spectrum')
+
+
+def png_size(path):
+    with open(path, 'rb') as f:
+        head = f.read(24)
+    assert head[:8] == b'\x89PNG\r\n\x1a\n', path
+    return struct.unpack('>II', head[16:24])
+
+
+class TrackSpectrumTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.data = os.path.join(self.tmp.name, 'data')
+        self.out = os.path.join(self.tmp.name, 'spectrum.png')
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def add(self, name, wind, split, xy):
+        """An example folder with a label and tracks (no frames: the script reads none)."""
+        folder = os.path.join(self.data, name)
+        os.makedirs(folder)
+        with open(os.path.join(folder, 'label.json'), 'w') as f:
+            json.dump({'wind_speed': wind, 'split': split}, f)
+        with open(os.path.join(folder, 'tracks.json'), 'w') as f:
+            json.dump({'format': 'clothwind-tracks', 'version': 1, 'grid': [2, 1], 'width': 64,
+                       'height': 64, 'vertices': [0, 1], 'xy': xy}, f)
+        return folder
+
+    @staticmethod
+    def sine(frames, cycles_per_frame, amplitude, start_phase=0.3):
+        """Two points 20 px apart, both moving in x as one sine: xy per frame."""
+        return [[20 + amplitude * math.sin(2 * math.pi * cycles_per_frame * n + start_phase), 32,
+                 40 + amplitude * math.sin(2 * math.pi * cycles_per_frame * n + start_phase), 32]
+                for n in range(frames)]
+
+    def run_script(self, *args):
+        return subprocess.run([SCRIPT, self.data, self.out, *args], capture_output=True, text=True)
+
+    def table(self, stdout):
+        """The band rows: {band: (n, centroid, peak, bin-1 share, amplitude)}."""
+        rows = {}
+        for line in stdout.splitlines():
+            parts = line.split()
+            if len(parts) == 6 and '-' in parts[0] and parts[1].isdigit():
+                rows[parts[0]] = (int(parts[1]), *map(float, parts[2:]))
+        return rows
+
+    def test_a_sine_on_a_bin_returns_its_frequency_and_amplitude(self):
+        # Two cycles per 30-frame window at 25 fps: bin 2, 1.667 Hz. The window is centred in
+        # 60 frames (frames 15..44), and 2/30 cycles a frame is whole cycles in any 30 frames.
+        self.add('flag-000000-v0', 3.2, 'test', self.sine(60, 2 / 30, 4.0))
+        r = self.run_script('--band', '1')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        n, centroid, peak, bin1, amplitude = self.table(r.stdout)['3-4']
+        self.assertEqual(n, 1)
+        self.assertAlmostEqual(peak, 2 * 25 / 30, places=2)
+        self.assertAlmostEqual(centroid, 2 * 25 / 30, delta=0.03)  # Hann leaks to bins 1 and 3 alike
+        # rms of a sine of amplitude 4 over whole cycles, over a flag 10 px in rms radius
+        self.assertAlmostEqual(amplitude, 4 / math.sqrt(2) / 10, delta=0.002)
+        self.assertLess(bin1, 0.3)
+        self.assertEqual(png_size(self.out), (1000, 420))
+
+    def test_a_faster_wind_band_reads_a_higher_frequency(self):
+        self.add('flag-000000-v0', 1.5, 'test', self.sine(60, 1 / 30, 3.0))
+        self.add('flag-000001-v0', 8.5, 'test', self.sine(60, 3 / 30, 3.0))
+        self.add('flag-000002-v0', 5.0, 'train', self.sine(60, 5 / 30, 3.0))
+        rows = self.table(self.run_script().stdout)
+        self.assertEqual(sorted(rows), ['0-2', '8-10'])  # the training example is not read
+        self.assertAlmostEqual(rows['0-2'][2], 25 / 30, places=2)
+        self.assertAlmostEqual(rows['8-10'][2], 3 * 25 / 30, places=2)
+        self.assertGreater(rows['0-2'][3], rows['8-10'][3])  # bin-1 share
+        rows = self.table(self.run_script('--split', 'all').stdout)
+        self.assertIn('4-6', rows)
+
+    def test_the_window_is_the_one_asked_for(self):
+        # Frames 0..29 move at bin 1, frames 30..59 at bin 4: the offset picks which is read.
+        xy = self.sine(30, 1 / 30, 3.0) + self.sine(30, 4 / 30, 3.0)
+        self.add('flag-000000-v0', 0.5, 'test', xy)
+        self.assertAlmostEqual(self.table(self.run_script('--offset', '0').stdout)['0-2'][2], 25 / 30, places=2)
+        self.assertAlmostEqual(self.table(self.run_script('--offset', '30').stdout)['0-2'][2], 4 * 25 / 30,
+                               places=2)
+
+    def test_refusals_name_what_is_wrong(self):
+        folder = self.add('flag-000000-v0', 2.0, 'test', self.sine(40, 2 / 30, 3.0))
+        r = self.run_script('--offset', '20')
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn('tracks.json: 40 frames, window [20, 50) does not fit', r.stderr)
+        r = self.run_script('--window', '2')
+        self.assertIn('--window 2: expected at least 4 frames', r.stderr)
+        r = self.run_script('--split', 'val')
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("no example of split 'val' with tracks.json", r.stderr)
+        with open(os.path.join(folder, 'label.json'), 'w') as f:
+            f.write('{"split": "test",')
+        r = self.run_script()
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn(os.path.join(folder, 'label.json'), r.stderr)
+        self.assertFalse(os.path.exists(self.out))
+
+
+if __name__ == '__main__':
+    unittest.main()
