@@ -185,7 +185,8 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
                   "also write each example's tracks.json: where a COLSxROWS grid of the cloth's material "
                   "points is in each frame (e.g. 8x6; training's --aux-tracks reads them)");
   sub->add_flag("--add-tracks", a->o.add_tracks,
-                "render nothing: give the examples already in --out their tracks.json (needs --tracks and "
+                "render nothing: give the examples already in --out their tracks.json, or tracks.json with the points' "
+                "positions where theirs has none (needs --tracks and "
                 "the options the dataset was made with; each replayed simulation is checked against "
                 "its stored frames)");
   sub->add_option("--split", a->o.split,

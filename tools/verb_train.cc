@@ -106,6 +106,9 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                   "fly corner's at DFT bins 1..N (0: none), the flag's travelling wave")
       ->check(CLI::Range(0, learn::kTrackBins))
       ->capture_default_str();
+  sub->add_flag("--aux-world", o.aux_world,
+                "with --aux-tracks: the auxiliary head also regresses the points' positions and motion in metres "
+                "(tracks.json's \"world\": the cloth's shape whatever camera filmed it)");
   sub->add_flag("--init-only", o.init_only, "write an initialised (untrained) model and stop (tests, smoke runs)");
   sub->add_option("--lr", o.lr, "initial learning rate (Adam)")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--lr-schedule", o.lr_schedule,

@@ -42,19 +42,24 @@ struct ClipTracks {
   // frames x points x 2 continuous image coordinates [px] (x right, y down; pixel (i, j) covers
   // [i, i+1) x [j, j+1), render::PinholeCamera's convention), row-major.
   Eigen::MatrixXf xy;
+  // frames x points x 3 positions of the same points in the simulator's frame [m] (FlagSim: x
+  // downwind, z up, the hoist on the z axis; the mesh not lifted), row-major: what the cloth did,
+  // whatever camera saw it.
+  Eigen::MatrixXf world;
   int frames() const { return static_cast<int>(xy.rows()); }
 };
 
 // Projects the grid's vertices of frames [0, count) of `animation` (frame k at time k /
 // params.fps, as RenderAnimation draws it) through the camera of `params` (render::PlaceCamera,
-// the mesh lifted by params.mesh_height). Throws std::runtime_error when a point is behind the
+// the mesh lifted by params.mesh_height), and keeps their positions (ClipTracks::world). Throws std::runtime_error when a point is behind the
 // camera (the frames would not show it).
 ClipTracks ProjectTracks(const ClothAnimation& animation, const render::RenderParams& params,
                          const TrackGrid& grid, int count);
 
 // tracks.json: {"format": "clothwind-tracks", "version": 1, "grid": [cols, rows], "width",
-// "height", "vertices": [...], "xy": [[x0, y0, x1, y1, ...] per frame]} with coordinates to
-// 1/100 px. (learn/track_targets.h reads it: learn does not link the simulator and renderer.)
+// "height", "vertices": [...], "xy": [[x0, y0, x1, y1, ...] per frame], "world": [[x0, y0, z0,
+// x1, ...] per frame]} with image coordinates to 1/100 px and positions to 1/10 mm ("world" is
+// left out when ClipTracks::world is empty; files made before it lack it). (learn/track_targets.h reads it: learn does not link the simulator and renderer.)
 nlohmann::json TracksJson(const ClipTracks& tracks);
 
 }  // namespace clothwind::data

@@ -104,6 +104,24 @@ TEST(ClipTracksTest, JsonHoldsTheGridAndEveryFramesPixelsToAHundredthOfAPixel) {
   }
 }
 
+TEST(ClipTracksTest, WorldHoldsTheGridVerticesPositionsUnliftedAndJsonKeepsThemToATenthOfAMillimetre) {
+  const ClothAnimation a = FlatFlag(9, 7, 3, 0.1234567);
+  const ClipTracks t = ProjectTracks(a, SideOn(5.0), TrackGrid{4, 3}, 3);
+  ASSERT_EQ(t.world.rows(), 3);
+  ASSERT_EQ(t.world.cols(), 3 * 12);
+  for (int k = 0; k < 3; ++k)
+    for (int p = 0; p < 12; ++p)
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(t.world(k, 3 * p + c), a.frames[k].V(t.vertices[p], c), 1e-6);
+  const nlohmann::json j = TracksJson(t);
+  ASSERT_EQ(j.at("world").size(), 3u);
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < 36; ++i) EXPECT_NEAR(j["world"][k][i].get<double>(), t.world(k, i), 0.5e-4 + 1e-6);
+  // Tracks without positions write none.
+  ClipTracks bare = t;
+  bare.world.resize(0, 0);
+  EXPECT_FALSE(TracksJson(bare).contains("world"));
+}
+
 TEST(ClipTracksTest, GridTextIsParsedOrRefusedByName) {
   const TrackGrid g = ParseTrackGrid("--tracks", "8x6");
   EXPECT_EQ(g.cols, 8);

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -140,6 +141,15 @@ sim::SceneSetup SetupFor(const Prepared& p, const SimulationSample& s, render::S
   // ApplyTheta keeps the direction and sets the speed; a calm sample keeps +x.
   setup.wind.velocity = s.wind_velocity.norm() > 0 ? s.wind_velocity : Eigen::Vector3d::UnitX();
   return setup;
+}
+
+// Whether an example's tracks.json holds the points' positions ("world"; data/clip_tracks.h).
+// Files written before them, and unreadable ones, do not: --add-tracks makes them again.
+bool TracksHaveWorld(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) return false;
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  return j.is_object() && j.contains("world");
 }
 
 void CheckFinite(const sim::Trajectory& t) {
@@ -347,7 +357,8 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
     return fs::exists(fs::path(o.out) / ExampleName(o.kind, i, v) / file);
   };
   auto view_done = [&](int64_t i, int v) {
-    return o.add_tracks ? !has(i, v, "label.json") || has(i, v, "tracks.json") : has(i, v, "label.json");
+    if (!o.add_tracks) return has(i, v, "label.json");
+    return !has(i, v, "label.json") || TracksHaveWorld(fs::path(o.out) / ExampleName(o.kind, i, v) / "tracks.json");
   };
   std::vector<int64_t> todo;
   for (int64_t i = o.shard; i < o.count; i += o.shards) {

@@ -57,7 +57,8 @@ struct DatasetOptions {
   // each frame (data/clip_tracks.h), recorded in the settings as "tracks": [cols, rows].
   std::optional<TrackGrid> tracks;
   // With `tracks`: render nothing new, but give every example already in DIR that lacks it its
-  // tracks.json, from its simulation run again. The run checks each replay against the example's
+  // tracks.json, from its simulation run again; a tracks.json without the points' positions
+  // ("world", written since 2026-11-28) is made again with them. The run checks each replay against the example's
   // stored last frame (kMaxReplayGreyDifference) so that tracks never describe other frames.
   bool add_tracks = false;
   // Only the simulations of this split ("train", "val" or "test"; "": all), each exactly as the whole

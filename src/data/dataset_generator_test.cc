@@ -466,6 +466,16 @@ TEST_F(DatasetGeneratorTest, AddTracksGivesADatasetTheTracksItWouldHaveBeenMadeW
   EXPECT_EQ(ReadIndex((root_ / "with-tracks").string())["dataset"]["tracks"], nlohmann::json({4, 3}));
   // Again: nothing left to do.
   EXPECT_EQ(GenerateDataset(add).simulated, 0);
+  // Tracks written before the points' positions were stored are made again, with them; the others stay.
+  const std::string name0 = ExampleName(render::SceneKind::kFlag, 0, 0);
+  nlohmann::json old = nlohmann::json::parse(Bytes(added / name0 / "tracks.json"));
+  ASSERT_TRUE(old.contains("world"));
+  old.erase("world");
+  std::ofstream(added / name0 / "tracks.json") << old.dump() << "\n";
+  const DatasetSummary upgraded = GenerateDataset(add);
+  ASSERT_TRUE(upgraded.errors.empty()) << upgraded.errors[0];
+  EXPECT_EQ(upgraded.examples_written, 1);
+  EXPECT_EQ(Bytes(added / name0 / "tracks.json"), Bytes(root_ / "with-tracks" / name0 / "tracks.json"));
   // Resuming a dataset made without tracks with --tracks alone would leave its examples without:
   // refused, pointing at --add-tracks.
   const fs::path plain = root_ / "plain-resumed-with-tracks";

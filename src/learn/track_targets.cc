@@ -38,10 +38,74 @@ Tracks ReadTracks(const std::filesystem::path& file) {
                                  std::to_string(2 * t.points()) + " coordinates (x, y of each grid point)");
       for (const auto& value : xy[k]) t.xy.push_back(value.get<float>());
     }
+    if (j.contains("world")) {
+      const nlohmann::json& world = j["world"];
+      if (!world.is_array() || static_cast<int>(world.size()) != t.frames)
+        throw std::runtime_error(where + "'world' must hold one row per frame of 'xy' (" + std::to_string(t.frames) +
+                                 ")");
+      t.world.reserve(static_cast<size_t>(t.frames) * 3 * t.points());
+      for (int k = 0; k < t.frames; ++k) {
+        if (!world[k].is_array() || static_cast<int>(world[k].size()) != 3 * t.points())
+          throw std::runtime_error(where + "'world[" + std::to_string(k) + "]' must hold " +
+                                   std::to_string(3 * t.points()) + " coordinates (x, y, z of each grid point)");
+        for (const auto& value : world[k]) t.world.push_back(value.get<float>());
+      }
+    }
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(file.string() + ": " + e.what());
   }
   return t;
+}
+
+namespace {
+
+// The periodic Hann window of `frames` samples (the spectral layer's) and its sum.
+std::vector<double> Hann(int frames, double* sum) {
+  std::vector<double> w(frames);
+  *sum = 0;
+  for (int t = 0; t < frames; ++t) *sum += w[t] = 0.5 - 0.5 * std::cos(2 * M_PI * t / frames);
+  return w;
+}
+
+// Σ_t w_t (series_t - mean) e^{-2πi jt/T} / Σ_t w_t: one series' spectrum at bin j.
+std::complex<double> BinOf(const std::vector<double>& series, double mean, const std::vector<double>& hann,
+                           double hann_sum, int j) {
+  const int frames = static_cast<int>(series.size());
+  std::complex<double> sum = 0;
+  for (int t = 0; t < frames; ++t) sum += hann[t] * (series[t] - mean) * std::polar(1.0, -2 * M_PI * j * t / frames);
+  return sum / hann_sum;
+}
+
+}  // namespace
+
+std::vector<float> WorldTrackTargets(const Tracks& tracks, int first, int frames, bool flipped) {
+  const int points = tracks.points();
+  if (tracks.world.size() != static_cast<size_t>(tracks.frames) * 3 * points)
+    throw std::invalid_argument("WorldTrackTargets: the tracks hold no positions ('world')");
+  if (first < 0 || frames < 2 || first + frames > tracks.frames)
+    throw std::invalid_argument("WorldTrackTargets: window " + std::to_string(first) + "+" + std::to_string(frames) +
+                                " outside tracks of " + std::to_string(tracks.frames) + " frames");
+  double hann_sum = 0;
+  const std::vector<double> hann = Hann(frames, &hann_sum);
+  std::vector<float> out;
+  out.reserve(static_cast<size_t>(points) * kWorldTargetsPerPoint);
+  std::vector<double> series(frames);
+  for (int p = 0; p < points; ++p) {
+    std::vector<float> means, amplitudes;
+    for (int c = 0; c < 3; ++c) {
+      const double sign = c == 1 && flipped ? -1.0 : 1.0;
+      double mean = 0;
+      for (int t = 0; t < frames; ++t)
+        mean += series[t] = sign * tracks.world[(static_cast<size_t>(first + t) * points + p) * 3 + c];
+      mean /= frames;
+      means.push_back(static_cast<float>(mean));
+      for (int j = 1; j <= kTrackBins; ++j)
+        amplitudes.push_back(static_cast<float>(std::log(1e-4 + std::abs(BinOf(series, mean, hann, hann_sum, j)))));
+    }
+    out.insert(out.end(), means.begin(), means.end());
+    out.insert(out.end(), amplitudes.begin(), amplitudes.end());
+  }
+  return out;
 }
 
 std::vector<float> TrackTargets(const Tracks& tracks, int first, int frames, const cv::Rect& crop, int source_side,
@@ -56,9 +120,8 @@ std::vector<float> TrackTargets(const Tracks& tracks, int first, int frames, con
                                 std::to_string(phase_bins));
   const int points = tracks.points();
   const double scale = static_cast<double>(source_side) / tracks.width;
-  std::vector<double> hann(frames);
   double hann_sum = 0;
-  for (int t = 0; t < frames; ++t) hann_sum += hann[t] = 0.5 - 0.5 * std::cos(2 * M_PI * t / frames);
+  const std::vector<double> hann = Hann(frames, &hann_sum);
   // spectrum[(p * 2 + c) * kTrackBins + j - 1]: coordinate c of point p at bin j, / Σ w_t.
   std::vector<std::complex<double>> spectrum(static_cast<size_t>(points) * 2 * kTrackBins);
   std::vector<float> out;
@@ -78,11 +141,9 @@ std::vector<float> TrackTargets(const Tracks& tracks, int first, int frames, con
       mean /= frames;
       means.push_back(static_cast<float>(mean));
       for (int j = 1; j <= kTrackBins; ++j) {
-        std::complex<double> sum = 0;
-        for (int t = 0; t < frames; ++t)
-          sum += hann[t] * (series[t] - mean) * std::polar(1.0, -2 * M_PI * j * t / frames);
-        spectrum[(static_cast<size_t>(p) * 2 + c) * kTrackBins + j - 1] = sum / hann_sum;
-        amplitudes.push_back(static_cast<float>(std::log(1e-4 + std::abs(sum) / hann_sum)));
+        const std::complex<double> bin = BinOf(series, mean, hann, hann_sum, j);
+        spectrum[(static_cast<size_t>(p) * 2 + c) * kTrackBins + j - 1] = bin;
+        amplitudes.push_back(static_cast<float>(std::log(1e-4 + std::abs(bin))));
       }
     }
     out.insert(out.end(), means.begin(), means.end());

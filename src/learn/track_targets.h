@@ -21,11 +21,14 @@ struct Tracks {
   int frames = 0;
   // frames x points x 2 continuous image coordinates [px] (x right, y down), row-major.
   std::vector<float> xy;
+  // frames x points x 3 positions in the simulator's frame [m] (FlagSim: x downwind, y across,
+  // z up), row-major; empty for files written before they were stored.
+  std::vector<float> world;
   int points() const { return cols * rows; }
 };
 
-// Reads a tracks.json file (format "clothwind-tracks", version 1). Throws std::runtime_error
-// naming the file and the field that is missing or inconsistent.
+// Reads a tracks.json file (format "clothwind-tracks", version 1; "world" optional). Throws
+// std::runtime_error naming the file and the field that is missing or inconsistent.
 Tracks ReadTracks(const std::filesystem::path& file);
 
 // DFT bins whose amplitudes are targets: 1..kTrackBins (0.83-4.2 Hz for 30 frames at 25 Hz,
@@ -60,6 +63,23 @@ inline int TrackTargetCount(int points, int phase_bins) {
 // phase_bins is outside [0, kTrackBins].
 std::vector<float> TrackTargets(const Tracks& tracks, int first, int frames, const cv::Rect& crop, int source_side,
                                 bool flipped, int phase_bins = 0);
+
+// Targets per point of WorldTrackTargets: for each of x, y, z its window mean and its log
+// amplitude at each bin.
+constexpr int kWorldTargetsPerPoint = 3 * (1 + kTrackBins);
+
+// The targets of one sample from the points' positions (Tracks::world): where the cloth is and how
+// it moves in metres, whatever camera filmed it. The window oracle reads the wind to ~0.19 m/s a
+// window from these and to ~0.30 from the same points seen through FlagSim's cameras
+// (docs/sdn-experiments.md, "How much one window can tell"): asking the network for them asks it
+// to undo the camera.
+// Inputs: tracks (with world); first, frames  the sample's window; flipped  whether it was mirrored.
+// Output: points · kWorldTargetsPerPoint values, point-major; per point the x, y, z means [m], then
+//   x's, y's and z's log(1e-4 + A_j) for j = 1..kTrackBins (A_j [m] as TrackTargets'). A mirrored
+//   image is the mirrored scene, whose wind-aligned frame has y negated: flipping negates the y mean.
+//   The crop changes nothing.
+// Throws std::invalid_argument when the tracks have no positions or the window is outside them.
+std::vector<float> WorldTrackTargets(const Tracks& tracks, int first, int frames, bool flipped);
 
 // Per-target mean and standard deviation over `targets` (rows of one length), to standardise
 // the targets so that each weighs about as much in the loss whatever its units. A constant target

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 
@@ -167,6 +168,68 @@ TEST(TrackTargetsTest, ScaleStandardisesEachTargetAndLeavesAConstantOneAtStdOne)
   EXPECT_FLOAT_EQ(s.mean[2], 5);
 }
 
+// Gives `t` positions: point p at world(p, k) = (x, y, z) [m].
+template <typename W>
+Tracks WithWorld(Tracks t, W world) {
+  for (int k = 0; k < t.frames; ++k)
+    for (int p = 0; p < t.points(); ++p) {
+      const std::array<double, 3> w = world(p, k);
+      for (double v : w) t.world.push_back(static_cast<float>(v));
+    }
+  return t;
+}
+
+// Index of a point's world target: c (0 x, 1 y, 2 z) mean; c's bin j.
+int WorldMean(int p, int c) { return p * kWorldTargetsPerPoint + c; }
+int WorldBin(int p, int c, int j) { return p * kWorldTargetsPerPoint + 3 + c * kTrackBins + j - 1; }
+
+TEST(WorldTrackTargetsTest, ASwingAcrossTheWindReadsHalfItsAmplitudeInMetresWhereverTheCameraWas) {
+  // Point 1 (the fly edge) swings 0.2 m across the wind at bin 3 of a 30-frame window, 2.5 m
+  // downwind and 1 m up; point 0 hangs still at the hoist. The image tracks are a still point:
+  // what the camera showed does not enter.
+  const int T = 30;
+  const Tracks t = WithWorld(MakeTracks(1, 2, 128, 40, [](int, int) { return 64.0; }, [](int, int) { return 64.0; }),
+                             [&](int p, int k) {
+                               return p == 0 ? std::array<double, 3>{0.0, 0.0, 1.0}
+                                             : std::array<double, 3>{2.5, 0.2 * std::sin(2 * M_PI * 3 * k / T), 1.0};
+                             });
+  const std::vector<float> y = WorldTrackTargets(t, 10, T, false);
+  ASSERT_EQ(y.size(), 2u * kWorldTargetsPerPoint);
+  EXPECT_NEAR(y[WorldMean(1, 0)], 2.5, 1e-6);
+  EXPECT_NEAR(y[WorldMean(1, 1)], 0.0, 1e-6);
+  EXPECT_NEAR(y[WorldMean(1, 2)], 1.0, 1e-6);
+  EXPECT_NEAR(y[WorldBin(1, 1, 3)], std::log(1e-4 + 0.1), 1e-4);
+  EXPECT_NEAR(y[WorldBin(1, 1, 2)], std::log(1e-4 + 0.05), 1e-4);  // the Hann window's neighbours: a quarter
+  EXPECT_LT(y[WorldBin(1, 1, 5)], std::log(2e-4));
+  for (int j = 1; j <= kTrackBins; ++j) {
+    EXPECT_NEAR(y[WorldBin(1, 0, j)], std::log(1e-4), 1e-6) << j;  // no motion along the wind or up
+    EXPECT_NEAR(y[WorldBin(1, 2, j)], std::log(1e-4), 1e-6) << j;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(y[WorldBin(0, c, j)], std::log(1e-4), 1e-6) << j;
+  }
+}
+
+TEST(WorldTrackTargetsTest, AMirroredSampleIsTheMirroredSceneYNegatedAndTheMotionKept) {
+  const Tracks t = WithWorld(MakeTracks(2, 2, 128, 40, [](int, int) { return 10.0; }, [](int, int) { return 10.0; }),
+                             [](int p, int k) {
+                               return std::array<double, 3>{1.0 + 0.5 * p + 0.03 * std::cos(0.5 * k),
+                                                            0.1 * p + 0.2 * std::sin(0.9 * k + p), 2.0 - 0.3 * p};
+                             });
+  const std::vector<float> a = WorldTrackTargets(t, 3, 30, false), b = WorldTrackTargets(t, 3, 30, true);
+  for (int p = 0; p < 4; ++p) {
+    EXPECT_NEAR(b[WorldMean(p, 0)], a[WorldMean(p, 0)], 1e-6);
+    EXPECT_NEAR(b[WorldMean(p, 1)], -a[WorldMean(p, 1)], 1e-6);
+    EXPECT_NE(a[WorldMean(p, 1)], 0.0f);
+    EXPECT_NEAR(b[WorldMean(p, 2)], a[WorldMean(p, 2)], 1e-6);
+    for (int c = 0; c < 3; ++c)
+      for (int j = 1; j <= kTrackBins; ++j) EXPECT_NEAR(b[WorldBin(p, c, j)], a[WorldBin(p, c, j)], 1e-5);
+  }
+  // Tracks without positions, or a window past them, are refused.
+  Tracks bare = t;
+  bare.world.clear();
+  EXPECT_THROW(WorldTrackTargets(bare, 0, 30, false), std::invalid_argument);
+  EXPECT_THROW(WorldTrackTargets(t, 11, 30, false), std::invalid_argument);
+}
+
 class TracksFileTest : public ::testing::Test {
  protected:
   void SetUp() override { path_ = fs::temp_directory_path() / ("cw_tracks_" + std::to_string(::getpid()) + ".json"); }
@@ -185,6 +248,14 @@ TEST_F(TracksFileTest, ReadsTheGridAndFramesMakeDatasetWrites) {
   ASSERT_EQ(t.xy.size(), 12u);
   EXPECT_FLOAT_EQ(t.xy[4], 1.25);  // frame 1, point 0, x
   EXPECT_FLOAT_EQ(t.xy[7], 4.25);  // frame 1, point 1, y
+  EXPECT_TRUE(t.world.empty());     // a file from before positions were stored
+  Write({{"format", "clothwind-tracks"}, {"version", 1}, {"grid", {1, 2}}, {"width", 128}, {"height", 128},
+         {"xy", {{1.5, 2.5, 3.5, 4.5}, {1.25, 2.25, 3.25, 4.25}}},
+         {"world", {{0.5, 0, 1, 2.5, 0.25, 1}, {0.5, 0, 1, 2.5, -0.25, 1.5}}}});
+  const Tracks w = ReadTracks(path_);
+  ASSERT_EQ(w.world.size(), 12u);
+  EXPECT_FLOAT_EQ(w.world[10], -0.25);  // frame 1, point 1, y
+  EXPECT_FLOAT_EQ(w.world[11], 1.5);    // frame 1, point 1, z
 }
 
 TEST_F(TracksFileTest, ErrorsNameTheFileAndTheField) {
@@ -210,6 +281,11 @@ TEST_F(TracksFileTest, ErrorsNameTheFileAndTheField) {
   j = good;
   j["format"] = "clothwind-dataset";
   EXPECT_NE(message(j).find("'format'"), std::string::npos);
+  j = good;
+  j["world"] = {{0, 0, 1, 2, 0}};  // 5 of 6 coordinates
+  EXPECT_NE(message(j).find("'world[0]'"), std::string::npos);
+  j["world"] = {{0, 0, 1, 2, 0, 1}, {0, 0, 1, 2, 0, 1}};  // 2 frames of 1
+  EXPECT_NE(message(j).find("'world'"), std::string::npos);
 }
 
 }  // namespace

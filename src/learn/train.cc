@@ -42,16 +42,31 @@ struct Batch {
 struct AuxTargets {
   std::vector<Tracks> tracks;  // one per training clip, in its order
   int phase_bins = 0;          // TrackTargets' phase_bins (TrainOptions::aux_phase_bins)
+  bool world = false;          // WorldTrackTargets follow TrackTargets' (TrainOptions::aux_world)
   TargetScale scale;
   int outputs() const { return static_cast<int>(scale.mean.size()); }
 };
 
+// One sample's auxiliary targets, unscaled: TrackTargets', then with `world` WorldTrackTargets'.
+std::vector<float> AuxTargetsOf(const Tracks& tracks, int first, int frames, const cv::Rect& crop, int source_side,
+                                bool flipped, int phase_bins, bool world) {
+  std::vector<float> y = TrackTargets(tracks, first, frames, crop, source_side, flipped, phase_bins);
+  if (world) {
+    const std::vector<float> w = WorldTrackTargets(tracks, first, frames, flipped);
+    y.insert(y.end(), w.begin(), w.end());
+  }
+  return y;
+}
+
 // Reads every clip's tracks.json and scales the targets by those of the clips' evaluation
 // windows, as they are and mirrored (the training windows' augmentations). Throws
-// std::runtime_error naming the first clip without tracks, or with tracks that do not fit it.
-AuxTargets ReadAuxTargets(const std::vector<ClipInfo>& clips, const SampleOptions& options, int phase_bins) {
+// std::runtime_error naming the first clip without tracks, or with tracks that do not fit it
+// (with `world`: that hold no positions).
+AuxTargets ReadAuxTargets(const std::vector<ClipInfo>& clips, const SampleOptions& options, int phase_bins,
+                          bool world) {
   AuxTargets aux;
   aux.phase_bins = phase_bins;
+  aux.world = world;
   aux.tracks.resize(clips.size());
   std::vector<std::vector<float>> eval_targets;
   for (size_t i = 0; i < clips.size(); ++i) {
@@ -69,11 +84,15 @@ AuxTargets ReadAuxTargets(const std::vector<ClipInfo>& clips, const SampleOption
                                std::to_string(t.points()) + " points, expected the clip's " +
                                std::to_string(c.num_frames) + " frames of " + std::to_string(c.width) + "x" +
                                std::to_string(c.height) + (i > 0 ? " and the other clips' grid" : ""));
+    if (world && t.world.empty())
+      throw std::runtime_error(file.string() + ": field 'world' is missing: --aux-world needs the points' positions "
+                               "(give the dataset them with `clothwind make-dataset --add-tracks --tracks COLSxROWS` "
+                               "and the options it was made with)");
     const int first = (c.num_frames - options.frames) / 2;
     const cv::Rect whole = CentreSquare(c.width, c.height);
     try {
       for (bool flipped : {false, true})
-        eval_targets.push_back(TrackTargets(t, first, options.frames, whole, c.width, flipped, phase_bins));
+        eval_targets.push_back(AuxTargetsOf(t, first, options.frames, whole, c.width, flipped, phase_bins, world));
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(file.string() + ": " + e.what());
     }
@@ -115,8 +134,8 @@ Batch LoadBatch(const std::vector<ClipInfo>& clips, const std::vector<size_t>& i
         // A cache's crops are of its input_size squares; the files' of the clip's own frames.
         const int source_side = cache ? options.input_size : clips[clip].width;
         const std::vector<float> y =
-            TrackTargets(aux->tracks[clip], sample.first_frame, options.frames, sample.crop, source_side,
-                         sample.flipped, aux->phase_bins);
+            AuxTargetsOf(aux->tracks[clip], sample.first_frame, options.frames, sample.crop, source_side,
+                         sample.flipped, aux->phase_bins, aux->world);
         float* row = b.aux.data_ptr<float>() + i * aux->outputs();
         for (int k = 0; k < aux->outputs(); ++k) row[k] = (y[k] - aux->scale.mean[k]) / aux->scale.std[k];
       }
@@ -292,9 +311,13 @@ TrainResult Train(const TrainOptions& o) {
     throw std::runtime_error("aux_phase_bins: must be in [0, " + std::to_string(kTrackBins) +
                              "], and above 0 only with an auxiliary loss (--aux-tracks W > 0)");
   if (o.resume) RefuseChangedOnResume(state_path, "--aux-phases", state.value("aux_phase_bins", 0), o.aux_phase_bins);
+  if (o.aux_world && o.aux_tracks <= 0)
+    throw std::runtime_error("aux_world: the points' positions are regressed only with an auxiliary loss "
+                             "(--aux-tracks W > 0)");
+  if (o.resume) RefuseChangedOnResume(state_path, "--aux-world", state.value("aux_world", false), o.aux_world);
   std::unique_ptr<AuxTargets> aux;
   if (o.aux_tracks > 0 && !train.empty()) {
-    aux = std::make_unique<AuxTargets>(ReadAuxTargets(train, config.Sampling(), o.aux_phase_bins));
+    aux = std::make_unique<AuxTargets>(ReadAuxTargets(train, config.Sampling(), o.aux_phase_bins, o.aux_world));
     if (o.resume && config.aux_outputs != aux->outputs()) {
       throw std::runtime_error(state_path.string() + ": the run's auxiliary head has " +
                                std::to_string(config.aux_outputs) + " outputs, the dataset's tracks give " +
@@ -439,7 +462,7 @@ TrainResult Train(const TrainOptions& o) {
     for (const EpochRecord& e : result.log) log.push_back(EpochJson(e));
     state = {{"epoch", epoch}, {"model", ToJson(config)}, {"log", log}, {"seed", o.seed},
              {"crop_scales", o.crop_scales}, {"aux_tracks", o.aux_tracks},
-             {"aux_phase_bins", o.aux_phase_bins},
+             {"aux_phase_bins", o.aux_phase_bins}, {"aux_world", o.aux_world},
              {"best_val_rmse", result.best_val_rmse}};
     WriteFileAtomically(state_path, state.dump(2));
     WriteFileAtomically(o.out / "log.tsv", LogTsv(result.log));

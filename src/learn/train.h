@@ -53,6 +53,9 @@ struct TrainOptions {
   // With aux_tracks > 0: also regress each point's phase relative to a fly corner's at DFT bins
   // 1..aux_phase_bins (TrackTargets' phase_bins; 0: none), the travelling wave the oracle reads.
   int aux_phase_bins = 0;
+  // With aux_tracks > 0: also regress the points' positions and motion in metres
+  // (WorldTrackTargets, from tracks.json's "world"): the cloth's shape whatever camera filmed it.
+  bool aux_world = false;
   uint64_t seed = 1;
   std::function<void(const TrainProgress&)> progress;  // after each batch (may be empty)
   std::function<void(const EpochRecord&)> epoch_done;  // after each epoch (may be empty)

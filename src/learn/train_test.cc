@@ -770,22 +770,27 @@ TEST_F(TrainTest, FlowChannelsTrainRoundTripAndAreRefusedWhenInconsistent) {
 }
 
 // Gives every clip of the dataset in `dir` a tracks.json: a 2x2 grid whose points swing 1.5 px
-// across at the clip's stripe frequency (1 + 0.5 v Hz, ToyDatasetOptions' defaults).
-void WriteToyTracks(const fs::path& dir) {
+// across at the clip's stripe frequency (1 + 0.5 v Hz, ToyDatasetOptions' defaults); with
+// `world`, also their positions, swinging 0.1 m across the wind at that frequency.
+void WriteToyTracks(const fs::path& dir, bool world = false) {
   for (const ClipInfo& c : ReadDataset(dir).clips) {
     const double f = 1.0 + 0.5 * c.wind_speed;
-    nlohmann::json xy = nlohmann::json::array();
+    nlohmann::json xy = nlohmann::json::array(), xyz = nlohmann::json::array();
     for (int k = 0; k < c.num_frames; ++k) {
-      nlohmann::json row = nlohmann::json::array();
+      nlohmann::json row = nlohmann::json::array(), row3 = nlohmann::json::array();
       for (int p = 0; p < 4; ++p) {
-        row.push_back(8.0 + 16 * (p / 2) + 1.5 * std::sin(2 * M_PI * f * k / c.frame_rate + p));
+        const double swing = std::sin(2 * M_PI * f * k / c.frame_rate + p);
+        row.push_back(8.0 + 16 * (p / 2) + 1.5 * swing);
         row.push_back(8.0 + 16 * (p % 2));
+        for (double v : {1.5 * (p / 2), 0.1 * swing, 1.0 * (p % 2)}) row3.push_back(v);
       }
       xy.push_back(row);
+      xyz.push_back(row3);
     }
-    std::ofstream(c.dir / "tracks.json") << nlohmann::json{{"format", "clothwind-tracks"}, {"version", 1},
-                                                           {"grid", {2, 2}}, {"width", c.width},
-                                                           {"height", c.height}, {"xy", xy}}.dump();
+    nlohmann::json j = {{"format", "clothwind-tracks"}, {"version", 1},         {"grid", {2, 2}},
+                        {"width", c.width},             {"height", c.height}, {"xy", xy}};
+    if (world) j["world"] = xyz;
+    std::ofstream(c.dir / "tracks.json") << j.dump();
   }
 }
 
@@ -830,6 +835,26 @@ TEST_F(TrainTest, AuxTracksTrainASecondHeadOnTheClipsTracks) {
   without.out = *root_ / "aux_phases_alone";
   without.aux_tracks = 0;
   ExpectTrainRefused(without, "phase targets without the auxiliary loss were accepted", {"aux_phase_bins"});
+  // The points' positions add kWorldTargetsPerPoint a point; tracks without them are refused, naming
+  // the file and the field, and so is a resume that changes the flag.
+  TrainOptions world = t;
+  world.out = *root_ / "aux_world";
+  world.epochs = 1;
+  world.aux_world = true;
+  ExpectTrainRefused(world, "--aux-world on tracks without positions was accepted", {"tracks.json", "'world'"});
+  fs::copy(*root_ / "data", *root_ / "data_world", fs::copy_options::recursive);
+  WriteToyTracks(*root_ / "data_world", /*world=*/true);
+  world.data = *root_ / "data_world";
+  EXPECT_EQ(LoadWindNet(Train(world).model)->config().aux_outputs, 4 * (kTargetsPerPoint + kWorldTargetsPerPoint));
+  TrainOptions changed = world;
+  changed.epochs = 2;
+  changed.resume = true;
+  changed.aux_world = false;
+  ExpectTrainRefused(changed, "a resume without the run's --aux-world was accepted", {"--aux-world"});
+  TrainOptions alone = world;
+  alone.out = *root_ / "aux_world_alone";
+  alone.aux_tracks = 0;
+  ExpectTrainRefused(alone, "positions without the auxiliary loss were accepted", {"aux_world"});
 }
 
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
