@@ -9,6 +9,23 @@
 
 namespace clothwind::learn {
 
+namespace {
+
+// Appends the rows of `rows` (one array per frame, each `per_row` numbers) to `out`, naming
+// `where` + 'name[k]' and what each point holds (`coordinates`, e.g. "x, y") in the error when a
+// row is not an array of that length: xy and world share the layout, point after point.
+void AppendFrameRows(const nlohmann::json& rows, const std::string& where, const std::string& name, int per_row,
+                     const std::string& coordinates, std::vector<float>& out) {
+  for (size_t k = 0; k < rows.size(); ++k) {
+    if (!rows[k].is_array() || static_cast<int>(rows[k].size()) != per_row)
+      throw std::runtime_error(where + "'" + name + "[" + std::to_string(k) + "]' must hold " +
+                               std::to_string(per_row) + " coordinates (" + coordinates + " of each grid point)");
+    for (const auto& value : rows[k]) out.push_back(value.get<float>());
+  }
+}
+
+}  // namespace
+
 Tracks ReadTracks(const std::filesystem::path& file) {
   const nlohmann::json j = ReadJson(file);
   const std::string where = file.string() + ": field ";
@@ -32,24 +49,14 @@ Tracks ReadTracks(const std::filesystem::path& file) {
     if (!xy.is_array() || xy.empty()) throw std::runtime_error(where + "'xy' must be a non-empty array of frames");
     t.frames = static_cast<int>(xy.size());
     t.xy.reserve(static_cast<size_t>(t.frames) * 2 * t.points());
-    for (int k = 0; k < t.frames; ++k) {
-      if (!xy[k].is_array() || static_cast<int>(xy[k].size()) != 2 * t.points())
-        throw std::runtime_error(where + "'xy[" + std::to_string(k) + "]' must hold " +
-                                 std::to_string(2 * t.points()) + " coordinates (x, y of each grid point)");
-      for (const auto& value : xy[k]) t.xy.push_back(value.get<float>());
-    }
+    AppendFrameRows(xy, where, "xy", 2 * t.points(), "x, y", t.xy);
     if (j.contains("world")) {
       const nlohmann::json& world = j["world"];
       if (!world.is_array() || static_cast<int>(world.size()) != t.frames)
         throw std::runtime_error(where + "'world' must hold one row per frame of 'xy' (" + std::to_string(t.frames) +
                                  ")");
       t.world.reserve(static_cast<size_t>(t.frames) * 3 * t.points());
-      for (int k = 0; k < t.frames; ++k) {
-        if (!world[k].is_array() || static_cast<int>(world[k].size()) != 3 * t.points())
-          throw std::runtime_error(where + "'world[" + std::to_string(k) + "]' must hold " +
-                                   std::to_string(3 * t.points()) + " coordinates (x, y, z of each grid point)");
-        for (const auto& value : world[k]) t.world.push_back(value.get<float>());
-      }
+      AppendFrameRows(world, where, "world", 3 * t.points(), "x, y, z", t.world);
     }
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(file.string() + ": " + e.what());
