@@ -16,6 +16,7 @@ namespace {
 // row is not an array of that length: xy and world share the layout, point after point.
 void AppendFrameRows(const nlohmann::json& rows, const std::string& where, const std::string& name, int per_row,
                      const std::string& coordinates, std::vector<float>& out) {
+  out.reserve(out.size() + rows.size() * static_cast<size_t>(per_row));
   for (size_t k = 0; k < rows.size(); ++k) {
     if (!rows[k].is_array() || static_cast<int>(rows[k].size()) != per_row)
       throw std::runtime_error(where + "'" + name + "[" + std::to_string(k) + "]' must hold " +
@@ -48,14 +49,12 @@ Tracks ReadTracks(const std::filesystem::path& file) {
     const nlohmann::json& xy = need("xy");
     if (!xy.is_array() || xy.empty()) throw std::runtime_error(where + "'xy' must be a non-empty array of frames");
     t.frames = static_cast<int>(xy.size());
-    t.xy.reserve(static_cast<size_t>(t.frames) * 2 * t.points());
     AppendFrameRows(xy, where, "xy", 2 * t.points(), "x, y", t.xy);
     if (j.contains("world")) {
       const nlohmann::json& world = j["world"];
       if (!world.is_array() || static_cast<int>(world.size()) != t.frames)
         throw std::runtime_error(where + "'world' must hold one row per frame of 'xy' (" + std::to_string(t.frames) +
                                  ")");
-      t.world.reserve(static_cast<size_t>(t.frames) * 3 * t.points());
       AppendFrameRows(world, where, "world", 3 * t.points(), "x, y, z", t.world);
     }
   } catch (const nlohmann::json::exception& e) {
