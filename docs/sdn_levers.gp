@@ -24,7 +24,7 @@ $levers << EOD
 17 0.419 0.421 1 "the head also regresses metres, --aux-world (e2)"
 18 0.414 0.412 1 "no stem pool (e3)"
 19 0.414 0.407 1 "128-px spectra pooled (e3)"
-20 0.419 0.387 1 "128-px spectra pooled, with the head (e2)"
+20 0.420 0.394 1 "128-px spectra pooled, with the head (e2, 2 seeds)"
 21 0.383 0.373 1 "width 64 (e5)"
 22 0.383 0.377 1 "60 frames at once (e5)"
 23 0.383 0.380 1 "26 epochs (e5)"
