@@ -109,6 +109,12 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_flag("--aux-world", o.aux_world,
                 "with --aux-tracks: the auxiliary head also regresses the points' positions and motion in metres "
                 "(tracks.json's \"world\": the cloth's shape whatever camera filmed it)");
+  sub->add_option("--weight-average", o.weight_average,
+                  "decay of an exponential moving average of the weights, updated every step (0: off; 0.999: "
+                  "over ~1000 steps); validation then reads the average, model.pt is its best epoch and "
+                  "raw_model.pt the trained weights' best")
+      ->check(CLI::Range(0.0, 0.9999999))
+      ->capture_default_str();
   sub->add_flag("--init-only", o.init_only, "write an initialised (untrained) model and stop (tests, smoke runs)");
   sub->add_option("--lr", o.lr, "initial learning rate (Adam)")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--lr-schedule", o.lr_schedule,
@@ -159,6 +165,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                 << "  train loss " << e.train_loss << " rmse " << e.train_rmse << "  val loss " << e.val_loss
                 << " rmse " << e.val_rmse << " acc@0.5 " << e.val_acc05;
       if (o.aux_tracks > 0) std::cout << "  aux loss " << e.train_aux_loss;
+      if (o.weight_average > 0) std::cout << "  (trained weights: val rmse " << e.raw_val_rmse << ")";
       std::cout << "  " << std::setprecision(1) << e.seconds << " s" << std::endl;
     };
     const learn::TrainResult r = learn::Train(o);

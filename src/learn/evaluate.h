@@ -128,6 +128,9 @@ struct EpochRecord {
   double val_acc05 = 0;
   double seconds = 0;                   // wall time of the epoch
   double train_aux_loss = 0;            // AuxLoss over the epoch (0 without auxiliary targets)
+  // With a weight average (TrainOptions::weight_average), val_rmse is the average's and this the
+  // trained weights' own [m/s]; 0 without one.
+  double raw_val_rmse = 0;
 };
 
 // Training and validation RMSE per epoch as a PNG via gnuplot (atomically).

@@ -27,6 +27,7 @@
 #include "learn/frame_cache.h"
 #include "learn/networks.h"
 #include "learn/track_targets.h"
+#include "learn/weight_average.h"
 
 namespace clothwind::learn {
 namespace fs = std::filesystem;
@@ -153,7 +154,8 @@ Batch LoadBatch(const std::vector<ClipInfo>& clips, const std::vector<size_t>& i
 nlohmann::json EpochJson(const EpochRecord& e) {
   return {{"epoch", e.epoch},         {"lr", e.lr},           {"train_loss", e.train_loss},
           {"val_loss", e.val_loss},   {"train_rmse", e.train_rmse}, {"val_rmse", e.val_rmse},
-          {"val_acc05", e.val_acc05}, {"seconds", e.seconds}, {"train_aux_loss", e.train_aux_loss}};
+          {"val_acc05", e.val_acc05}, {"seconds", e.seconds}, {"train_aux_loss", e.train_aux_loss},
+          {"raw_val_rmse", e.raw_val_rmse}};
 }
 
 EpochRecord EpochFromJson(const nlohmann::json& j) {
@@ -167,16 +169,18 @@ EpochRecord EpochFromJson(const nlohmann::json& j) {
   e.val_acc05 = j.at("val_acc05").get<double>();
   e.seconds = j.at("seconds").get<double>();
   e.train_aux_loss = j.value("train_aux_loss", 0.0);  // absent in runs from before auxiliary targets
+  e.raw_val_rmse = j.value("raw_val_rmse", 0.0);      // absent in runs from before weight averages
   return e;
 }
 
 std::string LogTsv(const std::vector<EpochRecord>& log) {
   std::ostringstream s;
-  s << "epoch\tlr\ttrain_loss\tval_loss\ttrain_rmse\tval_rmse\tval_acc05\tseconds\ttrain_aux_loss\n"
+  s << "epoch\tlr\ttrain_loss\tval_loss\ttrain_rmse\tval_rmse\tval_acc05\tseconds\ttrain_aux_loss\traw_val_rmse\n"
     << std::setprecision(6);
   for (const EpochRecord& e : log) {
     s << e.epoch << "\t" << e.lr << "\t" << e.train_loss << "\t" << e.val_loss << "\t" << e.train_rmse << "\t"
-      << e.val_rmse << "\t" << e.val_acc05 << "\t" << e.seconds << "\t" << e.train_aux_loss << "\n";
+      << e.val_rmse << "\t" << e.val_acc05 << "\t" << e.seconds << "\t" << e.train_aux_loss << "\t"
+      << e.raw_val_rmse << "\n";
   }
   return s.str();
 }
@@ -197,6 +201,37 @@ void RefuseChangedOnResume(const fs::path& state_path, const std::string& flag, 
   throw std::runtime_error(state_path.string() + ": the run trained with " + flag + " " + std::to_string(ran) +
                            ", these options give " + std::to_string(given) + "; resume with the " + flag +
                            " the run started with");
+}
+
+// A network's validation: mean WindLoss (normalised units) and metrics in m/s.
+struct Validation {
+  double loss = 0;
+  Metrics metrics;
+};
+
+// Validates `model` (put in eval mode) on `val` in batches of `batch`, as evaluation reads clips.
+Validation Validate(WindNet& model, const std::vector<ClipInfo>& val, int batch, const SampleOptions& options,
+                    FrameCache* cache, const ModelConfig& config, const at::Device& device) {
+  model->eval();
+  at::NoGradGuard no_grad;
+  const float mean = static_cast<float>(config.label_mean), inv_std = static_cast<float>(1.0 / config.label_std);
+  std::vector<size_t> all(val.size());
+  std::iota(all.begin(), all.end(), 0);
+  std::vector<double> truth, predicted;
+  double loss = 0;
+  for (size_t b = 0; b < all.size(); b += batch) {
+    Batch clips = LoadBatch(val, all, b, std::min(all.size(), b + batch), options, 0, cache, nullptr);
+    at::Tensor y = (clips.speeds - mean) * inv_std;
+    at::Tensor out = model->forward(clips.clips.to(device)).to(at::kCPU);
+    loss += WindLoss(out, y).item<double>() * y.size(0);
+    at::Tensor speed = (out.select(1, 0) * config.label_std + config.label_mean).to(at::kDouble).contiguous();
+    at::Tensor label = clips.speeds.to(at::kDouble).contiguous();
+    for (int64_t i = 0; i < y.size(0); ++i) {
+      predicted.push_back(speed.data_ptr<double>()[i]);
+      truth.push_back(label.data_ptr<double>()[i]);
+    }
+  }
+  return {loss / std::max<size_t>(val.size(), 1), ComputeMetrics(truth, predicted)};
 }
 
 }  // namespace
@@ -315,6 +350,13 @@ TrainResult Train(const TrainOptions& o) {
     throw std::runtime_error("aux_world: the points' positions are regressed only with an auxiliary loss "
                              "(--aux-tracks W > 0)");
   if (o.resume) RefuseChangedOnResume(state_path, "--aux-world", state.value("aux_world", false), o.aux_world);
+  if (!(o.weight_average >= 0 && o.weight_average < 1)) {
+    throw std::runtime_error("weight_average: the average's decay must lie in [0, 1), got " +
+                             std::to_string(o.weight_average));
+  }
+  if (o.resume) {
+    RefuseChangedOnResume(state_path, "--weight-average", state.value("weight_average", 0.0), o.weight_average);
+  }
   std::unique_ptr<AuxTargets> aux;
   if (o.aux_tracks > 0 && !train.empty()) {
     aux = std::make_unique<AuxTargets>(ReadAuxTargets(train, config.Sampling(), o.aux_phase_bins, o.aux_world));
@@ -333,6 +375,19 @@ TrainResult Train(const TrainOptions& o) {
     torch::load(net, last.string(), at::Device(at::kCPU));
     torch::load(optimizer, last_optim.string(), at::Device(at::kCPU));
   }
+  // The weight average starts at the initial weights and lives beside them on the device.
+  const fs::path last_average = o.out / "last_average.pt", raw_model = o.out / "raw_model.pt";
+  WindNet average{nullptr};
+  int64_t average_steps = 0;
+  if (o.weight_average > 0) {
+    average = WindNet(config);
+    CopyWeights(*net, *average);
+    if (o.resume) {
+      torch::load(average, last_average.string(), at::Device(at::kCPU));
+      average_steps = state.value("average_steps", int64_t{0});
+    }
+    average->to(device);
+  }
   net->to(device);
   for (auto& entry : optimizer.state()) {  // Adam's moments live beside their parameters
     auto& state = static_cast<torch::optim::AdamParamState&>(*entry.second);
@@ -346,7 +401,11 @@ TrainResult Train(const TrainOptions& o) {
   }
 
   result.best_val_rmse = std::numeric_limits<double>::infinity();
-  for (const EpochRecord& e : result.log) result.best_val_rmse = std::min(result.best_val_rmse, e.val_rmse);
+  double best_raw_val_rmse = std::numeric_limits<double>::infinity();
+  for (const EpochRecord& e : result.log) {
+    result.best_val_rmse = std::min(result.best_val_rmse, e.val_rmse);
+    best_raw_val_rmse = std::min(best_raw_val_rmse, e.raw_val_rmse);
+  }
   const SampleOptions val_options = config.Sampling();
   SampleOptions train_options = config.Sampling();
   train_options.augment = true;
@@ -410,6 +469,7 @@ TrainResult Train(const TrainOptions& o) {
       loss.backward();
       if (grad_clip > 0) torch::nn::utils::clip_grad_norm_(net->parameters(), grad_clip);
       optimizer.step();
+      if (!average.is_empty()) BlendWeights(*net, *average, AverageDecayAt(o.weight_average, average_steps++));
       const int64_t n = x.size(0);
       loss_sum += loss.item<double>() * n;
       se_sum += ((out.select(1, 0).detach() - y).square().sum()).item<double>() * config.label_std * config.label_std;
@@ -420,49 +480,39 @@ TrainResult Train(const TrainOptions& o) {
     record.train_rmse = std::sqrt(se_sum / std::max<size_t>(seen, 1));
     record.train_aux_loss = aux_sum / std::max<size_t>(seen, 1);
 
-    // Validation: evaluation preprocessing, no augmentation.
-    net->eval();
-    {
-      at::NoGradGuard no_grad;
-      std::vector<size_t> all(val.size());
-      std::iota(all.begin(), all.end(), 0);
-      std::vector<double> truth, predicted;
-      double val_loss = 0;
-      for (size_t b = 0; b < all.size(); b += o.batch) {
-        Batch batch =
-            LoadBatch(val, all, b, std::min(all.size(), b + o.batch), val_options, 0, val_cache.get(), nullptr);
-        at::Tensor y = (batch.speeds - mean) * inv_std;
-        at::Tensor out = net->forward(batch.clips.to(device)).to(at::kCPU);
-        val_loss += WindLoss(out, y).item<double>() * y.size(0);
-        at::Tensor speed = (out.select(1, 0) * config.label_std + config.label_mean).to(at::kDouble).contiguous();
-        at::Tensor label = batch.speeds.to(at::kDouble).contiguous();
-        for (int64_t i = 0; i < y.size(0); ++i) {
-          predicted.push_back(speed.data_ptr<double>()[i]);
-          truth.push_back(label.data_ptr<double>()[i]);
-        }
-      }
-      const Metrics m = ComputeMetrics(truth, predicted);
-      record.val_loss = val_loss / std::max<size_t>(val.size(), 1);
-      record.val_rmse = m.rmse;
-      record.val_acc05 = m.acc05;
-    }
+    // Validation: evaluation preprocessing, no augmentation; the average's, when there is one.
+    const Validation raw = Validate(net, val, o.batch, val_options, val_cache.get(), config, device);
+    const Validation chosen =
+        average.is_empty() ? raw : Validate(average, val, o.batch, val_options, val_cache.get(), config, device);
+    record.val_loss = chosen.loss;
+    record.val_rmse = chosen.metrics.rmse;
+    record.val_acc05 = chosen.metrics.acc05;
+    if (!average.is_empty()) record.raw_val_rmse = raw.metrics.rmse;
     record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.log.push_back(record);
 
     // Checkpoint: weights on the CPU so any machine can load them.
     net->to(at::kCPU);
+    if (!average.is_empty()) average->to(at::kCPU);
     if (record.val_rmse < result.best_val_rmse) {
       result.best_val_rmse = record.val_rmse;
-      SaveWindNet(net, result.model);
+      SaveWindNet(average.is_empty() ? net : average, result.model);
+    }
+    if (!average.is_empty() && record.raw_val_rmse < best_raw_val_rmse) {
+      best_raw_val_rmse = record.raw_val_rmse;
+      SaveWindNet(net, raw_model);
     }
     SaveAtomically(net, last);
+    if (!average.is_empty()) SaveAtomically(average, last_average);
     net->to(device);
+    if (!average.is_empty()) average->to(device);
     SaveAtomically(optimizer, last_optim);
     nlohmann::json log = nlohmann::json::array();
     for (const EpochRecord& e : result.log) log.push_back(EpochJson(e));
     state = {{"epoch", epoch}, {"model", ToJson(config)}, {"log", log}, {"seed", o.seed},
              {"crop_scales", o.crop_scales}, {"aux_tracks", o.aux_tracks},
              {"aux_phase_bins", o.aux_phase_bins}, {"aux_world", o.aux_world},
+             {"weight_average", o.weight_average}, {"average_steps", average_steps},
              {"best_val_rmse", result.best_val_rmse}};
     WriteFileAtomically(state_path, state.dump(2));
     WriteFileAtomically(o.out / "log.tsv", LogTsv(result.log));

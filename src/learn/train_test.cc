@@ -713,6 +713,44 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
 }
 
+// With a weight average, validation reads the average and model.pt holds its best epoch while
+// raw_model.pt holds the trained weights' best: each reproduces its column of the log when
+// evaluated. A resumed run restores the average and repeats the uninterrupted run's epoch.
+TEST_F(TrainTest, WeightAverageIsWhatModelHoldsAndResumes) {
+  TrainOptions t = Options("sdn", "average");
+  t.epochs = 3;
+  t.weight_average = 0.9;
+  const TrainResult r = Train(t);
+  ASSERT_EQ(r.log.size(), 3u);
+  double best_raw = 1e9, largest_gap = 0;
+  for (const EpochRecord& e : r.log) {
+    EXPECT_GT(e.raw_val_rmse, 0.0) << e.epoch;
+    best_raw = std::min(best_raw, e.raw_val_rmse);
+    largest_gap = std::max(largest_gap, std::abs(e.val_rmse - e.raw_val_rmse));
+  }
+  EXPECT_GT(largest_gap, 1e-4);  // the average is not the trained weights
+  EXPECT_NEAR(Evaluate(r.model, *root_ / "data", "val", 2, "cpu", 8).metrics.rmse, r.best_val_rmse, 1e-4);
+  EXPECT_NEAR(Evaluate(t.out / "raw_model.pt", *root_ / "data", "val", 2, "cpu", 8).metrics.rmse, best_raw, 1e-4);
+
+  TrainOptions u = Options("sdn", "average_resumed");
+  u.weight_average = 0.9;
+  u.epochs = 2;
+  Train(u);
+  u.epochs = 3;
+  u.resume = true;
+  const TrainResult resumed = Train(u);
+  ASSERT_EQ(resumed.log.size(), 3u);
+  EXPECT_NEAR(resumed.log[2].val_rmse, r.log[2].val_rmse, 1e-5);
+  EXPECT_NEAR(resumed.log[2].raw_val_rmse, r.log[2].raw_val_rmse, 1e-5);
+
+  u.weight_average = 0.99;  // another average than the run's
+  ExpectTrainRefused(u, "a resume with another weight average was accepted",
+                     {"state.json: the run trained with --weight-average", "--weight-average"});
+  TrainOptions w = Options("sdn", "average_bad");
+  w.weight_average = 1.0;
+  ExpectTrainRefused(w, "a weight average that never moves was accepted", {"weight_average", "[0, 1)"});
+}
+
 TEST_F(TrainTest, CropScalesOutsideTheFrameAreRefused) {
   for (const std::vector<double>& scales : {std::vector<double>{}, {1.0, 0.0}, {1.2}}) {
     TrainOptions t = Options("sdn", "bad_scales");
