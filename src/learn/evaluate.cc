@@ -299,15 +299,20 @@ bool PlotPredictions(const EvalResult& r, const fs::path& png, std::string* erro
 bool PlotLearningCurve(const std::vector<EpochRecord>& log, const fs::path& png, std::string* error) {
   const fs::path data = png.string() + ".dat";
   std::ostringstream d;
-  d << "# epoch train_rmse val_rmse train_loss val_loss\n";
+  d << "# epoch train_rmse val_rmse train_loss val_loss raw_val_rmse\n";
+  bool averaged = false;  // a run with a weight average also draws its trained weights' validation
   for (const EpochRecord& e : log) {
-    d << e.epoch << " " << e.train_rmse << " " << e.val_rmse << " " << e.train_loss << " " << e.val_loss << "\n";
+    d << e.epoch << " " << e.train_rmse << " " << e.val_rmse << " " << e.train_loss << " " << e.val_loss << " "
+      << e.raw_val_rmse << "\n";
+    averaged = averaged || e.raw_val_rmse > 0;
   }
   WriteFileAtomically(data, d.str());
   std::ostringstream s;
   s << "set title 'learning curve'\nset xlabel 'epoch'\nset ylabel 'RMSE [m/s]'\nset grid\nset key top right\n"
     << "plot '" << data.string() << "' using 1:2 with linespoints title 'train RMSE', '' using 1:3 with "
-    << "linespoints title 'validation RMSE'\n";
+    << "linespoints title '" << (averaged ? "validation RMSE (weight average)" : "validation RMSE") << "'";
+  if (averaged) s << ", '' using 1:6 with linespoints title 'validation RMSE (trained weights)'";
+  s << "\n";
   return RunGnuplot(s.str(), png, error);
 }
 

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <unistd.h>
 
 #include <ATen/ATen.h>
@@ -731,6 +732,20 @@ TEST_F(TrainTest, WeightAverageIsWhatModelHoldsAndResumes) {
   EXPECT_GT(largest_gap, 1e-4);  // the average is not the trained weights
   EXPECT_NEAR(Evaluate(r.model, *root_ / "data", "val", 2, "cpu", 8).metrics.rmse, r.best_val_rmse, 1e-4);
   EXPECT_NEAR(Evaluate(t.out / "raw_model.pt", *root_ / "data", "val", 2, "cpu", 8).metrics.rmse, best_raw, 1e-4);
+  // The learning curve's data carries both validations (the sixth column is the trained weights').
+  std::ifstream curve(t.out / "learning_curve.png.dat");
+  std::string header, line;
+  std::getline(curve, header);
+  EXPECT_NE(header.find("raw_val_rmse"), std::string::npos) << header;
+  for (const EpochRecord& e : r.log) {
+    ASSERT_TRUE(std::getline(curve, line));
+    std::istringstream row(line);
+    double c[6];
+    for (double& x : c) row >> x;
+    EXPECT_NEAR(c[2], e.val_rmse, 1e-4 * e.val_rmse);
+    EXPECT_NEAR(c[5], e.raw_val_rmse, 1e-4 * e.raw_val_rmse);
+  }
+  EXPECT_TRUE(fs::exists(t.out / "learning_curve.png"));
 
   TrainOptions u = Options("sdn", "average_resumed");
   u.weight_average = 0.9;
