@@ -110,8 +110,8 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                 "with --aux-tracks: the auxiliary head also regresses the points' positions and motion in metres "
                 "(tracks.json's \"world\": the cloth's shape whatever camera filmed it)");
   sub->add_option("--weight-average", o.weight_average,
-                  "decay of an exponential moving average of the weights, updated every step (0: off; 0.999: "
-                  "over ~1000 steps); validation then reads the average, model.pt is its best epoch and "
+                  "decay of an exponential moving average of the weights, updated every step (0: off); until "
+                  "step 9/(1-D)-10 (8990 for 0.999) a warm-up keeps it over the last ~1/9 of the steps; validation then reads the average, model.pt is its best epoch and "
                   "raw_model.pt the trained weights' best")
       ->check(CLI::Range(0.0, 0.9999999))
       ->capture_default_str();

@@ -57,7 +57,7 @@ struct TrainOptions {
   // (WorldTrackTargets, from tracks.json's "world"): the cloth's shape whatever camera filmed it.
   bool aux_world = false;
   // Decay of an exponential moving average of the weights, updated after every step
-  // (learn/weight_average.h; 0: off; 0.999 averages over ~1000 steps). With it, validation reads
+  // (learn/weight_average.h, with its warm-up; 0: off). With it, validation reads
   // the average, model.pt is the average's best epoch and raw_model.pt the trained weights' best,
   // and the log keeps both validations: one run measures what the average is worth.
   double weight_average = 0;

@@ -22,9 +22,10 @@ void CopyWeights(const torch::nn::Module& from, torch::nn::Module& to);
 // Throws std::runtime_error as CopyWeights, and for d outside [0, 1].
 void BlendWeights(const torch::nn::Module& from, torch::nn::Module& to, double d);
 
-// The decay of averaging step `t` (0-based): min(decay, (1 + t) / (10 + t)). Early steps,
-// taken from random initial weights, would otherwise linger in the mean for ~1 / (1 − decay)
-// steps; this warm-up lets the mean follow them until it has seen about as many steps.
+// The decay of averaging step `t` (0-based): min(decay, (1 + t) / (10 + t)) (TensorFlow's and
+// timm's warm-up). Early steps, taken from random initial weights, would otherwise linger in the
+// mean for ~1 / (1 − decay) steps. With the warm-up the mean spans about the last t / 9 steps
+// until the cap binds, from t = 9 / (1 − decay) − 10 on (8990 steps for 0.999).
 // Inputs: decay in [0, 1); t >= 0.
 double AverageDecayAt(double decay, int64_t t);
 
