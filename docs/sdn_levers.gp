@@ -26,7 +26,7 @@ $levers << EOD
 19 0.414 0.407 1 "128-px spectra pooled (e3)"
 20 0.420 0.394 1 "128-px spectra pooled, with the head (e2, 2 seeds)"
 21 0.396 0.385 1 "128-px spectra pooled, with the head (e3)"
-22 0.437 0.428 1 "weight average 0.999 (e2, 2 seeds, paired)"
+22 0.437 0.429 1 "weight average (e2, 4 paired runs)"
 23 0.383 0.373 1 "width 64 (e5)"
 24 0.383 0.377 1 "60 frames at once (e5)"
 25 0.383 0.380 1 "26 epochs (e5)"
