@@ -10,6 +10,8 @@
 
 #include <ATen/ATen.h>
 
+#include "learn/weight_average.h"
+
 namespace clothwind::learn {
 namespace {
 
@@ -196,11 +198,7 @@ WindNet WithoutAuxHead(WindNet& net) {
   ModelConfig config = net->config();
   config.aux_outputs = 0;
   WindNet stripped(config);
-  torch::NoGradGuard no_grad;
-  const auto from_parameters = net->named_parameters();
-  const auto from_buffers = net->named_buffers();
-  for (auto& p : stripped->named_parameters()) p.value().copy_(from_parameters[p.key()].to(torch::kCPU));
-  for (auto& b : stripped->named_buffers()) b.value().copy_(from_buffers[b.key()].to(torch::kCPU));
+  CopyWeights(*net, *stripped);  // every tensor of the stripped network, by name, onto its CPU
   stripped->eval();
   return stripped;
 }
