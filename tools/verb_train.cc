@@ -85,6 +85,9 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                   "with --flow: compute the flow on the crop resized to this side [px], then bring it to "
                   "--input-size (0: at --input-size)")
       ->check(CLI::NonNegativeNumber);
+  sub->add_flag("--colour", o.model.colour,
+                "colour frames (Y, Cr, Cb: three input channels) instead of grey ones: the edges between "
+                "two colours of one grey (FlagSim's red and green) move too; not with --flow");
   sub->add_flag("--mean-map", o.model.mean_map, "SDN: add the clip's per-pixel temporal mean (the pose) as a channel");
   sub->add_option("--threads", o.threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--device", o.device, "cpu, cuda or auto (CUDA when libtorch finds one)")

@@ -130,7 +130,7 @@ std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& spl
   return out;
 }
 
-std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count) {
+std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count, bool colour) {
   if (first < 0 || count < 1 || first + count > clip.num_frames) {
     throw std::runtime_error((clip.dir / "label.json").string() + ": frames " + std::to_string(first) + ".." +
                              std::to_string(first + count - 1) + " requested but num_frames is " +
@@ -141,8 +141,9 @@ std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count) {
   for (int i = first; i < first + count; ++i) {
     const fs::path path = clip.dir / FrameName(clip, i);
     if (!fs::exists(path)) throw std::runtime_error(path.string() + ": missing frame");
-    cv::Mat image = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+    cv::Mat image = cv::imread(path.string(), colour ? cv::IMREAD_COLOR : cv::IMREAD_GRAYSCALE);
     if (image.empty()) throw std::runtime_error(path.string() + ": not a readable image");
+    if (colour) cv::cvtColor(image, image, cv::COLOR_BGR2YCrCb);
     if (image.cols != clip.width || image.rows != clip.height) {
       throw std::runtime_error(path.string() + ": image is " + std::to_string(image.cols) + "x" +
                                std::to_string(image.rows) + " but label.json says " + std::to_string(clip.width) +
@@ -232,6 +233,9 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
                                 std::to_string(options.frames) + " expected");
   }
   if (options.flow && options.frames < 2) throw std::invalid_argument("MakeSample: flow needs at least 2 frames");
+  if (options.flow && options.colour) {
+    throw std::invalid_argument("MakeSample: flow and colour are exclusive (the flow is the grey frames')");
+  }
   const int w = frames[0].cols, h = frames[0].rows;
   const int side = std::min(w, h);
   Sample sample;
@@ -254,27 +258,39 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
   const size_t grey = static_cast<size_t>(options.frames) * plane;
   sample.channels = options.channels();
   sample.pixels.resize(grey * sample.channels);
-  double sum = 0, sum2 = 0;
+  // The frames' own channels (grey, or Y Cr Cb), each normalised below; flow channels follow.
+  const int own = options.colour ? 3 : 1;
+  const int type = options.colour ? CV_8UC3 : CV_8UC1;
+  std::vector<double> sum(own, 0.0), sum2(own, 0.0);
+  cv::Mat resized;
+  std::vector<cv::Mat> split(own);
   for (int t = 0; t < options.frames; ++t) {
     const cv::Mat& f = frames[t];
-    if (f.type() != CV_8UC1 || f.cols != w || f.rows != h) {
+    if (f.type() != type || f.cols != w || f.rows != h) {
       throw std::invalid_argument("MakeSample: frame " + std::to_string(t) + " is not " + std::to_string(w) + "x" +
-                                  std::to_string(h) + " mono8");
+                                  std::to_string(h) + (options.colour ? " 8-bit YCrCb" : " mono8"));
     }
-    cv::Mat resized;
     ResizeCrop(f, sample.crop, s, resized);
     if (sample.flipped) cv::flip(resized, resized, 1);
-    cv::Mat out(s, s, CV_32F, sample.pixels.data() + static_cast<size_t>(t) * plane);
-    resized.convertTo(out, CV_32F);
-    const cv::Scalar m = cv::sum(out);
-    sum += m[0];
-    sum2 += out.dot(out);
+    if (own == 1) split[0] = resized;
+    else cv::split(resized, split);
+    for (int c = 0; c < own; ++c) {
+      cv::Mat out(s, s, CV_32F, sample.pixels.data() + grey * c + static_cast<size_t>(t) * plane);
+      split[c].convertTo(out, CV_32F);
+      sum[c] += cv::sum(out)[0];
+      sum2[c] += out.dot(out);
+    }
   }
+  // One scale for all of the frames' channels: their deviations' joint std.
   const double n = static_cast<double>(grey);
-  const double mean = sum / n;
-  const double std = std::sqrt(std::max(sum2 / n - mean * mean, 0.0));
-  const float inv = static_cast<float>(1.0 / std::max(std, 1e-3));
-  for (size_t i = 0; i < grey; ++i) sample.pixels[i] = (sample.pixels[i] - static_cast<float>(mean)) * inv;
+  double variance = 0;
+  for (int c = 0; c < own; ++c) variance += std::max(sum2[c] / n - (sum[c] / n) * (sum[c] / n), 0.0);
+  const float inv = static_cast<float>(1.0 / std::max(std::sqrt(variance / own), 1e-3));
+  for (int c = 0; c < own; ++c) {
+    const float mean = static_cast<float>(sum[c] / n);
+    float* p = sample.pixels.data() + grey * c;
+    for (size_t i = 0; i < grey; ++i) p[i] = (p[i] - mean) * inv;
+  }
   if (options.flow) {
     std::vector<cv::Mat> computed;
     if (flows == nullptr) {
@@ -329,7 +345,8 @@ Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t s
 }
 
 Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t seed) {
-  return LoadSample(clip, options, seed, [&clip](int first, int count) { return LoadFrames(clip, first, count); });
+  return LoadSample(clip, options, seed,
+                    [&clip, &options](int first, int count) { return LoadFrames(clip, first, count, options.colour); });
 }
 
 std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions& o) {

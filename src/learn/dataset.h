@@ -45,13 +45,16 @@ Dataset ReadDataset(const std::filesystem::path& dir);
 // The examples of one split ("train", "val", "test"), or all of them for "all".
 std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& split);
 
-// Frames first..first+count-1 of a clip as greyscale CV_8UC1 images (colour JPEGs converted).
+// Frames first..first+count-1 of a clip as greyscale CV_8UC1 images (colour JPEGs converted) or,
+// with `colour`, as CV_8UC3 images in YCrCb order (OpenCV's BGR2YCrCb: Y is the grey of the
+// greyscale frames, Cr and Cb say how red and how blue a pixel is beyond its grey).
 // Throws std::runtime_error naming the frame file when it is missing, unreadable or of a size
 // other than the label's.
-std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count);
+std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count, bool colour = false);
 
 // How a clip becomes a network input [C, frames, input_size, input_size]: C = 1 (greyscale, as
-// the seed) or, with `flow`, C = 3 (greyscale, then the optical flow's x and y components).
+// the seed) or, with `flow`, C = 3 (greyscale, then the optical flow's x and y components) or,
+// with `colour`, C = 3 (Y, Cr, Cb).
 struct SampleOptions {
   int frames = 30;        // N_t
   int input_size = 112;   // output side [px]
@@ -62,15 +65,22 @@ struct SampleOptions {
   // Side [px] the crop is resized to for the flow, which is then resized to input_size and
   // scaled with it (0: input_size). A finer flow reads the cloth's sub-pixel motion more exactly.
   int flow_size = 0;
+  // Colour frames (LoadFrames' YCrCb) instead of grey, why: the grey of a flag's colours can
+  // coincide (FlagSim's red and green differ by 4 of 255 in grey, sky blue and orange by 7), and
+  // a stripe edge the grey hides moves without changing a grey pixel. Not with flow.
+  bool colour = false;
   // Crop side as fractions of the frame's shorter side (multi-scale cropping, as TSN).
   std::vector<double> crop_scales = {1.0, 0.875, 0.75, 0.66};
-  // C, the channels per frame of the samples these options make: 1 (grey), 3 with flow.
-  int channels() const { return flow ? 3 : 1; }
+  // C, the channels per frame of the samples these options make: 1 (grey), 3 with flow or colour.
+  int channels() const { return flow || colour ? 3 : 1; }
 };
 
 // A network input with the augmentation that produced it (for tests and logs).
 struct Sample {
   // C x frames x input_size x input_size. Channel 0: grey, per-clip zero mean and unit std.
+  // Channels 1, 2 (options.colour): Cr and Cb, each less its per-clip mean, divided by the one
+  // std of all three channels' deviations together (so a flag whose colours share one grey keeps
+  // its colour edges at their strength, and a black-and-white one gets no amplified JPEG noise).
   // Channels 1, 2 (options.flow): flow x (right) and y (down) [input pixels per frame], unnormalised:
   // how far the cloth moves is the measurement, so it keeps its scale.
   std::vector<float> pixels;
@@ -117,7 +127,8 @@ std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames, const cv::R
 // The same for frames that are already the sample's squares (crop: all of them; flow_side = side).
 std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames);
 
-// Turns greyscale frames (all of one size, count = options.frames) into a Sample: crop (random
+// Turns greyscale frames (all of one size, count = options.frames; CV_8UC3 YCrCb with
+// options.colour) into a Sample: crop (random
 // multi-scale position and size when augmenting, the centred square of the shorter side
 // otherwise), resize to input_size (area interpolation), flip horizontally with probability
 // 1/2 when augmenting (always when options.mirror and not augmenting), and normalise the whole clip to zero mean and unit standard deviation.

@@ -83,6 +83,16 @@ TEST_F(DatasetTest, ReadsIndexLabelsAndFrames) {
   EXPECT_EQ(frames[0].type(), CV_8UC1);
   EXPECT_EQ(frames[0].size(), cv::Size(48, 48));
   EXPECT_THROW(LoadFrames(d.clips[0], 38, 3), std::runtime_error);
+  // In colour, YCrCb: the toy's frames are grey, so Y is the grey frame and Cr, Cb sit at 128.
+  const std::vector<cv::Mat> colour = LoadFrames(d.clips[0], 5, 3, true);
+  ASSERT_EQ(colour.size(), 3u);
+  ASSERT_EQ(colour[0].type(), CV_8UC3);
+  std::vector<cv::Mat> ycc;
+  cv::split(colour[1], ycc);
+  EXPECT_LE(cv::norm(ycc[0], frames[1], cv::NORM_INF), 1.0);
+  EXPECT_LE(cv::norm(ycc[1], cv::Mat(48, 48, CV_8U, cv::Scalar(128)), cv::NORM_INF), 1.0);
+  EXPECT_LE(cv::norm(ycc[2], cv::Mat(48, 48, CV_8U, cv::Scalar(128)), cv::NORM_INF), 1.0);
+  EXPECT_THROW(LoadFrames(d.clips[0], 38, 3, true), std::runtime_error);
 }
 
 TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
@@ -379,6 +389,96 @@ TEST(MakeSample, FlowChannelsFollowTheMotionAndTheFlip) {
   EXPECT_EQ(MakeSample(frames, o, rng, &given).pixels, s.pixels);
   const std::vector<cv::Mat> short_by_one(given.begin() + 1, given.end());
   EXPECT_THROW(MakeSample(frames, o, rng, &short_by_one), std::invalid_argument);
+}
+
+
+// FlagSim's red and green (sRGB) as OpenCV's BGR: 74 and 79 of 255 in grey.
+const cv::Vec3b kRed(46, 16, 200), kGreen(61, 122, 0);
+
+// Frames whose lower half is a red field and a green one with their edge swinging 4 px left and
+// right, under a still grey ramp (the sky) that sets the clip's contrast, as YCrCb (`colour`) or
+// grey, as LoadFrames gives them.
+std::vector<cv::Mat> RedGreenEdgeFrames(bool colour) {
+  std::vector<cv::Mat> frames;
+  for (int t = 0; t < 16; ++t) {
+    cv::Mat bgr(32, 32, CV_8UC3);
+    const int edge = 16 + static_cast<int>(std::lround(4 * std::sin(2 * M_PI * t / 8.0)));
+    for (int y = 0; y < 32; ++y) {
+      for (int x = 0; x < 32; ++x) {
+        const uint8_t sky = static_cast<uint8_t>(40 + 6 * x);
+        bgr.at<cv::Vec3b>(y, x) = y < 16 ? cv::Vec3b(sky, sky, sky) : (x < edge ? kRed : kGreen);
+      }
+    }
+    cv::Mat out;
+    cv::cvtColor(bgr, out, colour ? cv::COLOR_BGR2YCrCb : cv::COLOR_BGR2GRAY);
+    frames.push_back(out);
+  }
+  return frames;
+}
+
+// Temporal standard deviation of channel `c` of a sample over a window of pixels, the largest.
+double LargestTemporalStd(const Sample& s, int c, int frames, int side, const cv::Rect& where) {
+  double largest = 0;
+  for (int y = where.y; y < where.y + where.height; ++y) {
+    for (int x = where.x; x < where.x + where.width; ++x) {
+      double sum = 0, sum2 = 0;
+      for (int t = 0; t < frames; ++t) {
+        const double v = s.pixels[((static_cast<size_t>(c) * frames + t) * side + y) * side + x];
+        sum += v;
+        sum2 += v * v;
+      }
+      largest = std::max(largest, std::sqrt(std::max(sum2 / frames - sum * sum / frames / frames, 0.0)));
+    }
+  }
+  return largest;
+}
+
+TEST(MakeSample, ColourChannelsSeeAnEdgeTheGreyHides) {
+  SampleOptions o;
+  o.frames = 16;
+  o.input_size = 32;
+  std::mt19937_64 rng(0);
+  const Sample grey = MakeSample(RedGreenEdgeFrames(false), o, rng);
+  o.colour = true;
+  const Sample colour = MakeSample(RedGreenEdgeFrames(true), o, rng);
+  ASSERT_EQ(colour.channels, 3);
+  ASSERT_EQ(colour.pixels.size(), 3u * 16 * 32 * 32);
+  // The edge's swing in units of each clip's own contrast: barely a flicker in grey, a full
+  // swing in Cr (red against green).
+  const cv::Rect edge(12, 16, 9, 16);
+  const double in_grey = LargestTemporalStd(grey, 0, 16, 32, edge);
+  const double in_cr = LargestTemporalStd(colour, 1, 16, 32, edge);
+  EXPECT_LT(in_grey, 0.15);
+  EXPECT_GT(in_cr, 5 * in_grey) << "grey " << in_grey << ", Cr " << in_cr;
+  // Y is the grey: channel 0 follows the grey sample's pixels (one scale and offset apart).
+  const size_t n = 16 * 32 * 32;
+  double sxy = 0, sxx = 0, syy = 0;
+  for (size_t i = 0; i < n; ++i) {
+    sxy += grey.pixels[i] * colour.pixels[i];
+    sxx += grey.pixels[i] * grey.pixels[i];
+    syy += colour.pixels[i] * colour.pixels[i];
+  }
+  EXPECT_GT(sxy / std::sqrt(sxx * syy), 0.999);
+  // All three channels together have zero mean each and unit std jointly.
+  double joint = 0;
+  for (int c = 0; c < 3; ++c) {
+    const double mean = std::accumulate(colour.pixels.begin() + c * n, colour.pixels.begin() + (c + 1) * n, 0.0) / n;
+    EXPECT_NEAR(mean, 0.0, 1e-4) << c;
+    for (size_t i = c * n; i < (c + 1) * n; ++i) joint += colour.pixels[i] * colour.pixels[i];
+  }
+  EXPECT_NEAR(joint / (3 * n), 1.0, 1e-3);
+  // The mirror image mirrors every channel.
+  o.mirror = true;
+  const Sample mirrored = MakeSample(RedGreenEdgeFrames(true), o, rng);
+  for (int c = 0; c < 3; ++c)
+    for (int y = 0; y < 32; ++y)
+      for (int x = 0; x < 32; ++x)
+        ASSERT_FLOAT_EQ(mirrored.pixels[((c * 16 + 5) * 32 + y) * 32 + x], colour.pixels[((c * 16 + 5) * 32 + y) * 32 + 31 - x]);
+  // Grey frames for a colour sample, and colour with flow, are refused.
+  EXPECT_THROW(MakeSample(RedGreenEdgeFrames(false), o, rng), std::invalid_argument);
+  o.mirror = false;
+  o.flow = true;
+  EXPECT_THROW(MakeSample(RedGreenEdgeFrames(true), o, rng), std::invalid_argument);
 }
 
 }  // namespace

@@ -5,8 +5,8 @@
 
 namespace clothwind::learn {
 
-FrameCache::FrameCache(const std::vector<ClipInfo>& clips, int input_size)
-    : clips_(clips), input_size_(input_size) {
+FrameCache::FrameCache(const std::vector<ClipInfo>& clips, int input_size, bool colour)
+    : clips_(clips), input_size_(input_size), colour_(colour) {
   if (input_size < 1) throw std::invalid_argument("FrameCache: input size must be >= 1");
   slots_.reserve(clips.size());
   for (size_t i = 0; i < clips.size(); ++i) slots_.push_back(std::make_unique<Slot>());
@@ -37,6 +37,7 @@ std::vector<cv::Mat> FrameCache::Frames(size_t index, int first, int count) {
 }
 
 std::vector<cv::Mat> FrameCache::Flows(size_t index, int first, int count, int flow_side) {
+  if (colour_) throw std::invalid_argument("FrameCache: flow asked of a colour cache (the flow is the grey frames')");
   if (flow_side == 0) flow_side = input_size_;
   int expected = 0;
   if (!flow_side_.compare_exchange_strong(expected, flow_side) && expected != flow_side) {
@@ -78,9 +79,9 @@ std::vector<cv::Mat> FrameCache::Flows(size_t index, int first, int count, int f
 std::vector<cv::Mat> FrameCache::FramesLocked(size_t index, Slot& slot, int first, int count) {
   const ClipInfo& clip = clips_.at(index);
   if (first < 0 || count < 1 || first + count > clip.num_frames) {
-    return LoadFrames(clip, first, count);  // throws the error a direct read gives
+    return LoadFrames(clip, first, count, colour_);  // throws the error a direct read gives
   }
-  const size_t plane = static_cast<size_t>(input_size_) * input_size_;
+  const size_t plane = static_cast<size_t>(input_size_) * input_size_ * (colour_ ? 3 : 1);
   if (slot.pixels.empty()) {
     slot.pixels.resize(static_cast<size_t>(clip.num_frames) * plane);
     slot.loaded.assign(static_cast<size_t>(clip.num_frames), false);
@@ -90,9 +91,10 @@ std::vector<cv::Mat> FrameCache::FramesLocked(size_t index, Slot& slot, int firs
   out.reserve(static_cast<size_t>(count));
   for (int t = first; t < first + count; ++t) {
     // A header over the clip's buffer: no copy, and valid as long as the cache.
-    cv::Mat held(input_size_, input_size_, CV_8UC1, slot.pixels.data() + static_cast<size_t>(t) * plane);
+    cv::Mat held(input_size_, input_size_, colour_ ? CV_8UC3 : CV_8UC1,
+                 slot.pixels.data() + static_cast<size_t>(t) * plane);
     if (!slot.loaded[static_cast<size_t>(t)]) {
-      const cv::Mat frame = LoadFrames(clip, t, 1)[0];
+      const cv::Mat frame = LoadFrames(clip, t, 1, colour_)[0];
       // MakeSample's own crop and resize, written into `held` in place.
       ResizeCrop(frame, CentreSquare(frame.cols, frame.rows), input_size_, held);
       slot.loaded[static_cast<size_t>(t)] = true;
@@ -107,6 +109,11 @@ Sample LoadSample(FrameCache& cache, size_t index, const SampleOptions& options,
   if (options.input_size != cache.input_size()) {
     throw std::invalid_argument("LoadSample: input size " + std::to_string(options.input_size) +
                                 " but the frame cache holds " + std::to_string(cache.input_size()) + " px");
+  }
+  if (options.colour != cache.colour()) {
+    throw std::invalid_argument(std::string("LoadSample: ") + (options.colour ? "colour" : "grey") +
+                                " samples asked of a frame cache holding " + (cache.colour() ? "colour" : "grey") +
+                                " frames");
   }
   // MakeSample's crop offsets are 0 on a whole square, and resizing S to S is a copy in OpenCV.
   return LoadSample(

@@ -28,7 +28,8 @@ class FrameCache {
   //   clips       the examples it serves, addressed by their index in this vector (kept by
   //               reference: it must outlive the cache)
   //   input_size  S, the side the frames are resized to [px]
-  FrameCache(const std::vector<ClipInfo>& clips, int input_size);
+  //   colour      hold LoadFrames' colour frames (YCrCb, 3 bytes a pixel) instead of grey ones
+  FrameCache(const std::vector<ClipInfo>& clips, int input_size, bool colour = false);
 
   // Whether LoadSample(cache, ...) with `options` gives the same samples as LoadSample(clip, ...):
   // true when the sample's crop is always the centre square, i.e. evaluation, or augmentation
@@ -36,7 +37,8 @@ class FrameCache {
   // When false, `why` says which option or frame size breaks it.
   static bool Exact(const SampleOptions& options, const ClipInfo& clip, std::string* why);
 
-  // Frames first..first+count-1 of clip `index` as S x S CV_8UC1 images, decoding and resizing
+  // Frames first..first+count-1 of clip `index` as S x S CV_8UC1 images (CV_8UC3 YCrCb for a
+  // colour cache), decoding and resizing
   // the ones not yet held. Safe to call from several threads.
   // Throws what LoadFrames throws for a missing or malformed frame.
   std::vector<cv::Mat> Frames(size_t index, int first, int count);
@@ -45,13 +47,14 @@ class FrameCache {
   // S x S) with the flow computed at flow_side (0: S), computing and keeping (16 bits per
   // component) the flows not yet held. Equal to WindowFlows(files' frames, centre square,
   // flow_side, S). A cache holds one flow_side: another throws std::invalid_argument. Safe to call
-  // from several threads.
+  // from several threads. A colour cache has no flows (std::invalid_argument).
   std::vector<cv::Mat> Flows(size_t index, int first, int count, int flow_side = 0);
 
   const ClipInfo& clip(size_t index) const { return clips_.at(index); }
   int input_size() const { return input_size_; }
+  bool colour() const { return colour_; }
   size_t size() const { return slots_.size(); }
-  // Pixel bytes allocated now: num_frames x S^2 for every clip read so far (at most
+  // Pixel bytes allocated now: num_frames x S^2 (x 3 in colour) for every clip read so far (at most
   // clips x frames x S^2), and how many frames of them have been decoded.
   size_t bytes() const { return bytes_.load(); }
   size_t frames_held() const { return frames_held_.load(); }
@@ -64,7 +67,7 @@ class FrameCache {
   // whose frames are 4.7 GB in all.
   struct Slot {
     std::mutex mutex;
-    std::vector<uint8_t> pixels;  // num_frames x S x S, allocated at the first read
+    std::vector<uint8_t> pixels;  // num_frames x S x S (x 3 in colour), allocated at the first read
     std::vector<bool> loaded;     // per frame
     std::vector<int16_t> flow;    // num_frames x S x S x 2: frame t's flow from frame t - 1 (t >= 1)
     std::vector<bool> flow_loaded;
@@ -73,6 +76,7 @@ class FrameCache {
   std::vector<cv::Mat> FramesLocked(size_t index, Slot& slot, int first, int count);
   const std::vector<ClipInfo>& clips_;
   int input_size_;
+  bool colour_;
   std::vector<std::unique_ptr<Slot>> slots_;
   std::atomic<size_t> bytes_{0};
   std::atomic<size_t> frames_held_{0};

@@ -88,6 +88,29 @@ TEST_F(FrameCacheTest, EvaluationSamplesEqualTheFilesWithAndWithoutMirror) {
   }
 }
 
+TEST_F(FrameCacheTest, ColourSamplesEqualTheFilesBitForBit) {
+  FrameCache cache(*clips_, 32, true);
+  EXPECT_TRUE(cache.colour());
+  SampleOptions o = Training();
+  o.colour = true;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (size_t i = 0; i < clips_->size(); ++i) {
+      ExpectSameSample(LoadSample((*clips_)[i], o, 11 + i), LoadSample(cache, i, o, 11 + i));
+    }
+  }
+  EXPECT_EQ(cache.Frames(0, 0, 1)[0].type(), CV_8UC3);
+  EXPECT_EQ(cache.bytes(), clips_->size() * 40u * 32 * 32 * 3);
+  o.augment = false;
+  ExpectSameSample(LoadSample((*clips_)[2], o, 3), LoadSample(cache, 2, o, 3));
+  // Grey samples from a colour cache, colour ones from a grey cache, and flow from colour frames
+  // are refused.
+  FrameCache grey(*clips_, 32);
+  EXPECT_THROW(LoadSample(grey, 0, o, 1), std::invalid_argument);
+  o.colour = false;
+  EXPECT_THROW(LoadSample(cache, 0, o, 1), std::invalid_argument);
+  EXPECT_THROW(cache.Flows(0, 0, 4), std::invalid_argument);
+}
+
 TEST_F(FrameCacheTest, HoldsEachFrameOnceAndOnlyTheFramesRead) {
   FrameCache cache(*clips_, 32);
   EXPECT_EQ(cache.bytes(), 0u);

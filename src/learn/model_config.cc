@@ -47,6 +47,7 @@ SampleOptions ModelConfig::Sampling() const {
   o.input_size = input_size;
   o.flow = flow;
   o.flow_size = flow_size;
+  o.colour = colour;
   return o;
 }
 
@@ -66,6 +67,7 @@ std::string ModelConfig::Name() const {
   else s << arch;
   if (flow) s << "-flow";
   if (flow && flow_size != 0) s << flow_size;
+  if (colour) s << "-ycc";
   if (!stem_pool) s << "-np";
   if (coord_maps) s << "-xy";
   s << "-w" << width << "-" << input_size << "-" << frames << "f";
@@ -74,7 +76,7 @@ std::string ModelConfig::Name() const {
 
 std::string ModelConfig::Modality() const {
   std::ostringstream s;
-  if (flow) {
+  if (flow || colour) {
     s << frames << "x" << channels << "x" << input_size << "x" << input_size;
   } else {
     s << frames * channels << "x" << input_size << "x" << input_size;
@@ -85,6 +87,7 @@ std::string ModelConfig::Modality() const {
 nlohmann::json ToJson(const ModelConfig& c) {
   return {{"format", "clothwind-model"}, {"version", 1},   {"arch", c.arch},
           {"frames", c.frames},          {"channels", c.channels}, {"flow", c.flow}, {"flow_size", c.flow_size},
+          {"colour", c.colour},
           {"k", c.k},                    {"include_dc", c.include_dc},
           {"mean_map", c.mean_map},      {"dft_size", c.dft_size},
           {"local_peaks", c.local_peaks},  {"phase_steps", c.phase_steps},
@@ -115,6 +118,8 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     // Absent in models written before flow channels existed: greyscale only.
     c.flow = j.contains("flow") ? j.at("flow").get<bool>() : false;
     c.flow_size = j.contains("flow_size") ? j.at("flow_size").get<int>() : 0;
+    // Absent in models written before colour input existed: greyscale.
+    c.colour = j.contains("colour") ? j.at("colour").get<bool>() : false;
     c.k = need("k").get<int>();
     c.include_dc = need("include_dc").get<bool>();
     // Absent in models written before the mean map existed: they had none.
@@ -153,9 +158,12 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     throw std::runtime_error(where + ": frames, channels, width, k must be >= 1, input_size >= 16, "
                              "frame_rate, label_std and std_scale > 0");
   }
+  if (c.flow && c.colour) {
+    throw std::runtime_error(where + ": field \"colour\" must be false with \"flow\" (the flow is the grey frames')");
+  }
   if (c.channels != c.ChannelsForInput()) {
     throw std::runtime_error(where + ": field \"channels\" must be " + std::to_string(c.ChannelsForInput()) +
-                             (c.flow ? " (grey and flow x, y)" : " (grey)") + ", got " + std::to_string(c.channels));
+                             (c.flow ? " (grey and flow x, y)" : c.colour ? " (Y, Cr, Cb)" : " (grey)") + ", got " + std::to_string(c.channels));
   }
   if (!c.FlowSizeIsValid()) {
     throw std::runtime_error(where + ": field \"flow_size\" must be 0, or at least 16 with \"flow\", got " +

@@ -18,13 +18,16 @@ struct ModelConfig {
   // recurrent baseline: a ResNet-18 trunk per frame, an LSTM over the frames' features)
   std::string arch = "sdn";
   int frames = 30;           // N_t, input frames per clip
-  int channels = 1;          // C, channels per frame: 1 (greyscale, as the seed), 3 with flow
+  int channels = 1;          // C, channels per frame: 1 (greyscale, as the seed), 3 with flow or colour
   // Each frame's optical flow from the one before as two more channels (SampleOptions::flow):
   // the spectral layer then reads how far the cloth moves, not only how its texture flickers.
   bool flow = false;
   // With flow: the side [px] the flow is computed at before it is resized to input_size (0:
   // input_size; SampleOptions::flow_size).
   int flow_size = 0;
+  // Colour frames, Y Cr Cb, instead of grey ones (SampleOptions::colour: the edges between two
+  // colours of one grey); not with flow.
+  bool colour = false;
   int k = 3;                 // SDN: spectral peaks kept per pixel (2kC trunk input channels)
   bool include_dc = false;   // SDN: the DC bin among the candidate peaks (no detrend)
   bool mean_map = false;     // SDN: the clip's per-pixel temporal mean as C more trunk channels
@@ -82,16 +85,16 @@ struct ModelConfig {
   // How a clip becomes this model's input: frames, input size and flow set, no augmentation
   // (evaluation's and the node's; training adds its augmentation to these).
   SampleOptions Sampling() const;
-  // The channels per frame that `flow` implies (1 or 3): Sampling().channels().
+  // The channels per frame that `flow` or `colour` imply (1 or 3): Sampling().channels().
   int ChannelsForInput() const { return Sampling().channels(); }
   // flow_size is 0, or a side of at least 16 px on a model with flow.
   bool FlowSizeIsValid() const { return flow_size == 0 || (flow && flow_size >= 16); }
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("…-flow-…" with flow, "sdn-k3m-…" with mean_map,
   // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps,
   // "…s4-" with phase_step_far 4, "…o-" with mode_shape, "…s/2-" with spectral_pool 2, "…-xy-" with
-  // coord_maps).
+  // coord_maps, "…-ycc-" with colour).
   std::string Name() const;
-  // Table 1's "input modality", e.g. "30x112x112" ("30x3x64x64" with flow's three channels).
+  // Table 1's "input modality", e.g. "30x112x112" ("30x3x64x64" with flow's or colour's three channels).
   std::string Modality() const;
 };
 

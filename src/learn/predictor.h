@@ -48,10 +48,11 @@ class Predictor {
   // A raw greyscale clip as a node receives it: the last config().frames frames, centred square
   // crop, resized and normalised as for evaluation. `maps` (may be null; SDN only) receives the
   // strongest peak maps of the same input.
-  // Throws std::invalid_argument when there are too few frames or they are not equal CV_8UC1.
+  // Throws std::invalid_argument when there are too few frames or they are not equal CV_8UC1
+  // (CV_8UC3 YCrCb, LoadFrames' colour frames, for a model with config().colour).
   Prediction PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps* maps = nullptr);
 
-  // A clip with the evaluation preprocessing (no augmentation) from raw greyscale frames.
+  // A clip with the evaluation preprocessing (no augmentation) from raw greyscale (or YCrCb) frames.
   Sample Prepare(const std::vector<cv::Mat>& frames) const;
 
  private:

@@ -291,7 +291,7 @@ TrainResult Train(const TrainOptions& o) {
   }
 
   ModelConfig config = o.model;
-  config.channels = config.ChannelsForInput();  // greyscale, as the seed (+ flow x, y)
+  config.channels = config.ChannelsForInput();  // greyscale, as the seed (+ flow x, y), or Y Cr Cb
   if (!train.empty()) {
     double sum = 0, sum2 = 0;
     for (const ClipInfo& c : train) {
@@ -418,8 +418,8 @@ TrainResult Train(const TrainOptions& o) {
         throw std::runtime_error("--cache-frames would change the training samples: " + why);
       }
     }
-    train_cache = std::make_unique<FrameCache>(train, config.input_size);
-    val_cache = std::make_unique<FrameCache>(val, config.input_size);
+    train_cache = std::make_unique<FrameCache>(train, config.input_size, config.colour);
+    val_cache = std::make_unique<FrameCache>(val, config.input_size, config.colour);
   }
   // The seed clips gradients (max norm 10) for its recurrent models only.
   const double grad_clip = o.grad_clip >= 0 ? o.grad_clip : (config.arch == "lstm" ? 10.0 : 0.0);

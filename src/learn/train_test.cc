@@ -822,6 +822,46 @@ TEST_F(TrainTest, FlowChannelsTrainRoundTripAndAreRefusedWhenInconsistent) {
   EXPECT_FALSE(ModelConfigFromJson(without, "old/model.json").flow);
 }
 
+TEST_F(TrainTest, ColourChannelsTrainRoundTripAndAreRefusedWhenInconsistent) {
+  TrainOptions t = Options("sdn", "colour");
+  t.model.colour = true;
+  t.model.phase_steps = true;
+  t.epochs = 1;
+  t.cache_frames = true;
+  t.crop_scales = {1.0};
+  const TrainResult r = Train(t);
+  Predictor p(r.model, 1, "cpu");
+  EXPECT_TRUE(p.config().colour);
+  EXPECT_EQ(p.config().channels, 3);
+  EXPECT_NE(p.config().Name().find("-ycc"), std::string::npos) << p.config().Name();
+  EXPECT_EQ(p.config().Modality(), "30x3x32x32");
+  EXPECT_EQ(p.config().TrunkInputChannels(), (2 * 3 + 4) * 3);
+  // Evaluation's path (the files) and the node's (Prepare: the last N_t frames) agree.
+  const Dataset dataset = ReadDataset(*root_ / "data");
+  const Sample sample = LoadSample(dataset.clips[0], p.config().Sampling(), 0);
+  const std::vector<cv::Mat> frames = LoadFrames(dataset.clips[0], 0, 30, true);
+  EXPECT_EQ(p.Prepare(std::vector<cv::Mat>(frames.begin(), frames.end())).pixels,
+            LoadSample(dataset.clips[0], [&] { SampleOptions o = p.config().Sampling(); o.first_frame = 0; return o; }(), 0).pixels);
+  EXPECT_TRUE(std::isfinite(p.Predict({&sample}).front().speed));
+  // Grey frames are refused by a colour model, by name; so is a model file with flow and colour.
+  try {
+    p.PredictFrames(LoadFrames(dataset.clips[0], 0, 30));
+    ADD_FAILURE() << "grey frames accepted by a colour model";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("YCrCb"), std::string::npos) << e.what();
+  }
+  nlohmann::json j = ToJson(p.config());
+  j["flow"] = true;
+  ExpectFieldRefused(j, "colour");
+  j = ToJson(p.config());
+  j["channels"] = 1;
+  ExpectFieldRefused(j, "channels");
+  // Older model files have no "colour" field: greyscale.
+  nlohmann::json without = ToJson(ModelConfig());
+  without.erase("colour");
+  EXPECT_FALSE(ModelConfigFromJson(without, "old/model.json").colour);
+}
+
 // Gives every clip of the dataset in `dir` a tracks.json: a 2x2 grid whose points swing 1.5 px
 // across at the clip's stripe frequency (1 + 0.5 v Hz, ToyDatasetOptions' defaults); with
 // `world`, also their positions, swinging 0.1 m across the wind at that frequency.
