@@ -259,8 +259,8 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
   sample.channels = options.channels();
   sample.pixels.resize(grey * sample.channels);
   // The frames' own channels (grey, or Y Cr Cb), each normalised below; flow channels follow.
-  const int own = options.colour ? 3 : 1;
-  const int type = options.colour ? CV_8UC3 : CV_8UC1;
+  const int type = FrameType(options.colour);
+  const int own = CV_MAT_CN(type);
   std::vector<double> sum(own, 0.0), sum2(own, 0.0);
   cv::Mat resized;
   std::vector<cv::Mat> split(own);

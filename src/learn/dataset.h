@@ -52,6 +52,9 @@ std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& spl
 // other than the label's.
 std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count, bool colour = false);
 
+// The OpenCV type of LoadFrames' frames: CV_8UC1 (grey) or, with `colour`, CV_8UC3 (YCrCb).
+inline int FrameType(bool colour) { return colour ? CV_8UC3 : CV_8UC1; }
+
 // How a clip becomes a network input [C, frames, input_size, input_size]: C = 1 (greyscale, as
 // the seed) or, with `flow`, C = 3 (greyscale, then the optical flow's x and y components) or,
 // with `colour`, C = 3 (Y, Cr, Cb).

@@ -81,7 +81,8 @@ std::vector<cv::Mat> FrameCache::FramesLocked(size_t index, Slot& slot, int firs
   if (first < 0 || count < 1 || first + count > clip.num_frames) {
     return LoadFrames(clip, first, count, colour_);  // throws the error a direct read gives
   }
-  const size_t plane = static_cast<size_t>(input_size_) * input_size_ * (colour_ ? 3 : 1);
+  const int type = FrameType(colour_);
+  const size_t plane = static_cast<size_t>(input_size_) * input_size_ * CV_MAT_CN(type);
   if (slot.pixels.empty()) {
     slot.pixels.resize(static_cast<size_t>(clip.num_frames) * plane);
     slot.loaded.assign(static_cast<size_t>(clip.num_frames), false);
@@ -91,8 +92,7 @@ std::vector<cv::Mat> FrameCache::FramesLocked(size_t index, Slot& slot, int firs
   out.reserve(static_cast<size_t>(count));
   for (int t = first; t < first + count; ++t) {
     // A header over the clip's buffer: no copy, and valid as long as the cache.
-    cv::Mat held(input_size_, input_size_, colour_ ? CV_8UC3 : CV_8UC1,
-                 slot.pixels.data() + static_cast<size_t>(t) * plane);
+    cv::Mat held(input_size_, input_size_, type, slot.pixels.data() + static_cast<size_t>(t) * plane);
     if (!slot.loaded[static_cast<size_t>(t)]) {
       const cv::Mat frame = LoadFrames(clip, t, 1, colour_)[0];
       // MakeSample's own crop and resize, written into `held` in place.

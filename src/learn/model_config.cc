@@ -158,7 +158,7 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     throw std::runtime_error(where + ": frames, channels, width, k must be >= 1, input_size >= 16, "
                              "frame_rate, label_std and std_scale > 0");
   }
-  if (c.flow && c.colour) {
+  if (!c.ColourIsValid()) {
     throw std::runtime_error(where + ": field \"colour\" must be false with \"flow\" (the flow is the grey frames')");
   }
   if (c.channels != c.ChannelsForInput()) {

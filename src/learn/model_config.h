@@ -87,6 +87,8 @@ struct ModelConfig {
   SampleOptions Sampling() const;
   // The channels per frame that `flow` or `colour` imply (1 or 3): Sampling().channels().
   int ChannelsForInput() const { return Sampling().channels(); }
+  // colour is off, or on a model without flow (the flow is computed from the grey frames).
+  bool ColourIsValid() const { return !(colour && flow); }
   // flow_size is 0, or a side of at least 16 px on a model with flow.
   bool FlowSizeIsValid() const { return flow_size == 0 || (flow && flow_size >= 16); }
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("…-flow-…" with flow, "sdn-k3m-…" with mean_map,

@@ -100,7 +100,7 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
     throw std::invalid_argument("WindNet: flow_size " + std::to_string(config.flow_size) +
                                 " must be 0, or at least 16 on a model with flow");
   }
-  if (config.flow && config.colour) {
+  if (!config.ColourIsValid()) {
     throw std::invalid_argument("WindNet: flow and colour are exclusive (the flow is the grey frames'), in " + config.Name());
   }
   trunk_ = register_module("trunk", ResNet18Trunk(config.TrunkInputChannels(), config.width, config.stem_pool));

@@ -76,7 +76,7 @@ Sample Predictor::Prepare(const std::vector<cv::Mat>& frames) const {
                                 " needs " + std::to_string(c.frames));
   }
   for (const cv::Mat& f : frames) {
-    if (f.type() != (c.colour ? CV_8UC3 : CV_8UC1) || f.size() != frames[0].size() || f.empty()) {
+    if (f.type() != FrameType(c.colour) || f.size() != frames[0].size() || f.empty()) {
       throw std::invalid_argument(c.colour ? "clip frames must be non-empty 8-bit YCrCb images of one size (the model " +
                                                  c.Name() + " reads colour)"
                                            : std::string("clip frames must be non-empty mono8 images of one size"));
