@@ -2,7 +2,7 @@
 //
 // Subscribes  camera/image_raw (sensor_msgs/Image), camera/camera_info (kept for recorded
 //             clips' metadata), anemometer/wind (clothwind/WindMeasurement)
-// Publishes   clips (clothwind/Clip), clips/preview (sensor_msgs/Image mono8: the latest clip's
+// Publishes   clips (clothwind/Clip), clips/preview (sensor_msgs/Image mono8, bgr8 with ~colour: the latest clip's
 //             middle frame, only built while someone subscribes), /diagnostics
 // All the logic is in sensors::ClipPipeline and sensors::DatasetWriter (see docs/clips.md).
 #include <cmath>
@@ -35,6 +35,7 @@ class ClipBufferNode {
     pnh.param("num_frames", o.num_frames, o.num_frames);
     pnh.param("stride", o.stride, o.stride);
     pnh.param("size", o.size, o.size);
+    pnh.param("colour", o.colour, o.colour);
     pnh.param("gap_tolerance", o.gap_tolerance, o.gap_tolerance);
     pnh.param("label_window", o.label_window, o.label_window);
     pnh.param("label_delay", o.label_delay, o.label_delay);
@@ -71,9 +72,9 @@ class ClipBufferNode {
     updater_.setHardwareID("clip_buffer");
     updater_.add("clip buffer", this, &ClipBufferNode::Diagnose);
     flush_timer_ = nh.createWallTimer(ros::WallDuration(0.25), &ClipBufferNode::OnTimer, this);
-    ROS_INFO("clip_buffer: %d frames at %.1f fps every %d frames, %dx%d, roi %s, label window %.0f s (delay %.1f s), "
+    ROS_INFO("clip_buffer: %d frames at %.1f fps every %d frames, %dx%d %s, roi %s, label window %.0f s (delay %.1f s), "
              "gap tolerance %.3f s",
-             o.num_frames, o.frame_rate, o.stride, o.size, o.size,
+             o.num_frames, o.frame_rate, o.stride, o.size, o.size, sensors::ClipFrameEncoding(o.colour),
              o.roi.size > 0 ? ("[" + std::to_string(o.roi.x) + ", " + std::to_string(o.roi.y) + ", " +
                                std::to_string(o.roi.size) + "]").c_str()
                             : "centre square",
@@ -140,7 +141,7 @@ class ClipBufferNode {
         const auto& middle = c.clip.frames[c.clip.frames.size() / 2];
         std_msgs::Header h = msg->header;
         h.stamp = ros::Time(middle.stamp);
-        preview_pub_.publish(ros_bridge::MonoImageMsg(middle.image, h));
+        preview_pub_.publish(ros_bridge::ClipFrameImageMsg(middle.image, h));
       }
       clip_pub_.publish(msg);
       Record(c);
@@ -170,6 +171,7 @@ class ClipBufferNode {
     } else {
       stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "making clips");
     }
+    stat.add("encoding", sensors::ClipFrameEncoding(pipeline_->options().colour));
     stat.add("frames in", s.frames_in);
     stat.add("frames dropped", s.frames_dropped);
     stat.add("frames out (25 fps)", s.frames_out);

@@ -11,6 +11,8 @@
 // Parameters: ~model (model.pt of a training run; model.json beside it), ~threads (2),
 // ~device (cpu | cuda | auto), ~queue_size (2 clips; older ones are dropped when the node lags),
 // ~mean_window (60 s, the field protocol's label window).
+// Clips may be mono8 or bgr8; a model trained with --colour needs bgr8 (clip_buffer ~colour) and
+// reports a grey clip as an ERROR naming that parameter.
 // Diagnostics: model, device, latency and rate; a malformed clip is an ERROR, not a crash. A
 // model that cannot be loaded is retried every 2 s (ERROR until it loads).
 #include <chrono>
@@ -78,7 +80,9 @@ class SdnNode {
       // first clip's latency.
       const auto& c = predictor->config();
       std::vector<cv::Mat> frames;
-      for (int i = 0; i < c.frames; ++i) frames.emplace_back(c.input_size, c.input_size, CV_8UC1, cv::Scalar(i % 7));
+      for (int i = 0; i < c.frames; ++i) {
+        frames.emplace_back(c.input_size, c.input_size, clothwind::learn::FrameType(c.colour), cv::Scalar::all(i % 7));
+      }
       const auto t0 = std::chrono::steady_clock::now();
       predictor->PredictFrames(frames);
       const double warm = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -101,7 +105,9 @@ class SdnNode {
       return;
     }
     try {
-      const std::vector<cv::Mat> frames = clothwind::ros_bridge::ClipFrames(*clip);
+      // A colour model reads Y, Cr and Cb from bgr8 clips; a grey one the grey of either kind.
+      const std::vector<cv::Mat> frames = clothwind::learn::CameraFramesForModel(
+          clothwind::ros_bridge::ClipFrames(*clip), predictor_->config().colour);
       const bool want_maps = power_pub_.getNumSubscribers() > 0 || frequency_pub_.getNumSubscribers() > 0;
       clothwind::learn::PeakMaps maps;
       const clothwind::learn::Prediction p = predictor_->PredictFrames(frames, want_maps ? &maps : nullptr);

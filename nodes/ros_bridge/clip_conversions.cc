@@ -43,16 +43,19 @@ clothwind::Clip ToClipMsg(const sensors::LabelledClip& c, const std::string& fra
   msg.num_frames = static_cast<uint32_t>(frames.size());
   msg.height = static_cast<uint32_t>(frames.front().image.rows);
   msg.width = static_cast<uint32_t>(frames.front().image.cols);
-  msg.encoding = "mono8";
-  const size_t frame_bytes = static_cast<size_t>(msg.height) * msg.width;
+  const bool colour = frames.front().image.type() == CV_8UC3;
+  msg.encoding = sensors::ClipFrameEncoding(colour);
+  const size_t row_bytes = static_cast<size_t>(msg.width) * (colour ? 3 : 1);
+  const size_t frame_bytes = row_bytes * msg.height;
   msg.data.resize(frame_bytes * frames.size());
   for (size_t i = 0; i < frames.size(); ++i) {
     const cv::Mat& img = frames[i].image;
-    if (img.type() != CV_8UC1 || static_cast<uint32_t>(img.rows) != msg.height ||
+    if (img.type() != sensors::ClipFrameCvType(colour) || static_cast<uint32_t>(img.rows) != msg.height ||
         static_cast<uint32_t>(img.cols) != msg.width)
-      throw std::invalid_argument("clip frame " + std::to_string(i) + " is not a mono8 image of the clip's size");
+      throw std::invalid_argument("clip frame " + std::to_string(i) + " is not a " + msg.encoding +
+                                  " image of the clip's size");
     uint8_t* dst = msg.data.data() + i * frame_bytes;
-    for (int r = 0; r < img.rows; ++r) std::memcpy(dst + static_cast<size_t>(r) * img.cols, img.ptr(r), img.cols);
+    for (int r = 0; r < img.rows; ++r) std::memcpy(dst + r * row_bytes, img.ptr(r), row_bytes);
     msg.frame_stamps.push_back(ros::Time(frames[i].stamp));
   }
   msg.roi.x_offset = c.roi.x;
@@ -70,17 +73,20 @@ clothwind::Clip ToClipMsg(const sensors::LabelledClip& c, const std::string& fra
   return msg;
 }
 
-sensor_msgs::Image MonoImageMsg(const cv::Mat& image, const std_msgs::Header& header) {
+sensor_msgs::Image ClipFrameImageMsg(const cv::Mat& image, const std_msgs::Header& header) {
+  if (image.type() != CV_8UC1 && image.type() != CV_8UC3)
+    throw std::invalid_argument("ClipFrameImageMsg: expected a CV_8UC1 or CV_8UC3 image");
+  const bool colour = image.type() == CV_8UC3;
   sensor_msgs::Image msg;
   msg.header = header;
   msg.height = image.rows;
   msg.width = image.cols;
-  msg.encoding = "mono8";
+  msg.encoding = sensors::ClipFrameEncoding(colour);
   msg.is_bigendian = 0;
-  msg.step = image.cols;
-  msg.data.resize(static_cast<size_t>(image.rows) * image.cols);
+  msg.step = image.cols * (colour ? 3 : 1);
+  msg.data.resize(static_cast<size_t>(image.rows) * msg.step);
   for (int r = 0; r < image.rows; ++r)
-    std::memcpy(msg.data.data() + static_cast<size_t>(r) * image.cols, image.ptr(r), image.cols);
+    std::memcpy(msg.data.data() + static_cast<size_t>(r) * msg.step, image.ptr(r), msg.step);
   return msg;
 }
 

@@ -31,12 +31,12 @@ sensors::LabelReading ToLabelReading(const clothwind::WindMeasurement& msg);
 
 // A labelled clip as a clothwind/Clip message.
 // Inputs:
-//   clip      labelled clip (num_frames frames of size x size mono8)
+//   clip      labelled clip (num_frames frames of size x size, all mono8 or all bgr8)
 //   frame_id  the camera's optical frame
 clothwind::Clip ToClipMsg(const sensors::LabelledClip& clip, const std::string& frame_id);
 
-// A mono8 Image message holding a copy of `image` (CV_8UC1).
-sensor_msgs::Image MonoImageMsg(const cv::Mat& image, const std_msgs::Header& header);
+// A clip frame as an Image message holding a copy of it: mono8 for CV_8UC1, bgr8 for CV_8UC3.
+sensor_msgs::Image ClipFrameImageMsg(const cv::Mat& image, const std_msgs::Header& header);
 
 // The camera_info facts worth keeping with a recorded clip (size, K, D, distortion model).
 nlohmann::json CameraInfoJson(const sensor_msgs::CameraInfo& info);

@@ -10,20 +10,22 @@
 namespace clothwind::ros_bridge {
 
 std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg) {
-  if (msg.encoding != "mono8") {
-    throw std::invalid_argument("Clip.encoding must be \"mono8\", got \"" + msg.encoding + "\"");
+  if (msg.encoding != "mono8" && msg.encoding != "bgr8") {
+    throw std::invalid_argument("Clip.encoding must be \"mono8\" or \"bgr8\", got \"" + msg.encoding + "\"");
   }
+  const int channels = msg.encoding == "bgr8" ? 3 : 1;
   if (msg.num_frames == 0 || msg.width == 0 || msg.height == 0) {
     throw std::invalid_argument("Clip.num_frames, width and height must be positive (got " +
                                 std::to_string(msg.num_frames) + ", " + std::to_string(msg.width) + ", " +
                                 std::to_string(msg.height) + ")");
   }
-  const size_t frame = static_cast<size_t>(msg.width) * msg.height;
+  const size_t frame = static_cast<size_t>(msg.width) * msg.height * channels;
   const size_t expected = frame * msg.num_frames;
   if (msg.data.size() != expected) {
-    throw std::invalid_argument("Clip.data has " + std::to_string(msg.data.size()) + " bytes, num_frames x height x width = " +
-                                std::to_string(msg.num_frames) + " x " + std::to_string(msg.height) + " x " +
-                                std::to_string(msg.width) + " = " + std::to_string(expected));
+    throw std::invalid_argument("Clip.data has " + std::to_string(msg.data.size()) +
+                                " bytes, num_frames x height x width x channels = " + std::to_string(msg.num_frames) +
+                                " x " + std::to_string(msg.height) + " x " + std::to_string(msg.width) + " x " +
+                                std::to_string(channels) + " = " + std::to_string(expected));
   }
   if (!msg.frame_stamps.empty() && msg.frame_stamps.size() != msg.num_frames) {
     throw std::invalid_argument("Clip.frame_stamps has " + std::to_string(msg.frame_stamps.size()) +
@@ -32,7 +34,7 @@ std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg) {
   std::vector<cv::Mat> frames;
   frames.reserve(msg.num_frames);
   for (uint32_t i = 0; i < msg.num_frames; ++i) {
-    frames.emplace_back(static_cast<int>(msg.height), static_cast<int>(msg.width), CV_8UC1,
+    frames.emplace_back(static_cast<int>(msg.height), static_cast<int>(msg.width), CV_8UC(channels),
                         const_cast<uint8_t*>(msg.data.data() + i * frame));
   }
   return frames;

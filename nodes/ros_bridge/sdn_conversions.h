@@ -16,8 +16,8 @@
 
 namespace clothwind::ros_bridge {
 
-// The frames of a Clip as num_frames mono8 images viewing msg.data (no copy: valid while `msg`
-// lives). Throws std::invalid_argument naming the field that is inconsistent (encoding,
+// The frames of a Clip as num_frames images viewing msg.data (no copy: valid while `msg` lives):
+// CV_8UC1 for a mono8 clip, CV_8UC3 BGR for a bgr8 one. Throws std::invalid_argument naming the field that is inconsistent (encoding,
 // num_frames, width/height, data length, frame_stamps count).
 std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg);
 

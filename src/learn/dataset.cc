@@ -154,6 +154,27 @@ std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count, bool
   return frames;
 }
 
+std::vector<cv::Mat> CameraFramesForModel(const std::vector<cv::Mat>& frames, bool colour) {
+  std::vector<cv::Mat> out;
+  out.reserve(frames.size());
+  for (const cv::Mat& f : frames) {
+    if (f.type() == CV_8UC1 && !colour) {
+      out.push_back(f);
+    } else if (f.type() == CV_8UC3) {
+      cv::Mat converted;
+      cv::cvtColor(f, converted, colour ? cv::COLOR_BGR2YCrCb : cv::COLOR_BGR2GRAY);
+      out.push_back(converted);
+    } else if (f.type() == CV_8UC1) {
+      throw std::invalid_argument(
+          "the model reads colour (Y, Cr, Cb) but the clip is grey (mono8); set the clip buffer's ~colour "
+          "parameter to true so clips come as bgr8");
+    } else {
+      throw std::invalid_argument("clip frames must be 8-bit grey (mono8) or BGR (bgr8) images");
+    }
+  }
+  return out;
+}
+
 int ChooseFirstFrame(int num_frames, const SampleOptions& options, std::mt19937_64& rng) {
   if (num_frames < options.frames) {
     throw std::runtime_error("clip has " + std::to_string(num_frames) + " frames, the model needs " +

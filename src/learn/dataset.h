@@ -55,6 +55,18 @@ std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count, bool
 // The OpenCV type of LoadFrames' frames: CV_8UC1 (grey) or, with `colour`, CV_8UC3 (YCrCb).
 inline int FrameType(bool colour) { return colour ? CV_8UC3 : CV_8UC1; }
 
+// Camera clip frames (the clip buffer's mono8 or bgr8) as LoadFrames would give them, so a node
+// feeds a model what it was trained on: grey frames for a grey model (BGR converted), YCrCb for a
+// colour one.
+// Inputs:
+//   frames  T images of one size, all CV_8UC1 (grey) or all CV_8UC3 (BGR)
+//   colour  the model reads colour (ModelConfig::colour)
+// Returns T images of type FrameType(colour); grey frames for a grey model are returned as they
+// are (no copy). Throws std::invalid_argument for grey frames given to a colour model (the grey
+// cannot be coloured back: the clip buffer must send bgr8, its ~colour parameter) and for other
+// image types.
+std::vector<cv::Mat> CameraFramesForModel(const std::vector<cv::Mat>& frames, bool colour);
+
 // How a clip becomes a network input [C, frames, input_size, input_size]: C = 1 (greyscale, as
 // the seed) or, with `flow`, C = 3 (greyscale, then the optical flow's x and y components) or,
 // with `colour`, C = 3 (Y, Cr, Cb).

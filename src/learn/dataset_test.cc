@@ -433,6 +433,34 @@ double LargestTemporalStd(const Sample& s, int c, int frames, int side, const cv
   return largest;
 }
 
+TEST(CameraFramesForModel, GreyForGreyModelsYCrCbForColourOnesAndNoColourFromGrey) {
+  cv::Mat bgr(12, 12, CV_8UC3);
+  cv::randu(bgr, 0, 256);
+  cv::Mat grey(12, 12, CV_8UC1);
+  cv::randu(grey, 0, 256);
+  // A grey model: grey frames pass as they are (no copy), BGR ones become their grey.
+  const std::vector<cv::Mat> g = CameraFramesForModel({grey, bgr}, false);
+  ASSERT_EQ(g.size(), 2u);
+  EXPECT_EQ(g[0].data, grey.data);
+  cv::Mat expected;
+  cv::cvtColor(bgr, expected, cv::COLOR_BGR2GRAY);
+  ASSERT_EQ(g[1].type(), FrameType(false));
+  EXPECT_EQ(cv::norm(g[1], expected, cv::NORM_INF), 0.0);
+  // A colour model: BGR becomes YCrCb, as LoadFrames gives colour frames.
+  const std::vector<cv::Mat> c = CameraFramesForModel({bgr}, true);
+  ASSERT_EQ(c[0].type(), FrameType(true));
+  cv::cvtColor(bgr, expected, cv::COLOR_BGR2YCrCb);
+  EXPECT_EQ(cv::norm(c[0], expected, cv::NORM_INF), 0.0);
+  // Grey frames for a colour model are refused with the parameter that fixes it.
+  try {
+    CameraFramesForModel({grey}, true);
+    FAIL() << "grey frames given to a colour model";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("~colour"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(CameraFramesForModel({cv::Mat(4, 4, CV_16UC1)}, false), std::invalid_argument);
+}
+
 TEST(MakeSample, ColourChannelsSeeAnEdgeTheGreyHides) {
   SampleOptions o;
   o.frames = 16;

@@ -15,7 +15,7 @@ struct ClipFrame {
   int64_t tick = 0;           // output tick number (consecutive within one unbroken stream)
   double stamp = 0.0;         // tick time [s] (exactly 1/rate apart within a clip)
   double source_stamp = 0.0;  // stamp of the camera frame shown [s]
-  cv::Mat image;              // size x size CV_8UC1 (shared, never modified after creation)
+  cv::Mat image;              // size x size CV_8UC1, or CV_8UC3 BGR for colour clips (shared, never modified)
 };
 
 // N_t consecutive frames.

@@ -42,7 +42,7 @@ void ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
       resampler_.Reset();  // a new image size is a new stream
       assembler_.Break();
     }
-    processed = PreprocessClipFrame(image, encoding, roi_, options_.size);
+    processed = PreprocessClipFrame(image, encoding, roi_, options_.size, options_.colour);
   } catch (...) {
     ++stats_.frames_dropped;
     source_width_ = source_height_ = 0;  // re-resolve the roi on the next frame

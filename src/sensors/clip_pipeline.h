@@ -24,6 +24,7 @@ struct ClipPipelineOptions {
   int stride = 30;             // a clip every `stride` output frames
   int size = 300;              // output frame side [px]
   SquareRoi roi;               // crop in source pixels; size 0: centred square
+  bool colour = false;         // frames bgr8 (for a model that reads colour) instead of mono8
   double label_window = 60.0;  // anemometer window before each clip's last frame [s]
   // A finished clip waits until the data (frame or reading stamps) has reached its end plus this
   // long [s] before it is labelled, so readings stamped inside its window that arrive a little late
@@ -57,7 +58,7 @@ struct ClipPipelineStats {
 
 // The ROS-free clip buffer: camera frames and anemometer readings in (each by stamp), labelled
 // clips out. Frames go through FrameResampler (nearest frame by stamp onto a 25 fps grid),
-// PreprocessClipFrame (crop, grey, resize) and ClipAssembler (N_t frames every stride, broken at
+// PreprocessClipFrame (crop, grey or colour, resize) and ClipAssembler (N_t frames every stride, broken at
 // gaps); finished clips wait in a queue until their label is due (see label_delay), then get the
 // WindLabeller's statistics over [last frame - label_window, last frame].
 class ClipPipeline {

@@ -128,5 +128,26 @@ TEST(ClipPipelineTest, BgrFramesAreCroppedToRoi) {
   EXPECT_EQ(p.stats().frames_dropped, 1u);
 }
 
+TEST(ClipPipelineTest, ColourOptionMakesBgrClips) {
+  ClipPipelineOptions o = SmallOptions();
+  o.colour = true;
+  ClipPipeline p(o);
+  for (int i = 0; i < 15; ++i) {
+    cv::Mat bgr(48, 64, CV_8UC3, cv::Scalar(10, 20, i));
+    p.AddFrame(kT0 + i / 30.0, bgr, ClipSourceEncoding::kBgr8);
+  }
+  const auto clips = p.Flush();
+  ASSERT_EQ(clips.size(), 1u);
+  for (const auto& f : clips[0].clip.frames) {
+    ASSERT_EQ(f.image.type(), CV_8UC3);
+    ASSERT_EQ(f.image.rows, o.size);
+    // Blue and green as sent; red says which camera frame this tick showed (nearest by stamp).
+    const cv::Vec3b px = f.image.at<cv::Vec3b>(3, 3);
+    EXPECT_EQ(px[0], 10);
+    EXPECT_EQ(px[1], 20);
+    EXPECT_NEAR(f.source_stamp, kT0 + px[2] / 30.0, 1e-9);
+  }
+}
+
 }  // namespace
 }  // namespace clothwind::sensors

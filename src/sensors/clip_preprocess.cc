@@ -7,6 +7,45 @@
 
 namespace clothwind::sensors {
 
+namespace {
+
+// Resizes a square crop to out_size x out_size: INTER_AREA averages the source pixels under each
+// output pixel when shrinking (no aliasing of the fine flag texture); enlarging is bilinear.
+cv::Mat ResizeSquare(const cv::Mat& crop, int out_size) {
+  cv::Mat out;
+  if (crop.cols == out_size) {
+    out = crop.clone();
+  } else {
+    cv::resize(crop, out, cv::Size(out_size, out_size), 0, 0,
+               crop.cols > out_size ? cv::INTER_AREA : cv::INTER_LINEAR);
+  }
+  return out;
+}
+
+// The colour variant of PreprocessClipFrame: crop, to BGR, resize.
+cv::Mat PreprocessColourClipFrame(const cv::Mat& image, ClipSourceEncoding encoding, const SquareRoi& roi,
+                                  int out_size) {
+  const SquareRoi r = ResolveRoi(roi, image.cols, image.rows);
+  const cv::Mat crop = image(cv::Rect(r.x, r.y, r.size, r.size));
+  cv::Mat bgr;
+  switch (encoding) {
+    case ClipSourceEncoding::kMono8: cv::cvtColor(crop, bgr, cv::COLOR_GRAY2BGR); break;
+    case ClipSourceEncoding::kMono16: {
+      cv::Mat eight;
+      crop.convertTo(eight, CV_8U, 1.0 / 256.0);
+      cv::cvtColor(eight, bgr, cv::COLOR_GRAY2BGR);
+      break;
+    }
+    case ClipSourceEncoding::kBgr8: bgr = crop; break;
+    case ClipSourceEncoding::kRgb8: cv::cvtColor(crop, bgr, cv::COLOR_RGB2BGR); break;
+    case ClipSourceEncoding::kBgra8: cv::cvtColor(crop, bgr, cv::COLOR_BGRA2BGR); break;
+    case ClipSourceEncoding::kRgba8: cv::cvtColor(crop, bgr, cv::COLOR_RGBA2BGR); break;
+  }
+  return ResizeSquare(bgr, out_size);
+}
+
+}  // namespace
+
 ClipSourceEncoding ParseClipSourceEncoding(const std::string& encoding) {
   if (encoding == "mono8" || encoding == "8UC1") return ClipSourceEncoding::kMono8;
   if (encoding == "mono16" || encoding == "16UC1") return ClipSourceEncoding::kMono16;
@@ -47,11 +86,16 @@ SquareRoi ResolveRoi(const SquareRoi& requested, int width, int height) {
   return requested;
 }
 
+int ClipFrameCvType(bool colour) { return colour ? CV_8UC3 : CV_8UC1; }
+
+const char* ClipFrameEncoding(bool colour) { return colour ? "bgr8" : "mono8"; }
+
 cv::Mat PreprocessClipFrame(const cv::Mat& image, ClipSourceEncoding encoding, const SquareRoi& roi,
-                            int out_size) {
+                            int out_size, bool colour) {
   if (out_size <= 0) throw std::invalid_argument("clip frame size must be > 0, got " + std::to_string(out_size));
   if (image.type() != ClipSourceCvType(encoding))
     throw std::invalid_argument("image type does not match its encoding");
+  if (colour) return PreprocessColourClipFrame(image, encoding, roi, out_size);
   const SquareRoi r = ResolveRoi(roi, image.cols, image.rows);
   // Crop first (a view, no copy) so colour conversion only touches the pixels we keep.
   const cv::Mat crop = image(cv::Rect(r.x, r.y, r.size, r.size));
@@ -64,16 +108,7 @@ cv::Mat PreprocessClipFrame(const cv::Mat& image, ClipSourceEncoding encoding, c
     case ClipSourceEncoding::kBgra8: cv::cvtColor(crop, grey, cv::COLOR_BGRA2GRAY); break;
     case ClipSourceEncoding::kRgba8: cv::cvtColor(crop, grey, cv::COLOR_RGBA2GRAY); break;
   }
-  cv::Mat out;
-  if (r.size == out_size) {
-    out = grey.clone();
-  } else {
-    // INTER_AREA averages the source pixels under each output pixel when shrinking (no aliasing of
-    // the fine flag texture); when enlarging it behaves like bilinear.
-    cv::resize(grey, out, cv::Size(out_size, out_size), 0, 0,
-               r.size > out_size ? cv::INTER_AREA : cv::INTER_LINEAR);
-  }
-  return out;
+  return ResizeSquare(grey, out_size);
 }
 
 }  // namespace clothwind::sensors

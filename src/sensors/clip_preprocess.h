@@ -35,15 +35,24 @@ SquareRoi ResolveRoi(const SquareRoi& requested, int width, int height);
 
 // Turns one camera frame into one clip frame the way the paper prepared its real videos: square
 // crop around the flag, greyscale (ITU-R BT.601 luma, as cv::cvtColor), area-averaged resize
-// (anti-aliased downsampling) to out_size x out_size.
+// (anti-aliased downsampling) to out_size x out_size. With `colour` the frame keeps its colour
+// (BGR) for a model that reads Y, Cr and Cb (learn::ModelConfig::colour).
 // Inputs:
 //   image     rows x cols source frame, type ClipSourceCvType(encoding)
 //   encoding  its pixel layout (mono16 is scaled by 1/256 to 8 bits)
 //   roi       resolved square roi (ResolveRoi) inside the image
 //   out_size  side of the output frame [px] > 0 (300)
-// Returns an out_size x out_size CV_8UC1 image (a new buffer, never a view of the input).
+//   colour    false: grey output; true: BGR output (a grey source repeated in all three channels)
+// Returns an out_size x out_size ClipFrameCvType(colour) image (a new buffer, never a view of the
+// input).
 cv::Mat PreprocessClipFrame(const cv::Mat& image, ClipSourceEncoding encoding, const SquareRoi& roi,
-                            int out_size);
+                            int out_size, bool colour = false);
+
+// Type of a clip frame: CV_8UC1 (mono8) grey, CV_8UC3 (bgr8) colour.
+int ClipFrameCvType(bool colour);
+
+// ROS encoding of a clip frame: "mono8" grey, "bgr8" colour.
+const char* ClipFrameEncoding(bool colour);
 
 }  // namespace clothwind::sensors
 

@@ -1,6 +1,10 @@
 #include "sensors/clip_preprocess.h"
 
+#include <cstdlib>
+#include <vector>
+
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 namespace clothwind::sensors {
 namespace {
@@ -37,6 +41,36 @@ TEST(ClipPreprocessTest, CropsGreysAndResizes) {
   const cv::Mat swapped = PreprocessClipFrame(image, ClipSourceEncoding::kRgb8, {50, 20, 100}, 50);
   EXPECT_NEAR(swapped.at<uint8_t>(25, 10), 76, 1);
   EXPECT_NEAR(swapped.at<uint8_t>(25, 40), 29, 1);
+}
+
+TEST(ClipPreprocessTest, ColourFramesKeepTheColourAndTheirGreyIsTheGreyFrame) {
+  // Red against green of nearly one grey (76 and 75): the grey frame hides the edge, the colour
+  // frame keeps it, and the colour frame's grey is the grey frame (up to resize rounding).
+  cv::Mat image(240, 320, CV_8UC3, cv::Scalar(0, 128, 0));
+  image(cv::Rect(100, 0, 220, 240)).setTo(cv::Scalar(0, 0, 255));
+  const cv::Mat grey = PreprocessClipFrame(image, ClipSourceEncoding::kBgr8, {50, 20, 100}, 50);
+  const cv::Mat colour = PreprocessClipFrame(image, ClipSourceEncoding::kBgr8, {50, 20, 100}, 50, true);
+  ASSERT_EQ(colour.type(), ClipFrameCvType(true));
+  ASSERT_EQ(colour.size(), grey.size());
+  EXPECT_EQ(colour.at<cv::Vec3b>(25, 10), cv::Vec3b(0, 128, 0));
+  EXPECT_EQ(colour.at<cv::Vec3b>(25, 40), cv::Vec3b(0, 0, 255));
+  EXPECT_LE(std::abs(grey.at<uint8_t>(25, 10) - grey.at<uint8_t>(25, 40)), 2);
+  cv::Mat grey_of_colour;
+  cv::cvtColor(colour, grey_of_colour, cv::COLOR_BGR2GRAY);
+  EXPECT_LE(cv::norm(grey_of_colour, grey, cv::NORM_INF), 1.0);
+  // rgb8 bytes are reordered to BGR; a grey source is repeated in all three channels.
+  const cv::Mat from_rgb = PreprocessClipFrame(image, ClipSourceEncoding::kRgb8, {50, 20, 100}, 50, true);
+  EXPECT_EQ(from_rgb.at<cv::Vec3b>(25, 40), cv::Vec3b(255, 0, 0));
+  cv::Mat mono(240, 320, CV_8UC1);
+  cv::randu(mono, 0, 256);
+  const cv::Mat mono_grey = PreprocessClipFrame(mono, ClipSourceEncoding::kMono8, {}, 60);
+  const cv::Mat mono_colour = PreprocessClipFrame(mono, ClipSourceEncoding::kMono8, {}, 60, true);
+  std::vector<cv::Mat> planes;
+  cv::split(mono_colour, planes);
+  ASSERT_EQ(planes.size(), 3u);
+  for (const cv::Mat& plane : planes) EXPECT_EQ(cv::norm(plane, mono_grey, cv::NORM_INF), 0.0);
+  EXPECT_STREQ(ClipFrameEncoding(true), "bgr8");
+  EXPECT_STREQ(ClipFrameEncoding(false), "mono8");
 }
 
 TEST(ClipPreprocessTest, AreaResizeAveragesFineTexture) {

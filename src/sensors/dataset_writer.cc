@@ -79,7 +79,8 @@ nlohmann::json ClipLabelJson(const LabelledClip& c, const ClipSourceInfo& source
   j["frame_rate"] = c.frame_rate;
   j["width"] = frames.empty() ? 0 : frames.front().image.cols;
   j["height"] = frames.empty() ? 0 : frames.front().image.rows;
-  j["encoding"] = "mono8";
+  // The dataset format names colour JPEG frames "rgb8" (as FlagSim's), whatever the byte order in memory.
+  j["encoding"] = !frames.empty() && frames.front().image.channels() == 3 ? "rgb8" : "mono8";
   j["frame_pattern"] = "%03d.jpg";
   j["start"] = frames.empty() ? 0.0 : frames.front().stamp;
   j["end"] = frames.empty() ? 0.0 : frames.back().stamp;

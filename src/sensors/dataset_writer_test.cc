@@ -75,6 +75,23 @@ TEST_F(DatasetWriterTest, WritesFramesLabelAndIndex) {
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }
 
+TEST_F(DatasetWriterTest, ColourClipsAreColourJpegsLabelledRgb8) {
+  LabelledClip c = MakeClip(5, 1700000000.5, 2);
+  for (auto& f : c.clip.frames) f.image = cv::Mat(32, 32, CV_8UC3, cv::Scalar(30, 90, 200));
+  DatasetWriter w(root_.string(), 95);
+  const std::string dir = w.Write(c, {"camera_optical_frame", "test", nullptr});
+  const cv::Mat img = cv::imread((fs::path(dir) / "001.jpg").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(img.type(), CV_8UC3);
+  const cv::Vec3b px = img.at<cv::Vec3b>(16, 16);
+  EXPECT_NEAR(px[0], 30, 3);
+  EXPECT_NEAR(px[1], 90, 3);
+  EXPECT_NEAR(px[2], 200, 3);
+  // The dataset format's name for colour JPEG frames, as FlagSim's: what learn::ReadDataset takes.
+  EXPECT_EQ(Read(fs::path(dir) / "label.json")["encoding"], "rgb8");
+  EXPECT_EQ(Read(fs::path(w.Write(MakeClip(6, 1700000010.5), {"", "test", nullptr})) / "label.json")["encoding"],
+            "mono8");
+}
+
 TEST_F(DatasetWriterTest, ReopenAppendsAndRewriteReplaces) {
   {
     DatasetWriter w(root_.string());

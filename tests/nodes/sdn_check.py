@@ -13,7 +13,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from sensor_msgs.msg import Image
 
 
-def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0):
+def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encoding="mono8"):
     clip = Clip()
     clip.header.frame_id = "camera_optical"
     clip.header.stamp = start
@@ -23,16 +23,25 @@ def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0):
     clip.num_frames = count
     clip.height = size
     clip.width = size
-    clip.encoding = "mono8"
-    # Vertical stripes travelling at `frequency` Hz, brightness 40..220.
-    data = bytearray(count * size * size)
+    clip.encoding = encoding
+    # Vertical stripes travelling at `frequency` Hz, brightness 40..220; in bgr8 grey stripes
+    # (equal channels) or, with "bgr8-red-green", red against green of one grey.
+    channels = 1 if encoding == "mono8" else 3
+    clip.encoding = "mono8" if channels == 1 else "bgr8"
+    data = bytearray(count * size * size * channels)
     wavelength = size / 6.0
     for t in range(count):
-        row = bytes(
-            int(130 + 90 * math.sin(2 * math.pi * (frequency * t / rate - x / wavelength))) for x in range(size))
-        base = t * size * size
+        row = bytearray()
+        for x in range(size):
+            v = int(130 + 90 * math.sin(2 * math.pi * (frequency * t / rate - x / wavelength)))
+            if encoding == "bgr8-red-green":
+                row += bytes((0, 150, 0) if v > 130 else (0, 0, 255))  # grey 88 and 76
+            else:
+                row += bytes([v] * channels)
+        line = size * channels
+        base = t * size * line
         for y in range(size):
-            data[base + y * size: base + (y + 1) * size] = row
+            data[base + y * line: base + (y + 1) * line] = row
     clip.data = bytes(data)
     clip.source_width = size
     clip.source_height = size
@@ -50,6 +59,8 @@ class SdnNodeTest(unittest.TestCase):
         self.estimates = []
         self.means = []
         self.statuses = []
+        self.colour_statuses = []
+        self.colour_estimates = []
         self.power = []
         self.frequency = []
         rospy.Subscriber("wind/estimate", WindEstimate, self.on_estimate, queue_size=100)
@@ -58,6 +69,9 @@ class SdnNodeTest(unittest.TestCase):
         rospy.Subscriber("sdn/power", Image, lambda m: self.append(self.power, m), queue_size=10)
         rospy.Subscriber("sdn/frequency", Image, lambda m: self.append(self.frequency, m), queue_size=10)
         self.pub = rospy.Publisher("clips", Clip, queue_size=100)
+        rospy.Subscriber("colour/wind/estimate", WindEstimate, lambda m: self.append(self.colour_estimates, m),
+                         queue_size=10)
+        self.colour_pub = rospy.Publisher("colour/clips", Clip, queue_size=10)
 
     def append(self, where, msg):
         with self.lock:
@@ -69,8 +83,10 @@ class SdnNodeTest(unittest.TestCase):
     def on_diagnostics(self, msg):
         with self.lock:
             for s in msg.status:
-                if "sdn" in s.name:
+                if s.name.startswith("sdn:"):
                     self.statuses.append(s)
+                elif s.name.startswith("colour/"):
+                    self.colour_statuses.append(s)
 
     def wait_for(self, predicate, timeout, what):
         deadline = rospy.get_time() + timeout
@@ -163,6 +179,34 @@ class SdnNodeTest(unittest.TestCase):
         keys = {kv.key: kv.value for kv in status.values}
         self.assertIn("latency mean [s]", keys)
         self.assertIn("rate [clips/s]", keys)
+        # A bgr8 clip of grey stripes is, to a grey model, the mono8 clip of the same stripes.
+        later = start + rospy.Duration.from_sec(1000.0)
+        self.pub.publish(make_clip(200, later, size, frequency, 4.0))
+        self.pub.publish(make_clip(201, later, size, frequency, 4.0, encoding="bgr8"))
+        self.wait_for(lambda: {200, 201} <= {e.clip_sequence for e in self.estimates}, 30, "the mono8 and bgr8 pair")
+        with self.lock:
+            pair = {e.clip_sequence: e.speed for e in self.estimates if e.clip_sequence >= 200}
+        self.assertAlmostEqual(pair[200], pair[201], places=6)
+
+    def test_colour_model(self):
+        """A model trained with --colour: bgr8 clips get estimates, a mono8 clip an ERROR that names
+        the clip buffer's ~colour parameter (the grey cannot be coloured back)."""
+        size = rospy.get_param("~size", 300)
+        self.wait_for(lambda: self.colour_pub.get_num_connections() > 0, 120, "the colour sdn_node to subscribe")
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.colour_statuses), 60,
+                      "an OK diagnostic from the colour node (model loaded)")
+        start = rospy.Time(1700000000, 0)
+        self.colour_pub.publish(make_clip(0, start, size, 3.0, 4.0))
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.ERROR and "~colour" in s.message
+                                  for s in self.colour_statuses), 30, "an ERROR naming ~colour for the grey clip")
+        self.colour_pub.publish(make_clip(1, start + rospy.Duration.from_sec(2.0), size, 3.0, 4.0,
+                                          encoding="bgr8-red-green"))
+        self.wait_for(lambda: len(self.colour_estimates) > 0, 30, "an estimate of the bgr8 clip")
+        with self.lock:
+            e = self.colour_estimates[0]
+        self.assertEqual(e.clip_sequence, 1, "no estimate for the grey clip")
+        self.assertTrue(math.isfinite(e.speed))
+        self.assertIn("-ycc", e.model)
 
 
 if __name__ == "__main__":
