@@ -70,6 +70,9 @@ class ReplayTest(unittest.TestCase):
         cls.min_segments = rospy.get_param('~min_segments', 1)             # > 1: gaps expected
         cls.max_segments = rospy.get_param('~max_segments', 1)
         cls.record_dir = rospy.get_param('~record_dir', '')
+        # What the clip buffer was told (config/clip_buffer.yaml, or the test's override).
+        cls.colour = bool(rospy.get_param('/clip_buffer/colour', False))
+        cls.encoding = 'bgr8' if cls.colour else 'mono8'
         cls.clips, cls.previews = [], []
         rospy.Subscriber('clips', Clip, cls.clips.append, queue_size=100)
         rospy.Subscriber('clips/preview', Image, cls.previews.append, queue_size=10)
@@ -146,9 +149,11 @@ class ReplayTest(unittest.TestCase):
                 self.assertFalse(start <= a and b <= end, 'clip %d spans the hole %.3f..%.3f' % (clip.sequence, a, b))
 
     def test_frames_are_cropped_grey_and_resized(self):
+        # mono8 clips, or bgr8 with the clip buffer's ~colour; either way the luma is checked.
+        channels = 3 if self.colour else 1
         for clip, exp in zip(self.clips, self.expected):
-            self.assertEqual((clip.width, clip.height, clip.encoding), (SIZE, SIZE, 'mono8'))
-            self.assertEqual(len(clip.data), NUM_FRAMES * SIZE * SIZE)
+            self.assertEqual((clip.width, clip.height, clip.encoding), (SIZE, SIZE, self.encoding))
+            self.assertEqual(len(clip.data), NUM_FRAMES * SIZE * SIZE * channels)
             self.assertEqual((clip.roi.x_offset, clip.roi.y_offset, clip.roi.width), (40, 0, 240))
             self.assertEqual((clip.source_width, clip.source_height), (320, 240))
             # The first frame's mean brightness is that of the centred 240x240 crop of the nearest
@@ -161,10 +166,10 @@ class ReplayTest(unittest.TestCase):
                 for c in range(40, 280):
                     p = row + 3 * c
                     total += 0.114 * data[p] + 0.587 * data[p + 1] + 0.299 * data[p + 2]
-            frame0 = clip.data[:SIZE * SIZE]
+            frame0 = luma(clip.data[:SIZE * SIZE * channels], channels)
             self.assertAlmostEqual(sum(frame0) / (SIZE * SIZE), total / (240 * 240), delta=1.0)
             # The flag moves within a clip.
-            middle = clip.data[15 * SIZE * SIZE:16 * SIZE * SIZE]
+            middle = luma(clip.data[15 * SIZE * SIZE * channels:16 * SIZE * SIZE * channels], channels)
             self.assertGreater(sum(abs(a - b) for a, b in zip(frame0, middle)), SIZE * SIZE)
 
     def test_labels_match_the_anemometer_by_stamp(self):
@@ -203,6 +208,7 @@ class ReplayTest(unittest.TestCase):
             self.assertAlmostEqual(label['wind']['mean'], clip.wind_mean, delta=1e-9)
             self.assertEqual(label['wind']['count'], clip.wind_count)
             self.assertEqual(label['roi'], {'x': 40, 'y': 0, 'size': 240})
+            self.assertEqual(label['encoding'], 'rgb8' if self.colour else 'mono8')
             for got, want in zip(label['frame_stamps'], clip.frame_stamps):
                 self.assertAlmostEqual(got, want.to_sec(), delta=2e-6)
             for i in range(NUM_FRAMES):
@@ -212,7 +218,14 @@ class ReplayTest(unittest.TestCase):
     def test_preview_is_published(self):
         self.assertGreater(len(self.previews), 0)
         p = self.previews[-1]
-        self.assertEqual((p.width, p.height, p.encoding), (SIZE, SIZE, 'mono8'))
+        self.assertEqual((p.width, p.height, p.encoding), (SIZE, SIZE, self.encoding))
+
+
+def luma(data, channels):
+    """The grey of one frame's bytes: as they are for mono8, BT.601 of B, G, R for bgr8."""
+    if channels == 1:
+        return list(data)
+    return [0.114 * data[i] + 0.587 * data[i + 1] + 0.299 * data[i + 2] for i in range(0, len(data), 3)]
 
 
 if __name__ == '__main__':
