@@ -2,8 +2,9 @@
 //
 // Subscribes  camera/image_raw (sensor_msgs/Image), camera/camera_info (kept for recorded
 //             clips' metadata), anemometer/wind (clothwind/WindMeasurement)
-// Publishes   clips (clothwind/Clip), clips/preview (sensor_msgs/Image mono8, bgr8 with ~colour: the latest clip's
-//             middle frame, only built while someone subscribes), /diagnostics
+// Publishes   clips (clothwind/Clip), clips/preview (sensor_msgs/Image mono8, or bgr8 with
+//             ~colour: the latest clip's middle frame, only built while someone subscribes),
+//             /diagnostics
 // All the logic is in sensors::ClipPipeline and sensors::DatasetWriter (see docs/clips.md).
 #include <cmath>
 #include <memory>
