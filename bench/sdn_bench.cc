@@ -1,9 +1,10 @@
-// Wind network inference latency per clip as sdn_node sees it: 30 frames of 300x300 mono8 in,
-// crop/resize/normalise + forward pass, for the SDN and the frame-stack baseline at several
-// widths and input sizes, on 1 and 2 threads (the goal: <= 50 ms per 30-frame clip on 2 cores
-// at the shipped size). Models are initialised in a temporary folder (speed does not depend on
-// the weights). Prints a table. --model benches given trained models (e.g. the shipped
-// models/sdn.pt) instead of the initialised ones.
+// Wind network inference latency per clip as sdn_node sees it: 30 frames of 300x300 mono8 in
+// (bgr8 for a colour model, converted to YCrCb as the node does), crop/resize/normalise +
+// forward pass, for the SDN and the frame-stack baseline at several widths and input sizes, on 1
+// and 2 threads (the goal: <= 50 ms per 30-frame clip on 2 cores at the shipped size). Models are
+// initialised in a temporary folder (speed does not depend on the weights). Prints a table.
+// --model benches given trained models (e.g. the shipped models/sdn.pt) instead of the
+// initialised ones.
 //
 //   sdn_bench [--repeats N] [--quick] [--model PATH.pt ...]
 
@@ -18,6 +19,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include <opencv2/core.hpp>
 
 #include "bench_clock.h"
 #include "learn/predictor.h"
@@ -56,13 +59,17 @@ int main(int argc, char** argv) {
   if (quick) cases = {{"sdn", 16, 112, 30}, {"sdn", 64, 112, 30}};
   if (!given.empty()) cases.clear();
   const fs::path dir = fs::temp_directory_path() / ("clothwind_sdn_bench_" + std::to_string(::getpid()));
-  // A clip as the node receives it: 30 frames 300x300 of moving stripes.
-  std::vector<cv::Mat> frames;
+  // A clip as the node receives it: 30 frames 300x300 of moving stripes, mono8 for grey models
+  // and bgr8 (red and green stripes) for colour ones, which the node converts to YCrCb per clip.
+  std::vector<cv::Mat> grey_frames, bgr_frames;
   for (int t = 0; t < 30; ++t) {
     cv::Mat f(300, 300, CV_8UC1);
     for (int y = 0; y < 300; ++y)
       for (int x = 0; x < 300; ++x) f.at<uint8_t>(y, x) = static_cast<uint8_t>(128 + 100 * std::sin(0.05 * x + 0.9 * t));
-    frames.push_back(f);
+    grey_frames.push_back(f);
+    cv::Mat bgr;
+    cv::merge(std::vector<cv::Mat>{cv::Mat::zeros(f.size(), CV_8UC1), 255 - f, f}, bgr);
+    bgr_frames.push_back(bgr);
   }
   std::printf("%-28s %7s %10s %10s %10s %14s\n", "model", "threads", "mean [ms]", "p90 [ms]",
               "min [ms]", "cpu/clip [ms]");
@@ -81,12 +88,14 @@ int main(int argc, char** argv) {
   for (const fs::path& model : models) {
     for (int threads : {1, 2}) {
       cl::Predictor p(model, threads, "cpu");
-      p.PredictFrames(frames);  // warm-up, as the node does
+      const bool colour = p.config().colour;
+      const std::vector<cv::Mat>& clip = colour ? bgr_frames : grey_frames;
+      p.PredictFrames(cl::CameraFramesForModel(clip, colour));  // warm-up, as the node does
       std::vector<double> ms;
       const double cpu0 = ProcessCpuMs();
       for (int i = 0; i < repeats; ++i) {
         const double t0 = WallMs();
-        p.PredictFrames(frames);
+        p.PredictFrames(cl::CameraFramesForModel(clip, colour));
         ms.push_back(WallMs() - t0);
       }
       const double cpu = (ProcessCpuMs() - cpu0) / repeats;
