@@ -22,26 +22,23 @@ cv::Mat ResizeSquare(const cv::Mat& crop, int out_size) {
   return out;
 }
 
-// The colour variant of PreprocessClipFrame: crop, to BGR, resize.
-cv::Mat PreprocessColourClipFrame(const cv::Mat& image, ClipSourceEncoding encoding, const SquareRoi& roi,
-                                  int out_size) {
-  const SquareRoi r = ResolveRoi(roi, image.cols, image.rows);
-  const cv::Mat crop = image(cv::Rect(r.x, r.y, r.size, r.size));
-  cv::Mat bgr;
+// The crop's pixels as a clip frame's: 8-bit grey, or BGR with `colour` (grey repeated).
+cv::Mat ToClipPixels(const cv::Mat& crop, ClipSourceEncoding encoding, bool colour) {
+  cv::Mat eight = crop;
+  if (encoding == ClipSourceEncoding::kMono16) crop.convertTo(eight, CV_8U, 1.0 / 256.0);
+  int code = -1;  // no conversion
   switch (encoding) {
-    case ClipSourceEncoding::kMono8: cv::cvtColor(crop, bgr, cv::COLOR_GRAY2BGR); break;
-    case ClipSourceEncoding::kMono16: {
-      cv::Mat eight;
-      crop.convertTo(eight, CV_8U, 1.0 / 256.0);
-      cv::cvtColor(eight, bgr, cv::COLOR_GRAY2BGR);
-      break;
-    }
-    case ClipSourceEncoding::kBgr8: bgr = crop; break;
-    case ClipSourceEncoding::kRgb8: cv::cvtColor(crop, bgr, cv::COLOR_RGB2BGR); break;
-    case ClipSourceEncoding::kBgra8: cv::cvtColor(crop, bgr, cv::COLOR_BGRA2BGR); break;
-    case ClipSourceEncoding::kRgba8: cv::cvtColor(crop, bgr, cv::COLOR_RGBA2BGR); break;
+    case ClipSourceEncoding::kMono8:
+    case ClipSourceEncoding::kMono16: code = colour ? cv::COLOR_GRAY2BGR : -1; break;
+    case ClipSourceEncoding::kBgr8: code = colour ? -1 : cv::COLOR_BGR2GRAY; break;
+    case ClipSourceEncoding::kRgb8: code = colour ? cv::COLOR_RGB2BGR : cv::COLOR_RGB2GRAY; break;
+    case ClipSourceEncoding::kBgra8: code = colour ? cv::COLOR_BGRA2BGR : cv::COLOR_BGRA2GRAY; break;
+    case ClipSourceEncoding::kRgba8: code = colour ? cv::COLOR_RGBA2BGR : cv::COLOR_RGBA2GRAY; break;
   }
-  return ResizeSquare(bgr, out_size);
+  if (code < 0) return eight;
+  cv::Mat out;
+  cv::cvtColor(eight, out, code);
+  return out;
 }
 
 }  // namespace
@@ -95,20 +92,10 @@ cv::Mat PreprocessClipFrame(const cv::Mat& image, ClipSourceEncoding encoding, c
   if (out_size <= 0) throw std::invalid_argument("clip frame size must be > 0, got " + std::to_string(out_size));
   if (image.type() != ClipSourceCvType(encoding))
     throw std::invalid_argument("image type does not match its encoding");
-  if (colour) return PreprocessColourClipFrame(image, encoding, roi, out_size);
   const SquareRoi r = ResolveRoi(roi, image.cols, image.rows);
   // Crop first (a view, no copy) so colour conversion only touches the pixels we keep.
   const cv::Mat crop = image(cv::Rect(r.x, r.y, r.size, r.size));
-  cv::Mat grey;
-  switch (encoding) {
-    case ClipSourceEncoding::kMono8: grey = crop; break;
-    case ClipSourceEncoding::kMono16: crop.convertTo(grey, CV_8U, 1.0 / 256.0); break;
-    case ClipSourceEncoding::kBgr8: cv::cvtColor(crop, grey, cv::COLOR_BGR2GRAY); break;
-    case ClipSourceEncoding::kRgb8: cv::cvtColor(crop, grey, cv::COLOR_RGB2GRAY); break;
-    case ClipSourceEncoding::kBgra8: cv::cvtColor(crop, grey, cv::COLOR_BGRA2GRAY); break;
-    case ClipSourceEncoding::kRgba8: cv::cvtColor(crop, grey, cv::COLOR_RGBA2GRAY); break;
-  }
-  return ResizeSquare(grey, out_size);
+  return ResizeSquare(ToClipPixels(crop, encoding, colour), out_size);
 }
 
 }  // namespace clothwind::sensors
