@@ -70,6 +70,7 @@ std::string ModelConfig::Name() const {
   if (colour) s << "-ycc";
   if (!stem_pool) s << "-np";
   if (coord_maps) s << "-xy";
+  if (head_hidden > 0) s << "-h" << head_hidden;
   s << "-w" << width << "-" << input_size << "-" << frames << "f";
   return s.str();
 }
@@ -95,6 +96,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"spectral_pool", c.spectral_pool}, {"stem_pool", c.stem_pool},
           {"coord_maps", c.coord_maps},
           {"dropout", c.dropout},        {"aux_outputs", c.aux_outputs},
+          {"head_hidden", c.head_hidden},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
           {"label_std", c.label_std},    {"std_scale", c.std_scale}};
@@ -139,6 +141,9 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     // Absent in models written before auxiliary targets existed: no second head.
     c.aux_outputs = j.contains("aux_outputs") ? j.at("aux_outputs").get<int>() : 0;
     if (c.aux_outputs < 0) throw std::runtime_error(where + ": field \"aux_outputs\" must be >= 0");
+    // Absent in models written before the option existed: a linear wind head.
+    c.head_hidden = j.contains("head_hidden") ? j.at("head_hidden").get<int>() : 0;
+    if (c.head_hidden < 0) throw std::runtime_error(where + ": field \"head_hidden\" must be >= 0");
     c.frame_rate = need("frame_rate").get<double>();
     c.width = need("width").get<int>();
     c.input_size = need("input_size").get<int>();

@@ -50,6 +50,10 @@ struct ModelConfig {
   // droops, and convolutions followed by average pooling see where only through the zero padding.
   bool coord_maps = false;
   double dropout = 0.0;      // dropout probability on the trunk's pooled features while training
+  // The wind head: 0 reads the pooled features linearly (ResNet's); N > 0 puts a hidden layer of
+  // N ReLU units before it. Why: the window oracle reads the wind from its features with boosted
+  // trees, not a linear map (docs/sdn-experiments.md, "How much one window can tell").
+  int head_hidden = 0;
   // Training only: a second head on the trunk's pooled features with this many outputs, which
   // training fits to the clip's track targets (learn/track_targets.h, --aux-tracks); 0: none.
   // The wind estimate never reads it, so a model with one predicts as one without.
@@ -94,7 +98,7 @@ struct ModelConfig {
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("…-flow-…" with flow, "sdn-k3m-…" with mean_map,
   // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps,
   // "…s4-" with phase_step_far 4, "…o-" with mode_shape, "…s/2-" with spectral_pool 2, "…-xy-" with
-  // coord_maps, "…-ycc-" with colour).
+  // coord_maps, "…-ycc-" with colour, "…-h256-" with head_hidden 256).
   std::string Name() const;
   // Table 1's "input modality", e.g. "30x112x112" ("30x3x64x64" with flow's or colour's three channels).
   std::string Modality() const;

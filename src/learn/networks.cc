@@ -109,7 +109,14 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
     const int features = trunk_->feature_size();
     lstm_ = register_module("lstm", torch::nn::LSTM(torch::nn::LSTMOptions(features, features).batch_first(true)));
   }
-  head_ = register_module("head", torch::nn::Linear(trunk_->feature_size(), 2));
+  if (config.head_hidden < 0) throw std::invalid_argument("WindNet: head_hidden must be >= 0");
+  // The output layer keeps the name "head" either way, so files of linear-head models load as before.
+  int head_inputs = trunk_->feature_size();
+  if (config.head_hidden > 0) {
+    head_hidden_ = register_module("head_hidden", torch::nn::Linear(head_inputs, config.head_hidden));
+    head_inputs = config.head_hidden;
+  }
+  head_ = register_module("head", torch::nn::Linear(head_inputs, 2));
   if (config.aux_outputs < 0) throw std::invalid_argument("WindNet: aux_outputs must be >= 0");
   if (config.aux_outputs > 0)
     aux_head_ = register_module("aux_head", torch::nn::Linear(trunk_->feature_size(), config.aux_outputs));
@@ -178,6 +185,7 @@ WindNetImpl::Outputs WindNetImpl::ForwardWithAux(const at::Tensor& clips) {
   // memorise a simulation.
   if (aux_head_) outputs.aux = aux_head_->forward(features);
   if (config_.dropout > 0) features = at::dropout(features, config_.dropout, is_training());
+  if (head_hidden_) features = at::relu(head_hidden_->forward(features));
   at::Tensor out = head_->forward(features);
   outputs.wind = at::stack({out.select(1, 0), out.select(1, 1).clamp(-12.0, 8.0)}, 1);
   return outputs;

@@ -97,6 +97,7 @@ class WindNetImpl : public torch::nn::Module {
   ModelConfig config_;
   ResNet18Trunk trunk_{nullptr};
   torch::nn::LSTM lstm_{nullptr};  // lstm only: hidden size = the trunk's 8w features
+  torch::nn::Linear head_hidden_{nullptr};  // head_hidden > 0 only: features -> ReLU units
   torch::nn::Linear head_{nullptr};
   torch::nn::Linear aux_head_{nullptr};  // aux_outputs > 0 only
 };

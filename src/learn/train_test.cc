@@ -454,6 +454,52 @@ TEST(ModelConfig, WithoutTheStemPoolTheTrunkKeepsTwiceTheResolution) {
   EXPECT_EQ(net->forward(at::randn({3, 1, 30, 16, 16})).sizes(), (at::IntArrayRef{3, 2}));
 }
 
+TEST(ModelConfig, AHiddenHeadLayerIsReluUnitsBeforeTheOutputAndOlderFilesHaveNone) {
+  ModelConfig c = TinySdn();
+  c.head_hidden = 8;
+  EXPECT_EQ(c.Name(), "sdn-k2-h8-w4-16-30f");
+  EXPECT_EQ(ModelConfigFromJson(ToJson(c), "x.json").head_hidden, 8);
+  nlohmann::json old = ToJson(c);
+  old.erase("head_hidden");
+  EXPECT_EQ(ModelConfigFromJson(old, "x.json").head_hidden, 0);
+  nlohmann::json negative = ToJson(c);
+  negative["head_hidden"] = -1;
+  try {
+    ModelConfigFromJson(negative, "x.json");
+    ADD_FAILURE() << "a negative head_hidden was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("x.json: field \"head_hidden\""), std::string::npos) << e.what();
+  }
+  ModelConfig bad = c;
+  bad.head_hidden = -2;
+  EXPECT_THROW(WindNet{bad}, std::invalid_argument);
+
+  // The linear head keeps its one layer, named as in older files; the hidden one adds a layer
+  // before it and the output layer reads the hidden units.
+  WindNet linear(TinySdn()), hidden(c);
+  auto lp = linear->named_parameters(), hp = hidden->named_parameters();
+  EXPECT_EQ(lp.find("head_hidden.weight"), nullptr);
+  EXPECT_EQ(lp["head.weight"].sizes(), (at::IntArrayRef{2, 32}));
+  EXPECT_EQ(hp["head_hidden.weight"].sizes(), (at::IntArrayRef{8, 32}));
+  EXPECT_EQ(hp["head.weight"].sizes(), (at::IntArrayRef{2, 8}));
+
+  // The units are rectified: with every unit's bias far below zero none fires, and the estimate
+  // is the output layer's bias whatever the clip (a linear hidden layer would follow the clip).
+  at::manual_seed(2);
+  hidden->eval();
+  const at::Tensor clips = at::randn({3, 1, 30, 16, 16});
+  at::NoGradGuard no_grad;
+  const at::Tensor live = hidden->forward(clips);
+  EXPECT_GT((live.select(1, 0) - live.select(1, 0)[0]).abs().max().item<double>(), 1e-6);
+  hp["head_hidden.bias"].fill_(-1e6);
+  const at::Tensor dead = hidden->forward(clips);
+  const at::Tensor bias = hp["head.bias"];
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_FLOAT_EQ(dead[i][0].item<float>(), bias[0].item<float>());
+    EXPECT_FLOAT_EQ(dead[i][1].item<float>(), bias[1].item<float>());
+  }
+}
+
 TEST(ModelConfig, CoordMapsAreEachPixelsColumnAndRowAfterEveryArchitecturesImages) {
   at::manual_seed(5);
   const at::Tensor clips = at::randn({2, 1, 30, 16, 16});
