@@ -62,6 +62,19 @@ void ExpectFieldRefused(const nlohmann::json& j, const std::string& field) {
   }
 }
 
+// Expects c's count field (member, JSON `field`) to survive the JSON round trip, to read as
+// `absent` from a file written before the field existed, and to be refused by name when negative.
+void ExpectCountFieldRoundTrips(const ModelConfig& c, int ModelConfig::*member, const std::string& field,
+                                int absent) {
+  EXPECT_EQ(ModelConfigFromJson(ToJson(c), "x.json").*member, c.*member);
+  nlohmann::json old = ToJson(c);
+  old.erase(field);
+  EXPECT_EQ(ModelConfigFromJson(old, "x.json").*member, absent);
+  nlohmann::json negative = ToJson(c);
+  negative[field] = -1;
+  ExpectFieldRefused(negative, field);
+}
+
 // Expects Train(o) to refuse, with a message holding every one of `words`; `accepted` says what
 // was wrongly accepted.
 void ExpectTrainRefused(const TrainOptions& o, const std::string& accepted, const std::vector<std::string>& words) {
@@ -458,13 +471,7 @@ TEST(ModelConfig, AHiddenHeadLayerIsReluUnitsBeforeTheOutputAndOlderFilesHaveNon
   ModelConfig c = TinySdn();
   c.head_hidden = 8;
   EXPECT_EQ(c.Name(), "sdn-k2-h8-w4-16-30f");
-  EXPECT_EQ(ModelConfigFromJson(ToJson(c), "x.json").head_hidden, 8);
-  nlohmann::json old = ToJson(c);
-  old.erase("head_hidden");
-  EXPECT_EQ(ModelConfigFromJson(old, "x.json").head_hidden, 0);
-  nlohmann::json negative = ToJson(c);
-  negative["head_hidden"] = -1;
-  ExpectFieldRefused(negative, "head_hidden");
+  ExpectCountFieldRoundTrips(c, &ModelConfig::head_hidden, "head_hidden", 0);
   ModelConfig bad = c;
   bad.head_hidden = -2;
   EXPECT_THROW(WindNet{bad}, std::invalid_argument);
@@ -566,13 +573,7 @@ TEST(ModelConfig, DropoutActsInTrainingOnlyAndRoundTrips) {
 TEST(ModelConfig, TheAuxiliaryHeadTrainsTheTrunkAndNotTheWindHeadAndRoundTrips) {
   ModelConfig c = TinySdn();
   c.aux_outputs = 5;
-  EXPECT_EQ(ModelConfigFromJson(ToJson(c), "x.json").aux_outputs, 5);
-  nlohmann::json old = ToJson(c);
-  old.erase("aux_outputs");
-  EXPECT_EQ(ModelConfigFromJson(old, "x.json").aux_outputs, 0);
-  nlohmann::json bad = ToJson(c);
-  bad["aux_outputs"] = -1;
-  ExpectFieldRefused(bad, "aux_outputs");
+  ExpectCountFieldRoundTrips(c, &ModelConfig::aux_outputs, "aux_outputs", 0);
 
   at::manual_seed(5);
   const at::Tensor clips = at::randn({3, 1, 30, 16, 16});
