@@ -91,6 +91,10 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--head-hidden", o.model.head_hidden,
                   "ReLU units of a hidden layer before the wind output (0: a linear head, ResNet's)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  sub->add_option("--frame-channels", o.model.frame_channels,
+                  "SDN: this many of the window's frames, evenly spaced, as more trunk channels beside the "
+                  "spectral maps: where the cloth is at those instants, which the spectra drop (0: none)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   sub->add_flag("--mean-map", o.model.mean_map, "SDN: add the clip's per-pixel temporal mean (the pose) as a channel");
   sub->add_option("--threads", o.threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--device", o.device, "cpu, cuda or auto (CUDA when libtorch finds one)")

@@ -11,7 +11,7 @@ int ModelConfig::TrunkInputChannels() const {
   const int coords = coord_maps ? 2 : 0;
   if (arch == "sdn") {
     const int phase = phase_steps ? (phase_step_far > 1 ? 8 : 4) : 0;
-    return (2 * k + (mean_map ? 1 : 0) + phase + (mode_shape ? 2 : 0)) * channels + coords;
+    return (2 * k + (mean_map ? 1 : 0) + phase + (mode_shape ? 2 : 0) + frame_channels) * channels + coords;
   }
   return (arch == "lstm" ? channels : frames * channels) + coords;
 }
@@ -35,6 +35,16 @@ int ModelConfig::SpectralCandidates() const {
 
 bool ModelConfig::PhaseStepFarIsValid() const {
   return phase_step_far == 0 || (phase_step_far >= 2 && phase_steps);
+}
+
+std::vector<int64_t> ModelConfig::FrameChannelIndices() const {
+  std::vector<int64_t> indices;
+  if (frame_channels == 1) indices.push_back((frames - 1) / 2);
+  for (int i = 0; frame_channels > 1 && i < frame_channels; ++i) {
+    // i·(T−1)/(N−1) rounded half up, in integers: exact for every N and T.
+    indices.push_back((2 * static_cast<int64_t>(i) * (frames - 1) + (frame_channels - 1)) / (2 * (frame_channels - 1)));
+  }
+  return indices;
 }
 
 bool ModelConfig::SpectralPoolIsValid() const {
@@ -62,6 +72,7 @@ std::string ModelConfig::Name() const {
     if (phase_steps) s << "s";
     if (phase_steps && phase_step_far > 1) s << phase_step_far;
     if (mode_shape) s << "o";
+    if (frame_channels > 0) s << "+f" << frame_channels;
     if (spectral_pool != 1) s << "/" << spectral_pool;
   }
   else s << arch;
@@ -94,7 +105,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"local_peaks", c.local_peaks},  {"phase_steps", c.phase_steps},
           {"phase_step_far", c.phase_step_far}, {"mode_shape", c.mode_shape},
           {"spectral_pool", c.spectral_pool}, {"stem_pool", c.stem_pool},
-          {"coord_maps", c.coord_maps},
+          {"coord_maps", c.coord_maps}, {"frame_channels", c.frame_channels},
           {"dropout", c.dropout},        {"aux_outputs", c.aux_outputs},
           {"head_hidden", c.head_hidden},
           {"frame_rate", c.frame_rate},  {"width", c.width},
@@ -137,6 +148,9 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.stem_pool = j.contains("stem_pool") ? j.at("stem_pool").get<bool>() : true;
     // Absent in models written before the option existed: no coordinate channels.
     c.coord_maps = j.contains("coord_maps") ? j.at("coord_maps").get<bool>() : false;
+    // Absent in models written before the option existed: the spectral maps alone.
+    c.frame_channels = j.contains("frame_channels") ? j.at("frame_channels").get<int>() : 0;
+    if (c.frame_channels < 0) throw std::runtime_error(where + ": field \"frame_channels\" must be >= 0");
     c.dropout = j.contains("dropout") ? j.at("dropout").get<double>() : 0.0;
     // Absent in models written before auxiliary targets existed: no second head.
     c.aux_outputs = j.contains("aux_outputs") ? j.at("aux_outputs").get<int>() : 0;

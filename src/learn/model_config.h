@@ -3,8 +3,10 @@
 #ifndef CLOTHWIND_LEARN_MODEL_CONFIG_H_
 #define CLOTHWIND_LEARN_MODEL_CONFIG_H_
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -49,6 +51,11 @@ struct ModelConfig {
   // camera aimed at the flag's rest centre, where in the frame the flag moves says how far it
   // droops, and convolutions followed by average pooling see where only through the zero padding.
   bool coord_maps = false;
+  // SDN: this many of the clip's own frames, evenly spaced over it, as N·C more trunk channels
+  // after the spectral maps (0: none). Why: the spectral layer keeps each pixel's strongest
+  // frequencies and their power but not where the cloth is at any instant, which the window
+  // oracle's point tracks hold (docs/sdn-experiments.md, "The frames beside the spectra").
+  int frame_channels = 0;
   double dropout = 0.0;      // dropout probability on the trunk's pooled features while training
   // The wind head: 0 reads the pooled features linearly (ResNet's); N > 0 puts a hidden layer of
   // N ReLU units before it. Why: the window oracle reads the wind from its features with boosted
@@ -81,9 +88,16 @@ struct ModelConfig {
   bool ModeShapeIsValid() const { return !mode_shape || (arch == "sdn" && !include_dc); }
   // spectral_pool is >= 1, divides input_size, and is 1 unless the model is an SDN.
   bool SpectralPoolIsValid() const;
+  // frame_channels is 0, or 1..frames on an SDN.
+  bool FrameChannelsAreValid() const {
+    return frame_channels == 0 || (arch == "sdn" && frame_channels >= 1 && frame_channels <= frames);
+  }
+  // The frames an SDN with frame_channels N shows its trunk: N indices evenly spaced over
+  // 0..frames-1, rounded (first and last included; N = 1: the middle frame). Empty for N = 0.
+  std::vector<int64_t> FrameChannelIndices() const;
 
   // Channels entering the ResNet trunk: 2kC (+C with mean_map, +4C or 8C with phase steps, +2C
-  // with mode_shape) for the SDN, N_t·C for the frame-stack baseline, C for the recurrent one
+  // with mode_shape, +N·C with frame_channels N) for the SDN, N_t·C for the frame-stack baseline, C for the recurrent one
   // (its trunk reads one frame at a time); +2 with coord_maps for every architecture.
   int TrunkInputChannels() const;
   // How a clip becomes this model's input: frames, input size and flow set, no augmentation
@@ -98,7 +112,7 @@ struct ModelConfig {
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("…-flow-…" with flow, "sdn-k3m-…" with mean_map,
   // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps,
   // "…s4-" with phase_step_far 4, "…o-" with mode_shape, "…s/2-" with spectral_pool 2, "…-xy-" with
-  // coord_maps, "…-ycc-" with colour, "…-h256-" with head_hidden 256).
+  // coord_maps, "…-ycc-" with colour, "…-h256-" with head_hidden 256, "…s+f10-" with frame_channels 10).
   std::string Name() const;
   // Table 1's "input modality", e.g. "30x112x112" ("30x3x64x64" with flow's or colour's three channels).
   std::string Modality() const;

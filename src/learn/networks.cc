@@ -100,6 +100,11 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
     throw std::invalid_argument("WindNet: flow_size " + std::to_string(config.flow_size) +
                                 " must be 0, or at least 16 on a model with flow");
   }
+  if (!config.FrameChannelsAreValid()) {
+    throw std::invalid_argument("WindNet: frame_channels " + std::to_string(config.frame_channels) +
+                                " must be 0, or 1 to the clip's " + std::to_string(config.frames) +
+                                " frames on an SDN, not on " + config.Name());
+  }
   if (!config.ColourIsValid()) {
     throw std::invalid_argument("WindNet: flow and colour are exclusive (the flow is the grey frames'), in " + config.Name());
   }
@@ -143,6 +148,13 @@ at::Tensor WindNetImpl::ArchImages(const at::Tensor& clips) const {
     if (config_.mean_map) parts.push_back(clips.mean(2));
     if (config_.phase_steps) parts.push_back(maps.phase);
     if (config_.mode_shape) parts.push_back(maps.mode);
+    // A few of the (normalised) frames themselves: where the cloth is at those instants, which
+    // no per-pixel spectrum keeps. [N_b, C, N, H, W] -> [N_b, C·N, H, W], channel c·N + i.
+    if (config_.frame_channels > 0) {
+      const std::vector<int64_t> indices = config_.FrameChannelIndices();
+      const at::Tensor picked = clips.index_select(2, at::tensor(indices, at::TensorOptions().dtype(at::kLong)).to(clips.device()));
+      parts.push_back(picked.reshape({clips.size(0), clips.size(1) * config_.frame_channels, clips.size(3), clips.size(4)}));
+    }
     at::Tensor maps_in = at::cat(parts, 1);
     // Pooling after the per-pixel spectra, not before: a stripe's edge that moves by less than a
     // pooled pixel still shows its power here, where downsampling the frames first blurs it away.

@@ -80,7 +80,8 @@ class WindNetImpl : public torch::nn::Module {
   // The trunk's input images: the stacked spectral maps [N_b, 2kC, H, W] (SDN: log1p of the
   // power, frequency divided by the Nyquist rate, so both are O(1)), the frames as channels
   // [N_b, N_t·C, H, W] (resnet18), or every frame on its own [N_b·N_t, C, H, W] (lstm). An SDN
-  // with spectral_pool p > 1 returns its maps average-pooled to [N_b, ·, H/p, W/p].
+  // with spectral_pool p > 1 returns its maps average-pooled to [N_b, ·, H/p, W/p]; one with
+  // frame_channels N appends the frames FrameChannelIndices() picks as N·C channels after them.
   // With coord_maps every architecture's images get two more channels last: the column and the
   // row of each pixel centre, scaled to (-1, 1).
   at::Tensor TrunkInput(const at::Tensor& clips) const;

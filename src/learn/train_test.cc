@@ -312,6 +312,52 @@ TEST(WindNet, OnlyTheMeanMapSeesAStillPose) {
   EXPECT_THROW(ModelConfigFromJson(bad, "x.json"), std::runtime_error);
 }
 
+TEST(WindNet, FrameChannelsAreTheWindowsOwnFramesAfterTheSpectra) {
+  ModelConfig c = TinySdn();
+  const ModelConfig plain_config = c;
+  // Evenly spaced, rounded, first and last included; one frame is the middle one.
+  c.frame_channels = 4;
+  EXPECT_EQ(c.FrameChannelIndices(), (std::vector<int64_t>{0, 10, 19, 29}));
+  ModelConfig one = c, two = c, all = c;
+  one.frame_channels = 1;
+  two.frame_channels = 2;
+  all.frame_channels = 30;
+  EXPECT_EQ(one.FrameChannelIndices(), (std::vector<int64_t>{14}));
+  EXPECT_EQ(two.FrameChannelIndices(), (std::vector<int64_t>{0, 29}));
+  ASSERT_EQ(all.FrameChannelIndices().size(), 30u);
+  for (int64_t t = 0; t < 30; ++t) EXPECT_EQ(all.FrameChannelIndices()[t], t);
+  EXPECT_EQ(c.Name(), "sdn-k2+f4-w4-16-30f");
+  EXPECT_EQ(c.TrunkInputChannels(), plain_config.TrunkInputChannels() + 4);
+  ExpectCountFieldRoundTrips(c, &ModelConfig::frame_channels, "frame_channels", 0);
+
+  // The trunk reads the plain SDN's maps, then exactly the chosen frames.
+  at::manual_seed(7);
+  const at::Tensor clips = at::randn({2, 1, 30, 16, 16});
+  at::NoGradGuard no_grad;
+  WindNet framed(c), plain(plain_config);
+  const at::Tensor in = framed->TrunkInput(clips), plain_in = plain->TrunkInput(clips);
+  ASSERT_EQ(in.sizes(), (at::IntArrayRef{2, 8, 16, 16}));
+  EXPECT_TRUE(at::equal(in.slice(1, 0, 4), plain_in));
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_TRUE(at::equal(in.select(1, 4 + i), clips.select(1, 0).select(1, c.FrameChannelIndices()[i])));
+  }
+  // The same motion over two different still images: the detrended spectra are the same, the
+  // frames are not.
+  const at::Tensor moving = 0.1 * at::randn({1, 1, 30, 16, 16}) + at::randn({2, 1, 1, 16, 16});
+  framed->eval();
+  plain->eval();
+  const at::Tensor p = plain->forward(moving), q = framed->forward(moving);
+  EXPECT_TRUE(at::allclose(p[0], p[1], 1e-4, 1e-5)) << p;
+  EXPECT_FALSE(at::allclose(q[0], q[1], 1e-3, 1e-4)) << q;
+
+  // More frames than the clip has, or frames on a baseline that already reads them all, are refused.
+  ModelConfig too_many = c, baseline = c;
+  too_many.frame_channels = 31;
+  baseline.arch = "resnet18";
+  EXPECT_THROW(WindNet{too_many}, std::invalid_argument);
+  EXPECT_THROW(WindNet{baseline}, std::invalid_argument);
+}
+
 TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
   ModelConfig c = TinySdn();
   c.dft_size = 120;
