@@ -38,9 +38,9 @@ bool ModelConfig::PhaseStepFarIsValid() const {
 }
 
 std::vector<int64_t> ModelConfig::FrameChannelIndices() const {
+  if (frame_channels == 1) return {(frames - 1) / 2};
   std::vector<int64_t> indices;
-  if (frame_channels == 1) indices.push_back((frames - 1) / 2);
-  for (int i = 0; frame_channels > 1 && i < frame_channels; ++i) {
+  for (int i = 0; i < frame_channels; ++i) {
     // i·(T−1)/(N−1) rounded half up, in integers: exact for every N and T.
     indices.push_back((2 * static_cast<int64_t>(i) * (frames - 1) + (frame_channels - 1)) / (2 * (frame_channels - 1)));
   }

@@ -151,9 +151,8 @@ at::Tensor WindNetImpl::ArchImages(const at::Tensor& clips) const {
     // A few of the (normalised) frames themselves: where the cloth is at those instants, which
     // no per-pixel spectrum keeps. [N_b, C, N, H, W] -> [N_b, C·N, H, W], channel c·N + i.
     if (config_.frame_channels > 0) {
-      const std::vector<int64_t> indices = config_.FrameChannelIndices();
-      const at::Tensor picked = clips.index_select(2, at::tensor(indices, at::TensorOptions().dtype(at::kLong)).to(clips.device()));
-      parts.push_back(picked.reshape({clips.size(0), clips.size(1) * config_.frame_channels, clips.size(3), clips.size(4)}));
+      const at::Tensor indices = at::tensor(config_.FrameChannelIndices(), at::kLong).to(clips.device());
+      parts.push_back(clips.index_select(2, indices).flatten(1, 2));
     }
     at::Tensor maps_in = at::cat(parts, 1);
     // Pooling after the per-pixel spectra, not before: a stripe's edge that moves by less than a
