@@ -148,6 +148,13 @@ class TrackOracleTest(unittest.TestCase):
         write_json(path, t)
         done = self.run_oracle('--coords', 'world')
         self.assertIn('no "world" field', done.stderr)
+        del t['width']
+        write_json(path, t)
+        done = self.run_oracle()
+        self.assertNotEqual(done.returncode, 0)
+        self.assertIn(path, done.stderr)
+        self.assertIn('"width"', done.stderr)
+        self.assertNotIn('Traceback', done.stderr)
 
     def test_a_dataset_without_a_split_is_refused(self):
         clips = make_dataset(self.data, sims_per_split=(1, 1, 0), views=1)
