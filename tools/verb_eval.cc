@@ -5,6 +5,7 @@
 
 #include "learn/evaluate.h"
 #include "learn/model_config.h"
+#include "learn/track_head_eval.h"
 #include "learn/view_breakdown.h"
 #include "progress_bar.h"
 #include "verb_registry.h"
@@ -13,11 +14,12 @@ namespace clothwind::tools {
 namespace {
 
 struct EvalArgs {
-  std::string model, data, split = "test", json, plot;
+  std::string model, data, split = "test", json, plot, track_head_rows;
   int threads = 2, batch = 8, windows = 1;
   std::string device = "auto";
   bool mirror = false;
   bool by_view = false;
+  bool track_head = false;
 };
 
 VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
@@ -41,10 +43,19 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
   sub->add_flag("--by-view", a->by_view,
                "also break the errors down by the clips' views (camera elevation, angle, distance; texture), "
                "read from each simulated clip's label.json");
+  sub->add_flag("--track-head", a->track_head,
+               "also report how well the run's auxiliary track head (--aux-tracks) knows the points: window-mean "
+               "positions in pixels of the input, log amplitudes per bin (a run's model.pt; export drops the head)");
+  sub->add_option("--track-head-rows", a->track_head_rows,
+                  "with --track-head: write each clip's predicted and true track targets to this file (TSV)");
   sub->add_option("--device", a->device, "cpu, cuda or auto")
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
       ->capture_default_str();
   return [a]() {
+    if (!a->track_head_rows.empty() && !a->track_head) {
+      std::cerr << "clothwind eval: --track-head-rows needs --track-head\n";
+      return 2;
+    }
     ProgressBar::Options b;
     b.label = "eval";
     b.unit = "clips";
@@ -65,6 +76,25 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
         json["by_view"] = learn::ViewBreakdownJson(breakdown);
       } catch (const std::exception& e) {
         by_view_error = e.what();
+      }
+    }
+    if (a->track_head) {
+      ProgressBar::Options h = b;
+      h.label = "track head";
+      ProgressBar head_bar(h);
+      const learn::TrackHeadReport head = learn::EvaluateTrackHead(
+          a->model, a->data, a->split, a->threads, a->batch, [&](int done, int total) { head_bar.Update(done, total); });
+      head_bar.Finish();
+      std::cout << learn::TrackHeadTable(head);
+      json["track_head"] = {{"position_rmse_x_px", head.position_rmse_x},
+                            {"position_rmse_y_px", head.position_rmse_y},
+                            {"position_r2", head.position_r2},
+                            {"amplitude_rmse", head.amplitude_rmse},
+                            {"amplitude_r2", head.amplitude_r2},
+                            {"standardised_mse", head.standardised_mse}};
+      if (!a->track_head_rows.empty()) {
+        learn::WriteTrackHeadRows(head, a->track_head_rows);
+        std::cout << "track head rows: " << a->track_head_rows << "\n";
       }
     }
     const std::filesystem::path plot =

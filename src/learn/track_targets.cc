@@ -76,6 +76,8 @@ std::vector<double> Hann(int frames, double* sum) {
 // Σ_t w_t (series_t - mean) e^{-2πi jt/T} / Σ_t w_t: one series' spectrum at bin j.
 std::complex<double> BinOf(const std::vector<double>& series, double mean, const std::vector<double>& hann,
                            double hann_sum, int j) {
+  // One frame shows no motion (its Hann window is all zero): every bin reads 0.
+  if (hann_sum <= 0) return 0.0;
   const int frames = static_cast<int>(series.size());
   std::complex<double> sum = 0;
   for (int t = 0; t < frames; ++t) sum += hann[t] * (series[t] - mean) * std::polar(1.0, -2 * M_PI * j * t / frames);
@@ -88,7 +90,7 @@ std::vector<float> WorldTrackTargets(const Tracks& tracks, int first, int frames
   const int points = tracks.points();
   if (tracks.world.size() != static_cast<size_t>(tracks.frames) * 3 * points)
     throw std::invalid_argument("WorldTrackTargets: the tracks hold no positions ('world')");
-  if (first < 0 || frames < 2 || first + frames > tracks.frames)
+  if (first < 0 || frames < 1 || first + frames > tracks.frames)
     throw std::invalid_argument("WorldTrackTargets: window " + std::to_string(first) + "+" + std::to_string(frames) +
                                 " outside tracks of " + std::to_string(tracks.frames) + " frames");
   double hann_sum = 0;
@@ -116,7 +118,7 @@ std::vector<float> WorldTrackTargets(const Tracks& tracks, int first, int frames
 
 std::vector<float> TrackTargets(const Tracks& tracks, int first, int frames, const cv::Rect& crop, int source_side,
                                 bool flipped, int phase_bins) {
-  if (first < 0 || frames < 2 || first + frames > tracks.frames)
+  if (first < 0 || frames < 1 || first + frames > tracks.frames)
     throw std::invalid_argument("TrackTargets: window " + std::to_string(first) + "+" + std::to_string(frames) +
                                 " outside tracks of " + std::to_string(tracks.frames) + " frames");
   if (tracks.width != tracks.height || crop.width != crop.height || crop.width < 1 || source_side < 1)

@@ -59,6 +59,8 @@ inline int TrackTargetCount(int points, int phase_bins) {
 //   move). Relative phases are what the window oracle reads a travelling wave by, and they do not
 //   depend on when the window starts; the sqrt(A_j) weight fades them out where a point hardly moves
 //   and its phase is noise.
+// A window of one frame (a per-frame network's, --frames 1) has no motion: its amplitudes read
+// log(1e-4) and its phases 0, so only the positions teach the head.
 // Throws std::invalid_argument when the window is outside the tracks, the frames are not square or
 // phase_bins is outside [0, kTrackBins].
 std::vector<float> TrackTargets(const Tracks& tracks, int first, int frames, const cv::Rect& crop, int source_side,

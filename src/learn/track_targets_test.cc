@@ -104,6 +104,33 @@ TEST(TrackTargetsTest, TheWindowIsTheSamplesFrames) {
   EXPECT_THROW(TrackTargets(t, 31, 30, cv::Rect(0, 0, 128, 128), 128, false), std::invalid_argument);
 }
 
+// Four points of a 2x2 grid, each moving on its own, for one-frame windows.
+Tracks TravellingWaveForOneFrame() {
+  return MakeTracks(
+      2, 2, 128, 10, [](int p, int k) { return 30.0 + 20 * p + 3 * std::sin(0.7 * k + p); },
+      [](int p, int k) { return 50.0 + 10 * p + 2 * std::cos(0.5 * k); });
+}
+
+TEST(TrackTargetsTest, AOneFrameWindowHoldsThatFramesPositionsAndNoMotion) {
+  // A per-frame network (--frames 1) learns where the points are in its one frame; the moving
+  // point's amplitudes and phases must read "no motion", not the NaN of an all-zero Hann window.
+  const Tracks t = TravellingWaveForOneFrame();
+  for (int k : {0, 7}) {
+    const std::vector<float> y = TrackTargets(t, k, 1, cv::Rect(0, 0, 128, 128), 128, false, 2);
+    ASSERT_EQ(y.size(), static_cast<size_t>(TrackTargetCount(4, 2)));
+    for (int p = 0; p < 4; ++p) {
+      EXPECT_NEAR(y[UMean(p)], 2.0 * t.xy[(k * 4 + p) * 2] / 128 - 1, 1e-6) << k << " " << p;
+      EXPECT_NEAR(y[VMean(p)], 2.0 * t.xy[(k * 4 + p) * 2 + 1] / 128 - 1, 1e-6) << k << " " << p;
+      for (int j = 1; j <= kTrackBins; ++j) {
+        EXPECT_FLOAT_EQ(y[UBin(p, j)], std::log(1e-4f)) << p << " " << j;
+        EXPECT_FLOAT_EQ(y[VBin(p, j)], std::log(1e-4f)) << p << " " << j;
+      }
+    }
+    for (size_t i = 4 * kTargetsPerPoint; i < y.size(); ++i) EXPECT_EQ(y[i], 0.0f) << i;
+  }
+  EXPECT_THROW(TrackTargets(t, 0, 0, cv::Rect(0, 0, 128, 128), 128, false), std::invalid_argument);
+}
+
 // Index of point p's phase target at bin j (of `bins`): coordinate c (0 u, 1 v), part 0 re, 1 im.
 int Phase(int points, int bins, int p, int j, int c, int part) {
   return points * kTargetsPerPoint + (p * bins + j - 1) * kPhaseTargetsPerPointAndBin + c * 2 + part;

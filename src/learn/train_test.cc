@@ -16,10 +16,12 @@
 #include <torch/nn/utils/clip_grad.h>
 #include <torch/optim/adam.h>
 
+#include "learn/aux_targets.h"
 #include "learn/dataset.h"
 #include "learn/evaluate.h"
 #include "learn/networks.h"
 #include "learn/predictor.h"
+#include "learn/track_head_eval.h"
 #include "learn/track_targets.h"
 #include "learn/view_breakdown.h"
 
@@ -1036,6 +1038,95 @@ TEST_F(TrainTest, AuxTracksTrainASecondHeadOnTheClipsTracks) {
   alone.out = *root_ / "aux_world_alone";
   alone.aux_tracks = 0;
   ExpectTrainRefused(alone, "positions without the auxiliary loss were accepted", {"aux_world"});
+}
+
+TEST_F(TrainTest, TrackHeadEvaluationReadsTheHeadBackInTheTargetsUnits) {
+  const fs::path data = *root_ / "data_head";
+  fs::copy(*root_ / "data", data, fs::copy_options::recursive);
+  WriteToyTracks(data);
+  TrainOptions t = Options("sdn", "head");
+  t.data = data;
+  t.epochs = 2;
+  t.aux_tracks = 1.0;
+  const TrainResult r = Train(t);
+  const TrackHeadReport head = EvaluateTrackHead(r.model, data, "val", 1, 3);
+  const std::vector<ClipInfo> val = SelectSplit(ReadDataset(data), "val");
+  ASSERT_EQ(head.names.size(), val.size());
+  ASSERT_EQ(head.points, 4);
+  // Each clip's row is the head's output for its evaluation window, unstandardised by the train
+  // split's scale (training's), beside that window's own targets.
+  WindNet net = LoadWindNet(r.model);
+  const SampleOptions options = net->config().Sampling();
+  const AuxTargets train = ReadAuxTargets(SelectSplit(ReadDataset(data), "train"), options, 0, false);
+  for (size_t i : {size_t{0}, val.size() - 1}) {
+    ASSERT_EQ(head.names[i], val[i].name);
+    Sample s = LoadSample(val[i], options, 0);
+    at::NoGradGuard no_grad;
+    const at::Tensor aux =
+        net->ForwardWithAux(at::from_blob(s.pixels.data(), {1, 1, options.frames, options.input_size,
+                                                            options.input_size}, at::kFloat))
+            .aux;
+    const std::vector<float> truth = AuxTargetsOf(ReadTracks(val[i].dir / "tracks.json"), s.first_frame,
+                                                  options.frames, s.crop, val[i].width, false, 0, false);
+    ASSERT_EQ(head.predicted[i].size(), truth.size());
+    for (size_t k = 0; k < truth.size(); ++k) {
+      EXPECT_NEAR(head.predicted[i][k], aux[0][k].item<float>() * train.scale.std[k] + train.scale.mean[k], 1e-4)
+          << i << " " << k;
+      EXPECT_FLOAT_EQ(head.truth[i][k], truth[k]) << i << " " << k;
+    }
+  }
+  // The figures are the rows': positions in pixels of the 32-px input, where [-1, 1] spans it.
+  double se_x = 0, se = 0, n = 0;
+  for (size_t i = 0; i < val.size(); ++i)
+    for (int p = 0; p < 4; ++p) {
+      se_x += std::pow(head.predicted[i][p * kTargetsPerPoint] - head.truth[i][p * kTargetsPerPoint], 2);
+      n += 1;
+      for (int k = 0; k < kTargetsPerPoint; ++k) {
+        const int o = p * kTargetsPerPoint + k;
+        se += std::pow((head.predicted[i][o] - head.truth[i][o]) / train.scale.std[o], 2);
+      }
+    }
+  EXPECT_NEAR(head.position_rmse_x, std::sqrt(se_x / n) * 16, 1e-4);
+  EXPECT_NEAR(head.standardised_mse, se / (n * kTargetsPerPoint), 1e-5);
+  ASSERT_EQ(head.amplitude_rmse.size(), static_cast<size_t>(kTrackBins));
+  for (double e : head.amplitude_rmse) EXPECT_TRUE(std::isfinite(e) && e >= 0);
+  // The rows file holds both rows per clip after a header.
+  const fs::path rows = *root_ / "head_rows.tsv";
+  WriteTrackHeadRows(head, rows);
+  std::ifstream in(rows);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line.rfind("# name", 0), 0u);
+  std::getline(in, line);
+  std::istringstream fields(line);
+  std::string name;
+  fields >> name;
+  EXPECT_EQ(name, val[0].name);
+  int values = 0;
+  for (double v; fields >> v;) ++values;
+  EXPECT_EQ(values, 1 + 2 * 4 * kTargetsPerPoint);
+  // An exported model has no head: refused, naming the file.
+  const fs::path stripped = *root_ / "head_stripped" / "model.pt";
+  fs::create_directories(stripped.parent_path());
+  WindNet without = WithoutAuxHead(net);
+  SaveWindNet(without, stripped);
+  try {
+    EvaluateTrackHead(stripped, data, "val", 1, 3);
+    ADD_FAILURE() << "a model without a head was evaluated";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(stripped.string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no track head"), std::string::npos) << e.what();
+  }
+  // A per-frame network (one frame a sample) trains the head on where the points are: its
+  // targets' motion is zero, not the NaN of a one-frame Hann window.
+  TrainOptions frame = Options("resnet18", "head_frame");
+  frame.data = data;
+  frame.model.frames = 1;
+  frame.epochs = 1;
+  frame.aux_tracks = 1.0;
+  const TrainResult one = Train(frame);
+  EXPECT_TRUE(std::isfinite(one.log[0].train_aux_loss) && one.log[0].train_aux_loss > 0) << one.log[0].train_aux_loss;
+  EXPECT_TRUE(std::isfinite(EvaluateTrackHead(one.model, data, "val", 1, 3).position_rmse_x));
 }
 
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
