@@ -3,6 +3,8 @@
 layout: the trees read the wind from the column group and targets asked for (exact truth reads
 better than a noisy head, positions alone read what they hold), and bad rows are refused naming
 the file and line."""
+import importlib.machinery
+import importlib.util
 import json
 import os
 import subprocess
@@ -14,6 +16,9 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPT = os.path.join(ROOT, 'scripts', 'head-oracle')
 POINTS, PER_POINT = 3, 12
+_loader = importlib.machinery.SourceFileLoader('head_oracle', SCRIPT)
+oracle = importlib.util.module_from_spec(importlib.util.spec_from_loader('head_oracle', _loader))
+_loader.exec_module(oracle)
 
 
 def targets(speed, rng):
@@ -82,6 +87,23 @@ class HeadOracleTest(unittest.TestCase):
         self.assertGreater(results['predicted', 'positions'], results['truth', 'positions'] + 0.2)
         # The amplitudes hold nothing here: adding them does not help the exact reading much.
         self.assertLess(results['truth', 'all'], results['truth', 'positions'] + 0.5)
+
+    def test_position_noise_is_pixels_of_the_input_on_the_means_only(self):
+        write_rows(self.dir, head_noise=0.0)
+        path = os.path.join(self.dir, 'rows-test.tsv')
+        _, _, exact = oracle.read_rows(path, 'truth', 'all')
+        _, _, noisy = oracle.read_rows(path, 'truth', 'all', 2.0, np.random.RandomState(1))
+        change = noisy - exact
+        means = [p * PER_POINT + k for p in range(POINTS) for k in (0, 1)]
+        others = [i for i in range(POINTS * PER_POINT) if i not in means]
+        self.assertAlmostEqual(float(change[:, means].std()) * 64 / 2, 2.0, delta=0.3)  # 2 px of 64
+        self.assertTrue(np.all(change[:, others] == 0))
+        # As much noise on the exact means as the noisy head has reads about as the head does.
+        write_rows(self.dir, head_noise=0.08)
+        exact = rmse_of(self.run_oracle('--columns', 'truth', '--targets', 'positions').stdout)
+        noisy = rmse_of(self.run_oracle('--columns', 'truth', '--targets', 'positions',
+                                        '--position-noise', str(0.08 * 32)).stdout)
+        self.assertGreater(noisy, exact + 0.2)
 
     def test_predictions_file_has_each_test_clip(self):
         write_rows(self.dir, head_noise=0.0)
