@@ -15,7 +15,7 @@ namespace {
 
 struct EvalArgs {
   std::string model, data, split = "test", json, plot, track_head_rows;
-  int threads = 2, batch = 8, windows = 1;
+  int threads = 2, batch = 8, windows = 1, track_head_window = 0;
   std::string device = "auto";
   bool mirror = false;
   bool by_view = false;
@@ -48,6 +48,12 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
                "positions in pixels of the input, log amplitudes per bin (a run's model.pt; export drops the head)");
   sub->add_option("--track-head-rows", a->track_head_rows,
                   "with --track-head: write each clip's predicted and true track targets to this file (TSV)");
+  sub->add_option("--track-head-window", a->track_head_window,
+                  "with --track-head: read the head over this many centred frames, a multiple of the model's, "
+                  "its outputs averaged over the consecutive inputs (0: the model's own frames; 30 with a "
+                  "--frames 1 network: the window-mean positions a per-frame tracker gives a 30-frame window)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   sub->add_option("--device", a->device, "cpu, cuda or auto")
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
       ->capture_default_str();
@@ -83,10 +89,12 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       h.label = "track head";
       ProgressBar head_bar(h);
       const learn::TrackHeadReport head = learn::EvaluateTrackHead(
-          a->model, a->data, a->split, a->threads, a->batch, [&](int done, int total) { head_bar.Update(done, total); });
+          a->model, a->data, a->split, a->threads, a->batch, [&](int done, int total) { head_bar.Update(done, total); },
+          a->track_head_window);
       head_bar.Finish();
       std::cout << learn::TrackHeadTable(head);
-      json["track_head"] = {{"position_rmse_x_px", head.position_rmse_x},
+      json["track_head"] = {{"window", head.window},
+                            {"position_rmse_x_px", head.position_rmse_x},
                             {"position_rmse_y_px", head.position_rmse_y},
                             {"position_r2", head.position_r2},
                             {"amplitude_rmse", head.amplitude_rmse},

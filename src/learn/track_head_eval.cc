@@ -57,7 +57,8 @@ struct Pooled {
 }  // namespace
 
 TrackHeadReport EvaluateTrackHead(const fs::path& model, const fs::path& data, const std::string& split,
-                                  int threads, int batch, const std::function<void(int, int)>& progress) {
+                                  int threads, int batch, const std::function<void(int, int)>& progress,
+                                  int window) {
   const auto start = std::chrono::steady_clock::now();
   if (threads > 0) at::set_num_threads(threads);
   WindNet net = LoadWindNet(model);
@@ -71,6 +72,11 @@ TrackHeadReport EvaluateTrackHead(const fs::path& model, const fs::path& data, c
   bool world = false;
   ReadRunAuxOptions(model, &phase_bins, &world);
   const SampleOptions options = r.config.Sampling();
+  r.window = window == 0 ? r.config.frames : window;
+  if (r.window < r.config.frames || r.window % r.config.frames != 0)
+    throw std::invalid_argument("EvaluateTrackHead: window " + std::to_string(window) + " must be 0 or a multiple of " +
+                                "the model's " + std::to_string(r.config.frames) + " frames");
+  const int parts = r.window / r.config.frames;  // consecutive model inputs per window
   const Dataset dataset = ReadDataset(data);
   // The scale training standardised the head's targets by: its train split's.
   const AuxTargets train = ReadAuxTargets(SelectSplit(dataset, "train"), options, phase_bins, world);
@@ -89,8 +95,21 @@ TrackHeadReport EvaluateTrackHead(const fs::path& model, const fs::path& data, c
   at::NoGradGuard no_grad;
   for (size_t i = 0; i < clips.size(); i += batch) {
     const size_t end = std::min(clips.size(), i + static_cast<size_t>(batch));
+    // Clip j's part q is sample (j - i) * parts + q: its window's q-th run of config.frames frames.
     std::vector<Sample> samples;
-    for (size_t j = i; j < end; ++j) samples.push_back(LoadSample(clips[j], options, 0));
+    std::vector<int> window_first;
+    for (size_t j = i; j < end; ++j) {
+      const int first = (clips[j].num_frames - r.window) / 2;  // the centred window, as Sampling()'s
+      if (first < 0)
+        throw std::runtime_error(clips[j].name + ": " + std::to_string(clips[j].num_frames) +
+                                 " frames, fewer than the window's " + std::to_string(r.window));
+      window_first.push_back(first);
+      for (int q = 0; q < parts; ++q) {
+        SampleOptions part = options;
+        part.first_frame = first + q * r.config.frames;
+        samples.push_back(LoadSample(clips[j], part, 0));
+      }
+    }
     const int64_t per = static_cast<int64_t>(samples[0].pixels.size());
     at::Tensor input = at::empty({static_cast<int64_t>(samples.size()), options.channels(), options.frames,
                                   options.input_size, options.input_size});
@@ -98,14 +117,16 @@ TrackHeadReport EvaluateTrackHead(const fs::path& model, const fs::path& data, c
       std::copy(samples[j].pixels.begin(), samples[j].pixels.end(), input.data_ptr<float>() + j * per);
     const at::Tensor aux = net->ForwardWithAux(input).aux.to(at::kFloat).contiguous();
     for (size_t j = i; j < end; ++j) {
-      const Sample& s = samples[j - i];
+      const Sample& s = samples[(j - i) * parts];
       r.names.push_back(clips[j].name);
       r.wind.push_back(clips[j].wind_speed);
-      r.truth.push_back(AuxTargetsOf(tracks.tracks[j], s.first_frame, options.frames, s.crop, clips[j].width,
+      r.truth.push_back(AuxTargetsOf(tracks.tracks[j], window_first[j - i], r.window, s.crop, clips[j].width,
                                      s.flipped, phase_bins, world));
-      const float* row = aux.data_ptr<float>() + (j - i) * outputs;
-      std::vector<float> y(outputs);
-      for (int k = 0; k < outputs; ++k) y[k] = row[k] * train.scale.std[k] + train.scale.mean[k];
+      std::vector<float> y(outputs, 0.0f);
+      for (int q = 0; q < parts; ++q) {
+        const float* row = aux.data_ptr<float>() + ((j - i) * parts + q) * outputs;
+        for (int k = 0; k < outputs; ++k) y[k] += (row[k] * train.scale.std[k] + train.scale.mean[k]) / parts;
+      }
       r.predicted.push_back(std::move(y));
     }
     if (progress) progress(static_cast<int>(r.names.size()), static_cast<int>(clips.size()));
@@ -142,7 +163,9 @@ std::string TrackHeadTable(const TrackHeadReport& r) {
   std::ostringstream s;
   s << std::fixed << std::setprecision(3);
   s << "track head of " << r.config.Name() << " on " << r.names.size() << " " << r.split << " clips, " << r.points
-    << " points, " << r.config.frames << "-frame centred window\n";
+    << " points, " << r.window << "-frame centred window";
+  if (r.window != r.config.frames) s << " (" << r.window / r.config.frames << " inputs averaged)";
+  s << "\n";
   s << "window-mean position  rmse x " << r.position_rmse_x << " px, y " << r.position_rmse_y << " px (of "
     << r.config.input_size << "), R^2 " << r.position_r2 << "\n";
   for (size_t j = 0; j < r.amplitude_rmse.size(); ++j)
@@ -155,7 +178,7 @@ void WriteTrackHeadRows(const TrackHeadReport& r, const fs::path& file) {
   std::ostringstream s;
   const int outputs = r.config.aux_outputs;
   s << "# name\twind [m/s]\tpredicted[" << outputs << "]\ttruth[" << outputs << "]  (TrackTargets' order, "
-    << r.points << " points, input " << r.config.input_size << " px, " << r.config.frames << " frames)\n";
+    << r.points << " points, input " << r.config.input_size << " px, " << r.window << " frames)\n";
   s << std::setprecision(7);
   for (size_t i = 0; i < r.names.size(); ++i) {
     s << r.names[i] << '\t' << r.wind[i];

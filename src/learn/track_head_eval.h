@@ -19,6 +19,7 @@ struct TrackHeadReport {
   ModelConfig config;
   std::string split;
   int points = 0;
+  int window = 0;  // frames of the window the targets are of (config.frames unless asked otherwise)
   std::vector<std::string> names;  // each clip, in the split's order
   std::vector<double> wind;        // [m/s] each clip's true wind
   // [clips][config.aux_outputs] the head's outputs unstandardised, and the targets of the same
@@ -40,12 +41,17 @@ struct TrackHeadReport {
 // drops the head) over one split of `data`, with the targets standardised as training did: by the
 // scale of the dataset's train split (ReadAuxTargets), with the run's phase bins and world targets
 // read from state.json beside the model (none when it is absent).
-// Inputs: threads  torch threads; batch  clips per forward pass; progress  (done, total) per batch.
+// Inputs: threads  torch threads; batch  clips per forward pass; progress  (done, total) per batch;
+//   window  0: the model's own frames (config.frames, centred); a multiple T of config.frames: the
+//           centred T-frame window read as T / config.frames consecutive inputs whose outputs are
+//           averaged, against the T-frame window's targets. A per-frame network (--frames 1) read
+//           with window 30 gives the window-mean positions a tracker would give the SDN's window;
+//           its amplitudes are then its own windows' (none for one frame), not the window's.
 // Throws std::runtime_error naming the model when it has no head, the state file when the
 // dataset's tracks give another number of targets than the head has, and the clip without tracks.
 TrackHeadReport EvaluateTrackHead(const std::filesystem::path& model, const std::filesystem::path& data,
                                   const std::string& split, int threads, int batch,
-                                  const std::function<void(int, int)>& progress = {});
+                                  const std::function<void(int, int)>& progress = {}, int window = 0);
 
 // The report's figures as lines of text (positions in px of the input, amplitudes per bin).
 std::string TrackHeadTable(const TrackHeadReport& report);

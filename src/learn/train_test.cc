@@ -1127,6 +1127,41 @@ TEST_F(TrainTest, TrackHeadEvaluationReadsTheHeadBackInTheTargetsUnits) {
   const TrainResult one = Train(frame);
   EXPECT_TRUE(std::isfinite(one.log[0].train_aux_loss) && one.log[0].train_aux_loss > 0) << one.log[0].train_aux_loss;
   EXPECT_TRUE(std::isfinite(EvaluateTrackHead(one.model, data, "val", 1, 3).position_rmse_x));
+  // Read over a 30-frame window, the per-frame head's positions are its 30 frames' mean, against
+  // the 30-frame window's own targets: what a tracker would give the SDN's window.
+  const TrackHeadReport over = EvaluateTrackHead(one.model, data, "val", 1, 2, {}, 30);
+  EXPECT_EQ(over.window, 30);
+  WindNet per_frame = LoadWindNet(one.model);
+  const SampleOptions frame_options = per_frame->config().Sampling();
+  const int first = (val[1].num_frames - 30) / 2;
+  std::vector<double> mean(2 * 4, 0.0);
+  for (int q = 0; q < 30; ++q) {
+    SampleOptions o = frame_options;
+    o.first_frame = first + q;
+    Sample s = LoadSample(val[1], o, 0);
+    at::NoGradGuard no_grad;
+    const at::Tensor aux =
+        per_frame->ForwardWithAux(at::from_blob(s.pixels.data(), {1, 1, 1, o.input_size, o.input_size}, at::kFloat))
+            .aux;
+    const AuxTargets frame_scale = ReadAuxTargets(SelectSplit(ReadDataset(data), "train"), frame_options, 0, false);
+    for (int p = 0; p < 4; ++p)
+      for (int c = 0; c < 2; ++c) {
+        const int k = p * kTargetsPerPoint + c;
+        mean[p * 2 + c] += (aux[0][k].item<float>() * frame_scale.scale.std[k] + frame_scale.scale.mean[k]) / 30;
+      }
+  }
+  const std::vector<float> window_truth = AuxTargetsOf(ReadTracks(val[1].dir / "tracks.json"), first, 30,
+                                                       CentreSquare(val[1].width, val[1].height), val[1].width,
+                                                       false, 0, false);
+  for (int p = 0; p < 4; ++p)
+    for (int c = 0; c < 2; ++c) {
+      const int k = p * kTargetsPerPoint + c;
+      EXPECT_NEAR(over.predicted[1][k], mean[p * 2 + c], 1e-4) << p << " " << c;
+      EXPECT_FLOAT_EQ(over.truth[1][k], window_truth[k]) << p << " " << c;
+    }
+  // A window longer than the clips, or not made of whole model inputs, is refused.
+  EXPECT_THROW(EvaluateTrackHead(one.model, data, "val", 1, 2, {}, 61), std::runtime_error);
+  EXPECT_THROW(EvaluateTrackHead(r.model, data, "val", 1, 2, {}, 45), std::invalid_argument);
 }
 
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
