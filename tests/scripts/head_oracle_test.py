@@ -105,6 +105,18 @@ class HeadOracleTest(unittest.TestCase):
                                         '--position-noise', str(0.08 * 32)).stdout)
         self.assertGreater(noisy, exact + 0.2)
 
+    def test_amplitudes_can_come_from_the_other_group(self):
+        write_rows(self.dir, head_noise=0.1)
+        path = os.path.join(self.dir, 'rows-train.tsv')
+        _, _, head = oracle.read_rows(path, 'predicted', 'all')
+        _, _, exact = oracle.read_rows(path, 'truth', 'all')
+        _, _, mixed = oracle.read_rows(path, 'truth', 'all', amplitudes_from='predicted')
+        means = [p * PER_POINT + k for p in range(POINTS) for k in (0, 1)]
+        others = [i for i in range(POINTS * PER_POINT) if i not in means]
+        np.testing.assert_array_equal(mixed[:, means], exact[:, means])
+        np.testing.assert_array_equal(mixed[:, others], head[:, others])
+        self.assertFalse(np.allclose(head, exact))
+
     def test_predictions_file_has_each_test_clip(self):
         write_rows(self.dir, head_noise=0.0)
         out = os.path.join(self.dir, 'pred.dat')
