@@ -88,7 +88,10 @@ TrackHeadReport EvaluateTrackHead(const fs::path& model, const fs::path& data, c
                              ": another dataset or run options than the model's");
   const std::vector<ClipInfo> clips = SelectSplit(dataset, split);
   if (clips.empty()) throw std::runtime_error((data / "index.json").string() + ": no examples in split " + split);
-  const AuxTargets tracks = split == "train" ? train : ReadAuxTargets(clips, options, phase_bins, world);
+  // The split's own tracks (the train split's are read already: not again, nor copied, ~1 GB on e5).
+  AuxTargets read;
+  if (split != "train") read = ReadAuxTargets(clips, options, phase_bins, world);
+  const AuxTargets& tracks = split == "train" ? train : read;
   r.points = tracks.tracks[0].points();
   const int outputs = r.config.aux_outputs;
   batch = std::max(1, batch);

@@ -1075,6 +1075,15 @@ TEST_F(TrainTest, TrackHeadEvaluationReadsTheHeadBackInTheTargetsUnits) {
       EXPECT_FLOAT_EQ(head.truth[i][k], truth[k]) << i << " " << k;
     }
   }
+  // On the train split the tracks the scale was read from are the rows' own.
+  const TrackHeadReport on_train = EvaluateTrackHead(r.model, data, "train", 1, 8);
+  const std::vector<ClipInfo> train_clips = SelectSplit(ReadDataset(data), "train");
+  ASSERT_EQ(on_train.names.size(), train_clips.size());
+  const ClipInfo& last = train_clips.back();
+  EXPECT_EQ(on_train.names.back(), last.name);
+  EXPECT_EQ(on_train.truth.back(),
+            AuxTargetsOf(ReadTracks(last.dir / "tracks.json"), (last.num_frames - options.frames) / 2, options.frames,
+                         CentreSquare(last.width, last.height), last.width, false, 0, false));
   // The figures are the rows': positions in pixels of the 32-px input, where [-1, 1] spans it.
   double se_x = 0, se = 0, n = 0;
   for (size_t i = 0; i < val.size(); ++i)
