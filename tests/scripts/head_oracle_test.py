@@ -116,6 +116,14 @@ class HeadOracleTest(unittest.TestCase):
         np.testing.assert_array_equal(mixed[:, means], exact[:, means])
         np.testing.assert_array_equal(mixed[:, others], head[:, others])
         self.assertFalse(np.allclose(head, exact))
+        # Exact positions of chosen points only, the rest of the row the head's.
+        chosen = oracle.read_rows(path, 'predicted', 'all', exact_points=[1])[2]
+        point1 = [PER_POINT, PER_POINT + 1]
+        np.testing.assert_array_equal(chosen[:, point1], exact[:, point1])
+        rest = [i for i in range(POINTS * PER_POINT) if i not in point1]
+        np.testing.assert_array_equal(chosen[:, rest], head[:, rest])
+        with self.assertRaisesRegex(ValueError, r'rows-train.tsv:1: --exact-points 3: the rows hold points 0..2'):
+            oracle.read_rows(path, 'predicted', 'all', exact_points=[3])
 
     def test_predictions_file_has_each_test_clip(self):
         write_rows(self.dir, head_noise=0.0)
