@@ -119,6 +119,9 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_flag("--aux-world", o.aux_world,
                 "with --aux-tracks: the auxiliary head also regresses the points' positions and motion in metres "
                 "(tracks.json's \"world\": the cloth's shape whatever camera filmed it)");
+  sub->add_flag("--point-maps", o.point_maps,
+                "with --aux-tracks: the points' window-mean positions come from heat maps on the trunk's stage "
+                "maps (a feature pyramid and a soft argmax) instead of the linear head on pooled features");
   sub->add_option("--weight-average", o.weight_average,
                   "decay of an exponential moving average of the weights, updated every step (0: off); until "
                   "step 9/(1-D)-10 (8990 for 0.999) a warm-up keeps it over the last ~1/9 of the steps; validation then reads the average, model.pt is its best epoch and "

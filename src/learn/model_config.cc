@@ -1,5 +1,7 @@
 #include "learn/model_config.h"
 
+#include "learn/track_targets.h"
+
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -61,6 +63,10 @@ SampleOptions ModelConfig::Sampling() const {
   return o;
 }
 
+bool ModelConfig::PointMapsAreValid() const {
+  return point_maps == 0 || (point_maps > 0 && arch != "lstm" && aux_outputs >= point_maps * kTargetsPerPoint);
+}
+
 bool IsKnownArch(const std::string& arch) { return arch == "sdn" || arch == "resnet18" || arch == "lstm"; }
 
 std::string ModelConfig::Name() const {
@@ -82,6 +88,7 @@ std::string ModelConfig::Name() const {
   if (!stem_pool) s << "-np";
   if (coord_maps) s << "-xy";
   if (head_hidden > 0) s << "-h" << head_hidden;
+  if (point_maps > 0) s << "-pm";
   s << "-w" << width << "-" << input_size << "-" << frames << "f";
   return s.str();
 }
@@ -106,7 +113,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"phase_step_far", c.phase_step_far}, {"mode_shape", c.mode_shape},
           {"spectral_pool", c.spectral_pool}, {"stem_pool", c.stem_pool},
           {"coord_maps", c.coord_maps}, {"frame_channels", c.frame_channels},
-          {"dropout", c.dropout},        {"aux_outputs", c.aux_outputs},
+          {"dropout", c.dropout},        {"aux_outputs", c.aux_outputs}, {"point_maps", c.point_maps},
           {"head_hidden", c.head_hidden},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
@@ -155,6 +162,8 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     // Absent in models written before auxiliary targets existed: no second head.
     c.aux_outputs = j.contains("aux_outputs") ? j.at("aux_outputs").get<int>() : 0;
     if (c.aux_outputs < 0) throw std::runtime_error(where + ": field \"aux_outputs\" must be >= 0");
+    // Absent in models written before the option existed: the linear head finds the points.
+    c.point_maps = j.contains("point_maps") ? j.at("point_maps").get<int>() : 0;
     // Absent in models written before the option existed: a linear wind head.
     c.head_hidden = j.contains("head_hidden") ? j.at("head_hidden").get<int>() : 0;
     if (c.head_hidden < 0) throw std::runtime_error(where + ": field \"head_hidden\" must be >= 0");
@@ -194,6 +203,11 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
   if (!c.PhaseStepFarIsValid()) {
     throw std::runtime_error(where + ": field \"phase_step_far\" must be 0, or at least 2 with \"phase_steps\", got " +
                              std::to_string(c.phase_step_far));
+  }
+  if (!c.PointMapsAreValid()) {
+    throw std::runtime_error(where + ": field \"point_maps\" must be 0, or the number of points P > 0 of an "
+                             "\"aux_outputs\" of at least 12 P on an sdn or resnet18, got " +
+                             std::to_string(c.point_maps));
   }
   if (!c.ModeShapeIsValid()) {
     throw std::runtime_error(where + ": field \"mode_shape\" is for \"arch\" \"sdn\" without \"include_dc\" only, got \"" +

@@ -65,6 +65,11 @@ struct ModelConfig {
   // training fits to the clip's track targets (learn/track_targets.h, --aux-tracks); 0: none.
   // The wind estimate never reads it, so a model with one predicts as one without.
   int aux_outputs = 0;
+  // Training only, with aux_outputs: the points' window-mean positions among the auxiliary targets
+  // come from heat maps on the trunk's stage maps (learn/point_maps.h, --point-maps) instead of the
+  // linear head; the count of points P (0: none). Why: a linear head on pooled features knows
+  // them to ~1.1 px of 64, where the wind needs a fraction of a pixel.
+  int point_maps = 0;
   double frame_rate = 25.0;  // [Hz] of the clips the model reads
   int width = 64;            // ResNet-18 base width (64 as the original; 16 trains on a CPU)
   int input_size = 112;      // side of the square input [px] (224 as the seed, 112 for a CPU)
@@ -107,6 +112,9 @@ struct ModelConfig {
   int ChannelsForInput() const { return Sampling().channels(); }
   // colour is off, or on a model without flow (the flow is computed from the grey frames).
   bool ColourIsValid() const { return !(colour && flow); }
+  // point_maps needs a trunk that sees a whole clip (not lstm's per-frame one) and an auxiliary head
+  // with every point's kTargetsPerPoint targets.
+  bool PointMapsAreValid() const;
   // flow_size is 0, or a side of at least 16 px on a model with flow.
   bool FlowSizeIsValid() const { return flow_size == 0 || (flow && flow_size >= 16); }
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("…-flow-…" with flow, "sdn-k3m-…" with mean_map,

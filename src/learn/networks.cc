@@ -10,6 +10,7 @@
 
 #include <ATen/ATen.h>
 
+#include "learn/track_targets.h"
 #include "learn/weight_average.h"
 
 namespace clothwind::learn {
@@ -39,7 +40,8 @@ at::Tensor BasicBlockImpl::forward(const at::Tensor& x) {
   return at::relu(y + (shortcut_ ? shortcut_->forward(x) : x));
 }
 
-ResNet18TrunkImpl::ResNet18TrunkImpl(int in_channels, int width, bool stem_pool) : stem_pool_(stem_pool) {
+ResNet18TrunkImpl::ResNet18TrunkImpl(int in_channels, int width, bool stem_pool)
+    : stem_pool_(stem_pool), width_(width) {
   stem_ = register_module("stem", Conv(in_channels, width, 7, 2));
   stem_bn_ = register_module("stem_bn", torch::nn::BatchNorm2d(width));
   torch::nn::Sequential stages;
@@ -65,6 +67,19 @@ at::Tensor ResNet18TrunkImpl::FeatureMap(const at::Tensor& x) {
   if (stem_pool_) y = at::max_pool2d(y, {3, 3}, {2, 2}, {1, 1});
   return stages_->forward(y);
 }
+
+std::vector<at::Tensor> ResNet18TrunkImpl::StageMaps(const at::Tensor& x) {
+  at::Tensor y = at::relu(stem_bn_->forward(stem_->forward(x)));
+  if (stem_pool_) y = at::max_pool2d(y, {3, 3}, {2, 2}, {1, 1});
+  std::vector<at::Tensor> maps;
+  for (size_t block = 0; block < stages_->size(); ++block) {
+    y = stages_->ptr<BasicBlockImpl>(block)->forward(y);
+    if (block % 2 == 1) maps.push_back(y);  // two blocks a stage
+  }
+  return maps;
+}
+
+std::vector<int> ResNet18TrunkImpl::stage_channels() const { return {width_, 2 * width_, 4 * width_, 8 * width_}; }
 
 at::Tensor ResNet18TrunkImpl::forward(const at::Tensor& x) {
   return at::adaptive_avg_pool2d(FeatureMap(x), {1, 1}).flatten(1);
@@ -125,6 +140,37 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
   if (config.aux_outputs < 0) throw std::invalid_argument("WindNet: aux_outputs must be >= 0");
   if (config.aux_outputs > 0)
     aux_head_ = register_module("aux_head", torch::nn::Linear(trunk_->feature_size(), config.aux_outputs));
+  if (!config.PointMapsAreValid()) {
+    throw std::invalid_argument("WindNet: point_maps " + std::to_string(config.point_maps) +
+                                " must be 0, or P points of an auxiliary head of at least 12 P outputs on " +
+                                "an sdn or resnet18, not " + config.Name() + " with " +
+                                std::to_string(config.aux_outputs));
+  }
+  if (config.point_maps > 0) {
+    const int points = config.point_maps;
+    point_head_ = register_module("point_head", PointMapHead(trunk_->stage_channels(), points));
+    point_mean_ = register_buffer("point_mean", at::zeros({points, 2}));
+    point_std_ = register_buffer("point_std", at::ones({points, 2}));
+    std::vector<int64_t> columns;
+    for (int p = 0; p < points; ++p) {
+      columns.push_back(static_cast<int64_t>(p) * kTargetsPerPoint);
+      columns.push_back(static_cast<int64_t>(p) * kTargetsPerPoint + 1);
+    }
+    point_columns_ = at::tensor(columns, at::kLong);  // not a buffer: no file need hold it
+  }
+}
+
+void WindNetImpl::SetPointScale(const at::Tensor& mean, const at::Tensor& std) {
+  if (!point_head_) throw std::invalid_argument("WindNet::SetPointScale: " + config_.Name() + " has no point maps");
+  const std::vector<int64_t> shape = {config_.point_maps, 2};
+  if (mean.sizes() != at::IntArrayRef(shape) || std.sizes() != at::IntArrayRef(shape) ||
+      !(std.min().item<double>() > 0)) {
+    throw std::invalid_argument("WindNet::SetPointScale: expected mean and std [" + std::to_string(config_.point_maps) +
+                                ", 2] with std > 0");
+  }
+  at::NoGradGuard no_grad;
+  point_mean_.copy_(mean);
+  point_std_.copy_(std);
 }
 
 at::Tensor WindNetImpl::TrunkInput(const at::Tensor& clips) const {
@@ -183,7 +229,14 @@ at::Tensor WindNetImpl::WithCoordMaps(const at::Tensor& images) const {
 at::Tensor WindNetImpl::forward(const at::Tensor& clips) { return ForwardWithAux(clips).wind; }
 
 WindNetImpl::Outputs WindNetImpl::ForwardWithAux(const at::Tensor& clips) {
-  at::Tensor features = trunk_->forward(TrunkInput(clips));
+  std::vector<at::Tensor> stage_maps;
+  at::Tensor features;
+  if (point_head_) {
+    stage_maps = trunk_->StageMaps(TrunkInput(clips));
+    features = at::adaptive_avg_pool2d(stage_maps.back(), {1, 1}).flatten(1);
+  } else {
+    features = trunk_->forward(TrunkInput(clips));
+  }
   if (config_.arch == "lstm") {
     // [N_b·N_t, F] -> [N_b, N_t, F] -> the LSTM's output after the last frame [N_b, F].
     at::Tensor sequence = std::get<0>(lstm_->forward(features.reshape({clips.size(0), clips.size(2), -1})));
@@ -195,6 +248,11 @@ WindNetImpl::Outputs WindNetImpl::ForwardWithAux(const at::Tensor& clips) {
   // The auxiliary head reads the features before dropout: it describes the clip, it does not
   // memorise a simulation.
   if (aux_head_) outputs.aux = aux_head_->forward(features);
+  if (point_head_) {
+    // [N_b, P, 2] in the image's unit square -> standardised as the targets, over the linear head's columns.
+    const at::Tensor positions = (point_head_->forward(stage_maps) - point_mean_) / point_std_;
+    outputs.aux = outputs.aux.index_copy(1, point_columns_.to(positions.device()), positions.flatten(1));
+  }
   if (config_.dropout > 0) features = at::dropout(features, config_.dropout, is_training());
   if (head_hidden_) features = at::relu(head_hidden_->forward(features));
   at::Tensor out = head_->forward(features);
@@ -219,6 +277,7 @@ void SaveWindNet(WindNet& net, const std::filesystem::path& weights, WeightPreci
 WindNet WithoutAuxHead(WindNet& net) {
   ModelConfig config = net->config();
   config.aux_outputs = 0;
+  config.point_maps = 0;
   WindNet stripped(config);
   CopyWeights(*net, *stripped);  // every tensor of the stripped network, by name, onto its CPU
   stripped->eval();

@@ -17,6 +17,7 @@
 #include <torch/nn/pimpl.h>
 
 #include "learn/model_config.h"
+#include "learn/point_maps.h"
 #include "learn/spectral_layer.h"
 #include "learn/weights_io.h"
 
@@ -49,6 +50,12 @@ class ResNet18TrunkImpl : public torch::nn::Module {
   // x [N_b, in_channels, H, W] -> the last stage's map [N_b, 8w, ⌈H/32⌉, ⌈W/32⌉] (⌈H/16⌉, ⌈W/16⌉
   // without the stem pool)
   at::Tensor FeatureMap(const at::Tensor& x);
+  // x [N_b, in_channels, H, W] -> the four stages' maps, finest first: [N_b, w, H/4, W/4],
+  // [N_b, 2w, H/8, W/8], [N_b, 4w, H/16, W/16], [N_b, 8w, H/32, W/32] (sizes rounded up; twice
+  // each without the stem pool). The last is FeatureMap's.
+  std::vector<at::Tensor> StageMaps(const at::Tensor& x);
+  // Channels of StageMaps' maps, finest first.
+  std::vector<int> stage_channels() const;
   int feature_size() const { return features_; }
 
  private:
@@ -56,6 +63,7 @@ class ResNet18TrunkImpl : public torch::nn::Module {
   torch::nn::BatchNorm2d stem_bn_{nullptr};
   torch::nn::Sequential stages_{nullptr};
   bool stem_pool_ = true;
+  int width_ = 0;
   int features_ = 0;
 };
 TORCH_MODULE(ResNet18Trunk);
@@ -73,6 +81,9 @@ class WindNetImpl : public torch::nn::Module {
   at::Tensor forward(const at::Tensor& clips);
   // forward's output and, with config.aux_outputs > 0, the auxiliary head's [N_b, aux_outputs]
   // (standardised track targets; undefined without the head), from one pass through the trunk.
+  // With config.point_maps = P > 0 the window-mean positions among them (columns 12p and 12p + 1,
+  // TrackTargets' order) are the point map head's, standardised by SetPointScale's scale; the
+  // other columns stay the linear head's.
   struct Outputs {
     at::Tensor wind, aux;
   };
@@ -88,6 +99,10 @@ class WindNetImpl : public torch::nn::Module {
   const ModelConfig& config() const { return config_; }
   // Sets the calibration factor of the predicted std (no weight depends on it).
   void set_std_scale(double scale) { config_.std_scale = scale; }
+  // With point_maps = P > 0: the mean and std [P, 2] that standardise the (u, v) positions the
+  // point map head finds, as the targets are (training sets them from its train split; they are
+  // buffers, saved with the weights). Throws std::invalid_argument on other shapes or without maps.
+  void SetPointScale(const at::Tensor& mean, const at::Tensor& std);
 
  private:
   // TrunkInput without the coordinate maps: the architecture's own images of checked clips.
@@ -101,6 +116,9 @@ class WindNetImpl : public torch::nn::Module {
   torch::nn::Linear head_hidden_{nullptr};  // head_hidden > 0 only: features -> ReLU units
   torch::nn::Linear head_{nullptr};
   torch::nn::Linear aux_head_{nullptr};  // aux_outputs > 0 only
+  PointMapHead point_head_{nullptr};     // point_maps > 0 only
+  at::Tensor point_mean_, point_std_;    // point_maps > 0 only: [P, 2] buffers
+  at::Tensor point_columns_;             // point_maps > 0 only: the aux columns of the positions [2P] (CPU)
 };
 TORCH_MODULE(WindNet);
 

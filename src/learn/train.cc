@@ -172,6 +172,17 @@ Validation Validate(WindNet& model, const std::vector<ClipInfo>& val, int batch,
   return {loss / std::max<size_t>(val.size(), 1), ComputeMetrics(truth, predicted)};
 }
 
+// The [points, 2] means (or stds) of the points' window-mean (u, v) targets, TrackTargets' columns
+// kTargetsPerPoint · p and kTargetsPerPoint · p + 1 of `scale`.
+at::Tensor PointScale(const TargetScale& scale, int points, bool std) {
+  const std::vector<float>& values = std ? scale.std : scale.mean;
+  at::Tensor out = at::empty({points, 2}, at::kFloat);
+  for (int p = 0; p < points; ++p) {
+    for (int c = 0; c < 2; ++c) out[p][c] = values.at(static_cast<size_t>(p) * kTargetsPerPoint + c);
+  }
+  return out;
+}
+
 }  // namespace
 
 double LearningRateAt(const TrainOptions& o, int epoch) {
@@ -288,6 +299,9 @@ TrainResult Train(const TrainOptions& o) {
     throw std::runtime_error("aux_world: the points' positions are regressed only with an auxiliary loss "
                              "(--aux-tracks W > 0)");
   if (o.resume) RefuseChangedOnResume(state_path, "--aux-world", state.value("aux_world", false), o.aux_world);
+  if (o.point_maps && o.aux_tracks <= 0)
+    throw std::runtime_error("point_maps: the points are found on maps only with an auxiliary loss (--aux-tracks W > 0)");
+  if (o.resume) RefuseChangedOnResume(state_path, "--point-maps", state.value("point_maps", false), o.point_maps);
   if (!(o.weight_average >= 0 && o.weight_average < 1)) {
     throw std::runtime_error("weight_average: the average's decay must lie in [0, 1), got " +
                              std::to_string(o.weight_average));
@@ -304,9 +318,13 @@ TrainResult Train(const TrainOptions& o) {
                                std::to_string(aux->outputs()));
     }
     config.aux_outputs = aux->outputs();
+    config.point_maps = o.point_maps ? aux->tracks.front().points() : 0;
   }
   at::manual_seed(o.seed);
   WindNet net(config);
+  // The maps' positions are standardised as the targets are; on resume the buffers come with the weights.
+  if (config.point_maps > 0) net->SetPointScale(PointScale(aux->scale, config.point_maps, false),
+                                                PointScale(aux->scale, config.point_maps, true));
   torch::optim::Adam optimizer(net->parameters(), torch::optim::AdamOptions(o.lr).weight_decay(o.weight_decay));
   if (o.resume) {
     // Loaded onto the CPU whatever device wrote them, then moved with the network.
@@ -449,7 +467,7 @@ TrainResult Train(const TrainOptions& o) {
     for (const EpochRecord& e : result.log) log.push_back(EpochJson(e));
     state = {{"epoch", epoch}, {"model", ToJson(config)}, {"log", log}, {"seed", o.seed},
              {"crop_scales", o.crop_scales}, {"aux_tracks", o.aux_tracks},
-             {"aux_phase_bins", o.aux_phase_bins}, {"aux_world", o.aux_world},
+             {"aux_phase_bins", o.aux_phase_bins}, {"aux_world", o.aux_world}, {"point_maps", o.point_maps},
              {"weight_average", o.weight_average}, {"average_steps", average_steps},
              {"best_val_rmse", result.best_val_rmse}};
     WriteFileAtomically(state_path, state.dump(2));

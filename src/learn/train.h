@@ -56,6 +56,9 @@ struct TrainOptions {
   // With aux_tracks > 0: also regress the points' positions and motion in metres
   // (WorldTrackTargets, from tracks.json's "world"): the cloth's shape whatever camera filmed it.
   bool aux_world = false;
+  // With aux_tracks > 0: the points' window-mean positions come from a point map head
+  // (ModelConfig::point_maps, learn/point_maps.h) instead of the linear head.
+  bool point_maps = false;
   // Decay of an exponential moving average of the weights, updated after every step
   // (learn/weight_average.h, with its warm-up; 0: off). With it, validation reads
   // the average, model.pt is the average's best epoch and raw_model.pt the trained weights' best,

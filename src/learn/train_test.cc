@@ -1040,6 +1040,39 @@ TEST_F(TrainTest, AuxTracksTrainASecondHeadOnTheClipsTracks) {
   ExpectTrainRefused(alone, "positions without the auxiliary loss were accepted", {"aux_world"});
 }
 
+TEST_F(TrainTest, PointMapsFindThePointsWithTheTrainSplitsPositionScale) {
+  const fs::path data = *root_ / "data_point_maps";
+  fs::copy(*root_ / "data", data, fs::copy_options::recursive);
+  WriteToyTracks(data);
+  TrainOptions t = Options("sdn", "point_maps");
+  t.data = data;
+  t.epochs = 4;
+  t.point_maps = true;
+  ExpectTrainRefused(t, "--point-maps without the auxiliary loss was accepted", {"point_maps", "--aux-tracks"});
+  t.aux_tracks = 1.0;
+  const TrainResult r = Train(t);
+  ASSERT_EQ(r.log.size(), 4u);
+  EXPECT_LT(r.log[3].train_aux_loss, r.log[0].train_aux_loss);
+  WindNet net = LoadWindNet(r.model);
+  EXPECT_EQ(net->config().point_maps, 4);
+  // The maps' positions are standardised by the scale the targets are: the train split's.
+  const AuxTargets train =
+      ReadAuxTargets(SelectSplit(ReadDataset(data), "train"), net->config().Sampling(), 0, false);
+  auto buffers = net->named_buffers();
+  ASSERT_NE(buffers.find("point_mean"), nullptr);
+  for (int p = 0; p < 4; ++p) {
+    for (int c = 0; c < 2; ++c) {
+      EXPECT_FLOAT_EQ(buffers["point_mean"][p][c].item<float>(), train.scale.mean[p * kTargetsPerPoint + c]);
+      EXPECT_FLOAT_EQ(buffers["point_std"][p][c].item<float>(), train.scale.std[p * kTargetsPerPoint + c]);
+    }
+  }
+  TrainOptions again = t;
+  again.epochs = 5;
+  again.resume = true;
+  again.point_maps = false;
+  ExpectTrainRefused(again, "a resume without the run's --point-maps was accepted", {"--point-maps"});
+}
+
 TEST_F(TrainTest, TrackHeadEvaluationReadsTheHeadBackInTheTargetsUnits) {
   const fs::path data = *root_ / "data_head";
   fs::copy(*root_ / "data", data, fs::copy_options::recursive);
