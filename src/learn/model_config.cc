@@ -1,11 +1,11 @@
 #include "learn/model_config.h"
 
-#include "learn/track_targets.h"
-
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <unistd.h>
+
+#include "learn/track_targets.h"
 
 namespace clothwind::learn {
 

@@ -40,8 +40,7 @@ at::Tensor BasicBlockImpl::forward(const at::Tensor& x) {
   return at::relu(y + (shortcut_ ? shortcut_->forward(x) : x));
 }
 
-ResNet18TrunkImpl::ResNet18TrunkImpl(int in_channels, int width, bool stem_pool)
-    : stem_pool_(stem_pool), width_(width) {
+ResNet18TrunkImpl::ResNet18TrunkImpl(int in_channels, int width, bool stem_pool) : stem_pool_(stem_pool) {
   stem_ = register_module("stem", Conv(in_channels, width, 7, 2));
   stem_bn_ = register_module("stem_bn", torch::nn::BatchNorm2d(width));
   torch::nn::Sequential stages;
@@ -62,11 +61,7 @@ ResNet18TrunkImpl::ResNet18TrunkImpl(int in_channels, int width, bool stem_pool)
   }
 }
 
-at::Tensor ResNet18TrunkImpl::FeatureMap(const at::Tensor& x) {
-  at::Tensor y = at::relu(stem_bn_->forward(stem_->forward(x)));
-  if (stem_pool_) y = at::max_pool2d(y, {3, 3}, {2, 2}, {1, 1});
-  return stages_->forward(y);
-}
+at::Tensor ResNet18TrunkImpl::FeatureMap(const at::Tensor& x) { return StageMaps(x).back(); }
 
 std::vector<at::Tensor> ResNet18TrunkImpl::StageMaps(const at::Tensor& x) {
   at::Tensor y = at::relu(stem_bn_->forward(stem_->forward(x)));
@@ -79,11 +74,14 @@ std::vector<at::Tensor> ResNet18TrunkImpl::StageMaps(const at::Tensor& x) {
   return maps;
 }
 
-std::vector<int> ResNet18TrunkImpl::stage_channels() const { return {width_, 2 * width_, 4 * width_, 8 * width_}; }
-
-at::Tensor ResNet18TrunkImpl::forward(const at::Tensor& x) {
-  return at::adaptive_avg_pool2d(FeatureMap(x), {1, 1}).flatten(1);
+std::vector<int> ResNet18TrunkImpl::stage_channels() const {
+  const int w = features_ / 8;  // the last stage's 8w
+  return {w, 2 * w, 4 * w, 8 * w};
 }
+
+at::Tensor ResNet18TrunkImpl::Pooled(const at::Tensor& map) { return at::adaptive_avg_pool2d(map, {1, 1}).flatten(1); }
+
+at::Tensor ResNet18TrunkImpl::forward(const at::Tensor& x) { return Pooled(FeatureMap(x)); }
 
 WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
   if (!IsKnownArch(config.arch)) {
@@ -151,12 +149,6 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
     point_head_ = register_module("point_head", PointMapHead(trunk_->stage_channels(), points));
     point_mean_ = register_buffer("point_mean", at::zeros({points, 2}));
     point_std_ = register_buffer("point_std", at::ones({points, 2}));
-    std::vector<int64_t> columns;
-    for (int p = 0; p < points; ++p) {
-      columns.push_back(static_cast<int64_t>(p) * kTargetsPerPoint);
-      columns.push_back(static_cast<int64_t>(p) * kTargetsPerPoint + 1);
-    }
-    point_columns_ = at::tensor(columns, at::kLong);  // not a buffer: no file need hold it
   }
 }
 
@@ -217,10 +209,7 @@ at::Tensor WindNetImpl::ArchImages(const at::Tensor& clips) const {
 at::Tensor WindNetImpl::WithCoordMaps(const at::Tensor& images) const {
   if (!config_.coord_maps) return images;
   const int64_t n = images.size(0), h = images.size(2), w = images.size(3);
-  // Pixel centres: column j of W reads -1 + (2j + 1) / W, so the image centre reads 0 at any size.
-  const auto options = images.options();
-  const at::Tensor column = (at::arange(w, options) * 2 + 1) / static_cast<double>(w) - 1;
-  const at::Tensor row = (at::arange(h, options) * 2 + 1) / static_cast<double>(h) - 1;
+  const at::Tensor column = PixelCentres(w, images.options()), row = PixelCentres(h, images.options());
   const at::Tensor x = column.view({1, 1, 1, w}).expand({n, 1, h, w});
   const at::Tensor y = row.view({1, 1, h, 1}).expand({n, 1, h, w});
   return at::cat({images, x, y}, 1);
@@ -229,14 +218,8 @@ at::Tensor WindNetImpl::WithCoordMaps(const at::Tensor& images) const {
 at::Tensor WindNetImpl::forward(const at::Tensor& clips) { return ForwardWithAux(clips).wind; }
 
 WindNetImpl::Outputs WindNetImpl::ForwardWithAux(const at::Tensor& clips) {
-  std::vector<at::Tensor> stage_maps;
-  at::Tensor features;
-  if (point_head_) {
-    stage_maps = trunk_->StageMaps(TrunkInput(clips));
-    features = at::adaptive_avg_pool2d(stage_maps.back(), {1, 1}).flatten(1);
-  } else {
-    features = trunk_->forward(TrunkInput(clips));
-  }
+  const std::vector<at::Tensor> stage_maps = trunk_->StageMaps(TrunkInput(clips));
+  at::Tensor features = ResNet18TrunkImpl::Pooled(stage_maps.back());
   if (config_.arch == "lstm") {
     // [N_b·N_t, F] -> [N_b, N_t, F] -> the LSTM's output after the last frame [N_b, F].
     at::Tensor sequence = std::get<0>(lstm_->forward(features.reshape({clips.size(0), clips.size(2), -1})));
@@ -249,9 +232,14 @@ WindNetImpl::Outputs WindNetImpl::ForwardWithAux(const at::Tensor& clips) {
   // memorise a simulation.
   if (aux_head_) outputs.aux = aux_head_->forward(features);
   if (point_head_) {
-    // [N_b, P, 2] in the image's unit square -> standardised as the targets, over the linear head's columns.
+    // [N_b, P, 2] in the image's unit square -> standardised as the targets, in place of the first two
+    // of each point's kTargetsPerPoint columns (TrackTargets' point-major blocks come first).
     const at::Tensor positions = (point_head_->forward(stage_maps) - point_mean_) / point_std_;
-    outputs.aux = outputs.aux.index_copy(1, point_columns_.to(positions.device()), positions.flatten(1));
+    const int64_t n = outputs.aux.size(0), block = int64_t{config_.point_maps} * kTargetsPerPoint;
+    const at::Tensor points = outputs.aux.narrow(1, 0, block).view({n, config_.point_maps, kTargetsPerPoint});
+    outputs.aux = at::cat({at::cat({positions, points.narrow(2, 2, kTargetsPerPoint - 2)}, 2).flatten(1),
+                           outputs.aux.narrow(1, block, outputs.aux.size(1) - block)},
+                          1);
   }
   if (config_.dropout > 0) features = at::dropout(features, config_.dropout, is_training());
   if (head_hidden_) features = at::relu(head_hidden_->forward(features));

@@ -47,6 +47,8 @@ class ResNet18TrunkImpl : public torch::nn::Module {
   ResNet18TrunkImpl(int in_channels, int width, bool stem_pool = true);
   // x [N_b, in_channels, H, W] -> features [N_b, 8w]: FeatureMap averaged over its pixels
   at::Tensor forward(const at::Tensor& x);
+  // map [N_b, C, h, w] -> [N_b, C], averaged over its pixels (forward's pooling)
+  static at::Tensor Pooled(const at::Tensor& map);
   // x [N_b, in_channels, H, W] -> the last stage's map [N_b, 8w, ⌈H/32⌉, ⌈W/32⌉] (⌈H/16⌉, ⌈W/16⌉
   // without the stem pool)
   at::Tensor FeatureMap(const at::Tensor& x);
@@ -63,7 +65,6 @@ class ResNet18TrunkImpl : public torch::nn::Module {
   torch::nn::BatchNorm2d stem_bn_{nullptr};
   torch::nn::Sequential stages_{nullptr};
   bool stem_pool_ = true;
-  int width_ = 0;
   int features_ = 0;
 };
 TORCH_MODULE(ResNet18Trunk);
@@ -118,7 +119,6 @@ class WindNetImpl : public torch::nn::Module {
   torch::nn::Linear aux_head_{nullptr};  // aux_outputs > 0 only
   PointMapHead point_head_{nullptr};     // point_maps > 0 only
   at::Tensor point_mean_, point_std_;    // point_maps > 0 only: [P, 2] buffers
-  at::Tensor point_columns_;             // point_maps > 0 only: the aux columns of the positions [2P] (CPU)
 };
 TORCH_MODULE(WindNet);
 

@@ -7,6 +7,10 @@
 
 namespace clothwind::learn {
 
+at::Tensor PixelCentres(int64_t n, const at::TensorOptions& options) {
+  return (at::arange(n, options) * 2 + 1) / static_cast<double>(n) - 1;
+}
+
 at::Tensor SoftArgmax2d(const at::Tensor& logits) {
   if (logits.dim() != 4) {
     throw std::invalid_argument("SoftArgmax2d: expected logits [N, P, H, W], got " + std::to_string(logits.dim()) +
@@ -14,9 +18,7 @@ at::Tensor SoftArgmax2d(const at::Tensor& logits) {
   }
   const int64_t n = logits.size(0), p = logits.size(1), h = logits.size(2), w = logits.size(3);
   const at::Tensor prob = at::softmax(logits.reshape({n, p, h * w}), 2).reshape({n, p, h, w});
-  const auto options = logits.options();
-  const at::Tensor x = (at::arange(w, options) * 2 + 1) / static_cast<double>(w) - 1;
-  const at::Tensor y = (at::arange(h, options) * 2 + 1) / static_cast<double>(h) - 1;
+  const at::Tensor x = PixelCentres(w, logits.options()), y = PixelCentres(h, logits.options());
   // The marginals' expectations: Σ_j (Σ_i p_ij) x_j and Σ_i (Σ_j p_ij) y_i.
   const at::Tensor u = (prob.sum(2) * x).sum(2);
   const at::Tensor v = (prob.sum(3) * y).sum(2);

@@ -19,6 +19,11 @@
 
 namespace clothwind::learn {
 
+// The centres of `n` pixels along one image axis in the unit square: (2j + 1) / n - 1 for j = 0..n-1,
+// so the image's edges are -1 and 1 and its centre 0 at any n (the coordinate maps' and TrackTargets'
+// convention). Output: [n] with `options`' dtype and device.
+at::Tensor PixelCentres(int64_t n, const at::TensorOptions& options);
+
 // The expected position under each map's softmax, in the image's unit square.
 // Inputs: logits [N, P, H, W]. Output: [N, P, 2], each point's (u, v) = Σ softmax(logits) · (x, y),
 //   with pixel (row i, column j) at x = (2j + 1) / W - 1, y = (2i + 1) / H - 1: the coordinate maps'

@@ -176,11 +176,8 @@ Validation Validate(WindNet& model, const std::vector<ClipInfo>& val, int batch,
 // kTargetsPerPoint · p and kTargetsPerPoint · p + 1 of `scale`.
 at::Tensor PointScale(const TargetScale& scale, int points, bool std) {
   const std::vector<float>& values = std ? scale.std : scale.mean;
-  at::Tensor out = at::empty({points, 2}, at::kFloat);
-  for (int p = 0; p < points; ++p) {
-    for (int c = 0; c < 2; ++c) out[p][c] = values.at(static_cast<size_t>(p) * kTargetsPerPoint + c);
-  }
-  return out;
+  const std::vector<float> blocks(values.begin(), values.begin() + static_cast<size_t>(points) * kTargetsPerPoint);
+  return at::tensor(blocks).view({points, kTargetsPerPoint}).narrow(1, 0, 2).contiguous();
 }
 
 }  // namespace

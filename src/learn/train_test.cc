@@ -977,15 +977,21 @@ void WriteToyTracks(const fs::path& dir, bool world = false) {
   }
 }
 
+// A copy of the toy dataset at `root`/data in `root`/`name`, its clips given WriteToyTracks' tracks.
+fs::path ToyDataWithTracks(const fs::path& root, const std::string& name, bool world = false) {
+  const fs::path data = root / name;
+  fs::copy(root / "data", data, fs::copy_options::recursive);
+  WriteToyTracks(data, world);
+  return data;
+}
+
 TEST_F(TrainTest, AuxTracksTrainASecondHeadOnTheClipsTracks) {
   // A dataset without tracks is refused, naming the file it lacks.
   TrainOptions t = Options("sdn", "aux");
   t.epochs = 6;
   t.aux_tracks = 1.0;
   ExpectTrainRefused(t, "--aux-tracks trained without tracks", {"tracks.json not found"});
-  fs::copy(*root_ / "data", *root_ / "data_tracks", fs::copy_options::recursive);
-  WriteToyTracks(*root_ / "data_tracks");
-  t.data = *root_ / "data_tracks";
+  t.data = ToyDataWithTracks(*root_, "data_tracks");
   const TrainResult r = Train(t);
   ASSERT_EQ(r.log.size(), 6u);
   // The head regresses what the targets hold: its loss (about 1 per standardised target at the
@@ -1025,9 +1031,7 @@ TEST_F(TrainTest, AuxTracksTrainASecondHeadOnTheClipsTracks) {
   world.epochs = 1;
   world.aux_world = true;
   ExpectTrainRefused(world, "--aux-world on tracks without positions was accepted", {"tracks.json", "'world'"});
-  fs::copy(*root_ / "data", *root_ / "data_world", fs::copy_options::recursive);
-  WriteToyTracks(*root_ / "data_world", /*world=*/true);
-  world.data = *root_ / "data_world";
+  world.data = ToyDataWithTracks(*root_, "data_world", /*world=*/true);
   EXPECT_EQ(LoadWindNet(Train(world).model)->config().aux_outputs, 4 * (kTargetsPerPoint + kWorldTargetsPerPoint));
   TrainOptions changed = world;
   changed.epochs = 2;
@@ -1041,9 +1045,7 @@ TEST_F(TrainTest, AuxTracksTrainASecondHeadOnTheClipsTracks) {
 }
 
 TEST_F(TrainTest, PointMapsFindThePointsWithTheTrainSplitsPositionScale) {
-  const fs::path data = *root_ / "data_point_maps";
-  fs::copy(*root_ / "data", data, fs::copy_options::recursive);
-  WriteToyTracks(data);
+  const fs::path data = ToyDataWithTracks(*root_, "data_point_maps");
   TrainOptions t = Options("sdn", "point_maps");
   t.data = data;
   t.epochs = 4;
@@ -1074,9 +1076,7 @@ TEST_F(TrainTest, PointMapsFindThePointsWithTheTrainSplitsPositionScale) {
 }
 
 TEST_F(TrainTest, TrackHeadEvaluationReadsTheHeadBackInTheTargetsUnits) {
-  const fs::path data = *root_ / "data_head";
-  fs::copy(*root_ / "data", data, fs::copy_options::recursive);
-  WriteToyTracks(data);
+  const fs::path data = ToyDataWithTracks(*root_, "data_head");
   TrainOptions t = Options("sdn", "head");
   t.data = data;
   t.epochs = 2;
