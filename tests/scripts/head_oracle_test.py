@@ -125,6 +125,28 @@ class HeadOracleTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, r'rows-train.tsv:1: --exact-points 3: the rows hold points 0..2'):
             oracle.read_rows(path, 'predicted', 'all', exact_points=[3])
 
+    def test_points_keeps_those_points_targets_only(self):
+        write_rows(self.dir, head_noise=0.1)
+        path = os.path.join(self.dir, 'rows-train.tsv')
+        _, _, every = oracle.read_rows(path, 'truth', 'all')
+        _, _, two = oracle.read_rows(path, 'truth', 'all', points_kept=[0, 2])
+        np.testing.assert_array_equal(two, every[:, list(range(PER_POINT)) + list(range(2 * PER_POINT, 3 * PER_POINT))])
+        # With the positions only, and with a kept point's positions exact among the head's.
+        _, _, head = oracle.read_rows(path, 'predicted', 'positions')
+        _, _, mixed = oracle.read_rows(path, 'predicted', 'positions', exact_points=[2], points_kept=[1, 2])
+        _, _, exact = oracle.read_rows(path, 'truth', 'positions')
+        np.testing.assert_array_equal(mixed, np.concatenate([head[:, 2:4], exact[:, 4:6]], axis=1))
+        with self.assertRaisesRegex(ValueError, r'rows-train.tsv:1: --points 5: the rows hold points 0..2'):
+            oracle.read_rows(path, 'truth', 'all', points_kept=[5])
+        # Through the head's noise the point that droops least reads the wind worse alone than
+        # beside the other two (exact, any one point would read it as well as all three).
+        all_three = rmse_of(self.run_oracle('--targets', 'positions').stdout)
+        first = self.run_oracle('--targets', 'positions', '--points', '0')
+        self.assertEqual(first.returncode, 0, first.stderr)
+        self.assertIn("1 points' targets only", first.stdout)
+        self.assertGreater(rmse_of(first.stdout), all_three)
+        self.assertIn('--points: expected comma-separated', self.run_oracle('--points', 'a,b').stderr)
+
     def test_predictions_file_has_each_test_clip(self):
         write_rows(self.dir, head_noise=0.0)
         out = os.path.join(self.dir, 'pred.dat')
