@@ -143,6 +143,9 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
       ->delimiter(',')
       ->check(CLI::Range(1e-3, 1.0))
       ->capture_default_str();
+  sub->add_flag_callback("--no-flip", [args] { args->o.flip = false; },
+                         "train on each clip the way round it was filmed, without the seed's random horizontal flips "
+                         "(FlagSim's cameras all stand on one side of the flag)");
   sub->add_option("--weight-decay", o.weight_decay, "Adam weight decay")->check(CLI::NonNegativeNumber)->capture_default_str();
   sub->add_option("--grad-clip", o.grad_clip, "max gradient norm (0: off; -1: the seed's, 10 for lstm and off otherwise)")
       ->check(CLI::Range(-1.0, 1e9))

@@ -269,7 +269,7 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
     const int x = std::uniform_int_distribution<int>(0, w - crop)(rng);
     const int y = std::uniform_int_distribution<int>(0, h - crop)(rng);
     sample.crop = cv::Rect(x, y, crop, crop);
-    sample.flipped = std::uniform_int_distribution<int>(0, 1)(rng) == 1;
+    sample.flipped = std::uniform_int_distribution<int>(0, 1)(rng) == 1 && options.flip;
   } else {
     sample.crop = CentreSquare(w, h);
     sample.flipped = options.mirror;

@@ -74,6 +74,11 @@ struct SampleOptions {
   int frames = 30;        // N_t
   int input_size = 112;   // output side [px]
   bool augment = false;   // training: random temporal offset, multi-scale crop, flip
+  // Augmenting: flip horizontally with probability 1/2 (the seed's). false keeps every sample
+  // the way round the camera filmed it, why: FlagSim's cameras all stand on one side of the flag,
+  // so its test clips all fly one way. The coin is still drawn, so that the other draws are the
+  // same either way.
+  bool flip = true;
   int first_frame = -1;   // >= 0: start the window here (evaluation over several windows)
   bool mirror = false;    // not augmenting: flip horizontally (evaluation's mirror averaging)
   bool flow = false;      // two more channels: each frame's optical flow from the one before (FrameFlow)

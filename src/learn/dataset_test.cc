@@ -204,6 +204,22 @@ TEST_F(DatasetTest, AugmentationShapesAndDeterminismBySeed) {
   EXPECT_GT(flipped, 5);
   EXPECT_LT(flipped, 35);
   EXPECT_TRUE(differs);
+  // Without flips (--no-flip): the same offsets and crops seed by seed, never a flip, and the very
+  // samples the seed's recipe drew unflipped.
+  SampleOptions unflipped = o;
+  unflipped.flip = false;
+  int same_pixels = 0;
+  for (uint64_t seed = 0; seed < 40; ++seed) {
+    const Sample with = LoadSample(clip, o, seed), without = LoadSample(clip, unflipped, seed);
+    EXPECT_FALSE(without.flipped);
+    EXPECT_EQ(without.first_frame, with.first_frame);
+    EXPECT_EQ(without.crop, with.crop);
+    if (!with.flipped) {
+      EXPECT_EQ(without.pixels, with.pixels);
+      ++same_pixels;
+    }
+  }
+  EXPECT_EQ(same_pixels, 40 - flipped);
   // Evaluation: centred window, whole square, no flip; the seed does not matter.
   o.augment = false;
   const Sample e1 = LoadSample(clip, o, 1), e2 = LoadSample(clip, o, 99);

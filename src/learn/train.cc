@@ -288,6 +288,7 @@ TrainResult Train(const TrainOptions& o) {
   // Auxiliary track targets: read (and their head sized) before the network is built.
   if (!(o.aux_tracks >= 0)) throw std::runtime_error("aux_tracks: the loss weight must be >= 0");
   if (o.resume) RefuseChangedOnResume(state_path, "--aux-tracks", state.value("aux_tracks", 0.0), o.aux_tracks);
+  if (o.resume) RefuseChangedOnResume(state_path, "--no-flip", !state.value("flip", true), !o.flip);
   if (o.aux_phase_bins < 0 || o.aux_phase_bins > kTrackBins || (o.aux_phase_bins > 0 && o.aux_tracks <= 0))
     throw std::runtime_error("aux_phase_bins: must be in [0, " + std::to_string(kTrackBins) +
                              "], and above 0 only with an auxiliary loss (--aux-tracks W > 0)");
@@ -363,6 +364,7 @@ TrainResult Train(const TrainOptions& o) {
   SampleOptions train_options = config.Sampling();
   train_options.augment = true;
   train_options.crop_scales = o.crop_scales;
+  train_options.flip = o.flip;
   std::unique_ptr<FrameCache> train_cache, val_cache;
   if (o.cache_frames) {
     std::string why;
@@ -463,7 +465,7 @@ TrainResult Train(const TrainOptions& o) {
     nlohmann::json log = nlohmann::json::array();
     for (const EpochRecord& e : result.log) log.push_back(EpochJson(e));
     state = {{"epoch", epoch}, {"model", ToJson(config)}, {"log", log}, {"seed", o.seed},
-             {"crop_scales", o.crop_scales}, {"aux_tracks", o.aux_tracks},
+             {"crop_scales", o.crop_scales}, {"flip", o.flip}, {"aux_tracks", o.aux_tracks},
              {"aux_phase_bins", o.aux_phase_bins}, {"aux_world", o.aux_world}, {"point_maps", o.point_maps},
              {"weight_average", o.weight_average}, {"average_steps", average_steps},
              {"best_val_rmse", result.best_val_rmse}};

@@ -37,6 +37,9 @@ struct TrainOptions {
   // the frame's shorter side, one drawn per clip. Evaluation always takes the whole square, so
   // scales below 1 also train on zoomed views that the test never shows.
   std::vector<double> crop_scales = {1.0, 0.875, 0.75, 0.66};
+  // Random horizontal flips (the seed's); false trains on clips the way round they were filmed
+  // (SampleOptions::flip).
+  bool flip = true;
   double grad_clip = -1;             // max gradient norm; 0: off; < 0: the seed's (10 for lstm, else off)
   int threads = 2;                   // torch intra-op threads
   std::string device = "auto";       // cpu | cuda | auto

@@ -802,6 +802,15 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   ExpectTrainRefused(x, "a resume with other crop scales was accepted",
                      {"state.json: the run trained with crop scales [1.0,0.875,0.75,0.66]", "--crop-scales"});
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
+
+  // And one that turns the flips off: the run trained with them (state.json "flip": true).
+  TrainOptions y = Options("sdn", "resume");
+  y.epochs = 3;
+  y.resume = true;
+  y.flip = false;
+  ExpectTrainRefused(y, "a resume without the run's flips was accepted",
+                     {"state.json: the run trained with --no-flip 0, these options give 1"});
+  EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
 }
 
 // With a weight average, validation reads the average and model.pt holds its best epoch while
