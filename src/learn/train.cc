@@ -131,13 +131,20 @@ void SaveAtomically(T& object, const fs::path& path) {
   fs::rename(tmp, path);
 }
 
+// An option's value as the refusal below names it: a flag on or off, a number as it is.
+std::string OptionValue(bool v) { return v ? "on" : "off"; }
+template <typename T>
+std::string OptionValue(T v) {
+  return std::to_string(v);
+}
+
 // On a resume, refuses an option whose value differs from the one the run started with (`ran`,
 // from its state.json at state_path), naming the flag.
 template <typename T>
 void RefuseChangedOnResume(const fs::path& state_path, const std::string& flag, T ran, T given) {
   if (ran == given) return;
-  throw std::runtime_error(state_path.string() + ": the run trained with " + flag + " " + std::to_string(ran) +
-                           ", these options give " + std::to_string(given) + "; resume with the " + flag +
+  throw std::runtime_error(state_path.string() + ": the run trained with " + flag + " " + OptionValue(ran) +
+                           ", these options give " + OptionValue(given) + "; resume with the " + flag +
                            " the run started with");
 }
 

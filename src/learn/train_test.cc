@@ -809,7 +809,7 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   y.resume = true;
   y.flip = false;
   ExpectTrainRefused(y, "a resume without the run's flips was accepted",
-                     {"state.json: the run trained with --no-flip 0, these options give 1"});
+                     {"state.json: the run trained with --no-flip off, these options give on"});
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
 }
 
