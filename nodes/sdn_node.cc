@@ -10,7 +10,9 @@
 //                   while someone subscribes, SDN models only.
 // Parameters: ~model (model.pt of a training run; model.json beside it), ~threads (2),
 // ~device (cpu | cuda | auto), ~queue_size (2 clips; older ones are dropped when the node lags),
-// ~mean_window (60 s, the field protocol's label window).
+// ~mean_window (60 s, the field protocol's label window), ~flag_flies (right | left | auto; unset:
+// auto for a model trained without flips, which knows only flags flying right as FlagSim's do,
+// right, as filmed, for one trained with them; learn/fly_direction.h).
 // Clips may be mono8 or bgr8; a model trained with --colour needs bgr8 (clip_buffer ~colour) and
 // reports a grey clip as an ERROR naming that parameter.
 // Diagnostics: model, device, latency and rate; a malformed clip is an ERROR, not a crash. A
@@ -45,6 +47,7 @@ class SdnNode {
     pnh.param("device", device_, std::string("cpu"));
     int queue_size = 2;
     pnh.param("queue_size", queue_size, 2);
+    pnh.param("flag_flies", flag_flies_param_, std::string());
     estimate_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate", 10);
     mean_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate_mean", 10);
     power_pub_ = transport_.advertise("sdn/power", 1);
@@ -86,9 +89,18 @@ class SdnNode {
       const auto t0 = std::chrono::steady_clock::now();
       predictor->PredictFrames(frames);
       const double warm = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (!flag_flies_param_.empty()) {
+        try {
+          predictor->set_flag_flies(clothwind::learn::FlagFliesFromName(flag_flies_param_, "~flag_flies"));
+        } catch (const std::invalid_argument& e) {
+          ROS_ERROR("sdn_node: %s; using %s, the model's default", e.what(),
+                    clothwind::learn::FlagFliesName(predictor->flag_flies()).c_str());
+        }
+      }
       model_name_ = c.Name() + " (" + model_path_ + ")";
-      ROS_INFO("sdn_node: model %s on %s, %d threads, warm-up %.0f ms", model_name_.c_str(),
-               predictor->device().c_str(), threads_, 1e3 * warm);
+      ROS_INFO("sdn_node: model %s on %s, %d threads, warm-up %.0f ms, flag flies %s", model_name_.c_str(),
+               predictor->device().c_str(), threads_, 1e3 * warm,
+               clothwind::learn::FlagFliesName(predictor->flag_flies()).c_str());
       predictor_ = std::move(predictor);
       load_error_.clear();
     } catch (const std::exception& e) {
@@ -117,6 +129,7 @@ class SdnNode {
       PublishMean(estimate);
       if (want_maps && !maps.power.empty()) PublishMaps(*clip, maps);
       ++estimates_;
+      turned_ += p.turned;
       latencies_.push_back(latency);
       if (latencies_.size() > 50) latencies_.pop_front();
       stamps_.push_back(ros::WallTime::now().toSec());
@@ -190,6 +203,8 @@ class SdnNode {
     stat.add("latency max [s]", max);
     stat.add("rate [clips/s]", rate);
     stat.add("estimates", estimates_);
+    stat.add("flag flies", predictor_ ? clothwind::learn::FlagFliesName(predictor_->flag_flies()) : std::string("-"));
+    stat.add("clips turned round (flag flying left)", turned_);
     stat.add("trailing mean [m/s]", trailing_.Mean());
     stat.add("clips in the trailing mean", trailing_.Count());
     stat.add("malformed clips", errors_);
@@ -203,13 +218,13 @@ class SdnNode {
   ros::Subscriber clip_sub_;
   diagnostic_updater::Updater updater_;
   ros::WallTimer diag_timer_, load_timer_;
-  std::string model_path_, device_, model_name_, load_error_, last_error_;
+  std::string model_path_, device_, model_name_, load_error_, last_error_, flag_flies_param_;
   int threads_ = 2;
   std::unique_ptr<clothwind::learn::Predictor> predictor_;
   std::deque<double> latencies_, stamps_;
   clothwind::sensors::TrailingMean trailing_;
   std::deque<std::pair<double, ros::Time>> starts_;  // (clip end [s], clip start) of the averaged clips
-  uint64_t estimates_ = 0, errors_ = 0, dropped_ = 0;
+  uint64_t estimates_ = 0, errors_ = 0, dropped_ = 0, turned_ = 0;
   bool error_pending_ = false;
 };
 

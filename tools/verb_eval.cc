@@ -18,6 +18,8 @@ struct EvalArgs {
   int threads = 2, batch = 8, windows = 1, track_head_window = 0;
   std::string device = "auto";
   bool mirror = false;
+  bool mirror_clips = false;
+  std::string flag_flies = "right";
   bool by_view = false;
   bool track_head = false;
 };
@@ -40,6 +42,15 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       ->capture_default_str();
   sub->add_flag("--mirror", a->mirror,
                "also predict each window's mirror image (horizontal flip) and average the two (Table 1: off)");
+  sub->add_flag("--mirror-clips", a->mirror_clips,
+               "mirror every clip first, as if its flag flew left (FlagSim's all fly right): how the model reads "
+               "flags flying the other way");
+  sub->add_option("--flag-flies", a->flag_flies,
+                  "turn each clip round before the model reads it: right (as it comes), left (mirror every clip) "
+                  "or auto (mirror those whose motion says the flag flies left; the node's default for a model "
+                  "trained with --no-flip)")
+      ->check(CLI::IsMember({"right", "left", "auto"}))
+      ->capture_default_str();
   sub->add_flag("--by-view", a->by_view,
                "also break the errors down by the clips' views (camera elevation, angle, distance; texture), "
                "read from each simulated clip's label.json");
@@ -68,7 +79,9 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     b.rate_unit = "clips/s";
     ProgressBar bar(b);
     const learn::EvalResult r = learn::Evaluate(a->model, a->data, a->split, a->threads, a->device, a->batch,
-                                                a->windows, a->mirror, [&](int done, int total) { bar.Update(done, total); });
+                                                a->windows, a->mirror, a->mirror_clips,
+                                                learn::FlagFliesFromName(a->flag_flies, "--flag-flies"),
+                                                [&](int done, int total) { bar.Update(done, total); });
     bar.Finish();
     std::cout << learn::EvalTable(r);
     nlohmann::json json = learn::EvalJson(r);

@@ -247,6 +247,36 @@ std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames) {
   return WindowFlows(frames, cv::Rect(0, 0, side, frames[0].rows), side, side);
 }
 
+namespace {
+
+// Whether options.flag_flies turns the clip (its first options.frames frames, cropped to `crop`)
+// round, so that its flag flies right; `score` receives EstimateFlyDirection's score with kAuto.
+// The frames are judged as the model will see them: cropped, resized, mirrored by mirror_clip,
+// grey (the Y of colour frames). Frames MakeSample would refuse are not judged (false): its own
+// checks then name them.
+bool TurnsToFlyRight(const std::vector<cv::Mat>& frames, const cv::Rect& crop, const SampleOptions& options,
+                     double* score) {
+  *score = 0;
+  if (options.flag_flies == FlagFlies::kRight) return false;
+  if (options.flag_flies == FlagFlies::kLeft) return true;
+  if (options.frames < 4) return false;  // too short to judge (EstimateFlyDirection's minimum)
+  const int type = FrameType(options.colour);
+  std::vector<cv::Mat> grey(options.frames);
+  for (int t = 0; t < options.frames; ++t) {
+    if (frames[t].type() != type || frames[t].size() != frames[0].size()) return false;
+    cv::Mat resized;
+    ResizeCrop(frames[t], crop, options.input_size, resized);
+    if (resized.channels() > 1) cv::extractChannel(resized, resized, 0);
+    if (options.mirror_clip) cv::flip(resized, resized, 1);
+    grey[t] = resized;
+  }
+  const FlyDirectionCues cues = EstimateFlyDirection(grey);
+  *score = cues.score;
+  return cues.direction == FlyDirection::kLeft;
+}
+
+}  // namespace
+
 Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& options, std::mt19937_64& rng,
                   const std::vector<cv::Mat>* flows) {
   if (static_cast<int>(frames.size()) != options.frames || frames.empty()) {
@@ -272,7 +302,8 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
     sample.flipped = std::uniform_int_distribution<int>(0, 1)(rng) == 1 && options.flip;
   } else {
     sample.crop = CentreSquare(w, h);
-    sample.flipped = options.mirror;
+    sample.turned = TurnsToFlyRight(frames, sample.crop, options, &sample.fly_score);
+    sample.flipped = (options.mirror_clip != sample.turned) != options.mirror;
   }
   const int s = options.input_size;
   const size_t plane = static_cast<size_t>(s) * s;

@@ -14,6 +14,8 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "learn/fly_direction.h"
+
 namespace clothwind::learn {
 
 // One example as listed by index.json and described by its label.json.
@@ -81,6 +83,15 @@ struct SampleOptions {
   bool flip = true;
   int first_frame = -1;   // >= 0: start the window here (evaluation over several windows)
   bool mirror = false;    // not augmenting: flip horizontally (evaluation's mirror averaging)
+  // Not augmenting: mirror the clip before anything else, as if its flag flew the other way
+  // (eval --mirror-clips: how a model reads flags that fly left, which FlagSim has none of).
+  bool mirror_clip = false;
+  // Not augmenting: which way the clip's flag flies, so that it is turned to fly right before
+  // the model reads it (after mirror_clip, before mirror): kRight reads it as it comes, kLeft
+  // mirrors it, kAuto mirrors it when EstimateFlyDirection of the cropped, resized grey (or Y)
+  // frames says left. Why: a model trained without flips (train --no-flip) knows only flags
+  // that fly right.
+  FlagFlies flag_flies = FlagFlies::kRight;
   bool flow = false;      // two more channels: each frame's optical flow from the one before (FrameFlow)
   // Side [px] the crop is resized to for the flow, which is then resized to input_size and
   // scaled with it (0: input_size). A finer flow reads the cloth's sub-pixel motion more exactly.
@@ -108,7 +119,9 @@ struct Sample {
   float wind_speed = 0;       // [m/s]
   int first_frame = 0;        // temporal offset used
   cv::Rect crop;              // square crop taken from the frames [px]
-  bool flipped = false;
+  bool flipped = false;       // the pixels are mirrored relative to the frames given
+  bool turned = false;        // SampleOptions::flag_flies mirrored the clip (its flag flies left)
+  double fly_score = 0;       // with flag_flies kAuto: EstimateFlyDirection's score (> 0: right)
 };
 
 // The frame window of a clip: options.first_frame when set, else uniformly random when augmenting,
@@ -151,7 +164,8 @@ std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames);
 // options.colour) into a Sample: crop (random
 // multi-scale position and size when augmenting, the centred square of the shorter side
 // otherwise), resize to input_size (area interpolation), flip horizontally with probability
-// 1/2 when augmenting (always when options.mirror and not augmenting), and normalise the whole clip to zero mean and unit standard deviation.
+// 1/2 when augmenting (not augmenting: once for each of options.mirror_clip, a turn by
+// options.flag_flies and options.mirror), and normalise the whole clip to zero mean and unit standard deviation.
 // With options.flow, the flow of the resized frames (WindowFlows) follows as channels 1 and 2,
 // flipped with the frames (mirrored, x negated). `flows`, when given, are those T - 1 flows
 // already computed (a cache's): only for frames that are already input_size squares, whose crop

@@ -301,6 +301,65 @@ TEST(MakeSample, FlipMirrorsTheFrames) {
   EXPECT_LT(plain.pixels[0], plain.pixels[15]);  // the ramp rises left to right unflipped
 }
 
+// A flag held at column 8 of 64 x 48 frames (a 16-px margin either side of the centred square),
+// flying right: ripples that grow toward the fly end and travel there, on a still grey.
+std::vector<cv::Mat> FlagFlyingRight(int frames) {
+  std::vector<cv::Mat> out;
+  for (int t = 0; t < frames; ++t) {
+    cv::Mat f(48, 64, CV_8UC1, cv::Scalar::all(100));
+    for (int y = 0; y < 48; ++y) {
+      for (int x = 24; x < 56; ++x) {
+        const double amplitude = 60.0 * (x - 24) / 32.0;
+        f.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(100 + amplitude * std::sin(0.4 * x - 2 * M_PI * 3 * t / frames));
+      }
+    }
+    out.push_back(f);
+  }
+  return out;
+}
+
+TEST(MakeSample, FlagFliesTurnsAFlagFlyingLeftToFlyRight) {
+  // As a model trained without flips reads a flag: mirrored clips (mirror_clip, a flag flying
+  // left) come back to the as-filmed sample, by --flag-flies left always, by auto from the motion.
+  SampleOptions o;
+  o.frames = 30;
+  o.input_size = 32;
+  std::mt19937_64 rng(0);
+  const std::vector<cv::Mat> frames = FlagFlyingRight(30);
+  const Sample filmed = MakeSample(frames, o, rng);
+  EXPECT_FALSE(filmed.flipped);
+  EXPECT_FALSE(filmed.turned);
+
+  o.mirror_clip = true;
+  const Sample left = MakeSample(frames, o, rng);
+  EXPECT_TRUE(left.flipped);
+  EXPECT_NE(left.pixels, filmed.pixels);
+  for (const FlagFlies f : {FlagFlies::kLeft, FlagFlies::kAuto}) {
+    SCOPED_TRACE(FlagFliesName(f));
+    o.flag_flies = f;
+    const Sample turned = MakeSample(frames, o, rng);
+    EXPECT_TRUE(turned.turned);
+    EXPECT_FALSE(turned.flipped);
+    EXPECT_EQ(turned.pixels, filmed.pixels);
+    if (f == FlagFlies::kAuto) {
+      EXPECT_LT(turned.fly_score, 0);
+    }
+  }
+  // Auto leaves a flag that flies right as it is, scoring the opposite of its mirror image.
+  o.mirror_clip = false;
+  const Sample kept = MakeSample(frames, o, rng);
+  EXPECT_FALSE(kept.turned);
+  EXPECT_GT(kept.fly_score, 0);
+  EXPECT_EQ(kept.pixels, filmed.pixels);
+  // Evaluation's mirror averaging still mirrors the turned clip.
+  o.mirror_clip = true;
+  o.mirror = true;
+  const Sample both = MakeSample(frames, o, rng);
+  EXPECT_TRUE(both.turned);
+  EXPECT_TRUE(both.flipped);
+  EXPECT_EQ(both.pixels, left.pixels);
+}
+
 // A smooth random texture, as a flag's print and shading look to the flow at 64 px.
 cv::Mat Texture(int side, uint64_t seed) {
   cv::Mat noise(side, side, CV_32F);

@@ -132,8 +132,8 @@ SimulationMetrics ComputeSimulationMetrics(const std::vector<double>& truth, con
 }
 
 EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::string& split, int threads,
-                    const std::string& device, int batch, int windows, bool mirror,
-                    const std::function<void(int, int)>& progress) {
+                    const std::string& device, int batch, int windows, bool mirror, bool mirror_clips,
+                    FlagFlies flag_flies, const std::function<void(int, int)>& progress) {
   const auto start = std::chrono::steady_clock::now();
   if (windows < 1) throw std::invalid_argument("Evaluate: windows must be >= 1, got " + std::to_string(windows));
   Predictor predictor(model, threads, device);
@@ -144,8 +144,12 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   r.split = split;
   r.windows = windows;
   r.mirror = mirror;
+  r.mirror_clips = mirror_clips;
+  r.flag_flies = flag_flies;
   const int passes = windows * (mirror ? 2 : 1);
-  const SampleOptions options = r.config.Sampling();
+  SampleOptions options = r.config.Sampling();
+  options.mirror_clip = mirror_clips;
+  options.flag_flies = flag_flies;
   batch = std::max(1, batch);
   for (size_t i = 0; i < clips.size(); i += batch) {
     const size_t end = std::min(clips.size(), i + batch);
@@ -168,6 +172,9 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
       std::vector<const Sample*> pointers;
       for (const Sample& s : samples) pointers.push_back(&s);
       const std::vector<Prediction> predictions = predictor.Predict(pointers);
+      if (pass % (mirror ? 2 : 1) == 0) {
+        for (const Sample& sample : samples) r.turned += sample.turned;
+      }
       for (size_t j = 0; j < samples.size(); ++j) {
         sum[j] += predictions[j].speed;
         sum_var[j] += predictions[j].speed_std * predictions[j].speed_std;
@@ -213,6 +220,7 @@ nlohmann::json EvalJson(const EvalResult& r) {
   return {{"rmse", r.metrics.rmse},   {"acc05", r.metrics.acc05}, {"count", r.metrics.count},
           {"model", r.config.Name()}, {"arch", r.config.arch},    {"modality", r.config.Modality()},
           {"split", r.split},         {"windows", r.windows},     {"mirror", r.mirror},
+          {"mirror_clips", r.mirror_clips}, {"flag_flies", FlagFliesName(r.flag_flies)}, {"turned", r.turned},
           {"seconds", r.seconds},
           {"std_within_1", Number(StdCoverage(r, 1))}, {"std_within_2", Number(StdCoverage(r, 2))},
           {"bands", bands},
@@ -238,6 +246,11 @@ std::string EvalTable(const EvalResult& r) {
   s << "(" << r.metrics.count << " examples, split " << r.split;
   if (r.windows > 1) s << ", mean of " << r.windows << " frame windows per clip";
   if (r.mirror) s << ", each averaged with its mirror image";
+  if (r.mirror_clips) s << ", clips mirrored (flags flying left)";
+  if (r.flag_flies == FlagFlies::kLeft) s << ", every clip turned round (--flag-flies left)";
+  if (r.flag_flies == FlagFlies::kAuto) {
+    s << ", turned round by their motion: " << r.turned << " of " << r.metrics.count * r.windows << " windows";
+  }
   s << ")\n";
   if (!r.predicted_std.empty()) {
     s << "  predicted std: errors within 1 std " << StdCoverage(r, 1) << ", within 2 std " << StdCoverage(r, 2)

@@ -71,6 +71,9 @@ struct EvalResult {
   std::vector<int> simulations;  // each clip's simulation id (ClipInfo::simulation; -1: none)
   int windows = 1;      // frame windows averaged per clip
   bool mirror = false;  // each window averaged with its mirror image
+  bool mirror_clips = false;  // every clip mirrored first, as if its flag flew left
+  FlagFlies flag_flies = FlagFlies::kRight;  // how each clip was turned before the model read it
+  int turned = 0;  // windows that flag_flies turned round (mirrored: their flag flew left)
   Metrics metrics;
   std::vector<BandMetrics> bands;  // by true speed, kEvalBandWidth wide
   SimulationMetrics per_simulation;  // simulations == 0 for a dataset without simulation ids
@@ -86,15 +89,21 @@ struct EvalResult {
 //                  their errors are not independent);
 //         mirror   also predict each window's mirror image (horizontal flip, as training's
 //                  augmentation: a flag seen from the other side) and average the two the same way;
+//         mirror_clips  mirror every clip before anything else (SampleOptions::mirror_clip): FlagSim's
+//                  flags all fly right, so this is how a model reads flags that fly left;
+//         flag_flies  how each clip is then turned round (SampleOptions::flag_flies; kRight: as it
+//                  comes, the default here whatever the model, so that figures stay comparable);
 //         progress  called after each batch with (done, total) (may be empty).
 EvalResult Evaluate(const std::filesystem::path& model, const std::filesystem::path& data, const std::string& split,
                     int threads, const std::string& device, int batch, int windows = 1, bool mirror = false,
+                    bool mirror_clips = false, FlagFlies flag_flies = FlagFlies::kRight,
                     const std::function<void(int, int)>& progress = {});
 
 // {"rmse", "acc05", "bias", "count"} of one group of examples; NaN figures (an empty group) as null.
 nlohmann::json MetricsJson(const Metrics& metrics);
 
-// {"rmse": …, "acc05": …, "count": …} plus the model, split, windows, mirror, "bands" (a list of
+// {"rmse": …, "acc05": …, "count": …} plus the model, split, windows, mirror, mirror_clips,
+// flag_flies, turned, "bands" (a list of
 // {"lo", "hi", "rmse", "acc05", "bias", "count"}; NaNs of empty bands as null) and
 // "per_simulation" ({"rmse", "scatter", "simulations", "clips"}; null without simulation ids).
 nlohmann::json EvalJson(const EvalResult& result);

@@ -114,7 +114,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"spectral_pool", c.spectral_pool}, {"stem_pool", c.stem_pool},
           {"coord_maps", c.coord_maps}, {"frame_channels", c.frame_channels},
           {"dropout", c.dropout},        {"aux_outputs", c.aux_outputs}, {"point_maps", c.point_maps},
-          {"head_hidden", c.head_hidden},
+          {"head_hidden", c.head_hidden}, {"flips_in_training", c.flips_in_training},
           {"frame_rate", c.frame_rate},  {"width", c.width},
           {"input_size", c.input_size},  {"label_mean", c.label_mean},
           {"label_std", c.label_std},    {"std_scale", c.std_scale}};
@@ -167,6 +167,8 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     // Absent in models written before the option existed: a linear wind head.
     c.head_hidden = j.contains("head_hidden") ? j.at("head_hidden").get<int>() : 0;
     if (c.head_hidden < 0) throw std::runtime_error(where + ": field \"head_hidden\" must be >= 0");
+    // Absent in models written before train --no-flip existed: they were trained with flips.
+    c.flips_in_training = j.contains("flips_in_training") ? j.at("flips_in_training").get<bool>() : true;
     c.frame_rate = need("frame_rate").get<double>();
     c.width = need("width").get<int>();
     c.input_size = need("input_size").get<int>();

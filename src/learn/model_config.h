@@ -70,6 +70,10 @@ struct ModelConfig {
   // linear head; the count of points P (0: none). Why: a linear head on pooled features knows
   // them to ~1.1 px of 64, where the wind needs a fraction of a pixel.
   int point_maps = 0;
+  // Training flipped clips left to right at random (the seed's; train --no-flip: false). A model
+  // trained without flips knows only flags flying right, as FlagSim's do, so the node turns clips
+  // of flags flying left round for it by default (DefaultFlagFlies).
+  bool flips_in_training = true;
   double frame_rate = 25.0;  // [Hz] of the clips the model reads
   int width = 64;            // ResNet-18 base width (64 as the original; 16 trains on a CPU)
   int input_size = 112;      // side of the square input [px] (224 as the seed, 112 for a CPU)
@@ -101,6 +105,9 @@ struct ModelConfig {
   // 0..frames-1, rounded (first and last included; N = 1: the middle frame). Empty for N = 0.
   std::vector<int64_t> FrameChannelIndices() const;
 
+  // How the node turns clips for this model unless told (~flag_flies): kAuto for a model trained
+  // without flips, kRight (as filmed) for one that has seen flags fly both ways.
+  FlagFlies DefaultFlagFlies() const { return flips_in_training ? FlagFlies::kRight : FlagFlies::kAuto; }
   // Channels entering the ResNet trunk: 2kC (+C with mean_map, +4C or 8C with phase steps, +2C
   // with mode_shape, +N·C with frame_channels N) for the SDN, N_t·C for the frame-stack baseline, C for the recurrent one
   // (its trunk reads one frame at a time); +2 with coord_maps for every architecture.

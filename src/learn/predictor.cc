@@ -37,6 +37,7 @@ Predictor::Predictor(const std::filesystem::path& weights, int threads, const st
   impl_->net = LoadWindNet(weights);
   impl_->net->to(impl_->device);
   impl_->net->eval();
+  flag_flies_ = config().DefaultFlagFlies();
 }
 
 Predictor::~Predictor() = default;
@@ -82,7 +83,8 @@ Sample Predictor::Prepare(const std::vector<cv::Mat>& frames) const {
                                            : std::string("clip frames must be non-empty mono8 images of one size"));
     }
   }
-  const SampleOptions options = c.Sampling();
+  SampleOptions options = c.Sampling();
+  options.flag_flies = flag_flies_;
   std::vector<cv::Mat> last(frames.end() - c.frames, frames.end());
   std::mt19937_64 unused(0);
   return MakeSample(last, options, unused);
@@ -91,6 +93,7 @@ Sample Predictor::Prepare(const std::vector<cv::Mat>& frames) const {
 Prediction Predictor::PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps* maps) {
   Sample sample = Prepare(frames);
   Prediction p = Predict({&sample})[0];
+  p.turned = sample.turned;
   const ModelConfig& c = config();
   if (maps != nullptr && c.arch == "sdn") {
     // The grey channel's maps (channel 0; flow channels, when the model has them, follow it).

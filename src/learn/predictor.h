@@ -18,6 +18,7 @@ namespace clothwind::learn {
 struct Prediction {
   double speed = 0;      // [m/s]
   double speed_std = 0;  // [m/s] predicted standard deviation (the network's uncertainty)
+  bool turned = false;   // PredictFrames mirrored the clip first: its flag flies left (flag_flies())
 };
 
 // The strongest spectral peak of every pixel of a clip (SDN models only), at input resolution.
@@ -41,6 +42,12 @@ class Predictor {
   const ModelConfig& config() const;
   std::string device() const;  // "cpu" or "cuda"
 
+  // How PredictFrames and Prepare turn a clip before the model reads it (fly_direction.h):
+  // config().DefaultFlagFlies() until set (auto for a model trained without flips, as filmed
+  // otherwise). The node's ~flag_flies sets it.
+  FlagFlies flag_flies() const { return flag_flies_; }
+  void set_flag_flies(FlagFlies flag_flies) { flag_flies_ = flag_flies; }
+
   // Predictions for prepared samples (each config().frames x input_size² floats, as MakeSample
   // makes them), in one batch.
   std::vector<Prediction> Predict(const std::vector<const Sample*>& samples);
@@ -52,12 +59,14 @@ class Predictor {
   // (CV_8UC3 YCrCb, LoadFrames' colour frames, for a model with config().colour).
   Prediction PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps* maps = nullptr);
 
-  // A clip with the evaluation preprocessing (no augmentation) from raw greyscale (or YCrCb) frames.
+  // A clip with the evaluation preprocessing (no augmentation) from raw greyscale (or YCrCb)
+  // frames, turned as flag_flies() says (Sample::turned).
   Sample Prepare(const std::vector<cv::Mat>& frames) const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  FlagFlies flag_flies_ = FlagFlies::kRight;
 };
 
 // A false-colour BGR image of `value` (CV_32F) scaled from [lo, hi] to OpenCV colour map

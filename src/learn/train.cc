@@ -296,6 +296,7 @@ TrainResult Train(const TrainOptions& o) {
   if (!(o.aux_tracks >= 0)) throw std::runtime_error("aux_tracks: the loss weight must be >= 0");
   if (o.resume) RefuseChangedOnResume(state_path, "--aux-tracks", state.value("aux_tracks", 0.0), o.aux_tracks);
   if (o.resume) RefuseChangedOnResume(state_path, "--no-flip", !state.value("flip", true), !o.flip);
+  config.flips_in_training = o.flip;
   if (o.aux_phase_bins < 0 || o.aux_phase_bins > kTrackBins || (o.aux_phase_bins > 0 && o.aux_tracks <= 0))
     throw std::runtime_error("aux_phase_bins: must be in [0, " + std::to_string(kTrackBins) +
                              "], and above 0 only with an auxiliary loss (--aux-tracks W > 0)");

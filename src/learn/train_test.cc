@@ -216,6 +216,21 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
     largest_difference = std::max(largest_difference, std::abs(a.speed - b.speed));
   }
   EXPECT_GT(largest_difference, 0.1);
+  // Clips mirrored first (--mirror-clips: flags flying left) are what mirror averaging's second
+  // pass reads; turned round again (--flag-flies left) they are the plain clips.
+  const EvalResult left = Evaluate(r.model, *root_ / "data", "val", 2, "cpu", 4, 1, false, true);
+  const EvalResult back = Evaluate(r.model, *root_ / "data", "val", 2, "cpu", 4, 1, false, true, FlagFlies::kLeft);
+  EXPECT_EQ(left.turned, 0);
+  EXPECT_EQ(back.turned, static_cast<int>(val.size()));
+  for (size_t i = 0; i < val.size(); ++i) {
+    EXPECT_NEAR(left.predicted[i], 2 * em.predicted[i] - e.predicted[i], 4e-3);
+    EXPECT_NEAR(back.predicted[i], e.predicted[i], 1e-6);
+  }
+  EXPECT_TRUE(EvalJson(back)["mirror_clips"].get<bool>());
+  EXPECT_EQ(EvalJson(back)["flag_flies"].get<std::string>(), "left");
+  EXPECT_EQ(EvalJson(back)["turned"].get<int>(), static_cast<int>(val.size()));
+  EXPECT_NE(EvalTable(back).find("clips mirrored (flags flying left), every clip turned round"), std::string::npos)
+      << EvalTable(back);
   // The plots are PNGs made by gnuplot (installed with the project's dependencies).
   EXPECT_EQ(r.plot_error, "");
   std::string error;
@@ -1233,6 +1248,43 @@ TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
   // Every pixel alternates each frame: the strongest peak is the Nyquist rate, 12.5 Hz.
   EXPECT_NEAR(maps.frequency.at<float>(10, 10), 12.5f, 1e-4);
   EXPECT_THROW(p.PredictFrames(std::vector<cv::Mat>(29, frames[0])), std::invalid_argument);
+  // Trained with flips (the default): it reads clips as they come.
+  EXPECT_TRUE(p.config().flips_in_training);
+  EXPECT_EQ(p.flag_flies(), FlagFlies::kRight);
+  EXPECT_FALSE(pred.turned);
+}
+
+TEST_F(TrainTest, AModelTrainedWithoutFlipsTurnsFlagsFlyingLeft) {
+  TrainOptions t;
+  t.model.arch = "sdn";
+  t.model.width = 4;
+  t.model.input_size = 32;
+  t.out = *root_ / "no-flip";
+  t.init_only = true;
+  t.flip = false;
+  const TrainResult r = Train(t);
+  std::ifstream json(r.model.parent_path() / "model.json");
+  EXPECT_FALSE(nlohmann::json::parse(json).at("flips_in_training").get<bool>());
+  Predictor p(r.model, 1, "cpu");
+  EXPECT_FALSE(p.config().flips_in_training);
+  EXPECT_EQ(p.flag_flies(), FlagFlies::kAuto);  // the node's default for it
+
+  cv::RNG rng(3);
+  std::vector<cv::Mat> frames(30), mirrored(30);
+  for (int i = 0; i < 30; ++i) {
+    frames[i] = cv::Mat(40, 50, CV_8UC1);
+    rng.fill(frames[i], cv::RNG::UNIFORM, 0, 256);
+    cv::flip(frames[i], mirrored[i], 1);
+  }
+  p.set_flag_flies(FlagFlies::kRight);
+  const Prediction filmed = p.PredictFrames(frames), other_way = p.PredictFrames(mirrored);
+  EXPECT_FALSE(filmed.turned);
+  EXPECT_NE(filmed.speed, other_way.speed);  // the network is not mirror-symmetric
+  p.set_flag_flies(FlagFlies::kLeft);
+  const Prediction turned = p.PredictFrames(mirrored);
+  EXPECT_TRUE(turned.turned);
+  EXPECT_DOUBLE_EQ(turned.speed, filmed.speed);
+  EXPECT_DOUBLE_EQ(turned.speed_std, filmed.speed_std);
 }
 
 // A float below FLT_MIN: with denormals flushed it becomes 0 when multiplied. volatile keeps the

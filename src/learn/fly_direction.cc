@@ -1,0 +1,129 @@
+#include "learn/fly_direction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <stdexcept>
+
+namespace clothwind::learn {
+namespace {
+
+// The frames as CV_64F planes, checked.
+std::vector<cv::Mat> AsDouble(const std::vector<cv::Mat>& frames) {
+  if (frames.size() < 4) {
+    throw std::invalid_argument("EstimateFlyDirection: expected at least 4 frames, got " +
+                                std::to_string(frames.size()));
+  }
+  const cv::Size size = frames[0].size();
+  std::vector<cv::Mat> out(frames.size());
+  for (size_t t = 0; t < frames.size(); ++t) {
+    const cv::Mat& f = frames[t];
+    if (f.type() != CV_8UC1 && f.type() != CV_32FC1) {
+      throw std::invalid_argument("EstimateFlyDirection: frame " + std::to_string(t) +
+                                  " is not single-channel CV_8UC1 or CV_32FC1");
+    }
+    if (f.size() != size || size.width < 3) {
+      throw std::invalid_argument("EstimateFlyDirection: frame " + std::to_string(t) + " is " +
+                                  std::to_string(f.cols) + "x" + std::to_string(f.rows) + ", expected " +
+                                  std::to_string(size.width) + "x" + std::to_string(size.height) +
+                                  " with at least 3 columns, as frame 0");
+    }
+    f.convertTo(out[t], CV_64F);
+  }
+  return out;
+}
+
+double MotionSkewness(const std::vector<cv::Mat>& f) {
+  const double n = static_cast<double>(f.size());
+  cv::Mat sum = cv::Mat::zeros(f[0].size(), CV_64F), sq = sum.clone();
+  for (const cv::Mat& x : f) {
+    sum += x;
+    sq += x.mul(x);
+  }
+  cv::Mat var = sq / n - (sum / n).mul(sum / n), sd;
+  cv::max(var, 0.0, var);
+  cv::sqrt(var, sd);
+  cv::Mat profile;
+  cv::reduce(sd, profile, 0, cv::REDUCE_SUM, CV_64F);
+  std::vector<double> m(profile.begin<double>(), profile.end<double>());
+  std::vector<double> sorted = m;
+  std::sort(sorted.begin(), sorted.end());
+  const double floor = sorted[sorted.size() / 10];
+  double w = 0, mu = 0;
+  for (size_t i = 0; i < m.size(); ++i) {
+    m[i] = std::max(m[i] - floor, 0.0);
+    w += m[i];
+    mu += static_cast<double>(i) * m[i];
+  }
+  if (!(w > 0)) return 0.0;
+  mu /= w;
+  double m2 = 0, m3 = 0;
+  for (size_t i = 0; i < m.size(); ++i) {
+    const double d = static_cast<double>(i) - mu;
+    m2 += m[i] * d * d;
+    m3 += m[i] * d * d * d;
+  }
+  m2 /= w;
+  m3 /= w;
+  return m2 > 0 ? m3 / std::pow(m2, 1.5) : 0.0;
+}
+
+double PhaseStep(const std::vector<cv::Mat>& f) {
+  const int T = static_cast<int>(f.size());
+  const int rows = f[0].rows, cols = f[0].cols;
+  const size_t pixels = static_cast<size_t>(rows) * cols;
+  cv::Mat mean = cv::Mat::zeros(f[0].size(), CV_64F);
+  for (const cv::Mat& x : f) mean += x / T;
+  std::complex<double> total(0, 0);
+  std::vector<std::complex<double>> z(pixels);
+  for (int k = 1; k <= T / 2 - 1; ++k) {
+    std::fill(z.begin(), z.end(), std::complex<double>(0, 0));
+    for (int t = 0; t < T; ++t) {
+      const std::complex<double> e = std::polar(1.0, -2 * M_PI * k * t / T);
+      const cv::Mat d = f[t] - mean;
+      for (int y = 0; y < rows; ++y) {
+        const double* row = d.ptr<double>(y);
+        for (int x = 0; x < cols; ++x) z[static_cast<size_t>(y) * cols + x] += row[x] * e;
+      }
+    }
+    for (int y = 0; y < rows; ++y) {
+      const std::complex<double>* row = z.data() + static_cast<size_t>(y) * cols;
+      for (int x = 0; x + 1 < cols; ++x) total += row[x + 1] * std::conj(row[x]);
+    }
+  }
+  return std::abs(total) > 0 ? std::arg(total) : 0.0;
+}
+
+}  // namespace
+
+std::string FlyDirectionName(FlyDirection direction) {
+  return direction == FlyDirection::kRight ? "right" : "left";
+}
+
+std::string FlagFliesName(FlagFlies flag_flies) {
+  switch (flag_flies) {
+    case FlagFlies::kRight: return "right";
+    case FlagFlies::kLeft: return "left";
+    case FlagFlies::kAuto: return "auto";
+  }
+  return "right";
+}
+
+FlagFlies FlagFliesFromName(const std::string& name, const std::string& where) {
+  for (const FlagFlies f : {FlagFlies::kRight, FlagFlies::kLeft, FlagFlies::kAuto}) {
+    if (name == FlagFliesName(f)) return f;
+  }
+  throw std::invalid_argument(where + ": expected right, left or auto, got '" + name + "'");
+}
+
+FlyDirectionCues EstimateFlyDirection(const std::vector<cv::Mat>& frames) {
+  const std::vector<cv::Mat> f = AsDouble(frames);
+  FlyDirectionCues c;
+  c.motion_skewness = MotionSkewness(f);
+  c.phase_step = PhaseStep(f);
+  c.score = kSkewnessWeight * -c.motion_skewness + kPhaseWeight * -c.phase_step;
+  c.direction = c.score >= 0 ? FlyDirection::kRight : FlyDirection::kLeft;
+  return c;
+}
+
+}  // namespace clothwind::learn
