@@ -15,8 +15,9 @@
 // right, as filmed, for one trained with them; learn/fly_direction.h).
 // Clips may be mono8 or bgr8; a model trained with --colour needs bgr8 (clip_buffer ~colour) and
 // reports a grey clip as an ERROR naming that parameter.
-// Diagnostics: model, device, latency and rate; a malformed clip is an ERROR, not a crash. A
-// model that cannot be loaded is retried every 2 s (ERROR until it loads).
+// Diagnostics: model, device, latency and rate, the flag's way and the clips turned round; a
+// malformed clip is an ERROR, not a crash. A model that cannot be loaded is retried every 2 s
+// (ERROR until it loads). A model trained without flips left on ~flag_flies auto is a WARN.
 #include <chrono>
 #include <cstdio>
 #include <cmath>
@@ -192,6 +193,12 @@ class SdnNode {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no model: " + load_error_);
     } else if (error_pending_) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "malformed clip: " + last_error_);
+    } else if (!predictor_->config().flips_in_training && predictor_->flag_flies() == clothwind::learn::FlagFlies::kAuto) {
+      // A model trained without flips misreads a flag flying left by ~2.5 m/s, and the clip's own
+      // motion misjudges the way of 7-9 % of FlagSim's clips (docs/sdn.md, "Flags that fly left").
+      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   "estimating; the model knows only flags flying right and judges each clip's way from its "
+                   "motion: set ~flag_flies to right or left");
     } else {
       stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "estimating");
     }

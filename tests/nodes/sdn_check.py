@@ -13,7 +13,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from sensor_msgs.msg import Image
 
 
-def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encoding="mono8"):
+def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encoding="mono8", flag=None):
     clip = Clip()
     clip.header.frame_id = "camera_optical"
     clip.header.stamp = start
@@ -25,7 +25,9 @@ def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encod
     clip.width = size
     clip.encoding = encoding
     # Vertical stripes travelling at `frequency` Hz, brightness 40..220; in bgr8 grey stripes
-    # (equal channels) or, with "bgr8-red-green", red against green of one grey.
+    # (equal channels) or, with "bgr8-red-green", red against green of one grey. With flag
+    # "right" (mono8 only) the stripes grow from nothing at the left edge to full at the right, as
+    # a flag's ripples grow from the pole to the fly end; "left" is the mirror image of that clip.
     channels = 1 if encoding == "mono8" else 3
     clip.encoding = "mono8" if channels == 1 else "bgr8"
     data = bytearray(count * size * size * channels)
@@ -33,11 +35,14 @@ def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encod
     for t in range(count):
         row = bytearray()
         for x in range(size):
-            v = int(130 + 90 * math.sin(2 * math.pi * (frequency * t / rate - x / wavelength)))
+            amplitude = 90 * (x / size if flag else 1.0)
+            v = int(130 + amplitude * math.sin(2 * math.pi * (frequency * t / rate - x / wavelength)))
             if encoding == "bgr8-red-green":
                 row += bytes((0, 150, 0) if v > 130 else (0, 0, 255))  # grey 88 and 76
             else:
                 row += bytes([v] * channels)
+        if flag == "left":
+            row = row[::-1]
         line = size * channels
         base = t * size * line
         for y in range(size):
@@ -72,6 +77,11 @@ class SdnNodeTest(unittest.TestCase):
         rospy.Subscriber("colour/wind/estimate", WindEstimate, lambda m: self.append(self.colour_estimates, m),
                          queue_size=10)
         self.colour_pub = rospy.Publisher("colour/clips", Clip, queue_size=10)
+        self.no_flip_statuses = []
+        self.no_flip_estimates = []
+        rospy.Subscriber("no_flip/wind/estimate", WindEstimate, lambda m: self.append(self.no_flip_estimates, m),
+                         queue_size=10)
+        self.no_flip_pub = rospy.Publisher("no_flip/clips", Clip, queue_size=10)
 
     def append(self, where, msg):
         with self.lock:
@@ -87,6 +97,8 @@ class SdnNodeTest(unittest.TestCase):
                     self.statuses.append(s)
                 elif s.name.startswith("colour/"):
                     self.colour_statuses.append(s)
+                elif s.name.startswith("no_flip/"):
+                    self.no_flip_statuses.append(s)
 
     def wait_for(self, predicate, timeout, what):
         deadline = rospy.get_time() + timeout
@@ -207,6 +219,32 @@ class SdnNodeTest(unittest.TestCase):
         self.assertEqual(e.clip_sequence, 1, "no estimate for the grey clip")
         self.assertTrue(math.isfinite(e.speed))
         self.assertIn("-ycc", e.model)
+
+    def test_no_flip_model(self):
+        """A model trained with --no-flip, ~flag_flies unset (auto): a WARN naming ~flag_flies, and a
+        clip of a flag flying left is turned round, so it gets the estimate of its mirror image."""
+        size = 256  # 4 pixels to each of the model's 64: area resizing keeps a mirror image exactly mirrored
+        self.wait_for(lambda: self.no_flip_pub.get_num_connections() > 0, 120, "the no-flip sdn_node to subscribe")
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.WARN and "~flag_flies" in s.message
+                                  for s in self.no_flip_statuses), 60, "a WARN naming ~flag_flies")
+        start = rospy.Time(1700000000, 0)
+        self.no_flip_pub.publish(make_clip(0, start, size, 3.0, 4.0, flag="right"))
+        self.no_flip_pub.publish(make_clip(1, start + rospy.Duration.from_sec(2.0), size, 3.0, 4.0, flag="left"))
+        self.wait_for(lambda: len(self.no_flip_estimates) >= 2, 30, "estimates of both clips")
+
+        def turned():
+            for s in self.no_flip_statuses:
+                values = {kv.key: kv.value for kv in s.values}
+                if values.get("clips turned round (flag flying left)") == "1":
+                    return values
+            return None
+
+        self.wait_for(lambda: turned() is not None, 10, "a diagnostic counting one clip turned round")
+        with self.lock:
+            values = turned()
+            speeds = {e.clip_sequence: e.speed for e in self.no_flip_estimates}
+        self.assertEqual(values["flag flies"], "auto")
+        self.assertAlmostEqual(speeds[0], speeds[1], places=5)
 
 
 if __name__ == "__main__":
