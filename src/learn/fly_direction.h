@@ -48,9 +48,11 @@ struct FlyDirectionCues {
 };
 
 // Weights of the cues in the score: a logistic regression without intercept (so a mirrored clip
-// gets exactly the opposite score) of 625 flagsim-e5 training clips and their mirror images, at
-// 64 px and 30 frames. On 448 test clips the score is right for 94.0 % (0-2 m/s: 80 %, 2-10
-// m/s: 97-100 %); the skewness alone 91.3 %, the phase alone 85.5 % (docs/sdn.md, "Flags that fly left").
+// gets exactly the opposite score) of the first 30 frames of 625 flagsim-e5 training clips and
+// their mirror images, at 64 px. The score is right for 91.3 % of 1344 test clips' centred
+// windows (0-2 m/s: 73 %, 8-10 m/s: 99 %), where the skewness alone or the phase alone are right
+// for ~91 % and ~86 % of first windows: too few for a model that misreads a flag flying left by
+// 2.5 m/s (docs/sdn.md, "Flags that fly left").
 constexpr double kSkewnessWeight = 7.417;
 constexpr double kPhaseWeight = 3.335;
 
