@@ -10,17 +10,21 @@
 //                   while someone subscribes, SDN models only.
 // Parameters: ~model (model.pt of a training run; model.json beside it), ~threads (2),
 // ~device (cpu | cuda | auto), ~queue_size (2 clips; older ones are dropped when the node lags),
-// ~mean_window (60 s, the field protocol's label window), ~flag_flies (right | left | auto; unset:
-// auto for a model trained without flips, which knows only flags flying right as FlagSim's do,
-// right, as filmed, for one trained with them; learn/fly_direction.h).
+// ~mean_window (60 s, the field protocol's label window), ~flag_flies (right | left | auto | wind;
+// unset: auto for a model trained without flips, which knows only flags flying right as FlagSim's
+// do, right, as filmed, for one trained with them; learn/fly_direction.h). wind: each clip's way
+// from its anemometer direction (wind_direction_mean) and ~camera_heading (the optical axis's angle
+// in the anemometer's frame [rad], required), a wind within ~end_on_angle (20 deg) of the axis
+// keeping the way last known.
 // Clips may be mono8 or bgr8; a model trained with --colour needs bgr8 (clip_buffer ~colour) and
 // reports a grey clip as an ERROR naming that parameter.
 // Diagnostics: model, device, latency and rate, the flag's way and the clips turned round; a
 // malformed clip is an ERROR, not a crash. A model that cannot be loaded is retried every 2 s
 // (ERROR until it loads). A model trained without flips left on ~flag_flies auto is a WARN.
 #include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <deque>
 #include <memory>
 #include <string>
@@ -49,6 +53,15 @@ class SdnNode {
     int queue_size = 2;
     pnh.param("queue_size", queue_size, 2);
     pnh.param("flag_flies", flag_flies_param_, std::string());
+    pnh.param("camera_heading", camera_heading_, std::numeric_limits<double>::quiet_NaN());
+    double end_on_deg = 20.0;
+    pnh.param("end_on_angle", end_on_deg, 20.0);
+    end_on_ = end_on_deg * M_PI / 180.0;
+    if (flag_flies_param_ == "wind" && !std::isfinite(camera_heading_)) {
+      ROS_ERROR("sdn_node: ~flag_flies wind needs ~camera_heading (the optical axis's angle in the "
+                "anemometer's frame [rad]); using the model's default");
+      flag_flies_param_.clear();
+    }
     estimate_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate", 10);
     mean_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate_mean", 10);
     power_pub_ = transport_.advertise("sdn/power", 1);
@@ -90,11 +103,13 @@ class SdnNode {
       const auto t0 = std::chrono::steady_clock::now();
       predictor->PredictFrames(frames);
       const double warm = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (!flag_flies_param_.empty()) {
+      if (flag_flies_param_ == "wind") {
+        predictor->set_flag_flies(clothwind::learn::FlagFlies::kRight);  // until the wind says
+      } else if (!flag_flies_param_.empty()) {
         try {
           predictor->set_flag_flies(clothwind::learn::FlagFliesFromName(flag_flies_param_, "~flag_flies"));
         } catch (const std::invalid_argument& e) {
-          ROS_ERROR("sdn_node: %s; using %s, the model's default", e.what(),
+          ROS_ERROR("sdn_node: %s (or wind, with ~camera_heading); using %s, the model's default", e.what(),
                     clothwind::learn::FlagFliesName(predictor->flag_flies()).c_str());
         }
       }
@@ -117,6 +132,7 @@ class SdnNode {
       ++dropped_;
       return;
     }
+    if (flag_flies_param_ == "wind") FollowTheWind(clip->wind_direction_mean);
     try {
       // A colour model reads Y, Cr and Cb from bgr8 clips; a grey one the grey of either kind.
       const std::vector<cv::Mat> frames = clothwind::learn::CameraFramesForModel(
@@ -141,6 +157,18 @@ class SdnNode {
       error_pending_ = true;
       ROS_ERROR_THROTTLE(5.0, "sdn_node: %s", last_error_.c_str());
       updater_.force_update();
+    }
+  }
+
+  // ~flag_flies wind: the way the anemometer's wind makes the flag fly; a wind end-on to the
+  // camera, or none, keeps the way last known (as filmed until one is).
+  void FollowTheWind(double wind_direction) {
+    const auto way = clothwind::learn::FlyDirectionFromWind(wind_direction, camera_heading_, end_on_);
+    if (!way) {
+      ++wind_unknown_;
+    } else {
+      predictor_->set_flag_flies(*way == clothwind::learn::FlyDirection::kRight ? clothwind::learn::FlagFlies::kRight
+                                                                              : clothwind::learn::FlagFlies::kLeft);
     }
   }
 
@@ -210,7 +238,9 @@ class SdnNode {
     stat.add("latency max [s]", max);
     stat.add("rate [clips/s]", rate);
     stat.add("estimates", estimates_);
-    stat.add("flag flies", predictor_ ? clothwind::learn::FlagFliesName(predictor_->flag_flies()) : std::string("-"));
+    const std::string way = predictor_ ? clothwind::learn::FlagFliesName(predictor_->flag_flies()) : "-";
+    stat.add("flag flies", flag_flies_param_ == "wind" ? "wind: " + way : way);
+    if (flag_flies_param_ == "wind") stat.add("clips with the wind end-on or unknown", wind_unknown_);
     stat.add("clips turned round (flag flying left)", turned_);
     stat.add("trailing mean [m/s]", trailing_.Mean());
     stat.add("clips in the trailing mean", trailing_.Count());
@@ -226,12 +256,13 @@ class SdnNode {
   diagnostic_updater::Updater updater_;
   ros::WallTimer diag_timer_, load_timer_;
   std::string model_path_, device_, model_name_, load_error_, last_error_, flag_flies_param_;
+  double camera_heading_ = 0, end_on_ = 0;  // [rad], ~flag_flies wind
   int threads_ = 2;
   std::unique_ptr<clothwind::learn::Predictor> predictor_;
   std::deque<double> latencies_, stamps_;
   clothwind::sensors::TrailingMean trailing_;
   std::deque<std::pair<double, ros::Time>> starts_;  // (clip end [s], clip start) of the averaged clips
-  uint64_t estimates_ = 0, errors_ = 0, dropped_ = 0, turned_ = 0;
+  uint64_t estimates_ = 0, errors_ = 0, dropped_ = 0, turned_ = 0, wind_unknown_ = 0;
   bool error_pending_ = false;
 };
 

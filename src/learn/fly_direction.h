@@ -4,6 +4,7 @@
 #ifndef CLOTHWIND_LEARN_FLY_DIRECTION_H_
 #define CLOTHWIND_LEARN_FLY_DIRECTION_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,19 @@ constexpr double kPhaseWeight = 3.335;
 // Returns the cues and the direction. A still clip scores 0 and flies right (as filmed).
 // Throws std::invalid_argument naming the frame and what was expected.
 FlyDirectionCues EstimateFlyDirection(const std::vector<cv::Mat>& frames);
+
+// The way a flag flies in a camera's picture from the anemometer's wind direction, for a model that
+// must be told (the clip's own motion is too often wrong). A flag flies downwind, so it flies to
+// the picture's right when the air moves toward the camera's right.
+// Inputs:
+//   wind_direction  [rad] where the air blows TO, counter-clockwise about +z from +x of the
+//                   anemometer's frame (WindMeasurement's convention; a clip's wind_direction_mean)
+//   camera_heading  [rad] the camera's optical axis in the same frame and convention, the camera
+//                   taken as level (its picture's right is the heading turned 90 deg clockwise)
+//   end_on          [rad] >= 0: a wind within this angle of the optical axis, toward or away from
+//                   the camera, shows the flag end-on, with no side to fly to
+// Returns the way, or nothing when the wind is end-on or either angle is not finite.
+std::optional<FlyDirection> FlyDirectionFromWind(double wind_direction, double camera_heading, double end_on);
 
 }  // namespace clothwind::learn
 

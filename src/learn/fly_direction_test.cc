@@ -142,5 +142,27 @@ TEST(FlyDirectionTest, FlagFliesNamesRoundTripAndAStrangerIsRefusedByWhere) {
   }
 }
 
+TEST(FlyDirectionTest, FromTheWindAFlagFliesTowardThePictureSideTheAirMovesTo) {
+  // ENU: x east, y north. A camera looking north (heading 90 deg) has east on its right.
+  const double north = M_PI / 2, end_on = 20 * M_PI / 180;
+  EXPECT_EQ(FlyDirectionFromWind(0.0, north, end_on), FlyDirection::kRight);     // air moving east
+  EXPECT_EQ(FlyDirectionFromWind(M_PI, north, end_on), FlyDirection::kLeft);     // west
+  EXPECT_EQ(FlyDirectionFromWind(-M_PI / 4, north, end_on), FlyDirection::kRight);  // south-east, toward the camera
+  EXPECT_EQ(FlyDirectionFromWind(3 * M_PI / 4, north, end_on), FlyDirection::kLeft);  // north-west, away
+  // Along the optical axis, either way, and within end_on of it: end-on, no side.
+  EXPECT_EQ(FlyDirectionFromWind(north, north, end_on), std::nullopt);
+  EXPECT_EQ(FlyDirectionFromWind(-north, north, end_on), std::nullopt);
+  EXPECT_EQ(FlyDirectionFromWind(north - 0.3, north, end_on), std::nullopt);
+  EXPECT_EQ(FlyDirectionFromWind(north - 0.4, north, end_on), FlyDirection::kRight);
+  // Turning camera and wind together changes nothing; angles wrap.
+  for (const double turn : {0.7, -2.0, 2 * M_PI}) {
+    EXPECT_EQ(FlyDirectionFromWind(0.3 + turn, north + turn, end_on), FlyDirection::kRight) << turn;
+    EXPECT_EQ(FlyDirectionFromWind(M_PI - 0.3 + turn, north + turn, end_on), FlyDirection::kLeft) << turn;
+  }
+  // No reading (NaN) or no heading: nothing.
+  EXPECT_EQ(FlyDirectionFromWind(std::nan(""), north, end_on), std::nullopt);
+  EXPECT_EQ(FlyDirectionFromWind(0.0, std::nan(""), end_on), std::nullopt);
+}
+
 }  // namespace
 }  // namespace clothwind::learn

@@ -13,7 +13,8 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from sensor_msgs.msg import Image
 
 
-def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encoding="mono8", flag=None):
+def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encoding="mono8", flag=None,
+              wind_direction=0.0):
     clip = Clip()
     clip.header.frame_id = "camera_optical"
     clip.header.stamp = start
@@ -54,7 +55,7 @@ def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encod
     clip.wind_mean = wind_mean
     clip.wind_std = 0.3
     clip.wind_count = 60 if not math.isnan(wind_mean) else 0
-    clip.wind_direction_mean = 0.0
+    clip.wind_direction_mean = wind_direction
     return clip
 
 
@@ -82,6 +83,11 @@ class SdnNodeTest(unittest.TestCase):
         rospy.Subscriber("no_flip/wind/estimate", WindEstimate, lambda m: self.append(self.no_flip_estimates, m),
                          queue_size=10)
         self.no_flip_pub = rospy.Publisher("no_flip/clips", Clip, queue_size=10)
+        self.wind_statuses = []
+        self.wind_estimates = []
+        rospy.Subscriber("wind/wind/estimate", WindEstimate, lambda m: self.append(self.wind_estimates, m),
+                         queue_size=10)
+        self.wind_pub = rospy.Publisher("wind/clips", Clip, queue_size=10)
 
     def append(self, where, msg):
         with self.lock:
@@ -99,6 +105,8 @@ class SdnNodeTest(unittest.TestCase):
                     self.colour_statuses.append(s)
                 elif s.name.startswith("no_flip/"):
                     self.no_flip_statuses.append(s)
+                elif s.name.startswith("wind/"):
+                    self.wind_statuses.append(s)
 
     def wait_for(self, predicate, timeout, what):
         deadline = rospy.get_time() + timeout
@@ -245,6 +253,36 @@ class SdnNodeTest(unittest.TestCase):
             speeds = {e.clip_sequence: e.speed for e in self.no_flip_estimates}
         self.assertEqual(values["flag flies"], "auto")
         self.assertAlmostEqual(speeds[0], speeds[1], places=5)
+
+    def test_no_flip_model_told_by_the_wind(self):
+        """~flag_flies wind, the camera looking along +y of the anemometer's frame (+x on its right):
+        a flag flying right under a wind toward +x stays, one flying left under a wind toward -x
+        is turned round, and a wind along the optical axis keeps the way last known."""
+        size = 256
+        self.wait_for(lambda: self.wind_pub.get_num_connections() > 0, 120, "the wind-told sdn_node to subscribe")
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.wind_statuses), 60,
+                      "an OK diagnostic from the wind-told node (no WARN: it is told the way)")
+        start = rospy.Time(1700000000, 0)
+        for seq, flag, direction in ((0, "right", 0.0), (1, "left", math.pi), (2, "left", math.pi / 2)):
+            self.wind_pub.publish(make_clip(seq, start + rospy.Duration.from_sec(2.0 * seq), size, 3.0, 4.0,
+                                            flag=flag, wind_direction=direction))
+        self.wait_for(lambda: len(self.wind_estimates) >= 3, 30, "estimates of the three clips")
+
+        def counted():
+            for s in self.wind_statuses:
+                values = {kv.key: kv.value for kv in s.values}
+                if values.get("clips turned round (flag flying left)") == "2":
+                    return values
+            return None
+
+        self.wait_for(lambda: counted() is not None, 10, "a diagnostic counting two clips turned round")
+        with self.lock:
+            values = counted()
+            speeds = {e.clip_sequence: e.speed for e in self.wind_estimates}
+        self.assertEqual(values["flag flies"], "wind: left")
+        self.assertEqual(values["clips with the wind end-on or unknown"], "1")
+        self.assertAlmostEqual(speeds[0], speeds[1], places=5)
+        self.assertAlmostEqual(speeds[0], speeds[2], places=5)
 
 
 if __name__ == "__main__":
