@@ -1230,14 +1230,19 @@ TEST_F(TrainTest, TrackHeadEvaluationReadsTheHeadBackInTheTargetsUnits) {
   EXPECT_THROW(EvaluateTrackHead(r.model, data, "val", 1, 2, {}, 45), std::invalid_argument);
 }
 
-TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
+// A tiny initialised SDN (width 4, 32 px), written without data into `out`.
+TrainOptions InitOnly(const fs::path& out) {
   TrainOptions t;
   t.model.arch = "sdn";
   t.model.width = 4;
   t.model.input_size = 32;
-  t.out = *root_ / "init";
+  t.out = out;
   t.init_only = true;
-  const TrainResult r = Train(t);
+  return t;
+}
+
+TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
+  const TrainResult r = Train(InitOnly(*root_ / "init"));
   Predictor p(r.model, 1, "cpu");
   std::vector<cv::Mat> frames(30, cv::Mat(40, 50, CV_8UC1, cv::Scalar(9)));
   for (int i = 0; i < 30; ++i) frames[i] = cv::Mat(40, 50, CV_8UC1, cv::Scalar(9 + 3 * (i % 2)));
@@ -1255,12 +1260,7 @@ TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
 }
 
 TEST_F(TrainTest, AModelTrainedWithoutFlipsTurnsFlagsFlyingLeft) {
-  TrainOptions t;
-  t.model.arch = "sdn";
-  t.model.width = 4;
-  t.model.input_size = 32;
-  t.out = *root_ / "no-flip";
-  t.init_only = true;
+  TrainOptions t = InitOnly(*root_ / "no-flip");
   t.flip = false;
   const TrainResult r = Train(t);
   std::ifstream json(r.model.parent_path() / "model.json");
@@ -1298,12 +1298,7 @@ TEST_F(TrainTest, TrainingAndInferenceFlushDenormals) {
   // Denormal weights made CPU epochs several times slower late in training (docs/sdn-experiments.md).
   at::globalContext().setFlushDenormal(false);
   ASSERT_NE(DenormalProduct(), 0.0f);  // the check can see the difference
-  TrainOptions t;
-  t.model.width = 4;
-  t.model.input_size = 32;
-  t.out = *root_ / "denormal";
-  t.init_only = true;
-  const TrainResult r = Train(t);
+  const TrainResult r = Train(InitOnly(*root_ / "denormal"));
   EXPECT_EQ(DenormalProduct(), 0.0f);
   at::globalContext().setFlushDenormal(false);
   Predictor p(r.model, 1, "cpu");

@@ -117,6 +117,19 @@ class SdnNodeTest(unittest.TestCase):
             rospy.sleep(0.1)
         self.fail("timed out waiting for " + what)
 
+    def wait_for_turned(self, statuses, count):
+        """The key-value pairs of the first of `statuses` that counts `count` clips turned round."""
+        def find():
+            for s in statuses:
+                values = {kv.key: kv.value for kv in s.values}
+                if values.get("clips turned round (flag flying left)") == str(count):
+                    return values
+            return None
+
+        self.wait_for(lambda: find() is not None, 10, "a diagnostic counting %d clips turned round" % count)
+        with self.lock:
+            return find()
+
     def test_estimates(self):
         n = rospy.get_param("~clips", 6)
         malformed_after = rospy.get_param("~malformed_after", 2)
@@ -239,17 +252,8 @@ class SdnNodeTest(unittest.TestCase):
         self.no_flip_pub.publish(make_clip(0, start, size, 3.0, 4.0, flag="right"))
         self.no_flip_pub.publish(make_clip(1, start + rospy.Duration.from_sec(2.0), size, 3.0, 4.0, flag="left"))
         self.wait_for(lambda: len(self.no_flip_estimates) >= 2, 30, "estimates of both clips")
-
-        def turned():
-            for s in self.no_flip_statuses:
-                values = {kv.key: kv.value for kv in s.values}
-                if values.get("clips turned round (flag flying left)") == "1":
-                    return values
-            return None
-
-        self.wait_for(lambda: turned() is not None, 10, "a diagnostic counting one clip turned round")
+        values = self.wait_for_turned(self.no_flip_statuses, 1)
         with self.lock:
-            values = turned()
             speeds = {e.clip_sequence: e.speed for e in self.no_flip_estimates}
         self.assertEqual(values["flag flies"], "auto")
         self.assertAlmostEqual(speeds[0], speeds[1], places=5)
@@ -267,17 +271,8 @@ class SdnNodeTest(unittest.TestCase):
             self.wind_pub.publish(make_clip(seq, start + rospy.Duration.from_sec(2.0 * seq), size, 3.0, 4.0,
                                             flag=flag, wind_direction=direction))
         self.wait_for(lambda: len(self.wind_estimates) >= 3, 30, "estimates of the three clips")
-
-        def counted():
-            for s in self.wind_statuses:
-                values = {kv.key: kv.value for kv in s.values}
-                if values.get("clips turned round (flag flying left)") == "2":
-                    return values
-            return None
-
-        self.wait_for(lambda: counted() is not None, 10, "a diagnostic counting two clips turned round")
+        values = self.wait_for_turned(self.wind_statuses, 2)
         with self.lock:
-            values = counted()
             speeds = {e.clip_sequence: e.speed for e in self.wind_estimates}
         self.assertEqual(values["flag flies"], "wind: left")
         self.assertEqual(values["clips with the wind end-on or unknown"], "1")
