@@ -73,6 +73,12 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       std::cerr << "clothwind eval: --track-head-rows needs --track-head\n";
       return 2;
     }
+    if (a->track_head && (a->mirror_clips || a->flag_flies != "right")) {
+      // The head's targets are the points of the clip as filmed.
+      std::cerr << "clothwind eval: --track-head reads clips as filmed, not with --mirror-clips or --flag-flies "
+                << a->flag_flies << "\n";
+      return 2;
+    }
     ProgressBar::Options b;
     b.label = "eval";
     b.unit = "clips";
