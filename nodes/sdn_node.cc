@@ -24,8 +24,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -226,7 +226,7 @@ class SdnNode {
       // motion misjudges the way of 7-9 % of FlagSim's clips (docs/sdn.md, "Flags that fly left").
       stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
                    "estimating; the model knows only flags flying right and judges each clip's way from its "
-                   "motion: set ~flag_flies to right or left");
+                   "motion: set ~flag_flies to right, left or wind");
     } else {
       stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "estimating");
     }
