@@ -4,9 +4,10 @@
 // and 2 threads (the goal: <= 50 ms per 30-frame clip on 2 cores at the shipped size). Models are
 // initialised in a temporary folder (speed does not depend on the weights). Prints a table.
 // --model benches given trained models (e.g. the shipped models/sdn.pt) instead of the
-// initialised ones.
+// initialised ones; --flag-flies auto adds judging each clip's way from its motion, as sdn_node
+// does for a model trained without flips (learn/fly_direction.h).
 //
-//   sdn_bench [--repeats N] [--quick] [--model PATH.pt ...]
+//   sdn_bench [--repeats N] [--quick] [--model PATH.pt ...] [--flag-flies right|left|auto]
 
 #include <unistd.h>
 
@@ -45,14 +46,23 @@ int main(int argc, char** argv) {
   int repeats = 20;
   bool quick = false;
   std::vector<fs::path> given;
+  std::string flag_flies;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--quick")) quick = true;
     else if (!std::strcmp(argv[i], "--model") && i + 1 < argc) given.push_back(argv[++i]);
+    else if (!std::strcmp(argv[i], "--flag-flies") && i + 1 < argc) flag_flies = argv[++i];
     else {
-      std::fprintf(stderr, "usage: sdn_bench [--repeats N] [--quick] [--model PATH.pt ...]\n");
+      std::fprintf(stderr, "usage: sdn_bench [--repeats N] [--quick] [--model PATH.pt ...] [--flag-flies right|left|auto]\n");
       return 2;
     }
+  }
+  cl::FlagFlies way = cl::FlagFlies::kRight;
+  try {
+    if (!flag_flies.empty()) way = cl::FlagFliesFromName(flag_flies, "--flag-flies");
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "sdn_bench: %s\n", e.what());
+    return 2;
   }
   std::vector<Case> cases = {{"sdn", 32, 64, 30},  {"sdn", 16, 112, 30},       {"sdn", 32, 112, 30},
                              {"sdn", 64, 112, 30}, {"resnet18", 64, 112, 30}, {"sdn", 64, 224, 30}};
@@ -88,6 +98,7 @@ int main(int argc, char** argv) {
   for (const fs::path& model : models) {
     for (int threads : {1, 2}) {
       cl::Predictor p(model, threads, "cpu");
+      if (!flag_flies.empty()) p.set_flag_flies(way);
       const bool colour = p.config().colour;
       const std::vector<cv::Mat>& clip = colour ? bgr_frames : grey_frames;
       p.PredictFrames(cl::CameraFramesForModel(clip, colour));  // warm-up, as the node does
@@ -103,7 +114,8 @@ int main(int argc, char** argv) {
       double mean = 0;
       for (double m : ms) mean += m;
       mean /= ms.size();
-      std::printf("%-28s %7d %10.1f %10.1f %10.1f %14.1f\n", p.config().Name().c_str(), threads, mean,
+      const std::string name = p.config().Name() + (flag_flies.empty() ? "" : " " + flag_flies);
+      std::printf("%-28s %7d %10.1f %10.1f %10.1f %14.1f\n", name.c_str(), threads, mean,
                   ms[std::min(ms.size() - 1, ms.size() * 9 / 10)], ms.front(), cpu);
       std::fflush(stdout);
     }
