@@ -252,23 +252,30 @@ namespace {
 // Whether options.flag_flies turns the clip (its first options.frames frames, cropped to `crop`)
 // round, so that its flag flies right; `score` receives EstimateFlyDirection's score with kAuto.
 // The frames are judged as the model will see them: cropped, resized, mirrored by mirror_clip,
-// grey (the Y of colour frames). Frames MakeSample would refuse are not judged (false): its own
-// checks then name them.
+// grey (the Y of colour frames). With kAuto `resized` receives the cropped, resized frames (not
+// mirrored), which MakeSample then uses rather than resize them twice (at 300 px the resizing
+// costs more than the judging). Frames MakeSample would refuse are not judged (false, `resized`
+// left empty): its own checks then name them.
 bool TurnsToFlyRight(const std::vector<cv::Mat>& frames, const cv::Rect& crop, const SampleOptions& options,
-                     double* score) {
+                     double* score, std::vector<cv::Mat>* resized) {
   *score = 0;
+  resized->clear();
   if (options.flag_flies == FlagFlies::kRight) return false;
   if (options.flag_flies == FlagFlies::kLeft) return true;
   if (options.frames < 4) return false;  // too short to judge (EstimateFlyDirection's minimum)
   const int type = FrameType(options.colour);
-  std::vector<cv::Mat> grey(options.frames);
   for (int t = 0; t < options.frames; ++t) {
     if (frames[t].type() != type || frames[t].size() != frames[0].size()) return false;
-    cv::Mat resized;
-    ResizeCrop(frames[t], crop, options.input_size, resized);
-    if (resized.channels() > 1) cv::extractChannel(resized, resized, 0);
-    if (options.mirror_clip) cv::flip(resized, resized, 1);
-    grey[t] = resized;
+  }
+  std::vector<cv::Mat> grey(options.frames);
+  resized->resize(options.frames);
+  for (int t = 0; t < options.frames; ++t) {
+    ResizeCrop(frames[t], crop, options.input_size, (*resized)[t]);
+    // The grey (or Y) plane, mirrored into new data: `resized` must stay as it was cropped.
+    cv::Mat g = (*resized)[t];
+    if (g.channels() > 1) cv::extractChannel(g, g, 0);
+    if (options.mirror_clip) cv::flip(g, grey[t], 1);
+    else grey[t] = g;
   }
   const FlyDirectionCues cues = EstimateFlyDirection(grey);
   *score = cues.score;
@@ -290,6 +297,7 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
   const int w = frames[0].cols, h = frames[0].rows;
   const int side = std::min(w, h);
   Sample sample;
+  std::vector<cv::Mat> judged;  // the resized frames flag_flies auto judged (empty otherwise)
   if (options.augment) {
     const double scale = options.crop_scales.empty()
                              ? 1.0
@@ -302,7 +310,7 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
     sample.flipped = std::uniform_int_distribution<int>(0, 1)(rng) == 1 && options.flip;
   } else {
     sample.crop = CentreSquare(w, h);
-    sample.turned = TurnsToFlyRight(frames, sample.crop, options, &sample.fly_score);
+    sample.turned = TurnsToFlyRight(frames, sample.crop, options, &sample.fly_score, &judged);
     sample.flipped = (options.mirror_clip != sample.turned) != options.mirror;
   }
   const int s = options.input_size;
@@ -322,7 +330,11 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
       throw std::invalid_argument("MakeSample: frame " + std::to_string(t) + " is not " + std::to_string(w) + "x" +
                                   std::to_string(h) + (options.colour ? " 8-bit YCrCb" : " mono8"));
     }
-    ResizeCrop(f, sample.crop, s, resized);
+    if (judged.empty()) {
+      ResizeCrop(f, sample.crop, s, resized);
+    } else {
+      resized = judged[t];
+    }
     if (sample.flipped) cv::flip(resized, resized, 1);
     if (own == 1) split[0] = resized;
     else cv::split(resized, split);

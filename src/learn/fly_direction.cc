@@ -72,24 +72,41 @@ double PhaseStep(const std::vector<cv::Mat>& f) {
   const int T = static_cast<int>(f.size());
   const int rows = f[0].rows, cols = f[0].cols;
   const size_t pixels = static_cast<size_t>(rows) * cols;
-  cv::Mat mean = cv::Mat::zeros(f[0].size(), CV_64F);
-  for (const cv::Mat& x : f) mean += x / T;
+  // Each frame less the clip's mean, as one contiguous T x pixels array.
+  std::vector<double> d(static_cast<size_t>(T) * pixels, 0.0), mean(pixels, 0.0);
+  for (int t = 0; t < T; ++t) {
+    for (int y = 0; y < rows; ++y) {
+      const double* row = f[t].ptr<double>(y);
+      std::copy(row, row + cols, d.data() + t * pixels + static_cast<size_t>(y) * cols);
+    }
+    for (size_t i = 0; i < pixels; ++i) mean[i] += d[t * pixels + i] / T;
+  }
+  for (int t = 0; t < T; ++t)
+    for (size_t i = 0; i < pixels; ++i) d[t * pixels + i] -= mean[i];
   std::complex<double> total(0, 0);
-  std::vector<std::complex<double>> z(pixels);
+  std::vector<double> re(pixels), im(pixels);
   for (int k = 1; k <= T / 2 - 1; ++k) {
-    std::fill(z.begin(), z.end(), std::complex<double>(0, 0));
+    std::fill(re.begin(), re.end(), 0.0);
+    std::fill(im.begin(), im.end(), 0.0);
     for (int t = 0; t < T; ++t) {
-      const std::complex<double> e = std::polar(1.0, -2 * M_PI * k * t / T);
-      const cv::Mat d = f[t] - mean;
-      for (int y = 0; y < rows; ++y) {
-        const double* row = d.ptr<double>(y);
-        for (int x = 0; x < cols; ++x) z[static_cast<size_t>(y) * cols + x] += row[x] * e;
+      const double c = std::cos(2 * M_PI * k * t / T), s = -std::sin(2 * M_PI * k * t / T);
+      const double* dt = d.data() + t * pixels;
+      for (size_t i = 0; i < pixels; ++i) {
+        re[i] += dt[i] * c;
+        im[i] += dt[i] * s;
       }
     }
+    // z(x + 1) conj(z(x)) summed along every row.
+    double sum_re = 0, sum_im = 0;
     for (int y = 0; y < rows; ++y) {
-      const std::complex<double>* row = z.data() + static_cast<size_t>(y) * cols;
-      for (int x = 0; x + 1 < cols; ++x) total += row[x + 1] * std::conj(row[x]);
+      const size_t base = static_cast<size_t>(y) * cols;
+      for (int x = 0; x + 1 < cols; ++x) {
+        const size_t a = base + x + 1, b = base + x;
+        sum_re += re[a] * re[b] + im[a] * im[b];
+        sum_im += im[a] * re[b] - re[a] * im[b];
+      }
     }
+    total += std::complex<double>(sum_re, sum_im);
   }
   return std::abs(total) > 0 ? std::arg(total) : 0.0;
 }
