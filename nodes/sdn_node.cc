@@ -27,6 +27,7 @@
 #include <deque>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -52,16 +53,7 @@ class SdnNode {
     pnh.param("device", device_, std::string("cpu"));
     int queue_size = 2;
     pnh.param("queue_size", queue_size, 2);
-    pnh.param("flag_flies", flag_flies_param_, std::string());
-    pnh.param("camera_heading", camera_heading_, std::numeric_limits<double>::quiet_NaN());
-    double end_on_deg = 20.0;
-    pnh.param("end_on_angle", end_on_deg, 20.0);
-    end_on_ = end_on_deg * M_PI / 180.0;
-    if (flag_flies_param_ == "wind" && !std::isfinite(camera_heading_)) {
-      ROS_ERROR("sdn_node: ~flag_flies wind needs ~camera_heading (the optical axis's angle in the "
-                "anemometer's frame [rad]); using the model's default");
-      flag_flies_param_.clear();
-    }
+    ReadFlagFlies(pnh);
     estimate_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate", 10);
     mean_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate_mean", 10);
     power_pub_ = transport_.advertise("sdn/power", 1);
@@ -89,6 +81,30 @@ class SdnNode {
     return window;
   }
 
+  // ~flag_flies and, for wind, ~camera_heading and ~end_on_angle, checked once at start: a bad
+  // value is an ERROR and leaves the model's default.
+  void ReadFlagFlies(ros::NodeHandle& pnh) {
+    std::string name;
+    pnh.param("flag_flies", name, std::string());
+    pnh.param("camera_heading", camera_heading_, std::numeric_limits<double>::quiet_NaN());
+    double end_on_deg = 20.0;
+    pnh.param("end_on_angle", end_on_deg, 20.0);
+    end_on_ = end_on_deg * M_PI / 180.0;
+    if (name == "wind") {
+      follow_wind_ = std::isfinite(camera_heading_);
+      if (!follow_wind_) {
+        ROS_ERROR("sdn_node: ~flag_flies wind needs ~camera_heading (the optical axis's angle in the "
+                  "anemometer's frame [rad]); using the model's default");
+      }
+    } else if (!name.empty()) {
+      try {
+        told_flag_flies_ = clothwind::learn::FlagFliesFromName(name, "~flag_flies");
+      } catch (const std::invalid_argument& e) {
+        ROS_ERROR("sdn_node: %s (or wind, with ~camera_heading); using the model's default", e.what());
+      }
+    }
+  }
+
   void TryLoad() {
     try {
       if (model_path_.empty()) throw std::runtime_error("parameter ~model is not set");
@@ -103,15 +119,10 @@ class SdnNode {
       const auto t0 = std::chrono::steady_clock::now();
       predictor->PredictFrames(frames);
       const double warm = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (flag_flies_param_ == "wind") {
+      if (follow_wind_) {
         predictor->set_flag_flies(clothwind::learn::FlagFlies::kRight);  // until the wind says
-      } else if (!flag_flies_param_.empty()) {
-        try {
-          predictor->set_flag_flies(clothwind::learn::FlagFliesFromName(flag_flies_param_, "~flag_flies"));
-        } catch (const std::invalid_argument& e) {
-          ROS_ERROR("sdn_node: %s (or wind, with ~camera_heading); using %s, the model's default", e.what(),
-                    clothwind::learn::FlagFliesName(predictor->flag_flies()).c_str());
-        }
+      } else if (told_flag_flies_) {
+        predictor->set_flag_flies(*told_flag_flies_);
       }
       model_name_ = c.Name() + " (" + model_path_ + ")";
       ROS_INFO("sdn_node: model %s on %s, %d threads, warm-up %.0f ms, flag flies %s", model_name_.c_str(),
@@ -132,7 +143,7 @@ class SdnNode {
       ++dropped_;
       return;
     }
-    if (flag_flies_param_ == "wind") FollowTheWind(clip->wind_direction_mean);
+    if (follow_wind_) FollowTheWind(clip->wind_direction_mean);
     try {
       // A colour model reads Y, Cr and Cb from bgr8 clips; a grey one the grey of either kind.
       const std::vector<cv::Mat> frames = clothwind::learn::CameraFramesForModel(
@@ -239,8 +250,8 @@ class SdnNode {
     stat.add("rate [clips/s]", rate);
     stat.add("estimates", estimates_);
     const std::string way = predictor_ ? clothwind::learn::FlagFliesName(predictor_->flag_flies()) : "-";
-    stat.add("flag flies", flag_flies_param_ == "wind" ? "wind: " + way : way);
-    if (flag_flies_param_ == "wind") stat.add("clips with the wind end-on or unknown", wind_unknown_);
+    stat.add("flag flies", follow_wind_ ? "wind: " + way : way);
+    if (follow_wind_) stat.add("clips with the wind end-on or unknown", wind_unknown_);
     stat.add("clips turned round (flag flying left)", turned_);
     stat.add("trailing mean [m/s]", trailing_.Mean());
     stat.add("clips in the trailing mean", trailing_.Count());
@@ -255,8 +266,10 @@ class SdnNode {
   ros::Subscriber clip_sub_;
   diagnostic_updater::Updater updater_;
   ros::WallTimer diag_timer_, load_timer_;
-  std::string model_path_, device_, model_name_, load_error_, last_error_, flag_flies_param_;
-  double camera_heading_ = 0, end_on_ = 0;  // [rad], ~flag_flies wind
+  std::string model_path_, device_, model_name_, load_error_, last_error_;
+  std::optional<clothwind::learn::FlagFlies> told_flag_flies_;  // ~flag_flies right, left or auto
+  bool follow_wind_ = false;                                     // ~flag_flies wind
+  double camera_heading_ = 0, end_on_ = 0;                       // [rad], for follow_wind_
   int threads_ = 2;
   std::unique_ptr<clothwind::learn::Predictor> predictor_;
   std::deque<double> latencies_, stamps_;
