@@ -15,12 +15,14 @@
 // do, right, as filmed, for one trained with them; learn/fly_direction.h). wind: each clip's way
 // from its anemometer direction (wind_direction_mean) and ~camera_heading (the optical axis's angle
 // in the anemometer's frame [rad], required), a wind within ~end_on_angle (20 deg) of the axis
-// keeping the way last known.
+// keeping the way last known. auto asks ~fly_judge (a train-fly-judge file; unset: fly_judge.pt
+// beside the model when there is one, as models/ ships it, else the clip's motion cues).
 // Clips may be mono8 or bgr8; a model trained with --colour needs bgr8 (clip_buffer ~colour) and
 // reports a grey clip as an ERROR naming that parameter.
 // Diagnostics: model, device, latency and rate, the flag's way and the clips turned round; a
 // malformed clip is an ERROR, not a crash. A model that cannot be loaded is retried every 2 s
-// (ERROR until it loads). A model trained without flips left on ~flag_flies auto is a WARN.
+// (ERROR until it loads). A model trained without flips left on ~flag_flies auto with no fly
+// judge (the motion cues misjudge ~9 % of clips) is a WARN, as is a ~fly_judge that cannot load.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -53,6 +55,7 @@ class SdnNode {
     pnh.param("device", device_, std::string("cpu"));
     int queue_size = 2;
     pnh.param("queue_size", queue_size, 2);
+    pnh.param("fly_judge", fly_judge_path_, std::string());
     ReadFlagFlies(pnh);
     estimate_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate", 10);
     mean_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate_mean", 10);
@@ -124,6 +127,7 @@ class SdnNode {
       } else if (told_flag_flies_) {
         predictor->set_flag_flies(*told_flag_flies_);
       }
+      LoadFlyJudge(*predictor);
       model_name_ = c.Name() + " (" + model_path_ + ")";
       ROS_INFO("sdn_node: model %s on %s, %d threads, warm-up %.0f ms, flag flies %s", model_name_.c_str(),
                predictor->device().c_str(), threads_, 1e3 * warm,
@@ -135,6 +139,19 @@ class SdnNode {
       load_error_ = e.what();
     }
     updater_.force_update();
+  }
+
+  // ~fly_judge, when set, replaces the judge beside the model; one that cannot load is a WARN and
+  // leaves the one beside the model (or the motion cues): estimates go on either way.
+  void LoadFlyJudge(clothwind::learn::Predictor& predictor) {
+    judge_error_.clear();
+    if (fly_judge_path_.empty()) return;
+    try {
+      predictor.LoadFlyJudge(fly_judge_path_);
+    } catch (const std::exception& e) {
+      judge_error_ = e.what();
+      ROS_ERROR("sdn_node: cannot load ~fly_judge: %s", e.what());
+    }
   }
 
   void OnClip(const clothwind::Clip::ConstPtr& clip) {
@@ -232,12 +249,15 @@ class SdnNode {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no model: " + load_error_);
     } else if (error_pending_) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "malformed clip: " + last_error_);
-    } else if (!predictor_->config().flips_in_training && predictor_->flag_flies() == clothwind::learn::FlagFlies::kAuto) {
+    } else if (!judge_error_.empty()) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "estimating; ~fly_judge did not load: " + judge_error_);
+    } else if (!predictor_->config().flips_in_training &&
+               predictor_->flag_flies() == clothwind::learn::FlagFlies::kAuto && !predictor_->fly_judge()) {
       // A model trained without flips misreads a flag flying left by ~2.5 m/s, and the clip's own
       // motion misjudges the way of 7-9 % of FlagSim's clips (docs/sdn.md, "Flags that fly left").
       stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-                   "estimating; the model knows only flags flying right and judges each clip's way from its "
-                   "motion: set ~flag_flies to right, left or wind");
+                   "estimating; the model knows only flags flying right and, with no fly judge, judges each "
+                   "clip's way from its motion: set ~fly_judge, or ~flag_flies to right, left or wind");
     } else {
       stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "estimating");
     }
@@ -251,6 +271,10 @@ class SdnNode {
     stat.add("estimates", estimates_);
     const std::string way = predictor_ ? clothwind::learn::FlagFliesName(predictor_->flag_flies()) : "-";
     stat.add("flag flies", follow_wind_ ? "wind: " + way : way);
+    if (predictor_) {
+      stat.add("fly judge (for auto)", predictor_->fly_judge() ? predictor_->fly_judge_path().string()
+                                                               : std::string("none: the clip's motion cues"));
+    }
     if (follow_wind_) stat.add("clips with the wind end-on or unknown", wind_unknown_);
     stat.add("clips turned round (flag flying left)", turned_);
     stat.add("trailing mean [m/s]", trailing_.Mean());
@@ -267,6 +291,7 @@ class SdnNode {
   diagnostic_updater::Updater updater_;
   ros::WallTimer diag_timer_, load_timer_;
   std::string model_path_, device_, model_name_, load_error_, last_error_;
+  std::string fly_judge_path_, judge_error_;  // ~fly_judge and why it did not load
   std::optional<clothwind::learn::FlagFlies> told_flag_flies_;  // ~flag_flies right, left or auto
   bool follow_wind_ = false;                                     // ~flag_flies wind
   double camera_heading_ = 0, end_on_ = 0;                       // [rad], for follow_wind_

@@ -20,6 +20,7 @@ struct EvalArgs {
   bool mirror = false;
   bool mirror_clips = false;
   std::string flag_flies = "right";
+  std::string fly_judge;
   bool by_view = false;
   bool track_head = false;
 };
@@ -47,10 +48,14 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
                "flags flying the other way");
   sub->add_option("--flag-flies", a->flag_flies,
                   "turn each clip round before the model reads it: right (as it comes), left (mirror every clip) "
-                  "or auto (mirror those whose motion says the flag flies left; the node's default for a model "
-                  "trained with --no-flip)")
+                  "or auto (mirror those the fly judge, or without one their motion, says fly left; the node's "
+                  "default for a model trained with --no-flip)")
       ->check(CLI::IsMember({"right", "left", "auto"}))
       ->capture_default_str();
+  sub->add_option("--fly-judge", a->fly_judge,
+                  "with --flag-flies auto: the judge that decides (train-fly-judge's file; default: fly_judge.pt "
+                  "beside the model when there is one, else the clip's motion cues)")
+      ->check(CLI::ExistingFile);
   sub->add_flag("--by-view", a->by_view,
                "also break the errors down by the clips' views (camera elevation, angle, distance; texture), "
                "read from each simulated clip's label.json");
@@ -73,6 +78,10 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       std::cerr << "clothwind eval: --track-head-rows needs --track-head\n";
       return 2;
     }
+    if (!a->fly_judge.empty() && a->flag_flies != "auto") {
+      std::cerr << "clothwind eval: --fly-judge decides only with --flag-flies auto\n";
+      return 2;
+    }
     if (a->track_head && (a->mirror_clips || a->flag_flies != "right")) {
       // The head's targets are the points of the clip as filmed.
       std::cerr << "clothwind eval: --track-head reads clips as filmed, not with --mirror-clips or --flag-flies "
@@ -87,7 +96,7 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     const learn::EvalResult r = learn::Evaluate(a->model, a->data, a->split, a->threads, a->device, a->batch,
                                                 a->windows, a->mirror, a->mirror_clips,
                                                 learn::FlagFliesFromName(a->flag_flies, "--flag-flies"),
-                                                [&](int done, int total) { bar.Update(done, total); });
+                                                [&](int done, int total) { bar.Update(done, total); }, a->fly_judge);
     bar.Finish();
     std::cout << learn::EvalTable(r);
     nlohmann::json json = learn::EvalJson(r);

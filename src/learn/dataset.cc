@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "learn/fly_judge.h"
 #include "learn/model_config.h"
 
 namespace clothwind::learn {
@@ -250,7 +251,8 @@ std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames) {
 namespace {
 
 // Whether options.flag_flies turns the clip (its first options.frames frames, cropped to `crop`)
-// round, so that its flag flies right; `score` receives EstimateFlyDirection's score with kAuto.
+// round, so that its flag flies right; `score` receives the judge's (or EstimateFlyDirection's)
+// score with kAuto.
 // The frames are judged as the model will see them: cropped, resized, mirrored by mirror_clip,
 // grey (the Y of colour frames). With kAuto `resized` receives the cropped, resized frames (not
 // mirrored), which MakeSample then uses rather than resize them twice (at 300 px the resizing
@@ -277,6 +279,7 @@ bool TurnsToFlyRight(const std::vector<cv::Mat>& frames, const cv::Rect& crop, c
     if (options.mirror_clip) cv::flip(g, grey[t], 1);
     else grey[t] = g;
   }
+  if (options.fly_judge) return options.fly_judge->Judge(grey, score) == FlyDirection::kLeft;
   const FlyDirectionCues cues = EstimateFlyDirection(grey);
   *score = cues.score;
   return cues.direction == FlyDirection::kLeft;

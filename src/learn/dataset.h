@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -17,6 +18,8 @@
 #include "learn/fly_direction.h"
 
 namespace clothwind::learn {
+
+class FlyJudge;  // fly_judge.h
 
 // One example as listed by index.json and described by its label.json.
 struct ClipInfo {
@@ -88,10 +91,13 @@ struct SampleOptions {
   bool mirror_clip = false;
   // Not augmenting: which way the clip's flag flies, so that it is turned to fly right before
   // the model reads it (after mirror_clip, before mirror): kRight reads it as it comes, kLeft
-  // mirrors it, kAuto mirrors it when EstimateFlyDirection of the cropped, resized grey (or Y)
-  // frames says left. Why: a model trained without flips (train --no-flip) knows only flags
-  // that fly right.
+  // mirrors it, kAuto mirrors it when fly_judge (or, without one, EstimateFlyDirection) of the
+  // cropped, resized grey (or Y) frames says left. Why: a model trained without flips (train
+  // --no-flip) knows only flags that fly right.
   FlagFlies flag_flies = FlagFlies::kRight;
+  // With kAuto: the learned judge that decides (fly_judge.h; shared, it is only read). Null: the
+  // clip's motion cues (EstimateFlyDirection), right for only ~91 % of FlagSim's clips.
+  std::shared_ptr<const FlyJudge> fly_judge;
   bool flow = false;      // two more channels: each frame's optical flow from the one before (FrameFlow)
   // Side [px] the crop is resized to for the flow, which is then resized to input_size and
   // scaled with it (0: input_size). A finer flow reads the cloth's sub-pixel motion more exactly.
@@ -121,7 +127,7 @@ struct Sample {
   cv::Rect crop;              // square crop taken from the frames [px]
   bool flipped = false;       // the pixels are mirrored relative to the frames given
   bool turned = false;        // SampleOptions::flag_flies mirrored the clip (its flag flies left)
-  double fly_score = 0;       // with flag_flies kAuto: EstimateFlyDirection's score (> 0: right)
+  double fly_score = 0;       // with flag_flies kAuto: the fly judge's (or motion cues') score (> 0: right)
 };
 
 // The frame window of a clip: options.first_frame when set, else uniformly random when augmenting,

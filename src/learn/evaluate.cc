@@ -133,7 +133,8 @@ SimulationMetrics ComputeSimulationMetrics(const std::vector<double>& truth, con
 
 EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::string& split, int threads,
                     const std::string& device, int batch, int windows, bool mirror, bool mirror_clips,
-                    FlagFlies flag_flies, const std::function<void(int, int)>& progress) {
+                    FlagFlies flag_flies, const std::function<void(int, int)>& progress,
+                    const std::filesystem::path& fly_judge) {
   const auto start = std::chrono::steady_clock::now();
   if (windows < 1) throw std::invalid_argument("Evaluate: windows must be >= 1, got " + std::to_string(windows));
   Predictor predictor(model, threads, device);
@@ -150,6 +151,11 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   SampleOptions options = r.config.Sampling();
   options.mirror_clip = mirror_clips;
   options.flag_flies = flag_flies;
+  if (!fly_judge.empty()) predictor.LoadFlyJudge(fly_judge);
+  options.fly_judge = predictor.fly_judge();
+  if (flag_flies == FlagFlies::kAuto) {
+    r.fly_judge = options.fly_judge ? predictor.fly_judge_path().string() : std::string("motion cues");
+  }
   batch = std::max(1, batch);
   for (size_t i = 0; i < clips.size(); i += batch) {
     const size_t end = std::min(clips.size(), i + batch);
@@ -221,6 +227,7 @@ nlohmann::json EvalJson(const EvalResult& r) {
           {"model", r.config.Name()}, {"arch", r.config.arch},    {"modality", r.config.Modality()},
           {"split", r.split},         {"windows", r.windows},     {"mirror", r.mirror},
           {"mirror_clips", r.mirror_clips}, {"flag_flies", FlagFliesName(r.flag_flies)}, {"turned", r.turned},
+          {"fly_judge", r.fly_judge.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.fly_judge)},
           {"seconds", r.seconds},
           {"std_within_1", Number(StdCoverage(r, 1))}, {"std_within_2", Number(StdCoverage(r, 2))},
           {"bands", bands},
@@ -249,7 +256,8 @@ std::string EvalTable(const EvalResult& r) {
   if (r.mirror_clips) s << ", clips mirrored (flags flying left)";
   if (r.flag_flies == FlagFlies::kLeft) s << ", every clip turned round (--flag-flies left)";
   if (r.flag_flies == FlagFlies::kAuto) {
-    s << ", turned round by their motion: " << r.turned << " of " << r.metrics.count * r.windows << " windows";
+    s << ", turned round by " << (r.fly_judge == "motion cues" ? "their motion" : "the judge " + r.fly_judge) << ": "
+      << r.turned << " of " << r.metrics.count * r.windows << " windows";
   }
   s << ")\n";
   if (!r.predicted_std.empty()) {

@@ -74,6 +74,8 @@ struct EvalResult {
   bool mirror_clips = false;  // every clip mirrored first, as if its flag flew left
   FlagFlies flag_flies = FlagFlies::kRight;  // how each clip was turned before the model read it
   int turned = 0;  // windows that flag_flies turned round (mirrored: their flag flew left)
+  // With flag_flies kAuto: the judge's file, or "motion cues" without one (empty otherwise).
+  std::string fly_judge;
   Metrics metrics;
   std::vector<BandMetrics> bands;  // by true speed, kEvalBandWidth wide
   SimulationMetrics per_simulation;  // simulations == 0 for a dataset without simulation ids
@@ -93,17 +95,20 @@ struct EvalResult {
 //                  flags all fly right, so this is how a model reads flags that fly left;
 //         flag_flies  how each clip is then turned round (SampleOptions::flag_flies; kRight: as it
 //                  comes, the default here whatever the model, so that figures stay comparable);
-//         progress  called after each batch with (done, total) (may be empty).
+//         progress  called after each batch with (done, total) (may be empty);
+//         fly_judge  with kAuto, the judge that decides (FlyJudge::Load); empty: the one beside the
+//                  model (Predictor::fly_judge), or the motion cues when there is none.
 EvalResult Evaluate(const std::filesystem::path& model, const std::filesystem::path& data, const std::string& split,
                     int threads, const std::string& device, int batch, int windows = 1, bool mirror = false,
                     bool mirror_clips = false, FlagFlies flag_flies = FlagFlies::kRight,
-                    const std::function<void(int, int)>& progress = {});
+                    const std::function<void(int, int)>& progress = {},
+                    const std::filesystem::path& fly_judge = {});
 
 // {"rmse", "acc05", "bias", "count"} of one group of examples; NaN figures (an empty group) as null.
 nlohmann::json MetricsJson(const Metrics& metrics);
 
 // {"rmse": …, "acc05": …, "count": …} plus the model, split, windows, mirror, mirror_clips,
-// flag_flies, turned, "bands" (a list of
+// flag_flies, turned, fly_judge (null unless flag_flies is auto), "bands" (a list of
 // {"lo", "hi", "rmse", "acc05", "bias", "count"}; NaNs of empty bands as null) and
 // "per_simulation" ({"rmse", "scatter", "simulations", "clips"}; null without simulation ids).
 nlohmann::json EvalJson(const EvalResult& result);

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <ATen/core/grad_mode.h>
 
+#include "learn/fly_judge.h"
 #include "learn/networks.h"
 #include "learn/spectral_layer.h"
 
@@ -38,6 +39,17 @@ Predictor::Predictor(const std::filesystem::path& weights, int threads, const st
   impl_->net->to(impl_->device);
   impl_->net->eval();
   flag_flies_ = config().DefaultFlagFlies();
+  const std::filesystem::path beside = weights.parent_path() / kFlyJudgeFile;
+  if (std::filesystem::exists(beside)) LoadFlyJudge(beside);
+}
+
+void Predictor::LoadFlyJudge(const std::filesystem::path& path) {
+  if (path.empty()) {
+    fly_judge_.reset();
+  } else {
+    fly_judge_ = std::make_shared<const FlyJudge>(FlyJudge::Load(path));
+  }
+  fly_judge_path_ = path;
 }
 
 Predictor::~Predictor() = default;
@@ -85,6 +97,7 @@ Sample Predictor::Prepare(const std::vector<cv::Mat>& frames) const {
   }
   SampleOptions options = c.Sampling();
   options.flag_flies = flag_flies_;
+  options.fly_judge = fly_judge_;
   std::vector<cv::Mat> last(frames.end() - c.frames, frames.end());
   std::mt19937_64 unused(0);
   return MakeSample(last, options, unused);

@@ -48,6 +48,14 @@ class Predictor {
   FlagFlies flag_flies() const { return flag_flies_; }
   void set_flag_flies(FlagFlies flag_flies) { flag_flies_ = flag_flies; }
 
+  // The judge flag_flies auto asks (SampleOptions::fly_judge): the one in kFlyJudgeFile beside
+  // the weights when there is one (models/fly_judge.pt beside models/sdn.pt), else none (the
+  // clip's motion cues). fly_judge_path() is its file, empty for none.
+  const std::shared_ptr<const FlyJudge>& fly_judge() const { return fly_judge_; }
+  const std::filesystem::path& fly_judge_path() const { return fly_judge_path_; }
+  // Loads another judge (FlyJudge::Load; empty: none, the motion cues). Throws as FlyJudge::Load.
+  void LoadFlyJudge(const std::filesystem::path& path);
+
   // Predictions for prepared samples (each config().frames x input_size² floats, as MakeSample
   // makes them), in one batch.
   std::vector<Prediction> Predict(const std::vector<const Sample*>& samples);
@@ -67,7 +75,12 @@ class Predictor {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   FlagFlies flag_flies_ = FlagFlies::kRight;
+  std::shared_ptr<const FlyJudge> fly_judge_;
+  std::filesystem::path fly_judge_path_;
 };
+
+// The judge's file name a Predictor looks for beside its weights.
+inline constexpr const char* kFlyJudgeFile = "fly_judge.pt";
 
 // A false-colour BGR image of `value` (CV_32F) scaled from [lo, hi] to OpenCV colour map
 // `colormap` (e.g. cv::COLORMAP_INFERNO); values outside are clamped.

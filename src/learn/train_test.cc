@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <unistd.h>
 
@@ -19,6 +20,7 @@
 #include "learn/aux_targets.h"
 #include "learn/dataset.h"
 #include "learn/evaluate.h"
+#include "learn/fly_judge.h"
 #include "learn/networks.h"
 #include "learn/predictor.h"
 #include "learn/track_head_eval.h"
@@ -231,6 +233,32 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
   EXPECT_EQ(EvalJson(back)["turned"].get<int>(), static_cast<int>(val.size()));
   EXPECT_NE(EvalTable(back).find("clips mirrored (flags flying left), every clip turned round"), std::string::npos)
       << EvalTable(back);
+  EXPECT_TRUE(EvalJson(back)["fly_judge"].is_null());
+  // With auto a judge file decides: each clip is turned exactly when its mirror image is not (the
+  // judge's score is antisymmetric and no toy clip is still), and the result names the judge.
+  std::mt19937_64 rng(11);
+  std::normal_distribution<float> n(0.0f, 0.3f);
+  Eigen::MatrixXf w1(8, kMotionMapGrid * kMotionMapGrid);
+  Eigen::VectorXf b1(8), w2(8);
+  for (int i = 0; i < w1.size(); ++i) w1.data()[i] = n(rng);
+  for (int i = 0; i < 8; ++i) b1[i] = n(rng), w2[i] = n(rng);
+  const fs::path judge_file = r.model.parent_path() / "judge" / "fly_judge.pt";
+  fs::create_directories(judge_file.parent_path());
+  FlyJudge(w1, b1, w2, 0.1f).Save(judge_file);
+  const EvalResult judged =
+      Evaluate(r.model, *root_ / "data", "val", 2, "cpu", 4, 1, false, false, FlagFlies::kAuto, {}, judge_file);
+  const EvalResult judged_left =
+      Evaluate(r.model, *root_ / "data", "val", 2, "cpu", 4, 1, false, true, FlagFlies::kAuto, {}, judge_file);
+  EXPECT_EQ(judged.turned + judged_left.turned, static_cast<int>(val.size()));
+  EXPECT_EQ(judged.fly_judge, judge_file.string());
+  EXPECT_EQ(EvalJson(judged)["fly_judge"].get<std::string>(), judge_file.string());
+  EXPECT_NE(EvalTable(judged).find("turned round by the judge"), std::string::npos) << EvalTable(judged);
+  for (size_t i = 0; i < val.size(); ++i) {
+    // Whichever way each reads a clip, the two read it the same way round.
+    EXPECT_NEAR(judged.predicted[i], judged_left.predicted[i], 1e-6);
+  }
+  EXPECT_EQ(Evaluate(r.model, *root_ / "data", "val", 2, "cpu", 4, 1, false, false, FlagFlies::kAuto).fly_judge,
+            "motion cues");
   // The plots are PNGs made by gnuplot (installed with the project's dependencies).
   EXPECT_EQ(r.plot_error, "");
   std::string error;

@@ -88,6 +88,16 @@ class SdnNodeTest(unittest.TestCase):
         rospy.Subscriber("wind/wind/estimate", WindEstimate, lambda m: self.append(self.wind_estimates, m),
                          queue_size=10)
         self.wind_pub = rospy.Publisher("wind/clips", Clip, queue_size=10)
+        self.judge_statuses = []
+        self.judge_estimates = []
+        rospy.Subscriber("judge/wind/estimate", WindEstimate, lambda m: self.append(self.judge_estimates, m),
+                         queue_size=10)
+        self.judge_pub = rospy.Publisher("judge/clips", Clip, queue_size=10)
+        self.bad_judge_statuses = []
+        self.bad_judge_estimates = []
+        rospy.Subscriber("bad_judge/wind/estimate", WindEstimate,
+                         lambda m: self.append(self.bad_judge_estimates, m), queue_size=10)
+        self.bad_judge_pub = rospy.Publisher("bad_judge/clips", Clip, queue_size=10)
 
     def append(self, where, msg):
         with self.lock:
@@ -107,6 +117,10 @@ class SdnNodeTest(unittest.TestCase):
                     self.no_flip_statuses.append(s)
                 elif s.name.startswith("wind/"):
                     self.wind_statuses.append(s)
+                elif s.name.startswith("judge/"):
+                    self.judge_statuses.append(s)
+                elif s.name.startswith("bad_judge/"):
+                    self.bad_judge_statuses.append(s)
 
     def wait_for(self, predicate, timeout, what):
         deadline = rospy.get_time() + timeout
@@ -278,6 +292,35 @@ class SdnNodeTest(unittest.TestCase):
         self.assertEqual(values["clips with the wind end-on or unknown"], "1")
         self.assertAlmostEqual(speeds[0], speeds[1], places=5)
         self.assertAlmostEqual(speeds[0], speeds[2], places=5)
+
+    def test_no_flip_model_with_the_fly_judge(self):
+        """~fly_judge, the shipped judge: no WARN (the judge, not the motion cues, tells the way),
+        the judge named in the diagnostics, and a clip of a flag flying left turned round."""
+        size = 256
+        self.wait_for(lambda: self.judge_pub.get_num_connections() > 0, 120, "the judged sdn_node to subscribe")
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.judge_statuses), 60,
+                      "an OK diagnostic from the node with a fly judge")
+        start = rospy.Time(1700000000, 0)
+        self.judge_pub.publish(make_clip(0, start, size, 3.0, 4.0, flag="right"))
+        self.judge_pub.publish(make_clip(1, start + rospy.Duration.from_sec(2.0), size, 3.0, 4.0, flag="left"))
+        self.wait_for(lambda: len(self.judge_estimates) >= 2, 30, "estimates of both clips")
+        values = self.wait_for_turned(self.judge_statuses, 1)
+        with self.lock:
+            speeds = {e.clip_sequence: e.speed for e in self.judge_estimates}
+        self.assertEqual(values["flag flies"], "auto")
+        self.assertTrue(values["fly judge (for auto)"].endswith("models/fly_judge.pt"), values)
+        self.assertAlmostEqual(speeds[0], speeds[1], places=5)
+
+    def test_fly_judge_that_does_not_load(self):
+        """A ~fly_judge file that is not there: a WARN saying so, and the clips still estimated."""
+        size = 64
+        self.wait_for(lambda: self.bad_judge_pub.get_num_connections() > 0, 120,
+                      "the badly judged sdn_node to subscribe")
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.WARN and "~fly_judge did not load" in s.message
+                                  and "/nonexistent/fly_judge" in s.message for s in self.bad_judge_statuses), 60,
+                      "a WARN naming the judge file that did not load")
+        self.bad_judge_pub.publish(make_clip(0, rospy.Time(1700000000, 0), size, 3.0, 4.0, flag="right"))
+        self.wait_for(lambda: len(self.bad_judge_estimates) >= 1, 30, "an estimate all the same")
 
 
 if __name__ == "__main__":

@@ -1,0 +1,152 @@
+#include "learn/fly_judge.h"
+
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+#include <torch/nn/module.h>
+#include <torch/nn/modules/linear.h>
+
+#include "learn/dataset.h"
+#include "learn/model_config.h"
+#include "learn/weights_io.h"
+
+namespace clothwind::learn {
+namespace {
+
+constexpr int kMapSize = kMotionMapGrid * kMotionMapGrid;
+
+// The weights file's layout: two linear layers, as torch would save them ("hidden.weight", ...).
+struct JudgeModule : torch::nn::Module {
+  explicit JudgeModule(int hidden_units)
+      : hidden(register_module("hidden", torch::nn::Linear(kMapSize, hidden_units))),
+        output(register_module("output", torch::nn::Linear(hidden_units, 1))) {}
+  torch::nn::Linear hidden{nullptr}, output{nullptr};
+};
+
+Eigen::VectorXf Flattened(const cv::Mat& map) {
+  if (map.type() != CV_32FC1 || map.rows != kMotionMapGrid || map.cols != kMotionMapGrid) {
+    throw std::invalid_argument("FlyJudge: expected a " + std::to_string(kMotionMapGrid) + "x" +
+                                std::to_string(kMotionMapGrid) + " CV_32FC1 motion map, got " + std::to_string(map.cols) +
+                                "x" + std::to_string(map.rows));
+  }
+  cv::Mat c = map.isContinuous() ? map : map.clone();
+  return Eigen::Map<const Eigen::VectorXf>(c.ptr<float>(), kMapSize);
+}
+
+}  // namespace
+
+cv::Mat MotionMap(const std::vector<cv::Mat>& frames) {
+  if (frames.size() < 2) {
+    throw std::invalid_argument("MotionMap: expected at least 2 frames, got " + std::to_string(frames.size()));
+  }
+  const cv::Size size = frames[0].size();
+  const cv::Size side(kMotionMapSide, kMotionMapSide);
+  cv::Mat sum = cv::Mat::zeros(side, CV_64F), sq = sum.clone(), resized, x;
+  for (size_t t = 0; t < frames.size(); ++t) {
+    const cv::Mat& f = frames[t];
+    if ((f.type() != CV_8UC1 && f.type() != CV_32FC1) || f.size() != size || f.empty()) {
+      throw std::invalid_argument("MotionMap: frame " + std::to_string(t) + " is " + std::to_string(f.cols) + "x" +
+                                  std::to_string(f.rows) + " with " + std::to_string(f.channels()) +
+                                  " channel(s); expected a non-empty single-channel CV_8UC1 or CV_32FC1 image of " +
+                                  std::to_string(size.width) + "x" + std::to_string(size.height) + ", as frame 0");
+    }
+    if (f.size() == side) {
+      resized = f;
+    } else {
+      cv::resize(f, resized, side, 0, 0, f.cols > kMotionMapSide ? cv::INTER_AREA : cv::INTER_LINEAR);
+    }
+    resized.convertTo(x, CV_64F);
+    sum += x;
+    sq += x.mul(x);
+  }
+  const double n = static_cast<double>(frames.size());
+  cv::Mat mean = sum / n, var = sq / n - mean.mul(mean), sd, grid;
+  cv::max(var, 0.0, var);  // rounding can make a still pixel's variance slightly negative
+  cv::sqrt(var, sd);
+  cv::resize(sd, grid, cv::Size(kMotionMapGrid, kMotionMapGrid), 0, 0, cv::INTER_AREA);
+  const double average = cv::mean(grid)[0];
+  cv::Mat map;
+  // A still clip (or one whose only change is 8-bit noise far below a grey level) has no shape.
+  grid.convertTo(map, CV_32F, average > 1e-6 ? 1.0 / average : 0.0);
+  return map;
+}
+
+FlyJudge::FlyJudge(Eigen::MatrixXf hidden_weights, Eigen::VectorXf hidden_bias, Eigen::VectorXf output_weights,
+                   float output_bias)
+    : hidden_weights_(std::move(hidden_weights)),
+      hidden_bias_(std::move(hidden_bias)),
+      output_weights_(std::move(output_weights)),
+      output_bias_(output_bias) {
+  const auto h = hidden_bias_.size();
+  if (h < 1 || hidden_weights_.rows() != h || hidden_weights_.cols() != kMapSize || output_weights_.size() != h) {
+    throw std::invalid_argument("FlyJudge: hidden weights " + std::to_string(hidden_weights_.rows()) + "x" +
+                                std::to_string(hidden_weights_.cols()) + ", hidden bias " + std::to_string(h) +
+                                ", output weights " + std::to_string(output_weights_.size()) + "; expected Hx" +
+                                std::to_string(kMapSize) + ", H, H with H >= 1");
+  }
+}
+
+FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
+  const std::filesystem::path card_path = ConfigPathFor(path);
+  const nlohmann::json card = ReadJson(card_path);
+  if (!card.contains("hidden") || !card["hidden"].is_number_integer() || card["hidden"].get<int>() < 1) {
+    throw std::runtime_error(card_path.string() + ": field \"hidden\" must be the judge's hidden units (an integer >= 1)");
+  }
+  if (card.value("grid", 0) != kMotionMapGrid || card.value("side", 0) != kMotionMapSide) {
+    throw std::runtime_error(card_path.string() + ": fields \"grid\" and \"side\" must be " +
+                             std::to_string(kMotionMapGrid) + " and " + std::to_string(kMotionMapSide) +
+                             " (the motion map this build computes)");
+  }
+  const int h = card["hidden"].get<int>();
+  JudgeModule module(h);
+  LoadModuleWeights(module, path);
+  const at::Tensor w1 = module.hidden->weight.detach().contiguous();
+  const at::Tensor b1 = module.hidden->bias.detach().contiguous();
+  const at::Tensor w2 = module.output->weight.detach().contiguous();
+  // torch is row-major: the H x G*G weight maps onto a row-major Eigen matrix, copied to ours.
+  Eigen::MatrixXf hidden_weights =
+      Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(w1.data_ptr<float>(), h,
+                                                                                               kMapSize);
+  return FlyJudge(std::move(hidden_weights), Eigen::Map<const Eigen::VectorXf>(b1.data_ptr<float>(), h),
+                  Eigen::Map<const Eigen::VectorXf>(w2.data_ptr<float>(), h),
+                  module.output->bias.detach().item<float>());
+}
+
+void FlyJudge::Save(const std::filesystem::path& path, nlohmann::json card) const {
+  const int h = hidden();
+  JudgeModule module(h);
+  {
+    torch::NoGradGuard no_grad;
+    Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> w1 = hidden_weights_;
+    module.hidden->weight.copy_(torch::from_blob(w1.data(), {h, kMapSize}, torch::kFloat));
+    Eigen::VectorXf b1 = hidden_bias_, w2 = output_weights_;
+    module.hidden->bias.copy_(torch::from_blob(b1.data(), {h}, torch::kFloat));
+    module.output->weight.copy_(torch::from_blob(w2.data(), {1, h}, torch::kFloat));
+    module.output->bias.fill_(output_bias_);
+  }
+  SaveModuleWeights(module, path, WeightPrecision::kFloat32);
+  card["hidden"] = h;
+  card["grid"] = kMotionMapGrid;
+  card["side"] = kMotionMapSide;
+  WriteFileAtomically(ConfigPathFor(path), card.dump(2) + "\n");
+}
+
+double FlyJudge::Logit(const Eigen::VectorXf& map) const {
+  const Eigen::VectorXf a = (hidden_weights_ * map + hidden_bias_).cwiseMax(0.0f);
+  return static_cast<double>(output_weights_.dot(a)) + output_bias_;
+}
+
+double FlyJudge::Score(const cv::Mat& map) const {
+  cv::Mat mirrored;
+  cv::flip(map, mirrored, 1);
+  return Logit(Flattened(map)) - Logit(Flattened(mirrored));
+}
+
+FlyDirection FlyJudge::Judge(const std::vector<cv::Mat>& frames, double* score) const {
+  const double s = Score(MotionMap(frames));
+  if (score != nullptr) *score = s;
+  return s < 0 ? FlyDirection::kLeft : FlyDirection::kRight;
+}
+
+}  // namespace clothwind::learn

@@ -1,0 +1,275 @@
+// The learned fly-direction judge: its motion map (unit mean, mirrored with the clip, blind to
+// contrast), the exact antisymmetry of its score, its file round trip and refusals, and that
+// training on flags held at the left, wherever they hang, teaches it the side of held-out flags
+// and of their mirror images.
+#include "learn/fly_judge.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "learn/fly_judge_train.h"
+#include "learn/model_config.h"
+
+namespace clothwind::learn {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kFrames = 30;
+constexpr int kSide = 64;
+
+// A flag held at column x0 and flying right over `length` columns, rows y0 .. y0 + height: at
+// column x its ripples have amplitude gain * ((x - x0) / length)^power, travelling along it at
+// wavenumber k, on a grey 90 background with Gaussian noise of `noise` grey levels.
+struct FlagClip {
+  int x0 = 8, length = 40, y0 = 16, height = 30;
+  double gain = 60, power = 1, k = 0.4, omega = 2 * M_PI * 3 / kFrames, noise = 0;
+};
+
+std::vector<cv::Mat> Clip(const FlagClip& c, std::mt19937_64& rng) {
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::vector<cv::Mat> frames;
+  for (int t = 0; t < kFrames; ++t) {
+    cv::Mat f(kSide, kSide, CV_8UC1);
+    for (int y = 0; y < kSide; ++y) {
+      for (int x = 0; x < kSide; ++x) {
+        double v = 90;
+        const double along = static_cast<double>(x - c.x0) / c.length;
+        if (y >= c.y0 && y < c.y0 + c.height && along >= 0 && along <= 1) {
+          v = 140 + c.gain * std::pow(along, c.power) * std::sin(c.k * x - c.omega * t + 0.1 * y);
+        }
+        if (c.noise > 0) v += c.noise * noise(rng);
+        f.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(v);
+      }
+    }
+    frames.push_back(f);
+  }
+  return frames;
+}
+
+std::vector<cv::Mat> Mirrored(const std::vector<cv::Mat>& frames) {
+  std::vector<cv::Mat> out;
+  for (const cv::Mat& f : frames) {
+    cv::Mat m;
+    cv::flip(f, m, 1);
+    out.push_back(m);
+  }
+  return out;
+}
+
+// A judge with random weights (H hidden units).
+FlyJudge RandomJudge(int hidden, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<float> n(0.0f, 0.3f);
+  Eigen::MatrixXf w1(hidden, kMotionMapGrid * kMotionMapGrid);
+  Eigen::VectorXf b1(hidden), w2(hidden);
+  for (int i = 0; i < w1.size(); ++i) w1.data()[i] = n(rng);
+  for (int i = 0; i < hidden; ++i) {
+    b1[i] = n(rng);
+    w2[i] = n(rng);
+  }
+  return FlyJudge(w1, b1, w2, n(rng));
+}
+
+TEST(MotionMapTest, AveragesOneMirrorsWithTheClipAndIgnoresContrast) {
+  std::mt19937_64 rng(1);
+  const std::vector<cv::Mat> clip = Clip(FlagClip{}, rng);
+  const cv::Mat map = MotionMap(clip);
+  ASSERT_EQ(map.type(), CV_32FC1);
+  ASSERT_EQ(map.rows, kMotionMapGrid);
+  ASSERT_EQ(map.cols, kMotionMapGrid);
+  EXPECT_NEAR(cv::mean(map)[0], 1.0, 1e-5);
+  // The flag's right (fly) end moves most; left of the hoist nothing moves.
+  EXPECT_GT(map.at<float>(8, 11), 2 * map.at<float>(8, 4));
+  EXPECT_FLOAT_EQ(map.at<float>(8, 0), 0.0f);
+
+  cv::Mat flipped;
+  cv::flip(map, flipped, 1);
+  EXPECT_LT(cv::norm(MotionMap(Mirrored(clip)), flipped, cv::NORM_INF), 1e-5);
+
+  FlagClip half;
+  half.gain = 30;  // half the contrast: the same shape, up to 8-bit rounding
+  EXPECT_LT(cv::norm(MotionMap(Clip(half, rng)), map, cv::NORM_INF), 0.05);
+}
+
+TEST(MotionMapTest, ResizesAnySideToItsOwn) {
+  std::mt19937_64 rng(2);
+  const std::vector<cv::Mat> clip = Clip(FlagClip{}, rng);
+  std::vector<cv::Mat> big;
+  for (const cv::Mat& f : clip) {
+    cv::Mat b;
+    cv::resize(f, b, cv::Size(2 * kSide, 2 * kSide), 0, 0, cv::INTER_NEAREST);
+    big.push_back(b);
+  }
+  EXPECT_LT(cv::norm(MotionMap(big), MotionMap(clip), cv::NORM_INF), 1e-4);
+}
+
+TEST(MotionMapTest, StillClipHasNoShapeAndFliesRightAsFilmed) {
+  const std::vector<cv::Mat> still(kFrames, cv::Mat(kSide, kSide, CV_8UC1, cv::Scalar(120)));
+  EXPECT_EQ(cv::countNonZero(MotionMap(still)), 0);
+  double score = 1;
+  EXPECT_EQ(RandomJudge(8, 3).Judge(still, &score), FlyDirection::kRight);
+  EXPECT_EQ(score, 0.0);
+}
+
+TEST(MotionMapTest, RefusesNamingTheFrame) {
+  std::vector<cv::Mat> frames(3, cv::Mat(kSide, kSide, CV_8UC1, cv::Scalar(0)));
+  frames[2] = cv::Mat(kSide, kSide, CV_8UC3, cv::Scalar(0, 0, 0));
+  try {
+    MotionMap(frames);
+    FAIL() << "a colour frame was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("frame 2"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(MotionMap({frames[0]}), std::invalid_argument);
+}
+
+TEST(FlyJudgeTest, ScoreIsExactlyAntisymmetricUnderMirroring) {
+  const FlyJudge judge = RandomJudge(16, 4);
+  std::mt19937_64 rng(5);
+  for (int trial = 0; trial < 5; ++trial) {
+    FlagClip c;
+    c.x0 = 2 + trial * 3;
+    const std::vector<cv::Mat> clip = Clip(c, rng);
+    double right = 0, left = 0;
+    const FlyDirection a = judge.Judge(clip, &right), b = judge.Judge(Mirrored(clip), &left);
+    EXPECT_NEAR(left, -right, 1e-5 * (1 + std::abs(right)));  // the maps agree to float rounding
+    if (std::abs(right) > 1e-3) {
+      EXPECT_NE(a, b);
+    }
+    cv::Mat map = MotionMap(clip), flipped;
+    cv::flip(map, flipped, 1);
+    EXPECT_EQ(judge.Score(flipped), -judge.Score(map));  // the same two logits, subtracted the other way
+  }
+}
+
+TEST(FlyJudgeTest, SaveLoadRoundTripKeepsScoresAndCard) {
+  const fs::path dir = fs::temp_directory_path() / ("fly_judge_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const FlyJudge judge = RandomJudge(12, 6);
+  judge.Save(dir / "judge.pt", {{"data", "synthetic"}});
+  const FlyJudge loaded = FlyJudge::Load(dir / "judge.pt");
+  EXPECT_EQ(loaded.hidden(), 12);
+  EXPECT_EQ((loaded.hidden_weights() - judge.hidden_weights()).cwiseAbs().maxCoeff(), 0.0f);
+  EXPECT_EQ(loaded.output_bias(), judge.output_bias());
+  std::mt19937_64 rng(7);
+  const cv::Mat map = MotionMap(Clip(FlagClip{}, rng));
+  EXPECT_EQ(loaded.Score(map), judge.Score(map));
+  const nlohmann::json card = ReadJson(dir / "judge.json");
+  EXPECT_EQ(card.at("data"), "synthetic");
+  EXPECT_EQ(card.at("grid"), kMotionMapGrid);
+
+  // A card that disagrees with the weights' shape is refused, naming the weights file.
+  WriteFileAtomically(dir / "judge.json", nlohmann::json{{"hidden", 5}, {"grid", 16}, {"side", 64}}.dump());
+  try {
+    FlyJudge::Load(dir / "judge.pt");
+    FAIL() << "a 12-unit file loaded as 5 units";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("judge.pt"), std::string::npos) << e.what();
+  }
+  WriteFileAtomically(dir / "judge.json", nlohmann::json{{"hidden", 12}, {"grid", 8}, {"side", 64}}.dump());
+  EXPECT_THROW(FlyJudge::Load(dir / "judge.pt"), std::runtime_error);
+  fs::remove(dir / "judge.json");
+  try {
+    FlyJudge::Load(dir / "judge.pt");
+    FAIL() << "loaded without its card";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("judge.json"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(FlyJudgeTest, RefusesWeightsOfTheWrongShape) {
+  EXPECT_THROW(FlyJudge(Eigen::MatrixXf::Zero(4, 10), Eigen::VectorXf::Zero(4), Eigen::VectorXf::Zero(4), 0),
+               std::invalid_argument);
+  EXPECT_THROW(FlyJudge(Eigen::MatrixXf::Zero(4, 256), Eigen::VectorXf::Zero(3), Eigen::VectorXf::Zero(4), 0),
+               std::invalid_argument);
+}
+
+// Flags held at the left, of random place, size, shape of growth, wave and noise.
+MotionMaps RandomFlags(int count, std::mt19937_64& rng) {
+  std::uniform_int_distribution<int> x0(0, 22), length(20, 40), y0(4, 24), height(16, 36);
+  std::uniform_real_distribution<double> gain(20, 70), power(0.5, 2.0), k(-0.6, 0.6), noise(0, 4);
+  MotionMaps out;
+  for (int i = 0; i < count; ++i) {
+    FlagClip c;
+    c.x0 = x0(rng);
+    c.length = length(rng);
+    c.y0 = y0(rng);
+    c.height = height(rng);
+    c.gain = gain(rng);
+    c.power = power(rng);
+    c.k = k(rng);
+    c.noise = noise(rng);
+    out.maps.push_back(MotionMap(Clip(c, rng)));
+    out.wind_speeds.push_back(c.gain / 7);  // any label: only the bands read it
+  }
+  return out;
+}
+
+TEST(FlyJudgeTrainTest, LearnsTheHoistSideOfHeldOutFlagsAndTheirMirrors) {
+  std::mt19937_64 rng(8);
+  const MotionMaps train = RandomFlags(240, rng), test = RandomFlags(80, rng);
+  FlyJudgeTrainOptions o;
+  o.hidden = 16;
+  o.epochs = 40;
+  o.batch = 32;
+  o.learning_rate = 3e-3;
+  std::vector<double> losses;
+  const FlyJudge judge = TrainFlyJudge(train.maps, o, [&](int, int, double loss) { losses.push_back(loss); });
+  ASSERT_EQ(static_cast<int>(losses.size()), o.epochs);
+  EXPECT_LT(losses.back(), 0.5 * losses.front());
+
+  const FlyJudgeAccuracy untrained = MeasureFlyJudge(RandomJudge(16, 9), test);
+  const FlyJudgeAccuracy a = MeasureFlyJudge(judge, test);
+  EXPECT_EQ(a.count, 80);
+  EXPECT_GE(a.accuracy(), 0.95);
+  EXPECT_LT(untrained.accuracy(), 0.8);  // the flags do not make any judge right
+  int banded = 0;
+  for (const auto& b : a.bands) banded += b.count;
+  EXPECT_EQ(banded, a.count);
+  // Mirror images are called left exactly as often as the originals right.
+  MotionMaps mirrored = test;
+  for (cv::Mat& m : mirrored.maps) cv::flip(m, m, 1);
+  EXPECT_EQ(MeasureFlyJudge(judge, mirrored).right, a.count - a.right - a.undecided);
+
+  const nlohmann::json j = ToJson(a);
+  EXPECT_DOUBLE_EQ(j.at("accuracy").get<double>(), a.accuracy());
+  EXPECT_THROW(TrainFlyJudge({}, o), std::invalid_argument);
+}
+
+TEST(FlyJudgeTrainTest, CollectsOneMapPerWindowOfEachClip) {
+  const fs::path dir = fs::temp_directory_path() / ("fly_judge_toy_" + std::to_string(::getpid()));
+  ToyDatasetOptions toy;
+  toy.clips = 4;
+  toy.frames = 40;
+  toy.size = 48;
+  WriteToyDataset(dir, toy);
+  const std::vector<ClipInfo> clips = SelectSplit(ReadDataset(dir), "all");
+  int calls = 0;
+  const MotionMaps m = CollectMotionMaps(clips, kFrames, 3, [&](int done, int total) {
+    ++calls;
+    EXPECT_EQ(total, 4);
+    EXPECT_EQ(done, calls);
+  });
+  ASSERT_EQ(m.maps.size(), 12u);
+  for (size_t i = 0; i < m.maps.size(); ++i) {
+    EXPECT_NEAR(cv::mean(m.maps[i])[0], 1.0, 1e-5);
+    EXPECT_EQ(m.wind_speeds[i], clips[i / 3].wind_speed);
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace clothwind::learn

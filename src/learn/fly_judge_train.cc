@@ -1,0 +1,127 @@
+#include "learn/fly_judge_train.h"
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <stdexcept>
+
+#include <torch/torch.h>
+
+namespace clothwind::learn {
+namespace {
+
+constexpr int kMapSize = kMotionMapGrid * kMotionMapGrid;
+
+// The maps as an N x G x G float tensor.
+at::Tensor Stack(const std::vector<cv::Mat>& maps) {
+  at::Tensor x = at::empty({static_cast<int64_t>(maps.size()), kMotionMapGrid, kMotionMapGrid}, at::kFloat);
+  for (size_t i = 0; i < maps.size(); ++i) {
+    const cv::Mat& m = maps[i];
+    if (m.type() != CV_32FC1 || m.rows != kMotionMapGrid || m.cols != kMotionMapGrid) {
+      throw std::invalid_argument("TrainFlyJudge: map " + std::to_string(i) + " is not a " +
+                                  std::to_string(kMotionMapGrid) + "x" + std::to_string(kMotionMapGrid) +
+                                  " CV_32FC1 motion map");
+    }
+    const cv::Mat c = m.isContinuous() ? m : m.clone();
+    std::copy_n(c.ptr<float>(), kMapSize, x[i].data_ptr<float>());
+  }
+  return x;
+}
+
+}  // namespace
+
+MotionMaps CollectMotionMaps(const std::vector<ClipInfo>& clips, int frames, int windows,
+                             const std::function<void(int, int)>& progress) {
+  MotionMaps out;
+  std::vector<cv::Mat> window(frames);
+  for (size_t i = 0; i < clips.size(); ++i) {
+    const ClipInfo& clip = clips[i];
+    const std::vector<int> starts = EvenWindowStarts(clip.num_frames, frames, windows);
+    const int first = starts.front();
+    const std::vector<cv::Mat> all = LoadFrames(clip, first, starts.back() + frames - first);
+    const cv::Rect crop = CentreSquare(clip.width, clip.height);
+    for (const int start : starts) {
+      for (int t = 0; t < frames; ++t) ResizeCrop(all[start - first + t], crop, kMotionMapSide, window[t]);
+      out.maps.push_back(MotionMap(window));
+      out.wind_speeds.push_back(clip.wind_speed);
+    }
+    if (progress) progress(static_cast<int>(i + 1), static_cast<int>(clips.size()));
+  }
+  return out;
+}
+
+FlyJudge TrainFlyJudge(const std::vector<cv::Mat>& maps, const FlyJudgeTrainOptions& o,
+                       const std::function<void(int, int, double)>& epoch_done) {
+  if (maps.empty()) throw std::invalid_argument("TrainFlyJudge: no maps to train on");
+  if (o.hidden < 1 || o.epochs < 1 || o.batch < 1 || !(o.learning_rate > 0) || !(o.weight_decay >= 0)) {
+    throw std::invalid_argument("TrainFlyJudge: hidden, epochs and batch must be >= 1, the learning rate > 0 and "
+                                "the weight decay >= 0");
+  }
+  at::manual_seed(o.seed);
+  torch::nn::Linear hidden(kMapSize, o.hidden), output(o.hidden, 1);
+  const auto logit = [&](const at::Tensor& x) {
+    return output->forward(torch::relu(hidden->forward(x.reshape({x.size(0), kMapSize})))).squeeze(1);
+  };
+  std::vector<at::Tensor> parameters = hidden->parameters();
+  for (const at::Tensor& p : output->parameters()) parameters.push_back(p);
+  torch::optim::Adam optimizer(parameters,
+                               torch::optim::AdamOptions(o.learning_rate).weight_decay(o.weight_decay));
+  const at::Tensor x = Stack(maps);
+  const at::Tensor mirrored = x.flip({2});  // each map mirrored left-right (its columns reversed)
+  std::vector<int64_t> order(maps.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937_64 rng(o.seed);
+  for (int epoch = 1; epoch <= o.epochs; ++epoch) {
+    std::shuffle(order.begin(), order.end(), rng);
+    double loss_sum = 0;
+    for (size_t i = 0; i < order.size(); i += o.batch) {
+      const size_t end = std::min(order.size(), i + o.batch);
+      const at::Tensor index = at::tensor(std::vector<int64_t>(order.begin() + i, order.begin() + end), at::kLong);
+      const at::Tensor score = logit(x.index_select(0, index)) - logit(mirrored.index_select(0, index));
+      const at::Tensor loss = torch::softplus(-score).mean();
+      optimizer.zero_grad();
+      loss.backward();
+      optimizer.step();
+      loss_sum += loss.item<double>() * static_cast<double>(end - i);
+    }
+    if (epoch_done) epoch_done(epoch, o.epochs, loss_sum / static_cast<double>(order.size()));
+  }
+  const at::Tensor w1 = hidden->weight.detach().contiguous(), b1 = hidden->bias.detach().contiguous();
+  const at::Tensor w2 = output->weight.detach().contiguous();
+  return FlyJudge(Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+                      w1.data_ptr<float>(), o.hidden, kMapSize),
+                  Eigen::Map<const Eigen::VectorXf>(b1.data_ptr<float>(), o.hidden),
+                  Eigen::Map<const Eigen::VectorXf>(w2.data_ptr<float>(), o.hidden),
+                  output->bias.detach().item<float>());
+}
+
+FlyJudgeAccuracy MeasureFlyJudge(const FlyJudge& judge, const MotionMaps& maps, double band_width, int bands) {
+  if (!(band_width > 0) || bands < 1) throw std::invalid_argument("MeasureFlyJudge: band_width > 0, bands >= 1");
+  FlyJudgeAccuracy a;
+  for (int b = 0; b < bands; ++b) a.bands.push_back({b * band_width, (b + 1) * band_width, 0, 0});
+  for (size_t i = 0; i < maps.maps.size(); ++i) {
+    const double score = judge.Score(maps.maps[i]);
+    const bool right = score > 0;
+    ++a.count;
+    a.right += right;
+    a.undecided += score == 0;
+    const int b = std::clamp(static_cast<int>(maps.wind_speeds[i] / band_width), 0, bands - 1);
+    ++a.bands[b].count;
+    a.bands[b].right += right;
+  }
+  return a;
+}
+
+nlohmann::json ToJson(const FlyJudgeAccuracy& a) {
+  nlohmann::json bands = nlohmann::json::array();
+  for (const auto& b : a.bands) {
+    bands.push_back({{"low", b.low},
+                     {"high", b.high},
+                     {"count", b.count},
+                     {"accuracy", b.count > 0 ? static_cast<double>(b.right) / b.count : 0.0}});
+  }
+  return {{"count", a.count}, {"right", a.right}, {"undecided", a.undecided}, {"accuracy", a.accuracy()},
+          {"bands", bands}};
+}
+
+}  // namespace clothwind::learn

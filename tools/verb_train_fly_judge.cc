@@ -1,0 +1,126 @@
+// clothwind train-fly-judge: trains the learned judge of which way a flag flies (learn/fly_judge.h)
+// on a dataset's training clips, measures it on every split (each clip and, by the judge's
+// antisymmetry, its mirror image) and writes it with a card of how it was made and how often it
+// is right. A model trained without flips (train --no-flip) uses the judge beside it on
+// ~flag_flies auto (docs/sdn.md, "Flags that fly left").
+#include <ATen/Parallel.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "learn/dataset.h"
+#include "learn/fly_judge_train.h"
+#include "learn/model_config.h"
+#include "progress_bar.h"
+#include "verb_registry.h"
+
+namespace clothwind::tools {
+namespace {
+
+struct JudgeArgs {
+  std::string data, out;
+  int windows = 3, frames = 30, threads = 2;
+  learn::FlyJudgeTrainOptions train;
+};
+
+learn::MotionMaps Collect(const learn::Dataset& dataset, const std::string& split, int frames, int windows) {
+  const std::vector<learn::ClipInfo> clips = learn::SelectSplit(dataset, split);
+  ProgressBar::Options b;
+  b.label = "motion maps (" + split + ")";
+  b.unit = "clips";
+  b.rate_unit = "clips/s";
+  ProgressBar bar(b);
+  learn::MotionMaps maps = learn::CollectMotionMaps(clips, frames, windows, [&](int d, int t) { bar.Update(d, t); });
+  bar.Finish();
+  return maps;
+}
+
+// One line of the table: split, windows, right, accuracy and the accuracy per band.
+std::string Row(const std::string& split, const learn::FlyJudgeAccuracy& a) {
+  char line[256];
+  std::snprintf(line, sizeof line, "%-6s %7d %7d %9.2f %%", split.c_str(), a.count, a.right, 100 * a.accuracy());
+  std::string row = line;
+  for (const auto& b : a.bands) {
+    std::snprintf(line, sizeof line, " %8.2f", b.count > 0 ? 100.0 * b.right / b.count : 0.0);
+    row += line;
+  }
+  return row + "\n";
+}
+
+VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<int()> {
+  auto a = std::make_shared<JudgeArgs>();
+  auto* sub = app.add_subcommand("train-fly-judge",
+                                 "train the judge of which way a flag flies (for models trained with --no-flip) on a "
+                                 "dataset of flags that fly right, and measure it on every split");
+  sub->add_option("--data", a->data, "dataset folder (its flags must all fly right, as FlagSim's do)")->required();
+  sub->add_option("--out", a->out, "weights file, e.g. models/fly_judge.pt (its card .json is written beside it)")
+      ->required();
+  sub->add_option("--windows", a->windows, "evenly spaced training windows per clip (val and test: the centred one)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_option("--frames", a->frames, "frames per window (the models')")->check(CLI::Range(2, 10000))->capture_default_str();
+  sub->add_option("--hidden", a->train.hidden, "hidden units")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--epochs", a->train.epochs, "passes over the training maps")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--batch", a->train.batch, "maps per Adam step")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--lr", a->train.learning_rate, "Adam's learning rate")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--weight-decay", a->train.weight_decay, "Adam's L2 term")->check(CLI::NonNegativeNumber)->capture_default_str();
+  sub->add_option("--seed", a->train.seed, "initialisation and order")->capture_default_str();
+  sub->add_option("--threads", a->threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
+  return [a]() {
+    at::set_num_threads(a->threads);
+    const learn::Dataset dataset = learn::ReadDataset(a->data);
+    const learn::MotionMaps train = Collect(dataset, "train", a->frames, a->windows);
+    if (train.maps.empty()) {
+      std::cerr << "train-fly-judge: " << (std::filesystem::path(a->data) / "index.json").string()
+                << " lists no clips in split train\n";
+      return 2;
+    }
+    const learn::MotionMaps val = Collect(dataset, "val", a->frames, 1);
+    const learn::MotionMaps test = Collect(dataset, "test", a->frames, 1);
+
+    ProgressBar::Options b;
+    b.label = "train-fly-judge";
+    b.unit = "epochs";
+    b.rate_unit = "epochs/s";
+    ProgressBar bar(b);
+    const learn::FlyJudge judge = learn::TrainFlyJudge(train.maps, a->train, [&](int epoch, int epochs, double loss) {
+      bar.Update(epoch, epochs, "loss " + std::to_string(loss));
+    });
+    bar.Finish();
+
+    nlohmann::json accuracy;
+    std::ostringstream table;
+    table << "split   windows   right  accuracy    by wind speed [m/s]: 0-2      2-4      4-6      6-8      8-\n";
+    for (const auto& [name, maps] : {std::pair{"train", &train}, std::pair{"val", &val}, std::pair{"test", &test}}) {
+      if (maps->maps.empty()) continue;
+      const learn::FlyJudgeAccuracy acc = learn::MeasureFlyJudge(judge, *maps);
+      accuracy[name] = learn::ToJson(acc);
+      table << Row(name, acc);
+    }
+    std::cout << table.str()
+              << "(each clip's mirror image is judged left exactly as often: the score is antisymmetric)\n";
+    nlohmann::json card = {
+        {"what", "clothwind fly-direction judge (learn/fly_judge.h): which way a flag flies, for models trained "
+                 "with --no-flip"},
+        {"data", std::filesystem::absolute(a->data).lexically_normal().string()},
+        {"train_windows_per_clip", a->windows},
+        {"frames", a->frames},
+        {"epochs", a->train.epochs},
+        {"batch", a->train.batch},
+        {"learning_rate", a->train.learning_rate},
+        {"weight_decay", a->train.weight_decay},
+        {"seed", a->train.seed},
+        {"accuracy", accuracy}};
+    const std::filesystem::path parent = std::filesystem::path(a->out).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+    judge.Save(a->out, card);
+    std::cout << "wrote " << a->out << " and its card " << learn::ConfigPathFor(a->out).string() << "\n";
+    return 0;
+  };
+});
+
+}  // namespace
+}  // namespace clothwind::tools
