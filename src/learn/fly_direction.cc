@@ -34,15 +34,7 @@ std::vector<cv::Mat> AsDouble(const std::vector<cv::Mat>& frames) {
 }
 
 double MotionSkewness(const std::vector<cv::Mat>& f) {
-  const double n = static_cast<double>(f.size());
-  cv::Mat sum = cv::Mat::zeros(f[0].size(), CV_64F), sq = sum.clone();
-  for (const cv::Mat& x : f) {
-    sum += x;
-    sq += x.mul(x);
-  }
-  cv::Mat var = sq / n - (sum / n).mul(sum / n), sd;
-  cv::max(var, 0.0, var);
-  cv::sqrt(var, sd);
+  const cv::Mat sd = TemporalStd(f);
   cv::Mat profile;
   cv::reduce(sd, profile, 0, cv::REDUCE_SUM, CV_64F);
   std::vector<double> m(profile.begin<double>(), profile.end<double>());
@@ -112,6 +104,19 @@ double PhaseStep(const std::vector<cv::Mat>& f) {
 }
 
 }  // namespace
+
+cv::Mat TemporalStd(const std::vector<cv::Mat>& frames) {
+  const double n = static_cast<double>(frames.size());
+  cv::Mat sum = cv::Mat::zeros(frames[0].size(), CV_64F), sq = sum.clone();
+  for (const cv::Mat& x : frames) {
+    sum += x;
+    sq += x.mul(x);
+  }
+  cv::Mat mean = sum / n, var = sq / n - mean.mul(mean), sd;
+  cv::max(var, 0.0, var);  // rounding can make a still pixel's variance slightly negative
+  cv::sqrt(var, sd);
+  return sd;
+}
 
 std::string FlyDirectionName(FlyDirection direction) {
   return direction == FlyDirection::kRight ? "right" : "left";

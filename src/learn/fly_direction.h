@@ -65,6 +65,12 @@ constexpr double kPhaseWeight = 3.335;
 // Throws std::invalid_argument naming the frame and what was expected.
 FlyDirectionCues EstimateFlyDirection(const std::vector<cv::Mat>& frames);
 
+// Each pixel's standard deviation over time (population: divided by T), where a clip moves; the
+// motion cues' skewness and the fly judge's map (fly_judge.h) both read it.
+// Inputs: frames  T >= 1 CV_64FC1 images of one size, in any order.
+// Returns a CV_64FC1 image of that size.
+cv::Mat TemporalStd(const std::vector<cv::Mat>& frames);
+
 // The way a flag flies in a camera's picture from the anemometer's wind direction, for a model that
 // must be told (the clip's own motion is too often wrong). A flag flies downwind, so it flies to
 // the picture's right when the air moves toward the camera's right.

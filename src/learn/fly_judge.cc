@@ -42,7 +42,8 @@ cv::Mat MotionMap(const std::vector<cv::Mat>& frames) {
   }
   const cv::Size size = frames[0].size();
   const cv::Size side(kMotionMapSide, kMotionMapSide);
-  cv::Mat sum = cv::Mat::zeros(side, CV_64F), sq = sum.clone(), resized, x;
+  std::vector<cv::Mat> planes(frames.size());
+  cv::Mat resized;
   for (size_t t = 0; t < frames.size(); ++t) {
     const cv::Mat& f = frames[t];
     if ((f.type() != CV_8UC1 && f.type() != CV_32FC1) || f.size() != size || f.empty()) {
@@ -56,15 +57,10 @@ cv::Mat MotionMap(const std::vector<cv::Mat>& frames) {
     } else {
       cv::resize(f, resized, side, 0, 0, f.cols > kMotionMapSide ? cv::INTER_AREA : cv::INTER_LINEAR);
     }
-    resized.convertTo(x, CV_64F);
-    sum += x;
-    sq += x.mul(x);
+    resized.convertTo(planes[t], CV_64F);
   }
-  const double n = static_cast<double>(frames.size());
-  cv::Mat mean = sum / n, var = sq / n - mean.mul(mean), sd, grid;
-  cv::max(var, 0.0, var);  // rounding can make a still pixel's variance slightly negative
-  cv::sqrt(var, sd);
-  cv::resize(sd, grid, cv::Size(kMotionMapGrid, kMotionMapGrid), 0, 0, cv::INTER_AREA);
+  cv::Mat grid;
+  cv::resize(TemporalStd(planes), grid, cv::Size(kMotionMapGrid, kMotionMapGrid), 0, 0, cv::INTER_AREA);
   const double average = cv::mean(grid)[0];
   cv::Mat map;
   // A still clip (or one whose only change is 8-bit noise far below a grey level) has no shape.
