@@ -9,7 +9,10 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
 #include <opencv2/core.hpp>
+
+#include "learn/test_mirrored_frames.h"
 
 namespace clothwind::learn {
 namespace {
@@ -35,16 +38,6 @@ std::vector<cv::Mat> Clip(Amplitude amplitude, double k) {
     frames.push_back(f);
   }
   return frames;
-}
-
-std::vector<cv::Mat> Mirrored(const std::vector<cv::Mat>& frames) {
-  std::vector<cv::Mat> out;
-  for (const cv::Mat& f : frames) {
-    cv::Mat m;
-    cv::flip(f, m, 1);
-    out.push_back(m);
-  }
-  return out;
 }
 
 // A flag on a pole at column 8, flying right to column 40: still at the hoist, its ripples

@@ -15,11 +15,13 @@
 #include <unistd.h>
 
 #include <gtest/gtest.h>
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "learn/fly_judge_train.h"
 #include "learn/model_config.h"
+#include "learn/test_mirrored_frames.h"
 
 namespace clothwind::learn {
 namespace {
@@ -56,16 +58,6 @@ std::vector<cv::Mat> Clip(const FlagClip& c, std::mt19937_64& rng) {
     frames.push_back(f);
   }
   return frames;
-}
-
-std::vector<cv::Mat> Mirrored(const std::vector<cv::Mat>& frames) {
-  std::vector<cv::Mat> out;
-  for (const cv::Mat& f : frames) {
-    cv::Mat m;
-    cv::flip(f, m, 1);
-    out.push_back(m);
-  }
-  return out;
 }
 
 // A judge with random weights (H hidden units).

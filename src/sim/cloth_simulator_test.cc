@@ -13,6 +13,8 @@
 #include <Eigen/SVD>
 #include <gtest/gtest.h>
 
+#include "sim/test_expect_throw.h"
+
 namespace clothwind::sim {
 namespace {
 
@@ -331,15 +333,6 @@ TEST(ClothSimulatorTest, DeterministicAcrossInstancesAndThreads) {
   t2.join();
   EXPECT_TRUE(a == b);
   EXPECT_TRUE(a == c);
-}
-
-void ExpectThrowContaining(const std::function<void()>& fn, const std::string& needle) {
-  try {
-    fn();
-    ADD_FAILURE() << "expected an exception containing '" << needle << "'";
-  } catch (const std::exception& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
 }
 
 TEST(ClothSimulatorTest, BadInputsFailClearly) {

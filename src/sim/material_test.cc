@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include "sim/test_expect_throw.h"
+
 namespace clothwind::sim {
 namespace {
 
@@ -82,15 +84,6 @@ std::string WriteText(const std::string& name, const std::string& text) {
   const std::string path = ::testing::TempDir() + "/clothwind_material_test_" + name;
   std::ofstream(path) << text;
   return path;
-}
-
-void ExpectThrowContaining(const std::function<void()>& fn, const std::string& needle) {
-  try {
-    fn();
-    ADD_FAILURE() << "expected an exception containing '" << needle << "'";
-  } catch (const std::exception& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
 }
 
 TEST(MaterialTest, BadFilesFailNamingFileAndField) {

@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include "sim/test_expect_throw.h"
+
 namespace clothwind::sim {
 namespace {
 
@@ -79,15 +81,6 @@ TEST(ObjTest, ReadsSlashFormsAndNegativeIndices) {
   EXPECT_EQ(m.U(1, 0), 1.0);  // from vt, not from x
   EXPECT_DOUBLE_EQ(SurfaceArea(m), 2.0);
   EXPECT_DOUBLE_EQ(RestArea(m), 0.5);
-}
-
-void ExpectThrowContaining(const std::function<void()>& fn, const std::string& needle) {
-  try {
-    fn();
-    ADD_FAILURE() << "expected an exception containing '" << needle << "'";
-  } catch (const std::exception& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
 }
 
 TEST(ObjTest, BadInputsFailWithFileAndLine) {
