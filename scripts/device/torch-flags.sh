@@ -1,6 +1,6 @@
 # Sourced by scripts/device-check and scripts/device-train: where libtorch is on this machine and
-# how to compile against it. Needs $cxx (the C++ compiler) and $out (where environment.txt goes);
-# sets abi, torch_inc, torch_lib and std.
+# how to compile against it. Needs $cxx (the C++ compiler), $out (where environment.txt goes) and
+# $root (the checkout); sets abi, torch_inc, torch_lib, std and launcher.
 #
 # The Python package's copy of libtorch has CUDA where Debian's has not; without Python's PyTorch
 # (as here) it falls back to Debian's, CPU only, which checks the scripts before a GPU is spent.
@@ -22,3 +22,9 @@ torch_lib="$torch_lib -ltorch -ltorch_cpu -lc10"
 # Newer libtorch headers want C++20; take the newest standard the compiler offers of the two.
 std=c++17
 echo 'int main(){}' | "$cxx" -std=c++20 -x c++ - -o /dev/null 2>/dev/null && std=c++20
+# ccache where there is one (here, not on the GPU machine), paths relative to the checkout
+# ($root), so CI's clean clone reuses the objects the last check compiled: prefix compiles with
+# "${launcher[@]}" (empty: the compiler alone).
+launcher=()
+# (an if, not &&: this file's last status is `source`'s, and the callers run under set -e)
+if command -v ccache >/dev/null; then launcher=(env CCACHE_BASEDIR="$root" ccache); fi
