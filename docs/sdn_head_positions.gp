@@ -35,7 +35,7 @@ set yrange [0.15:0.48]
 set grid
 set key top left
 set arrow from graph 0, first 0.343 to graph 1, first 0.343 nohead dt 2 lw 2 lc rgb "#606060"
-set label "shipped SDN 0.343" at 0.9, 0.336 tc rgb "#606060"
+set label "SDN aux2-e5c20 (shipped to 2026-12-03) 0.343" at 0.55, 0.336 tc rgb "#606060"
 set arrow from graph 0, first 0.25 to graph 1, first 0.25 nohead dt 2 lw 2 lc rgb "#c00000"
 set label "issue's target 0.25" at 0.9, 0.243 tc rgb "#c00000"
 set arrow from graph 0, first 0.18 to graph 1, first 0.18 nohead dt 3 lw 1.5 lc rgb "#404040"
