@@ -3,6 +3,10 @@
 # average's against the trained weights' own, from each run's log.tsv (val_rmse, raw_val_rmse).
 # docs/sdn-experiments.md, "Averaged weights". Regenerate from the repository root with
 #   gnuplot docs/sdn_weight_average.gp
+# It also draws docs/sdn_weight_average_e5.png: the shipped SDN's run on the whole of flagsim-e5
+# (`... --no-flip --weight-average 0.999`, runs/nfwa-e5c20), whose trained weights are the run
+# shipped before it (runs/nf-e5c20) epoch for epoch; docs/sdn-experiments.md, "The weight average
+# on the whole of e5".
 $curves << EOD
 # epoch, seed 3: average, trained weights; seed 2: average, trained weights (validation RMSE [m/s])
 1 0.6552 1.7139 0.7013 0.7399
@@ -39,3 +43,34 @@ plot $curves using 1:3 with linespoints pt 6 lw 1.5 lc rgb "#9ab6d8" title "seed
      $curves using 1:2 with linespoints pt 7 lw 2 lc rgb "#1f4e9a" title "seed 3, weight average", \
      $curves using 1:5 with linespoints pt 4 lw 1.5 lc rgb "#f2b48a" title "seed 2, trained weights", \
      $curves using 1:4 with linespoints pt 5 lw 2 lc rgb "#c0501a" title "seed 2, weight average"
+
+$e5 << EOD
+# epoch, weight average, trained weights (validation RMSE [m/s], 2540 clips)
+1 0.4738 0.6569
+2 0.4381 0.8173
+3 0.4467 0.5922
+4 0.4161 1.1675
+5 0.3990 0.4862
+6 0.4018 0.4725
+7 0.3947 0.4061
+8 0.3996 0.4720
+9 0.4050 0.4818
+10 0.3910 0.4735
+11 0.3749 0.4486
+12 0.3646 0.3961
+13 0.3564 0.3938
+14 0.3511 0.3879
+15 0.3445 0.3709
+16 0.3418 0.3553
+17 0.3397 0.3556
+18 0.3379 0.3448
+19 0.3387 0.3467
+20 0.3389 0.3420
+EOD
+set output "docs/sdn_weight_average_e5.png"
+set title "Validation RMSE per epoch on flagsim-e5: the weight average against the trained weights"
+set yrange [0.32:0.70]
+set arrow from 0.5, 0.3420 to 20.5, 0.3420 nohead dt 2 lc rgb "#808080"
+set label "model shipped before: 0.3420" at 1, 0.3365 tc rgb "#606060"
+plot $e5 using 1:3 with linespoints pt 6 lw 1.5 lc rgb "#9ab6d8" title "trained weights (the run shipped before)", \
+     $e5 using 1:2 with linespoints pt 7 lw 2 lc rgb "#1f4e9a" title "weight average 0.999 (best, epoch 18: shipped)"
