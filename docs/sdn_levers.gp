@@ -55,7 +55,7 @@ $levers << EOD
 48 0.334 0.329 0 "weight average on the no-flip run (all of e5, paired)"
 49 0.329 0.314 0 "96-px input, width 32, with the weight average, no flips (all of e5)"
 EOD
-set terminal pngcairo size 1150,900 font "DejaVu Sans,10"
+set terminal pngcairo size 1250,900 font "DejaVu Sans,10"
 set output "docs/sdn_levers.png"
 set title "What each measured change did to the SDN's test RMSE (one window; arrow: control → change)"
 set xlabel "test RMSE [m/s]"
