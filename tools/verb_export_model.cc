@@ -43,6 +43,10 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
       std::cerr << "export-model: --out must differ from --model (" << a->out << ")\n";
       return 2;
     }
+    // As `train --out`, the output's folder is made when missing, before the minute of loading and
+    // calibrating rather than at the write after it.
+    const std::filesystem::path folder = std::filesystem::path(a->out).parent_path();
+    if (!folder.empty()) std::filesystem::create_directories(folder);
     learn::WindNet net = learn::LoadWindNet(a->model);
     // A head trained beside the wind's (--aux-tracks) only shaped the trunk: no estimate reads it.
     if (net->config().aux_outputs > 0) {

@@ -1,5 +1,7 @@
 #include "learn/model_config.h"
 
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -237,9 +239,11 @@ void WriteFileAtomically(const std::filesystem::path& path, const std::string& t
   tmp += ".tmp" + std::to_string(::getpid());
   {
     std::ofstream out(tmp, std::ios::binary);
+    // errno is read at once: the stream's failure leaves it set by open() or write().
+    if (!out) throw std::runtime_error(tmp.string() + ": cannot write (" + std::strerror(errno) + ")");
     out << text;
     out.flush();
-    if (!out) throw std::runtime_error(tmp.string() + ": cannot write");
+    if (!out) throw std::runtime_error(tmp.string() + ": cannot write (" + std::strerror(errno) + ")");
   }
   std::filesystem::rename(tmp, path);
 }

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -51,6 +52,24 @@ TEST_F(WeightsIoTest, Float32RoundTripIsExact) {
   auto ba = a->named_buffers(), bb = b->named_buffers();
   for (const auto& item : ba) EXPECT_TRUE(at::equal(item.value(), bb[item.key()])) << item.key();
   EXPECT_EQ(bb["1.num_batches_tracked"].scalar_type(), at::kLong);
+}
+
+// A write into a folder that is not there fails naming the file it tried and why, and leaves
+// nothing behind; the same text into an existing folder lands whole under its final name.
+TEST_F(WeightsIoTest, AtomicWriteNamesTheFileAndTheReason) {
+  const fs::path missing = dir_ / "no_such_folder" / "model.json";
+  try {
+    WriteFileAtomically(missing, "{}\n");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find((dir_ / "no_such_folder" / "model.json.tmp").string()), std::string::npos) << what;
+    EXPECT_NE(what.find("No such file or directory"), std::string::npos) << what;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "no_such_folder"));
+  WriteFileAtomically(dir_ / "model.json", "{\"a\": 1}\n");
+  EXPECT_EQ(fs::file_size(dir_ / "model.json"), 9u);
+  for (const auto& entry : fs::directory_iterator(dir_)) EXPECT_EQ(entry.path().filename(), "model.json");
 }
 
 TEST_F(WeightsIoTest, Float16HalvesTheFileAndRoundsEachParameterOnce) {
