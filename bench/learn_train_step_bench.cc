@@ -7,6 +7,10 @@
 // network and optimiser live on the GPU and each timed call ends in a device synchronisation, so
 // wall time is the GPU's (scripts/device-check runs it so on a lent GPU machine).
 //
+// The layer runs its CPU selection in one pass (learn/spectral_peaks_cpu.h); "tensor ops" times
+// the same layer through tensor operations (SpectralOptions::one_pass false, as on a GPU), the
+// way it ran before that pass, to show what the pass saves.
+//
 // Freed memory is kept for reuse as `clothwind train` keeps it (learn/heap_reuse.h); --glibc-heap
 // leaves glibc's defaults, to measure what that saves.
 //
@@ -115,8 +119,8 @@ int main(int argc, char** argv) {
   std::printf("SDN training step on %s, batch %d x 30 frames, width %d, k 3, phase steps, %d thread(s), median of %d, %s\n",
               device_name.c_str(), batch, width, threads, repeats,
               glibc_heap ? "glibc's default heap" : "freed heap kept for reuse");
-  std::printf("%-6s %-5s | %-17s | %-17s | %-17s\n", "input", "pool", "layer wall/cpu ms", "trunk input ms",
-              "whole step ms");
+  std::printf("%-6s %-5s | %-17s | %-17s | %-17s | %-17s\n", "input", "pool", "layer wall/cpu ms",
+              "tensor ops ms", "trunk input ms", "whole step ms");
   for (const Case& c : cases) {
     cl::ModelConfig config;
     config.arch = "sdn";
@@ -137,6 +141,12 @@ int main(int argc, char** argv) {
       at::NoGradGuard no_grad;
       cl::SpectralDecomposition(clips, config.Spectral());
     });
+    cl::SpectralOptions tensor_ops = config.Spectral();
+    tensor_ops.one_pass = false;
+    const Timing layer_tensor_ops = Measure(repeats, cuda, [&] {
+      at::NoGradGuard no_grad;
+      cl::SpectralDecomposition(clips, tensor_ops);
+    });
     const Timing input = Measure(repeats, cuda, [&] {
       at::NoGradGuard no_grad;
       net->TrunkInput(clips);
@@ -146,8 +156,9 @@ int main(int argc, char** argv) {
       cl::WindLoss(net->forward(clips), target).backward();
       adam.step();
     });
-    std::printf("%-6d %-5d | %7.1f / %7.1f | %7.1f / %7.1f | %7.1f / %7.1f\n", c.input_size, c.spectral_pool,
-                layer.wall_ms, layer.cpu_ms, input.wall_ms, input.cpu_ms, step.wall_ms, step.cpu_ms);
+    std::printf("%-6d %-5d | %7.1f / %7.1f | %7.1f / %7.1f | %7.1f / %7.1f | %7.1f / %7.1f\n", c.input_size,
+                c.spectral_pool, layer.wall_ms, layer.cpu_ms, layer_tensor_ops.wall_ms, layer_tensor_ops.cpu_ms,
+                input.wall_ms, input.cpu_ms, step.wall_ms, step.cpu_ms);
   }
   return 0;
 }

@@ -8,9 +8,17 @@
 
 #include <ATen/ATen.h>
 
+#include "learn/spectral_peaks_cpu.h"
+
 namespace clothwind::learn {
 
 namespace {
+
+// ε of the phase steps' normalisation: 1e-6 of the mean |X|² over all bins of the one-sided
+// spectra [N_b C H W, F] (complex), so that still pixels read ~0.
+double PhaseStepEps(const at::Tensor& spectrum) {
+  return 1e-6 * (at::real(spectrum).square() + at::imag(spectrum).square()).mean().item<double>() + 1e-30;
+}
 
 // Phase steps over each of `distances` pixels from the one-sided spectra [N_b C H W, F] (complex)
 // and each pixel's strongest bin [N_b C H W, 1] (index into F): [N_b, 4C·#distances, H, W]
@@ -22,7 +30,7 @@ at::Tensor PhaseSteps(const at::Tensor& spectrum, const at::Tensor& bin, int64_t
   at::Tensor re = at::real(spectrum).reshape({nb, c, h, w, f});
   at::Tensor im = at::imag(spectrum).reshape({nb, c, h, w, f});
   at::Tensor index = bin.reshape({nb, c, h, w, 1});
-  const double eps = 1e-6 * (re.square() + im.square()).mean().item<double>() + 1e-30;
+  const double eps = PhaseStepEps(spectrum);
   // One step along spatial dimension `dim` (2: y, down; 3: x, right): pixel p's bin read at p and
   // at the pixel d further, then their normalised cross product.
   auto step = [&](int64_t dim, int64_t d) {
@@ -121,6 +129,24 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
   // carries the pixel's windowed mean brightness.
   if (!include_dc) signals = signals - signals.mean(1, /*keepdim=*/true);
   at::Tensor spectrum = at::fft_rfft(signals * window, length, /*dim=*/1);
+  std::vector<int64_t> distances;
+  if (options.phase_steps) {
+    distances.push_back(1);
+    if (options.phase_step_far > 1) distances.push_back(options.phase_step_far);
+  }
+  // On the CPU, without autograd, the selection runs in one pass over the spectra (on one
+  // thread at a 96-px input at::topk and the phase steps' gathers were two thirds of the
+  // layer's time); it gives the tensor path's maps bit for bit. Local peaks and the mode shape
+  // keep the tensor path.
+  const bool one_pass = options.one_pass && x.device().is_cpu() && !options.local_peaks &&
+                        !options.mode_shape && !(at::GradMode::is_enabled() && x.requires_grad());
+  if (one_pass) {
+    spectrum = spectrum.contiguous();
+    const double eps = options.phase_steps ? PhaseStepEps(spectrum) : 0.0;
+    SpectralPeaks peaks = SpectralPeaksCpu(spectrum, window.square().sum(), first, candidates, k,
+                                           frame_rate / static_cast<double>(length), nb, c, h, w, distances, eps);
+    return SpectralMaps{peaks.power, peaks.frequency, peaks.phase, at::Tensor()};
+  }
   at::Tensor periodogram = (at::real(spectrum).square() + at::imag(spectrum).square()) /
                            window.square().sum();
   periodogram = periodogram.narrow(1, first, candidates);
@@ -149,11 +175,7 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
     return t.reshape({nb, c, h, w, k}).permute({0, 1, 4, 2, 3}).reshape({nb, c * k, h, w});
   };
   SpectralMaps maps{to_map(power), to_map(frequency), at::Tensor(), at::Tensor()};
-  if (options.phase_steps) {
-    std::vector<int64_t> distances = {1};
-    if (options.phase_step_far > 1) distances.push_back(options.phase_step_far);
-    maps.phase = PhaseSteps(spectrum, bin.narrow(1, 0, 1) + first, nb, c, h, w, distances);
-  }
+  if (options.phase_steps) maps.phase = PhaseSteps(spectrum, bin.narrow(1, 0, 1) + first, nb, c, h, w, distances);
   if (options.mode_shape) maps.mode = ModeShape(spectrum, periodogram, first, nb, c, h, w);
   return maps;
 }

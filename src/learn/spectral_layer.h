@@ -39,6 +39,11 @@ struct SpectralOptions {
   // noise; against one reference the whole flag's phase ramp shows at once, as stripes whose
   // spacing is the wavelength (with the frequency, the wave's speed, which grows with the wind).
   bool mode_shape = false;
+  // On the CPU, select the peaks and phase steps in one pass over the spectra
+  // (learn/spectral_peaks_cpu.h) instead of through tensor ops: the same maps bit for bit, in
+  // less time. The tensor ops run anyway on other devices, with autograd (a clip that requires
+  // grad), with local_peaks and with mode_shape; false asks for them here too (to compare).
+  bool one_pass = true;
 };
 
 // Power and frequency maps of a batch of clips.
