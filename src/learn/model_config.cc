@@ -238,12 +238,13 @@ void WriteFileAtomically(const std::filesystem::path& path, const std::string& t
   std::filesystem::path tmp = path;
   tmp += ".tmp" + std::to_string(::getpid());
   {
+    // errno is read right after the failing step, while open() or write() still holds it there.
+    auto fail = [&tmp] { throw std::runtime_error(tmp.string() + ": cannot write (" + std::strerror(errno) + ")"); };
     std::ofstream out(tmp, std::ios::binary);
-    // errno is read at once: the stream's failure leaves it set by open() or write().
-    if (!out) throw std::runtime_error(tmp.string() + ": cannot write (" + std::strerror(errno) + ")");
+    if (!out) fail();
     out << text;
     out.flush();
-    if (!out) throw std::runtime_error(tmp.string() + ": cannot write (" + std::strerror(errno) + ")");
+    if (!out) fail();
   }
   std::filesystem::rename(tmp, path);
 }
