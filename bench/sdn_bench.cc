@@ -5,9 +5,11 @@
 // initialised in a temporary folder (speed does not depend on the weights). Prints a table.
 // --model benches given trained models (e.g. the shipped models/sdn.pt) instead of the
 // initialised ones; --flag-flies auto adds judging each clip's way from its motion, as sdn_node
-// does for a model trained without flips (learn/fly_direction.h).
+// does for a model trained without flips (learn/fly_direction.h). The convolutions run in
+// channels-last order, as the Predictor runs them on the CPU; --both-orders times each model in
+// torch's default order too (column "order": nhwc, nchw), to show what that order saves.
 //
-//   sdn_bench [--repeats N] [--quick] [--model PATH.pt ...] [--flag-flies right|left|auto]
+//   sdn_bench [--repeats N] [--quick] [--model PATH.pt ...] [--flag-flies right|left|auto] [--both-orders]
 
 #include <unistd.h>
 
@@ -47,13 +49,17 @@ int main(int argc, char** argv) {
   bool quick = false;
   std::vector<fs::path> given;
   std::string flag_flies;
+  bool both_orders = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--quick")) quick = true;
     else if (!std::strcmp(argv[i], "--model") && i + 1 < argc) given.push_back(argv[++i]);
     else if (!std::strcmp(argv[i], "--flag-flies") && i + 1 < argc) flag_flies = argv[++i];
+    else if (!std::strcmp(argv[i], "--both-orders")) both_orders = true;
     else {
-      std::fprintf(stderr, "usage: sdn_bench [--repeats N] [--quick] [--model PATH.pt ...] [--flag-flies right|left|auto]\n");
+      std::fprintf(stderr,
+                   "usage: sdn_bench [--repeats N] [--quick] [--model PATH.pt ...] [--flag-flies right|left|auto] "
+                   "[--both-orders]\n");
       return 2;
     }
   }
@@ -81,7 +87,7 @@ int main(int argc, char** argv) {
     cv::merge(std::vector<cv::Mat>{cv::Mat::zeros(f.size(), CV_8UC1), 255 - f, f}, bgr);
     bgr_frames.push_back(bgr);
   }
-  std::printf("%-28s %7s %10s %10s %10s %14s\n", "model", "threads", "mean [ms]", "p90 [ms]",
+  std::printf("%-28s %7s %5s %10s %10s %10s %14s\n", "model", "threads", "order", "mean [ms]", "p90 [ms]",
               "min [ms]", "cpu/clip [ms]");
   std::vector<fs::path> models = given;
   for (const Case& c : cases) {
@@ -97,27 +103,30 @@ int main(int argc, char** argv) {
   }
   for (const fs::path& model : models) {
     for (int threads : {1, 2}) {
-      cl::Predictor p(model, threads, "cpu");
-      if (!flag_flies.empty()) p.set_flag_flies(way);
-      const bool colour = p.config().colour;
-      const std::vector<cv::Mat>& clip = colour ? bgr_frames : grey_frames;
-      p.PredictFrames(cl::CameraFramesForModel(clip, colour));  // warm-up, as the node does
-      std::vector<double> ms;
-      const double cpu0 = ProcessCpuMs();
-      for (int i = 0; i < repeats; ++i) {
-        const double t0 = WallMs();
-        p.PredictFrames(cl::CameraFramesForModel(clip, colour));
-        ms.push_back(WallMs() - t0);
+      for (bool channels_last : both_orders ? std::vector<bool>{true, false} : std::vector<bool>{true}) {
+        cl::Predictor p(model, threads, "cpu", channels_last);
+        if (!flag_flies.empty()) p.set_flag_flies(way);
+        const bool colour = p.config().colour;
+        const std::vector<cv::Mat>& clip = colour ? bgr_frames : grey_frames;
+        p.PredictFrames(cl::CameraFramesForModel(clip, colour));  // warm-up, as the node does
+        std::vector<double> ms;
+        const double cpu0 = ProcessCpuMs();
+        for (int i = 0; i < repeats; ++i) {
+          const double t0 = WallMs();
+          p.PredictFrames(cl::CameraFramesForModel(clip, colour));
+          ms.push_back(WallMs() - t0);
+        }
+        const double cpu = (ProcessCpuMs() - cpu0) / repeats;
+        std::sort(ms.begin(), ms.end());
+        double mean = 0;
+        for (double m : ms) mean += m;
+        mean /= ms.size();
+        const std::string name = p.config().Name() + (flag_flies.empty() ? "" : " " + flag_flies);
+        std::printf("%-28s %7d %5s %10.1f %10.1f %10.1f %14.1f\n", name.c_str(), threads,
+                    channels_last ? "nhwc" : "nchw", mean, ms[std::min(ms.size() - 1, ms.size() * 9 / 10)], ms.front(),
+                    cpu);
+        std::fflush(stdout);
       }
-      const double cpu = (ProcessCpuMs() - cpu0) / repeats;
-      std::sort(ms.begin(), ms.end());
-      double mean = 0;
-      for (double m : ms) mean += m;
-      mean /= ms.size();
-      const std::string name = p.config().Name() + (flag_flies.empty() ? "" : " " + flag_flies);
-      std::printf("%-28s %7d %10.1f %10.1f %10.1f %14.1f\n", name.c_str(), threads, mean,
-                  ms[std::min(ms.size() - 1, ms.size() * 9 / 10)], ms.front(), cpu);
-      std::fflush(stdout);
     }
   }
   fs::remove_all(dir);

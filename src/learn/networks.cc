@@ -293,4 +293,13 @@ WindNet LoadWindNet(const std::filesystem::path& weights) {
   return net;
 }
 
+void UseChannelsLast(torch::nn::Module& module) {
+  at::NoGradGuard no_grad;
+  auto convert = [](at::Tensor& t) {
+    if (t.defined() && t.dim() == 4) t.set_data(t.data().contiguous(at::MemoryFormat::ChannelsLast));
+  };
+  for (at::Tensor& p : module.parameters()) convert(p);
+  for (at::Tensor& b : module.buffers()) convert(b);
+}
+
 }  // namespace clothwind::learn

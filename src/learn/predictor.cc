@@ -21,7 +21,8 @@ struct Predictor::Impl {
   at::Device device = at::kCPU;
 };
 
-Predictor::Predictor(const std::filesystem::path& weights, int threads, const std::string& device)
+Predictor::Predictor(const std::filesystem::path& weights, int threads, const std::string& device,
+                     bool channels_last)
     : impl_(std::make_unique<Impl>()) {
   // Flush denormals to zero: weight decay drives many weights and activations towards zero, and
   // denormal floats made CPU training epochs 3x slower after ~10 epochs. Set before the intra-op
@@ -38,6 +39,7 @@ Predictor::Predictor(const std::filesystem::path& weights, int threads, const st
   impl_->net = LoadWindNet(weights);
   impl_->net->to(impl_->device);
   impl_->net->eval();
+  if (channels_last && impl_->device.is_cpu()) UseChannelsLast(*impl_->net);
   flag_flies_ = config().DefaultFlagFlies();
   const std::filesystem::path beside = weights.parent_path() / kFlyJudgeFile;
   if (std::filesystem::exists(beside)) LoadFlyJudge(beside);

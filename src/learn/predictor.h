@@ -33,8 +33,12 @@ class Predictor {
   //   weights  a model saved by training (model.pt with model.json beside it)
   //   threads  torch intra-op threads (process-wide setting)
   //   device   "cpu", "cuda" (error when absent) or "auto" (CUDA when libtorch finds one)
+  //   channels_last  on the CPU, run the convolutions in channels-last order (UseChannelsLast:
+  //            ~10 % faster, the same predictions to float rounding); false keeps torch's
+  //            default order (bench/sdn_bench --both-orders measures the difference)
   // Throws std::runtime_error naming the file when the model cannot be loaded.
-  Predictor(const std::filesystem::path& weights, int threads, const std::string& device);
+  Predictor(const std::filesystem::path& weights, int threads, const std::string& device,
+            bool channels_last = true);
   ~Predictor();
   Predictor(const Predictor&) = delete;
   Predictor& operator=(const Predictor&) = delete;

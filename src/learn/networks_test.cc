@@ -1,0 +1,105 @@
+// UseChannelsLast: the convolutions' kernels change memory order and nothing else, so a network
+// answers as in torch's default order to float rounding, and so does the Predictor built on it.
+#include "learn/networks.h"
+
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include "learn/predictor.h"
+
+namespace clothwind::learn {
+namespace {
+
+// The shipped SDN's shape at a smaller input: grey clips, k = 3 with phase steps, width 8.
+ModelConfig SmallSdn() {
+  ModelConfig config;
+  config.arch = "sdn";
+  config.frames = 30;
+  config.k = 3;
+  config.phase_steps = true;
+  config.width = 8;
+  config.input_size = 32;
+  return config;
+}
+
+// Clips whose pixels oscillate at frequencies that vary across the frame, plus noise: the
+// spectral maps then vary, so the trunk's convolutions see varied inputs.
+at::Tensor WavyClips(int64_t n, int64_t size) {
+  at::manual_seed(7);
+  const at::Tensor t = at::arange(30, at::kFloat).reshape({1, 1, 30, 1, 1});
+  const at::Tensor x = at::arange(size, at::kFloat).reshape({1, 1, 1, 1, size});
+  const at::Tensor phase = at::rand({n, 1, 1, 1, 1}) * 6.0;
+  return at::sin(0.4 * t + 0.3 * x + phase) + 0.1 * at::randn({n, 1, 30, size, size});
+}
+
+TEST(UseChannelsLastTest, ConvertsEveryKernelAndKeepsTheValues) {
+  at::manual_seed(1);
+  WindNet net(SmallSdn());
+  net->eval();
+  std::vector<at::Tensor> before;
+  for (const at::Tensor& p : net->parameters()) before.push_back(p.detach().clone());
+  UseChannelsLast(*net);
+  int kernels = 0;
+  size_t i = 0;
+  for (const at::Tensor& p : net->parameters()) {
+    EXPECT_TRUE(at::equal(p, before[i++]));
+    if (p.dim() == 4) {
+      ++kernels;
+      EXPECT_TRUE(p.is_contiguous(at::MemoryFormat::ChannelsLast));
+      // A 1x1 kernel's two orders are one and the same layout; a larger one's are not.
+      if (p.size(2) > 1) {
+        EXPECT_FALSE(p.is_contiguous());
+      }
+    }
+  }
+  // ResNet-18: the stem, 16 convolutions in the stages and 3 projection shortcuts.
+  EXPECT_EQ(kernels, 20);
+}
+
+TEST(UseChannelsLastTest, NetworkAnswersAsInTheDefaultOrder) {
+  at::manual_seed(2);
+  WindNet first(SmallSdn());
+  // Train-mode steps so the batch norms' running statistics are not the identity.
+  {
+    torch::optim::Adam adam(first->parameters(), torch::optim::AdamOptions(1e-3));
+    first->train();
+    for (int step = 0; step < 3; ++step) {
+      adam.zero_grad();
+      WindLoss(first->forward(WavyClips(4, 32)), at::randn({4})).backward();
+      adam.step();
+    }
+  }
+  first->eval();
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("clothwind_networks_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  SaveWindNet(first, dir / "model.pt");
+  WindNet last = LoadWindNet(dir / "model.pt");
+  UseChannelsLast(*last);
+  at::NoGradGuard no_grad;
+  const at::Tensor clips = WavyClips(5, 32);
+  const at::Tensor a = first->forward(clips), b = last->forward(clips);
+  ASSERT_EQ(a.sizes(), b.sizes());
+  EXPECT_TRUE(at::allclose(a, b, /*rtol=*/1e-4, /*atol=*/1e-5)) << (a - b).abs().max().item<double>();
+  // Not the same numbers by accident of an unconverted path: the outputs differ between clips.
+  EXPECT_GT((a.select(1, 0) - a.select(1, 0).mean()).abs().max().item<double>(), 1e-4);
+
+  // The Predictor converts on the CPU by default; without it, torch's order: same speeds.
+  Sample sample;
+  const at::Tensor one = clips[2].contiguous();
+  sample.pixels.assign(one.data_ptr<float>(), one.data_ptr<float>() + one.numel());
+  Predictor nhwc(dir / "model.pt", 1, "cpu"), nchw(dir / "model.pt", 1, "cpu", /*channels_last=*/false);
+  const Prediction p = nhwc.Predict({&sample})[0], q = nchw.Predict({&sample})[0];
+  const ModelConfig& c = first->config();
+  EXPECT_NEAR(q.speed, c.label_mean + c.label_std * a[2][0].item<double>(), 1e-5 * c.label_std);
+  EXPECT_NEAR(p.speed, q.speed, 1e-4 * c.label_std);
+  EXPECT_NEAR(p.speed_std, q.speed_std, 1e-4 * q.speed_std);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace clothwind::learn
