@@ -11,6 +11,10 @@
 // the same layer through tensor operations (SpectralOptions::one_pass false, as on a GPU), the
 // way it ran before that pass, to show what the pass saves.
 //
+// "val batch" times a validation batch (eval mode, no gradients) from the clips, and "val from
+// images" from their trunk input computed beforehand, as `clothwind train` keeps its validation
+// split's images (the layer has no weights), to show what keeping them saves each epoch.
+//
 // Freed memory is kept for reuse as `clothwind train` keeps it (learn/heap_reuse.h); --glibc-heap
 // leaves glibc's defaults, to measure what that saves.
 //
@@ -119,8 +123,8 @@ int main(int argc, char** argv) {
   std::printf("SDN training step on %s, batch %d x 30 frames, width %d, k 3, phase steps, %d thread(s), median of %d, %s\n",
               device_name.c_str(), batch, width, threads, repeats,
               glibc_heap ? "glibc's default heap" : "freed heap kept for reuse");
-  std::printf("%-6s %-5s | %-17s | %-17s | %-17s | %-17s\n", "input", "pool", "layer wall/cpu ms",
-              "tensor ops ms", "trunk input ms", "whole step ms");
+  std::printf("%-6s %-5s | %-17s | %-17s | %-17s | %-17s | %-17s | %-17s\n", "input", "pool", "layer wall/cpu ms",
+              "tensor ops ms", "trunk input ms", "whole step ms", "val batch ms", "val from images");
   for (const Case& c : cases) {
     cl::ModelConfig config;
     config.arch = "sdn";
@@ -156,9 +160,27 @@ int main(int argc, char** argv) {
       cl::WindLoss(net->forward(clips), target).backward();
       adam.step();
     });
-    std::printf("%-6d %-5d | %7.1f / %7.1f | %7.1f / %7.1f | %7.1f / %7.1f | %7.1f / %7.1f\n", c.input_size,
-                c.spectral_pool, layer.wall_ms, layer.cpu_ms, layer_tensor_ops.wall_ms, layer_tensor_ops.cpu_ms,
-                input.wall_ms, input.cpu_ms, step.wall_ms, step.cpu_ms);
+    // A validation batch: the network in eval mode, from the clips, and from their trunk input
+    // images computed beforehand, as training keeps them for its validation split.
+    net->eval();
+    const Timing val = Measure(repeats, cuda, [&] {
+      at::NoGradGuard no_grad;
+      net->forward(clips);
+    });
+    at::Tensor images;
+    {
+      at::NoGradGuard no_grad;
+      images = net->TrunkInput(clips);
+    }
+    const Timing val_images = Measure(repeats, cuda, [&] {
+      at::NoGradGuard no_grad;
+      net->ForwardImages(images, batch);
+    });
+    net->train();
+    std::printf("%-6d %-5d | %7.1f / %7.1f | %7.1f / %7.1f | %7.1f / %7.1f | %7.1f / %7.1f | %7.1f / %7.1f | %7.1f / %7.1f\n",
+                c.input_size, c.spectral_pool, layer.wall_ms, layer.cpu_ms, layer_tensor_ops.wall_ms,
+                layer_tensor_ops.cpu_ms, input.wall_ms, input.cpu_ms, step.wall_ms, step.cpu_ms, val.wall_ms,
+                val.cpu_ms, val_images.wall_ms, val_images.cpu_ms);
   }
   return 0;
 }

@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <future>
 #include <set>
 #include <string>
@@ -209,6 +211,47 @@ TEST_F(FrameCacheTest, SaysWhenItWouldChangeTheSamples) {
   FrameCache cache(*clips_, 24);
   EXPECT_THROW(LoadSample(cache, 0, Training(), 1), std::invalid_argument);  // 32 px asked of a 24 px cache
   EXPECT_THROW(cache.Frames(0, 30, 20), std::runtime_error);                 // past the clip's 40 frames
+}
+
+// With the cache, training keeps its validation split's trunk input images after the first
+// validation (train.cc, ValidationImages) and drops the frames: every later validation, of the
+// trained and of the averaged weights, reads those images. The run must be the files' run to the bit.
+TEST_F(FrameCacheTest, TrainingWithTheCacheIsTheFilesRunBitForBit) {
+  auto run = [&](bool cache_frames) {
+    TrainOptions o;
+    o.data = *dir_;
+    o.out = *dir_ / (cache_frames ? "run_cached" : "run_files");
+    o.model.arch = "sdn";
+    o.model.frames = 20;
+    o.model.input_size = 32;
+    o.model.width = 8;
+    o.model.phase_steps = true;
+    o.crop_scales = {1.0};
+    o.batch = 2;  // validation in several batches, the last a short one where the split is odd
+    o.epochs = 3;
+    o.lr = 1e-3;
+    o.weight_average = 0.5;  // two validations an epoch
+    o.cache_frames = cache_frames;
+    return Train(o);
+  };
+  const TrainResult files = run(false), cached = run(true);
+  ASSERT_EQ(files.log.size(), 3u);
+  ASSERT_EQ(cached.log.size(), 3u);
+  for (size_t e = 0; e < files.log.size(); ++e) {
+    EXPECT_EQ(files.log[e].train_loss, cached.log[e].train_loss) << "epoch " << e + 1;
+    EXPECT_EQ(files.log[e].val_loss, cached.log[e].val_loss) << "epoch " << e + 1;
+    EXPECT_EQ(files.log[e].val_rmse, cached.log[e].val_rmse) << "epoch " << e + 1;
+    EXPECT_EQ(files.log[e].raw_val_rmse, cached.log[e].raw_val_rmse) << "epoch " << e + 1;
+  }
+  // The epochs differ from one another, so equal figures are not equal constants.
+  EXPECT_NE(files.log[0].val_rmse, files.log[2].val_rmse);
+  EXPECT_NE(files.log[2].val_rmse, files.log[2].raw_val_rmse);
+  for (const char* name : {"model.pt", "raw_model.pt", "last.pt", "last_average.pt"}) {
+    std::ifstream a(*dir_ / "run_files" / name, std::ios::binary), b(*dir_ / "run_cached" / name, std::ios::binary);
+    const std::string bytes_a((std::istreambuf_iterator<char>(a)), {}), bytes_b((std::istreambuf_iterator<char>(b)), {});
+    EXPECT_FALSE(bytes_a.empty()) << name;
+    EXPECT_TRUE(bytes_a == bytes_b) << name << " differs";
+  }
 }
 
 TEST_F(FrameCacheTest, TrainingRefusesTheCacheWithTheSeedsMultiScaleCrops) {

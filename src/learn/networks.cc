@@ -218,11 +218,15 @@ at::Tensor WindNetImpl::WithCoordMaps(const at::Tensor& images) const {
 at::Tensor WindNetImpl::forward(const at::Tensor& clips) { return ForwardWithAux(clips).wind; }
 
 WindNetImpl::Outputs WindNetImpl::ForwardWithAux(const at::Tensor& clips) {
-  const std::vector<at::Tensor> stage_maps = trunk_->StageMaps(TrunkInput(clips));
+  return ForwardImages(TrunkInput(clips), clips.size(0));
+}
+
+WindNetImpl::Outputs WindNetImpl::ForwardImages(const at::Tensor& images, int64_t batch) {
+  const std::vector<at::Tensor> stage_maps = trunk_->StageMaps(images);
   at::Tensor features = ResNet18TrunkImpl::Pooled(stage_maps.back());
   if (config_.arch == "lstm") {
     // [N_b·N_t, F] -> [N_b, N_t, F] -> the LSTM's output after the last frame [N_b, F].
-    at::Tensor sequence = std::get<0>(lstm_->forward(features.reshape({clips.size(0), clips.size(2), -1})));
+    at::Tensor sequence = std::get<0>(lstm_->forward(features.reshape({batch, -1, features.size(1)})));
     features = sequence.select(1, sequence.size(1) - 1);
   }
   // Dropout on the pooled features, in training only: the SDN fits its training clips better

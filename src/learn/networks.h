@@ -89,6 +89,10 @@ class WindNetImpl : public torch::nn::Module {
     at::Tensor wind, aux;
   };
   Outputs ForwardWithAux(const at::Tensor& clips);
+  // ForwardWithAux from the trunk's input images of `batch` clips (images = TrunkInput(clips)):
+  // the same outputs, for a caller that computed the images beforehand. TrunkInput has no
+  // weights, so training computes its validation clips' images once, not every epoch.
+  Outputs ForwardImages(const at::Tensor& images, int64_t batch);
   // The trunk's input images: the stacked spectral maps [N_b, 2kC, H, W] (SDN: log1p of the
   // power, frequency divided by the Nyquist rate, so both are O(1)), the frames as channels
   // [N_b, N_t·C, H, W] (resnet18), or every frame on its own [N_b·N_t, C, H, W] (lstm). An SDN
