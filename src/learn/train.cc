@@ -163,10 +163,10 @@ struct ValidationImages {
 };
 
 // Validates `model` (put in eval mode) on `val` in batches of `batch`, as evaluation reads clips.
-// With `kept`: reads the images kept there when it holds them, else computes them and keeps them there.
+// With `kept`: reads the images kept there when it holds them, else computes them from the files
+// and keeps them there.
 Validation Validate(WindNet& model, const std::vector<ClipInfo>& val, int batch, const SampleOptions& options,
-                    FrameCache* cache, const ModelConfig& config, const at::Device& device,
-                    ValidationImages* kept) {
+                    const ModelConfig& config, const at::Device& device, ValidationImages* kept) {
   model->eval();
   at::NoGradGuard no_grad;
   const float mean = static_cast<float>(config.label_mean), inv_std = static_cast<float>(1.0 / config.label_std);
@@ -181,7 +181,7 @@ Validation Validate(WindNet& model, const std::vector<ClipInfo>& val, int batch,
       images = kept->images.at(i).to(device);
       speeds = kept->speeds.at(i);
     } else {
-      Batch clips = LoadBatch(val, all, b, std::min(all.size(), b + batch), options, 0, cache, nullptr);
+      Batch clips = LoadBatch(val, all, b, std::min(all.size(), b + batch), options, 0, nullptr, nullptr);
       images = model->TrunkInput(clips.clips.to(device));
       speeds = clips.speeds;
       if (kept) {
@@ -396,7 +396,9 @@ TrainResult Train(const TrainOptions& o) {
   train_options.augment = true;
   train_options.crop_scales = o.crop_scales;
   train_options.flip = o.flip;
-  std::unique_ptr<FrameCache> train_cache, val_cache;
+  // With the frames cached, the validation split's files are read once, by the first validation,
+  // whose trunk input images serve every later one: a frame cache of it would be read only once.
+  std::unique_ptr<FrameCache> train_cache;
   std::unique_ptr<ValidationImages> val_images;
   if (o.cache_frames) {
     val_images = std::make_unique<ValidationImages>();
@@ -407,7 +409,6 @@ TrainResult Train(const TrainOptions& o) {
       }
     }
     train_cache = std::make_unique<FrameCache>(train, config.input_size, config.colour);
-    val_cache = std::make_unique<FrameCache>(val, config.input_size, config.colour);
   }
   // The seed clips gradients (max norm 10) for its recurrent models only.
   const double grad_clip = o.grad_clip >= 0 ? o.grad_clip : (config.arch == "lstm" ? 10.0 : 0.0);
@@ -469,14 +470,10 @@ TrainResult Train(const TrainOptions& o) {
     record.train_aux_loss = aux_sum / std::max<size_t>(seen, 1);
 
     // Validation: evaluation preprocessing, no augmentation; the average's, when there is one.
-    // With the frames cached the trunk's input images are kept after the first validation, and the
-    // frames they came from are no longer needed.
-    const Validation raw = Validate(net, val, o.batch, val_options, val_cache.get(), config, device, val_images.get());
-    if (val_images) val_cache.reset();
+    // With the frames cached the trunk's input images are kept after the first validation.
+    const Validation raw = Validate(net, val, o.batch, val_options, config, device, val_images.get());
     const Validation chosen =
-        average.is_empty()
-            ? raw
-            : Validate(average, val, o.batch, val_options, val_cache.get(), config, device, val_images.get());
+        average.is_empty() ? raw : Validate(average, val, o.batch, val_options, config, device, val_images.get());
     record.val_loss = chosen.loss;
     record.val_rmse = chosen.metrics.rmse;
     record.val_acc05 = chosen.metrics.acc05;
