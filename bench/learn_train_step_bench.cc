@@ -16,10 +16,13 @@
 // split's images (the layer has no weights), to show what keeping them saves each epoch.
 //
 // Freed memory is kept for reuse as `clothwind train` keeps it (learn/heap_reuse.h); --glibc-heap
-// leaves glibc's defaults, to measure what that saves.
+// leaves glibc's defaults, to measure what that saves. --channels-last puts the network's kernels
+// in NHWC order (learn::UseChannelsLast, as the Predictor does), to measure what oneDNN's NHWC
+// path would save a training step.
 //
 //   learn_train_step_bench [--repeats N] [--threads T] [--batch B] [--width W] [--device cpu|cuda]
-//                          [--cases SIZE:POOL,...] [--glibc-heap]   (default cases 64:1,96:1,128:2,128:1)
+//                          [--cases SIZE:POOL,...] [--glibc-heap] [--channels-last]
+//                          (default cases 64:1,96:1,128:2,128:1)
 
 #include <algorithm>
 #include <cstdio>
@@ -94,9 +97,10 @@ int main(int argc, char** argv) {
   int repeats = 10, threads = 2, batch = 16, width = 48;
   std::string device_name = "cpu";
   std::vector<Case> cases = {{64, 1}, {96, 1}, {128, 2}, {128, 1}};
-  bool ok = true, glibc_heap = false;
+  bool ok = true, glibc_heap = false, channels_last = false;
   for (int i = 1; i < argc && ok; ++i) {
     if (!std::strcmp(argv[i], "--glibc-heap")) glibc_heap = true;
+    else if (!std::strcmp(argv[i], "--channels-last")) channels_last = true;
     else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--batch") && i + 1 < argc) batch = std::max(1, std::atoi(argv[++i]));
@@ -108,7 +112,7 @@ int main(int argc, char** argv) {
   if (!ok || (device_name != "cpu" && device_name != "cuda")) {
     std::fprintf(stderr,
                  "usage: learn_train_step_bench [--repeats N] [--threads T] [--batch B] [--width W] [--device cpu|cuda]\n"
-                 "                              [--cases SIZE:POOL,...] [--glibc-heap]  (SIZE >= 8, divisible by POOL >= 1)\n");
+                 "                              [--cases SIZE:POOL,...] [--glibc-heap] [--channels-last]  (SIZE >= 8, divisible by POOL >= 1)\n");
     return 2;
   }
   if (!glibc_heap) cl::KeepFreedHeapForReuse();
@@ -120,9 +124,10 @@ int main(int argc, char** argv) {
   const at::Device device = cuda ? at::Device(at::kCUDA) : at::Device(at::kCPU);
   at::set_num_threads(threads);
   at::globalContext().setFlushDenormal(true);
-  std::printf("SDN training step on %s, batch %d x 30 frames, width %d, k 3, phase steps, %d thread(s), median of %d, %s\n",
+  std::printf("SDN training step on %s, batch %d x 30 frames, width %d, k 3, phase steps, %d thread(s), median of %d, %s, %s\n",
               device_name.c_str(), batch, width, threads, repeats,
-              glibc_heap ? "glibc's default heap" : "freed heap kept for reuse");
+              glibc_heap ? "glibc's default heap" : "freed heap kept for reuse",
+              channels_last ? "channels-last kernels" : "default (NCHW) kernels");
   std::printf("%-6s %-5s | %-17s | %-17s | %-17s | %-17s | %-17s | %-17s\n", "input", "pool", "layer wall/cpu ms",
               "tensor ops ms", "trunk input ms", "whole step ms", "val batch ms", "val from images");
   for (const Case& c : cases) {
@@ -137,6 +142,7 @@ int main(int argc, char** argv) {
     at::manual_seed(1);
     cl::WindNet net(config);
     net->to(device);
+    if (channels_last) cl::UseChannelsLast(*net);
     net->train();
     torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(1e-3).weight_decay(1e-4));
     const at::Tensor clips = at::randn({batch, 1, 30, c.input_size, c.input_size}).to(device);

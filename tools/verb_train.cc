@@ -172,7 +172,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
         bar_epoch = p.epoch;
       }
       std::ostringstream note;
-      note << "loss " << std::setprecision(4) << p.loss;
+      if (p.step > 0) note << "loss " << std::setprecision(4) << p.loss;
       bar->Update(p.step, p.steps, note.str());
     };
     o.epoch_done = [&](const learn::EpochRecord& e) {

@@ -440,6 +440,9 @@ TrainResult Train(const TrainOptions& o) {
                         std::min(usable, b + o.batch), std::cref(train_options), seed_base, train_cache.get(),
                         aux.get());
     };
+    // Step 0 opens the epoch before its first batch loads, so a reader's clock (a progress bar's
+    // rate and time left) counts that batch too.
+    if (o.progress) o.progress({epoch, o.epochs, 0, steps, 0});
     std::future<Batch> next = load(0);
     for (int step = 0; step < steps; ++step) {
       Batch batch = next.get();

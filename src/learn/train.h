@@ -18,7 +18,7 @@ namespace clothwind::learn {
 
 struct TrainProgress {
   int epoch = 0, epochs = 0;  // 1-based epoch being trained
-  int step = 0, steps = 0;    // batches done in this epoch, of
+  int step = 0, steps = 0;    // batches done in this epoch (0: the epoch starts), of
   double loss = 0;            // running mean training loss of this epoch
 };
 
@@ -68,7 +68,8 @@ struct TrainOptions {
   // and the log keeps both validations: one run measures what the average is worth.
   double weight_average = 0;
   uint64_t seed = 1;
-  std::function<void(const TrainProgress&)> progress;  // after each batch (may be empty)
+  // At each epoch's start (step 0) and after each batch (may be empty).
+  std::function<void(const TrainProgress&)> progress;
   std::function<void(const EpochRecord&)> epoch_done;  // after each epoch (may be empty)
 };
 

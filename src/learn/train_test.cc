@@ -724,9 +724,22 @@ TEST_F(TrainTest, CosineScheduleIsWhatTrainingUses) {
   TrainOptions t = Options("sdn", "cosine");
   t.epochs = 3;
   t.lr_schedule = "cosine";
+  // Progress reports, in order: each epoch opens at step 0, before any batch, and counts to its steps.
+  std::vector<TrainProgress> reports;
+  t.progress = [&](const TrainProgress& p) { reports.push_back(p); };
   const TrainResult r = Train(t);
   ASSERT_EQ(r.log.size(), 3u);
   for (int e = 1; e <= 3; ++e) EXPECT_DOUBLE_EQ(r.log[e - 1].lr, LearningRateAt(t, e)) << e;
+  ASSERT_FALSE(reports.empty());
+  const int steps = reports.front().steps;
+  ASSERT_GT(steps, 0);
+  ASSERT_EQ(reports.size(), 3u * (steps + 1));
+  for (size_t i = 0; i < reports.size(); ++i) {
+    EXPECT_EQ(reports[i].epoch, static_cast<int>(i / (steps + 1)) + 1) << i;
+    EXPECT_EQ(reports[i].step, static_cast<int>(i % (steps + 1))) << i;
+    EXPECT_EQ(reports[i].steps, steps) << i;
+    EXPECT_EQ(reports[i].epochs, 3) << i;
+  }
   t.lr_schedule = "warm";
   t.out = *root_ / "cosine_bad";
   ExpectTrainRefused(t, "unknown schedule accepted", {"warm"});
