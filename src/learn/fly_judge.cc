@@ -89,7 +89,10 @@ FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
   if (!card.contains("hidden") || !card["hidden"].is_number_integer() || card["hidden"].get<int>() < 1) {
     throw std::runtime_error(card_path.string() + ": field \"hidden\" must be the judge's hidden units (an integer >= 1)");
   }
-  if (card.value("grid", 0) != kMotionMapGrid || card.value("side", 0) != kMotionMapSide) {
+  const auto is_int = [&card](const char* key, int expected) {
+    return card.contains(key) && card[key].is_number_integer() && card[key].get<int>() == expected;
+  };
+  if (!is_int("grid", kMotionMapGrid) || !is_int("side", kMotionMapSide)) {
     throw std::runtime_error(card_path.string() + ": fields \"grid\" and \"side\" must be " +
                              std::to_string(kMotionMapGrid) + " and " + std::to_string(kMotionMapSide) +
                              " (the motion map this build computes)");

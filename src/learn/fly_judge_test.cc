@@ -172,6 +172,14 @@ TEST(FlyJudgeTest, SaveLoadRoundTripKeepsScoresAndCard) {
   }
   WriteFileAtomically(dir / "judge.json", nlohmann::json{{"hidden", 12}, {"grid", 8}, {"side", 64}}.dump());
   EXPECT_THROW(FlyJudge::Load(dir / "judge.pt"), std::runtime_error);
+  // A field of the wrong kind is refused as such, naming the card (not a bare JSON type error).
+  WriteFileAtomically(dir / "judge.json", nlohmann::json{{"hidden", 12}, {"grid", "16"}, {"side", 64}}.dump());
+  try {
+    FlyJudge::Load(dir / "judge.pt");
+    FAIL() << "a card with \"grid\": \"16\" loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("judge.json"), std::string::npos) << e.what();
+  }
   fs::remove(dir / "judge.json");
   try {
     FlyJudge::Load(dir / "judge.pt");

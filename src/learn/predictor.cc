@@ -42,7 +42,15 @@ Predictor::Predictor(const std::filesystem::path& weights, int threads, const st
   if (channels_last && impl_->device.is_cpu()) UseChannelsLast(*impl_->net);
   flag_flies_ = config().DefaultFlagFlies();
   const std::filesystem::path beside = weights.parent_path() / kFlyJudgeFile;
-  if (std::filesystem::exists(beside)) LoadFlyJudge(beside);
+  if (std::filesystem::exists(beside)) {
+    try {
+      LoadFlyJudge(beside);
+    } catch (const std::exception& e) {
+      // The model itself is fine: estimates go on (as filmed, or by the motion cues on auto), and
+      // the caller reports the judge it could not read.
+      fly_judge_error_ = std::string("the fly judge beside the model did not load: ") + e.what();
+    }
+  }
 }
 
 void Predictor::LoadFlyJudge(const std::filesystem::path& path) {
@@ -52,6 +60,7 @@ void Predictor::LoadFlyJudge(const std::filesystem::path& path) {
     fly_judge_ = std::make_shared<const FlyJudge>(FlyJudge::Load(path));
   }
   fly_judge_path_ = path;
+  fly_judge_error_.clear();
 }
 
 Predictor::~Predictor() = default;
@@ -121,6 +130,12 @@ Prediction Predictor::PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps
     maps->frequency = cv::Mat(c.input_size, c.input_size, CV_32F);
     std::copy_n(m.power.contiguous().data_ptr<float>(), m.power.numel(), maps->power.ptr<float>());
     std::copy_n(m.frequency.contiguous().data_ptr<float>(), m.frequency.numel(), maps->frequency.ptr<float>());
+    // The maps show the camera's picture: a clip turned round for the model is turned back (the
+    // layer is per pixel, so this is exactly the maps of the clip as filmed).
+    if (sample.flipped) {
+      cv::flip(maps->power, maps->power, 1);
+      cv::flip(maps->frequency, maps->frequency, 1);
+    }
   }
   return p;
 }

@@ -54,10 +54,14 @@ class Predictor {
 
   // The judge flag_flies auto asks (SampleOptions::fly_judge): the one in kFlyJudgeFile beside
   // the weights when there is one (models/fly_judge.pt beside models/sdn.pt), else none (the
-  // clip's motion cues). fly_judge_path() is its file, empty for none.
+  // clip's motion cues). fly_judge_path() is its file, empty for none. A judge beside the weights
+  // that cannot be read does not stop the model: the constructor leaves none and says why in
+  // fly_judge_error() (empty when there was nothing to say), for the caller to report.
   const std::shared_ptr<const FlyJudge>& fly_judge() const { return fly_judge_; }
   const std::filesystem::path& fly_judge_path() const { return fly_judge_path_; }
-  // Loads another judge (FlyJudge::Load; empty: none, the motion cues). Throws as FlyJudge::Load.
+  const std::string& fly_judge_error() const { return fly_judge_error_; }
+  // Loads another judge (FlyJudge::Load; empty: none, the motion cues) and clears
+  // fly_judge_error(). Throws as FlyJudge::Load, leaving the judge before it.
   void LoadFlyJudge(const std::filesystem::path& path);
 
   // Predictions for prepared samples (each config().frames x input_size² floats, as MakeSample
@@ -66,7 +70,8 @@ class Predictor {
 
   // A raw greyscale clip as a node receives it: the last config().frames frames, centred square
   // crop, resized and normalised as for evaluation. `maps` (may be null; SDN only) receives the
-  // strongest peak maps of the same input.
+  // strongest peak maps of the same input, oriented as the frames given (a clip turned round for
+  // the model has its maps turned back).
   // Throws std::invalid_argument when there are too few frames or they are not equal CV_8UC1
   // (CV_8UC3 YCrCb, LoadFrames' colour frames, for a model with config().colour).
   Prediction PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps* maps = nullptr);
@@ -81,6 +86,7 @@ class Predictor {
   FlagFlies flag_flies_ = FlagFlies::kRight;
   std::shared_ptr<const FlyJudge> fly_judge_;
   std::filesystem::path fly_judge_path_;
+  std::string fly_judge_error_;
 };
 
 // The judge's file name a Predictor looks for beside its weights.

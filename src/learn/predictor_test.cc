@@ -1,0 +1,101 @@
+#include "learn/predictor.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <opencv2/core.hpp>
+
+#include "learn/fly_judge.h"
+#include "learn/networks.h"
+
+namespace clothwind::learn {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A small SDN saved as a training run saves it, in a folder of its own.
+class PredictorTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("predictor_test_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    ModelConfig c;
+    c.arch = "sdn";
+    c.frames = 30;
+    c.k = 3;
+    c.phase_steps = true;
+    c.width = 8;
+    c.input_size = 32;
+    WindNet net(c);
+    SaveWindNet(net, dir_ / "model.pt");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path dir_;
+};
+
+// 30 frames of 32 x 32 px (the model's input: no resize) whose stripes travel at a frequency
+// that grows from left to right, with an amplitude that grows too: neither map is symmetric.
+std::vector<cv::Mat> LopsidedClip() {
+  std::vector<cv::Mat> frames;
+  for (int t = 0; t < 30; ++t) {
+    cv::Mat f(32, 32, CV_8UC1);
+    for (int y = 0; y < 32; ++y) {
+      for (int x = 0; x < 32; ++x) {
+        const double hz = 1.0 + 0.25 * x, amplitude = 20 + 3 * x;
+        f.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(128 + amplitude * std::sin(2 * M_PI * hz * t / 25.0 - 0.3 * y));
+      }
+    }
+    frames.push_back(f);
+  }
+  return frames;
+}
+
+double MaxAbsDiff(const cv::Mat& a, const cv::Mat& b) { return cv::norm(a, b, cv::NORM_INF); }
+
+TEST_F(PredictorTest, AFlyJudgeBesideTheModelThatCannotLoadLeavesTheModelWorking) {
+  // Not a torch file, and a card without the judge's fields.
+  std::ofstream(dir_ / kFlyJudgeFile) << "not weights";
+  std::ofstream(dir_ / "fly_judge.json") << R"({"hidden": 4, "grid": "16", "side": 64})";
+  Predictor predictor(dir_ / "model.pt", 1, "cpu");
+  EXPECT_EQ(predictor.fly_judge(), nullptr);
+  EXPECT_NE(predictor.fly_judge_error().find("fly_judge.json"), std::string::npos) << predictor.fly_judge_error();
+  const Prediction p = predictor.PredictFrames(LopsidedClip());
+  EXPECT_TRUE(std::isfinite(p.speed) && p.speed_std > 0);
+
+  // A judge that loads replaces the error.
+  FlyJudge(Eigen::MatrixXf::Zero(1, kMotionMapGrid * kMotionMapGrid), Eigen::VectorXf::Zero(1),
+           Eigen::VectorXf::Zero(1), 0)
+      .Save(dir_ / kFlyJudgeFile);
+  Predictor with_judge(dir_ / "model.pt", 1, "cpu");
+  ASSERT_NE(with_judge.fly_judge(), nullptr);
+  EXPECT_EQ(with_judge.fly_judge_error(), "");
+  EXPECT_EQ(with_judge.fly_judge_path(), dir_ / kFlyJudgeFile);
+}
+
+TEST_F(PredictorTest, MapsOfAClipTurnedRoundShowTheCamerasPicture) {
+  Predictor predictor(dir_ / "model.pt", 1, "cpu");
+  const std::vector<cv::Mat> clip = LopsidedClip();
+  PeakMaps filmed, turned;
+  predictor.set_flag_flies(FlagFlies::kRight);
+  EXPECT_FALSE(predictor.PredictFrames(clip, &filmed).turned);
+  predictor.set_flag_flies(FlagFlies::kLeft);
+  EXPECT_TRUE(predictor.PredictFrames(clip, &turned).turned);
+  ASSERT_EQ(filmed.frequency.size(), cv::Size(32, 32));
+  // The maps are lopsided, so a mirror image would differ...
+  cv::Mat mirrored;
+  cv::flip(filmed.frequency, mirrored, 1);
+  EXPECT_GT(MaxAbsDiff(mirrored, filmed.frequency), 1.0);
+  // ...and the turned clip's maps are the clip's as filmed, not their mirror image.
+  EXPECT_LT(MaxAbsDiff(turned.frequency, filmed.frequency), 1e-4);
+  EXPECT_LT(MaxAbsDiff(turned.power, filmed.power), 1e-3 * cv::norm(filmed.power, cv::NORM_INF));
+}
+
+}  // namespace
+}  // namespace clothwind::learn
