@@ -19,10 +19,15 @@
 // beside the model when there is one, as models/ ships it, else the clip's motion cues).
 // Clips may be mono8 or bgr8; a model trained with --colour needs bgr8 (clip_buffer ~colour) and
 // reports a grey clip as an ERROR naming that parameter.
-// Diagnostics: model, device, latency and rate, the flag's way and the clips turned round; a
-// malformed clip is an ERROR, not a crash. A model that cannot be loaded is retried every 2 s
-// (ERROR until it loads). A model trained without flips left on ~flag_flies auto with no fly
-// judge (the motion cues misjudge ~9 % of clips) is a WARN, as is a ~fly_judge that cannot load.
+// Diagnostics (published every wall second, so a paused or restarted bag does not stall them):
+// model, device, latency and rate, the flag's way and the clips turned round, clips missing from
+// the sequence. A malformed clip (wrong encoding, size, stamps, or a frame rate other than the
+// model's) is an ERROR, not a crash, until a good clip is estimated; a failure of the model itself
+// is an ERROR of its own. A model that cannot be loaded is retried every 2 s (ERROR until it
+// loads). No clip for 10 s after the first is a WARN. A model trained without flips left on
+// ~flag_flies auto with no fly judge (the motion cues misjudge ~9 % of clips) is a WARN, as is a
+// fly judge that cannot load (~fly_judge, or the one beside the model) and a parameter out of its
+// range (named, and its default used).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -52,10 +57,17 @@ class SdnNode {
   SdnNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : transport_(nh), trailing_(MeanWindow(pnh)) {
     pnh.param("model", model_path_, std::string());
     pnh.param("threads", threads_, 2);
+    if (threads_ < 1) threads_ = ParameterError("~threads must be >= 1, got " + std::to_string(threads_), 2);
     pnh.param("device", device_, std::string("cpu"));
+    if (device_ != "cpu" && device_ != "cuda" && device_ != "auto") {
+      ParameterError("~device must be cpu, cuda or auto, got \"" + device_ + "\"", 0);
+      device_ = "cpu";
+    }
     int queue_size = 2;
     pnh.param("queue_size", queue_size, 2);
+    if (queue_size < 1) queue_size = ParameterError("~queue_size must be >= 1 clip, got " + std::to_string(queue_size), 2);
     pnh.param("fly_judge", fly_judge_path_, std::string());
+    if (!mean_window_error_.empty()) parameter_errors_.push_back(mean_window_error_);
     ReadFlagFlies(pnh);
     estimate_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate", 10);
     mean_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate_mean", 10);
@@ -63,7 +75,10 @@ class SdnNode {
     frequency_pub_ = transport_.advertise("sdn/frequency", 1);
     updater_.setHardwareID("sdn:" + model_path_);
     updater_.add("sdn", this, &SdnNode::Diagnose);
-    diag_timer_ = nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { updater_.update(); });
+    // force_update: Updater::update() waits for ROS time, which stands still while a bag is
+    // paused and jumps back when it restarts.
+    diag_timer_ =
+        nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { updater_.force_update(); });
     TryLoad();
     if (!predictor_) {
       load_timer_ = nh.createWallTimer(ros::WallDuration(2.0), [this](const ros::WallTimerEvent&) {
@@ -74,11 +89,20 @@ class SdnNode {
   }
 
  private:
+  // A parameter out of its range: logged, kept for the diagnostics, and its default used.
+  int ParameterError(const std::string& what, int fallback) {
+    ROS_ERROR("sdn_node: %s; using the default", what.c_str());
+    parameter_errors_.push_back(what);
+    return fallback;
+  }
+
+  // Before the members: the trailing mean is built with it.
   static double MeanWindow(ros::NodeHandle& pnh) {
     double window = 60.0;
     pnh.param("mean_window", window, 60.0);
-    if (!(window > 0)) {
-      ROS_ERROR("sdn_node: ~mean_window must be > 0 s, got %g; using 60 s", window);
+    if (!(window > 0) || !std::isfinite(window)) {
+      mean_window_error_ = "~mean_window must be a finite number of seconds > 0, got " + std::to_string(window);
+      ROS_ERROR("sdn_node: %s; using 60 s", mean_window_error_.c_str());
       window = 60.0;
     }
     return window;
@@ -92,18 +116,22 @@ class SdnNode {
     pnh.param("camera_heading", camera_heading_, std::numeric_limits<double>::quiet_NaN());
     double end_on_deg = 20.0;
     pnh.param("end_on_angle", end_on_deg, 20.0);
+    if (!(end_on_deg >= 0 && end_on_deg <= 90)) {
+      end_on_deg = ParameterError("~end_on_angle must be 0 to 90 degrees, got " + std::to_string(end_on_deg), 20);
+    }
     end_on_ = end_on_deg * M_PI / 180.0;
     if (name == "wind") {
       follow_wind_ = std::isfinite(camera_heading_);
       if (!follow_wind_) {
-        ROS_ERROR("sdn_node: ~flag_flies wind needs ~camera_heading (the optical axis's angle in the "
-                  "anemometer's frame [rad]); using the model's default");
+        ParameterError("~flag_flies wind needs ~camera_heading (the optical axis's angle in the anemometer's "
+                       "frame [rad]); the model's way is used",
+                       0);
       }
     } else if (!name.empty()) {
       try {
         told_flag_flies_ = clothwind::learn::FlagFliesFromName(name, "~flag_flies");
       } catch (const std::invalid_argument& e) {
-        ROS_ERROR("sdn_node: %s (or wind, with ~camera_heading); using the model's default", e.what());
+        ParameterError(std::string(e.what()) + " (or wind, with ~camera_heading); the model's way is used", 0);
       }
     }
   }
@@ -160,11 +188,19 @@ class SdnNode {
       ++dropped_;
       return;
     }
-    if (follow_wind_) FollowTheWind(clip->wind_direction_mean);
     try {
       // A colour model reads Y, Cr and Cb from bgr8 clips; a grey one the grey of either kind.
-      const std::vector<cv::Mat> frames = clothwind::learn::CameraFramesForModel(
-          clothwind::ros_bridge::ClipFrames(*clip), predictor_->config().colour);
+      std::vector<cv::Mat> camera_frames;
+      try {
+        camera_frames = clothwind::ros_bridge::ClipFrames(*clip);
+        clothwind::ros_bridge::CheckClipFrameRate(*clip, predictor_->config().frame_rate);
+      } catch (const std::invalid_argument& e) {
+        throw MalformedClip(e.what());
+      }
+      CountSequence(clip->sequence);
+      if (follow_wind_) FollowTheWind(clip->wind_direction_mean);  // a clip that passed the checks only
+      const std::vector<cv::Mat> frames =
+          clothwind::learn::CameraFramesForModel(camera_frames, predictor_->config().colour);
       const bool want_maps = power_pub_.getNumSubscribers() > 0 || frequency_pub_.getNumSubscribers() > 0;
       clothwind::learn::PeakMaps maps;
       const clothwind::learn::Prediction p = predictor_->PredictFrames(frames, want_maps ? &maps : nullptr);
@@ -177,15 +213,38 @@ class SdnNode {
       turned_ += p.turned;
       latencies_.push_back(latency);
       if (latencies_.size() > 50) latencies_.pop_front();
-      stamps_.push_back(ros::WallTime::now().toSec());
-      while (stamps_.size() > 1 && stamps_.back() - stamps_.front() > 30.0) stamps_.pop_front();
+      last_estimate_wall_ = ros::WallTime::now().toSec();
+      stamps_.push_back(last_estimate_wall_);
+      TrimRate(last_estimate_wall_);
+      clip_error_.clear();
     } catch (const std::exception& e) {
-      ++errors_;
+      // Frames the model cannot read (a grey clip for a colour model, too few frames) are the
+      // clip's fault as much as a wrong size; anything else is the model's.
+      const bool malformed = dynamic_cast<const MalformedClip*>(&e) || dynamic_cast<const std::invalid_argument*>(&e);
+      ++(malformed ? errors_ : model_errors_);
       last_error_ = "clip " + std::to_string(clip->sequence) + ": " + e.what();
-      error_pending_ = true;
-      ROS_ERROR_THROTTLE(5.0, "sdn_node: %s", last_error_.c_str());
+      clip_error_ = (malformed ? "malformed clip: " : "the model failed on a clip: ") + last_error_;
+      ROS_ERROR_THROTTLE(5.0, "sdn_node: %s", clip_error_.c_str());
       updater_.force_update();
     }
+  }
+
+  // A clip that fails the message checks (ClipFrames, CheckClipFrameRate).
+  struct MalformedClip : std::invalid_argument {
+    using std::invalid_argument::invalid_argument;
+  };
+
+  // Clips missing between two received ones (dropped by this node's queue when it lags, or
+  // upstream); a sequence that starts again (a restarted buffer or bag) counts nothing.
+  void CountSequence(uint64_t sequence) {
+    if (have_sequence_ && sequence > last_sequence_ + 1) missing_ += sequence - last_sequence_ - 1;
+    last_sequence_ = sequence;
+    have_sequence_ = true;
+  }
+
+  // The estimates' wall times over the last 30 s, for the rate.
+  void TrimRate(double now) {
+    while (!stamps_.empty() && now - stamps_.front() > 30.0) stamps_.pop_front();
   }
 
   // ~flag_flies wind: the way the anemometer's wind makes the flag fly; a wind end-on to the
@@ -204,7 +263,10 @@ class SdnNode {
   // averaged, clip_end and the stamp those of this one.
   void PublishMean(const clothwind::WindEstimate& estimate) {
     const double end = estimate.clip_end.toSec();
-    if (!starts_.empty() && end < starts_.back().first) starts_.clear();  // time went back
+    if (!starts_.empty() && end < starts_.back().first) {  // clip time went back: a new bag, or a loop
+      starts_.clear();
+      ++mean_restarts_;
+    }
     trailing_.Add(end, estimate.speed, estimate.speed_std);
     starts_.emplace_back(end, estimate.clip_start);
     while (starts_.front().first < trailing_.Oldest()) starts_.pop_front();
@@ -220,7 +282,7 @@ class SdnNode {
 
   void PublishMaps(const clothwind::Clip& clip, const clothwind::learn::PeakMaps& maps) {
     std_msgs::Header header = clip.header;
-    header.stamp = clip.frame_stamps.empty() ? clip.header.stamp : clip.frame_stamps.back();
+    header.stamp = clothwind::ros_bridge::ClipEnd(clip);
     if (power_pub_.getNumSubscribers() > 0) {
       cv::Mat log_power;
       cv::log(maps.power + 1.0f, log_power);
@@ -243,14 +305,26 @@ class SdnNode {
       max = std::max(max, l);
     }
     if (!latencies_.empty()) mean /= latencies_.size();
-    const double rate =
-        stamps_.size() > 1 ? (stamps_.size() - 1) / std::max(stamps_.back() - stamps_.front(), 1e-9) : 0.0;
+    const double now = ros::WallTime::now().toSec();
+    TrimRate(now);
+    // Estimates over the last 30 s (or since the first, when that is more recent).
+    const double rate = stamps_.size() > 1 ? stamps_.size() / std::max(now - stamps_.front(), 1e-9) : 0.0;
+    const double idle = estimates_ > 0 ? now - last_estimate_wall_ : 0.0;
     if (!predictor_) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no model: " + load_error_);
-    } else if (error_pending_) {
-      stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "malformed clip: " + last_error_);
+    } else if (!clip_error_.empty()) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, clip_error_);
+    } else if (idle > 10.0) {
+      char what[96];
+      std::snprintf(what, sizeof what, "no clip for %.0f s (is the clip buffer, camera or bag running?)", idle);
+      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, what);
     } else if (!judge_error_.empty()) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "estimating; ~fly_judge did not load: " + judge_error_);
+    } else if (!predictor_->fly_judge_error().empty()) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "estimating; " + predictor_->fly_judge_error());
+    } else if (!parameter_errors_.empty()) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   "estimating with a default for a parameter out of range: " + parameter_errors_.front());
     } else if (!predictor_->config().flips_in_training &&
                predictor_->flag_flies() == clothwind::learn::FlagFlies::kAuto && !predictor_->fly_judge()) {
       // A model trained without flips misreads a flag flying left by ~2.5 m/s, and the clip's own
@@ -261,7 +335,6 @@ class SdnNode {
     } else {
       stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "estimating");
     }
-    error_pending_ = false;
     stat.add("model", model_name_.empty() ? model_path_ : model_name_);
     stat.add("device", predictor_ ? predictor_->device() : std::string("-"));
     stat.add("threads", threads_);
@@ -280,8 +353,15 @@ class SdnNode {
     stat.add("trailing mean [m/s]", trailing_.Mean());
     stat.add("clips in the trailing mean", trailing_.Count());
     stat.add("malformed clips", errors_);
+    stat.add("clips the model failed on", model_errors_);
     stat.add("clips dropped (no model)", dropped_);
+    stat.add("clips missing from the sequence (queue or upstream)", missing_);
+    stat.add("trailing mean restarts (clip time went back)", mean_restarts_);
+    stat.add("seconds since the last estimate", idle);
     stat.add("last error", last_error_);
+    std::string parameters;
+    for (const std::string& e : parameter_errors_) parameters += (parameters.empty() ? "" : "; ") + e;
+    stat.add("parameter errors", parameters.empty() ? std::string("none") : parameters);
   }
 
   image_transport::ImageTransport transport_;
@@ -300,8 +380,13 @@ class SdnNode {
   std::deque<double> latencies_, stamps_;
   clothwind::sensors::TrailingMean trailing_;
   std::deque<std::pair<double, ros::Time>> starts_;  // (clip end [s], clip start) of the averaged clips
-  uint64_t estimates_ = 0, errors_ = 0, dropped_ = 0, turned_ = 0, wind_unknown_ = 0;
-  bool error_pending_ = false;
+  uint64_t estimates_ = 0, errors_ = 0, model_errors_ = 0, dropped_ = 0, turned_ = 0, wind_unknown_ = 0;
+  uint64_t missing_ = 0, mean_restarts_ = 0, last_sequence_ = 0;
+  bool have_sequence_ = false;
+  double last_estimate_wall_ = 0;                  // [s] wall time of the last estimate
+  std::string clip_error_;                          // the last clip's failure; cleared by a good clip
+  std::vector<std::string> parameter_errors_;       // parameters out of range (their defaults used)
+  static inline std::string mean_window_error_;     // MeanWindow runs before the members exist
 };
 
 }  // namespace

@@ -31,6 +31,13 @@ std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg) {
     throw std::invalid_argument("Clip.frame_stamps has " + std::to_string(msg.frame_stamps.size()) +
                                 " stamps for num_frames = " + std::to_string(msg.num_frames));
   }
+  for (size_t i = 1; i < msg.frame_stamps.size(); ++i) {
+    if (!(msg.frame_stamps[i] > msg.frame_stamps[i - 1])) {
+      throw std::invalid_argument("Clip.frame_stamps must be strictly increasing; stamp " + std::to_string(i) +
+                                  " (" + std::to_string(msg.frame_stamps[i].toSec()) + " s) follows " +
+                                  std::to_string(msg.frame_stamps[i - 1].toSec()) + " s");
+    }
+  }
   std::vector<cv::Mat> frames;
   frames.reserve(msg.num_frames);
   for (uint32_t i = 0; i < msg.num_frames; ++i) {
@@ -40,11 +47,28 @@ std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg) {
   return frames;
 }
 
+void CheckClipFrameRate(const clothwind::Clip& msg, double model_rate) {
+  // Frequencies are read in Hz at the model's rate: a clip resampled at another rate would shift
+  // every spectral peak and the speed with it, silently.
+  if (!std::isfinite(msg.frame_rate) || !(msg.frame_rate > 0) ||
+      std::abs(msg.frame_rate - model_rate) > 0.01 * model_rate) {
+    throw std::invalid_argument("Clip.frame_rate is " + std::to_string(msg.frame_rate) + " Hz, the model reads " +
+                                std::to_string(model_rate) + " Hz clips (clip_buffer ~frame_rate)");
+  }
+}
+
+ros::Time ClipEnd(const clothwind::Clip& clip) {
+  if (!clip.frame_stamps.empty()) return clip.frame_stamps.back();
+  // header.stamp is the first frame's: the last one is num_frames - 1 periods later.
+  const double span = clip.num_frames > 1 && clip.frame_rate > 0 ? (clip.num_frames - 1) / clip.frame_rate : 0.0;
+  return clip.header.stamp + ros::Duration(span);
+}
+
 clothwind::WindEstimate ToWindEstimate(const clothwind::Clip& clip, const learn::Prediction& prediction,
                                        double latency, const std::string& model) {
   clothwind::WindEstimate e;
   e.header.frame_id = clip.header.frame_id;
-  e.header.stamp = clip.frame_stamps.empty() ? clip.header.stamp : clip.frame_stamps.back();
+  e.header.stamp = ClipEnd(clip);
   e.clip_sequence = clip.sequence;
   e.clip_start = clip.frame_stamps.empty() ? clip.header.stamp : clip.frame_stamps.front();
   e.clip_end = e.header.stamp;

@@ -17,9 +17,18 @@
 namespace clothwind::ros_bridge {
 
 // The frames of a Clip as num_frames images viewing msg.data (no copy: valid while `msg` lives):
-// CV_8UC1 for a mono8 clip, CV_8UC3 BGR for a bgr8 one. Throws std::invalid_argument naming the field that is inconsistent (encoding,
-// num_frames, width/height, data length, frame_stamps count).
+// CV_8UC1 for a mono8 clip, CV_8UC3 BGR for a bgr8 one. Throws std::invalid_argument naming the
+// field that is inconsistent (encoding, num_frames, width/height, data length, frame_stamps count,
+// frame_stamps not strictly increasing).
 std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg);
+
+// Throws std::invalid_argument naming Clip.frame_rate when it is not within 1 % of `model_rate`
+// [Hz], the rate the model was trained at (its spectra are in Hz).
+void CheckClipFrameRate(const clothwind::Clip& msg, double model_rate);
+
+// The stamp of the clip's last frame: frame_stamps.back(), or, for a clip without frame_stamps,
+// header.stamp (its first frame's) plus (num_frames - 1) / frame_rate.
+ros::Time ClipEnd(const clothwind::Clip& clip);
 
 // The estimate of one clip.
 // Inputs:
@@ -27,7 +36,7 @@ std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg);
 //   prediction  speed and its standard deviation [m/s]
 //   latency     seconds from receiving the clip to publishing [s]
 //   model       model name for the message
-// The header stamp is the clip's last frame stamp (the clip's header stamp when it has none);
+// The header stamp is the clip's last frame stamp (ClipEnd);
 // reference_speed is the clip's wind_mean, NaN when no anemometer reading fell in its window.
 clothwind::WindEstimate ToWindEstimate(const clothwind::Clip& clip, const learn::Prediction& prediction,
                                        double latency, const std::string& model);

@@ -319,8 +319,49 @@ class SdnNodeTest(unittest.TestCase):
         self.wait_for(lambda: any(s.level == DiagnosticStatus.WARN and "~fly_judge did not load" in s.message
                                   and "/nonexistent/fly_judge" in s.message for s in self.bad_judge_statuses), 60,
                       "a WARN naming the judge file that did not load")
-        self.bad_judge_pub.publish(make_clip(0, rospy.Time(1700000000, 0), size, 3.0, 4.0, flag="right"))
+        start = rospy.Time(1700000000, 0)
+        self.bad_judge_pub.publish(make_clip(0, start, size, 3.0, 4.0, flag="right"))
         self.wait_for(lambda: len(self.bad_judge_estimates) >= 1, 30, "an estimate all the same")
+
+        def latest():
+            with self.lock:
+                s = self.bad_judge_statuses[-1]
+            return s, {kv.key: kv.value for kv in s.values}
+
+        status, values = latest()
+        self.assertIn("~queue_size must be >= 1", values["parameter errors"])
+        self.assertIn("~end_on_angle must be 0 to 90", values["parameter errors"])
+        # A clip resampled at another rate than the model's is refused, and the ERROR stays on the
+        # periodic diagnostics (not only the one published at once) until a good clip comes.
+        self.bad_judge_pub.publish(make_clip(1, start + rospy.Duration.from_sec(2.0), size, 3.0, 4.0, rate=30.0))
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.ERROR and "frame_rate" in s.message
+                                  for s in self.bad_judge_statuses), 30, "an ERROR naming Clip.frame_rate")
+        rospy.sleep(2.5)
+        status, values = latest()
+        self.assertEqual(status.level, DiagnosticStatus.ERROR, status.message)
+        self.assertIn("frame_rate", status.message)
+        # Stamps that go back are refused, naming the field.
+        back = make_clip(2, start + rospy.Duration.from_sec(4.0), size, 3.0, 4.0)
+        back.frame_stamps[5], back.frame_stamps[6] = back.frame_stamps[6], back.frame_stamps[5]
+        self.bad_judge_pub.publish(back)
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.ERROR and "strictly increasing" in s.message
+                                  for s in self.bad_judge_statuses), 30, "an ERROR naming Clip.frame_stamps")
+        # A good clip without frame_stamps: estimated, its end its first frame + 29 periods, and the
+        # ERROR gone; clips 1-3 never made it into the sequence.
+        bare = make_clip(4, start + rospy.Duration.from_sec(6.0), size, 3.0, 4.0)
+        bare.frame_stamps = []
+        self.bad_judge_pub.publish(bare)
+        self.wait_for(lambda: any(e.clip_sequence == 4 for e in self.bad_judge_estimates), 30, "the bare clip's estimate")
+        with self.lock:
+            e = [e for e in self.bad_judge_estimates if e.clip_sequence == 4][0]
+        self.assertEqual(e.clip_start, bare.header.stamp)
+        self.assertAlmostEqual((e.clip_end - bare.header.stamp).to_sec(), 29 / 25.0, places=6)
+        self.assertEqual(e.header.stamp, e.clip_end)
+        rospy.sleep(1.5)
+        status, values = latest()
+        self.assertNotEqual(status.level, DiagnosticStatus.ERROR, status.message)
+        self.assertEqual(values["clips missing from the sequence (queue or upstream)"], "3")
+        self.assertEqual(values["malformed clips"], "2")
 
 
 if __name__ == "__main__":
