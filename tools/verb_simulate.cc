@@ -175,7 +175,8 @@ const VerbRegistrar kRegistrar{"simulate", [](CLI::App& app) -> std::function<in
   sub->add_option("--turbulence", args->turbulence, "turbulence intensity and length scale I,L [-, m]");
   sub->add_option("--seed", args->seed, "seed of the wind's turbulence and gusts");
   sub->add_option("--max-edge", args->max_edge,
-                  "refine to this edge length [m] (default: half the upper end of the scene's remeshing size range)");
+                  "refine uniformly to this edge length [m] (default: the scene's: uniformly to the upper end of its "
+                  "remeshing size range, then edges over 0.4 of it split)");
   sub->add_option("--frame-steps", args->frame_steps,
                   "time steps per frame (default: the scene's; fewer is faster but damps flapping)")
       ->check(CLI::NonNegativeNumber);
