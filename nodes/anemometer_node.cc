@@ -67,6 +67,9 @@ class AnemometerNode {
     double initial, maximum;
     pnh_.param("reconnect_initial_delay", initial, 0.1);
     pnh_.param("reconnect_max_delay", maximum, 2.0);
+    if (!PositiveSeconds("reconnect_initial_delay", initial) || !PositiveSeconds("reconnect_max_delay", maximum)) {
+      return false;
+    }
     backoff_ = Backoff(std::max(0.01, initial), std::max(initial, maximum));
 
     updater_.add("anemometer", this, &AnemometerNode::Diagnose);
@@ -104,11 +107,23 @@ class AnemometerNode {
       ROS_FATAL("~input: '%s' unknown (expected serial, usb or topic)", input_.c_str());
       return false;
     }
+    if (!PositiveSeconds("stale_timeout", stale_timeout_) ||
+        (input_ == "usb" && !PositiveSeconds("usb_poll_period", usb_poll_period_))) {
+      return false;
+    }
     if (input_ != "topic") raw_pub_ = nh_.advertise<clothwind::RawSentence>("anemometer/raw", 100);
     wind_pub_ = nh_.advertise<clothwind::WindMeasurement>("anemometer/wind", 100);
     ROS_INFO("anemometer_node: input %s, protocol %s, frame %s", input_.c_str(),
              AnemometerProtocolName(decoder_.protocol()), frame_id_.c_str());
     return true;
+  }
+
+  // A period parameter: finite, > 0 and at most a day (ros::WallDuration throws beyond its range,
+  // and a zero poll period would poll the station without pause).
+  static bool PositiveSeconds(const char* name, double value) {
+    if (std::isfinite(value) && value > 0 && value <= 86400) return true;
+    ROS_FATAL("~%s must be a time in seconds > 0 and <= 86400, got %g", name, value);
+    return false;
   }
 
   void Run() {

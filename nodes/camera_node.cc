@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include <camera_info_manager/camera_info_manager.h>
@@ -61,9 +62,17 @@ FrameSourceOptions ReadOptions(ros::NodeHandle& pnh) {
   pnh.param("timeout", o.timeout_s, 2.0);
   pnh.param("loop", o.loop, false);
   if (pnh.hasParam("auto_exposure")) {
-    bool on = true;
-    pnh.getParam("auto_exposure", on);
-    o.auto_exposure = on ? 1 : 0;
+    // `_auto_exposure:=0` arrives as an int, which getParam(bool) refuses (leaving it on): read
+    // either kind.
+    XmlRpc::XmlRpcValue v;
+    pnh.getParam("auto_exposure", v);
+    if (v.getType() == XmlRpc::XmlRpcValue::TypeBoolean) {
+      o.auto_exposure = static_cast<bool>(v) ? 1 : 0;
+    } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt && (static_cast<int>(v) == 0 || static_cast<int>(v) == 1)) {
+      o.auto_exposure = static_cast<int>(v);
+    } else {
+      throw std::invalid_argument("~auto_exposure must be true/false or 1/0");
+    }
   }
   pnh.param("exposure_absolute", o.exposure_absolute, -1);
   pnh.param("gain", o.gain, -1);
@@ -85,7 +94,13 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh;
   ros::NodeHandle pnh("~");
 
-  const FrameSourceOptions options = ReadOptions(pnh);
+  FrameSourceOptions options;
+  try {
+    options = ReadOptions(pnh);
+  } catch (const std::exception& e) {
+    ROS_FATAL("camera_node: %s", e.what());
+    return 1;
+  }
   std::string frame_id, camera_name, camera_info_url;
   pnh.param<std::string>("frame_id", frame_id, "camera_optical_frame");
   pnh.param<std::string>("camera_name", camera_name, "camera");

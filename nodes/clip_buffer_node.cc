@@ -129,7 +129,13 @@ class ClipBufferNode {
                flush_after_, pipeline_->pending());
       Publish(pipeline_->Flush());
     }
-    updater_.update();
+    // force_update once a wall second: Updater::update() waits for ROS time, which stands still
+    // while a bag is paused and jumps back when it loops.
+    const ros::WallTime now = ros::WallTime::now();
+    if ((now - last_diagnostics_).toSec() >= 1.0) {
+      last_diagnostics_ = now;
+      updater_.force_update();
+    }
   }
 
   void Publish(const std::vector<sensors::LabelledClip>& clips) {
@@ -202,6 +208,7 @@ class ClipBufferNode {
   ros::Subscriber image_sub_, info_sub_, wind_sub_;
   ros::WallTimer flush_timer_;
   diagnostic_updater::Updater updater_;
+  ros::WallTime last_diagnostics_;
 };
 
 }  // namespace
