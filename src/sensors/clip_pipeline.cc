@@ -1,7 +1,9 @@
 #include "sensors/clip_pipeline.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 namespace clothwind::sensors {
@@ -9,16 +11,40 @@ namespace {
 constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 }
 
+void ValidateClipPipelineOptions(const ClipPipelineOptions& o) {
+  auto fail = [](const std::string& name, const std::string& expected, double got) {
+    std::ostringstream s;
+    s << name << " must be " << expected << ", got " << got;
+    throw std::invalid_argument(s.str());
+  };
+  if (!(std::isfinite(o.frame_rate) && o.frame_rate > 0.0)) fail("frame_rate", "a finite rate > 0 Hz", o.frame_rate);
+  if (!(std::isfinite(o.gap_tolerance) && o.gap_tolerance > 0.0))
+    fail("gap_tolerance", "a finite interval > 0 s", o.gap_tolerance);
+  if (o.num_frames < 1) fail("num_frames", ">= 1", o.num_frames);
+  if (o.stride < 1) fail("stride", ">= 1", o.stride);
+  if (o.size < 1) fail("size", ">= 1 px", o.size);
+  if (o.roi.size < 0 || o.roi.x < 0 || o.roi.y < 0) fail("roi", "[x >= 0, y >= 0, size >= 0] in source pixels",
+                                                         std::min({o.roi.x, o.roi.y, o.roi.size}));
+  if (!(std::isfinite(o.label_window) && o.label_window > 0.0))
+    fail("label_window", "a finite window > 0 s", o.label_window);
+  if (!(std::isfinite(o.label_delay) && o.label_delay >= 0.0))
+    fail("label_delay", "a finite delay >= 0 s", o.label_delay);
+  if (!(o.max_future >= 0.0)) fail("max_future", ">= 0 s (inf: stamps not checked)", o.max_future);
+}
+
 ClipPipeline::ClipPipeline(const ClipPipelineOptions& options)
-    : options_(options),
+    : options_((ValidateClipPipelineOptions(options), options)),
       resampler_(options.frame_rate, options.gap_tolerance),
       assembler_(options.num_frames, options.stride),
       labeller_(options.label_window),
       data_time_(kNegInf),
       released_end_(kNegInf) {
-  if (options.size <= 0) throw std::invalid_argument("size must be > 0 px, got " + std::to_string(options.size));
-  if (!(options.label_delay >= 0.0))
-    throw std::invalid_argument("label_delay must be >= 0 s, got " + std::to_string(options.label_delay));
+}
+
+bool ClipPipeline::StampedInFuture(double stamp, double now) {
+  if (!(stamp > now + options_.max_future)) return false;
+  stats_.last_future_lead = stamp - now;
+  return true;
 }
 
 void ClipPipeline::Reset() {
@@ -26,13 +52,19 @@ void ClipPipeline::Reset() {
   assembler_.Break();
   previous_.release();
   pending_.clear();
+  released_at_jump_.clear();
   labeller_ = WindLabeller(options_.label_window);
   data_time_ = kNegInf;
   released_end_ = kNegInf;
 }
 
-void ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncoding encoding) {
+bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncoding encoding, double now) {
   ++stats_.frames_in;
+  if (StampedInFuture(stamp, now)) {
+    ++stats_.frames_future;
+    ++stats_.frames_dropped;
+    return false;
+  }
   cv::Mat processed;
   try {
     if (image.cols != source_width_ || image.rows != source_height_) {
@@ -51,7 +83,7 @@ void ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
   const FrameResampler::Result r = resampler_.Push(stamp);
   if (r.dropped) {
     ++stats_.frames_dropped;
-    return;
+    return true;
   }
   if (r.gap) {
     ++stats_.gaps;
@@ -60,7 +92,12 @@ void ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
   }
   if (r.restarted) assembler_.Break();
   if (r.jumped_back) {
-    // Time went back (a bag restarted): clips and readings of the old timeline are meaningless.
+    // Time went back (a bag restarted or looped): the old timeline's readings must not label the
+    // new one's clips. Its waiting clips are labelled now with what it has (as Flush does at the
+    // end of a stream) rather than lost, and its readings forgotten.
+    ++stats_.time_jumps;
+    stats_.clips_at_jumps += pending_.size();
+    for (auto& clip : pending_) released_at_jump_.push_back(Release(std::move(clip)));
     pending_.clear();
     labeller_ = WindLabeller(options_.label_window);
     data_time_ = kNegInf;
@@ -70,6 +107,7 @@ void ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
   previous_ = processed;
   last_frame_ = stamp;
   data_time_ = std::max(data_time_, stamp);
+  return true;
 }
 
 void ClipPipeline::Emit(const FrameResampler::Tick& tick, const cv::Mat& image) {
@@ -81,11 +119,16 @@ void ClipPipeline::Emit(const FrameResampler::Tick& tick, const cv::Mat& image) 
   }
 }
 
-void ClipPipeline::AddReading(const LabelReading& reading) {
-  if (!labeller_.Add(reading)) return;
+bool ClipPipeline::AddReading(const LabelReading& reading, double now) {
+  if (StampedInFuture(reading.stamp, now)) {
+    ++stats_.readings_future;
+    return false;
+  }
+  if (!labeller_.Add(reading)) return false;
   ++stats_.readings_in;
   if (reading.stamp <= released_end_) ++stats_.readings_late;
   data_time_ = std::max(data_time_, reading.stamp);
+  return true;
 }
 
 LabelledClip ClipPipeline::Release(AssembledClip clip) {
@@ -98,13 +141,19 @@ LabelledClip ClipPipeline::Release(AssembledClip clip) {
   out.source_height = source_height_;
   out.frame_rate = options_.frame_rate;
   ++stats_.clips_released;
-  if (out.label.count == 0) ++stats_.clips_unlabelled;
+  if (out.label.count == 0) {
+    ++stats_.clips_unlabelled;
+    ++stats_.unlabelled_run;
+  } else {
+    stats_.unlabelled_run = 0;
+  }
   released_end_ = std::max(released_end_, end);
   return out;
 }
 
 std::vector<LabelledClip> ClipPipeline::TakeReady() {
-  std::vector<LabelledClip> ready;
+  std::vector<LabelledClip> ready = std::move(released_at_jump_);
+  released_at_jump_.clear();
   while (!pending_.empty() && data_time_ >= pending_.front().frames.back().stamp + options_.label_delay) {
     ready.push_back(Release(std::move(pending_.front())));
     pending_.pop_front();
@@ -120,7 +169,8 @@ std::vector<LabelledClip> ClipPipeline::TakeReady() {
 }
 
 std::vector<LabelledClip> ClipPipeline::Flush() {
-  std::vector<LabelledClip> ready;
+  std::vector<LabelledClip> ready = std::move(released_at_jump_);
+  released_at_jump_.clear();
   while (!pending_.empty()) {
     ready.push_back(Release(std::move(pending_.front())));
     pending_.pop_front();

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,7 +31,18 @@ struct ClipPipelineOptions {
   // long [s] before it is labelled, so readings stamped inside its window that arrive a little late
   // still count. 1.5 s covers a 1 Hz anemometer's next reading plus transport.
   double label_delay = 1.5;
+  // A frame or reading stamped more than this after the clock passed with it [s] is refused: one
+  // stamp from a wrong clock would otherwise move the pipeline's time forward for good (every
+  // later clip released at once and the readings it needs pruned as old).
+  double max_future = 5.0;
 };
+
+// `now` of AddFrame/AddReading when there is no clock to compare with (stamps not checked).
+inline constexpr double kNoClock = std::numeric_limits<double>::infinity();
+
+// Throws std::invalid_argument naming the first option out of range (by its ROS parameter name)
+// and what was expected.
+void ValidateClipPipelineOptions(const ClipPipelineOptions& options);
 
 // A clip with its label, ready to publish or record.
 struct LabelledClip {
@@ -45,7 +57,7 @@ struct LabelledClip {
 // Counters for diagnostics.
 struct ClipPipelineStats {
   uint64_t frames_in = 0;         // camera frames pushed
-  uint64_t frames_dropped = 0;    // ignored: stamp not after the previous one, or bad image
+  uint64_t frames_dropped = 0;    // ignored: stamp not after the previous one or in the future, or bad image
   uint64_t frames_out = 0;        // resampled frames produced
   uint64_t gaps = 0;              // holes in the camera stream longer than gap_tolerance
   uint64_t clips_made = 0;        // clips assembled
@@ -53,6 +65,12 @@ struct ClipPipelineStats {
   uint64_t clips_unlabelled = 0;  // released with no reading in their window
   uint64_t readings_in = 0;       // usable anemometer readings
   uint64_t readings_late = 0;     // readings stamped inside an already released clip's window
+  uint64_t frames_future = 0;     // frames refused: stamped more than max_future after the clock
+  uint64_t readings_future = 0;   // readings refused for the same reason
+  double last_future_lead = 0.0;  // how far after the clock the last refused stamp was [s]
+  uint64_t time_jumps = 0;        // camera time went back (a bag restarted or looped)
+  uint64_t clips_at_jumps = 0;    // clips waiting at a jump, labelled with the readings held then
+  uint64_t unlabelled_run = 0;    // clips released since the last one with a reading (0: it had one)
   double last_gap = 0.0;          // length of the last gap [s]
 };
 
@@ -70,13 +88,17 @@ class ClipPipeline {
   //   stamp     capture time [s] (header.stamp)
   //   image     rows x cols, type ClipSourceCvType(encoding); only read during the call
   //   encoding  its pixel layout
+  //   now       the clock when it arrived [s] (ros::Time::now()), or kNoClock
+  // Returns false when the frame was refused as stamped in the future (counted in frames_future).
   // Throws std::invalid_argument (roi does not fit, wrong type) after counting it as dropped.
-  void AddFrame(double stamp, const cv::Mat& image, ClipSourceEncoding encoding);
+  bool AddFrame(double stamp, const cv::Mat& image, ClipSourceEncoding encoding, double now = kNoClock);
 
-  // Pushes one anemometer reading (any arrival order).
-  void AddReading(const LabelReading& reading);
+  // Pushes one anemometer reading (any arrival order). Returns false when it was refused: stamped
+  // more than max_future after `now` (counted in readings_future), or not finite.
+  bool AddReading(const LabelReading& reading, double now = kNoClock);
 
-  // Clips whose label is due (data time >= end + label_delay), oldest first.
+  // Clips whose label is due (data time >= end + label_delay), oldest first; clips that were
+  // waiting when camera time went back come first, labelled with the readings held then.
   std::vector<LabelledClip> TakeReady();
 
   // Every waiting clip, labelled with the readings held now (the stream ended or stalled).
@@ -92,6 +114,7 @@ class ClipPipeline {
  private:
   void Emit(const FrameResampler::Tick& tick, const cv::Mat& image);
   LabelledClip Release(AssembledClip clip);
+  bool StampedInFuture(double stamp, double now);
 
   ClipPipelineOptions options_;
   FrameResampler resampler_;
@@ -104,6 +127,7 @@ class ClipPipeline {
   double last_frame_ = 0.0;     // stamp of the last accepted camera frame [s]
   double released_end_;         // end of the last released clip [s]
   std::deque<AssembledClip> pending_;
+  std::vector<LabelledClip> released_at_jump_;  // labelled at a time jump, not taken yet
   ClipPipelineStats stats_;
 };
 

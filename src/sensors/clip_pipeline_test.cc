@@ -1,6 +1,8 @@
 #include "sensors/clip_pipeline.h"
 
 #include <cmath>
+#include <limits>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -96,19 +98,123 @@ TEST(ClipPipelineTest, LabelWaitsForLateReadingsByStamp) {
 }
 
 TEST(ClipPipelineTest, TimeJumpingBackStartsOver) {
-  // A bag played twice (rosbag play -l): the second pass must not mix with the first.
+  // A bag played twice (rosbag play -l): the second pass must not mix with the first, and the
+  // first pass's waiting clips are labelled with its own readings rather than lost.
   ClipPipeline p(SmallOptions());
   for (int s = 0; s <= 3; ++s) p.AddReading({kT0 + s, 9.0, 0.0});
   for (int i = 0; i < 90; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
-  EXPECT_GT(p.pending(), 0u);
-  // Back to the start: waiting clips and first-pass readings are dropped.
+  const size_t due = p.TakeReady().size();  // data time 3 s: clips ending by 1.5 s
+  EXPECT_EQ(due, 3u);
+  const size_t waiting = p.pending();
+  ASSERT_GT(waiting, 0u);
+  // Back to the start.
   for (int i = 0; i < 20; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  EXPECT_EQ(p.stats().time_jumps, 1u);
+  EXPECT_EQ(p.stats().clips_at_jumps, waiting);
+  const auto first_pass = p.TakeReady();
+  ASSERT_EQ(first_pass.size(), waiting);
+  for (const auto& c : first_pass) {
+    EXPECT_GT(c.label.count, 0u);
+    EXPECT_DOUBLE_EQ(c.label.mean, 9.0);
+  }
   p.AddReading({kT0 + 0.2, 1.0, 0.0});
   const auto clips = p.Flush();
   ASSERT_EQ(clips.size(), 1u);  // ticks 0..15 of the second pass: one clip of 10
   EXPECT_NEAR(clips[0].clip.frames.front().stamp, kT0, 1e-6);
-  EXPECT_EQ(clips[0].label.count, 1u);
+  EXPECT_EQ(clips[0].label.count, 1u);  // the first pass's readings are forgotten
   EXPECT_DOUBLE_EQ(clips[0].label.mean, 1.0);
+  EXPECT_EQ(p.stats().clips_made, p.stats().clips_released);  // no clip lost
+}
+
+// One reading from a clock an hour ahead: without the check it moves the pipeline's time an hour
+// on, every later clip is released at once and the readings it needs are pruned as old.
+TEST(ClipPipelineTest, ReadingStampedInTheFutureIsRefused) {
+  ClipPipeline p(SmallOptions());
+  std::vector<LabelledClip> clips;
+  for (int i = 0; i <= 20 * 30; ++i) {
+    const double t = kT0 + i / 30.0;
+    if (i % 30 == 0) {
+      EXPECT_TRUE(p.AddReading({t, 3.0, 0.0}, t));
+    }
+    if (i == 150) {
+      EXPECT_FALSE(p.AddReading({t + 3600.0, 50.0, 0.0}, t));
+      EXPECT_NEAR(p.stats().last_future_lead, 3600.0, 1e-6);
+    }
+    EXPECT_TRUE(p.AddFrame(t, Numbered(i), ClipSourceEncoding::kMono8, t));
+    for (auto& c : p.TakeReady()) {
+      // Released only once due: the data has reached its end + label_delay.
+      EXPECT_LE(c.clip.frames.back().stamp + 1.5, t + 1e-9);
+      clips.push_back(std::move(c));
+    }
+  }
+  EXPECT_EQ(p.stats().readings_future, 1u);
+  ASSERT_GE(clips.size(), 40u);
+  for (const auto& c : clips) {
+    EXPECT_GT(c.label.count, 0u) << "clip " << c.clip.sequence;
+    EXPECT_DOUBLE_EQ(c.label.mean, 3.0) << "clip " << c.clip.sequence;
+  }
+  EXPECT_EQ(p.stats().unlabelled_run, 0u);
+  // Within max_future of the clock (a camera on another machine a little ahead) is accepted.
+  EXPECT_TRUE(p.AddReading({kT0 + 20.5 + 4.0, 3.0, 0.0}, kT0 + 20.5));
+}
+
+TEST(ClipPipelineTest, FrameStampedInTheFutureIsRefusedWithoutBreakingTheClip) {
+  ClipPipeline p(SmallOptions());
+  for (int i = 0; i < 90; ++i) {
+    const double t = kT0 + i / 30.0;
+    if (i == 40) {
+      EXPECT_FALSE(p.AddFrame(t + 1e6, Numbered(i), ClipSourceEncoding::kMono8, t));
+    } else {
+      EXPECT_TRUE(p.AddFrame(t, Numbered(i), ClipSourceEncoding::kMono8, t));
+    }
+  }
+  EXPECT_EQ(p.stats().frames_future, 1u);
+  EXPECT_EQ(p.stats().gaps, 0u);  // one missing 30 fps frame is bridged
+  EXPECT_EQ(p.stats().time_jumps, 0u);
+  EXPECT_EQ(p.Flush().size(), 7u);  // ticks 0..74 of 3 s: the clips of an unbroken stream
+}
+
+TEST(ClipPipelineTest, UnlabelledRunCountsClipsSinceTheLastReading) {
+  ClipPipeline p(SmallOptions());  // label window 5 s
+  p.AddReading({kT0, 3.0, 0.0});
+  for (int i = 0; i < 12 * 30; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  const auto clips = p.Flush();
+  // Clips end every 0.4 s from 0.36 s; those ending after 5 s no longer see the reading at 0.
+  size_t after = 0;
+  for (const auto& c : clips) after += c.clip.frames.back().stamp > kT0 + 5.0 ? 1 : 0;
+  ASSERT_GT(after, 0u);
+  EXPECT_EQ(p.stats().unlabelled_run, after);
+  EXPECT_EQ(p.stats().clips_unlabelled, after);
+  p.AddReading({kT0 + 12.0, 3.0, 0.0});
+  for (int i = 12 * 30; i < 13 * 30; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  ASSERT_FALSE(p.Flush().empty());
+  EXPECT_EQ(p.stats().unlabelled_run, 0u);
+}
+
+TEST(ClipPipelineTest, OptionsOutOfRangeAreNamed) {
+  auto message = [](auto change) {
+    ClipPipelineOptions o;
+    change(o);
+    try {
+      ClipPipeline p(o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message([](auto& o) { o.frame_rate = 0.0; }).find("frame_rate"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.frame_rate = std::nan(""); }).find("frame_rate"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.gap_tolerance = -1.0; }).find("gap_tolerance"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.num_frames = 0; }).find("num_frames"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.stride = 0; }).find("stride"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.size = 0; }).find("size"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.roi = {-1, 0, 10}; }).find("roi"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.label_window = std::numeric_limits<double>::infinity(); }).find("label_window"),
+            std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.label_delay = -0.5; }).find("label_delay"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.max_future = std::nan(""); }).find("max_future"), std::string::npos);
+  EXPECT_EQ(message([](auto& o) { o.max_future = std::numeric_limits<double>::infinity(); }), "accepted");
+  EXPECT_EQ(message([](auto&) {}), "accepted");
 }
 
 TEST(ClipPipelineTest, BgrFramesAreCroppedToRoi) {
