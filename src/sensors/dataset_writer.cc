@@ -1,10 +1,13 @@
 #include "sensors/dataset_writer.h"
 
+#include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
@@ -30,21 +33,51 @@ std::string TempSuffix() {
 
 }  // namespace
 
+void WriteFileDurably(const std::string& path, const void* data, size_t size) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot open " + path + " for writing: " + std::strerror(errno));
+  const char* p = static_cast<const char*>(data);
+  size_t left = size;
+  std::string error;
+  while (left > 0 && error.empty()) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      error = "cannot write " + path + ": " + std::strerror(n < 0 ? errno : EIO);
+    } else {
+      p += n;
+      left -= static_cast<size_t>(n);
+    }
+  }
+  // fsync before the rename that publishes it: otherwise a power cut can leave the new name
+  // pointing at an empty file on ext4/xfs.
+  if (error.empty() && ::fsync(fd) != 0) error = "cannot sync " + path + ": " + std::strerror(errno);
+  if (::close(fd) != 0 && error.empty()) error = "cannot close " + path + ": " + std::strerror(errno);
+  if (!error.empty()) {
+    ::unlink(path.c_str());
+    throw std::runtime_error(error);
+  }
+}
+
+void SyncDirectory(const std::string& dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error("cannot open folder " + dir + ": " + std::strerror(errno));
+  const int rc = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  if (rc != 0) throw std::runtime_error("cannot sync folder " + dir + ": " + std::strerror(err));
+}
+
 void WriteFileAtomically(const std::string& path, const std::string& text) {
   const std::string tmp = path + TempSuffix();
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot open " + tmp + " for writing: " + std::strerror(errno));
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error("cannot write " + tmp + ": " + std::strerror(errno));
-  }
+  WriteFileDurably(tmp, text.data(), text.size());  // removes tmp itself when it fails
   std::error_code ec;
   fs::rename(tmp, path, ec);
   if (ec) {
-    fs::remove(tmp);
+    fs::remove(tmp, ec);
     throw std::runtime_error("cannot rename " + tmp + " to " + path + ": " + ec.message());
   }
+  SyncDirectory(fs::path(path).parent_path().empty() ? "." : fs::path(path).parent_path().string());
 }
 
 std::string ClipFolderName(double first_stamp, uint64_t sequence) {
@@ -118,6 +151,7 @@ DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality)
     index_ = {{"format", "clothwind-dataset"}, {"version", kFormatVersion}, {"kind", "real"},
               {"clips", nlohmann::json::array()}};
   }
+  recovered_ = RecoverLeftovers();
 }
 
 std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo& source) {
@@ -130,22 +164,32 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
   if (ec) throw std::runtime_error("cannot create " + tmp_dir + ": " + ec.message());
   try {
     const std::vector<int> params{cv::IMWRITE_JPEG_QUALITY, jpeg_quality_};
+    std::vector<uchar> jpeg;
     for (size_t i = 0; i < clip.clip.frames.size(); ++i) {
       char file[32];
       std::snprintf(file, sizeof file, "/%03zu.jpg", i);
-      if (!cv::imwrite(tmp_dir + file, clip.clip.frames[i].image, params))
-        throw std::runtime_error("cannot write " + tmp_dir + file);
+      if (!cv::imencode(".jpg", clip.clip.frames[i].image, jpeg, params))
+        throw std::runtime_error("cannot encode " + tmp_dir + file + " as JPEG");
+      WriteFileDurably(tmp_dir + file, jpeg.data(), jpeg.size());
     }
     const nlohmann::json label = ClipLabelJson(clip, source, name);
     WriteFileAtomically(tmp_dir + "/label.json", label.dump(2) + "\n");
     if (fs::exists(final_dir)) {  // replayed again: replace the old folder
+      // Two renames, not one: rename() cannot replace a non-empty folder. If the second fails the
+      // old copy is put back, so the name never stays empty or hidden.
       const std::string old_dir = root_ + "/." + name + ".old" + TempSuffix();
       fs::rename(final_dir, old_dir);
-      fs::rename(tmp_dir, final_dir);
+      try {
+        fs::rename(tmp_dir, final_dir);
+      } catch (...) {
+        fs::rename(old_dir, final_dir, ec);
+        throw;
+      }
       fs::remove_all(old_dir);
     } else {
       fs::rename(tmp_dir, final_dir);
     }
+    SyncDirectory(root_);
     auto& clips = index_["clips"];
     for (auto it = clips.begin(); it != clips.end(); ++it) {
       if ((*it)["name"] == name) {
@@ -162,7 +206,6 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
                      {"wind_speed", label["wind_speed"]},
                      {"wind_std", label["wind"]["std"]},
                      {"wind_count", label["wind"]["count"]}});
-    WriteIndex();
   } catch (const fs::filesystem_error& e) {
     fs::remove_all(tmp_dir, ec);
     throw std::runtime_error(std::string("recording clip ") + name + ": " + e.what());
@@ -170,7 +213,37 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
     fs::remove_all(tmp_dir, ec);
     throw;
   }
+  try {
+    WriteIndex();
+  } catch (const std::exception& e) {
+    // The clip is in place and in the index held here: the next index written lists it.
+    throw std::runtime_error("clip " + name + " recorded but " + root_ + "/index.json not updated (the next clip's "
+                             "update will list it): " + e.what());
+  }
   return final_dir;
+}
+
+size_t DatasetWriter::RecoverLeftovers() {
+  // Names this writer gives its temporaries: ".<clip>.tmp-<pid>-<n>" (a clip being written),
+  // ".<clip>.old.tmp-<pid>-<n>" (a clip being replaced) and "index.json.tmp-<pid>-<n>".
+  size_t handled = 0;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(root_, ec)) {
+    const std::string file = entry.path().filename().string();
+    const size_t at = file.rfind(".tmp-");
+    if (at == std::string::npos) continue;
+    const long pid = std::strtol(file.c_str() + at + 5, nullptr, 10);
+    if (pid <= 0 || (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM)) continue;  // still writing
+    const bool old_copy = file.size() > 5 && file.compare(at - 4, 4, ".old") == 0 && file[0] == '.';
+    const std::string clip = old_copy ? file.substr(1, at - 5) : "";
+    if (old_copy && !fs::exists(root_ + "/" + clip)) {
+      fs::rename(entry.path(), root_ + "/" + clip, ec);  // a crash between the two renames
+    } else {
+      fs::remove_all(entry.path(), ec);
+    }
+    ++handled;
+  }
+  return handled;
 }
 
 void DatasetWriter::WriteIndex() { WriteFileAtomically(root_ + "/index.json", index_.dump(1) + "\n"); }

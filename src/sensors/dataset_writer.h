@@ -29,35 +29,46 @@ nlohmann::json ClipLabelJson(const LabelledClip& clip, const ClipSourceInfo& sou
 // Records clips as a FlagReal-style dataset: <root>/<name>/000.jpg ... NNN.jpg + label.json, one
 // folder per clip, plus <root>/index.json listing every clip. Each clip folder is written under a
 // hidden temporary name and renamed into place, and the index is rewritten to a temporary file
-// and renamed, so a reader (or a crash) never sees a half-written clip or index. Opening an
-// existing dataset appends to its index.
+// and renamed, so a reader (or a crash) never sees a half-written clip or index; every file is
+// fsync'ed before the rename that publishes it and the folder after it, so a power cut leaves
+// the old version or the new one, not an empty file. Opening an existing dataset appends to its
+// index and clears what a writer that died left behind (its temporaries; a clip it was
+// replacing is put back).
 class DatasetWriter {
  public:
   // Inputs:
   //   root          dataset folder (created if missing)
   //   jpeg_quality  1..100 (95)
   // Throws std::runtime_error when the folder cannot be created or its index.json is not valid
-  // (the message names the file and what was expected).
+  // (the message names the file and what was expected); an index that cannot be read is never
+  // overwritten.
   explicit DatasetWriter(const std::string& root, int jpeg_quality = 95);
 
   // Writes one clip; returns the path of its folder. A folder of the same name is replaced (the
-  // same session replayed again). Throws std::runtime_error naming the file that failed.
+  // same session replayed again; if that fails the old folder stays). Throws std::runtime_error
+  // naming the file that failed; nothing half-written is left behind. When only the index update
+  // failed the message says so: the clip is in place and the next index written lists it.
   std::string Write(const LabelledClip& clip, const ClipSourceInfo& source);
 
   // Clips listed in the index.
   size_t size() const { return index_["clips"].size(); }
   const std::string& root() const { return root_; }
+  // Temporaries of a writer that died, cleared when this one opened the folder.
+  size_t recovered() const { return recovered_; }
 
  private:
   void WriteIndex();
+  size_t RecoverLeftovers();
 
   std::string root_;
   int jpeg_quality_;
   nlohmann::json index_;
+  size_t recovered_ = 0;
 };
 
-// Writes `text` to `path` through a temporary file in the same folder and a rename.
-// Throws std::runtime_error naming the path when it fails.
+// Writes `text` to `path` through a temporary file in the same folder, fsync and a rename (then
+// fsyncs the folder). Throws std::runtime_error naming the path when it fails; the temporary
+// file is removed then.
 void WriteFileAtomically(const std::string& path, const std::string& text);
 
 }  // namespace clothwind::sensors

@@ -1,9 +1,13 @@
 #include "sensors/dataset_writer.h"
 
+#include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <set>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -32,6 +36,16 @@ class DatasetWriterTest : public ::testing::Test {
     c.source_height = 240;
     c.label = ComputeWindLabel({{t0 - 1.0, 3.0, 0.5}, {t0, 5.0, 0.5}}, t0 + 0.12, 60.0);
     return c;
+  }
+
+  // Names in root_ that start with "." (the writer's temporaries).
+  std::set<std::string> Hidden() const {
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(root_)) {
+      const std::string n = e.path().filename().string();
+      if (n[0] == '.') names.insert(n);
+    }
+    return names;
   }
 
   static nlohmann::json Read(const fs::path& p) {
@@ -133,6 +147,83 @@ TEST_F(DatasetWriterTest, AtomicFileWriteReplacesContent) {
   in >> s;
   EXPECT_EQ(s, "two");
   EXPECT_THROW(WriteFileAtomically((root_ / "missing" / "b.txt").string(), "x"), std::runtime_error);
+}
+
+// A disk that fills up while a clip is replaced (RLIMIT_FSIZE stands in for a full disk: it fails
+// writes even for root, where file permissions would not): the error names the file, the old
+// copy and the index stay as they were and no temporary is left.
+TEST_F(DatasetWriterTest, FailedWriteKeepsTheOldCopyAndLeavesNoTemporary) {
+  DatasetWriter w(root_.string());
+  w.Write(MakeClip(0, 1700000000.0, 4), {});
+  const auto index_before = Read(root_ / "index.json");
+  const fs::path clip_dir = root_ / ClipFolderName(1700000000.0, 0);
+
+  rlimit saved{};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
+  auto* old_handler = ::signal(SIGXFSZ, SIG_IGN);  // else the write kills the process
+  rlimit small = saved;
+  small.rlim_cur = 64;  // bytes: smaller than any JPEG frame
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  std::string message;
+  try {
+    w.Write(MakeClip(0, 1700000000.0, 3), {});
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &saved), 0);
+  ::signal(SIGXFSZ, old_handler);
+
+  EXPECT_NE(message.find("000.jpg"), std::string::npos) << message;
+  EXPECT_EQ(Read(clip_dir / "label.json")["num_frames"], 4);  // the old copy, whole
+  EXPECT_TRUE(fs::exists(clip_dir / "003.jpg"));
+  EXPECT_EQ(Read(root_ / "index.json"), index_before);
+  EXPECT_TRUE(Hidden().empty()) << *Hidden().begin();
+}
+
+// The index cannot be replaced (a folder stands in its place): the clip is recorded, the error
+// says the index was not updated, and the next write's index lists both clips.
+TEST_F(DatasetWriterTest, FailedIndexUpdateIsToldAndCaughtUpNextTime) {
+  DatasetWriter w(root_.string());
+  w.Write(MakeClip(0, 1700000000.0), {});
+  fs::remove(root_ / "index.json");
+  fs::create_directories(root_ / "index.json" / "blocker");
+  std::string message;
+  try {
+    w.Write(MakeClip(1, 1700000001.2), {});
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("index.json not updated"), std::string::npos) << message;
+  EXPECT_TRUE(fs::exists(root_ / ClipFolderName(1700000001.2, 1) / "label.json"));
+  EXPECT_TRUE(Hidden().empty()) << *Hidden().begin();
+  fs::remove_all(root_ / "index.json");
+  w.Write(MakeClip(2, 1700000002.4), {});
+  EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 3u);
+}
+
+// What a writer that died leaves behind is cleared when the folder is opened again; a clip it was
+// replacing (renamed aside, the new copy not yet in place) is put back; a live writer's
+// temporaries are left alone.
+TEST_F(DatasetWriterTest, OpeningClearsADeadWritersLeftovers) {
+  {
+    DatasetWriter w(root_.string());
+    w.Write(MakeClip(0, 1700000000.0), {});
+    w.Write(MakeClip(1, 1700000001.2), {});
+  }
+  const std::string dead = ".tmp-999999999-";  // above any pid_max: no such process
+  const std::string clip1 = ClipFolderName(1700000001.2, 1);
+  fs::create_directories(root_ / ("." + ClipFolderName(1700000002.4, 2) + dead + "0"));
+  std::ofstream(root_ / ("index.json" + dead + "1")) << "{";
+  fs::rename(root_ / clip1, root_ / ("." + clip1 + ".old" + dead + "2"));
+  const std::string live = "index.json.tmp-" + std::to_string(::getpid()) + "-7";
+  std::ofstream(root_ / live) << "{";
+
+  DatasetWriter again(root_.string());
+  EXPECT_EQ(again.recovered(), 3u);
+  EXPECT_EQ(Read(root_ / clip1 / "label.json")["sequence"], 1);
+  EXPECT_EQ(Hidden(), std::set<std::string>{});
+  EXPECT_TRUE(fs::exists(root_ / live));
+  EXPECT_EQ(again.size(), 2u);
 }
 
 }  // namespace
