@@ -40,6 +40,7 @@ class ClipBufferNode {
     pnh.param("gap_tolerance", o.gap_tolerance, o.gap_tolerance);
     pnh.param("label_window", o.label_window, o.label_window);
     pnh.param("label_delay", o.label_delay, o.label_delay);
+    pnh.param("max_future", o.max_future, o.max_future);
     if (pnh.hasParam("roi")) {
       std::vector<double> roi;
       if (!pnh.getParam("roi", roi) || (roi.size() != 3 && !roi.empty()))
@@ -51,16 +52,25 @@ class ClipBufferNode {
     }
     pnh.param("flush_after", flush_after_, 3.0);
     pnh.param("frame_id", frame_id_, std::string());
-    int queue = 60, jpeg_quality = 95;
+    int queue = 60;
     pnh.param("queue_size", queue, queue);
-    pnh.param("jpeg_quality", jpeg_quality, jpeg_quality);
-    std::string record_dir;
-    pnh.param("record_dir", record_dir, std::string());
-    pipeline_ = std::make_unique<sensors::ClipPipeline>(o);
-    if (!record_dir.empty()) {
-      writer_ = std::make_unique<sensors::DatasetWriter>(record_dir, jpeg_quality);
-      ROS_INFO("clip_buffer: recording clips to %s (%zu already there)", record_dir.c_str(), writer_->size());
+    pnh.param("jpeg_quality", jpeg_quality_, jpeg_quality_);
+    pnh.param("record_dir", record_dir_, std::string());
+    // Out of range is refused at start, naming the parameter: a clip buffer that runs with a
+    // setting it did not mean records data that looks right and is not.
+    if (!(std::isfinite(flush_after_) && flush_after_ > 0.0))
+      throw std::invalid_argument("~flush_after must be a finite time > 0 s, got " + std::to_string(flush_after_));
+    if (queue < 1) throw std::invalid_argument("~queue_size must be >= 1, got " + std::to_string(queue));
+    if (jpeg_quality_ < 1 || jpeg_quality_ > 100)
+      throw std::invalid_argument("~jpeg_quality must be in 1..100, got " + std::to_string(jpeg_quality_));
+    try {
+      pipeline_ = std::make_unique<sensors::ClipPipeline>(o);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("~") + e.what());
     }
+    // A record folder that cannot be opened (a disk not mounted yet, a damaged index) stops the
+    // recording, not the clips: the node publishes, says why in its diagnostics and retries.
+    OpenRecording();
 
     clip_pub_ = nh.advertise<clothwind::Clip>("clips", 4);
     preview_pub_ = nh.advertise<sensor_msgs::Image>("clips/preview", 1, true);
@@ -82,6 +92,26 @@ class ClipBufferNode {
              o.label_window, o.label_delay, o.gap_tolerance);
   }
 
+  // Opens record_dir_ (when set and not open yet); on failure keeps why for the diagnostics.
+  void OpenRecording() {
+    if (record_dir_.empty() || writer_) return;
+    last_open_attempt_ = ros::WallTime::now();
+    try {
+      writer_ = std::make_unique<sensors::DatasetWriter>(record_dir_, jpeg_quality_);
+      if (!recording_error_.empty()) ROS_INFO("clip_buffer: recording works again");
+      recording_error_.clear();
+      ROS_INFO("clip_buffer: recording clips to %s (%zu already there%s)", record_dir_.c_str(), writer_->size(),
+               writer_->recovered() > 0
+                   ? (", " + std::to_string(writer_->recovered()) + " leftovers of an earlier run cleared").c_str()
+                   : "");
+    } catch (const std::exception& e) {
+      if (recording_error_ != e.what())
+        ROS_ERROR("clip_buffer: not recording (publishing clips still; retrying every %.0f s): %s", kReopenEvery,
+                  e.what());
+      recording_error_ = e.what();
+    }
+  }
+
   // Labels and records whatever is still waiting (called on shutdown; nothing is published then).
   void Finish() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -100,10 +130,13 @@ class ClipBufferNode {
       cv::Mat view;
       sensors::ClipSourceEncoding encoding;
       ros_bridge::ImageView(*msg, &view, &encoding);
-      pipeline_->AddFrame(msg->header.stamp.toSec(), view, encoding);
+      if (!pipeline_->AddFrame(msg->header.stamp.toSec(), view, encoding, Now())) {
+        last_future_ = ros::WallTime::now();
+        ROS_WARN_THROTTLE(5.0, "clip_buffer: frame stamped %.1f s after the clock refused (camera clock?)",
+                          pipeline_->stats().last_future_lead);
+      }
     } catch (const std::exception& e) {
-      last_error_ = e.what();
-      ROS_ERROR_THROTTLE(5.0, "clip_buffer: frame dropped: %s", e.what());
+      NoteError(std::string("frame dropped: ") + e.what());
     }
     Publish(pipeline_->TakeReady());
   }
@@ -111,7 +144,13 @@ class ClipBufferNode {
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     last_input_ = ros::WallTime::now();
-    pipeline_->AddReading(ros_bridge::ToLabelReading(*msg));
+    const uint64_t future_before = pipeline_->stats().readings_future;
+    pipeline_->AddReading(ros_bridge::ToLabelReading(*msg), Now());
+    if (pipeline_->stats().readings_future > future_before) {
+      last_future_ = ros::WallTime::now();
+      ROS_WARN_THROTTLE(5.0, "clip_buffer: anemometer reading stamped %.1f s after the clock refused",
+                        pipeline_->stats().last_future_lead);
+    }
     Publish(pipeline_->TakeReady());
   }
 
@@ -129,6 +168,8 @@ class ClipBufferNode {
                flush_after_, pipeline_->pending());
       Publish(pipeline_->Flush());
     }
+    if (!writer_ && !record_dir_.empty() && (ros::WallTime::now() - last_open_attempt_).toSec() >= kReopenEvery)
+      OpenRecording();
     // force_update once a wall second: Updater::update() waits for ROS time, which stands still
     // while a bag is paused and jumps back when it loops.
     const ros::WallTime now = ros::WallTime::now();
@@ -156,42 +197,81 @@ class ClipBufferNode {
   }
 
   void Record(const sensors::LabelledClip& c) {
-    if (!writer_) return;
+    if (record_dir_.empty()) return;
+    if (!writer_) {
+      ++not_recorded_;
+      return;
+    }
     try {
       source_.frame_id = frame_id_;
       writer_->Write(c, source_);
       ++recorded_;
     } catch (const std::exception& e) {
-      last_error_ = e.what();
-      ROS_ERROR_THROTTLE(5.0, "clip_buffer: recording failed: %s", e.what());
+      ++recording_failures_;
+      NoteError(std::string("recording failed: ") + e.what());
     }
   }
 
+  // The clock to check stamps against; none while simulated time has not started.
+  static double Now() {
+    const ros::Time now = ros::Time::now();
+    return now.isZero() ? sensors::kNoClock : now.toSec();
+  }
+
+  void NoteError(const std::string& what) {
+    ++errors_;
+    last_error_ = what;
+    last_error_time_ = ros::WallTime::now();
+    ROS_ERROR_THROTTLE(5.0, "clip_buffer: %s", what.c_str());
+  }
+
+  double SecondsSince(const ros::WallTime& t) const { return t.isZero() ? 1e9 : (ros::WallTime::now() - t).toSec(); }
+
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    using diagnostic_msgs::DiagnosticStatus;
     const auto& s = pipeline_->stats();
-    if (!last_error_.empty()) {
-      stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, last_error_);
-    } else if (s.clips_released > 0 && s.clips_unlabelled == s.clips_released) {
-      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "clips have no anemometer label");
-    } else if (s.frames_in == 0) {
-      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no camera frames yet");
-    } else {
-      stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "making clips");
-    }
+    stat.summary(DiagnosticStatus::OK, "making clips");
+    // Each condition adds itself; the worst level wins and the messages are joined.
+    if (!recording_error_.empty()) stat.mergeSummary(DiagnosticStatus::ERROR, "not recording: " + recording_error_);
+    // An error holds the ERROR for kErrorHold s, then stays in "last error" only: one bad frame an
+    // hour ago is not a fault now.
+    if (SecondsSince(last_error_time_) < kErrorHold) stat.mergeSummary(DiagnosticStatus::ERROR, last_error_);
+    if (s.frames_in == 0) stat.mergeSummary(DiagnosticStatus::WARN, "no camera frames yet");
+    if (s.unlabelled_run > 0)
+      stat.mergeSummaryf(DiagnosticStatus::WARN, "the last %lu clip(s) have no anemometer reading in their %.0f s window",
+                         static_cast<unsigned long>(s.unlabelled_run), pipeline_->options().label_window);
+    if (SecondsSince(last_future_) < kErrorHold)
+      stat.mergeSummaryf(DiagnosticStatus::WARN, "stamps %.1f s after the clock refused (a clock set wrong?)",
+                         s.last_future_lead);
+    if (s.frames_in > 0 && frame_id_.empty())
+      stat.mergeSummary(DiagnosticStatus::WARN, "clips have no frame_id (set ~frame_id or the camera's header.frame_id)");
     stat.add("encoding", sensors::ClipFrameEncoding(pipeline_->options().colour));
+    stat.add("frame_id", frame_id_);
     stat.add("frames in", s.frames_in);
     stat.add("frames dropped", s.frames_dropped);
+    stat.add("frames stamped in the future", s.frames_future);
     stat.add("frames out (25 fps)", s.frames_out);
     stat.add("gaps", s.gaps);
     stat.add("last gap [s]", s.last_gap);
+    stat.add("time jumps back", s.time_jumps);
+    stat.add("clips labelled at a time jump", s.clips_at_jumps);
     stat.add("clips made", s.clips_made);
     stat.add("clips published", s.clips_released);
     stat.add("clips without label", s.clips_unlabelled);
     stat.add("clips waiting for label", pipeline_->pending());
     stat.add("readings in", s.readings_in);
     stat.add("readings too late", s.readings_late);
+    stat.add("readings stamped in the future", s.readings_future);
+    stat.add("record folder", record_dir_.empty() ? "(not recording)" : record_dir_);
     stat.add("clips recorded", recorded_);
+    stat.add("clips not recorded", not_recorded_ + recording_failures_);
+    stat.add("errors", errors_);
+    stat.add("last error", last_error_.empty() ? "(none)" : last_error_);
+    stat.add("last error age [s]", last_error_.empty() ? 0.0 : SecondsSince(last_error_time_));
   }
+
+  static constexpr double kErrorHold = 10.0;   // [s] wall
+  static constexpr double kReopenEvery = 10.0; // [s] wall
 
   ros::NodeHandle nh_;
   std::mutex mutex_;
@@ -202,8 +282,14 @@ class ClipBufferNode {
   bool frame_id_from_msg_ = false;
   double flush_after_ = 3.0;
   ros::WallTime last_input_;
+  std::string record_dir_;
+  int jpeg_quality_ = 95;
+  std::string recording_error_;  // why record_dir_ is not open; empty when it is (or not set)
+  ros::WallTime last_open_attempt_;
   std::string last_error_;
-  uint64_t recorded_ = 0;
+  ros::WallTime last_error_time_, last_future_;
+  uint64_t errors_ = 0;
+  uint64_t recorded_ = 0, not_recorded_ = 0, recording_failures_ = 0;
   ros::Publisher clip_pub_, preview_pub_;
   ros::Subscriber image_sub_, info_sub_, wind_sub_;
   ros::WallTimer flush_timer_;
