@@ -83,6 +83,13 @@ ParseResult AnemometerDecoder::Decode(const std::string& record, AnemometerProto
     r.error = std::string("record looks like ") + AnemometerProtocolName(p) + " but the instrument speaks " +
               AnemometerProtocolName(locked_);
   }
+  if (r.status == ParseStatus::kOk && r.reading.valid) {
+    const std::string why = ImplausibleWindReason(r.reading);
+    if (!why.empty()) {
+      r.status = ParseStatus::kMalformed;
+      r.error = r.reading.source + ": " + why;
+    }
+  }
   switch (r.status) {
     case ParseStatus::kOk:
       ++counters_.readings;

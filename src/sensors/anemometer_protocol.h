@@ -42,7 +42,8 @@ struct DecoderCounters {
   uint64_t invalid_readings = 0;   // kOk results flagged invalid by the instrument
   uint64_t not_wind = 0;           // well-formed records without wind
   uint64_t checksum_failures = 0;
-  uint64_t parse_errors = 0;       // malformed, unrecognised, or of another protocol once locked
+  uint64_t parse_errors = 0;       // malformed, unrecognised, implausible (ImplausibleWindReason), or of
+                                   // another protocol once locked
 };
 
 // Decodes a stream of records. With a configured protocol, every record is parsed with it. In

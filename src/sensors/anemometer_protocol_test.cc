@@ -159,5 +159,43 @@ TEST(AnemometerDecoder, MutatedAndRandomBytesNeverGiveImpossibleReadings) {
   EXPECT_GT(checksum, 100u);  // and flips inside checksummed records are caught
 }
 
+// A Gill record with its checksum (XOR of the bytes between STX and ETX, two hex digits).
+std::string GillRecord(const std::string& body) {
+  char hex[3];
+  std::snprintf(hex, sizeof hex, "%02X", GillChecksum(body));
+  return "\x02" + body + "\x03" + hex;
+}
+
+// A reading the instrument calls valid but that cannot be wind (a misread unit, a corrupt record
+// whose checksum still matched) is a parse error naming the field, for every protocol; a reading
+// flagged void is passed as it is (its numbers are not used).
+TEST(AnemometerDecoder, ImplausibleReadingsAreParseErrors) {
+  struct Case {
+    std::string record, field;
+  };
+  const std::vector<Case> cases = {
+      {WithNmeaChecksum("IIMWV,229.0,R,500.0,M,A"), "speed 500"},
+      {WithNmeaChecksum("IIMWV,229.0,R,175.0,N,A"), "speed 90.0"},  // 175 kn = 90.03 m/s
+      {WithNmeaChecksum("WIXDR,A,400.0,D,WINDDIR,N,7.5,M,WINDSPEED"), "direction 400"},
+      {WithNmeaChecksum("WIXDR,N,7.5,M,WINDSPEED,N,120,M,WINDGUST"), "gust 120"},
+      {GillRecord("Q,229,095.00,M,00,"), "speed 95"},
+      {"3.25,270,91", "gust 91"},
+  };
+  for (const auto& c : cases) {
+    AnemometerDecoder d(AnemometerProtocol::kAuto);
+    ParseResult r = d.Decode(c.record);
+    EXPECT_EQ(r.status, ParseStatus::kMalformed) << c.record;
+    EXPECT_NE(r.error.find(c.field), std::string::npos) << r.error;
+    EXPECT_EQ(d.counters().parse_errors, 1u);
+    EXPECT_EQ(d.counters().readings, 0u);
+  }
+  AnemometerDecoder d(AnemometerProtocol::kNmea);
+  EXPECT_EQ(d.Decode(WithNmeaChecksum("IIMWV,229.0,R,89.9,M,A")).status, ParseStatus::kOk);
+  EXPECT_EQ(d.Decode(WithNmeaChecksum("IIMWV,360.0,R,0.0,M,A")).status, ParseStatus::kOk);
+  const ParseResult void_reading = d.Decode(WithNmeaChecksum("IIMWV,229.0,R,500.0,M,V"));
+  EXPECT_EQ(void_reading.status, ParseStatus::kOk);
+  EXPECT_FALSE(void_reading.reading.valid);
+}
+
 }  // namespace
 }  // namespace clothwind::sensors

@@ -98,7 +98,9 @@ ParseResult ParseMwd(const NmeaSentence& s) {
   }
   if (std::isfinite(w.from_angle_deg) && (w.from_angle_deg < 0.0 || w.from_angle_deg > 360.0))
     return Fail(ParseStatus::kMalformed, where + ": direction expected 0..360 deg");
-  w.reference = std::isfinite(w.from_angle_deg) ? AngleReference::kEarth : AngleReference::kNone;
+  w.reference = !std::isfinite(w.from_angle_deg) ? AngleReference::kNone
+                : w.status == "true"              ? AngleReference::kEarth
+                                                  : AngleReference::kMagnetic;
   if (std::isfinite(v[3])) w.speed = v[3];
   else if (std::isfinite(v[2])) w.speed = SpeedToMetresPerSecond(v[2], SpeedUnit::kKnots);
   else return Fail(ParseStatus::kMalformed, where + ": neither knots (field 5) nor m/s (field 7) speed given");

@@ -113,6 +113,14 @@ TEST(Nmea, MwdFallsBackToKnotsAndMagnetic) {
   EXPECT_NEAR(r.reading.speed, 10.0 * kKnot, 1e-9);
   EXPECT_DOUBLE_EQ(r.reading.from_angle_deg, 90.0);
   EXPECT_EQ(r.reading.status, "magnetic");
+  EXPECT_EQ(r.reading.reference, AngleReference::kMagnetic);
+  // A magnetic bearing is no direction until the declination is known; with 10 deg east, an
+  // easterly by the compass comes from 100 deg true and blows toward 280 deg: -x, slightly +y (ENU).
+  EXPECT_TRUE(std::isnan(WindDirection(r.reading)));
+  EXPECT_NEAR(WindDirection(r.reading, 10.0), DirectionFromBearing(100.0), 1e-12);
+  EXPECT_NEAR(WindDirection(r.reading, 0.0), M_PI, 1e-12);  // an easterly blows west
+  EXPECT_TRUE(std::isnan(WindVelocity(r.reading)[0]));
+  EXPECT_NEAR(WindVelocity(r.reading, 10.0)[1], 10.0 * kKnot * std::sin(10.0 * M_PI / 180), 1e-9);
   r = ParseNmea(WithNmeaChecksum("WIMWD,90.0,T,,M,,N,,M"));
   EXPECT_EQ(r.status, ParseStatus::kMalformed);
   r = ParseNmea(WithNmeaChecksum("WIMWD,90.0,T,,M,10,K,,M"));

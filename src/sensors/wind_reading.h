@@ -21,8 +21,14 @@ enum class SpeedUnit { kMetresPerSecond, kKnots, kKilometresPerHour, kMilesPerHo
 enum class AngleReference {
   kNone,        // no direction reported
   kInstrument,  // clockwise from the instrument's north mark / the bow (NMEA MWV, Gill, CSV)
-  kEarth,       // compass bearing clockwise from north (NMEA MWD, a north-aligned station)
+  kEarth,       // compass bearing clockwise from true north (NMEA MWD, a north-aligned station)
+  kMagnetic,    // compass bearing clockwise from magnetic north (NMEA MWD without a true bearing);
+                // needs the local magnetic declination to become a direction
 };
+
+// Fastest wind any instrument read here can report (Gill WindSonic 60 m/s, Fine Offset ~50):
+// a reading beyond it is a misread unit or a corrupt record, not wind. [m/s]
+inline constexpr double kMaxPlausibleWindSpeed = 90.0;
 
 // A parsed reading. Angles are kept as reported (degrees, "from", clockwise) so that the raw
 // meaning survives; WindDirection()/WindVelocity() apply the REP 103 convention.
@@ -85,17 +91,27 @@ double DirectionFromBearing(double bearing_deg);
 
 // The reading's direction in the WindMeasurement convention, NaN when it has none.
 // Inputs:
-//   r  reading
+//   r                     reading
+//   magnetic_declination  [deg] east of true north, for kMagnetic bearings (true = magnetic +
+//                         declination); NaN (unknown) gives a magnetic bearing no direction
 // Returns direction [rad] in (-pi, pi] or NaN.
-double WindDirection(const WindReading& r);
+double WindDirection(const WindReading& r, double magnetic_declination = kNaN);
 
 // The reading's air velocity speed * (cos d, sin d, 0) in the instrument (or ENU) frame.
 // A calm reading without direction (speed 0) gives the zero vector; a non-zero speed without
 // direction gives NaNs, since the vector is unknown.
 // Inputs:
-//   r  reading
+//   r                     reading
+//   magnetic_declination  as WindDirection's
 // Returns velocity [m/s], 3 components.
-std::array<double, 3> WindVelocity(const WindReading& r);
+std::array<double, 3> WindVelocity(const WindReading& r, double magnetic_declination = kNaN);
+
+// Why a reading the instrument calls valid cannot be wind, or "" when it can: speed or gust not
+// in [0, kMaxPlausibleWindSpeed], a reported angle not in [0, 360] deg.
+// Inputs:
+//   r  reading
+// Returns the reason, naming the field and the value.
+std::string ImplausibleWindReason(const WindReading& r);
 
 }  // namespace clothwind::sensors
 
