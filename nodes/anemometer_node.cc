@@ -9,6 +9,7 @@
 // and a vanished device is re-opened the same way. See docs/anemometer.md.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -55,6 +56,15 @@ class AnemometerNode {
   bool Init() {
     pnh_.param<std::string>("input", input_, "serial");
     pnh_.param<std::string>("frame_id", frame_id_, "anemometer");
+    pnh_.param<std::string>("earth_frame_id", earth_frame_id_, "");
+    if (pnh_.hasParam("magnetic_declination")) {
+      double d = 0.0;
+      if (!pnh_.getParam("magnetic_declination", d) || !std::isfinite(d) || d < -180.0 || d > 180.0) {
+        ROS_FATAL("~magnetic_declination: expected degrees east of true north in -180..180 (west negative)");
+        return false;
+      }
+      magnetic_declination_ = d;
+    }
     std::string protocol_name;
     pnh_.param<std::string>("protocol", protocol_name, "auto");
     AnemometerProtocol protocol;
@@ -215,17 +225,27 @@ class AnemometerNode {
     std::string error;
     if (!usb_.ReadCurrentRecord(&record, &address, &error)) {
       ++usb_read_errors_;
+      ++usb_errors_in_row_;
       last_error_ = error;
       ROS_WARN_THROTTLE(30.0, "anemometer_node: %s", error.c_str());
+      // A station that stays open but answers nothing (a wedged HID endpoint, a hub that lost
+      // power) only recovers by being opened again.
+      if (usb_.is_open() && usb_errors_in_row_ >= kUsbErrorsBeforeReopen) {
+        ROS_WARN("anemometer_node: %d USB reads in a row failed; reopening the station", usb_errors_in_row_);
+        usb_.Close();
+      }
       if (!usb_.is_open()) {
+        usb_errors_in_row_ = 0;
         state_ = "disconnected: " + error;
         ++disconnects_;
         next_attempt_ = now + ros::WallDuration(backoff_.Next());
       }
       return;
     }
-    // The station rewrites the current record only when its sensor transmits (every 48 s) or a
-    // new history slot starts: publish on change, at the device's own rate.
+    usb_errors_in_row_ = 0;
+    // The station rewrites the current record when its sensor transmits (every 48 s), when its
+    // delay byte counts another minute, or when a new history slot starts: publish on change, at
+    // the device's own rate (steady weather still changes the record once a minute).
     if (record == last_usb_record_ && address == last_usb_address_) return;
     last_usb_record_ = record;
     last_usb_address_ = address;
@@ -237,6 +257,17 @@ class AnemometerNode {
     HandleRecord(clothwind::ros_bridge::RawSentenceBytes(*msg), msg->header.stamp, frame, false);
   }
 
+  // The frame a reading's direction is in: earth-referenced bearings (NMEA MWD, a north-aligned
+  // station) in ~earth_frame_id when set, instrument-relative angles in the instrument's.
+  std::string FrameFor(const clothwind::sensors::WindReading& r, const std::string& instrument_frame) {
+    using clothwind::sensors::AngleReference;
+    const bool earth = r.reference == AngleReference::kEarth || r.reference == AngleReference::kMagnetic;
+    if (earth) saw_earth_ = true;
+    if (r.reference == AngleReference::kInstrument) saw_instrument_ = true;
+    if (r.reference == AngleReference::kMagnetic) saw_magnetic_ = true;
+    return earth && !earth_frame_id_.empty() ? earth_frame_id_ : instrument_frame;
+  }
+
   void HandleRecord(const std::string& data, const ros::Time& stamp, const std::string& frame, bool publish_raw) {
     AnemometerProtocol used = AnemometerProtocol::kAuto;
     const ParseResult r = decoder_.Decode(data, &used);
@@ -245,7 +276,10 @@ class AnemometerNode {
       raw_pub_.publish(clothwind::ros_bridge::ToRawSentence(data, protocol, stamp, frame));
     }
     if (r.status == ParseStatus::kOk) {
-      wind_pub_.publish(clothwind::ros_bridge::ToWindMeasurement(r.reading, stamp, frame));
+      wind_pub_.publish(clothwind::ros_bridge::ToWindMeasurement(r.reading, stamp, FrameFor(r.reading, frame),
+                                                                 magnetic_declination_));
+      last_status_ = r.reading.status;
+      last_reading_void_ = !r.reading.valid;
       if (r.reading.valid) {
         last_valid_ = r.reading;
         last_valid_wall_ = ros::WallTime::now();
@@ -272,11 +306,22 @@ class AnemometerNode {
     const double age = have_valid_ ? (now - last_valid_wall_).toSec() : -1.0;
 
     const bool connected = input_ == "topic" || port_.is_open() || usb_.is_open();
-    if (!connected) stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "not connected: " + state_);
-    else if (!have_valid_) stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "connected, no valid reading yet");
-    else if (age > stale_timeout_) stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "valid readings stale");
-    else if (new_errors) stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "receiving, with bad records");
-    else stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "receiving");
+    using diagnostic_msgs::DiagnosticStatus;
+    if (!connected) stat.summary(DiagnosticStatus::ERROR, "not connected: " + state_);
+    else if (!have_valid_) stat.summary(DiagnosticStatus::WARN, "connected, no valid reading yet");
+    else if (age > stale_timeout_) stat.summary(DiagnosticStatus::WARN, "valid readings stale");
+    else if (new_errors) stat.summary(DiagnosticStatus::WARN, "receiving, with bad records");
+    else stat.summary(DiagnosticStatus::OK, "receiving");
+    // The instrument's own word on its latest reading (Gill "04 blocked path", NMEA status V, a
+    // station that lost its outdoor sensor) says why readings are void; "stale" alone does not.
+    if (connected && last_reading_void_)
+      stat.mergeSummary(DiagnosticStatus::WARN, "instrument flags its readings void: " + last_status_);
+    if (saw_magnetic_ && !std::isfinite(magnetic_declination_))
+      stat.mergeSummary(DiagnosticStatus::WARN,
+                        "magnetic bearings (MWD) published without direction: set ~magnetic_declination");
+    if (saw_earth_ && saw_instrument_ && earth_frame_id_.empty())
+      stat.mergeSummary(DiagnosticStatus::WARN, "instrument-relative and earth-referenced directions share frame " +
+                                                    frame_id_ + ": set ~earth_frame_id");
 
     stat.add("input", input_);
     stat.add("connection", state_);
@@ -292,11 +337,15 @@ class AnemometerNode {
     stat.add("parse errors", c.parse_errors);
     stat.add("bytes dropped by framing", framer_.dropped_bytes());
     stat.add("last error", last_error_);
+    stat.add("instrument status", last_status_.empty() ? "(none yet)" : last_status_);
+    stat.add("magnetic declination [deg]",
+             std::isfinite(magnetic_declination_) ? std::to_string(magnetic_declination_) : "(not set)");
+    stat.add("earth frame", earth_frame_id_.empty() ? frame_id_ + " (~frame_id)" : earth_frame_id_);
     stat.add("connects", connects_);
     stat.add("disconnects", disconnects_);
     if (have_valid_) {
       stat.addf("last valid speed [m/s]", "%.3f", last_valid_.speed);
-      stat.addf("last valid direction [rad]", "%.4f", clothwind::sensors::WindDirection(last_valid_));
+      stat.addf("last valid direction [rad]", "%.4f", clothwind::sensors::WindDirection(last_valid_, magnetic_declination_));
       stat.addf("last valid age [s]", "%.2f", age);
     } else {
       stat.add("last valid age [s]", "none yet");
@@ -312,7 +361,11 @@ class AnemometerNode {
   ros::Publisher raw_pub_, wind_pub_;
   ros::Subscriber raw_sub_;
   diagnostic_updater::Updater updater_;
-  std::string input_, frame_id_, state_, last_error_;
+  std::string input_, frame_id_, earth_frame_id_, state_, last_error_, last_status_;
+  double magnetic_declination_ = std::numeric_limits<double>::quiet_NaN();  // [deg] east; NaN: unknown
+  bool last_reading_void_ = false, saw_earth_ = false, saw_instrument_ = false, saw_magnetic_ = false;
+  static constexpr int kUsbErrorsBeforeReopen = 3;
+  int usb_errors_in_row_ = 0;
   clothwind::sensors::SerialConfig serial_;
   clothwind::sensors::SerialPort port_;
   clothwind::sensors::FineOffsetUsb usb_;

@@ -6,14 +6,14 @@
 namespace clothwind::ros_bridge {
 
 clothwind::WindMeasurement ToWindMeasurement(const sensors::WindReading& r, const ros::Time& stamp,
-                                             const std::string& frame_id) {
+                                             const std::string& frame_id, double magnetic_declination) {
   clothwind::WindMeasurement m;
   m.header.stamp = stamp;
   m.header.frame_id = frame_id;
   m.speed = r.speed;
   m.gust = r.gust;
-  m.direction = sensors::WindDirection(r);
-  const auto v = sensors::WindVelocity(r);
+  m.direction = sensors::WindDirection(r, magnetic_declination);
+  const auto v = sensors::WindVelocity(r, magnetic_declination);
   m.velocity.x = v[0];
   m.velocity.y = v[1];
   m.velocity.z = v[2];

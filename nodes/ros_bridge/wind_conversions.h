@@ -19,10 +19,13 @@ namespace clothwind::ros_bridge {
 // Inputs:
 //   reading   parsed reading (SI units)
 //   stamp     arrival time of the record's first byte (or the raw message's stamp on replay)
-//   frame_id  the instrument's frame
+//   frame_id  the frame the direction is in (the instrument's, or an ENU frame for bearings)
+//   magnetic_declination  [deg] east of true north for magnetic bearings; NaN: unknown, such a
+//             reading gets no direction (see sensors::WindDirection)
 // Returns the message.
 clothwind::WindMeasurement ToWindMeasurement(const sensors::WindReading& reading, const ros::Time& stamp,
-                                             const std::string& frame_id);
+                                             const std::string& frame_id,
+                                             double magnetic_declination = sensors::kNaN);
 
 // Makes a RawSentence. Bytes outside 0x01..0x7F are written as "\xHH" so the string is always
 // valid UTF-8 (rospy decodes strings as UTF-8); the instruments' own records are plain ASCII

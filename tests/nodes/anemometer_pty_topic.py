@@ -13,6 +13,11 @@ from clothwind.msg import RawSentence, WindMeasurement
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 
 
+def nmea(body):
+    cs = functools.reduce(lambda a, c: a ^ c, body.encode('ascii'), 0)
+    return '$%s*%02X' % (body, cs)
+
+
 class AnemometerTopicTest(unittest.TestCase):
     def setUp(self):
         rospy.init_node('anemometer_pty_topic', anonymous=True)
@@ -66,6 +71,65 @@ class AnemometerTopicTest(unittest.TestCase):
             self.assertAlmostEqual(w.direction, math.pi - math.radians(229.0), places=9)
             self.assertEqual(w.source, 'gill')
             self.assertTrue(w.valid)
+
+    def diagnostics(self, hardware_id, count=2, timeout=10.0):
+        got = []
+
+        def on_diag(m):
+            got.extend(s for s in m.status if s.hardware_id == hardware_id)
+
+        sub = rospy.Subscriber('/diagnostics', DiagnosticArray, on_diag, queue_size=10)
+        deadline = time.time() + timeout
+        while time.time() < deadline and len(got) < count:
+            time.sleep(0.2)
+        sub.unregister()
+        self.assertGreaterEqual(len(got), count, 'no diagnostics from ' + hardware_id)
+        return got[-1], {kv.key: kv.value for kv in got[-1].values}
+
+    def winds_on(self, topic, records):
+        winds = []
+        sub = rospy.Subscriber(topic, WindMeasurement, winds.append, queue_size=50)
+        pub = rospy.Publisher(topic.replace('/wind', '/raw'), RawSentence, queue_size=50)
+        deadline = time.time() + 20.0
+        while time.time() < deadline and (pub.get_num_connections() == 0 or sub.get_num_connections() == 0):
+            time.sleep(0.1)
+        time.sleep(0.5)
+        for i, data in enumerate(records):
+            m = RawSentence()
+            m.header.stamp = rospy.Time(2000 + i, 0)
+            m.header.frame_id = 'recorded_frame'
+            m.data = data
+            pub.publish(m)
+            time.sleep(0.2)
+        time.sleep(0.5)
+        sub.unregister()
+        return winds
+
+    def test_wind_kinds(self):
+        mwv = nmea('IIMWV,229.0,R,5.8,M,A')
+        mwd_magnetic = nmea('WIMWD,,T,90.0,M,,N,5.0,M')
+        implausible = nmea('IIMWV,229.0,R,500.0,M,A')
+        void = nmea('IIMWV,229.0,R,5.8,M,V')  # status V: the instrument says the data is void
+        winds = self.winds_on('/replay/anemometer/wind', [mwv, mwd_magnetic, implausible, void])
+        self.assertEqual([w.source for w in winds], ['nmea_mwv', 'nmea_mwd', 'nmea_mwv'])
+        self.assertTrue(math.isnan(winds[1].direction))  # magnetic, no declination
+        self.assertAlmostEqual(winds[1].speed, 5.0)
+        self.assertFalse(winds[2].valid)
+        status, values = self.diagnostics('topic:/replay/anemometer/raw')
+        self.assertEqual(status.level, DiagnosticStatus.WARN)
+        self.assertIn('instrument flags its readings void: V', status.message)
+        self.assertIn('~magnetic_declination', status.message)
+        self.assertIn('~earth_frame_id', status.message)
+        self.assertIn('speed 500', values['last error'])
+
+        winds = self.winds_on('/replay_earth/anemometer/wind', [mwv, mwd_magnetic])
+        self.assertEqual([w.header.frame_id for w in winds], ['recorded_frame', 'enu'])
+        # Magnetic 90 + 10 east = 100 deg true, from the east-south-east: blows to 280 deg, i.e.
+        # 170 deg counter-clockwise from east.
+        self.assertAlmostEqual(winds[1].direction, math.radians(170.0), places=9)
+        status, values = self.diagnostics('topic:/replay_earth/anemometer/raw')
+        self.assertEqual(status.level, DiagnosticStatus.OK, status.message)
+        self.assertEqual(values['earth frame'], 'enu')
 
     def test_usb_without_station_keeps_retrying(self):
         got = []
