@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
       "camera/image_raw", updater,
       diagnostic_updater::FrequencyStatusParam(&min_rate, &max_rate, 0.1, 10),
       diagnostic_updater::TimeStampStatusParam(-0.05, 0.5));
-  uint64_t published = 0, read_errors = 0, last_drops_seen = 0;
+  uint64_t published = 0, read_errors = 0, last_drops_seen = 0, last_errors_seen = 0;
   std::string last_error;
   bool opened = false, ended = false;
   updater.add("camera source", [&](diagnostic_updater::DiagnosticStatusWrapper& stat) {
@@ -149,19 +149,34 @@ int main(int argc, char** argv) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "recording ended");
     } else if (state != "streaming" && state != "open") {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, state + ": " + last_error);
-    } else if (drops > last_drops_seen) {
-      stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu frames dropped since last report",
-                    static_cast<unsigned long long>(drops - last_drops_seen));
     } else {
       stat.summary(diagnostic_msgs::DiagnosticStatus::OK, state + ": " + source->Describe());
+      if (drops > last_drops_seen)
+        stat.mergeSummaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu frames dropped since last report",
+                           static_cast<unsigned long long>(drops - last_drops_seen));
+      // Frames the driver flagged corrupt or that would not decode: the stream runs, but not all
+      // of it reaches the clips (it used to stay OK).
+      if (read_errors > last_errors_seen)
+        stat.mergeSummaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu frames unreadable since last report: %s",
+                           static_cast<unsigned long long>(read_errors - last_errors_seen), last_error.c_str());
     }
     last_drops_seen = drops;
+    last_errors_seen = read_errors;
   });
 
   double open_backoff_s = 0.25;
+  ros::WallTime next_open;
   bool warned_size = false;
   while (ros::ok()) {
     if (!opened) {
+      // Wait for the next attempt in short slices: diagnostics and services (set_camera_info)
+      // keep running while the device is away (a single sleep of up to 5 s stalled them).
+      if (ros::WallTime::now() < next_open) {
+        ros::WallDuration(std::min(0.1, (next_open - ros::WallTime::now()).toSec())).sleep();
+        updater.update();
+        ros::spinOnce();
+        continue;
+      }
       if (source->Open()) {
         opened = true;
         const double rate = source->NominalRate();
@@ -172,7 +187,7 @@ int main(int argc, char** argv) {
         last_error = source->error();
         ROS_ERROR_STREAM_THROTTLE(5.0, "camera_node: " << last_error << " (retrying)");
         updater.update();
-        ros::WallDuration(open_backoff_s).sleep();
+        next_open = ros::WallTime::now() + ros::WallDuration(open_backoff_s);
         open_backoff_s = std::min(open_backoff_s * 2.0, 5.0);
         ros::spinOnce();
         continue;

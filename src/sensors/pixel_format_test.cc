@@ -152,6 +152,19 @@ TEST(PixelFormatTest, MjpegDecodesToBgrAndReportsGarbage) {
   std::vector<uint8_t> garbage(500, 0x5a);
   EXPECT_FALSE(ConvertToImage(PixelFormat::kMjpeg, garbage.data(), garbage.size(), 64, 48, 0,
                               &image, &error));
+  EXPECT_NE(error.find("start-of-image"), std::string::npos) << error;
+  // A JPEG cut short decodes (libjpeg greys the missing rows and only warns): refused by its
+  // missing end-of-image marker. Zeros after the marker (cameras pad their buffers) are fine.
+  std::vector<uint8_t> cut(jpeg.begin(), jpeg.begin() + jpeg.size() * 2 / 3);
+  EXPECT_FALSE(ConvertToImage(PixelFormat::kMjpeg, cut.data(), cut.size(), 64, 48, 0, &image, &error));
+  EXPECT_NE(error.find("truncated"), std::string::npos) << error;
+  std::vector<uint8_t> padded = jpeg;
+  padded.resize(jpeg.size() + 300, 0x00);
+  EXPECT_TRUE(ConvertToImage(PixelFormat::kMjpeg, padded.data(), padded.size(), 64, 48, 0, &image, &error))
+      << error;
+  // A start marker followed by garbage still fails in the decoder.
+  std::vector<uint8_t> headed = {0xFF, 0xD8, 0x12, 0x34, 0x56, 0xFF, 0xD9};
+  EXPECT_FALSE(ConvertToImage(PixelFormat::kMjpeg, headed.data(), headed.size(), 64, 48, 0, &image, &error));
   EXPECT_NE(error.find("MJPEG decode failed"), std::string::npos) << error;
 }
 

@@ -434,7 +434,11 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
     status = ReadStatus::kError;
   } else {
     const Buffer& b = buffers_[buf.index];
-    const size_t used = buf.bytesused > 0 ? std::min<size_t>(buf.bytesused, b.length) : b.length;
+    // bytesused 0 on a compressed format is an empty frame (the buffer still holds an older
+    // JPEG, which would be published as new); raw formats fill the buffer by definition.
+    const size_t used = buf.bytesused > 0                        ? std::min<size_t>(buf.bytesused, b.length)
+                        : negotiated_.format == PixelFormat::kMjpeg ? 0
+                                                                    : b.length;
     std::string why;
     if (!ConvertToImage(negotiated_.format, static_cast<const uint8_t*>(b.start), used,
                         negotiated_.width, negotiated_.height, negotiated_.bytes_per_line,

@@ -247,6 +247,29 @@ TEST(V4l2CameraTest, ConvertsEachFormat) {
   }
 }
 
+// An MJPEG buffer reported empty (bytesused 0) still holds a JPEG, and one cut short still
+// decodes (grey rows at the bottom): both are corrupt frames, not pictures to publish.
+TEST(V4l2CameraTest, EmptyAndTruncatedMjpegFramesAreErrors) {
+  FakeV4l2Config config;
+  config.bytesused_of = {{1, 0}, {2, 900}};
+  Rig rig(config, Ask(PixelFormat::kMjpeg, 320, 240, 15));
+  ASSERT_TRUE(rig.camera.Open()) << rig.camera.error();
+  Frame f;
+  ASSERT_EQ(rig.ReadFrame(&f), ReadStatus::kFrame) << rig.camera.error();
+  std::vector<std::string> errors;
+  ReadStatus s = ReadStatus::kNoFrame;
+  for (int i = 0; i < 100 && s != ReadStatus::kFrame; ++i) {
+    s = rig.camera.Read(&f, 0.1);
+    if (s == ReadStatus::kError) errors.push_back(rig.camera.error());
+  }
+  ASSERT_EQ(s, ReadStatus::kFrame);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_NE(errors[0].find("empty buffer"), std::string::npos) << errors[0];
+  EXPECT_NE(errors[1].find("truncated"), std::string::npos) << errors[1];
+  EXPECT_EQ(rig.camera.stats().corrupt, 2u);
+  EXPECT_EQ(f.sequence, 3u);
+}
+
 TEST(V4l2CameraTest, AppliesControlsTheDeviceHasAndSkipsOthers) {
   V4l2Options options = Ask(PixelFormat::kGrey, 320, 240, 15);
   options.auto_exposure = 1;

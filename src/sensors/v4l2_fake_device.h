@@ -45,6 +45,9 @@ struct FakeV4l2Config {
   int64_t jitter_ns = 4000000;    // latency varies by 0..4 steps of this, deterministically
   bool monotonic = true;          // V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC (else _UNKNOWN)
   std::map<uint64_t, uint32_t> skip_before;  // before capture k, the driver loses n frames
+  // Capture k reports bytesused n instead of the frame's size (0: an empty frame; fewer: a frame
+  // cut short), its buffer filled as usual.
+  std::map<uint64_t, uint32_t> bytesused_of;
   std::map<uint32_t, FakeV4l2Control> controls{
       {V4L2_CID_EXPOSURE_AUTO, {0, 3, 3, V4L2_CTRL_TYPE_MENU}},
       {V4L2_CID_GAIN, {0, 100, 10, V4L2_CTRL_TYPE_INTEGER}}};
@@ -301,7 +304,8 @@ class FakeV4l2Device : public V4l2Io {
     FakeBuffer& buf = buffers_[index];
     buf.queued = false;
     const uint8_t value = FrameValue(captures_);
-    const uint32_t bytes = Fill(&buf.mem, value);
+    uint32_t bytes = Fill(&buf.mem, value);
+    if (auto it = config_.bytesused_of.find(captures_); it != config_.bytesused_of.end()) bytes = it->second;
     std::memset(b, 0, sizeof(*b));
     b->type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     b->memory = V4L2_MEMORY_MMAP;

@@ -98,6 +98,7 @@ class CameraFolderTest(unittest.TestCase):
         cls.colour_folder = rospy.get_param("~colour_folder")
         cls.grey_folder = rospy.get_param("~grey_folder")
         cls.diagnostics = []
+        cls.started = time.time()
         rospy.Subscriber("/diagnostics", DiagnosticArray, lambda m: cls.diagnostics.append(m))
         cls.colour = Collector("/")
         cls.grey = Collector("/mono/")
@@ -205,6 +206,15 @@ class CameraFolderTest(unittest.TestCase):
         values = {kv.key: kv.value for kv in found.values}
         self.assertEqual(values["source"], "v4l2")
         self.assertEqual(values["published"], "0")
+        # Its diagnostics keep coming about once a second while the open backoff grows to 5 s
+        # (the node used to sleep through the backoff, leaving 5 s holes a monitor reads as stale).
+        time.sleep(max(0.0, self.started + 18.0 - time.time()))
+        stamps = sorted(array.header.stamp.to_sec() for array in list(self.diagnostics)
+                        for s in array.status if s.name == "absent/camera_node: camera source")
+        late = [t for t in stamps if t > stamps[0] + 8.0]  # backoff 0.25+0.5+1+2+4 s by then
+        self.assertGreaterEqual(len(late), 5, stamps)
+        gaps = [b - a for a, b in zip(late, late[1:])]
+        self.assertLess(max(gaps), 2.5, gaps)
 
 
 if __name__ == "__main__":
