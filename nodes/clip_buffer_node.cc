@@ -5,7 +5,9 @@
 // Publishes   clips (clothwind/Clip), clips/preview (sensor_msgs/Image mono8, or bgr8 with
 //             ~colour: the latest clip's middle frame, only built while someone subscribes),
 //             /diagnostics
-// All the logic is in sensors::ClipPipeline and sensors::DatasetWriter (see docs/clips.md).
+// All the logic is in sensors::ClipPipeline and sensors::DatasetWriter (see docs/clips.md); clips
+// are recorded on a thread of their own (sensors::AsyncDatasetWriter), so a slow disk never holds
+// up the camera callback.
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -22,6 +24,7 @@
 #include <clothwind/WindMeasurement.h>
 
 #include "ros_bridge/clip_conversions.h"
+#include "sensors/async_dataset_writer.h"
 #include "sensors/clip_pipeline.h"
 #include "sensors/dataset_writer.h"
 
@@ -97,10 +100,12 @@ class ClipBufferNode {
     if (record_dir_.empty() || writer_) return;
     last_open_attempt_ = ros::WallTime::now();
     try {
-      writer_ = std::make_unique<sensors::DatasetWriter>(record_dir_, jpeg_quality_);
+      writer_ = std::make_unique<sensors::AsyncDatasetWriter>(
+          std::make_unique<sensors::DatasetWriter>(record_dir_, jpeg_quality_), kRecordQueue);
       if (!recording_error_.empty()) ROS_INFO("clip_buffer: recording works again");
       recording_error_.clear();
-      ROS_INFO("clip_buffer: recording clips to %s (%zu already there%s)", record_dir_.c_str(), writer_->size(),
+      ROS_INFO("clip_buffer: recording clips to %s (%zu already there%s)", record_dir_.c_str(),
+               writer_->size_at_open(),
                writer_->recovered() > 0
                    ? (", " + std::to_string(writer_->recovered()) + " leftovers of an earlier run cleared").c_str()
                    : "");
@@ -116,6 +121,7 @@ class ClipBufferNode {
   void Finish() {
     std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& c : pipeline_->Flush()) Record(c);
+    if (writer_) writer_->Drain();
   }
 
  private:
@@ -170,6 +176,15 @@ class ClipBufferNode {
     }
     if (!writer_ && !record_dir_.empty() && (ros::WallTime::now() - last_open_attempt_).toSec() >= kReopenEvery)
       OpenRecording();
+    if (writer_) {  // the recording thread's failures, reported from here
+      const auto r = writer_->stats();
+      if (r.failed > failed_seen_) NoteError("recording failed: " + r.last_error);
+      if (r.dropped > dropped_seen_)
+        NoteError("recording too slow: " + std::to_string(r.dropped - dropped_seen_) +
+                  " clip(s) not recorded (queue of " + std::to_string(kRecordQueue) + " full)");
+      failed_seen_ = r.failed;
+      dropped_seen_ = r.dropped;
+    }
     // force_update once a wall second: Updater::update() waits for ROS time, which stands still
     // while a bag is paused and jumps back when it loops.
     const ros::WallTime now = ros::WallTime::now();
@@ -202,14 +217,8 @@ class ClipBufferNode {
       ++not_recorded_;
       return;
     }
-    try {
-      source_.frame_id = frame_id_;
-      writer_->Write(c, source_);
-      ++recorded_;
-    } catch (const std::exception& e) {
-      ++recording_failures_;
-      NoteError(std::string("recording failed: ") + e.what());
-    }
+    source_.frame_id = frame_id_;
+    writer_->Enqueue(c, source_);  // a full queue is counted by the writer, reported by OnTimer
   }
 
   // The clock to check stamps against; none while simulated time has not started.
@@ -263,8 +272,11 @@ class ClipBufferNode {
     stat.add("readings too late", s.readings_late);
     stat.add("readings stamped in the future", s.readings_future);
     stat.add("record folder", record_dir_.empty() ? "(not recording)" : record_dir_);
-    stat.add("clips recorded", recorded_);
-    stat.add("clips not recorded", not_recorded_ + recording_failures_);
+    const auto r = writer_ ? writer_->stats() : sensors::AsyncDatasetWriter::Stats();
+    stat.add("clips recorded", r.written);
+    stat.add("clips not recorded", not_recorded_ + r.failed + r.dropped);
+    stat.add("clips waiting to be written", r.queued);
+    stat.addf("slowest clip write [s]", "%.3f", r.max_write_s);
     stat.add("errors", errors_);
     stat.add("last error", last_error_.empty() ? "(none)" : last_error_);
     stat.add("last error age [s]", last_error_.empty() ? 0.0 : SecondsSince(last_error_time_));
@@ -272,11 +284,12 @@ class ClipBufferNode {
 
   static constexpr double kErrorHold = 10.0;   // [s] wall
   static constexpr double kReopenEvery = 10.0; // [s] wall
+  static constexpr size_t kRecordQueue = 16;   // clips (16 x 30 x 300^2 B = 43 MB of mono8 at most)
 
   ros::NodeHandle nh_;
   std::mutex mutex_;
   std::unique_ptr<sensors::ClipPipeline> pipeline_;
-  std::unique_ptr<sensors::DatasetWriter> writer_;
+  std::unique_ptr<sensors::AsyncDatasetWriter> writer_;
   sensors::ClipSourceInfo source_;
   std::string frame_id_;
   bool frame_id_from_msg_ = false;
@@ -289,7 +302,7 @@ class ClipBufferNode {
   std::string last_error_;
   ros::WallTime last_error_time_, last_future_;
   uint64_t errors_ = 0;
-  uint64_t recorded_ = 0, not_recorded_ = 0, recording_failures_ = 0;
+  uint64_t not_recorded_ = 0, failed_seen_ = 0, dropped_seen_ = 0;
   ros::Publisher clip_pub_, preview_pub_;
   ros::Subscriber image_sub_, info_sub_, wind_sub_;
   ros::WallTimer flush_timer_;

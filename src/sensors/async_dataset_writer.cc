@@ -1,0 +1,86 @@
+#include "sensors/async_dataset_writer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+
+namespace clothwind::sensors {
+
+AsyncDatasetWriter::AsyncDatasetWriter(std::unique_ptr<DatasetWriter> writer, size_t max_queue)
+    : writer_(std::move(writer)),
+      max_queue_(max_queue),
+      root_(writer_ ? writer_->root() : std::string()),
+      size_at_open_(writer_ ? writer_->size() : 0),
+      recovered_(writer_ ? writer_->recovered() : 0) {
+  if (!writer_) throw std::invalid_argument("AsyncDatasetWriter: no writer");
+  if (max_queue < 1) throw std::invalid_argument("AsyncDatasetWriter: max_queue must be >= 1");
+  thread_ = std::thread(&AsyncDatasetWriter::Run, this);
+}
+
+AsyncDatasetWriter::~AsyncDatasetWriter() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+bool AsyncDatasetWriter::Enqueue(LabelledClip clip, ClipSourceInfo source) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (queue_.size() >= max_queue_) {
+      ++stats_.dropped;
+      return false;
+    }
+    queue_.emplace_back(std::move(clip), std::move(source));
+  }
+  wake_.notify_one();
+  return true;
+}
+
+void AsyncDatasetWriter::Drain() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  idle_.wait(lock, [this] { return queue_.empty() && !busy_; });
+}
+
+AsyncDatasetWriter::Stats AsyncDatasetWriter::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Stats s = stats_;
+  s.queued = queue_.size() + (busy_ ? 1 : 0);
+  return s;
+}
+
+void AsyncDatasetWriter::Run() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+    if (queue_.empty()) break;  // stop_ and nothing left: the destructor's drain is done
+    auto item = std::move(queue_.front());
+    queue_.pop_front();
+    busy_ = true;
+    lock.unlock();
+    const auto start = std::chrono::steady_clock::now();
+    std::string error;
+    try {
+      writer_->Write(item.first, item.second);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    lock.lock();
+    busy_ = false;
+    stats_.last_write_s = seconds;
+    stats_.max_write_s = std::max(stats_.max_write_s, seconds);
+    if (error.empty()) {
+      ++stats_.written;
+    } else {
+      ++stats_.failed;
+      stats_.last_error = error;
+    }
+    if (queue_.empty()) idle_.notify_all();
+  }
+  idle_.notify_all();
+}
+
+}  // namespace clothwind::sensors

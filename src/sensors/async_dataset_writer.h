@@ -1,0 +1,71 @@
+#ifndef CLOTHWIND_SENSORS_ASYNC_DATASET_WRITER_H_
+#define CLOTHWIND_SENSORS_ASYNC_DATASET_WRITER_H_
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include "sensors/dataset_writer.h"
+
+namespace clothwind::sensors {
+
+// Records clips on a thread of its own, so the camera callback that makes a clip never waits for
+// the disk: a clip is 30 JPEGs and a label, each fsync'ed (DatasetWriter), which takes
+// milliseconds on an SSD and can take seconds on an SD card or a USB stick. The queue is bounded;
+// a clip that finds it full is not recorded and is counted (the frames keep flowing).
+class AsyncDatasetWriter {
+ public:
+  struct Stats {
+    uint64_t written = 0;          // clips recorded
+    uint64_t failed = 0;           // clips DatasetWriter::Write refused (last_error says why)
+    uint64_t dropped = 0;          // clips not queued: the queue was full
+    size_t queued = 0;             // clips waiting now
+    double last_write_s = 0.0;     // wall time the last write took [s]
+    double max_write_s = 0.0;      // the longest write so far [s]
+    std::string last_error;        // of the last failed write
+  };
+
+  // Inputs:
+  //   writer     an opened DatasetWriter (owned from now on)
+  //   max_queue  clips waiting at most (>= 1)
+  AsyncDatasetWriter(std::unique_ptr<DatasetWriter> writer, size_t max_queue = 16);
+  // Records what is queued, then stops the thread.
+  ~AsyncDatasetWriter();
+  AsyncDatasetWriter(const AsyncDatasetWriter&) = delete;
+  AsyncDatasetWriter& operator=(const AsyncDatasetWriter&) = delete;
+
+  // Queues one clip (its frames are shared, not copied: they must not be changed afterwards).
+  // Returns false when the queue was full (counted in dropped).
+  bool Enqueue(LabelledClip clip, ClipSourceInfo source);
+
+  // Blocks until every queued clip is recorded (or failed).
+  void Drain();
+
+  Stats stats() const;
+  const std::string& root() const { return root_; }
+  size_t size_at_open() const { return size_at_open_; }
+  size_t recovered() const { return recovered_; }
+
+ private:
+  void Run();
+
+  std::unique_ptr<DatasetWriter> writer_;  // used by the thread only, after construction
+  const size_t max_queue_;
+  const std::string root_;
+  const size_t size_at_open_, recovered_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_, idle_;
+  std::deque<std::pair<LabelledClip, ClipSourceInfo>> queue_;
+  bool busy_ = false, stop_ = false;
+  Stats stats_;
+  std::thread thread_;
+};
+
+}  // namespace clothwind::sensors
+
+#endif  // CLOTHWIND_SENSORS_ASYNC_DATASET_WRITER_H_
