@@ -123,7 +123,12 @@ nlohmann::json EstimateJson(const std::vector<EstimateRow>& rows) {
 
 cv::Mat DrawEstimatePlot(const std::vector<EstimateRow>& rows, double t0, int width, int height) {
   if (rows.empty()) throw std::invalid_argument("DrawEstimatePlot: no estimates to plot");
-  const std::vector<EstimateRow> sorted = SortedByEnd(rows);
+  // An estimate without a time (a clip stamped 0) would stretch the axis over decades: left out.
+  std::vector<EstimateRow> sorted;
+  for (const EstimateRow& r : SortedByEnd(rows))
+    if (std::isfinite(r.end) && r.end > 0) sorted.push_back(r);
+  if (sorted.empty()) throw std::invalid_argument("DrawEstimatePlot: no estimate has a time (clip end) to plot");
+  if (!std::isfinite(t0) || t0 <= 0) t0 = sorted.front().end;
   const double t_end = sorted.back().end;
   const double span = std::max(1.0, t_end - std::min(t0, sorted.front().end));
   WindHistory estimate(span * 2 + 1), label(span * 2 + 1);

@@ -56,8 +56,9 @@ nlohmann::json EstimateJson(const std::vector<EstimateRow>& rows);
 
 // Estimate (± std band) and anemometer label over the whole session, time since t0 on x: the
 // monitor's DrawWindPlot over a window that spans every row, with the summary as a title line.
-// Inputs: rows (at least one); t0 [s]; width, height [px] (at least 160 by 120).
-// Returns a CV_8UC3 image. Throws std::invalid_argument for no rows or a size too small.
+// Inputs: rows (at least one with a time: rows whose end is 0 or not finite are left out); t0 [s]
+//         (0 or not finite: the first row's end); width, height [px] (at least 160 by 120).
+// Returns a CV_8UC3 image. Throws std::invalid_argument for no rows with a time or a size too small.
 cv::Mat DrawEstimatePlot(const std::vector<EstimateRow>& rows, double t0, int width, int height);
 
 }  // namespace clothwind::sensors

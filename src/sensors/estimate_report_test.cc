@@ -101,19 +101,27 @@ TEST(EstimateReportTest, PlotShowsBothSeriesAtTheirSpeeds) {
   ASSERT_EQ(img.type(), CV_8UC3);
   ASSERT_EQ(img.cols, w);
   const double y_max = WindPlotAxisMax(7.0);
-  auto row_has = [&](int y, const cv::Scalar& c) {
+  auto row_has_in = [&](const cv::Mat& image, int y, const cv::Scalar& c) {
     for (int dy = -1; dy <= 1; ++dy) {
       for (int x = w / 3; x < 2 * w / 3; ++x) {
-        const cv::Vec3b p = img.at<cv::Vec3b>(y + dy, x);
+        const cv::Vec3b p = image.at<cv::Vec3b>(y + dy, x);
         if (p[0] == c[0] && p[1] == c[1] && p[2] == c[2]) return true;
       }
     }
     return false;
   };
+  auto row_has = [&](int y, const cv::Scalar& c) { return row_has_in(img, y, c); };
   EXPECT_TRUE(row_has(WindPlotRow(7.0, y_max, h), kEstimateColour));
   EXPECT_TRUE(row_has(WindPlotRow(2.0, y_max, h), kAnemometerColour));
   EXPECT_FALSE(row_has(WindPlotRow(2.0, y_max, h), kEstimateColour));
   EXPECT_THROW(DrawEstimatePlot({}, 0.0, w, h), std::invalid_argument);
+  // An estimate of a clip stamped 0 and a t0 of 0 (no clip reached the report): left out and
+  // taken from the rows, so the plot still shows the session, not 1.7e9 s of empty axis.
+  rows.push_back({99, 0.0, 50.0, 0.0, 2.0, 0.01});
+  const cv::Mat same = DrawEstimatePlot(rows, 0.0, w, h);
+  EXPECT_TRUE(row_has_in(same, WindPlotRow(7.0, y_max, h), kEstimateColour));
+  EXPECT_TRUE(row_has_in(same, WindPlotRow(2.0, y_max, h), kAnemometerColour));
+  EXPECT_THROW(DrawEstimatePlot({{1, 0.0, 3.0, 0.0, 2.0, 0.01}}, 0.0, w, h), std::invalid_argument);
 }
 
 }  // namespace

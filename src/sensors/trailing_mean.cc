@@ -1,6 +1,5 @@
 #include "sensors/trailing_mean.h"
 
-#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -15,41 +14,32 @@ TrailingMean::TrailingMean(double window) : window_(window) {
 }
 
 void TrailingMean::Add(double t, double value, double std) {
-  if (!entries_.empty() && t < entries_.back().t) *this = TrailingMean(window_);
+  if (!entries_.empty() && t < entries_.back().t) entries_.clear();
   const bool finite = std::isfinite(value);
-  const double var = std::isfinite(std) ? std * std : kNaN;
-  entries_.push_back({t, finite ? value : kNaN, var});
-  if (finite) {
+  entries_.push_back({t, finite ? value : kNaN, std::isfinite(std) ? std * std : kNaN});
+  while (!entries_.empty() && entries_.front().t <= t - window_) entries_.pop_front();
+  // Sums over the window recomputed from its entries (a minute holds ~50 clips): running sums
+  // kept by adding and subtracting lose a small value beside a huge one for good (one outlier of
+  // 1e17 left the mean of a stream of 4.0 at 3.2 after it had left the window).
+  count_ = no_std_ = 0;
+  sum_ = sum_var_ = 0.0;
+  for (const Entry& e : entries_) {
+    if (!std::isfinite(e.value)) continue;
     ++count_;
-    sum_ += value;
-    if (std::isfinite(var)) {
-      sum_var_ += var;
+    sum_ += e.value;
+    if (std::isfinite(e.var)) {
+      sum_var_ += e.var;
     } else {
       ++no_std_;
     }
   }
-  while (!entries_.empty() && entries_.front().t <= t - window_) {
-    const Entry& e = entries_.front();
-    if (std::isfinite(e.value)) {
-      --count_;
-      sum_ -= e.value;
-      if (std::isfinite(e.var)) {
-        sum_var_ -= e.var;
-      } else {
-        --no_std_;
-      }
-    }
-    entries_.pop_front();
-  }
-  // Running sums drift with many additions and removals; an empty window resets them exactly.
-  if (count_ == 0) sum_ = sum_var_ = 0;
 }
 
 double TrailingMean::Mean() const { return count_ == 0 ? kNaN : sum_ / count_; }
 
 double TrailingMean::Std() const {
   if (count_ == 0 || no_std_ > 0) return kNaN;
-  return std::sqrt(std::max(0.0, sum_var_) / count_);
+  return std::sqrt(sum_var_ / count_);
 }
 
 double TrailingMean::Oldest() const { return entries_.empty() ? kNaN : entries_.front().t; }

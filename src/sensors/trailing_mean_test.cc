@@ -89,5 +89,18 @@ TEST(TrailingMeanTest, MatchesABruteForceMeanOverALongRandomStream) {
   }
 }
 
+// An outlier far above the rest must leave no trace once it has left the window (running sums
+// lost the 4.0s added beside 1e17 for good).
+TEST(TrailingMeanTest, AnOutlierLeavesNoTraceAfterItsWindow) {
+  TrailingMean m(60.0);
+  double t = 0.0;
+  for (int i = 0; i < 100; ++i, t += 1.2) m.Add(t, 4.0, 0.3);
+  m.Add(t, 1e17, 1e16);
+  t += 1.2;
+  for (int i = 0; i < 100; ++i, t += 1.2) m.Add(t, 4.0, 0.3);
+  EXPECT_EQ(m.Mean(), 4.0);
+  EXPECT_DOUBLE_EQ(m.Std(), 0.3);
+}
+
 }  // namespace
 }  // namespace clothwind::sensors

@@ -53,9 +53,16 @@ void DrawSeries(cv::Mat& img, const WindHistory& h, double t_now, double window,
 
 void WindHistory::Add(const WindSample& s) {
   if (!std::isfinite(s.speed) || !std::isfinite(s.t)) return;
-  if (!samples_.empty() && s.t < samples_.back().t) samples_.clear();
-  samples_.push_back(s);
-  while (!samples_.empty() && samples_.front().t < s.t - span_) samples_.pop_front();
+  if (!samples_.empty() && s.t < samples_.back().t - kRestartAfter) samples_.clear();
+  if (samples_.empty() || s.t >= samples_.back().t) {
+    samples_.push_back(s);
+  } else {  // a little out of order: keep the history sorted by time
+    const auto at = std::upper_bound(samples_.begin(), samples_.end(), s.t,
+                                     [](double t, const WindSample& x) { return t < x.t; });
+    samples_.insert(at, s);
+  }
+  const double newest = samples_.back().t;
+  while (!samples_.empty() && samples_.front().t < newest - span_) samples_.pop_front();
 }
 
 double WindHistory::Mean(double t_now, double window, int* count) const {
@@ -89,13 +96,14 @@ std::string WindSummaryText(double estimate, double estimate_std, double anemome
 }
 
 double WindPlotAxisMax(double max_speed) {
-  if (!std::isfinite(max_speed) || max_speed < 2.0) return 2.0;
-  return std::ceil(max_speed * 1.1);  // headroom so the top line is not on the frame
+  if (std::isnan(max_speed) || max_speed < 2.0) return 2.0;
+  return std::min(kWindPlotAxisCap, std::ceil(max_speed * 1.1));  // headroom: the top line off the frame
 }
 
 int WindPlotRow(double speed, double y_max, int height) {
   const double y0 = PlotBottom(height), y1 = PlotTop();
-  return static_cast<int>(std::lround(y0 - speed / y_max * (y0 - y1)));
+  const double clamped = std::clamp(speed, 0.0, y_max);
+  return static_cast<int>(std::lround(y0 - clamped / y_max * (y0 - y1)));
 }
 
 cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer, double t_now, double window,
@@ -104,7 +112,9 @@ cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer,
     throw std::invalid_argument("DrawWindPlot: image " + std::to_string(width) + "x" + std::to_string(height) +
                                 " too small (expected at least 160x120)");
   }
-  if (!(window > 0)) throw std::invalid_argument("DrawWindPlot: window must be > 0 s");
+  if (!(window > 0) || !std::isfinite(window))
+    throw std::invalid_argument("DrawWindPlot: window must be a finite time > 0 s");
+  if (!std::isfinite(t_now)) throw std::invalid_argument("DrawWindPlot: t_now must be finite");
   double top = 0.0;
   for (const WindHistory* h : {&estimate, &anemometer}) {
     for (const WindSample& s : h->samples()) {
@@ -118,7 +128,7 @@ cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer,
   const cv::Scalar grid(225, 225, 225), ink(60, 60, 60);
   const double font = 0.4;
   // Horizontal grid at a round step, labelled in m/s.
-  const double step = y_max <= 4 ? 0.5 : y_max <= 10 ? 1.0 : y_max <= 20 ? 2.0 : 5.0;
+  const double step = y_max <= 4 ? 0.5 : y_max <= 10 ? 1.0 : y_max <= 20 ? 2.0 : y_max <= 50 ? 5.0 : 10.0;
   for (double v = 0.0; v <= y_max + 1e-9; v += step) {
     const int y = WindPlotRow(v, y_max, height);
     cv::line(img, {kLeft, y}, {width - kRight, y}, grid, 1);
@@ -127,7 +137,9 @@ cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer,
   }
   // Vertical grid every 10 s (every 30 s or 60 s for long windows), labelled in seconds before now
   // (live monitor) or in seconds since t_origin (a report over a whole session).
-  const double tstep = window <= 60 ? 10 : window <= 240 ? 30 : 60;
+  // At most ~12 lines whatever the window (a report over a session with one stamp at 0 spans decades).
+  double tstep = window <= 60 ? 10 : window <= 240 ? 30 : 60;
+  while (window / tstep > 12) tstep *= window / tstep > 120 ? 10 : 2;
   const bool since_origin = std::isfinite(t_origin);
   for (double a = 0.0; a <= window + 1e-9; a += tstep) {
     const double t = since_origin ? t_now - window + a : t_now - a;

@@ -26,9 +26,11 @@ class WindHistory {
   //   span  [s] how much history to keep (> 0)
   explicit WindHistory(double span) : span_(span) {}
 
-  // Appends a sample (non-finite speeds are ignored: they mean "no reading"). A sample older than
-  // the newest one (clock jumped back, e.g. a bag replayed again) clears the history first.
+  // Adds a sample (non-finite speeds and times are ignored: they mean "no reading"). A sample up to
+  // kRestartAfter older than the newest is put in its place (two sources on one topic, jitter);
+  // one older than that (the clock jumped back, e.g. a bag replayed again) clears the history first.
   void Add(const WindSample& s);
+  static constexpr double kRestartAfter = 5.0;  // [s]
 
   // Mean speed of the samples with t in (t_now - window, t_now]; NaN when there are none.
   // Inputs:
@@ -83,8 +85,11 @@ cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer,
 // Inputs: speed [m/s], y_max [m/s] top of the axis, height [px] image height
 int WindPlotRow(double speed, double y_max, int height);
 
-// The axis top DrawWindPlot uses for histories whose largest speed (+std) is max_speed [m/s].
+// The axis top DrawWindPlot uses for histories whose largest speed (+std) is max_speed [m/s]:
+// 2 m/s at least, kWindPlotAxisCap at most (a speed above it is drawn at the top edge; one absurd
+// value must not turn the axis into millions of grid lines).
 double WindPlotAxisMax(double max_speed);
+inline constexpr double kWindPlotAxisCap = 100.0;  // [m/s]
 
 }  // namespace clothwind::sensors
 

@@ -33,8 +33,28 @@ TEST(WindHistoryTest, MeanOverWindowAndForgetting) {
   EXPECT_EQ(n, 0);
   h.Add({201.0, kNaN, 0.0});  // no reading: ignored
   EXPECT_EQ(h.back().t, 200.0);
+  h.Add({197.5, 4.0, 0.0});  // a little out of order (two sources, jitter): kept, in its place
+  ASSERT_EQ(h.samples().size(), 102u);
+  EXPECT_EQ(h.back().t, 200.0);
+  EXPECT_EQ(h.samples()[h.samples().size() - 4].t, 197.5);
+  EXPECT_DOUBLE_EQ(h.Mean(200.0, 3.0, &n), (4.0 + 0 + 1 + 0) / 4);  // (197, 200]: 197.5, 198, 199, 200
   h.Add({5.0, 2.0, 0.0});  // clock jumped back (bag replayed again): start afresh
   EXPECT_EQ(h.samples().size(), 1u);
+}
+
+// One absurd speed (a CSV anemometer's 1e20) or a report whose first stamp is 0 must not turn the
+// grid loops into millions of lines (the redraw hung).
+TEST(WindPlotTest, AbsurdValuesAndSpansDrawPromptly) {
+  WindHistory est(1e10), anem(1e10);
+  est.Add({0.0, 3.0, 0.2});
+  est.Add({1.7e9, 1e20, 1e19});
+  anem.Add({1.7e9, 4.0, 0.0});
+  EXPECT_EQ(WindPlotAxisMax(1e20), kWindPlotAxisCap);
+  EXPECT_EQ(WindPlotRow(1e20, kWindPlotAxisCap, 240), WindPlotRow(kWindPlotAxisCap, kWindPlotAxisCap, 240));
+  const cv::Mat img = DrawWindPlot(est, anem, 1.7e9, 1.7e9, 320, 200, 0.0);  // hung before (CTest's timeout)
+  EXPECT_EQ(img.rows, 200);
+  EXPECT_THROW(DrawWindPlot(est, anem, 1.7e9, std::numeric_limits<double>::infinity(), 320, 200),
+               std::invalid_argument);
 }
 
 TEST(WindPlotTest, SummaryText) {
