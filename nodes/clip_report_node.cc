@@ -7,10 +7,13 @@
 // "Over": the clock (sim time from rosbag play --clock) has not moved for ~idle_timeout wall
 // seconds after it started, and no clip has arrived in that time either (the clip buffer labels
 // its last waiting clips ~flush_after wall seconds after its input stops). ~max_wall bounds it;
-// ~start_timeout gives up when the clock never starts.
+// ~start_timeout gives up when the clock never starts. Interrupted (Ctrl-C), it still prints and
+// writes what it has; a file it cannot write is an error that does not cost the others.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -44,6 +47,14 @@ class ClipReport {
     pnh.param("summary", summary_path_, std::string());
     pnh.param("estimates", want_estimates_, false);
     pnh.param("estimate_plot", estimate_plot_path_, std::string());
+    auto finite = [](double v) { return std::isfinite(v); };
+    if (!(finite(idle_timeout_) && idle_timeout_ > 0))
+      throw std::invalid_argument("~idle_timeout must be a finite time > 0 s, got " + std::to_string(idle_timeout_));
+    if (!(finite(start_timeout_) && start_timeout_ > 0))
+      throw std::invalid_argument("~start_timeout must be a finite time > 0 s, got " + std::to_string(start_timeout_));
+    if (!(finite(max_wall_) && max_wall_ >= 0))
+      throw std::invalid_argument("~max_wall must be a finite time >= 0 s (0: no bound), got " +
+                                  std::to_string(max_wall_));
     ros::NodeHandle nh;
     sub_ = nh.subscribe("clips", 50, &ClipReport::OnClip, this);
     if (want_estimates_) estimate_sub_ = nh.subscribe("wind/estimate", 50, &ClipReport::OnEstimate, this);
@@ -87,11 +98,21 @@ class ClipReport {
                 estimates_.size());
     std::printf("%s", cs::EstimateTable(estimates_, t0).c_str());
     (*summary)["estimates"] = cs::EstimateJson(estimates_);
-    if (!estimate_plot_path_.empty() && !estimates_.empty()) {
+  }
+
+  // The plot after the summary: a plot that cannot be drawn or written costs only itself.
+  bool WritePlot(double t0) {
+    namespace cs = clothwind::sensors;
+    if (estimate_plot_path_.empty() || estimates_.empty()) return true;
+    try {
       std::vector<uchar> png;
       cv::imencode(".png", cs::DrawEstimatePlot(estimates_, t0, 800, 360), png);
       cs::WriteFileAtomically(estimate_plot_path_, std::string(png.begin(), png.end()));
       std::printf("estimate plot: %s\n", estimate_plot_path_.c_str());
+      return true;
+    } catch (const std::exception& e) {
+      ROS_ERROR("clip_report: no estimate plot: %s", e.what());
+      return false;
     }
   }
 
@@ -115,11 +136,28 @@ class ClipReport {
     }
   }
 
-  void Print(double wall) {
+  // Prints and writes the report once (from the timer, or after spin() when interrupted).
+  // Returns false when a file could not be written.
+ public:
+  bool Finish() {
+    if (printed_) return ok_;
+    return Print((ros::WallTime::now() - start_wall_).toSec());
+  }
+
+ private:
+  bool Print(double wall) {
+    printed_ = true;
     std::printf("\nclip_report: %zu clip(s) from the replay\n", rows_.size());
     std::printf("%5s  %-12s  %-12s  %6s  %7s  %9s  %8s  %8s  %5s  %8s\n", "seq", "start [s]", "end [s]",
                 "frames", "span", "dt err", "wind m/s", "std", "count", "dir rad");
-    const double t0 = rows_.empty() ? 0.0 : rows_.front().start;
+    // The earliest clip start there is (a clip without frame_stamps has none); else the first
+    // estimate's clip end; 0 when there is neither.
+    double t0 = std::numeric_limits<double>::infinity();
+    for (const auto& r : rows_)
+      if (std::isfinite(r.start) && r.start > 0) t0 = std::min(t0, r.start);
+    for (const auto& e : estimates_)
+      if (!std::isfinite(t0) && std::isfinite(e.end) && e.end > 0) t0 = e.end;
+    if (!std::isfinite(t0)) t0 = 0.0;
     double label_sum = 0;
     size_t labelled = 0, frames = 0;
     double worst_spacing = 0;
@@ -155,7 +193,18 @@ class ClipReport {
                         {"wall_seconds", wall}};
     if (want_estimates_) PrintEstimates(t0, &j);
     std::fflush(stdout);
-    if (!summary_path_.empty()) clothwind::sensors::WriteFileAtomically(summary_path_, j.dump(1) + "\n");
+    ok_ = true;
+    if (!summary_path_.empty()) {
+      try {
+        clothwind::sensors::WriteFileAtomically(summary_path_, j.dump(1) + "\n");
+      } catch (const std::exception& e) {
+        ROS_ERROR("clip_report: no summary: %s", e.what());
+        ok_ = false;
+      }
+    }
+    if (want_estimates_) ok_ = WritePlot(t0) && ok_;
+    std::fflush(stdout);
+    return ok_;
   }
 
   double idle_timeout_ = 5.0, max_wall_ = 0.0, start_timeout_ = 60.0;
@@ -166,7 +215,7 @@ class ClipReport {
   ros::WallTimer timer_;
   ros::WallTime start_wall_, last_change_;
   ros::Time last_clock_;
-  bool clock_started_ = false;
+  bool clock_started_ = false, printed_ = false, ok_ = true;
   std::vector<Row> rows_;
   double rate_ = 0.0, window_ = 0.0;
 };
@@ -176,7 +225,12 @@ class ClipReport {
 int main(int argc, char** argv) {
   ros::init(argc, argv, "clip_report");
   ros::NodeHandle pnh("~");
-  ClipReport report(pnh);
-  ros::spin();
-  return 0;
+  try {
+    ClipReport report(pnh);
+    ros::spin();
+    return report.Finish() ? 0 : 1;  // Ctrl-C ends spin() before the timer printed: print now
+  } catch (const std::exception& e) {
+    ROS_FATAL("clip_report: %s", e.what());
+    return 1;
+  }
 }

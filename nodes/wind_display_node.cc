@@ -13,11 +13,20 @@
 // ~fixed_frame ("" = none): when set, a latched /tf_static places the display frame at this
 // frame with the identity transform, so rviz has a fixed frame without a robot's TF tree (the
 // monitor does not know where the anemometer is; leave it empty when a real TF tree exists).
+// ~stale_after [s] (10): an estimate older than this (by ROS time) is shown as "--", and the
+// anemometer's mean and arrow go when no reading is left in ~mean_window; the plot scrolls with
+// the clock while inputs pause. /diagnostics says how old each input is. Messages stamped 0 are
+// dropped (counted): they would stamp the displays 0 and empty the plot.
 // Drawing and averaging are the ROS-free sensors/wind_plot.
 #include <cmath>
+#include <limits>
 #include <string>
 
+#include <algorithm>
+#include <stdexcept>
+
 #include <clothwind/WindEstimate.h>
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <clothwind/WindMeasurement.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
@@ -43,12 +52,16 @@ class WindDisplayNode {
     pnh.param<std::string>("fixed_frame", fixed_frame_, "");
     double rate;
     pnh.param("rate", rate, 2.0);
-    if (!(mean_window_ > 0) || !(plot_window_ > 0) || !(rate > 0) || plot_width_ < 160 || plot_height_ < 120) {
-      ROS_FATAL("wind_display: ~mean_window, ~plot_window and ~rate must be > 0 and ~plot_width x ~plot_height "
-                "at least 160x120 (got %g, %g, %g, %dx%d)", mean_window_, plot_window_, rate, plot_width_,
-                plot_height_);
-      ros::shutdown();
-      return;
+    pnh.param("stale_after", stale_after_, 10.0);
+    auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+    if (!positive(mean_window_) || !positive(plot_window_) || !positive(rate) || !positive(stale_after_) ||
+        plot_width_ < 160 || plot_height_ < 120 || plot_width_ > 4096 || plot_height_ > 4096) {
+      char what[320];
+      std::snprintf(what, sizeof what,
+                    "~mean_window, ~plot_window, ~rate and ~stale_after must be finite and > 0, ~plot_width x "
+                    "~plot_height from 160x120 to 4096x4096 (got %g, %g, %g, %g, %dx%d)",
+                    mean_window_, plot_window_, rate, stale_after_, plot_width_, plot_height_);
+      throw std::invalid_argument(what);
     }
     const double span = std::max(mean_window_, plot_window_) + 10.0;
     estimates_ = WindHistory(span);
@@ -60,10 +73,19 @@ class WindDisplayNode {
     wind_sub_ = nh.subscribe("anemometer/wind", 50, &WindDisplayNode::OnWind, this);
     // Redraw on a timer, not per message: the plot scrolls with time even when inputs pause.
     timer_ = nh.createTimer(ros::Duration(1.0 / rate), &WindDisplayNode::Publish, this);
+    updater_.setHardwareID("wind_display");
+    updater_.add("wind display", this, &WindDisplayNode::Diagnose);
+    diagnostics_timer_ = nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
+      updater_.force_update();  // wall time: a paused bag must not stop them
+    });
   }
 
  private:
   void OnEstimate(const clothwind::WindEstimate::ConstPtr& msg) {
+    if (msg->header.stamp.isZero()) {
+      ++unstamped_;
+      return;
+    }
     estimates_.Add({msg->header.stamp.toSec(), msg->speed, msg->speed_std});
     last_estimate_ = *msg;
     have_estimate_ = true;
@@ -71,6 +93,10 @@ class WindDisplayNode {
   }
 
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
+    if (msg->header.stamp.isZero()) {
+      ++unstamped_;
+      return;
+    }
     if (!msg->valid) return;
     anemometer_.Add({msg->header.stamp.toSec(), msg->speed, 0.0});
     last_wind_ = *msg;
@@ -84,6 +110,37 @@ class WindDisplayNode {
     if (stamp > latest_stamp_ || stamp + ros::Duration(5.0) < latest_stamp_) latest_stamp_ = stamp;
   }
 
+  // The display's "now": ROS time (so the plot scrolls and old values age while inputs pause), but
+  // never before the newest input (latency) and the newest input while time has not started or
+  // has just gone back (a replay restarting, until its first message moves latest_stamp_ back).
+  ros::Time DisplayNow() const {
+    const ros::Time now = ros::Time::now();
+    if (now.isZero() || now + ros::Duration(WindHistory::kRestartAfter) < latest_stamp_) return latest_stamp_;
+    return std::max(now, latest_stamp_);
+  }
+
+  // Age of an input [s] at the display's now; infinity when there was none.
+  double Age(bool have, const ros::Time& stamp) const {
+    return have ? (DisplayNow() - stamp).toSec() : std::numeric_limits<double>::infinity();
+  }
+
+  void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    using diagnostic_msgs::DiagnosticStatus;
+    const double est_age = Age(have_estimate_, last_estimate_.header.stamp);
+    const double wind_age = Age(have_wind_, last_wind_.header.stamp);
+    stat.summary(DiagnosticStatus::OK, "showing estimate and anemometer");
+    if (!(est_age <= stale_after_))
+      stat.mergeSummary(DiagnosticStatus::WARN, have_estimate_ ? "estimate stale (shown as --)" : "no estimate yet");
+    if (!(wind_age <= mean_window_))
+      stat.mergeSummary(DiagnosticStatus::WARN,
+                        have_wind_ ? "no anemometer reading in the mean window" : "no anemometer reading yet");
+    if (unstamped_ > 0) stat.mergeSummary(DiagnosticStatus::WARN, "messages stamped 0 dropped");
+    stat.addf("estimate age [s]", "%.1f", est_age);
+    stat.addf("anemometer age [s]", "%.1f", wind_age);
+    stat.add("messages stamped 0 dropped", unstamped_);
+    stat.add("frame", FrameId());
+  }
+
   std::string FrameId() const {
     if (!frame_id_param_.empty()) return frame_id_param_;
     if (have_wind_ && !last_wind_.header.frame_id.empty()) return last_wind_.header.frame_id;
@@ -94,14 +151,18 @@ class WindDisplayNode {
     if (!have_estimate_ && !have_wind_) return;  // nothing to show yet
     const std::string frame = FrameId();
     if (!fixed_frame_.empty() && frame != tf_child_ && frame != fixed_frame_) PublishFixedFrame(frame);
-    const double t_now = latest_stamp_.toSec();
+    const ros::Time stamp = DisplayNow();
+    const double t_now = stamp.toSec();
     const double mean = anemometer_.Mean(t_now, mean_window_);
-    const double est = have_estimate_ ? last_estimate_.speed : std::nan("");
-    const double est_std = have_estimate_ ? last_estimate_.speed_std : std::nan("");
+    // A value older than it should be is not shown as if live (sdn_node died, the bag ended).
+    const bool est_live = Age(have_estimate_, last_estimate_.header.stamp) <= stale_after_;
+    const bool wind_live = Age(have_wind_, last_wind_.header.stamp) <= mean_window_;
+    const double est = est_live ? last_estimate_.speed : std::nan("");
+    const double est_std = est_live ? last_estimate_.speed_std : std::nan("");
 
     visualization_msgs::MarkerArray array;
     visualization_msgs::Marker text;
-    text.header.stamp = latest_stamp_;
+    text.header.stamp = stamp;
     text.header.frame_id = frame;
     text.ns = "wind_text";
     text.id = 0;
@@ -115,7 +176,7 @@ class WindDisplayNode {
     text.scale.z = 0.6;  // [m] letter height
     text.color.r = text.color.g = text.color.b = 1.0;
     text.color.a = 1.0;
-    const double est_mean = have_estimate_ ? estimates_.Mean(t_now, mean_window_) : std::nan("");
+    const double est_mean = est_live ? estimates_.Mean(t_now, mean_window_) : std::nan("");
     text.text = clothwind::sensors::WindSummaryText(est, est_std, mean, mean_window_, est_mean);
     const size_t bar = text.text.find(" | ");  // two lines: the 3-D view is narrow beside the images
     if (bar != std::string::npos) text.text.replace(bar, 3, "\n");
@@ -127,7 +188,7 @@ class WindDisplayNode {
     arrow.id = 0;
     arrow.type = visualization_msgs::Marker::ARROW;
     arrow.pose.orientation.w = 1.0;
-    const bool has_vector = have_wind_ && std::isfinite(last_wind_.velocity.x) && std::isfinite(last_wind_.velocity.y);
+    const bool has_vector = wind_live && std::isfinite(last_wind_.velocity.x) && std::isfinite(last_wind_.velocity.y);
     arrow.action = has_vector ? visualization_msgs::Marker::ADD : visualization_msgs::Marker::DELETE;
     if (has_vector) {
       geometry_msgs::Point tail, tip;
@@ -172,7 +233,10 @@ class WindDisplayNode {
     tf_child_ = frame;
   }
 
-  double mean_window_ = 60.0, plot_window_ = 180.0;
+  double mean_window_ = 60.0, plot_window_ = 180.0, stale_after_ = 10.0;
+  uint64_t unstamped_ = 0;
+  diagnostic_updater::Updater updater_;
+  ros::WallTimer diagnostics_timer_;
   int plot_width_ = 640, plot_height_ = 320;
   std::string frame_id_param_, fixed_frame_, tf_child_;
   WindHistory estimates_, anemometer_;
@@ -189,7 +253,12 @@ class WindDisplayNode {
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "wind_display");
-  WindDisplayNode node(ros::NodeHandle(), ros::NodeHandle("~"));
-  ros::spin();
+  try {
+    WindDisplayNode node(ros::NodeHandle(), ros::NodeHandle("~"));
+    ros::spin();
+  } catch (const std::exception& e) {
+    ROS_FATAL("wind_display: %s", e.what());
+    return 1;
+  }
   return 0;
 }

@@ -1,0 +1,113 @@
+#!/usr/bin/env python3
+"""rostest for wind_display_node and clip_report_node (see monitor_nodes.test)."""
+import json
+import os
+import sys
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from clothwind.msg import WindEstimate, WindMeasurement
+from diagnostic_msgs.msg import DiagnosticArray
+from visualization_msgs.msg import MarkerArray
+
+
+class MonitorNodesTest(unittest.TestCase):
+    def setUp(self):
+        self.lock = threading.RLock()
+        self.markers = []
+        self.statuses = []
+        rospy.Subscriber("monitor/wind_markers", MarkerArray, self.keep(self.markers), queue_size=10)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics, queue_size=50)
+        self.est_pub = rospy.Publisher("wind/estimate", WindEstimate, queue_size=20)
+        self.wind_pub = rospy.Publisher("anemometer/wind", WindMeasurement, queue_size=20)
+        deadline = time.time() + 20
+        while time.time() < deadline and (self.est_pub.get_num_connections() < 2 or
+                                          self.wind_pub.get_num_connections() < 1):
+            time.sleep(0.1)
+
+    def keep(self, where):
+        def add(msg):
+            with self.lock:
+                where.append(msg)
+        return add
+
+    def on_diagnostics(self, msg):
+        with self.lock:
+            self.statuses += [s for s in msg.status if s.name.endswith("wind display")]
+
+    def text(self):
+        with self.lock:
+            for m in reversed(self.markers):
+                for marker in m.markers:
+                    if marker.ns == "wind_text":
+                        return marker.text, [a for a in m.markers if a.ns == "anemometer_wind"][0].action
+        return None, None
+
+    def latest_status(self):
+        with self.lock:
+            s = self.statuses[-1]
+        return s, {kv.key: kv.value for kv in s.values}
+
+    def test_display_and_report(self):
+        start = rospy.Time.now()
+        for i in range(8):  # 4 s: estimates at 1 Hz, readings at 2 Hz
+            now = rospy.Time.now()
+            wind = WindMeasurement()
+            wind.header.stamp = now
+            wind.header.frame_id = "anemometer"
+            wind.speed, wind.direction, wind.valid = 3.0, 0.0, True
+            wind.velocity.x = 3.0
+            self.wind_pub.publish(wind)
+            if i % 2 == 0:
+                e = WindEstimate()
+                e.header.stamp = now
+                e.clip_sequence = i // 2
+                e.clip_start = now - rospy.Duration(1.16)
+                e.clip_end = now
+                e.speed, e.speed_std, e.reference_speed = 4.0, 0.3, 3.0
+                self.est_pub.publish(e)
+            time.sleep(0.5)
+        zero = WindEstimate()  # stamped 0: dropped by the display; the report leaves it out of its plot
+        zero.clip_sequence, zero.speed, zero.reference_speed = 9, 50.0, 3.0
+        self.est_pub.publish(zero)
+        zero_wind = WindMeasurement()
+        zero_wind.speed, zero_wind.valid = 3.0, True
+        self.wind_pub.publish(zero_wind)
+        time.sleep(0.3)
+        text, arrow = self.text()
+        self.assertIsNotNone(text, "no markers")
+        self.assertIn("estimate 4.0 \u00b1 0.3 m/s", text)
+        self.assertIn("anemometer 3.0 m/s", text)
+        self.assertEqual(arrow, 0)  # ADD
+
+        time.sleep(4.0)  # past stale_after (2 s) and mean_window (3 s)
+        text, arrow = self.text()
+        self.assertIn("estimate --", text)
+        self.assertIn("anemometer --", text)
+        self.assertEqual(arrow, 2)  # DELETE
+        status, values = self.latest_status()
+        self.assertIn("estimate stale", status.message)
+        self.assertIn("no anemometer reading in the mean window", status.message)
+        self.assertEqual(values["messages stamped 0 dropped"], "2")
+
+        # The report ends after max_wall (12 s; wall time never idles) and writes its summary
+        # although the plot's path lies under a file.
+        summary = rospy.get_param("~summary")
+        deadline = time.time() + 30
+        while time.time() < deadline and not os.path.exists(summary):
+            time.sleep(0.2)
+        self.assertTrue(os.path.exists(summary), "no summary written")
+        with open(summary) as f:
+            j = json.load(f)
+        self.assertEqual(j["estimates"]["count"], 5)
+        self.assertAlmostEqual(j["estimates"]["rmse"], 1.0 if j["estimates"]["compared"] == 4 else
+                               ((4 * 1.0 + 47.0 ** 2) / 5) ** 0.5, places=6)
+        del start
+
+
+if __name__ == "__main__":
+    rospy.init_node("monitor_nodes_check")
+    rostest.rosrun("clothwind", "monitor_nodes", MonitorNodesTest, sys.argv)
