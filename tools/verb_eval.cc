@@ -136,15 +136,16 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     const std::filesystem::path plot =
         a->plot.empty() ? std::filesystem::path(a->model).parent_path() / ("eval_" + a->split + ".png")
                         : std::filesystem::path(a->plot);
+    // The figures first: a plot that cannot be written (a read-only model folder) costs only itself.
+    if (!a->json.empty()) {
+      learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
+      std::cout << "json: " << a->json << "\n";
+    }
     std::string error;
     if (learn::PlotPredictions(r, plot, &error)) {
       std::cout << "plot: " << plot.string() << "\n";
     } else {
       std::cerr << "plot not drawn: " << error << "\n";
-    }
-    if (!a->json.empty()) {
-      learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
-      std::cout << "json: " << a->json << "\n";
     }
     if (!by_view_error.empty()) {
       std::cerr << "clothwind eval: --by-view: " << by_view_error << "\n";

@@ -278,12 +278,44 @@ std::string EvalTable(const EvalResult& r) {
   return s.str();
 }
 
+namespace {
+
+// `text` as one word for /bin/sh: in single quotes, each ' written as '\''.
+std::string ShellQuoted(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// `text` as a gnuplot string in single quotes (where '' stands for one ').
+std::string GnuplotQuoted(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("''") : std::string(1, c);
+  return out + "'";
+}
+
+// Runs `body` (which writes files and may throw): a plot that cannot be written is reported
+// through `error`, never thrown, so the results it would illustrate are kept.
+template <typename F>
+bool Plotting(std::string* error, F body) {
+  try {
+    return body();
+  } catch (const std::exception& e) {
+    if (error) *error = e.what();
+    return false;
+  }
+}
+
+}  // namespace
+
 bool RunGnuplot(const std::string& script, const fs::path& png, std::string* error) {
+  return Plotting(error, [&] {
   const std::string tmp = png.string() + ".tmp" + std::to_string(::getpid()) + ".png";
   const fs::path script_path = png.string() + ".gp";
-  WriteFileAtomically(script_path, "set terminal pngcairo size 800,600 noenhanced\nset output '" + tmp + "'\n" +
-                                       script);
-  const std::string command = "gnuplot '" + script_path.string() + "' 2>'" + script_path.string() + ".err'";
+  WriteFileAtomically(script_path, "set terminal pngcairo size 800,600 noenhanced\nset output " + GnuplotQuoted(tmp) +
+                                       "\n" + script);
+  const std::string command =
+      "gnuplot " + ShellQuoted(script_path.string()) + " 2>" + ShellQuoted(script_path.string() + ".err");
   const int rc = std::system(command.c_str());
   if (rc != 0 || !fs::exists(tmp)) {
     if (error) *error = "gnuplot failed (exit " + std::to_string(rc) + "), see " + script_path.string() + ".err";
@@ -293,9 +325,11 @@ bool RunGnuplot(const std::string& script, const fs::path& png, std::string* err
   fs::rename(tmp, png);
   fs::remove(script_path.string() + ".err");
   return true;
+  });
 }
 
 bool PlotPredictions(const EvalResult& r, const fs::path& png, std::string* error) {
+  return Plotting(error, [&] {
   const fs::path data = png.string() + ".dat";
   std::ostringstream d;
   d << "# true_speed predicted_speed predicted_std name\n" << std::setprecision(6);
@@ -312,12 +346,14 @@ bool PlotPredictions(const EvalResult& r, const fs::path& png, std::string* erro
     << "set xlabel 'true wind speed [m/s]'\nset ylabel 'predicted wind speed [m/s]'\n"
     << "set xrange [0:" << hi << "]\nset yrange [0:" << hi << "]\nset size square\nset key top left\nset grid\n"
     << "plot x+0.5 with lines dt 2 lc 'grey' title '±0.5 m/s', x-0.5 with lines dt 2 lc 'grey' notitle, "
-    << "x with lines lc 'black' title 'ideal', '" << data.string()
-    << "' using 1:2:3 with yerrorbars pt 7 ps 0.5 lc 'blue' title 'prediction ± std'\n";
+    << "x with lines lc 'black' title 'ideal', " << GnuplotQuoted(data.string())
+    << " using 1:2:3 with yerrorbars pt 7 ps 0.5 lc 'blue' title 'prediction ± std'\n";
   return RunGnuplot(s.str(), png, error);
+  });
 }
 
 bool PlotLearningCurve(const std::vector<EpochRecord>& log, const fs::path& png, std::string* error) {
+  return Plotting(error, [&] {
   const fs::path data = png.string() + ".dat";
   std::ostringstream d;
   d << "# epoch train_rmse val_rmse train_loss val_loss raw_val_rmse\n";
@@ -330,11 +366,12 @@ bool PlotLearningCurve(const std::vector<EpochRecord>& log, const fs::path& png,
   WriteFileAtomically(data, d.str());
   std::ostringstream s;
   s << "set title 'learning curve'\nset xlabel 'epoch'\nset ylabel 'RMSE [m/s]'\nset grid\nset key top right\n"
-    << "plot '" << data.string() << "' using 1:2 with linespoints title 'train RMSE', '' using 1:3 with "
+    << "plot " << GnuplotQuoted(data.string()) << " using 1:2 with linespoints title 'train RMSE', '' using 1:3 with "
     << "linespoints title '" << (averaged ? "validation RMSE (weight average)" : "validation RMSE") << "'";
   if (averaged) s << ", '' using 1:6 with linespoints title 'validation RMSE (trained weights)'";
   s << "\n";
   return RunGnuplot(s.str(), png, error);
+  });
 }
 
 }  // namespace clothwind::learn

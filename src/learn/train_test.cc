@@ -264,6 +264,13 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
   std::string error;
   const fs::path png = r.model.parent_path() / "eval_val.png";
   ASSERT_TRUE(PlotPredictions(e, png, &error)) << error;
+  // A plot that cannot be written is reported, not thrown (eval keeps its JSON); a path with a
+  // quote in it is quoted for the shell and for gnuplot.
+  EXPECT_FALSE(PlotPredictions(e, r.model.parent_path() / "missing" / "p.png", &error));
+  EXPECT_NE(error.find("missing/p.png"), std::string::npos) << error;
+  const fs::path quoted = r.model.parent_path() / "it's here.png";
+  ASSERT_TRUE(PlotPredictions(e, quoted, &error)) << error;
+  EXPECT_GT(fs::file_size(quoted), 1000u);
   for (const fs::path& p : {png, r.model.parent_path() / "learning_curve.png"}) {
     std::ifstream in(p, std::ios::binary);
     char magic[4] = {};
