@@ -64,6 +64,11 @@ void ValidateOptions(const DatasetOptions& o) {
   Check(!o.add_tracks || o.tracks, "--add-tracks needs the grid of the tracks (--tracks COLSxROWS)");
   Check(o.split.empty() || o.split == "train" || o.split == "val" || o.split == "test",
         "--split must be train, val or test");
+  // Checked before the index's header records them: a run refused for them later would leave a
+  // folder whose header every corrected run is refused against.
+  Check(o.val_fraction >= 0 && o.test_fraction >= 0 && o.val_fraction + o.test_fraction <= 1,
+        "--val and --test must be fractions >= 0 that add up to at most 1 (got " + std::to_string(o.val_fraction) +
+            " and " + std::to_string(o.test_fraction) + ")");
 }
 
 std::string TempPrefix(const std::string& name) { return "." + name + ".tmp-"; }

@@ -531,6 +531,30 @@ TEST(DatasetOptionsTest, AddTracksNeedsAGridAndADataset) {
   fs::remove_all(o.out);
 }
 
+// A label whose frame_pattern printf would misread ("%s" reads a string from nowhere: the contact
+// sheet and the index crashed) is refused naming the file and the field.
+TEST_F(DatasetGeneratorTest, BadFramePatternIsRefusedByName) {
+  const fs::path dir = root_ / "bad_pattern";
+  fs::create_directories(dir);
+  fs::copy(Ref() / "flag-000000-v0", dir / "flag-000000-v0", fs::copy_options::recursive);
+  fs::copy(Ref() / "index.json", dir / "index.json");
+  const fs::path label = dir / "flag-000000-v0" / "label.json";
+  nlohmann::json j;
+  {
+    std::ifstream in(label);
+    j = nlohmann::json::parse(in);
+  }
+  j["frame_pattern"] = "%s.jpg";
+  std::ofstream(label) << j.dump();
+  try {
+    ReindexDataset(dir.string());
+    ADD_FAILURE() << "a frame_pattern of %s was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("frame_pattern"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(label.string()), std::string::npos) << e.what();
+  }
+}
+
 TEST(DatasetOptionsTest, BadOptionsAreRejected) {
   DatasetOptions o;
   o.out = "/tmp/never";
@@ -544,6 +568,17 @@ TEST(DatasetOptionsTest, BadOptionsAreRejected) {
   o.views = 1;
   o.frame_ext = "ppm";
   EXPECT_THROW(GenerateDataset(o), std::invalid_argument);
+  o.frame_ext = "jpg";
+  // Split fractions that cannot be: refused before the folder's header records them.
+  o.val_fraction = 0.9;
+  o.test_fraction = 0.5;
+  try {
+    GenerateDataset(o);
+    ADD_FAILURE() << "--val 0.9 --test 0.5 was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--val and --test"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(o.out));
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "common/frame_pattern.h"
 #include "sim/trajectory_io.h"
 
 namespace clothwind::data {
@@ -93,7 +94,9 @@ nlohmann::json ReadLabel(const std::string& path) {
   Require(j, "height", has("height") && j["height"].is_number_integer(), path, "an integer");
   Require(j, "encoding", has("encoding") && (j["encoding"] == "rgb8" || j["encoding"] == "mono8"), path,
           "\"rgb8\" or \"mono8\"");
-  Require(j, "frame_pattern", has("frame_pattern") && j["frame_pattern"].is_string(), path, "a string");
+  Require(j, "frame_pattern",
+          has("frame_pattern") && j["frame_pattern"].is_string() && ValidFramePattern(j["frame_pattern"]), path,
+          "a file pattern with one integer conversion, e.g. \"%03d.jpg\"");
   Require(j, "wind_speed", has("wind_speed") && (j["wind_speed"].is_number() || j["wind_speed"].is_null()),
           path, "a number");
   return j;

@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "common/frame_pattern.h"
 #include "learn/fly_judge.h"
 #include "learn/model_config.h"
 
@@ -40,15 +41,6 @@ T Field(const nlohmann::json& j, const char* key, const fs::path& file, const ch
     throw std::runtime_error(file.string() + ": field \"" + key + "\" must be " + expected +
                              ", got " + j.at(key).dump());
   }
-}
-
-// A printf pattern with exactly one integer conversion (e.g. "%03d.jpg"), nothing else.
-bool ValidFramePattern(const std::string& p) {
-  size_t pos = p.find('%');
-  if (pos == std::string::npos || p.find('%', pos + 1) != std::string::npos) return false;
-  size_t i = pos + 1;
-  while (i < p.size() && (std::isdigit(static_cast<unsigned char>(p[i])) || p[i] == '0')) ++i;
-  return i < p.size() && p[i] == 'd' && p.find('/') == std::string::npos;
 }
 
 std::string FrameName(const ClipInfo& clip, int index) {
