@@ -101,6 +101,8 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
       ->capture_default_str();
   sub->add_flag("--resume", o.resume, "continue the run in --out from its last epoch");
+  sub->add_flag("--overwrite", o.overwrite,
+                "start again in an --out that holds a run (without it, or --resume, such an --out is refused)");
   sub->add_flag("--cache-frames", o.cache_frames,
                 "keep every frame decoded at the input size in memory after its first read: the same samples, "
                 "no rereading of a dataset larger than the page cache (needs --crop-scales 1; clips x frames x "

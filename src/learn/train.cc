@@ -248,6 +248,13 @@ TrainResult Train(const TrainOptions& o) {
   }
   const at::Device device = (o.device != "cpu" && torch::cuda::is_available()) ? at::Device(at::kCUDA)
                                                                                  : at::Device(at::kCPU);
+  if (!o.resume && !o.overwrite) {
+    for (const char* file : {"state.json", "model.pt"}) {
+      if (fs::exists(o.out / file))
+        throw std::runtime_error((o.out / file).string() + ": a run is already in " + o.out.string() +
+                                 "; --resume continues it, --overwrite starts it again (or choose another --out)");
+    }
+  }
   fs::create_directories(o.out);
   TrainResult result;
   result.device = device.is_cuda() ? "cuda" : "cpu";

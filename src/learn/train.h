@@ -44,6 +44,9 @@ struct TrainOptions {
   int threads = 2;                   // torch intra-op threads
   std::string device = "auto";       // cpu | cuda | auto
   bool resume = false;               // continue from out/last.pt and out/state.json
+  // Without resume, a folder that already holds a run (state.json or model.pt) is refused unless
+  // this is set: rerunning a command after a crash without --resume replaced a day's run.
+  bool overwrite = false;
   bool init_only = false;            // write an initialised (untrained) model and stop
   // Keep every frame decoded and resized in memory after its first read (learn/frame_cache.h):
   // the same samples, without rereading a dataset larger than the page cache each epoch.

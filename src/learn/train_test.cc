@@ -846,6 +846,21 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   EXPECT_NEAR(redo.log[2].train_loss, resumed.log[2].train_loss, 1e-5);
   EXPECT_NEAR(redo.log[2].val_rmse, resumed.log[2].val_rmse, 1e-5);
 
+  // Training into the folder again without --resume (a command rerun after a crash) is refused
+  // before anything is written; --overwrite starts it again.
+  TrainOptions again = Options("sdn", "resume");
+  again.epochs = 1;
+  const auto state_before = fs::last_write_time(*root_ / "resume" / "state.json");
+  ExpectTrainRefused(again, "a run was trained over without --resume or --overwrite",
+                     {"a run is already in", "--resume continues it, --overwrite starts it again"});
+  EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), state_before);
+  TrainOptions fresh = Options("sdn", "resume_overwritten");
+  fresh.epochs = 1;
+  fresh.init_only = true;
+  Train(fresh);
+  fresh.overwrite = true;
+  EXPECT_NO_THROW(Train(fresh));
+
   // Resuming under another schedule is refused before anything is written: epoch 2 ran at lr / 10
   // (step), the cosine schedule over 4 epochs gives 0.85 lr there.
   TrainOptions w = Options("sdn", "resume");

@@ -25,14 +25,14 @@ if [ ! -f "$model" ] || [ "$cli" -nt "$model" ] || [ "$0" -nt "$model" ]; then
   if [ -n "$toy" ]; then
     "$cli" make-toy-dataset --out "$toy" --clips 100 --frames 60 --size 32 --seed 1 >&2
     if [ "$half" = 1 ]; then
-      "$cli" train --data "$toy" --out "$(dirname "$model")/full" "${opts[@]}" >&2
+      "$cli" train --overwrite --data "$toy" --out "$(dirname "$model")/full" "${opts[@]}" >&2
       "$cli" export-model --model "$(dirname "$model")/full/model.pt" --out "$model" --precision float16 \
         --calibrate-std "$toy" >&2
     else
-      "$cli" train --data "$toy" --out "$(dirname "$model")" "${opts[@]}" >&2
+      "$cli" train --overwrite --data "$toy" --out "$(dirname "$model")" "${opts[@]}" >&2
     fi
   else
-    "$cli" train --init-only --out "$(dirname "$model")" "${opts[@]}" >&2
+    "$cli" train --overwrite --init-only --out "$(dirname "$model")" "${opts[@]}" >&2
   fi
 fi
 exec "$@"
