@@ -37,8 +37,10 @@ const VerbRegistrar kRegistrar{"contact-sheet", [](CLI::App& app) -> std::functi
   auto* sub = app.add_subcommand("contact-sheet", "grid of a dataset's middle frames with their wind speeds (PNG)");
   sub->add_option("dir", a->dir, "dataset folder (with index.json)")->required();
   sub->add_option("--out", a->out, "PNG to write (default: DIR/contact_sheet.png)");
-  sub->add_option("--tiles", a->options.max_tiles, "examples shown at most")->capture_default_str();
-  sub->add_option("--tile-size", a->options.tile, "tile size [px]")->capture_default_str();
+  sub->add_option("--tiles", a->options.max_tiles, "examples shown at most")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  sub->add_option("--tile-size", a->options.tile, "tile size [px]")->check(CLI::Range(16, 1024))->capture_default_str();
   return [a] { return Run(*a); };
 }};
 

@@ -153,9 +153,9 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
       ->capture_default_str();
   sub->add_option("--jpeg-quality", a->o.jpeg_quality, "JPEG quality 1..100")->capture_default_str();
   sub->add_option("--wind-min", a->wind_min, "lowest wind speed [m/s] (default: flag 0, cloth 0)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0.0, 100.0));
   sub->add_option("--wind-max", a->wind_max, "highest wind speed [m/s] (default: flag 10, cloth 5)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0.0, 100.0));
   // Why a narrow area weight: the wind's pressure balances the flag's weight, so the droop shows
   // rho v^2 / (w g); a flag of unknown weight in [w/2, 2w] leaves v uncertain by a factor of 2
   // (docs/datasets.md). A deployed flag can be weighed; its bending stiffness cannot easily.

@@ -4,6 +4,9 @@
 // --frames procedural (default, fast: an OpenCV-drawn flag) or rendered (the flag simulated in the
 // session's wind and rendered by render/, with the anemometer's sentences from its sensor model
 // sampling the same wind field: data/rendered_flag_generator.h).
+#include <cstdlib>
+#include <cerrno>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -99,6 +102,21 @@ int Run(const MakeSessionArgs& a) {
   namespace fs = std::filesystem;
   const fs::path out(a.out);
   if (out.has_parent_path()) fs::create_directories(out.parent_path());
+  // A run killed mid-write (Ctrl-C) leaves its temporary bag: clear those of dead processes.
+  {
+    std::error_code ec;
+    const std::string stem = out.filename().string() + ".tmp-";
+    const fs::path folder = out.has_parent_path() ? out.parent_path() : fs::path(".");
+    for (const auto& e : fs::directory_iterator(folder, ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.rfind(stem, 0) != 0) continue;
+      const long pid = std::strtol(name.c_str() + stem.size(), nullptr, 10);
+      if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
+        std::fprintf(stderr, "make-session: removing %s, left by a run that stopped\n", e.path().c_str());
+        fs::remove(e.path(), ec);
+      }
+    }
+  }
   const std::string tmp = a.out + ".tmp-" + std::to_string(::getpid());
   rosbag::Bag bag;
   bag.open(tmp, rosbag::bagmode::Write);
@@ -181,7 +199,10 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
   sub->add_option("--drop-probability", args->drop_probability, "chance a frame is lost")->capture_default_str();
   sub->add_option("--start-time", args->start_time, "stamp of the session start [s since epoch]")
       ->capture_default_str();
-  sub->add_option("--compression", args->compression, "none | lz4 | bz2")->capture_default_str();
+  // Checked when parsed: a bad value used to leave the temporary bag behind.
+  sub->add_option("--compression", args->compression, "none | lz4 | bz2")
+      ->check(CLI::IsMember({"none", "lz4", "bz2"}))
+      ->capture_default_str();
   sub->add_option("--camera-frame", args->camera_frame, "camera frame_id")->capture_default_str();
   sub->add_option("--anemometer-frame", args->anemometer_frame, "anemometer frame_id")->capture_default_str();
   sub->add_option("--preview", args->preview, "also write the first frame to this image file");

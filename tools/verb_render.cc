@@ -134,9 +134,11 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
   sub->add_option("--seed", a->seed, "seed of the render parameters zeta")->capture_default_str();
   sub->add_option("--zeta", a->zeta, "zeta JSON file (or an example's label.json) instead of --seed");
   sub->add_option("--format", a->format, "jpg or png")->capture_default_str();
-  sub->add_option("--jpeg-quality", a->jpeg_quality, "JPEG quality")->capture_default_str();
+  sub->add_option("--jpeg-quality", a->jpeg_quality, "JPEG quality")->check(CLI::Range(1, 100))->capture_default_str();
   sub->add_option("--start", a->start, "first frame's time in the animation [s]")->capture_default_str();
-  sub->add_option("--count", a->count, "frames to render (0: to the end)")->capture_default_str();
+  sub->add_option("--count", a->count, "frames to render (0: to the end)")
+      ->check(CLI::Range(0, 1000000))
+      ->capture_default_str();
   sub->add_option("--fps", a->fps, "output frame rate")->capture_default_str();
   sub->add_option("--frame-time", a->frame_time, "time between OBJ frames [s]")->capture_default_str();
   sub->add_option("--cloth", a->cloth, "which cloth (the CC of NNNN_CC.obj)")->capture_default_str();

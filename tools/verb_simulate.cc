@@ -87,8 +87,9 @@ int Run(const SimulateArgs& a) {
   options.duration = a.duration;
   options.warmup = a.warmup;
   if (a.seed >= 0) options.seed = static_cast<uint64_t>(a.seed);
-  if (a.duration == 0 || (a.duration < 0 && a.duration != -1)) {
-    throw std::invalid_argument("--duration must be > 0 [s]");
+  // -1: not given. NaN used to fall through to the scene's duration and inf to undefined behaviour.
+  if (a.duration != -1 && !(std::isfinite(a.duration) && a.duration > 0 && a.duration <= 86400)) {
+    throw std::invalid_argument("--duration must be a time > 0 and <= 86400 s, got " + std::to_string(a.duration));
   }
   fs::create_directories(a.out);
 

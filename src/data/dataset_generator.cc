@@ -1,5 +1,6 @@
 #include "data/dataset_generator.h"
 
+#include <cstdio>
 #include <unistd.h>
 
 #include <algorithm>
@@ -119,7 +120,9 @@ sim::MaterialMultipliers MultipliersOf(const sim::SceneMaterial& m) {
 Prepared Prepare(const DatasetOptions& o) {
   Prepared p;
   const std::string scene_path = o.scene.empty() ? DefaultScenePath(o.kind) : o.scene;
-  const sim::Scene scene = sim::LoadScene(scene_path, [](const std::string&) {});
+  // Warnings (a misspelt key, which the scene then runs without) go to stderr before a run of hours.
+  const sim::Scene scene = sim::LoadScene(
+      scene_path, [](const std::string& w) { std::fprintf(stderr, "make-dataset: warning: %s\n", w.c_str()); });
   if (scene.cloths.empty()) throw std::runtime_error(scene_path + ": field 'cloths' is empty");
   if (std::abs(scene.frame_time * o.fps - 1.0) > 1e-9)
     throw std::runtime_error(scene_path + ": field 'frame_time' is " + std::to_string(scene.frame_time) +

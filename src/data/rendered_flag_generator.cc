@@ -1,5 +1,6 @@
 #include "data/rendered_flag_generator.h"
 
+#include <cstdio>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -37,7 +38,9 @@ RenderedFlagGenerator::RenderedFlagGenerator(const sensors::SyntheticSessionOpti
   const std::string scene_path = options.scene.empty() ? DefaultScenePath(render::SceneKind::kFlag) : options.scene;
   sim::BuildOptions build;
   build.max_edge = options.max_edge;
-  const sim::SceneSetup setup = sim::BuildScene(sim::LoadScene(scene_path, [](const std::string&) {}), build);
+  const sim::SceneSetup setup = sim::BuildScene(sim::LoadScene(scene_path, [](const std::string& w) {
+    std::fprintf(stderr, "rendered flag: warning: %s\n", w.c_str());
+  }), build);
   const sim::ClothSetup& cloth = setup.cloths.at(0);
   F_ = cloth.mesh.F;
   const Eigen::MatrixXd U = cloth.mesh.U;
