@@ -14,6 +14,7 @@
 
 #include "data/cloth_animation.h"
 #include "progress_bar.h"
+#include "stale_frames.h"
 #include "render/render_params.h"
 #include "render/renderer.h"
 #include "render/sensor_model.h"
@@ -117,6 +118,15 @@ int Run(const RenderArgs& a) {
     bar.Update(k + 1, count);
   }
   bar.Finish();
+  // Frames of an earlier run beyond this one's (or in the other format) would read as its own.
+  const int stale = RemoveStaleFrames(a.out, [&](const std::string& name) {
+    for (const char* ext : {".jpg", ".png"}) {
+      const auto n = FrameNumber(name, 3, ext);
+      if (n && (*n >= count || a.format != std::string(ext + 1))) return true;
+    }
+    return false;
+  });
+  if (stale > 0) std::fprintf(stderr, "render: removed %d frames left by an earlier run\n", stale);
   std::printf("render: %d frames -> %s (%.1f ms/frame), zeta in %s/zeta.json\n", count, a.out.c_str(),
               1e3 * bar.Elapsed() / count, a.out.c_str());
   return 0;

@@ -19,6 +19,7 @@
 #include "sim/simulate.h"
 #include "sim/trajectory_io.h"
 #include "progress_bar.h"
+#include "stale_frames.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -128,6 +129,15 @@ int Run(const SimulateArgs& a) {
         mesh.V = t.frames[f].cast<double>();
         sim::WriteObj((fs::path(a.out) / FrameName(f, c)).string(), mesh);
       }
+      // A longer earlier run's frames of this cloth would read as this run's continuation.
+      char suffix[16];
+      std::snprintf(suffix, sizeof suffix, "_%02d.obj", c);
+      const int frames = t.num_frames();
+      const int stale = RemoveStaleFrames(a.out, [&](const std::string& name) {
+        const auto n = FrameNumber(name, 4, suffix);
+        return n && *n >= frames;
+      });
+      if (stale > 0) std::fprintf(stderr, "simulate: removed %d frames of cloth %d left by a longer run\n", stale, c);
     }
     // Everything simulated, warm-up included (what the wall time paid for).
     const double simulated = t.steps * setup.cloths[c].options.dt;
