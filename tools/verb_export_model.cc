@@ -13,6 +13,7 @@
 #include "learn/evaluate.h"
 #include "learn/networks.h"
 #include "learn/weights_io.h"
+#include "progress_bar.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -55,7 +56,15 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
     }
     std::cout << std::fixed << std::setprecision(3);
     if (!a->calibrate_data.empty()) {
-      const learn::EvalResult r = learn::Evaluate(a->model, a->calibrate_data, "val", a->threads, "cpu", 16);
+      ProgressBar::Options b;
+      b.label = "calibrate";
+      b.unit = "clips";
+      b.rate_unit = "clips/s";
+      ProgressBar bar(b);
+      const learn::EvalResult r =
+          learn::Evaluate(a->model, a->calibrate_data, "val", a->threads, "cpu", 16, 1, false, false,
+                          learn::FlagFlies::kRight, [&](int done, int total) { bar.Update(done, total); });
+      bar.Finish();
       const double k = learn::CalibrationScale(r);
       // Within m stds scaled by k is within m·k of the raw stds.
       const double one = learn::StdCoverage(r, 1), two = learn::StdCoverage(r, 2);

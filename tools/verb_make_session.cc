@@ -88,13 +88,13 @@ int Run(const MakeSessionArgs& a) {
   // Rendered sessions: the anemometer's sensor model samples the wind field the flag flew in.
   const std::vector<sensors::SyntheticReading> model_readings =
       rendered ? rendered->AnemometerReadings() : std::vector<sensors::SyntheticReading>{};
-  std::unique_ptr<ProgressBar> bar;
+  // A bar for both kinds: a procedural hour is ~100 000 frames of drawing and compressing.
+  ProgressBar::Options bo;
+  bo.label = "make-session";
+  bo.unit = "frames";
+  bo.rate_unit = "frames/s";
+  auto bar = std::make_unique<ProgressBar>(bo);
   if (rendered) {
-    ProgressBar::Options bo;
-    bo.label = "make-session";
-    bo.unit = "frames";
-    bo.rate_unit = "frames/s";
-    bar = std::make_unique<ProgressBar>(bo);
     std::fprintf(stderr, "make-session: rendering %zu frames of a simulated flag (%d vertices), %dx%d\n",
                  session.frame_stamps().size(), rendered->num_vertices(), a.width, a.height);
   }
