@@ -247,7 +247,10 @@ TEST_F(FrameCacheTest, TrainingWithTheCacheIsTheFilesRunBitForBit) {
   EXPECT_NE(files.log[0].val_rmse, files.log[2].val_rmse);
   EXPECT_NE(files.log[2].val_rmse, files.log[2].raw_val_rmse);
   for (const char* name : {"model.pt", "raw_model.pt", "last.pt", "last_average.pt"}) {
-    std::ifstream a(*dir_ / "run_files" / name, std::ios::binary), b(*dir_ / "run_cached" / name, std::ios::binary);
+    const bool checkpoint = std::string(name).rfind("last", 0) == 0;
+    const fs::path dir_a = checkpoint ? CheckpointDir(*dir_ / "run_files") : *dir_ / "run_files";
+    const fs::path dir_b = checkpoint ? CheckpointDir(*dir_ / "run_cached") : *dir_ / "run_cached";
+    std::ifstream a(dir_a / name, std::ios::binary), b(dir_b / name, std::ios::binary);
     const std::string bytes_a((std::istreambuf_iterator<char>(a)), {}), bytes_b((std::istreambuf_iterator<char>(b)), {});
     EXPECT_FALSE(bytes_a.empty()) << name;
     EXPECT_TRUE(bytes_a == bytes_b) << name << " differs";

@@ -131,6 +131,30 @@ void SaveAtomically(T& object, const fs::path& path) {
   fs::rename(tmp, path);
 }
 
+}  // namespace
+
+fs::path CheckpointDir(const fs::path& out) {
+  const fs::path state_path = out / "state.json";
+  std::ifstream in(state_path);
+  if (!in) throw std::runtime_error(state_path.string() + ": cannot open (nothing to resume)");
+  nlohmann::json state;
+  try {
+    state = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(state_path.string() + ": " + e.what());
+  }
+  // Runs written before checkpoint folders kept last.pt, ... beside state.json.
+  if (!state.contains("checkpoint")) return out;
+  if (!state["checkpoint"].is_string())
+    throw std::runtime_error(state_path.string() + ": field \"checkpoint\" must be a folder name");
+  const fs::path dir = out / state["checkpoint"].get<std::string>();
+  if (!fs::is_directory(dir))
+    throw std::runtime_error(state_path.string() + ": its checkpoint " + dir.string() + " is missing");
+  return dir;
+}
+
+namespace {
+
 // An option's value as the refusal below names it: a flag on or off, a number as it is.
 std::string OptionValue(bool v) { return v ? "on" : "off"; }
 template <typename T>
@@ -285,7 +309,7 @@ TrainResult Train(const TrainOptions& o) {
     const double var = sum2 / train.size() - config.label_mean * config.label_mean;
     config.label_std = var > 1e-12 ? std::sqrt(var) : 1.0;
   }
-  const fs::path last = o.out / "last.pt", last_optim = o.out / "last_optim.pt", state_path = o.out / "state.json";
+  const fs::path state_path = o.out / "state.json";
   nlohmann::json state;
   if (o.resume) {
     std::ifstream in(state_path);
@@ -362,20 +386,23 @@ TrainResult Train(const TrainOptions& o) {
   if (config.point_maps > 0) net->SetPointScale(PointScale(aux->scale, config.point_maps, false),
                                                 PointScale(aux->scale, config.point_maps, true));
   torch::optim::Adam optimizer(net->parameters(), torch::optim::AdamOptions(o.lr).weight_decay(o.weight_decay));
+  // The checkpoint state.json names (resume): the weights, their average and Adam's moments of
+  // its epoch, whatever a run stopped while saving the next one left beside them.
+  const fs::path resume_from = o.resume ? CheckpointDir(o.out) : fs::path();
   if (o.resume) {
     // Loaded onto the CPU whatever device wrote them, then moved with the network.
-    torch::load(net, last.string(), at::Device(at::kCPU));
-    torch::load(optimizer, last_optim.string(), at::Device(at::kCPU));
+    torch::load(net, (resume_from / "last.pt").string(), at::Device(at::kCPU));
+    torch::load(optimizer, (resume_from / "last_optim.pt").string(), at::Device(at::kCPU));
   }
   // The weight average starts at the initial weights and lives beside them on the device.
-  const fs::path last_average = o.out / "last_average.pt", raw_model = o.out / "raw_model.pt";
+  const fs::path raw_model = o.out / "raw_model.pt";
   WindNet average{nullptr};
   int64_t average_steps = 0;
   if (o.weight_average > 0) {
     average = WindNet(config);
     CopyWeights(*net, *average);
     if (o.resume) {
-      torch::load(average, last_average.string(), at::Device(at::kCPU));
+      torch::load(average, (resume_from / "last_average.pt").string(), at::Device(at::kCPU));
       average_steps = state.value("average_steps", int64_t{0});
     }
     average->to(device);
@@ -502,19 +529,39 @@ TrainResult Train(const TrainOptions& o) {
       best_raw_val_rmse = record.raw_val_rmse;
       SaveWindNet(net, raw_model);
     }
-    SaveAtomically(net, last);
-    if (!average.is_empty()) SaveAtomically(average, last_average);
+    // The epoch's checkpoint goes into a folder of its own, made whole under a hidden name and
+    // renamed; state.json, written after it, names it. A run stopped anywhere in between resumes
+    // from the checkpoint state.json names, never from weights of one epoch with another's
+    // optimiser state and log (which the files last.pt, ... rewritten in place allowed).
+    char checkpoint_name[32];
+    std::snprintf(checkpoint_name, sizeof checkpoint_name, "checkpoint-e%04d", epoch);
+    const fs::path checkpoint = o.out / checkpoint_name;
+    const fs::path checkpoint_tmp = o.out / ("." + std::string(checkpoint_name) + ".tmp");
+    fs::remove_all(checkpoint_tmp);
+    fs::create_directories(checkpoint_tmp);
+    SaveAtomically(net, checkpoint_tmp / "last.pt");
+    if (!average.is_empty()) SaveAtomically(average, checkpoint_tmp / "last_average.pt");
     net->to(device);
     if (!average.is_empty()) average->to(device);
-    SaveAtomically(optimizer, last_optim);
+    SaveAtomically(optimizer, checkpoint_tmp / "last_optim.pt");
+    fs::remove_all(checkpoint);
+    fs::rename(checkpoint_tmp, checkpoint);
     nlohmann::json log = nlohmann::json::array();
     for (const EpochRecord& e : result.log) log.push_back(EpochJson(e));
     state = {{"epoch", epoch}, {"model", ToJson(config)}, {"log", log}, {"seed", o.seed},
              {"crop_scales", o.crop_scales}, {"flip", o.flip}, {"aux_tracks", o.aux_tracks},
              {"aux_phase_bins", o.aux_phase_bins}, {"aux_world", o.aux_world}, {"point_maps", o.point_maps},
              {"weight_average", o.weight_average}, {"average_steps", average_steps},
-             {"best_val_rmse", result.best_val_rmse}};
+             {"best_val_rmse", result.best_val_rmse}, {"checkpoint", checkpoint_name}};
     WriteFileAtomically(state_path, state.dump(2));
+    // Older checkpoints (and the files of the layout before checkpoint folders) once state.json
+    // names the new one.
+    for (const auto& entry : fs::directory_iterator(o.out)) {
+      const std::string name = entry.path().filename().string();
+      if ((name.rfind("checkpoint-e", 0) == 0 && name != checkpoint_name) || name == "last.pt" ||
+          name == "last_optim.pt" || name == "last_average.pt")
+        fs::remove_all(entry.path());
+    }
     WriteFileAtomically(o.out / "log.tsv", LogTsv(result.log));
     if (!PlotLearningCurve(result.log, o.out / "learning_curve.png", &result.plot_error)) {
       // The plot is a convenience; training goes on without it.

@@ -25,7 +25,7 @@ struct TrainProgress {
 struct TrainOptions {
   ModelConfig model;                 // arch, frames, k, width, input_size (label stats filled in)
   std::filesystem::path data;        // dataset folder (docs/dataset.md); may be empty with init_only
-  std::filesystem::path out;         // run folder: model.pt/json (best), last.pt, log.tsv, plot
+  std::filesystem::path out;         // run folder: model.pt/json (best), checkpoint-eNNNN/, log.tsv, plot
   int epochs = 40;
   int batch = 16;
   double lr = 1e-2;
@@ -43,7 +43,7 @@ struct TrainOptions {
   double grad_clip = -1;             // max gradient norm; 0: off; < 0: the seed's (10 for lstm, else off)
   int threads = 2;                   // torch intra-op threads
   std::string device = "auto";       // cpu | cuda | auto
-  bool resume = false;               // continue from out/last.pt and out/state.json
+  bool resume = false;               // continue from out/state.json and the checkpoint it names
   // Without resume, a folder that already holds a run (state.json or model.pt) is refused unless
   // this is set: rerunning a command after a crash without --resume replaced a day's run.
   bool overwrite = false;
@@ -92,9 +92,16 @@ struct TrainResult {
 // Throws std::invalid_argument for an unknown schedule.
 double LearningRateAt(const TrainOptions& options, int epoch);
 
+// The folder holding the checkpoint out/state.json names (weights last.pt, their average
+// last_average.pt, Adam's last_optim.pt): out/checkpoint-eNNNN, or out itself for runs written
+// before checkpoint folders. Throws std::runtime_error naming state.json when it cannot be read
+// or names a folder that is not there.
+std::filesystem::path CheckpointDir(const std::filesystem::path& out);
+
 // Trains (or resumes) and writes to options.out:
 //   model.pt + model.json   best validation RMSE so far (what eval and sdn_node load)
-//   last.pt, last_optim.pt  the latest epoch (for --resume); state.json its epoch and log
+//   checkpoint-eNNNN/{last.pt, last_optim.pt[, last_average.pt]}  the latest epoch (for --resume);
+//   state.json its epoch, log and checkpoint folder (written after the folder is whole)
 //   log.tsv                 one line per epoch; learning_curve.png (gnuplot)
 // every file written atomically. Throws std::runtime_error on bad data or options.
 TrainResult Train(const TrainOptions& options);

@@ -148,9 +148,17 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
   EXPECT_LT(r.best_val_rmse, 0.4 * label_std) << "label std " << label_std;
   EXPECT_LT(r.best_val_rmse, 0.5 * LabelStd(val)) << "validation label std " << LabelStd(val);
   EXPECT_LT(r.log.back().train_loss, r.log.front().train_loss);
-  for (const char* f : {"model.pt", "model.json", "last.pt", "last_optim.pt", "state.json", "log.tsv"}) {
+  for (const char* f : {"model.pt", "model.json", "state.json", "log.tsv"}) {
     EXPECT_TRUE(fs::exists(r.model.parent_path() / f)) << f;
   }
+  // One checkpoint, the last epoch's, in the folder state.json names.
+  const fs::path checkpoint = CheckpointDir(r.model.parent_path());
+  EXPECT_EQ(checkpoint.filename(), "checkpoint-e0012");
+  for (const char* f : {"last.pt", "last_optim.pt"}) EXPECT_TRUE(fs::exists(checkpoint / f)) << f;
+  int checkpoints = 0;
+  for (const auto& e : fs::directory_iterator(r.model.parent_path()))
+    checkpoints += e.path().filename().string().rfind("checkpoint-e", 0) == 0 ? 1 : 0;
+  EXPECT_EQ(checkpoints, 1);
   // The evaluation of the saved model reproduces the best validation RMSE seen in training.
   const EvalResult e = Evaluate(r.model, *root_ / "data", "val", 2, "cpu", 4);
   EXPECT_EQ(e.metrics.count, static_cast<int>(val.size()));
@@ -842,7 +850,17 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   TrainOptions v = Options("sdn", "resume2");
   v.epochs = 2;
   Train(v);
+  // What a run stopped while saving epoch 3 leaves: that epoch's checkpoint whole or half made.
+  // state.json still names epoch 2's, and the resume reads that one.
+  for (const char* stray : {"checkpoint-e0003", ".checkpoint-e0003.tmp"}) {
+    fs::create_directories(*root_ / "resume2" / stray);
+    std::ofstream(*root_ / "resume2" / stray / "last.pt") << "not a checkpoint";
+  }
+  EXPECT_EQ(CheckpointDir(*root_ / "resume2").filename(), "checkpoint-e0002");
   const TrainResult redo = Train(u);
+  EXPECT_EQ(CheckpointDir(*root_ / "resume2").filename(), "checkpoint-e0003");
+  EXPECT_FALSE(fs::exists(*root_ / "resume2" / "checkpoint-e0002"));
+  EXPECT_FALSE(fs::exists(*root_ / "resume2" / ".checkpoint-e0003.tmp"));
   EXPECT_NEAR(redo.log[2].train_loss, resumed.log[2].train_loss, 1e-5);
   EXPECT_NEAR(redo.log[2].val_rmse, resumed.log[2].val_rmse, 1e-5);
 
