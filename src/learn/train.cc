@@ -368,6 +368,14 @@ TrainResult Train(const TrainOptions& o) {
   }
   if (o.resume) {
     RefuseChangedOnResume(state_path, "--weight-average", state.value("weight_average", 0.0), o.weight_average);
+    // The sampling order, batches and optimiser a resumed run repeats (runs before 2026-12-05
+    // recorded only the seed).
+    if (state.contains("seed")) RefuseChangedOnResume(state_path, "--seed", state["seed"].get<uint64_t>(), o.seed);
+    if (state.contains("batch")) RefuseChangedOnResume(state_path, "--batch", state["batch"].get<int>(), o.batch);
+    if (state.contains("weight_decay"))
+      RefuseChangedOnResume(state_path, "--weight-decay", state["weight_decay"].get<double>(), o.weight_decay);
+    if (state.contains("grad_clip"))
+      RefuseChangedOnResume(state_path, "--grad-clip", state["grad_clip"].get<double>(), o.grad_clip);
   }
   std::unique_ptr<AuxTargets> aux;
   if (o.aux_tracks > 0 && !train.empty()) {
@@ -552,7 +560,8 @@ TrainResult Train(const TrainOptions& o) {
              {"crop_scales", o.crop_scales}, {"flip", o.flip}, {"aux_tracks", o.aux_tracks},
              {"aux_phase_bins", o.aux_phase_bins}, {"aux_world", o.aux_world}, {"point_maps", o.point_maps},
              {"weight_average", o.weight_average}, {"average_steps", average_steps},
-             {"best_val_rmse", result.best_val_rmse}, {"checkpoint", checkpoint_name}};
+             {"best_val_rmse", result.best_val_rmse}, {"checkpoint", checkpoint_name},
+             {"batch", o.batch}, {"weight_decay", o.weight_decay}, {"grad_clip", o.grad_clip}};
     WriteFileAtomically(state_path, state.dump(2));
     // Older checkpoints (and the files of the layout before checkpoint folders) once state.json
     // names the new one.

@@ -899,6 +899,21 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
                      {"state.json: the run trained with crop scales [1.0,0.875,0.75,0.66]", "--crop-scales"});
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
 
+  // And one with another seed or batch: its samples and steps would not be the run's.
+  TrainOptions seeded = Options("sdn", "resume");
+  seeded.epochs = 3;
+  seeded.resume = true;
+  seeded.seed = 7;
+  ExpectTrainRefused(seeded, "a resume with another seed was accepted",
+                     {"state.json: the run trained with --seed 1, these options give 7"});
+  TrainOptions batched = Options("sdn", "resume");
+  batched.epochs = 3;
+  batched.resume = true;
+  batched.batch = 4;
+  ExpectTrainRefused(batched, "a resume with another batch was accepted",
+                     {"state.json: the run trained with --batch 8, these options give 4"});
+  EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
+
   // And one that turns the flips off: the run trained with them (state.json "flip": true).
   TrainOptions y = Options("sdn", "resume");
   y.epochs = 3;
