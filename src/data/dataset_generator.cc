@@ -21,6 +21,7 @@
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
+#include "common/atomic_file.h"
 #include "data/cloth_animation.h"
 #include "data/contact_sheet.h"
 #include "data/dataset_index.h"
@@ -176,17 +177,22 @@ void WriteExample(const std::string& out, const std::string& name, const std::ve
     std::vector<int> params;
     if (o.frame_ext == "jpg") params = {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality};
     cv::Mat grey;
+    std::vector<uchar> encoded;
     for (size_t k = 0; k < images.size(); ++k) {
       char file[32];
       std::snprintf(file, sizeof(file), "%03zu.%s", k, o.frame_ext.c_str());
       // PGM holds one channel: the grey the SDN reads (cv::imread's IMREAD_GRAYSCALE weights).
       if (o.frame_ext == "pgm") cv::cvtColor(images[k], grey, cv::COLOR_BGR2GRAY);
-      if (!cv::imwrite((tmp / file).string(), o.frame_ext == "pgm" ? grey : images[k], params))
-        throw std::runtime_error("cannot write " + (tmp / file).string());
+      if (!cv::imencode("." + o.frame_ext, o.frame_ext == "pgm" ? grey : images[k], encoded, params))
+        throw std::runtime_error("cannot encode " + (tmp / file).string());
+      // fsync'ed, as label.json is: a power cut must not leave an example whose label says it is
+      // complete (what a resumed run checks) beside empty frames.
+      WriteFileDurably((tmp / file).string(), encoded.data(), encoded.size());
     }
     if (!tracks.is_null()) sim::WriteFileAtomically((tmp / "tracks.json").string(), tracks.dump() + "\n");
     sim::WriteFileAtomically((tmp / "label.json").string(), label.dump(2) + "\n");
     fs::rename(tmp, fs::path(out) / name);
+    SyncDirectory(out);
   } catch (...) {
     std::error_code ec;
     fs::remove_all(tmp, ec);

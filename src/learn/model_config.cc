@@ -1,5 +1,7 @@
 #include "learn/model_config.h"
 
+#include "common/atomic_file.h"
+
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -235,18 +237,7 @@ std::filesystem::path ConfigPathFor(const std::filesystem::path& weights) {
 }
 
 void WriteFileAtomically(const std::filesystem::path& path, const std::string& text) {
-  std::filesystem::path tmp = path;
-  tmp += ".tmp" + std::to_string(::getpid());
-  {
-    // errno is read right after the failing step, while open() or write() still holds it there.
-    auto fail = [&tmp] { throw std::runtime_error(tmp.string() + ": cannot write (" + std::strerror(errno) + ")"); };
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) fail();
-    out << text;
-    out.flush();
-    if (!out) fail();
-  }
-  std::filesystem::rename(tmp, path);
+  clothwind::WriteFileAtomically(path.string(), text);
 }
 
 }  // namespace clothwind::learn

@@ -1,5 +1,7 @@
 #include "render/sensor_model.h"
 
+#include "common/atomic_file.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -122,17 +124,7 @@ void WriteFrameAtomic(const std::string& path, const cv::Mat& bgr8, int jpeg_qua
   if (ext != ".jpg" && ext != ".jpeg" && ext != ".png")
     throw std::runtime_error("WriteFrameAtomic: '" + path + "' must end in .jpg, .jpeg or .png");
   const std::vector<uint8_t> bytes = EncodeFrame(bgr8, ext == ".png" ? ".png" : ".jpg", jpeg_quality);
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw std::runtime_error("WriteFrameAtomic: cannot open '" + tmp + "' for writing");
-    f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    if (!f) throw std::runtime_error("WriteFrameAtomic: cannot write '" + tmp + "'");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("WriteFrameAtomic: cannot rename '" + tmp + "' to '" + path + "'");
-  }
+  clothwind::WriteFileAtomically(path, bytes.data(), bytes.size());
 }
 
 }  // namespace clothwind::render

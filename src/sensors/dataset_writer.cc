@@ -17,6 +17,8 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "common/atomic_file.h"
+
 namespace clothwind::sensors {
 namespace fs = std::filesystem;
 namespace {
@@ -33,51 +35,8 @@ std::string TempSuffix() {
 
 }  // namespace
 
-void WriteFileDurably(const std::string& path, const void* data, size_t size) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw std::runtime_error("cannot open " + path + " for writing: " + std::strerror(errno));
-  const char* p = static_cast<const char*>(data);
-  size_t left = size;
-  std::string error;
-  while (left > 0 && error.empty()) {
-    const ssize_t n = ::write(fd, p, left);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      error = "cannot write " + path + ": " + std::strerror(n < 0 ? errno : EIO);
-    } else {
-      p += n;
-      left -= static_cast<size_t>(n);
-    }
-  }
-  // fsync before the rename that publishes it: otherwise a power cut can leave the new name
-  // pointing at an empty file on ext4/xfs.
-  if (error.empty() && ::fsync(fd) != 0) error = "cannot sync " + path + ": " + std::strerror(errno);
-  if (::close(fd) != 0 && error.empty()) error = "cannot close " + path + ": " + std::strerror(errno);
-  if (!error.empty()) {
-    ::unlink(path.c_str());
-    throw std::runtime_error(error);
-  }
-}
-
-void SyncDirectory(const std::string& dir) {
-  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) throw std::runtime_error("cannot open folder " + dir + ": " + std::strerror(errno));
-  const int rc = ::fsync(fd);
-  const int err = errno;
-  ::close(fd);
-  if (rc != 0) throw std::runtime_error("cannot sync folder " + dir + ": " + std::strerror(err));
-}
-
 void WriteFileAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + TempSuffix();
-  WriteFileDurably(tmp, text.data(), text.size());  // removes tmp itself when it fails
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error("cannot rename " + tmp + " to " + path + ": " + ec.message());
-  }
-  SyncDirectory(fs::path(path).parent_path().empty() ? "." : fs::path(path).parent_path().string());
+  clothwind::WriteFileAtomically(path, text);
 }
 
 std::string ClipFolderName(double first_stamp, uint64_t sequence) {

@@ -1,0 +1,85 @@
+// Writing files so that a crash or a power cut leaves the old version or the new one, never a
+// half-written or empty file: every capability that records something (clips, datasets,
+// trajectories, models, checkpoints, reports) writes through these.
+#ifndef CLOTHWIND_COMMON_ATOMIC_FILE_H_
+#define CLOTHWIND_COMMON_ATOMIC_FILE_H_
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+namespace clothwind {
+
+// Writes `size` bytes to `path` (created or truncated) and fsyncs them. On failure removes the
+// file and throws std::runtime_error naming it and why (e.g. "No space left on device").
+inline void WriteFileDurably(const std::string& path, const void* data, size_t size) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot open " + path + " for writing: " + std::strerror(errno));
+  const char* p = static_cast<const char*>(data);
+  size_t left = size;
+  std::string error;
+  while (left > 0 && error.empty()) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      error = "cannot write " + path + ": " + std::strerror(n < 0 ? errno : EIO);
+    } else {
+      p += n;
+      left -= static_cast<size_t>(n);
+    }
+  }
+  // fsync before the rename that publishes it: otherwise a power cut can leave the new name
+  // pointing at an empty file (ext4, xfs).
+  if (error.empty() && ::fsync(fd) != 0) error = "cannot sync " + path + ": " + std::strerror(errno);
+  if (::close(fd) != 0 && error.empty()) error = "cannot close " + path + ": " + std::strerror(errno);
+  if (!error.empty()) {
+    ::unlink(path.c_str());
+    throw std::runtime_error(error);
+  }
+}
+
+// fsyncs a folder, so the renames and new names in it survive a power cut.
+// Throws std::runtime_error naming it when that fails.
+inline void SyncDirectory(const std::string& dir) {
+  const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error("cannot open folder " + dir + ": " + std::strerror(errno));
+  const int rc = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  if (rc != 0) throw std::runtime_error("cannot sync folder " + dir + ": " + std::strerror(err));
+}
+
+// A temporary name beside `path`, unique within this process and among processes.
+inline std::string TemporaryNameFor(const std::string& path) {
+  static std::atomic<unsigned long long> counter{0};
+  return path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+}
+
+// Writes `bytes` to `path` through a temporary file in the same folder (WriteFileDurably), a
+// rename and an fsync of the folder. Throws std::runtime_error naming the file when it fails; the
+// temporary is removed then and `path` keeps what it had.
+inline void WriteFileAtomically(const std::string& path, const void* data, size_t size) {
+  const std::string tmp = TemporaryNameFor(path);
+  WriteFileDurably(tmp, data, size);
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error("cannot rename " + tmp + " to " + path + ": " + ec.message());
+  }
+  SyncDirectory(std::filesystem::path(path).parent_path().string());
+}
+
+inline void WriteFileAtomically(const std::string& path, const std::string& bytes) {
+  WriteFileAtomically(path, bytes.data(), bytes.size());
+}
+
+}  // namespace clothwind
+
+#endif  // CLOTHWIND_COMMON_ATOMIC_FILE_H_

@@ -1,0 +1,79 @@
+#include "common/atomic_file.h"
+
+#include <signal.h>
+#include <sys/resource.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+namespace clothwind {
+namespace {
+namespace fs = std::filesystem;
+
+std::string Read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class AtomicFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("clothwind_atomic_file_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  size_t Entries() const { return static_cast<size_t>(std::distance(fs::directory_iterator(dir_), {})); }
+  fs::path dir_;
+};
+
+TEST_F(AtomicFileTest, ReplacesTheContentWhole) {
+  const std::string p = (dir_ / "a.json").string();
+  WriteFileAtomically(p, std::string("one"));
+  WriteFileAtomically(p, std::string("two, longer"));
+  EXPECT_EQ(Read(p), "two, longer");
+  EXPECT_EQ(Entries(), 1u);  // no temporary left
+  try {
+    WriteFileAtomically((dir_ / "missing" / "b.json").string(), std::string("x"));
+    ADD_FAILURE() << "a file in a missing folder was written";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing/b.json"), std::string::npos) << e.what();
+  }
+}
+
+// A disk that fills up mid-write (RLIMIT_FSIZE stands in: it fails writes for root too): the
+// old content stays, the error says why, and the temporary is gone.
+TEST_F(AtomicFileTest, AFailedWriteKeepsTheOldContentAndLeavesNoTemporary) {
+  const std::string p = (dir_ / "model.json").string();
+  WriteFileAtomically(p, std::string("old"));
+  rlimit saved{};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
+  auto* handler = ::signal(SIGXFSZ, SIG_IGN);
+  rlimit small = saved;
+  small.rlim_cur = 16;
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  std::string message;
+  try {
+    WriteFileAtomically(p, std::string(1000, 'x'));
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &saved), 0);
+  ::signal(SIGXFSZ, handler);
+  EXPECT_NE(message.find("cannot write"), std::string::npos) << message;
+  EXPECT_NE(message.find("too large"), std::string::npos) << message;  // EFBIG's text
+  EXPECT_EQ(Read(p), "old");
+  EXPECT_EQ(Entries(), 1u);
+}
+
+TEST_F(AtomicFileTest, TemporaryNamesDiffer) {
+  EXPECT_NE(TemporaryNameFor("x"), TemporaryNameFor("x"));
+  EXPECT_EQ(TemporaryNameFor("x").rfind("x.tmp-" + std::to_string(::getpid()) + "-", 0), 0u);
+}
+
+}  // namespace
+}  // namespace clothwind
