@@ -123,12 +123,12 @@ std::string LogTsv(const std::vector<EpochRecord>& log) {
   return s.str();
 }
 
+// A module's or an optimiser's state, written durably (fsync, rename, the folder synced).
 template <typename T>
 void SaveAtomically(T& object, const fs::path& path) {
-  fs::path tmp = path;
-  tmp += ".tmp";
-  torch::save(object, tmp.string());
-  fs::rename(tmp, path);
+  std::ostringstream bytes;
+  torch::save(object, bytes);
+  WriteFileAtomically(path, bytes.str());
 }
 
 }  // namespace
