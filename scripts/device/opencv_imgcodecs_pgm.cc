@@ -96,9 +96,16 @@ bool haveImageWriter(const String& filename) { return IsPgm(filename); }
 Mat imdecode(InputArray /*buf*/, int /*flags*/) { Refuse("imdecode"); }
 Mat imdecode(InputArray /*buf*/, int /*flags*/, Mat* /*dst*/) { Refuse("imdecode"); }
 
-bool imencode(const String& ext, InputArray /*img*/, std::vector<uchar>& /*buf*/,
-              const std::vector<int>& /*params*/) {
-  Refuse("imencode " + ext);
+// Encodes an 8-bit single-channel image as binary PGM (make-dataset encodes, then writes and
+// fsyncs the bytes itself).
+bool imencode(const String& ext, InputArray img, std::vector<uchar>& buf, const std::vector<int>& /*params*/) {
+  if (ext != ".pgm") Refuse("imencode " + ext);
+  const Mat m = img.getMat();
+  if (m.type() != CV_8UC1) Refuse("imencode " + ext + " (not an 8-bit grey image)");
+  const std::string header = "P5\n" + std::to_string(m.cols) + " " + std::to_string(m.rows) + "\n255\n";
+  buf.assign(header.begin(), header.end());
+  for (int y = 0; y < m.rows; ++y) buf.insert(buf.end(), m.ptr<uchar>(y), m.ptr<uchar>(y) + m.cols);
+  return true;
 }
 
 }  // namespace cv
