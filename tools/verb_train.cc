@@ -175,6 +175,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
       }
       std::ostringstream note;
       if (p.step > 0) note << "loss " << std::setprecision(4) << p.loss;
+      if (p.val_total > 0) note << ", validating " << p.val_done << "/" << p.val_total << " clips";
       bar->Update(p.step, p.steps, note.str());
     };
     o.epoch_done = [&](const learn::EpochRecord& e) {

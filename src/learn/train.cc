@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <future>
 #include <iomanip>
 #include <limits>
@@ -190,7 +191,8 @@ struct ValidationImages {
 // With `kept`: reads the images kept there when it holds them, else computes them from the files
 // and keeps them there.
 Validation Validate(WindNet& model, const std::vector<ClipInfo>& val, int batch, const SampleOptions& options,
-                    const ModelConfig& config, const at::Device& device, ValidationImages* kept) {
+                    const ModelConfig& config, const at::Device& device, ValidationImages* kept,
+                    const std::function<void(int)>& clips_done = {}) {
   model->eval();
   at::NoGradGuard no_grad;
   const float mean = static_cast<float>(config.label_mean), inv_std = static_cast<float>(1.0 / config.label_std);
@@ -222,6 +224,7 @@ Validation Validate(WindNet& model, const std::vector<ClipInfo>& val, int batch,
       predicted.push_back(speed.data_ptr<double>()[i]);
       truth.push_back(label.data_ptr<double>()[i]);
     }
+    if (clips_done) clips_done(static_cast<int>(truth.size()));
   }
   return {loss / std::max<size_t>(val.size(), 1), ComputeMetrics(truth, predicted)};
 }
@@ -516,9 +519,20 @@ TrainResult Train(const TrainOptions& o) {
 
     // Validation: evaluation preprocessing, no augmentation; the average's, when there is one.
     // With the frames cached the trunk's input images are kept after the first validation.
-    const Validation raw = Validate(net, val, o.batch, val_options, config, device, val_images.get());
+    // Validation shows on the epoch's bar (it takes minutes on a large split, after the bar is full).
+    const int val_total = static_cast<int>(val.size()) * (average.is_empty() ? 1 : 2);
+    const double train_loss = loss_sum / std::max<size_t>(seen, 1);
+    auto val_progress = [&](int offset) {
+      return [&, offset](int done) {
+        if (o.progress) o.progress({epoch, o.epochs, steps, steps, train_loss, offset + done, val_total});
+      };
+    };
+    const Validation raw =
+        Validate(net, val, o.batch, val_options, config, device, val_images.get(), val_progress(0));
     const Validation chosen =
-        average.is_empty() ? raw : Validate(average, val, o.batch, val_options, config, device, val_images.get());
+        average.is_empty() ? raw
+                           : Validate(average, val, o.batch, val_options, config, device, val_images.get(),
+                                      val_progress(static_cast<int>(val.size())));
     record.val_loss = chosen.loss;
     record.val_rmse = chosen.metrics.rmse;
     record.val_acc05 = chosen.metrics.acc05;

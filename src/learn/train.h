@@ -20,6 +20,9 @@ struct TrainProgress {
   int epoch = 0, epochs = 0;  // 1-based epoch being trained
   int step = 0, steps = 0;    // batches done in this epoch (0: the epoch starts), of
   double loss = 0;            // running mean training loss of this epoch
+  // After the last step: validation clips done of all it reads this epoch (twice the split with a
+  // weight average: the trained weights and their average); 0 of 0 while training.
+  int val_done = 0, val_total = 0;
 };
 
 struct TrainOptions {

@@ -931,8 +931,22 @@ TEST_F(TrainTest, WeightAverageIsWhatModelHoldsAndResumes) {
   TrainOptions t = Options("sdn", "average");
   t.epochs = 3;
   t.weight_average = 0.9;
+  // Validation reports its progress after the steps: the split twice (trained weights, average).
+  std::vector<TrainProgress> reports;
+  t.progress = [&](const TrainProgress& p) { reports.push_back(p); };
   const TrainResult r = Train(t);
   ASSERT_EQ(r.log.size(), 3u);
+  ASSERT_FALSE(reports.empty());
+  const TrainProgress& last = reports.back();
+  EXPECT_EQ(last.epoch, 3);
+  EXPECT_EQ(last.step, last.steps);
+  EXPECT_GT(last.val_total, 0);
+  EXPECT_EQ(last.val_done, last.val_total);
+  EXPECT_EQ(last.val_total % 2, 0);
+  int increasing = 0;
+  for (size_t i = 1; i < reports.size(); ++i)
+    increasing += reports[i].epoch == 3 && reports[i].val_done > reports[i - 1].val_done ? 1 : 0;
+  EXPECT_GE(increasing, 2);  // more than one report while validating
   double best_raw = 1e9, largest_gap = 0;
   for (const EpochRecord& e : r.log) {
     EXPECT_GT(e.raw_val_rmse, 0.0) << e.epoch;
