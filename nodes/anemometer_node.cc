@@ -6,7 +6,8 @@
 // byte) and every reading as anemometer/wind with the same stamp. In topic mode the wind is
 // stamped with the raw message's stamp, so a replay with use_sim_time keeps the recorded timing.
 // The device is opened with back-off retries (a port that does not exist yet is not an error),
-// and a vanished device is re-opened the same way. See docs/anemometer.md.
+// and a vanished device is re-opened the same way (a USB station also after 3 failed reads in a
+// row while open). See docs/anemometer.md.
 #include <algorithm>
 #include <cmath>
 #include <limits>

@@ -4,7 +4,7 @@
 // Publishes   camera/image_raw (sensor_msgs/Image, mono8 for GREY, bgr8 otherwise; through
 //             image_transport), camera/camera_info (sensor_msgs/CameraInfo, same stamp),
 //             /diagnostics (rate and stamp age of camera/image_raw, source state, negotiated
-//             format, dropped frames, reconnects)
+//             format, dropped and unreadable frames, reconnects)
 // Services    camera/set_camera_info (camera_info_manager: camera_calibration stores here)
 // Parameters  ~source (v4l2 | video | folder), ~device (/dev/video0), ~path (video file or image
 //             folder), ~pixel_format (YUYV | MJPEG | GREY), ~width, ~height [px], ~fps [Hz],

@@ -6,7 +6,8 @@
 //     anemometer's frame (header.frame_id of anemometer/wind, so rviz needs no transform when its
 //     fixed frame is that frame);
 //   monitor/wind_plot (sensor_msgs/Image, bgr8): estimate (with ±std band) vs anemometer over the
-//     last ~plot_window seconds, stamped with the newest input's stamp and the anemometer's frame.
+//     last ~plot_window seconds, in the anemometer's frame, stamped with the display's now (ROS
+//     time, never before the newest input's stamp).
 // Inputs: wind/estimate (clothwind/WindEstimate), anemometer/wind (clothwind/WindMeasurement).
 // Parameters: ~mean_window [s] (60), ~plot_window [s] (180), ~plot_width/~plot_height [px]
 // (640x320), ~rate [Hz] (2), ~frame_id ("" = the anemometer's frame, else this one),

@@ -104,7 +104,8 @@ class ClipPipeline {
   // Every waiting clip, labelled with the readings held now (the stream ended or stalled).
   std::vector<LabelledClip> Flush();
 
-  // Forgets the streams (e.g. time jumped back when a bag restarts); counters are kept.
+  // Forgets everything, waiting clips included; counters are kept. (A jump back in camera time is
+  // handled by AddFrame, which labels the waiting clips first.)
   void Reset();
 
   size_t pending() const { return pending_.size(); }

@@ -88,7 +88,8 @@ ParseResult ParseMwd(const NmeaSentence& s) {
   WindReading& w = r.reading;
   w.source = "nmea_mwd";
   w.relative = false;
-  // Prefer the true bearing: a magnetic one needs the local declination, which we do not know.
+  // Prefer the true bearing: a magnetic one needs the local declination (kMagnetic: the node's
+  // ~magnetic_declination, without which it gets no direction).
   if (std::isfinite(v[0])) {
     w.from_angle_deg = v[0];
     w.status = "true";
