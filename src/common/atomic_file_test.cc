@@ -50,20 +50,30 @@ TEST_F(AtomicFileTest, ReplacesTheContentWhole) {
 TEST_F(AtomicFileTest, AFailedWriteKeepsTheOldContentAndLeavesNoTemporary) {
   const std::string p = (dir_ / "model.json").string();
   WriteFileAtomically(p, std::string("old"));
-  rlimit saved{};
-  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
-  auto* handler = ::signal(SIGXFSZ, SIG_IGN);
-  rlimit small = saved;
-  small.rlim_cur = 16;
-  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
   std::string message;
-  try {
-    WriteFileAtomically(p, std::string(1000, 'x'));
-  } catch (const std::runtime_error& e) {
-    message = e.what();
+  {
+    // RLIMIT_FSIZE lowered and SIGXFSZ ignored for this scope only, restored however it is left.
+    struct Limit {
+      rlimit saved{};
+      sighandler_t handler;
+      Limit() {
+        ::getrlimit(RLIMIT_FSIZE, &saved);
+        handler = ::signal(SIGXFSZ, SIG_IGN);
+        rlimit small = saved;
+        small.rlim_cur = 16;
+        ::setrlimit(RLIMIT_FSIZE, &small);
+      }
+      ~Limit() {
+        ::setrlimit(RLIMIT_FSIZE, &saved);
+        ::signal(SIGXFSZ, handler);
+      }
+    } limit;
+    try {
+      WriteFileAtomically(p, std::string(1000, 'x'));
+    } catch (const std::exception& e) {
+      message = e.what();
+    }
   }
-  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &saved), 0);
-  ::signal(SIGXFSZ, handler);
   EXPECT_NE(message.find("cannot write"), std::string::npos) << message;
   EXPECT_NE(message.find("too large"), std::string::npos) << message;  // EFBIG's text
   EXPECT_EQ(Read(p), "old");

@@ -740,8 +740,11 @@ TEST_F(TrainTest, CosineScheduleIsWhatTrainingUses) {
   t.epochs = 3;
   t.lr_schedule = "cosine";
   // Progress reports, in order: each epoch opens at step 0, before any batch, and counts to its steps.
+  // (Validation's reports, after the steps, are left out here: WeightAverageIsWhatModelHoldsAndResumes.)
   std::vector<TrainProgress> reports;
-  t.progress = [&](const TrainProgress& p) { reports.push_back(p); };
+  t.progress = [&](const TrainProgress& p) {
+    if (p.val_total == 0) reports.push_back(p);
+  };
   const TrainResult r = Train(t);
   ASSERT_EQ(r.log.size(), 3u);
   for (int e = 1; e <= 3; ++e) EXPECT_DOUBLE_EQ(r.log[e - 1].lr, LearningRateAt(t, e)) << e;
@@ -872,12 +875,24 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   ExpectTrainRefused(again, "a run was trained over without --resume or --overwrite",
                      {"a run is already in", "--resume continues it, --overwrite starts it again"});
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), state_before);
+  // A folder with only an initialised model.pt (what --init-only writes) is a run too.
   TrainOptions fresh = Options("sdn", "resume_overwritten");
   fresh.epochs = 1;
   fresh.init_only = true;
   Train(fresh);
+  ASSERT_FALSE(fs::exists(*root_ / "resume_overwritten" / "state.json"));
+  ExpectTrainRefused(fresh, "an initialised model was written over without --overwrite",
+                     {"model.pt: a run is already in"});
   fresh.overwrite = true;
   EXPECT_NO_THROW(Train(fresh));
+  // A run of the layout before checkpoint folders (no "checkpoint" in state.json) resumes from
+  // the files beside state.json.
+  const fs::path legacy = *root_ / "legacy_layout";
+  fs::create_directories(legacy);
+  std::ofstream(legacy / "state.json") << R"({"epoch": 2})";
+  EXPECT_EQ(CheckpointDir(legacy), legacy);
+  std::ofstream(legacy / "state.json") << R"({"epoch": 2, "checkpoint": "checkpoint-e0002"})";
+  EXPECT_THROW(CheckpointDir(legacy), std::runtime_error);  // names a folder that is not there
 
   // Resuming under another schedule is refused before anything is written: epoch 2 ran at lr / 10
   // (step), the cosine schedule over 4 epochs gives 0.85 lr there.
@@ -912,6 +927,16 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   batched.batch = 4;
   ExpectTrainRefused(batched, "a resume with another batch was accepted",
                      {"state.json: the run trained with --batch 8, these options give 4"});
+  TrainOptions decayed = Options("sdn", "resume");
+  decayed.epochs = 3;
+  decayed.resume = true;
+  decayed.weight_decay = 0.0;
+  ExpectTrainRefused(decayed, "a resume with another weight decay was accepted", {"--weight-decay"});
+  TrainOptions clipped = Options("sdn", "resume");
+  clipped.epochs = 3;
+  clipped.resume = true;
+  clipped.grad_clip = 5.0;
+  ExpectTrainRefused(clipped, "a resume with another gradient clip was accepted", {"--grad-clip"});
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
 
   // And one that turns the flips off: the run trained with them (state.json "flip": true).

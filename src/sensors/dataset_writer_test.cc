@@ -16,6 +16,27 @@ namespace clothwind::sensors {
 namespace {
 namespace fs = std::filesystem;
 
+// RLIMIT_FSIZE lowered (a full disk, even for root) while it lives, with SIGXFSZ ignored so the
+// write fails instead of killing the process; both restored however the scope is left.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    ::getrlimit(RLIMIT_FSIZE, &saved_);
+    handler_ = ::signal(SIGXFSZ, SIG_IGN);
+    rlimit small = saved_;
+    small.rlim_cur = bytes;
+    ::setrlimit(RLIMIT_FSIZE, &small);
+  }
+  ~FileSizeLimit() {
+    ::setrlimit(RLIMIT_FSIZE, &saved_);
+    ::signal(SIGXFSZ, handler_);
+  }
+
+ private:
+  rlimit saved_{};
+  sighandler_t handler_;
+};
+
 class DatasetWriterTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -38,12 +59,13 @@ class DatasetWriterTest : public ::testing::Test {
     return c;
   }
 
-  // Names in root_ that start with "." (the writer's temporaries).
+  // The writer's temporaries in root_: hidden clip folders (".<clip>.tmp-...") and files beside
+  // the index ("index.json.tmp-..."). Names of live writers (this process's pid) included.
   std::set<std::string> Hidden() const {
     std::set<std::string> names;
     for (const auto& e : fs::directory_iterator(root_)) {
       const std::string n = e.path().filename().string();
-      if (n[0] == '.') names.insert(n);
+      if (n[0] == '.' || n.find(".tmp-") != std::string::npos) names.insert(n);
     }
     return names;
   }
@@ -149,29 +171,25 @@ TEST_F(DatasetWriterTest, AtomicFileWriteReplacesContent) {
   EXPECT_THROW(WriteFileAtomically((root_ / "missing" / "b.txt").string(), "x"), std::runtime_error);
 }
 
-// A disk that fills up while a clip is replaced (RLIMIT_FSIZE stands in for a full disk: it fails
-// writes even for root, where file permissions would not): the error names the file, the old
-// copy and the index stay as they were and no temporary is left.
+// A disk that fills up while a clip's replacement is written (RLIMIT_FSIZE stands in for a full
+// disk: it fails writes even for root, where file permissions would not): the error names the
+// file, the old copy and the index stay as they were and no temporary is left. (The put-back when
+// the final rename fails is not provoked here: no fault can be injected between the two renames.)
 TEST_F(DatasetWriterTest, FailedWriteKeepsTheOldCopyAndLeavesNoTemporary) {
   DatasetWriter w(root_.string());
   w.Write(MakeClip(0, 1700000000.0, 4), {});
   const auto index_before = Read(root_ / "index.json");
   const fs::path clip_dir = root_ / ClipFolderName(1700000000.0, 0);
 
-  rlimit saved{};
-  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
-  auto* old_handler = ::signal(SIGXFSZ, SIG_IGN);  // else the write kills the process
-  rlimit small = saved;
-  small.rlim_cur = 64;  // bytes: smaller than any JPEG frame
-  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
   std::string message;
-  try {
-    w.Write(MakeClip(0, 1700000000.0, 3), {});
-  } catch (const std::runtime_error& e) {
-    message = e.what();
+  {
+    const FileSizeLimit full_disk(64);  // bytes: smaller than any JPEG frame
+    try {
+      w.Write(MakeClip(0, 1700000000.0, 3), {});
+    } catch (const std::exception& e) {
+      message = e.what();
+    }
   }
-  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &saved), 0);
-  ::signal(SIGXFSZ, old_handler);
 
   EXPECT_NE(message.find("000.jpg"), std::string::npos) << message;
   EXPECT_EQ(Read(clip_dir / "label.json")["num_frames"], 4);  // the old copy, whole
@@ -220,8 +238,9 @@ TEST_F(DatasetWriterTest, OpeningClearsADeadWritersLeftovers) {
 
   DatasetWriter again(root_.string());
   EXPECT_EQ(again.recovered(), 3u);
+  EXPECT_FALSE(fs::exists(root_ / ("index.json" + dead + "1")));
   EXPECT_EQ(Read(root_ / clip1 / "label.json")["sequence"], 1);
-  EXPECT_EQ(Hidden(), std::set<std::string>{});
+  EXPECT_EQ(Hidden(), std::set<std::string>{live});  // the live writer's, left alone
   EXPECT_TRUE(fs::exists(root_ / live));
   EXPECT_EQ(again.size(), 2u);
 }

@@ -106,6 +106,8 @@ class AnemometerTopicTest(unittest.TestCase):
         return winds
 
     def test_wind_kinds(self):
+        # /replay's decoder already read test_replay_keeps_stamps' two Gill records (unittest runs
+        # tests by name): under 3, so it has not locked onto Gill and reads the NMEA ones below.
         mwv = nmea('IIMWV,229.0,R,5.8,M,A')
         mwd_magnetic = nmea('WIMWD,,T,90.0,M,,N,5.0,M')
         implausible = nmea('IIMWV,229.0,R,500.0,M,A')

@@ -91,6 +91,11 @@ class ClipBufferFaultsTest(unittest.TestCase):
         self.assertIn("not recording", status.message)
         self.assertIn("package.xml/clips", status.message)
         self.assertGreater(int(values["clips not recorded"]), 0)
+        with self.lock:
+            first = list(self.clips)
+        self.assertTrue(first)
+        for c in first:
+            self.assertGreater(c.wind_count, 0, "clip %d unlabelled" % c.sequence)
 
         # 2. A reading an hour ahead of the clock is refused; later clips keep their labels.
         def future(frame, stamp):
@@ -104,8 +109,13 @@ class ClipBufferFaultsTest(unittest.TestCase):
                                           "the future reading counted")
         self.assertIn("after the clock refused", status.message)
         self.assertIn("3600", status.message)
-        with self.lock:
-            later = self.clips[before:]
+        deadline = rospy.get_time() + 10
+        while rospy.get_time() < deadline:
+            with self.lock:
+                later = self.clips[before:]
+            if len(later) >= 8:
+                break
+            rospy.sleep(0.1)
         self.assertGreaterEqual(len(later), 8)
         for c in later:
             self.assertGreater(c.wind_count, 0, "clip %d unlabelled" % c.sequence)
