@@ -5,6 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <type_traits>
+#include <map>
+#include <limits>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
@@ -19,11 +22,12 @@
 namespace clothwind::learn {
 namespace fs = std::filesystem;
 nlohmann::json ReadJson(const fs::path& path) {
+  if (fs::is_directory(path)) throw std::runtime_error(path.string() + ": a folder, expected a JSON file");
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path.string() + ": cannot open");
   try {
     return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
+  } catch (const std::exception& e) {  // nlohmann's, and the stream's own (an unreadable file)
     throw std::runtime_error(path.string() + ": not valid JSON: " + e.what());
   }
 }
@@ -34,6 +38,13 @@ template <typename T>
 T Field(const nlohmann::json& j, const char* key, const fs::path& file, const char* expected) {
   if (!j.is_object() || !j.contains(key)) {
     throw std::runtime_error(file.string() + ": missing field \"" + key + "\" (" + expected + ")");
+  }
+  if constexpr (std::is_integral_v<T>) {
+    // get<int> truncates 30.7 and wraps 4294967326 to 30: an integer in range or an error.
+    const nlohmann::json& v = j.at(key);
+    if (!v.is_number_integer() || v.get<int64_t>() < std::numeric_limits<T>::min() ||
+        v.get<int64_t>() > std::numeric_limits<T>::max())
+      throw std::runtime_error(file.string() + ": field \"" + key + "\" must be " + expected + ", got " + v.dump());
   }
   try {
     return j.at(key).get<T>();
@@ -63,6 +74,7 @@ Dataset ReadDataset(const fs::path& dir) {
   if (!index.contains("clips") || !index["clips"].is_array()) {
     throw std::runtime_error(index_path.string() + ": missing field \"clips\" (an array)");
   }
+  std::map<std::string, size_t> seen;  // name -> its first entry
   for (size_t i = 0; i < index["clips"].size(); ++i) {
     const nlohmann::json& entry = index["clips"][i];
     ClipInfo clip;
@@ -70,6 +82,11 @@ Dataset ReadDataset(const fs::path& dir) {
     if (clip.name.empty() || clip.name.find('/') != std::string::npos || clip.name[0] == '.') {
       throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
                                "].name must be a folder name, got \"" + clip.name + "\"");
+    }
+    // A clip listed twice would count twice, or sit in two splits (a test clip trained on).
+    if (const auto [it, fresh] = seen.emplace(clip.name, i); !fresh) {
+      throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) + "].name \"" + clip.name +
+                               "\" repeats clips[" + std::to_string(it->second) + "]");
     }
     clip.dir = dir / clip.name;
     if (entry.contains("simulation")) {
@@ -92,17 +109,30 @@ Dataset ReadDataset(const fs::path& dir) {
       throw std::runtime_error(label_path.string() + ": field \"encoding\" must be \"mono8\" or \"rgb8\", got \"" +
                                encoding + "\"");
     }
-    if (!std::isfinite(clip.wind_speed) || clip.num_frames < 1 || !(clip.frame_rate > 0) ||
-        clip.width < 1 || clip.height < 1) {
-      throw std::runtime_error(label_path.string() +
-                               ": wind_speed must be finite, num_frames/width/height positive, frame_rate > 0");
-    }
+    // Each checked by name with its value. Bounds: a wind no anemometer reads (misread units, a
+    // corrupt label) must not be scored; a frame count or size no camera makes must not size a
+    // frame cache (num_frames 2e9 asked for 512 GB before reading a frame).
+    auto check = [&](bool ok, const char* field, const std::string& got, const char* expected) {
+      if (!ok)
+        throw std::runtime_error(label_path.string() + ": field \"" + field + "\" must be " + expected + ", got " +
+                                 got);
+    };
+    check(std::isfinite(clip.wind_speed) && clip.wind_speed >= 0 && clip.wind_speed <= 100,
+          "wind_speed", std::to_string(clip.wind_speed), "a speed in 0..100 m/s");
+    check(clip.num_frames >= 1 && clip.num_frames <= 100000, "num_frames", std::to_string(clip.num_frames),
+          "in 1..100000");
+    check(std::isfinite(clip.frame_rate) && clip.frame_rate > 0 && clip.frame_rate <= 10000, "frame_rate",
+          std::to_string(clip.frame_rate), "a rate in (0, 10000] Hz");
+    check(clip.width >= 1 && clip.width <= 16384, "width", std::to_string(clip.width), "in 1..16384 px");
+    check(clip.height >= 1 && clip.height <= 16384, "height", std::to_string(clip.height), "in 1..16384 px");
     if (!ValidFramePattern(clip.frame_pattern)) {
       throw std::runtime_error(label_path.string() + ": field \"frame_pattern\" must hold one integer "
                                "conversion like \"%03d.jpg\", got \"" + clip.frame_pattern + "\"");
     }
     // The split is the index's (fixed by seed at generation); label.json may repeat it.
-    clip.split = entry.value("split", label.value("split", std::string("train")));
+    clip.split = entry.contains("split") ? Field<std::string>(entry, "split", index_path, "\"train\", \"val\" or \"test\"")
+                 : label.contains("split") ? Field<std::string>(label, "split", label_path, "\"train\", \"val\" or \"test\"")
+                                           : std::string("train");
     if (clip.split != "train" && clip.split != "val" && clip.split != "test") {
       throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
                                "].split must be \"train\", \"val\" or \"test\", got \"" + clip.split + "\"");
@@ -134,7 +164,12 @@ std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count, bool
   for (int i = first; i < first + count; ++i) {
     const fs::path path = clip.dir / FrameName(clip, i);
     if (!fs::exists(path)) throw std::runtime_error(path.string() + ": missing frame");
-    cv::Mat image = cv::imread(path.string(), colour ? cv::IMREAD_COLOR : cv::IMREAD_GRAYSCALE);
+    cv::Mat image;
+    try {
+      image = cv::imread(path.string(), colour ? cv::IMREAD_COLOR : cv::IMREAD_GRAYSCALE);
+    } catch (const cv::Exception& e) {  // e.g. a header claiming more pixels than OpenCV allows
+      throw std::runtime_error(path.string() + ": not a readable image (" + e.err + ")");
+    }
     if (image.empty()) throw std::runtime_error(path.string() + ": not a readable image");
     if (colour) cv::cvtColor(image, image, cv::COLOR_BGR2YCrCb);
     if (image.cols != clip.width || image.rows != clip.height) {

@@ -151,6 +151,54 @@ TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
     std::ofstream(d / "toy-00000" / "label.json") << "{ not json";
     expect_error(d, (d / "toy-00000" / "label.json").string(), "not valid JSON");
   }
+  // Integers that get<int> would truncate or wrap, winds no anemometer reads, a clip listed
+  // twice, a split of the wrong type, a folder where the label should be, and an image whose
+  // header claims more pixels than OpenCV allows (imread throws: it ended the replay camera).
+  {
+    const fs::path d = Copy("fraction");
+    EditJson(d / "toy-00002" / "label.json", [](nlohmann::json& j) { j["num_frames"] = 30.7; });
+    expect_error(d, (d / "toy-00002" / "label.json").string(), "\"num_frames\" must be");
+  }
+  {
+    const fs::path d = Copy("wrap");
+    EditJson(d / "toy-00002" / "label.json", [](nlohmann::json& j) { j["width"] = 4294967328LL; });
+    expect_error(d, (d / "toy-00002" / "label.json").string(), "4294967328");
+  }
+  {
+    const fs::path d = Copy("huge");
+    EditJson(d / "toy-00002" / "label.json", [](nlohmann::json& j) { j["num_frames"] = 2000000000; });
+    expect_error(d, (d / "toy-00002" / "label.json").string(), "\"num_frames\" must be in 1..100000");
+  }
+  for (const double speed : {-50.0, 1e300}) {
+    const fs::path d = Copy("wind" + std::to_string(speed > 0));
+    EditJson(d / "toy-00003" / "label.json", [speed](nlohmann::json& j) { j["wind_speed"] = speed; });
+    expect_error(d, (d / "toy-00003" / "label.json").string(), "\"wind_speed\" must be a speed in 0..100 m/s");
+  }
+  {
+    const fs::path d = Copy("twice");
+    EditJson(d / "index.json", [](nlohmann::json& j) {
+      nlohmann::json again = j["clips"][0];
+      again["split"] = "test";
+      j["clips"].push_back(again);
+    });
+    expect_error(d, (d / "index.json").string(), "repeats clips[0]");
+  }
+  {
+    const fs::path d = Copy("split_type");
+    EditJson(d / "index.json", [](nlohmann::json& j) { j["clips"][1]["split"] = 5; });
+    expect_error(d, (d / "index.json").string(), "\"split\" must be");
+  }
+  {
+    const fs::path d = Copy("label_folder");
+    fs::remove(d / "toy-00001" / "label.json");
+    fs::create_directories(d / "toy-00001" / "label.json");
+    expect_error(d, (d / "toy-00001" / "label.json").string(), "a folder");
+  }
+  {
+    const fs::path d = Copy("bomb");
+    std::ofstream(d / "toy-00004" / "014.jpg", std::ios::binary) << "P5\n100000 100000\n255\n";
+    expect_error(d, (d / "toy-00004" / "014.jpg").string(), "not a readable image");
+  }
 }
 
 TEST_F(DatasetTest, ReadsEachClipsSimulation) {

@@ -86,7 +86,15 @@ bool ImageFolderSource::Open() {
 
 bool ImageFolderSource::LoadNext(std::string* why) {
   const std::string& file = files_[next_];
-  const cv::Mat raw = cv::imread(file, cv::IMREAD_UNCHANGED);
+  cv::Mat raw;
+  try {
+    raw = cv::imread(file, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    // A header claiming more pixels than OpenCV allows throws: reported like any unreadable
+    // image (it ended camera_node through std::terminate).
+    *why = "cannot read image " + file + " (" + e.err + ")";
+    return false;
+  }
   if (raw.empty()) {
     *why = "cannot read image " + file;
     return false;

@@ -106,6 +106,18 @@ TEST(ImageFolderSourceTest, ClearErrorsForMissingEmptyAndInconsistentFolders) {
   EXPECT_NE(source.error().find("frame_0002.png is 10x10 mono8, expected 32x24 mono8"),
             std::string::npos) << source.error();
   EXPECT_EQ(source.Read(&f, 1.0), ReadStatus::kEnd);
+
+  // A header claiming more pixels than OpenCV allows makes imread throw: an error naming the
+  // file, not an exception through the node (camera_node ended by std::terminate).
+  TempDir bomb;
+  WriteFrames(bomb.path(), 1, 1);
+  std::ofstream(bomb.path() + "/frame_0001.pgm", std::ios::binary) << "P5\n100000 100000\n255\n";
+  ImageFolderSource bombed(bomb.path(), 10.0, false, &clock);
+  ASSERT_TRUE(bombed.Open());
+  ASSERT_EQ(bombed.Read(&f, 1.0), ReadStatus::kFrame);
+  EXPECT_EQ(bombed.Read(&f, 1.0), ReadStatus::kError);
+  EXPECT_NE(bombed.error().find("cannot read image " + bomb.path() + "/frame_0001.pgm"), std::string::npos)
+      << bombed.error();
 }
 
 TEST(ImageFolderSourceTest, ClosesItselfWhenNothingIsReadableAnyMore) {
