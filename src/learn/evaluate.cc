@@ -155,6 +155,9 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   options.fly_judge = predictor.fly_judge();
   if (flag_flies == FlagFlies::kAuto) {
     r.fly_judge = options.fly_judge ? predictor.fly_judge_path().string() : std::string("motion cues");
+    // A judge beside the model that cannot be read: said, rather than falling back in silence.
+    if (!options.fly_judge && !predictor.fly_judge_error().empty())
+      r.fly_judge += " (the judge beside the model was not used: " + predictor.fly_judge_error() + ")";
   }
   batch = std::max(1, batch);
   for (size_t i = 0; i < clips.size(); i += batch) {
@@ -256,7 +259,8 @@ std::string EvalTable(const EvalResult& r) {
   if (r.mirror_clips) s << ", clips mirrored (flags flying left)";
   if (r.flag_flies == FlagFlies::kLeft) s << ", every clip turned round (--flag-flies left)";
   if (r.flag_flies == FlagFlies::kAuto) {
-    s << ", turned round by " << (r.fly_judge == "motion cues" ? "their motion" : "the judge " + r.fly_judge) << ": "
+    s << ", turned round by " << (r.fly_judge.rfind("motion cues", 0) == 0 ? "their motion" + r.fly_judge.substr(11)
+                                                                : "the judge " + r.fly_judge) << ": "
       << r.turned << " of " << r.metrics.count * r.windows << " windows";
   }
   s << ")\n";

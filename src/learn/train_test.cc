@@ -267,6 +267,15 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
   }
   EXPECT_EQ(Evaluate(r.model, *root_ / "data", "val", 2, "cpu", 4, 1, false, false, FlagFlies::kAuto).fly_judge,
             "motion cues");
+  // A judge beside the model that cannot be read is said, not passed over in silence.
+  const fs::path judged_copy = *root_ / "sdn_bad_judge";
+  fs::create_directories(judged_copy);
+  for (const char* f : {"model.pt", "model.json"}) fs::copy_file(r.model.parent_path() / f, judged_copy / f);
+  std::ofstream(judged_copy / "fly_judge.pt") << "junk";
+  const std::string said =
+      Evaluate(judged_copy / "model.pt", *root_ / "data", "val", 2, "cpu", 4, 1, false, false, FlagFlies::kAuto)
+          .fly_judge;
+  EXPECT_NE(said.find("motion cues (the judge beside the model was not used: "), std::string::npos) << said;
   // The plots are PNGs made by gnuplot (installed with the project's dependencies).
   EXPECT_EQ(r.plot_error, "");
   std::string error;

@@ -56,6 +56,12 @@ void ReadInto(torch::serialize::InputArchive& archive, const std::string& key, c
     throw std::runtime_error(path.string() + ": tensor " + name + " is " + std::string(read.dtype().name()) +
                              ", the network expects " + std::string(target.dtype().name()));
   }
+  // The archive's checksums are not verified on load: corrupt bytes read as values, often NaN or
+  // inf, and a model of them answers NaN for every clip (an evaluation then printed RMSE -nan
+  // and exited 0). Weights and running statistics of a trained network are finite.
+  if (read.is_floating_point() && !at::isfinite(read).all().item<bool>()) {
+    throw std::runtime_error(path.string() + ": tensor " + name + " holds values that are not finite (a corrupt file?)");
+  }
   if (read.scalar_type() == at::kHalf && !is_buffer) *any_half = true;
   at::NoGradGuard no_grad;
   target.copy_(read);

@@ -136,6 +136,20 @@ TEST_F(WeightsIoTest, RefusesOtherShapesAndOutOfRangeHalves) {
   }
   EXPECT_FALSE(fs::exists(dir_ / "big.pt"));
   EXPECT_THROW(LoadModuleWeights(*a, dir_ / "missing.pt"), std::runtime_error);
+  // Values that are not finite (what corrupt bytes in an archive read as) are refused by name.
+  torch::nn::Sequential nan_net = SmallNet(3);
+  {
+    at::NoGradGuard no_grad;
+    nan_net->named_parameters()["0.weight"][0][0][0][0].fill_(std::nan(""));
+  }
+  SaveModuleWeights(*nan_net, dir_ / "nan.pt", WeightPrecision::kFloat32);
+  try {
+    LoadModuleWeights(*SmallNet(4), dir_ / "nan.pt");
+    ADD_FAILURE() << "weights with a NaN were loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("nan.pt: tensor 0.weight holds values that are not finite"),
+              std::string::npos) << e.what();
+  }
   EXPECT_THROW(ParseWeightPrecision("bfloat16"), std::invalid_argument);
   EXPECT_EQ(ParseWeightPrecision(ToString(WeightPrecision::kFloat16)), WeightPrecision::kFloat16);
 }
