@@ -40,7 +40,7 @@ const VerbRegistrar kRegistrar{"contact-sheet", [](CLI::App& app) -> std::functi
   sub->add_option("--tiles", a->options.max_tiles, "examples shown at most")
       ->check(CLI::Range(1, 10000))
       ->capture_default_str();
-  sub->add_option("--tile-size", a->options.tile, "tile size [px]")->check(CLI::Range(16, 1024))->capture_default_str();
+  sub->add_option("--tile-size", a->options.tile, "tile size [px]")->check(CLI::Range(32, 1024))->capture_default_str();
   return [a] { return Run(*a); };
 }};
 

@@ -45,9 +45,21 @@ cv::Mat MakeContactSheet(const std::string& dir, const nlohmann::json& index,
     double wind;
   };
   std::vector<Item> items;
-  for (const auto& c : index.at("clips"))
-    items.push_back({c.at("name").get<std::string>(),
-                     c.at("wind_speed").is_number() ? c.at("wind_speed").get<double>() : NAN});
+  const std::string index_path = (fs::path(dir) / "index.json").string();
+  if (!index.contains("clips") || !index["clips"].is_array())
+    throw std::runtime_error(index_path + ": field \"clips\" must be an array");
+  for (size_t i = 0; i < index["clips"].size(); ++i) {
+    const nlohmann::json& c = index["clips"][i];
+    const std::string where = index_path + ": clips[" + std::to_string(i) + "]";
+    // A folder of this dataset, not a path that leads out of it ("../other", "/tmp/x").
+    if (!c.is_object() || !c.contains("name") || !c["name"].is_string())
+      throw std::runtime_error(where + ".name must be a string");
+    const std::string name = c["name"].get<std::string>();
+    if (name.empty() || name[0] == '.' || name.find('/') != std::string::npos)
+      throw std::runtime_error(where + ".name must be a folder name, got \"" + name + "\"");
+    const bool has_wind = c.contains("wind_speed") && c["wind_speed"].is_number();
+    items.push_back({name, has_wind ? c["wind_speed"].get<double>() : NAN});
+  }
   if (items.empty()) return cv::Mat();
   std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.wind < b.wind; });
   // Evenly spaced over the sorted list: the slowest and the fastest are always shown.

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "data/contact_sheet.h"
 #include "data/dataset_index.h"
 #include "data/paths.h"
 #include "sim/scene.h"
@@ -552,6 +553,27 @@ TEST_F(DatasetGeneratorTest, BadFramePatternIsRefusedByName) {
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("frame_pattern"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find(label.string()), std::string::npos) << e.what();
+  }
+}
+
+// The contact sheet tiles the dataset's own folders: a name leading out of it is refused naming
+// the entry, and a clip without a wind speed is still shown (sorted last).
+TEST_F(DatasetGeneratorTest, ContactSheetStaysInsideTheDataset) {
+  nlohmann::json index = ReadIndex(Ref().string());
+  ContactSheetOptions o;
+  o.tile = 32;
+  const cv::Mat sheet = MakeContactSheet(Ref().string(), index, o);
+  EXPECT_FALSE(sheet.empty());
+  index["clips"][0].erase("wind_speed");
+  EXPECT_FALSE(MakeContactSheet(Ref().string(), index, o).empty());
+  for (const char* bad : {"../reference", "/tmp"}) {
+    index["clips"][1]["name"] = bad;
+    try {
+      MakeContactSheet(Ref().string(), index, o);
+      ADD_FAILURE() << bad << " was read";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("clips[1].name must be a folder name"), std::string::npos) << e.what();
+    }
   }
 }
 
