@@ -1,5 +1,7 @@
 #include "sim/scene.h"
 
+#include <cstdint>
+#include <limits>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -69,7 +71,13 @@ class Reader {
   }
   int Integer(const json& j, const std::string& path) const {
     if (!j.is_number_integer()) Fail(path, std::string("expected an integer, got ") + TypeName(j));
-    return j.get<int>();
+    // get<int> wraps 4294967297 to 1: out of int's range is an error, not another number.
+    const int64_t v = j.is_number_unsigned() && j.get<uint64_t>() > static_cast<uint64_t>(INT64_MAX)
+                          ? INT64_MAX
+                          : j.get<int64_t>();
+    if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+      Fail(path, "expected an integer within int's range, got " + j.dump());
+    return static_cast<int>(v);
   }
   std::string String(const json& j, const std::string& path) const {
     if (!j.is_string()) Fail(path, std::string("expected a string, got ") + TypeName(j));
@@ -281,7 +289,7 @@ TurbulenceParams ParseTurbulence(const Reader& r, const json& j, const std::stri
   }
   if (j.contains("modes")) {
     t.modes = r.Integer(j["modes"], path + ".modes");
-    if (t.modes < 1) r.Fail(path + ".modes", "expected at least 1 mode");
+    if (t.modes < 1 || t.modes > 10000) r.Fail(path + ".modes", "expected 1..10000 modes");
   }
   if (j.contains("seed")) t.seed = Seed(r, j["seed"], path + ".seed");
   return t;
@@ -299,6 +307,8 @@ GustParams ParseGusts(const Reader& r, const json& j, const std::string& path) {
   }
   if (j.contains("duration")) g.duration = r.Positive(j["duration"], path + ".duration");
   if (j.contains("horizon")) g.horizon = r.Positive(j["horizon"], path + ".horizon");
+  // The gusts are drawn up front, rate x horizon of them: bounded, so a typo cannot ask for 1e300.
+  if (g.rate * g.horizon > 1e6) r.Fail(path + ".rate", "rate x horizon must be at most 1e6 gusts");
   if (j.contains("seed")) g.seed = Seed(r, j["seed"], path + ".seed");
   return g;
 }
@@ -363,7 +373,7 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
   if (j.contains("frame_time")) s.frame_time = r.Positive(j["frame_time"], "frame_time");
   if (j.contains("frame_steps")) {
     s.frame_steps = r.Integer(j["frame_steps"], "frame_steps");
-    if (s.frame_steps < 1) r.Fail("frame_steps", "expected an integer >= 1");
+    if (s.frame_steps < 1 || s.frame_steps > 10000) r.Fail("frame_steps", "expected an integer in 1..10000");
   }
   if (j.contains("duration") && j.contains("end_time")) {
     r.Warn("end_time", "both duration and end_time given; using end_time");
@@ -374,6 +384,12 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
     s.duration = r.Integer(j["end_frame"], "end_frame") * s.frame_time;
     if (!(s.duration > 0)) r.Fail("end_frame", "expected an integer >= 1");
   }
+  // A day of simulated time at most, in at most a million frames (the frame count is an int and
+  // its frames are reserved up front: 1e8 s failed in vector::reserve, 1e300 ran nothing, exit 0).
+  if (!(s.duration <= 86400)) r.Fail("duration", "expected at most 86400 s, got " + std::to_string(s.duration));
+  if (!(s.duration / s.frame_time <= 1e6))
+    r.Fail("frame_time", "expected at most 1e6 frames over the duration, got " +
+                             std::to_string(s.duration / s.frame_time));
   if (j.contains("motions")) {
     r.ExpectArray(j["motions"], "motions");
     for (const auto& m : j["motions"]) s.motions.push_back(m);

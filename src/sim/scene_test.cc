@@ -219,6 +219,18 @@ TEST_F(SceneFiles, WrongTypesNameTheJsonPathAndFile) {
   ExpectErrorNaming([&] { LoadScene(e); }, {e, "cloths", "missing"});
   const std::string f = Write("conf/f.json", SceneText(", \"wind\": {\"density\": -1}"));
   ExpectErrorNaming([&] { LoadScene(f); }, {f, "wind.density", ">= 0"});
+  // Integers get<int> would wrap (4294967297 read as 1) and counts or spans that would allocate
+  // without bound or overflow the frame count: each refused naming its key.
+  const std::string g = Write("conf/g.json", SceneText(", \"frame_steps\": 4294967297"));
+  ExpectErrorNaming([&] { LoadScene(g); }, {g, "frame_steps", "int's range", "4294967297"});
+  const std::string h = Write("conf/h.json", SceneText(", \"frame_steps\": 2000000000"));
+  ExpectErrorNaming([&] { LoadScene(h); }, {h, "frame_steps", "1..10000"});
+  const std::string i = Write("conf/i.json", SceneText(", \"duration\": 1e8"));
+  ExpectErrorNaming([&] { LoadScene(i); }, {i, "duration", "at most 86400 s"});
+  const std::string k = Write("conf/k.json", SceneText(", \"wind\": {\"turbulence\": {\"modes\": 2000000000}}"));
+  ExpectErrorNaming([&] { LoadScene(k); }, {k, "wind.turbulence.modes", "1..10000"});
+  const std::string l = Write("conf/l.json", SceneText(", \"wind\": {\"gusts\": {\"rate\": 1e300}}"));
+  ExpectErrorNaming([&] { LoadScene(l); }, {l, "wind.gusts.rate", "at most 1e6 gusts"});
 }
 
 TEST_F(SceneFiles, NaNIsRejectedNamingFileLineAndKey) {

@@ -100,7 +100,16 @@ Trajectory ReadTrajectory(const std::string& path) {
                  nframes = Get<uint32_t>(data, &pos);
   Trajectory t;
   t.frame_time = Get<double>(data, &pos);
-  if (!(t.frame_time > 0) || !std::isfinite(t.frame_time)) fail("frame_time must be > 0");
+  if (!(t.frame_time > 0) || !(t.frame_time <= 3600)) fail("frame_time must be in (0, 3600] s");
+  // An empty trajectory crashed the renderer (bounds of no vertices); the size is checked in
+  // pieces, each against what the file holds, so counts near 2^32 cannot wrap the sum.
+  if (nv < 3 || nf < 1 || nframes < 1)
+    fail("expected at least 3 vertices, 1 face and 1 frame, got " + std::to_string(nv) + ", " + std::to_string(nf) +
+         ", " + std::to_string(nframes));
+  const uint64_t payload = data.size() - 32;
+  if (12 * nf > payload || 8 * nv > payload - 12 * nf || nframes > (payload - 12 * nf - 8 * nv) / (12 * nv))
+    fail("size " + std::to_string(data.size()) + " bytes is less than its header (#V " + std::to_string(nv) +
+         ", #F " + std::to_string(nf) + ", #frames " + std::to_string(nframes) + ") implies");
   const uint64_t expected = 32 + 12 * nf + 8 * nv + 12 * nv * nframes;
   if (data.size() != expected) {
     fail("size " + std::to_string(data.size()) + " bytes, header (#V " + std::to_string(nv) +
@@ -121,6 +130,8 @@ Trajectory ReadTrajectory(const std::string& path) {
   for (uint64_t v = 0; v < nv; ++v) {
     t.uv(v, 0) = Get<float>(data, &pos);
     t.uv(v, 1) = Get<float>(data, &pos);
+    if (!std::isfinite(t.uv(v, 0)) || !std::isfinite(t.uv(v, 1)))
+      fail("vertex " + std::to_string(v) + "'s texture coordinates are not finite");
   }
   t.frames.resize(nframes);
   for (uint64_t k = 0; k < nframes; ++k) {

@@ -77,6 +77,35 @@ TEST(TrajectoryIo, CorruptFilesFailNamingTheFileAndProblem) {
   Trajectory t = Sample();
   t.frames[1].resize(3, 3);
   EXPECT_THROW(WriteTrajectory(path, t), std::invalid_argument);
+
+  // Headers that lie: no vertices (the renderer crashed on it), counts whose byte total wraps
+  // 64 bits (it passed the size check and read past the file), a frame time of 1e300.
+  auto header = [&](uint32_t nv, uint32_t nf, uint32_t nframes, double frame_time) {
+    std::string h(kTrajectoryMagic, 8);
+    auto put = [&h](const void* p, size_t n) { h.append(static_cast<const char*>(p), n); };
+    const uint32_t version = kTrajectoryVersion;
+    put(&version, 4);
+    put(&nv, 4);
+    put(&nf, 4);
+    put(&nframes, 4);
+    put(&frame_time, 8);
+    std::ofstream(path, std::ios::binary) << h;
+  };
+  auto expect = [&](const std::string& what) {
+    try {
+      ReadTrajectory(path);
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  header(0, 0, 1, 0.04);
+  expect("expected at least 3 vertices, 1 face and 1 frame");
+  header(2147483648u, 1, 715827882u, 0.04);
+  expect("is less than its header");
+  header(3, 1, 1, 1e300);
+  expect("frame_time must be in (0, 3600] s");
 }
 
 }  // namespace
