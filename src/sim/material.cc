@@ -196,8 +196,9 @@ Material LoadArcSimMaterial(const std::string& path, const MaterialMultipliers& 
   if (!(density > 0)) throw std::runtime_error(path + ": field 'density' must be > 0 [kg/m^2]");
   const Eigen::Matrix<double, 6, 4> stretching = table("stretching", 6, 4);
   const Eigen::Matrix<double, 3, 5> bending = table("bending", 3, 5);
-  if ((bending.array() < 0).any())
-    throw std::runtime_error(path + ": field 'bending' has negative stiffnesses");
+  // Every bending stiffness enters θ, which requires > 0: a zero here failed later naming no file.
+  if (!(bending.array() > 0).all())
+    throw std::runtime_error(path + ": field 'bending' must hold stiffnesses > 0 [N m]");
   try {
     return MakeMaterial(density, stretching, bending, mult);
   } catch (const std::invalid_argument& e) {

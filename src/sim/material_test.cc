@@ -99,6 +99,9 @@ TEST(MaterialTest, BadFilesFailNamingFileAndField) {
   ExpectThrowContaining([&] { LoadArcSimMaterial(bad_value); }, "field 'bending[1][1]' must be a number");
   const std::string negative = WriteText("negdensity.json", "{\"density\": -1, \"stretching\": " + rows + ", \"bending\": " + bend + "}");
   ExpectThrowContaining([&] { LoadArcSimMaterial(negative); }, "field 'density' must be > 0");
+  const std::string flat = WriteText("flatbending.json", "{\"density\": 0.1, \"stretching\": " + rows +
+                                                          ", \"bending\": [[0,0,0,0,0],[0,0,0,0,0],[0,0,0,0,0]]}");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(flat); }, flat + ": field 'bending' must hold stiffnesses > 0");
   const std::string broken = WriteText("broken.json", "{\"density\": ");
   ExpectThrowContaining([&] { LoadArcSimMaterial(broken); }, broken + ": not valid JSON");
   const std::string commented = WriteText("commented.json", "// a comment like paper.json's\n{\"density\": 0.1, /* x */ \"stretching\": " +
