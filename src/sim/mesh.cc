@@ -280,6 +280,12 @@ Mesh RefineMesh(const Mesh& input, double max_edge) {
   for (int level = 0; longest(mesh) > max_edge; ++level) {
     if (level >= 12) throw std::invalid_argument("RefineMesh: max_edge too small (over 12 levels)");
     const int nf = static_cast<int>(mesh.F.rows());
+    // Each level quadruples the faces: bounded before allocating (a remeshing size of 1e-9 went
+    // on towards 134M faces and gigabytes before the level limit). Cloths here have ~1e3-1e4.
+    constexpr int kMaxFaces = 2000000;
+    if (nf > kMaxFaces / 4)
+      throw std::invalid_argument("RefineMesh: max_edge " + std::to_string(max_edge) + " m would make more than " +
+                                  std::to_string(kMaxFaces) + " faces");
     EdgeMidpoints mid(mesh);
     Eigen::MatrixX3i F(4 * nf, 3);
     for (int f = 0; f < nf; ++f) {

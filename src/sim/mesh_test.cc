@@ -143,6 +143,13 @@ TEST(RefineMeshTest, PreservesAreaAndBoundaryAndBoundsEdges) {
   EXPECT_EQ(r.V.rows(), (side + 1) * (side + 1));
   EXPECT_NO_THROW(ValidateMesh(r));
   EXPECT_THROW(RefineMesh(m, 0.0), std::invalid_argument);
+  // A size no cloth needs stops before the faces outgrow memory, saying why.
+  try {
+    RefineMesh(m, 1e-9);
+    ADD_FAILURE() << "refined towards a billion faces";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("would make more than 2000000 faces"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SplitLongEdgesTest, SplitsOnlyLongEdgesAndStaysConforming) {
