@@ -195,6 +195,15 @@ Material LoadArcSimMaterial(const std::string& path, const MaterialMultipliers& 
   const double density = number(j["density"], "density");
   if (!(density > 0)) throw std::runtime_error(path + ": field 'density' must be > 0 [kg/m^2]");
   const Eigen::Matrix<double, 6, 4> stretching = table("stretching", 6, 4);
+  // Columns 0, 2 and 3 are the warp, weft and shear stiffnesses (1, their coupling, may be 0, as
+  // in paper.json): each needs a value > 0 somewhere, or the cloth has none in that direction
+  // after the clamping to >= 0 (an all-zero or all-negative table ran silently as a cloth that
+  // does not resist stretching).
+  for (const int c : {0, 2, 3}) {
+    if (!(stretching.col(c).maxCoeff() > 0))
+      throw std::runtime_error(path + ": field 'stretching' column " + std::to_string(c) + " (" +
+                               (c == 0 ? "warp" : c == 2 ? "weft" : "shear") + ") has no stiffness > 0");
+  }
   const Eigen::Matrix<double, 3, 5> bending = table("bending", 3, 5);
   // Every bending stiffness enters θ, which requires > 0: a zero here failed later naming no file.
   if (!(bending.array() > 0).all())

@@ -102,6 +102,12 @@ TEST(MaterialTest, BadFilesFailNamingFileAndField) {
   const std::string flat = WriteText("flatbending.json", "{\"density\": 0.1, \"stretching\": " + rows +
                                                           ", \"bending\": [[0,0,0,0,0],[0,0,0,0,0],[0,0,0,0,0]]}");
   ExpectThrowContaining([&] { LoadArcSimMaterial(flat); }, flat + ": field 'bending' must hold stiffnesses > 0");
+  std::string zero_rows = "[";
+  for (int r = 0; r < 6; ++r) zero_rows += std::string(r ? "," : "") + "[0,0,0,0]";
+  zero_rows += "]";
+  const std::string slack = WriteText("slack.json", "{\"density\": 0.1, \"stretching\": " + zero_rows +
+                                                        ", \"bending\": " + bend + "}");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(slack); }, slack + ": field 'stretching' column 0 (warp) has no stiffness > 0");
   const std::string broken = WriteText("broken.json", "{\"density\": ");
   ExpectThrowContaining([&] { LoadArcSimMaterial(broken); }, broken + ": not valid JSON");
   const std::string commented = WriteText("commented.json", "// a comment like paper.json's\n{\"density\": 0.1, /* x */ \"stretching\": " +
