@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 #include <unistd.h>
@@ -923,29 +924,25 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
                      {"state.json: the run trained with crop scales [1.0,0.875,0.75,0.66]", "--crop-scales"});
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
 
-  // And one with another seed or batch: its samples and steps would not be the run's.
-  TrainOptions seeded = Options("sdn", "resume");
-  seeded.epochs = 3;
-  seeded.resume = true;
-  seeded.seed = 7;
-  ExpectTrainRefused(seeded, "a resume with another seed was accepted",
-                     {"state.json: the run trained with --seed 1, these options give 7"});
-  TrainOptions batched = Options("sdn", "resume");
-  batched.epochs = 3;
-  batched.resume = true;
-  batched.batch = 4;
-  ExpectTrainRefused(batched, "a resume with another batch was accepted",
-                     {"state.json: the run trained with --batch 8, these options give 4"});
-  TrainOptions decayed = Options("sdn", "resume");
-  decayed.epochs = 3;
-  decayed.resume = true;
-  decayed.weight_decay = 0.0;
-  ExpectTrainRefused(decayed, "a resume with another weight decay was accepted", {"--weight-decay"});
-  TrainOptions clipped = Options("sdn", "resume");
-  clipped.epochs = 3;
-  clipped.resume = true;
-  clipped.grad_clip = 5.0;
-  ExpectTrainRefused(clipped, "a resume with another gradient clip was accepted", {"--grad-clip"});
+  // And one with another seed, batch, weight decay or gradient clip: its samples, steps and
+  // optimiser would not be the run's.
+  const struct {
+    const char* what;
+    std::function<void(TrainOptions&)> change;
+    std::vector<std::string> says;
+  } changes[] = {
+      {"seed", [](TrainOptions& o) { o.seed = 7; }, {"state.json: the run trained with --seed 1, these options give 7"}},
+      {"batch", [](TrainOptions& o) { o.batch = 4; }, {"state.json: the run trained with --batch 8, these options give 4"}},
+      {"weight decay", [](TrainOptions& o) { o.weight_decay = 0.0; }, {"--weight-decay"}},
+      {"gradient clip", [](TrainOptions& o) { o.grad_clip = 5.0; }, {"--grad-clip"}},
+  };
+  for (const auto& c : changes) {
+    TrainOptions changed = Options("sdn", "resume");
+    changed.epochs = 3;
+    changed.resume = true;
+    c.change(changed);
+    ExpectTrainRefused(changed, std::string("a resume with another ") + c.what + " was accepted", c.says);
+  }
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
 
   // And one that turns the flips off: the run trained with them (state.json "flip": true).
