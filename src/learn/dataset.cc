@@ -142,6 +142,15 @@ Dataset ReadDataset(const fs::path& dir) {
   return dataset;
 }
 
+void CheckClipRates(const std::vector<ClipInfo>& clips, double model_rate) {
+  for (const ClipInfo& c : clips) {
+    if (std::abs(c.frame_rate - model_rate) > 0.01 * model_rate)
+      throw std::runtime_error((c.dir / "label.json").string() + ": field \"frame_rate\" is " +
+                               std::to_string(c.frame_rate) + " Hz, the model reads clips at " +
+                               std::to_string(model_rate) + " Hz");
+  }
+}
+
 std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& split) {
   if (split != "all" && split != "train" && split != "val" && split != "test") {
     throw std::invalid_argument("split must be train, val, test or all, got \"" + split + "\"");

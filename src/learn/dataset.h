@@ -50,6 +50,11 @@ Dataset ReadDataset(const std::filesystem::path& dir);
 // The examples of one split ("train", "val", "test"), or all of them for "all".
 std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& split);
 
+// Throws std::runtime_error naming the first clip's label.json whose frame_rate differs from
+// `model_rate` [Hz] by more than 1 %: the SDN reads frequencies in Hz at its own rate, so a clip
+// at another rate gives a wrong wind without any other sign (sdn_node refuses them too).
+void CheckClipRates(const std::vector<ClipInfo>& clips, double model_rate);
+
 // Frames first..first+count-1 of a clip as greyscale CV_8UC1 images (colour JPEGs converted) or,
 // with `colour`, as CV_8UC3 images in YCrCb order (OpenCV's BGR2YCrCb: Y is the grey of the
 // greyscale frames, Cr and Cb say how red and how blue a pixel is beyond its grey).

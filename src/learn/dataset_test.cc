@@ -195,6 +195,21 @@ TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
     expect_error(d, (d / "toy-00001" / "label.json").string(), "a folder");
   }
   {
+    // A clip at another rate than the model reads: refused by name (its frequencies would read as
+    // another wind).
+    const fs::path d = Copy("rate");
+    EditJson(d / "toy-00002" / "label.json", [](nlohmann::json& j) { j["frame_rate"] = 5.0; });
+    const Dataset data = ReadDataset(d);
+    try {
+      CheckClipRates(data.clips, 25.0);
+      ADD_FAILURE() << "a 5 Hz clip was accepted for a 25 Hz model";
+    } catch (const std::runtime_error& e) {
+      EXPECT_THAT(e.what(), HasSubstr((d / "toy-00002" / "label.json").string()));
+      EXPECT_THAT(e.what(), HasSubstr("the model reads clips at 25"));
+    }
+    EXPECT_NO_THROW(CheckClipRates(ReadDataset(Copy("rate_ok")).clips, 25.1));  // within 1 %
+  }
+  {
     const fs::path d = Copy("bomb");
     std::ofstream(d / "toy-00004" / "014.jpg", std::ios::binary) << "P5\n100000 100000\n255\n";
     expect_error(d, (d / "toy-00004" / "014.jpg").string(), "not a readable image");

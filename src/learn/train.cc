@@ -301,6 +301,8 @@ TrainResult Train(const TrainOptions& o) {
   }
 
   ModelConfig config = o.model;
+  CheckClipRates(train, config.frame_rate);
+  CheckClipRates(val, config.frame_rate);
   config.channels = config.ChannelsForInput();  // greyscale, as the seed (+ flow x, y), or Y Cr Cb
   if (!train.empty()) {
     double sum = 0, sum2 = 0;
