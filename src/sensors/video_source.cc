@@ -27,6 +27,7 @@ bool VideoFileSource::OpenCapture() {
 
 bool VideoFileSource::Open() {
   Close();
+  error_.clear();  // a reason from an earlier open must not be reported for this one
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path_, ec)) {
     error_ = "video file " + path_ + " does not exist or is not a file";
@@ -61,6 +62,13 @@ ReadStatus VideoFileSource::Read(Frame* frame, double max_wait_s) {
   if (!pending_valid_) {
     cv::Mat raw;
     if (!capture_.read(raw) || raw.empty()) {
+      // A file that opens but yields no frame at all (a broken stream, a codec OpenCV lacks) is
+      // an error, not an empty recording that ended.
+      if (sequence_ == 0) {
+        error_ = "video " + path_ + ": no frame could be decoded (broken file or unsupported codec?)";
+        Close();
+        return ReadStatus::kError;
+      }
       if (!loop_) return ReadStatus::kEnd;
       // Seeking back is unreliable across backends; reopening is not.
       if (!OpenCapture() || !capture_.read(raw) || raw.empty()) {

@@ -70,6 +70,26 @@ TEST_F(VideoSourceTest, LoopsWithIncreasingStamps) {
   EXPECT_EQ(source.Status().at("loops"), "2");
 }
 
+// A file with no frame that decodes is an error either way it shows: OpenCV refusing to open it,
+// or the first read finding nothing (it used to end like an empty recording, in silence).
+TEST_F(VideoSourceTest, AVideoWithoutFramesIsAnErrorNotAnEnd) {
+  const std::string empty = dir_ + "/empty.avi";
+  {
+    cv::VideoWriter writer(empty, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 12.5, cv::Size(64, 48));
+    ASSERT_TRUE(writer.isOpened());
+  }
+  FakeClock clock;
+  VideoFileSource source(empty, 30.0, true, &clock);
+  if (!source.Open()) {
+    EXPECT_NE(source.error().find(empty), std::string::npos) << source.error();
+    return;
+  }
+  Frame f;
+  EXPECT_EQ(source.Read(&f, 0.1), ReadStatus::kError);
+  EXPECT_NE(source.error().find("no frame could be decoded"), std::string::npos) << source.error();
+  EXPECT_FALSE(source.IsOpen());
+}
+
 TEST_F(VideoSourceTest, MissingFileIsAClearError) {
   FakeClock clock;
   VideoFileSource source(dir_ + "/nope.mp4", 30.0, false, &clock);
