@@ -120,15 +120,16 @@ class WindDisplayNode {
     return std::max(now, latest_stamp_);
   }
 
-  // Age of an input [s] at the display's now; infinity when there was none.
-  double Age(bool have, const ros::Time& stamp) const {
-    return have ? (DisplayNow() - stamp).toSec() : std::numeric_limits<double>::infinity();
+  // Age of an input [s] at `now` (the display's); infinity when there was none.
+  static double Age(bool have, const ros::Time& stamp, const ros::Time& now) {
+    return have ? (now - stamp).toSec() : std::numeric_limits<double>::infinity();
   }
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
     using diagnostic_msgs::DiagnosticStatus;
-    const double est_age = Age(have_estimate_, last_estimate_.header.stamp);
-    const double wind_age = Age(have_wind_, last_wind_.header.stamp);
+    const ros::Time now = DisplayNow();
+    const double est_age = Age(have_estimate_, last_estimate_.header.stamp, now);
+    const double wind_age = Age(have_wind_, last_wind_.header.stamp, now);
     stat.summary(DiagnosticStatus::OK, "showing estimate and anemometer");
     if (!(est_age <= stale_after_))
       stat.mergeSummary(DiagnosticStatus::WARN, have_estimate_ ? "estimate stale (shown as --)" : "no estimate yet");
@@ -156,8 +157,8 @@ class WindDisplayNode {
     const double t_now = stamp.toSec();
     const double mean = anemometer_.Mean(t_now, mean_window_);
     // A value older than it should be is not shown as if live (sdn_node died, the bag ended).
-    const bool est_live = Age(have_estimate_, last_estimate_.header.stamp) <= stale_after_;
-    const bool wind_live = Age(have_wind_, last_wind_.header.stamp) <= mean_window_;
+    const bool est_live = Age(have_estimate_, last_estimate_.header.stamp, stamp) <= stale_after_;
+    const bool wind_live = Age(have_wind_, last_wind_.header.stamp, stamp) <= mean_window_;
     const double est = est_live ? last_estimate_.speed : std::nan("");
     const double est_std = est_live ? last_estimate_.speed_std : std::nan("");
 

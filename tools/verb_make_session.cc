@@ -4,11 +4,6 @@
 // --frames procedural (default, fast: an OpenCV-drawn flag) or rendered (the flag simulated in the
 // session's wind and rendered by render/, with the anemometer's sentences from its sensor model
 // sampling the same wind field: data/rendered_flag_generator.h).
-#include <cstdlib>
-#include <cerrno>
-#include <signal.h>
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -23,6 +18,7 @@
 
 #include <clothwind/RawSentence.h>
 
+#include "common/atomic_file.h"
 #include "data/rendered_flag_generator.h"
 #include "progress_bar.h"
 #include "sensors/synthetic_session.h"
@@ -109,15 +105,12 @@ int Run(const MakeSessionArgs& a) {
     const fs::path folder = out.has_parent_path() ? out.parent_path() : fs::path(".");
     for (const auto& e : fs::directory_iterator(folder, ec)) {
       const std::string name = e.path().filename().string();
-      if (name.rfind(stem, 0) != 0) continue;
-      const long pid = std::strtol(name.c_str() + stem.size(), nullptr, 10);
-      if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
-        std::fprintf(stderr, "make-session: removing %s, left by a run that stopped\n", e.path().c_str());
-        fs::remove(e.path(), ec);
-      }
+      if (name.rfind(stem, 0) != 0 || !IsTemporaryOfStoppedProcess(name)) continue;
+      std::fprintf(stderr, "make-session: removing %s, left by a run that stopped\n", e.path().c_str());
+      fs::remove(e.path(), ec);
     }
   }
-  const std::string tmp = a.out + ".tmp-" + std::to_string(::getpid());
+  const std::string tmp = TemporaryNameFor(a.out);
   rosbag::Bag bag;
   bag.open(tmp, rosbag::bagmode::Write);
   if (a.compression == "lz4") bag.setCompression(rosbag::compression::LZ4);

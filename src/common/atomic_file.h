@@ -5,10 +5,12 @@
 #define CLOTHWIND_COMMON_ATOMIC_FILE_H_
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
@@ -59,6 +61,18 @@ inline void SyncDirectory(const std::string& dir) {
 inline std::string TemporaryNameFor(const std::string& path) {
   static std::atomic<unsigned long long> counter{0};
   return path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+}
+
+// Whether `name` (a file name) is a temporary TemporaryNameFor gave a process that no longer
+// runs: what a crash or Ctrl-C left behind, safe to clear. A live writer's are not.
+// Inputs: name, a file or folder name. Outputs: at, where ".tmp-" starts in it (may be null).
+inline bool IsTemporaryOfStoppedProcess(const std::string& name, size_t* at = nullptr) {
+  const size_t pos = name.rfind(".tmp-");
+  if (pos == std::string::npos) return false;
+  const long pid = std::strtol(name.c_str() + pos + 5, nullptr, 10);
+  if (pid <= 0 || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) return false;
+  if (at) *at = pos;
+  return true;
 }
 
 // Writes `bytes` to `path` through a temporary file in the same folder (WriteFileDurably), a

@@ -1,12 +1,11 @@
 #include "common/atomic_file.h"
 
-#include <signal.h>
-#include <sys/resource.h>
-
 #include <fstream>
 #include <sstream>
 
 #include <gtest/gtest.h>
+
+#include "common/scoped_file_size_limit.h"
 
 namespace clothwind {
 namespace {
@@ -52,22 +51,7 @@ TEST_F(AtomicFileTest, AFailedWriteKeepsTheOldContentAndLeavesNoTemporary) {
   WriteFileAtomically(p, std::string("old"));
   std::string message;
   {
-    // RLIMIT_FSIZE lowered and SIGXFSZ ignored for this scope only, restored however it is left.
-    struct Limit {
-      rlimit saved{};
-      sighandler_t handler;
-      Limit() {
-        ::getrlimit(RLIMIT_FSIZE, &saved);
-        handler = ::signal(SIGXFSZ, SIG_IGN);
-        rlimit small = saved;
-        small.rlim_cur = 16;
-        ::setrlimit(RLIMIT_FSIZE, &small);
-      }
-      ~Limit() {
-        ::setrlimit(RLIMIT_FSIZE, &saved);
-        ::signal(SIGXFSZ, handler);
-      }
-    } limit;
+    const ScopedFileSizeLimit full_disk(16);
     try {
       WriteFileAtomically(p, std::string(1000, 'x'));
     } catch (const std::exception& e) {

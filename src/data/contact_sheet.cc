@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/dataset_names.h"
 #include "data/dataset_index.h"
 #include "render/sensor_model.h"
 
@@ -55,7 +56,7 @@ cv::Mat MakeContactSheet(const std::string& dir, const nlohmann::json& index,
     if (!c.is_object() || !c.contains("name") || !c["name"].is_string())
       throw std::runtime_error(where + ".name must be a string");
     const std::string name = c["name"].get<std::string>();
-    if (name.empty() || name[0] == '.' || name.find('/') != std::string::npos)
+    if (!ValidClipName(name))
       throw std::runtime_error(where + ".name must be a folder name, got \"" + name + "\"");
     const bool has_wind = c.contains("wind_speed") && c["wind_speed"].is_number();
     items.push_back({name, has_wind ? c["wind_speed"].get<double>() : NAN});

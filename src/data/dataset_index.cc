@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "common/frame_pattern.h"
+#include "common/dataset_names.h"
 #include "sim/trajectory_io.h"
 
 namespace clothwind::data {

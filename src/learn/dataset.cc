@@ -15,7 +15,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "common/frame_pattern.h"
+#include "common/dataset_names.h"
 #include "learn/fly_judge.h"
 #include "learn/model_config.h"
 
@@ -79,7 +79,7 @@ Dataset ReadDataset(const fs::path& dir) {
     const nlohmann::json& entry = index["clips"][i];
     ClipInfo clip;
     clip.name = Field<std::string>(entry, "name", index_path, "a string");
-    if (clip.name.empty() || clip.name.find('/') != std::string::npos || clip.name[0] == '.') {
+    if (!ValidClipName(clip.name)) {
       throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
                                "].name must be a folder name, got \"" + clip.name + "\"");
     }

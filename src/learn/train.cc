@@ -132,18 +132,20 @@ void SaveAtomically(T& object, const fs::path& path) {
   WriteFileAtomically(path, bytes.str());
 }
 
-}  // namespace
-
-fs::path CheckpointDir(const fs::path& out) {
-  const fs::path state_path = out / "state.json";
+// A run's state.json, parsed. Throws std::runtime_error naming it when it cannot be read.
+nlohmann::json ReadState(const fs::path& state_path) {
   std::ifstream in(state_path);
   if (!in) throw std::runtime_error(state_path.string() + ": cannot open (nothing to resume)");
-  nlohmann::json state;
   try {
-    state = nlohmann::json::parse(in);
+    return nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(state_path.string() + ": " + e.what());
   }
+}
+
+// The checkpoint folder `state` (out/state.json, parsed) names; see CheckpointDir.
+fs::path CheckpointDirOf(const nlohmann::json& state, const fs::path& out) {
+  const fs::path state_path = out / "state.json";
   // Runs written before checkpoint folders kept last.pt, ... beside state.json.
   if (!state.contains("checkpoint")) return out;
   if (!state["checkpoint"].is_string())
@@ -153,6 +155,10 @@ fs::path CheckpointDir(const fs::path& out) {
     throw std::runtime_error(state_path.string() + ": its checkpoint " + dir.string() + " is missing");
   return dir;
 }
+
+}  // namespace
+
+fs::path CheckpointDir(const fs::path& out) { return CheckpointDirOf(ReadState(out / "state.json"), out); }
 
 namespace {
 
@@ -317,10 +323,8 @@ TrainResult Train(const TrainOptions& o) {
   const fs::path state_path = o.out / "state.json";
   nlohmann::json state;
   if (o.resume) {
-    std::ifstream in(state_path);
-    if (!in) throw std::runtime_error(state_path.string() + ": cannot open (nothing to resume)");
+    state = ReadState(state_path);
     try {
-      state = nlohmann::json::parse(in);
       config = ModelConfigFromJson(state.at("model"), state_path.string());
       for (const auto& e : state.at("log")) result.log.push_back(EpochFromJson(e));
     } catch (const nlohmann::json::exception& e) {
@@ -401,7 +405,7 @@ TrainResult Train(const TrainOptions& o) {
   torch::optim::Adam optimizer(net->parameters(), torch::optim::AdamOptions(o.lr).weight_decay(o.weight_decay));
   // The checkpoint state.json names (resume): the weights, their average and Adam's moments of
   // its epoch, whatever a run stopped while saving the next one left beside them.
-  const fs::path resume_from = o.resume ? CheckpointDir(o.out) : fs::path();
+  const fs::path resume_from = o.resume ? CheckpointDirOf(state, o.out) : fs::path();
   if (o.resume) {
     // Loaded onto the CPU whatever device wrote them, then moved with the network.
     torch::load(net, (resume_from / "last.pt").string(), at::Device(at::kCPU));

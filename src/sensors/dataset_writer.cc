@@ -1,18 +1,10 @@
 #include "sensors/dataset_writer.h"
 
-#include <fcntl.h>
-#include <signal.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 #include <opencv2/imgcodecs.hpp>
@@ -27,11 +19,6 @@ constexpr int kFormatVersion = 1;
 
 // NaN and inf become null in JSON (nlohmann does that too, but say it explicitly).
 nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-std::string TempSuffix() {
-  static uint64_t counter = 0;
-  return ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-}
 
 }  // namespace
 
@@ -117,7 +104,7 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
   if (clip.clip.frames.empty()) throw std::invalid_argument("cannot record an empty clip");
   const std::string name = ClipFolderName(clip.clip.frames.front().stamp, clip.clip.sequence);
   const std::string final_dir = root_ + "/" + name;
-  const std::string tmp_dir = root_ + "/." + name + TempSuffix();
+  const std::string tmp_dir = TemporaryNameFor(root_ + "/." + name);
   std::error_code ec;
   fs::create_directory(tmp_dir, ec);
   if (ec) throw std::runtime_error("cannot create " + tmp_dir + ": " + ec.message());
@@ -136,7 +123,7 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
     if (fs::exists(final_dir)) {  // replayed again: replace the old folder
       // Two renames, not one: rename() cannot replace a non-empty folder. If the second fails the
       // old copy is put back, so the name never stays empty or hidden.
-      const std::string old_dir = root_ + "/." + name + ".old" + TempSuffix();
+      const std::string old_dir = TemporaryNameFor(root_ + "/." + name + ".old");
       fs::rename(final_dir, old_dir);
       try {
         fs::rename(tmp_dir, final_dir);
@@ -189,10 +176,8 @@ size_t DatasetWriter::RecoverLeftovers() {
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(root_, ec)) {
     const std::string file = entry.path().filename().string();
-    const size_t at = file.rfind(".tmp-");
-    if (at == std::string::npos) continue;
-    const long pid = std::strtol(file.c_str() + at + 5, nullptr, 10);
-    if (pid <= 0 || (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM)) continue;  // still writing
+    size_t at = 0;
+    if (!IsTemporaryOfStoppedProcess(file, &at)) continue;  // not a temporary, or still being written
     const bool old_copy = file.size() > 5 && file.compare(at - 4, 4, ".old") == 0 && file[0] == '.';
     const std::string clip = old_copy ? file.substr(1, at - 5) : "";
     if (old_copy && !fs::exists(root_ + "/" + clip)) {

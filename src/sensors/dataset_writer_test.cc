@@ -1,7 +1,5 @@
 #include "sensors/dataset_writer.h"
 
-#include <signal.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -12,30 +10,11 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "common/scoped_file_size_limit.h"
+
 namespace clothwind::sensors {
 namespace {
 namespace fs = std::filesystem;
-
-// RLIMIT_FSIZE lowered (a full disk, even for root) while it lives, with SIGXFSZ ignored so the
-// write fails instead of killing the process; both restored however the scope is left.
-class FileSizeLimit {
- public:
-  explicit FileSizeLimit(rlim_t bytes) {
-    ::getrlimit(RLIMIT_FSIZE, &saved_);
-    handler_ = ::signal(SIGXFSZ, SIG_IGN);
-    rlimit small = saved_;
-    small.rlim_cur = bytes;
-    ::setrlimit(RLIMIT_FSIZE, &small);
-  }
-  ~FileSizeLimit() {
-    ::setrlimit(RLIMIT_FSIZE, &saved_);
-    ::signal(SIGXFSZ, handler_);
-  }
-
- private:
-  rlimit saved_{};
-  sighandler_t handler_;
-};
 
 class DatasetWriterTest : public ::testing::Test {
  protected:
@@ -183,7 +162,7 @@ TEST_F(DatasetWriterTest, FailedWriteKeepsTheOldCopyAndLeavesNoTemporary) {
 
   std::string message;
   {
-    const FileSizeLimit full_disk(64);  // bytes: smaller than any JPEG frame
+    const ScopedFileSizeLimit full_disk(64);  // bytes: smaller than any JPEG frame
     try {
       w.Write(MakeClip(0, 1700000000.0, 3), {});
     } catch (const std::exception& e) {

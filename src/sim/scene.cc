@@ -72,12 +72,12 @@ class Reader {
   int Integer(const json& j, const std::string& path) const {
     if (!j.is_number_integer()) Fail(path, std::string("expected an integer, got ") + TypeName(j));
     // get<int> wraps 4294967297 to 1: out of int's range is an error, not another number.
-    const int64_t v = j.is_number_unsigned() && j.get<uint64_t>() > static_cast<uint64_t>(INT64_MAX)
-                          ? INT64_MAX
-                          : j.get<int64_t>();
-    if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
-      Fail(path, "expected an integer within int's range, got " + j.dump());
-    return static_cast<int>(v);
+    const bool in_range = j.is_number_unsigned()
+                              ? j.get<uint64_t>() <= static_cast<uint64_t>(std::numeric_limits<int>::max())
+                              : j.get<int64_t>() >= std::numeric_limits<int>::min() &&
+                                    j.get<int64_t>() <= std::numeric_limits<int>::max();
+    if (!in_range) Fail(path, "expected an integer within int's range, got " + j.dump());
+    return j.get<int>();
   }
   std::string String(const json& j, const std::string& path) const {
     if (!j.is_string()) Fail(path, std::string("expected a string, got ") + TypeName(j));

@@ -1,10 +1,17 @@
-#ifndef CLOTHWIND_COMMON_FRAME_PATTERN_H_
-#define CLOTHWIND_COMMON_FRAME_PATTERN_H_
+#ifndef CLOTHWIND_COMMON_DATASET_NAMES_H_
+#define CLOTHWIND_COMMON_DATASET_NAMES_H_
 
 #include <cctype>
 #include <string>
 
+// Names a dataset's files hold (docs/dataset.md) and readers check before using them.
 namespace clothwind {
+
+// Whether `name` is a clip folder name as index.json's clips[i].name: one folder inside the
+// dataset, not a path out of it ("../x", "/tmp/x") and not hidden (writers' temporaries).
+inline bool ValidClipName(const std::string& name) {
+  return !name.empty() && name[0] != '.' && name.find('/') == std::string::npos;
+}
 
 // Whether `p` is a frame file pattern as label.json's "frame_pattern" (docs/dataset.md): a printf
 // pattern with exactly one integer conversion and nothing else printf would read ("%03d.jpg"),
@@ -21,4 +28,4 @@ inline bool ValidFramePattern(const std::string& p) {
 
 }  // namespace clothwind
 
-#endif  // CLOTHWIND_COMMON_FRAME_PATTERN_H_
+#endif  // CLOTHWIND_COMMON_DATASET_NAMES_H_
