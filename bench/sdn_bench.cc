@@ -4,8 +4,11 @@
 // and 2 threads (the goal: <= 50 ms per 30-frame clip on 2 cores at the shipped size). Models are
 // initialised in a temporary folder (speed does not depend on the weights). Prints a table.
 // --model benches given trained models (e.g. the shipped models/sdn.pt) instead of the
-// initialised ones; --flag-flies auto adds judging each clip's way from its motion, as sdn_node
-// does for a model trained without flips (learn/fly_direction.h). The convolutions run in
+// initialised ones. Clips are read as filmed (--flag-flies right) unless --flag-flies says
+// otherwise: auto adds judging each clip's way (with the fly judge beside a model when there is
+// one), as sdn_node does for a model trained without flips (learn/fly_direction.h). (Before
+// 2026-12-05 the default was the model's own, auto for the shipped model: its "as filmed" rows
+// judged too.) The row names the way. The convolutions run in
 // channels-last order, as the Predictor runs them on the CPU; --both-orders times each model in
 // torch's default order too (column "order": nhwc, nchw), to show what that order saves.
 //
@@ -105,7 +108,7 @@ int main(int argc, char** argv) {
     for (int threads : {1, 2}) {
       for (bool channels_last : both_orders ? std::vector<bool>{true, false} : std::vector<bool>{true}) {
         cl::Predictor p(model, threads, "cpu", channels_last);
-        if (!flag_flies.empty()) p.set_flag_flies(way);
+        p.set_flag_flies(way);
         const bool colour = p.config().colour;
         const std::vector<cv::Mat>& clip = colour ? bgr_frames : grey_frames;
         p.PredictFrames(cl::CameraFramesForModel(clip, colour));  // warm-up, as the node does
@@ -121,7 +124,7 @@ int main(int argc, char** argv) {
         double mean = 0;
         for (double m : ms) mean += m;
         mean /= ms.size();
-        const std::string name = p.config().Name() + (flag_flies.empty() ? "" : " " + flag_flies);
+        const std::string name = p.config().Name() + " " + cl::FlagFliesName(way);
         std::printf("%-28s %7d %5s %10.1f %10.1f %10.1f %14.1f\n", name.c_str(), threads,
                     channels_last ? "nhwc" : "nchw", mean, ms[std::min(ms.size() - 1, ms.size() * 9 / 10)], ms.front(),
                     cpu);

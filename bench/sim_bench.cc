@@ -36,8 +36,10 @@ std::string DefaultScene() {
   return std::string(src ? src : ".") + "/config/scenes/flag.json";
 }
 
-// ArcSim's wall seconds per simulated second on the flag (the reference's table; its lower
-// ends, i.e. ArcSim's best case; 6 m/s was not measured).
+// ArcSim's wall seconds per simulated second on the flag (the reference's table, its lower
+// ends; 6 m/s was not measured). Two ArcSim jobs shared the reference machine's 2 cores, so
+// these are upper bounds, perhaps 1.5-2x what ArcSim takes alone: the "x faster" column may
+// overstate our speed-up by that factor.
 double ArcSimWallPerSimSecond(double wind) {
   static const std::map<double, double> figures = {{1.0, 21 * 60.0}, {3.0, 16 * 60.0}, {10.0, 9 * 60.0}};
   auto it = figures.find(wind);

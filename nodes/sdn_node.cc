@@ -161,6 +161,7 @@ class SdnNode {
                predictor->device().c_str(), threads_, 1e3 * warm,
                clothwind::learn::FlagFliesName(predictor->flag_flies()).c_str());
       predictor_ = std::move(predictor);
+      loaded_wall_ = ros::WallTime::now().toSec();
       load_error_.clear();
     } catch (const std::exception& e) {
       if (load_error_ != e.what()) ROS_ERROR("sdn_node: cannot load the model: %s (retrying)", e.what());
@@ -205,7 +206,11 @@ class SdnNode {
       clothwind::learn::PeakMaps maps;
       const clothwind::learn::Prediction p = predictor_->PredictFrames(frames, want_maps ? &maps : nullptr);
       const double latency = std::chrono::duration<double>(std::chrono::steady_clock::now() - received).count();
-      const clothwind::WindEstimate estimate = clothwind::ros_bridge::ToWindEstimate(*clip, p, latency, model_name_);
+      const clothwind::WindEstimate estimate = clothwind::ros_bridge::ToWindEstimate(
+          *clip, p, latency, model_name_, static_cast<uint32_t>(predictor_->config().frames));
+      // In ROS time, so a replay's is the bag's: the delay a reader of the estimate sees, queue included.
+      ages_.push_back((ros::Time::now() - estimate.clip_end).toSec());
+      if (ages_.size() > 50) ages_.pop_front();
       estimate_pub_.publish(estimate);
       PublishMean(estimate);
       if (want_maps && !maps.power.empty()) PublishMaps(*clip, maps);
@@ -307,16 +312,21 @@ class SdnNode {
     if (!latencies_.empty()) mean /= latencies_.size();
     const double now = ros::WallTime::now().toSec();
     TrimRate(now);
-    // Estimates over the last 30 s (or since the first, when that is more recent).
-    const double rate = stamps_.size() > 1 ? stamps_.size() / std::max(now - stamps_.front(), 1e-9) : 0.0;
-    const double idle = estimates_ > 0 ? now - last_estimate_wall_ : 0.0;
+    // Estimates over the last 30 s: the intervals between them, N - 1 over the time they span
+    // (N over the time since the first one overstated it until the window filled).
+    const double rate =
+        stamps_.size() > 1 ? (stamps_.size() - 1) / std::max(stamps_.back() - stamps_.front(), 1e-9) : 0.0;
+    // Before the first estimate, the time since the model loaded: a node whose clips never come (a
+    // wrong remap, no clip buffer) said OK "estimating" for ever.
+    const double idle = estimates_ > 0 ? now - last_estimate_wall_ : predictor_ ? now - loaded_wall_ : 0.0;
     if (!predictor_) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no model: " + load_error_);
     } else if (!clip_error_.empty()) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, clip_error_);
     } else if (idle > 10.0) {
-      char what[96];
-      std::snprintf(what, sizeof what, "no clip for %.0f s (is the clip buffer, camera or bag running?)", idle);
+      char what[112];
+      std::snprintf(what, sizeof what, "%s for %.0f s (is the clip buffer, camera or bag running?)",
+                    estimates_ > 0 ? "no clip" : "no clip received yet", idle);
       stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, what);
     } else if (!judge_error_.empty()) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "estimating; ~fly_judge did not load: " + judge_error_);
@@ -341,6 +351,9 @@ class SdnNode {
     stat.add("latency mean [s]", mean);
     stat.add("latency max [s]", max);
     stat.add("rate [clips/s]", rate);
+    double age = 0;
+    for (double a : ages_) age += a;
+    stat.add("clip age at estimate, mean [s]", ages_.empty() ? 0.0 : age / ages_.size());
     stat.add("estimates", estimates_);
     const std::string way = predictor_ ? clothwind::learn::FlagFliesName(predictor_->flag_flies()) : "-";
     stat.add("flag flies", follow_wind_ ? "wind: " + way : way);
@@ -377,13 +390,14 @@ class SdnNode {
   double camera_heading_ = 0, end_on_ = 0;                       // [rad], for follow_wind_
   int threads_ = 2;
   std::unique_ptr<clothwind::learn::Predictor> predictor_;
-  std::deque<double> latencies_, stamps_;
+  std::deque<double> latencies_, stamps_, ages_;  // ages_: [s] ROS time from clip end to its estimate
   clothwind::sensors::TrailingMean trailing_;
   std::deque<std::pair<double, ros::Time>> starts_;  // (clip end [s], clip start) of the averaged clips
   uint64_t estimates_ = 0, errors_ = 0, model_errors_ = 0, dropped_ = 0, turned_ = 0, wind_unknown_ = 0;
   uint64_t missing_ = 0, mean_restarts_ = 0, last_sequence_ = 0;
   bool have_sequence_ = false;
   double last_estimate_wall_ = 0;                  // [s] wall time of the last estimate
+  double loaded_wall_ = 0;                         // [s] wall time the model loaded
   std::string clip_error_;                          // the last clip's failure; cleared by a good clip
   std::vector<std::string> parameter_errors_;       // parameters out of range (their defaults used)
   static inline std::string mean_window_error_;     // MeanWindow runs before the members exist

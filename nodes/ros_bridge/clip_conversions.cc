@@ -5,21 +5,52 @@
 #include <limits>
 #include <stdexcept>
 
+#include <cv_bridge/cv_bridge.h>
+#include <sensor_msgs/image_encodings.h>
+
 namespace clothwind::ros_bridge {
 
+namespace {
+
+// Whether the clip core reads `msg`'s layout as it is (ParseClipSourceEncoding; mono16 only in
+// this machine's byte order, little-endian).
+bool ReadAsItIs(const sensor_msgs::Image& msg) {
+  try {
+    const sensors::ClipSourceEncoding e = sensors::ParseClipSourceEncoding(msg.encoding);
+    return !(e == sensors::ClipSourceEncoding::kMono16 && msg.is_bigendian);
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 void ImageView(const sensor_msgs::Image& msg, cv::Mat* view, sensors::ClipSourceEncoding* encoding) {
+  if (msg.width == 0 || msg.height == 0) throw std::invalid_argument("image is empty (width or height 0)");
+  if (!ReadAsItIs(msg)) {
+    // cv_bridge's conversions (debayering, YUV, depth and byte order) rather than our own; its
+    // own checks of step and size stand in for the ones below.
+    try {
+      *view = cv_bridge::toCvCopy(msg, sensor_msgs::image_encodings::BGR8)->image;
+    } catch (const cv_bridge::Exception& e) {
+      throw std::invalid_argument("image encoding '" + msg.encoding + "' not supported (" + e.what() +
+                                  "); expected mono8, mono16, bgr8, rgb8, bgra8, rgba8 or one cv_bridge "
+                                  "converts to bgr8 (bayer_*, yuv422, 16-bit colour)");
+    } catch (const cv::Exception& e) {
+      throw std::invalid_argument("image encoding '" + msg.encoding + "': cannot convert (" + e.err + ")");
+    }
+    *encoding = sensors::ClipSourceEncoding::kBgr8;
+    return;
+  }
   *encoding = sensors::ParseClipSourceEncoding(msg.encoding);
   const int type = sensors::ClipSourceCvType(*encoding);
   const size_t row_bytes = static_cast<size_t>(msg.width) * CV_ELEM_SIZE(type);
-  if (msg.width == 0 || msg.height == 0) throw std::invalid_argument("image is empty (width or height 0)");
   if (msg.step < row_bytes)
     throw std::invalid_argument("image step " + std::to_string(msg.step) + " < width * pixel size " +
                                 std::to_string(row_bytes));
   if (msg.data.size() < static_cast<size_t>(msg.step) * msg.height)
     throw std::invalid_argument("image data has " + std::to_string(msg.data.size()) + " bytes, expected step * height = " +
                                 std::to_string(static_cast<size_t>(msg.step) * msg.height));
-  if (*encoding == sensors::ClipSourceEncoding::kMono16 && msg.is_bigendian)
-    throw std::invalid_argument("big-endian mono16 images are not supported");
   *view = cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width), type,
                   const_cast<uint8_t*>(msg.data.data()), msg.step);
 }

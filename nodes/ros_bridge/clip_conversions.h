@@ -16,11 +16,15 @@
 
 namespace clothwind::ros_bridge {
 
-// Wraps an Image message's pixels as a cv::Mat (no copy: valid while `msg` lives).
+// Wraps an Image message's pixels as a cv::Mat: no copy for the layouts the clip core reads
+// (mono8, mono16 little-endian, bgr8, rgb8, bgra8, rgba8; the view is valid while `msg` lives);
+// any other layout cv_bridge knows (the Bayer mosaics of industrial cameras, the YUV 4:2:2 of
+// UVC ones, 16-bit colour, big-endian 16-bit grey) is converted by it to bgr8, a copy the view
+// owns.
 // Inputs:
-//   msg  image in mono8, mono16, bgr8, rgb8, bgra8 or rgba8 (little-endian for mono16)
+//   msg  an image
 // Outputs:
-//   view      msg.height x msg.width matrix over msg.data (respecting msg.step)
+//   view      msg.height x msg.width matrix
 //   encoding  its layout
 // Throws std::invalid_argument naming the field (encoding, step, data size) that is wrong.
 void ImageView(const sensor_msgs::Image& msg, cv::Mat* view, sensors::ClipSourceEncoding* encoding);

@@ -19,6 +19,14 @@ std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg) {
                                 std::to_string(msg.num_frames) + ", " + std::to_string(msg.width) + ", " +
                                 std::to_string(msg.height) + ")");
   }
+  // Bounded before they are multiplied: sizes whose product wraps round 2^64 once passed the
+  // data size check with a few bytes, and the frames then read far outside them (a crash).
+  if (msg.width > kMaxClipSide || msg.height > kMaxClipSide || msg.num_frames > kMaxClipFrames) {
+    throw std::invalid_argument("Clip width and height must be at most " + std::to_string(kMaxClipSide) +
+                                " px and num_frames at most " + std::to_string(kMaxClipFrames) + " (got " +
+                                std::to_string(msg.width) + " x " + std::to_string(msg.height) + ", " +
+                                std::to_string(msg.num_frames) + " frames)");
+  }
   const size_t frame = static_cast<size_t>(msg.width) * msg.height * channels;
   const size_t expected = frame * msg.num_frames;
   if (msg.data.size() != expected) {
@@ -30,6 +38,12 @@ std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg) {
   if (!msg.frame_stamps.empty() && msg.frame_stamps.size() != msg.num_frames) {
     throw std::invalid_argument("Clip.frame_stamps has " + std::to_string(msg.frame_stamps.size()) +
                                 " stamps for num_frames = " + std::to_string(msg.num_frames));
+  }
+  // A clip stamped 0 (a publisher that never set the stamp) would be estimated at the epoch, and
+  // every such estimate at the same time: the trailing mean would never let one go.
+  if (msg.frame_stamps.empty() ? msg.header.stamp.isZero() : msg.frame_stamps.front().isZero()) {
+    throw std::invalid_argument(std::string(msg.frame_stamps.empty() ? "Clip.header.stamp" : "Clip.frame_stamps[0]") +
+                                " is 0 (unset); a clip is stamped with its first frame's capture time");
   }
   for (size_t i = 1; i < msg.frame_stamps.size(); ++i) {
     if (!(msg.frame_stamps[i] > msg.frame_stamps[i - 1])) {
@@ -57,6 +71,11 @@ void CheckClipFrameRate(const clothwind::Clip& msg, double model_rate) {
   }
 }
 
+ros::Time ClipFrameStamp(const clothwind::Clip& clip, uint32_t i) {
+  if (i < clip.frame_stamps.size()) return clip.frame_stamps[i];
+  return clip.header.stamp + ros::Duration(clip.frame_rate > 0 ? i / clip.frame_rate : 0.0);
+}
+
 ros::Time ClipEnd(const clothwind::Clip& clip) {
   if (!clip.frame_stamps.empty()) return clip.frame_stamps.back();
   // header.stamp is the first frame's: the last one is num_frames - 1 periods later.
@@ -65,12 +84,14 @@ ros::Time ClipEnd(const clothwind::Clip& clip) {
 }
 
 clothwind::WindEstimate ToWindEstimate(const clothwind::Clip& clip, const learn::Prediction& prediction,
-                                       double latency, const std::string& model) {
+                                       double latency, const std::string& model, uint32_t frames_read) {
   clothwind::WindEstimate e;
   e.header.frame_id = clip.header.frame_id;
   e.header.stamp = ClipEnd(clip);
   e.clip_sequence = clip.sequence;
-  e.clip_start = clip.frame_stamps.empty() ? clip.header.stamp : clip.frame_stamps.front();
+  // The model reads the clip's last frames_read frames: the estimate is of those.
+  const uint32_t first = frames_read > 0 && frames_read < clip.num_frames ? clip.num_frames - frames_read : 0;
+  e.clip_start = ClipFrameStamp(clip, first);
   e.clip_end = e.header.stamp;
   e.speed = prediction.speed;
   e.speed_std = prediction.speed_std;

@@ -16,15 +16,24 @@
 
 namespace clothwind::ros_bridge {
 
+// Bounds of a Clip message's sizes (a 16K camera; the datasets' bound on frames per clip).
+constexpr uint32_t kMaxClipSide = 16384;
+constexpr uint32_t kMaxClipFrames = 100000;
+
 // The frames of a Clip as num_frames images viewing msg.data (no copy: valid while `msg` lives):
 // CV_8UC1 for a mono8 clip, CV_8UC3 BGR for a bgr8 one. Throws std::invalid_argument naming the
-// field that is inconsistent (encoding, num_frames, width/height, data length, frame_stamps count,
-// frame_stamps not strictly increasing).
+// field that is inconsistent (encoding, num_frames, width/height out of 1..kMaxClipSide or
+// 1..kMaxClipFrames, data length, frame_stamps count, frame_stamps not strictly increasing, a
+// first frame stamped 0).
 std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg);
 
 // Throws std::invalid_argument naming Clip.frame_rate when it is not within 1 % of `model_rate`
 // [Hz], the rate the model was trained at (its spectra are in Hz).
 void CheckClipFrameRate(const clothwind::Clip& msg, double model_rate);
+
+// The stamp of the clip's frame i: frame_stamps[i], or, for a clip without frame_stamps,
+// header.stamp (its first frame's) plus i / frame_rate.
+ros::Time ClipFrameStamp(const clothwind::Clip& clip, uint32_t i);
 
 // The stamp of the clip's last frame: frame_stamps.back(), or, for a clip without frame_stamps,
 // header.stamp (its first frame's) plus (num_frames - 1) / frame_rate.
@@ -34,12 +43,13 @@ ros::Time ClipEnd(const clothwind::Clip& clip);
 // Inputs:
 //   clip        the clip it came from (stamps, sequence, frame_id, anemometer label)
 //   prediction  speed and its standard deviation [m/s]
-//   latency     seconds from receiving the clip to publishing [s]
+//   latency     seconds from taking the clip off the queue to publishing [s]
 //   model       model name for the message
-// The header stamp is the clip's last frame stamp (ClipEnd);
+//   frames_read the frames the model read, the clip's last ones (0: all of them)
+// The header stamp is the clip's last frame stamp (ClipEnd), clip_start the first frame read's;
 // reference_speed is the clip's wind_mean, NaN when no anemometer reading fell in its window.
 clothwind::WindEstimate ToWindEstimate(const clothwind::Clip& clip, const learn::Prediction& prediction,
-                                       double latency, const std::string& model);
+                                       double latency, const std::string& model, uint32_t frames_read = 0);
 
 // A bgr8 Image message holding a copy of `bgr` (CV_8UC3).
 sensor_msgs::ImagePtr BgrImageMsg(const cv::Mat& bgr, const std_msgs::Header& header);

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/dataset_names.h"
+#include "common/image_file.h"
 #include "data/dataset_index.h"
 #include "render/sensor_model.h"
 
@@ -78,8 +79,9 @@ cv::Mat MakeContactSheet(const std::string& dir, const nlohmann::json& index,
     const nlohmann::json label = ReadLabel((folder / "label.json").string());
     const int middle = label["num_frames"].get<int>() / 2;
     const std::string file = (folder / FrameFile(label["frame_pattern"].get<std::string>(), middle)).string();
-    cv::Mat frame = cv::imread(file, cv::IMREAD_COLOR);
-    if (frame.empty()) throw std::runtime_error("contact sheet: cannot read " + file);
+    std::string why;
+    const cv::Mat frame = common::ReadImageFile(file, cv::IMREAD_COLOR, &why);
+    if (frame.empty()) throw std::runtime_error("contact sheet: cannot read " + file + " (" + why + ")");
     cv::Mat tile;
     cv::resize(frame, tile, cv::Size(o.tile, o.tile), 0, 0, cv::INTER_AREA);
     char wind[32];

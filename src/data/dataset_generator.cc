@@ -22,6 +22,7 @@
 #include <tbb/task_arena.h>
 
 #include "common/atomic_file.h"
+#include "common/image_file.h"
 #include "data/cloth_animation.h"
 #include "data/contact_sheet.h"
 #include "data/dataset_index.h"
@@ -206,8 +207,9 @@ void CheckReplay(const fs::path& example, int last_frame, const std::string& ext
   char file[32];
   std::snprintf(file, sizeof(file), "%03d.%s", last_frame, ext.c_str());
   const fs::path path = example / file;
-  const cv::Mat stored = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
-  if (stored.empty()) throw std::runtime_error("cannot read " + path.string());
+  std::string why;
+  const cv::Mat stored = common::ReadImageFile(path, cv::IMREAD_GRAYSCALE, &why);
+  if (stored.empty()) throw std::runtime_error("cannot read " + path.string() + " (" + why + ")");
   cv::Mat grey;
   cv::cvtColor(rendered, grey, cv::COLOR_BGR2GRAY);
   if (stored.size() != grey.size())

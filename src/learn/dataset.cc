@@ -16,6 +16,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "common/dataset_names.h"
+#include "common/image_file.h"
 #include "learn/fly_judge.h"
 #include "learn/model_config.h"
 
@@ -75,6 +76,7 @@ Dataset ReadDataset(const fs::path& dir) {
     throw std::runtime_error(index_path.string() + ": missing field \"clips\" (an array)");
   }
   std::map<std::string, size_t> seen;  // name -> its first entry
+  std::map<int, std::pair<std::string, std::string>> simulation_split;  // simulation -> (split, a clip's name)
   for (size_t i = 0; i < index["clips"].size(); ++i) {
     const nlohmann::json& entry = index["clips"][i];
     ClipInfo clip;
@@ -109,6 +111,7 @@ Dataset ReadDataset(const fs::path& dir) {
       throw std::runtime_error(label_path.string() + ": field \"encoding\" must be \"mono8\" or \"rgb8\", got \"" +
                                encoding + "\"");
     }
+    clip.encoding = encoding;
     // Each checked by name with its value. Bounds: a wind no anemometer reads (misread units, a
     // corrupt label) must not be scored; a frame count or size no camera makes must not size a
     // frame cache (num_frames 2e9 asked for 512 GB before reading a frame).
@@ -119,6 +122,17 @@ Dataset ReadDataset(const fs::path& dir) {
     };
     check(std::isfinite(clip.wind_speed) && clip.wind_speed >= 0 && clip.wind_speed <= 100,
           "wind_speed", std::to_string(clip.wind_speed), "a speed in 0..100 m/s");
+    // The index repeats each clip's wind (tools sort and pick clips by it); two winds for one clip
+    // mean one file was edited or belongs to another dataset, and which one the scores used
+    // would be a guess.
+    if (entry.contains("wind_speed")) {
+      const double listed = Field<double>(entry, "wind_speed", index_path, "a number [m/s]");
+      if (!(std::abs(listed - clip.wind_speed) <= 1e-6 * std::max(1.0, std::abs(clip.wind_speed)))) {
+        throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) + "].wind_speed is " +
+                                 std::to_string(listed) + " m/s but " + label_path.string() + " says " +
+                                 std::to_string(clip.wind_speed));
+      }
+    }
     check(clip.num_frames >= 1 && clip.num_frames <= 100000, "num_frames", std::to_string(clip.num_frames),
           "in 1..100000");
     check(std::isfinite(clip.frame_rate) && clip.frame_rate > 0 && clip.frame_rate <= 10000, "frame_rate",
@@ -137,13 +151,33 @@ Dataset ReadDataset(const fs::path& dir) {
       throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
                                "].split must be \"train\", \"val\" or \"test\", got \"" + clip.split + "\"");
     }
+    if (entry.contains("split") && label.contains("split") && label["split"] != entry["split"]) {
+      throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) + "].split is " +
+                               entry["split"].dump() + " but " + label_path.string() + " says " +
+                               label["split"].dump());
+    }
+    // The views of one simulation share its flag's motion: in two splits, a test clip's motion is
+    // trained on (the leak docs/sdn.md measures). The generator splits by simulation; a merged or
+    // re-indexed dataset might not.
+    if (clip.simulation >= 0) {
+      const auto [it, fresh] = simulation_split.emplace(clip.simulation, std::make_pair(clip.split, clip.name));
+      if (!fresh && it->second.first != clip.split) {
+        throw std::runtime_error(index_path.string() + ": simulation " + std::to_string(clip.simulation) +
+                                 " has clips in two splits (\"" + it->second.second + "\" in " + it->second.first +
+                                 ", \"" + clip.name + "\" in " + clip.split +
+                                 "): its views share one motion, so a split must hold all of them");
+      }
+    }
     dataset.clips.push_back(std::move(clip));
   }
   return dataset;
 }
 
-void CheckClipRates(const std::vector<ClipInfo>& clips, double model_rate) {
+void CheckClipsSuitModel(const std::vector<ClipInfo>& clips, double model_rate, bool colour) {
   for (const ClipInfo& c : clips) {
+    if (colour && c.encoding == "mono8")
+      throw std::runtime_error((c.dir / "label.json").string() +
+                               ": field \"encoding\" is \"mono8\", the model reads colour (rgb8) clips");
     if (std::abs(c.frame_rate - model_rate) > 0.01 * model_rate)
       throw std::runtime_error((c.dir / "label.json").string() + ": field \"frame_rate\" is " +
                                std::to_string(c.frame_rate) + " Hz, the model reads clips at " +
@@ -173,13 +207,10 @@ std::vector<cv::Mat> LoadFrames(const ClipInfo& clip, int first, int count, bool
   for (int i = first; i < first + count; ++i) {
     const fs::path path = clip.dir / FrameName(clip, i);
     if (!fs::exists(path)) throw std::runtime_error(path.string() + ": missing frame");
-    cv::Mat image;
-    try {
-      image = cv::imread(path.string(), colour ? cv::IMREAD_COLOR : cv::IMREAD_GRAYSCALE);
-    } catch (const cv::Exception& e) {  // e.g. a header claiming more pixels than OpenCV allows
-      throw std::runtime_error(path.string() + ": not a readable image (" + e.err + ")");
-    }
-    if (image.empty()) throw std::runtime_error(path.string() + ": not a readable image");
+    // Whole or refused: a JPEG cut short decodes with made-up grey rows (common/image_file.h).
+    std::string why;
+    cv::Mat image = common::ReadImageFile(path, colour ? cv::IMREAD_COLOR : cv::IMREAD_GRAYSCALE, &why);
+    if (image.empty()) throw std::runtime_error(path.string() + ": " + why);
     if (colour) cv::cvtColor(image, image, cv::COLOR_BGR2YCrCb);
     if (image.cols != clip.width || image.rows != clip.height) {
       throw std::runtime_error(path.string() + ": image is " + std::to_string(image.cols) + "x" +

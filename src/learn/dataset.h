@@ -32,6 +32,7 @@ struct ClipInfo {
   double frame_rate = 25;      // [Hz]
   int width = 0, height = 0;   // [px]
   std::string frame_pattern;   // printf pattern of one integer, e.g. "%03d.jpg"
+  std::string encoding = "mono8";  // of its frames: "mono8" or "rgb8"
 };
 
 struct Dataset {
@@ -52,8 +53,10 @@ std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& spl
 
 // Throws std::runtime_error naming the first clip's label.json whose frame_rate differs from
 // `model_rate` [Hz] by more than 1 %: the SDN reads frequencies in Hz at its own rate, so a clip
-// at another rate gives a wrong wind without any other sign (sdn_node refuses them too).
-void CheckClipRates(const std::vector<ClipInfo>& clips, double model_rate);
+// at another rate gives a wrong wind without any other sign (sdn_node refuses them too). With
+// `colour` (a model that reads Y Cr Cb), also the first clip whose encoding is "mono8": its frames
+// would read as colourless, two of the model's three channels constant.
+void CheckClipsSuitModel(const std::vector<ClipInfo>& clips, double model_rate, bool colour);
 
 // Frames first..first+count-1 of a clip as greyscale CV_8UC1 images (colour JPEGs converted) or,
 // with `colour`, as CV_8UC3 images in YCrCb order (OpenCV's BGR2YCrCb: Y is the grey of the

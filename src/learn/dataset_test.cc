@@ -201,30 +201,102 @@ TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
     EditJson(d / "toy-00002" / "label.json", [](nlohmann::json& j) { j["frame_rate"] = 5.0; });
     const Dataset data = ReadDataset(d);
     try {
-      CheckClipRates(data.clips, 25.0);
+      CheckClipsSuitModel(data.clips, 25.0, false);
       ADD_FAILURE() << "a 5 Hz clip was accepted for a 25 Hz model";
     } catch (const std::runtime_error& e) {
       EXPECT_THAT(e.what(), HasSubstr((d / "toy-00002" / "label.json").string()));
       EXPECT_THAT(e.what(), HasSubstr("the model reads clips at 25"));
     }
-    EXPECT_NO_THROW(CheckClipRates(ReadDataset(Copy("rate_ok")).clips, 25.1));  // within 1 %
+    EXPECT_NO_THROW(CheckClipsSuitModel(ReadDataset(Copy("rate_ok")).clips, 25.1, false));  // within 1 %
+  }
+  {
+    // Grey clips for a colour model: refused by name (two of its three channels would be constant).
+    const fs::path d = Copy("grey_for_colour");
+    try {
+      CheckClipsSuitModel(ReadDataset(d).clips, 25.0, true);
+      ADD_FAILURE() << "mono8 clips were accepted for a colour model";
+    } catch (const std::runtime_error& e) {
+      EXPECT_THAT(e.what(), HasSubstr("label.json: field \"encoding\" is \"mono8\""));
+    }
+    EditJson(d / "index.json", [](nlohmann::json& j) {
+      for (auto& c : j["clips"]) c.erase("wind_speed");  // and nothing else differs
+    });
+    for (const ClipInfo& c : ReadDataset(d).clips)
+      EditJson(c.dir / "label.json", [](nlohmann::json& j) { j["encoding"] = "rgb8"; });
+    EXPECT_NO_THROW(CheckClipsSuitModel(ReadDataset(d).clips, 25.0, true));
+  }
+  {
+    // The index and a label disagreeing on a clip's wind: refused naming both files.
+    const fs::path d = Copy("two_winds");
+    EditJson(d / "toy-00002" / "label.json", [](nlohmann::json& j) { j["wind_speed"] = j["wind_speed"].get<double>() + 0.5; });
+    expect_error(d, (d / "index.json").string() + ": clips[2].wind_speed", "toy-00002/label.json says");
   }
   {
     const fs::path d = Copy("bomb");
     std::ofstream(d / "toy-00004" / "014.jpg", std::ios::binary) << "P5\n100000 100000\n255\n";
     expect_error(d, (d / "toy-00004" / "014.jpg").string(), "not a readable image");
   }
+  {
+    // A frame cut short (a copy interrupted): cv::imread decodes it with grey rows and only warns;
+    // the reader refuses it by name.
+    const fs::path d = Copy("cut");
+    const fs::path frame = d / "toy-00001" / "007.jpg";
+    fs::resize_file(frame, fs::file_size(frame) / 2);
+    ASSERT_FALSE(cv::imread(frame.string()).empty());
+    expect_error(d, frame.string(), "JPEG truncated");
+  }
 }
 
 TEST_F(DatasetTest, ReadsEachClipsSimulation) {
   // A simulated dataset's index names each clip's simulation; its views share it.
+  // Pairs of clips, each pair in its first clip's split (index and label agreeing).
   const fs::path d = Copy("simulations");
-  EditJson(d / "index.json", [](nlohmann::json& j) {
-    for (size_t i = 0; i < j["clips"].size(); ++i) j["clips"][i]["simulation"] = static_cast<int>(i / 2);
+  std::vector<std::string> names;
+  EditJson(d / "index.json", [&](nlohmann::json& j) {
+    for (size_t i = 0; i < j["clips"].size(); ++i) {
+      j["clips"][i]["simulation"] = static_cast<int>(i / 2);
+      if (i % 2 == 1) j["clips"][i]["split"] = j["clips"][i - 1]["split"];
+      names.push_back(j["clips"][i]["name"].get<std::string>() + "=" + j["clips"][i]["split"].get<std::string>());
+    }
   });
+  for (const std::string& n : names) {
+    const std::string name = n.substr(0, n.find('=')), split = n.substr(n.find('=') + 1);
+    EditJson(d / name / "label.json", [&](nlohmann::json& j) { j["split"] = split; });
+  }
   const Dataset dataset = ReadDataset(d);
   ASSERT_EQ(dataset.clips.size(), 10u);
   for (size_t i = 0; i < dataset.clips.size(); ++i) EXPECT_EQ(dataset.clips[i].simulation, static_cast<int>(i / 2));
+
+  // One simulation in two splits (a merged or re-indexed dataset): its test views' motion would be
+  // trained on. Refused, naming the simulation and both clips.
+  const fs::path leak = Copy("leak");
+  std::string first_split;
+  EditJson(leak / "index.json", [&](nlohmann::json& j) {
+    for (auto& c : j["clips"]) c.erase("split");  // the labels' splits, then
+    j["clips"][0]["simulation"] = 7;
+    j["clips"][1]["simulation"] = 7;
+  });
+  EditJson(leak / "toy-00000" / "label.json", [](nlohmann::json& j) { j["split"] = "train"; });
+  EditJson(leak / "toy-00001" / "label.json", [](nlohmann::json& j) { j["split"] = "test"; });
+  try {
+    ReadDataset(leak);
+    ADD_FAILURE() << "a simulation in two splits was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("simulation 7 has clips in two splits (\"toy-00000\" in train, \"toy-00001\" in test)"));
+  }
+  // The index and a label naming different splits for one clip: which holds is a guess.
+  const fs::path two = Copy("two_splits");
+  std::string listed;
+  EditJson(two / "index.json", [&](nlohmann::json& j) { listed = j["clips"][3]["split"].get<std::string>(); });
+  EditJson(two / "toy-00003" / "label.json",
+           [&](nlohmann::json& j) { j["split"] = listed == "test" ? "train" : "test"; });
+  try {
+    ReadDataset(two);
+    ADD_FAILURE() << "an index and a label with two splits for a clip were accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("clips[3].split is"));
+    EXPECT_THAT(e.what(), HasSubstr("toy-00003/label.json says"));
+  }
 }
 
 double Mean(const std::vector<float>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); }

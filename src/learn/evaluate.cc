@@ -142,7 +142,7 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   if (clips.empty()) throw std::runtime_error((data / "index.json").string() + ": no examples in split " + split);
   EvalResult r;
   r.config = predictor.config();
-  CheckClipRates(clips, r.config.frame_rate);
+  CheckClipsSuitModel(clips, r.config.frame_rate, r.config.colour);
   r.split = split;
   r.windows = windows;
   r.mirror = mirror;

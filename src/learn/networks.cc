@@ -262,7 +262,10 @@ at::Tensor WindLoss(const at::Tensor& output, const at::Tensor& target) {
 at::Tensor AuxLoss(const at::Tensor& aux, const at::Tensor& target) { return (aux - target).square().mean(); }
 
 void SaveWindNet(WindNet& net, const std::filesystem::path& weights, WeightPrecision precision) {
-  SaveModuleWeights(*net, weights, precision);
+  // The configuration goes into the weights file as well as beside it: most of it (input size,
+  // frames, frame rate, label scale, ...) shapes no tensor, so weights loaded under another
+  // model.json would load without complaint and answer wrongly.
+  SaveModuleWeights(*net, weights, precision, ToJson(net->config()).dump());
   WriteFileAtomically(ConfigPathFor(weights), ToJson(net->config()).dump(2) + "\n");
 }
 
@@ -276,6 +279,38 @@ WindNet WithoutAuxHead(WindNet& net) {
   return stripped;
 }
 
+namespace {
+
+// Throws std::runtime_error naming config_path and every field in which `config` (read from it)
+// differs from `stored`, the configuration SaveWindNet saved inside `weights`.
+void CheckConfigMatchesWeights(const ModelConfig& config, const std::filesystem::path& config_path,
+                               const std::string& stored, const std::filesystem::path& weights) {
+  ModelConfig saved;
+  try {
+    saved = ModelConfigFromJson(nlohmann::json::parse(stored), weights.string() + " (its saved configuration)");
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(weights.string() + ": its saved configuration is not valid JSON: " + e.what());
+  }
+  // Compared through the struct, so keys a model.json may leave out (older files) compare as
+  // their defaults.
+  const nlohmann::json want = ToJson(saved), have = ToJson(config);
+  std::string differences;
+  for (const auto& [key, value] : want.items()) {
+    if (have.contains(key) && have[key] == value) continue;
+    differences += std::string(differences.empty() ? "" : "; ") + "field \"" + key + "\" is " +
+                   (have.contains(key) ? have[key].dump() : std::string("missing")) + ", the weights' is " +
+                   value.dump();
+  }
+  if (!differences.empty()) {
+    throw std::runtime_error(config_path.string() + " does not describe the network whose weights are in " +
+                             weights.string() + ": " + differences +
+                             " (a model.json is written with its weights; restore it, or export the model "
+                             "again with clothwind export-model)");
+  }
+}
+
+}  // namespace
+
 WindNet LoadWindNet(const std::filesystem::path& weights) {
   const std::filesystem::path config_path = ConfigPathFor(weights);
   std::ifstream in(config_path);
@@ -287,12 +322,14 @@ WindNet LoadWindNet(const std::filesystem::path& weights) {
     throw std::runtime_error(config_path.string() + ": not valid JSON: " + e.what());
   }
   WindNet net(ModelConfigFromJson(j, config_path.string()));
+  std::string stored;
   try {
-    LoadModuleWeights(*net, weights);
+    LoadModuleWeights(*net, weights, &stored);
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(std::string(e.what()) + " (" + config_path.string() + " describes a " +
                              net->config().Name() + " network)");
   }
+  if (!stored.empty()) CheckConfigMatchesWeights(net->config(), config_path, stored, weights);
   net->eval();
   return net;
 }

@@ -137,8 +137,8 @@ at::Tensor WindLoss(const at::Tensor& output, const at::Tensor& target);
 at::Tensor AuxLoss(const at::Tensor& aux, const at::Tensor& target);
 
 // Saves the network's parameters and buffers to `weights` (torch::save's layout; parameters
-// in float16 when asked: half the file, for the shipped model) and its ModelConfig to
-// ConfigPathFor(weights), both atomically (temporary file, then rename).
+// in float16 when asked: half the file, for the shipped model) with its ModelConfig inside, and
+// the ModelConfig to ConfigPathFor(weights), both atomically (temporary file, then rename).
 void SaveWindNet(WindNet& net, const std::filesystem::path& weights,
                  WeightPrecision precision = WeightPrecision::kFloat32);
 
@@ -150,7 +150,10 @@ WindNet WithoutAuxHead(WindNet& net);
 
 // Loads a network saved by SaveWindNet in either precision (config from the JSON beside the
 // weights) as float32, in eval mode on the CPU. Throws std::runtime_error naming the file
-// that is missing or does not match, and the tensor.
+// that is missing or does not match, and the tensor; and naming the JSON and each field in
+// which it differs from the configuration saved inside the weights (a model.json edited or
+// swapped: input_size, frames, frame_rate, label scale, ... shape no tensor). Weights saved
+// before the configuration was stored inside them load under their JSON as it is.
 WindNet LoadWindNet(const std::filesystem::path& weights);
 
 // Puts every 4-D parameter and buffer of `module` (the convolutions' kernels) in channels-last

@@ -124,7 +124,11 @@ Prediction Predictor::PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps
     at::Tensor clip = at::from_blob(sample.pixels.data(), {1, 1, c.frames, c.input_size, c.input_size}, at::kFloat);
     SpectralOptions strongest = c.Spectral();
     strongest.k = 1;
-    strongest.phase_steps = false;  // the node shows power and frequency only
+    // The node shows power and frequency only: none of the extra channels (phase_step_far without
+    // phase_steps is refused, so a model trained with it lost every estimate while rviz watched).
+    strongest.phase_steps = false;
+    strongest.phase_step_far = 0;
+    strongest.mode_shape = false;
     SpectralMaps m = SpectralDecomposition(clip, strongest);
     maps->power = cv::Mat(c.input_size, c.input_size, CV_32F);
     maps->frequency = cv::Mat(c.input_size, c.input_size, CV_32F);

@@ -97,5 +97,38 @@ TEST_F(PredictorTest, MapsOfAClipTurnedRoundShowTheCamerasPicture) {
   EXPECT_LT(MaxAbsDiff(turned.power, filmed.power), 1e-3 * cv::norm(filmed.power, cv::NORM_INF));
 }
 
+TEST_F(PredictorTest, MapsComeForEveryKindOfSdn) {
+  // The maps are the strongest peak's power and frequency whatever else the model reads: a model
+  // with far phase steps or the mode shape estimates with maps asked for as without (the far
+  // steps once made the maps' options invalid, and every estimate failed while rviz watched).
+  const std::vector<cv::Mat> clip = LopsidedClip();
+  for (const char* variant : {"far", "mode_shape"}) {
+    SCOPED_TRACE(variant);
+    ModelConfig c;
+    c.arch = "sdn";
+    c.k = 3;
+    c.width = 8;
+    c.input_size = 32;
+    if (std::string(variant) == "far") {
+      c.phase_steps = true;
+      c.phase_step_far = 4;
+    } else {
+      c.mode_shape = true;
+    }
+    WindNet net(c);
+    const fs::path path = dir_ / (std::string(variant) + ".pt");
+    SaveWindNet(net, path);
+    Predictor predictor(path, 1, "cpu");
+    PeakMaps maps;
+    const Prediction with = predictor.PredictFrames(clip, &maps);
+    const Prediction without = predictor.PredictFrames(clip);
+    EXPECT_EQ(with.speed, without.speed);
+    ASSERT_EQ(maps.frequency.size(), cv::Size(32, 32));
+    ASSERT_EQ(maps.power.size(), cv::Size(32, 32));
+    // The stripes' frequency grows from left to right (1 Hz + 0.25 Hz per pixel).
+    EXPECT_LT(maps.frequency.at<float>(16, 2), maps.frequency.at<float>(16, 20));
+  }
+}
+
 }  // namespace
 }  // namespace clothwind::learn

@@ -164,6 +164,7 @@ namespace {
 
 // An option's value as the refusal below names it: a flag on or off, a number as it is.
 std::string OptionValue(bool v) { return v ? "on" : "off"; }
+std::string OptionValue(const std::string& v) { return v; }
 template <typename T>
 std::string OptionValue(T v) {
   return std::to_string(v);
@@ -307,8 +308,8 @@ TrainResult Train(const TrainOptions& o) {
   }
 
   ModelConfig config = o.model;
-  CheckClipRates(train, config.frame_rate);
-  CheckClipRates(val, config.frame_rate);
+  CheckClipsSuitModel(train, config.frame_rate, config.colour);
+  CheckClipsSuitModel(val, config.frame_rate, config.colour);
   config.channels = config.ChannelsForInput();  // greyscale, as the seed (+ flow x, y), or Y Cr Cb
   if (!train.empty()) {
     double sum = 0, sum2 = 0;
@@ -385,6 +386,31 @@ TrainResult Train(const TrainOptions& o) {
       RefuseChangedOnResume(state_path, "--weight-decay", state["weight_decay"].get<double>(), o.weight_decay);
     if (state.contains("grad_clip"))
       RefuseChangedOnResume(state_path, "--grad-clip", state["grad_clip"].get<double>(), o.grad_clip);
+    // The schedule itself (recorded since 2026-12-05): the log's rates cannot refuse a cosine run
+    // resumed after one epoch with other --epochs, nor a step run resumed with other --epochs
+    // before its decay, and either would then run another schedule than the one it started.
+    if (state.contains("lr")) RefuseChangedOnResume(state_path, "--lr", state["lr"].get<double>(), o.lr);
+    if (state.contains("lr_schedule"))
+      RefuseChangedOnResume(state_path, "--lr-schedule", state["lr_schedule"].get<std::string>(), o.lr_schedule);
+    if (state.contains("lr_decay_epoch"))
+      RefuseChangedOnResume(state_path, "--lr-decay-epoch", state["lr_decay_epoch"].get<int>(), o.lr_decay_epoch);
+    // Other --epochs only where they leave every epoch's rate as the run's own schedule gives it
+    // (a step run with its decay epoch given may go on for longer; a cosine run may not).
+    if (state.contains("epochs")) {
+      TrainOptions started = o;
+      started.epochs = state["epochs"].get<int>();
+      // The started schedule read past its end: a step run's rate stays decayed, a cosine run's
+      // is 0 (so a cosine run is never extended).
+      for (int e = 1; e <= o.epochs; ++e) {
+        if (LearningRateAt(started, e) == LearningRateAt(o, e)) continue;
+        std::ostringstream what;
+        what << state_path.string() << ": the run started with --epochs " << started.epochs << ", whose "
+             << o.lr_schedule << " schedule runs epoch " << e << " at " << LearningRateAt(started, e)
+             << "; --epochs " << o.epochs << " gives " << LearningRateAt(o, e)
+             << " (resume with the --epochs the run started with, or give --lr-decay-epoch to extend a step run)";
+        throw std::runtime_error(what.str());
+      }
+    }
   }
   std::unique_ptr<AuxTargets> aux;
   if (o.aux_tracks > 0 && !train.empty()) {
@@ -474,6 +500,9 @@ TrainResult Train(const TrainOptions& o) {
       static_cast<torch::optim::AdamOptions&>(group.options()).lr(record.lr);
     }
     // The epoch's order and augmentations depend only on (seed, epoch): a resumed run repeats them.
+    // So do torch's own draws (dropout's masks): its generator is not in the checkpoint, so it is
+    // seeded afresh each epoch (a resumed run drew epoch 1's masks again).
+    at::manual_seed(o.seed * 104729 + static_cast<uint64_t>(epoch));
     std::vector<size_t> order(train.size());
     std::iota(order.begin(), order.end(), 0);
     std::mt19937_64 rng(o.seed * 7919 + epoch);
@@ -581,7 +610,8 @@ TrainResult Train(const TrainOptions& o) {
              {"aux_phase_bins", o.aux_phase_bins}, {"aux_world", o.aux_world}, {"point_maps", o.point_maps},
              {"weight_average", o.weight_average}, {"average_steps", average_steps},
              {"best_val_rmse", result.best_val_rmse}, {"checkpoint", checkpoint_name},
-             {"batch", o.batch}, {"weight_decay", o.weight_decay}, {"grad_clip", o.grad_clip}};
+             {"batch", o.batch}, {"weight_decay", o.weight_decay}, {"grad_clip", o.grad_clip},
+             {"epochs", o.epochs}, {"lr", o.lr}, {"lr_schedule", o.lr_schedule}, {"lr_decay_epoch", o.lr_decay_epoch}};
     WriteFileAtomically(state_path, state.dump(2));
     // Older checkpoints (and the files of the layout before checkpoint folders) once state.json
     // names the new one.

@@ -27,6 +27,7 @@
 #include "learn/track_head_eval.h"
 #include "learn/track_targets.h"
 #include "learn/view_breakdown.h"
+#include "learn/weights_io.h"
 
 namespace clothwind::learn {
 namespace {
@@ -343,6 +344,28 @@ TEST_F(TrainTest, CheckpointRoundTripGivesIdenticalPredictions) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("copy.pt"), std::string::npos) << e.what();
   }
+  // Nor one that changes no tensor's shape but what the weights read: another input size and
+  // frame rate load the same tensors and answer wrongly, so the configuration saved inside the
+  // weights refuses them, naming both fields.
+  j["width"] = c.width;
+  j["input_size"] = c.input_size * 2;
+  j["frame_rate"] = 30.0;
+  std::ofstream(*root_ / "roundtrip" / "copy.json") << j.dump();
+  try {
+    LoadWindNet(*root_ / "roundtrip" / "copy.pt");
+    ADD_FAILURE() << "a model.json with another input size accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("copy.json"), std::string::npos) << what;
+    EXPECT_NE(what.find("\"input_size\" is " + std::to_string(c.input_size * 2)), std::string::npos) << what;
+    EXPECT_NE(what.find("\"frame_rate\""), std::string::npos) << what;
+  }
+  // Weights saved before they held their configuration still load under their JSON.
+  SaveModuleWeights(*loaded, *root_ / "roundtrip" / "old.pt", WeightPrecision::kFloat32);
+  nlohmann::json old = ToJson(loaded->config());
+  old["input_size"] = c.input_size * 2;
+  std::ofstream(*root_ / "roundtrip" / "old.json") << old.dump();
+  EXPECT_EQ(LoadWindNet(*root_ / "roundtrip" / "old.pt")->config().input_size, c.input_size * 2);
 }
 
 TEST(WindNet, OnlyTheMeanMapSeesAStillPose) {
@@ -768,9 +791,45 @@ TEST_F(TrainTest, CosineScheduleIsWhatTrainingUses) {
     EXPECT_EQ(reports[i].steps, steps) << i;
     EXPECT_EQ(reports[i].epochs, 3) << i;
   }
+  // The log's rate is computed, not read from Adam: that the optimiser trains at it shows only
+  // against a run at a constant rate, equal in epoch 1 (both at --lr) and apart after it.
+  TrainOptions flat = Options("sdn", "cosine_flat");
+  flat.epochs = 3;
+  flat.lr_decay_epoch = 100;
+  const TrainResult f = Train(flat);
+  EXPECT_EQ(f.log[0].train_loss, r.log[0].train_loss);
+  EXPECT_NE(f.log[2].train_loss, r.log[2].train_loss);
+  // A cosine run stopped after its first epoch and resumed with other --epochs would run another
+  // schedule, though its one logged rate (--lr) fits both: refused, naming them.
+  TrainOptions started = t;
+  started.out = *root_ / "cosine_one";
+  started.epochs = 1;
+  Train(started);
+  started.epochs = 4;
+  started.resume = true;
+  ExpectTrainRefused(started, "a cosine run resumed with other --epochs", {"--epochs 1", "--epochs 4 gives"});
   t.lr_schedule = "warm";
   t.out = *root_ / "cosine_bad";
   ExpectTrainRefused(t, "unknown schedule accepted", {"warm"});
+}
+
+TEST_F(TrainTest, AResumedRunWithDropoutRepeatsTheUninterruptedOne) {
+  // Dropout draws from torch's generator, which no checkpoint holds: it is seeded per epoch, so
+  // epoch 2 of a run resumed after epoch 1 draws the masks the uninterrupted run drew.
+  TrainOptions whole = Options("sdn", "dropout_whole");
+  whole.model.dropout = 0.5;
+  whole.epochs = 2;
+  const TrainResult uninterrupted = Train(whole);
+  TrainOptions part = whole;
+  part.out = *root_ / "dropout_resumed";
+  part.epochs = 1;
+  Train(part);
+  part.epochs = 2;
+  part.resume = true;
+  const TrainResult resumed = Train(part);
+  ASSERT_EQ(resumed.log.size(), 2u);
+  EXPECT_NEAR(resumed.log[1].train_loss, uninterrupted.log[1].train_loss, 1e-6);
+  EXPECT_NEAR(resumed.log[1].val_rmse, uninterrupted.log[1].val_rmse, 1e-6);
 }
 
 // Clips whose whole image flickers at f = 1 + 0.5 v Hz (25 fps) with a random phase, on a random
@@ -1081,6 +1140,16 @@ TEST_F(TrainTest, ColourChannelsTrainRoundTripAndAreRefusedWhenInconsistent) {
   TrainOptions t = Options("sdn", "colour");
   t.model.colour = true;
   t.model.phase_steps = true;
+  // The toy clips are grey, which a colour model refuses by their labels' encoding: a copy whose
+  // labels say rgb8 (the grey JPEGs read as three equal channels).
+  t.data = *root_ / "data_rgb";
+  fs::remove_all(t.data);
+  fs::copy(*root_ / "data", t.data, fs::copy_options::recursive);
+  for (const ClipInfo& c : ReadDataset(t.data).clips) {
+    nlohmann::json label = ReadJson(c.dir / "label.json");
+    label["encoding"] = "rgb8";
+    std::ofstream(c.dir / "label.json") << label.dump(2);
+  }
   t.epochs = 1;
   t.cache_frames = true;
   t.crop_scales = {1.0};

@@ -14,6 +14,9 @@ namespace clothwind::learn {
 namespace {
 
 constexpr double kHalfMax = 65504.0;
+// The archive key of SaveModuleWeights' metadata string: not a name torch gives a parameter,
+// buffer or submodule of ours.
+constexpr const char* kMetadataKey = "clothwind.metadata";
 
 void Write(const torch::nn::Module& module, const std::string& prefix, WeightPrecision precision,
            torch::serialize::OutputArchive& archive) {
@@ -98,15 +101,17 @@ WeightPrecision ParseWeightPrecision(const std::string& name) {
 }
 
 void SaveModuleWeights(const torch::nn::Module& module, const std::filesystem::path& path,
-                       WeightPrecision precision) {
+                       WeightPrecision precision, const std::string& metadata) {
   torch::serialize::OutputArchive archive;
   Write(module, "", precision, archive);
+  if (!metadata.empty()) archive.write(kMetadataKey, c10::IValue(metadata));
   std::ostringstream bytes;
   archive.save_to(bytes);
   WriteFileAtomically(path, bytes.str());
 }
 
-WeightPrecision LoadModuleWeights(torch::nn::Module& module, const std::filesystem::path& path) {
+WeightPrecision LoadModuleWeights(torch::nn::Module& module, const std::filesystem::path& path,
+                                  std::string* metadata) {
   if (!std::filesystem::exists(path)) throw std::runtime_error(path.string() + ": no such file");
   torch::serialize::InputArchive archive;
   try {
@@ -117,6 +122,10 @@ WeightPrecision LoadModuleWeights(torch::nn::Module& module, const std::filesyst
   bool any_half = false;
   try {
     Read(module, "", archive, path, &any_half);
+    if (metadata) {
+      c10::IValue stored;
+      *metadata = archive.try_read(kMetadataKey, stored) && stored.isString() ? stored.toStringRef() : "";
+    }
   } catch (const c10::Error& e) {
     throw std::runtime_error(path.string() + ": " + e.what_without_backtrace());
   }

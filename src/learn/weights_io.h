@@ -26,17 +26,22 @@ WeightPrecision ParseWeightPrecision(const std::string& name);
 // file, then rename).
 // Inputs: module  any torch module on any device; path  destination file;
 //   precision  of the floating-point parameters in the file.
+//   metadata  a string stored with the weights (empty: none), read back by LoadModuleWeights;
+//     SaveWindNet stores the network's configuration there, so that the weights know what they
+//     were trained as even when the JSON beside them is edited or swapped.
 // Throws std::runtime_error naming the tensor if a parameter is not finite in float16
 // (|x| > 65504), so a file is never written with weights that would not load as they were.
 void SaveModuleWeights(const torch::nn::Module& module, const std::filesystem::path& path,
-                       WeightPrecision precision);
+                       WeightPrecision precision, const std::string& metadata = "");
 
 // Reads a file written by SaveModuleWeights or torch::save into `module` (on the CPU),
 // converting floating-point tensors to the module's dtype.
-// Outputs: the precision the file's parameters were stored in.
+// Outputs: the precision the file's parameters were stored in; *metadata (when not null) the
+//   string saved with them, empty for a file written without one (or by torch::save).
 // Throws std::runtime_error naming `path` and the tensor when one is missing, has another
 // shape, or mixes integer and floating point with the module's.
-WeightPrecision LoadModuleWeights(torch::nn::Module& module, const std::filesystem::path& path);
+WeightPrecision LoadModuleWeights(torch::nn::Module& module, const std::filesystem::path& path,
+                                  std::string* metadata = nullptr);
 
 }  // namespace clothwind::learn
 

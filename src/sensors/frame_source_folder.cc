@@ -9,6 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/image_file.h"
+
 namespace clothwind {
 namespace sensors {
 namespace fs = std::filesystem;
@@ -86,17 +88,12 @@ bool ImageFolderSource::Open() {
 
 bool ImageFolderSource::LoadNext(std::string* why) {
   const std::string& file = files_[next_];
-  cv::Mat raw;
-  try {
-    raw = cv::imread(file, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    // A header claiming more pixels than OpenCV allows throws: reported like any unreadable
-    // image (it ended camera_node through std::terminate).
-    *why = "cannot read image " + file + " (" + e.err + ")";
-    return false;
-  }
+  // OpenCV's exceptions (a header claiming more pixels than it allows ended camera_node through
+  // std::terminate) and JPEGs cut short (grey rows published as if seen) are unreadable images.
+  std::string reason;
+  const cv::Mat raw = common::ReadImageFile(file, cv::IMREAD_UNCHANGED, &reason);
   if (raw.empty()) {
-    *why = "cannot read image " + file;
+    *why = "cannot read image " + file + " (" + reason + ")";
     return false;
   }
   Frame f;

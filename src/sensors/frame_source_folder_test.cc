@@ -118,6 +118,21 @@ TEST(ImageFolderSourceTest, ClearErrorsForMissingEmptyAndInconsistentFolders) {
   EXPECT_EQ(bombed.Read(&f, 1.0), ReadStatus::kError);
   EXPECT_NE(bombed.error().find("cannot read image " + bomb.path() + "/frame_0001.pgm"), std::string::npos)
       << bombed.error();
+
+  // A JPEG cut short (a recording cut by a power loss) decodes with grey rows where its data ends:
+  // an error naming it, not a frame published as if seen.
+  TempDir cut;
+  cv::Mat noise(24, 32, CV_8UC1);
+  cv::randu(noise, 0, 255);
+  std::vector<uint8_t> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", noise, jpeg));
+  std::ofstream(cut.path() + "/frame_0000.jpg", std::ios::binary).write(reinterpret_cast<const char*>(jpeg.data()), jpeg.size());
+  std::ofstream(cut.path() + "/frame_0001.jpg", std::ios::binary).write(reinterpret_cast<const char*>(jpeg.data()), jpeg.size() / 2);
+  ImageFolderSource shortened(cut.path(), 10.0, false, &clock);
+  ASSERT_TRUE(shortened.Open()) << shortened.error();
+  ASSERT_EQ(shortened.Read(&f, 1.0), ReadStatus::kFrame);
+  EXPECT_EQ(shortened.Read(&f, 1.0), ReadStatus::kError);
+  EXPECT_NE(shortened.error().find("frame_0001.jpg (JPEG truncated"), std::string::npos) << shortened.error();
 }
 
 TEST(ImageFolderSourceTest, ClosesItselfWhenNothingIsReadableAnyMore) {

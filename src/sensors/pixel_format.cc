@@ -9,6 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/image_file.h"
+
 namespace clothwind {
 namespace sensors {
 
@@ -82,12 +84,8 @@ bool ConvertToImage(PixelFormat format, const uint8_t* data, size_t bytes_used, 
     // A frame cut short (USB bandwidth, a bulk transfer lost) still decodes: libjpeg fills the
     // missing rows with grey and only warns. Require the start- and end-of-image markers (some
     // cameras pad the buffer with zeros after the end marker).
-    size_t end = bytes_used;
-    while (end > 2 && data[end - 1] == 0x00) --end;
-    if (bytes_used < 4 || data[0] != 0xFF || data[1] != 0xD8)
-      return fail("MJPEG frame without a start-of-image marker (" + std::to_string(bytes_used) + " bytes)");
-    if (end < 4 || data[end - 2] != 0xFF || data[end - 1] != 0xD9)
-      return fail("MJPEG frame truncated: no end-of-image marker (" + std::to_string(bytes_used) + " bytes)");
+    const std::string whole = common::JpegWholeness(data, bytes_used);
+    if (!whole.empty()) return fail("MJPEG frame " + whole);
     // imdecode only reads the buffer; the const_cast is for cv::Mat's non-const constructor.
     const cv::Mat encoded(1, static_cast<int>(bytes_used), CV_8UC1, const_cast<uint8_t*>(data));
     cv::Mat decoded;

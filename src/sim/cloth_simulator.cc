@@ -118,9 +118,9 @@ void ClothSimulator::Impl::Build() {
   if (!options.gravity.allFinite()) throw std::invalid_argument("SimOptions.gravity must be finite");
   if (!(options.wind_density >= 0) || !(options.wind_drag >= 0))
     throw std::invalid_argument("SimOptions.wind_density and wind_drag must be >= 0");
-  if (!(options.strain_min >= 0) || !(options.strain_max > 0) || options.strain_min >= options.strain_max ||
-      (options.strain_min > 1) || (options.strain_max < 1))
-    throw std::invalid_argument("SimOptions strain limits must satisfy 0 <= strain_min <= 1 <= strain_max");
+  if (!StrainLimitsAreValid(options.strain_min, options.strain_max))
+    throw std::invalid_argument("SimOptions strain limits [" + std::to_string(options.strain_min) + ", " +
+                                std::to_string(options.strain_max) + "] must satisfy " + kStrainLimitsRule);
   if (!(options.repulsion_thickness >= 0) || !(options.collision_stiffness >= 0))
     throw std::invalid_argument("SimOptions.repulsion_thickness and collision_stiffness must be >= 0");
   if (!(options.cg_tolerance > 0) || options.cg_max_iterations < 1)

@@ -3,12 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iostream>
+#include <mutex>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
 
+#include "sim/json_comments.h"
 
 namespace clothwind::sim {
 namespace {
@@ -17,26 +21,6 @@ namespace {
 // |G01| in [0, 0.9667] (dde.cpp).
 constexpr int kSamples = 30;
 
-// ArcSim's JSON reader accepts `//` and `/* */` comments (paper.json starts with some); blank
-// them (keeping newlines, so parser positions stay valid) outside strings.
-std::string BlankComments(std::string s) {
-  bool in_string = false;
-  for (size_t i = 0; i < s.size(); ++i) {
-    if (in_string) {
-      if (s[i] == '\\') ++i;
-      else if (s[i] == '"') in_string = false;
-    } else if (s[i] == '"') {
-      in_string = true;
-    } else if (s[i] == '/' && i + 1 < s.size() && s[i + 1] == '/') {
-      for (; i < s.size() && s[i] != '\n'; ++i) s[i] = ' ';
-    } else if (s[i] == '/' && i + 1 < s.size() && s[i + 1] == '*') {
-      for (; i < s.size() && !(s[i] == '*' && i + 1 < s.size() && s[i + 1] == '/'); ++i)
-        if (s[i] != '\n') s[i] = ' ';
-      if (i < s.size()) s[i] = s[i + 1] = ' ';
-    }
-  }
-  return s;
-}
 
 // One stretching sample, as ArcSim's evaluate_stretching_sample: the principal stretch w0 (the
 // larger one) and its direction in material space pick a point between the unstretched row and
@@ -155,18 +139,60 @@ Material MakeMaterial(double density, const Eigen::Matrix<double, 6, 4>& stretch
   return m;
 }
 
-Material LoadArcSimMaterial(const std::string& path, const MaterialMultipliers& mult) {
+namespace {
+
+// The material file's JSON object (ArcSim's comments allowed). Throws std::runtime_error naming
+// the file when it cannot be read, parsed, or is not an object.
+nlohmann::json ReadMaterialJson(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open material file");
   std::stringstream ss;
   ss << in.rdbuf();
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(BlankComments(ss.str()));
+    j = nlohmann::json::parse(StripJsonComments(ss.str()));
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(path + ": not valid JSON: " + e.what());
+  } catch (const std::runtime_error& e) {  // an unclosed block comment
+    throw std::runtime_error(path + ": " + e.what());
   }
   if (!j.is_object()) throw std::runtime_error(path + ": expected a JSON object at the top level");
+  return j;
+}
+
+std::vector<std::string> IgnoredKeyWarnings(const nlohmann::json& j, const std::string& path) {
+  static const std::set<std::string> kRead = {"density", "stretching", "bending"};
+  // Read by ArcSim's material loader, not modelled here (damping comes from the scene's material
+  // entry instead; no plasticity, no strain limiting).
+  static const std::set<std::string> kArcSimOnly = {"damping", "strain_limits", "yield_curv", "weakening"};
+  std::vector<std::string> warnings;
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (kRead.count(it.key())) continue;
+    warnings.push_back(path + ": key '" + it.key() + "' " +
+                       (kArcSimOnly.count(it.key()) ? "is ArcSim's but not simulated here, ignored"
+                                                    : "is not a material field (density, stretching, bending), ignored"));
+  }
+  return warnings;
+}
+
+// Prints each warning to stderr the first time this process sees it.
+void WarnOnce(const std::vector<std::string>& warnings) {
+  static std::mutex mutex;
+  static std::set<std::string> given;
+  std::lock_guard<std::mutex> lock(mutex);
+  for (const std::string& w : warnings)
+    if (given.insert(w).second) std::cerr << "warning: " << w << "\n";
+}
+
+}  // namespace
+
+std::vector<std::string> ArcSimMaterialWarnings(const std::string& path) {
+  return IgnoredKeyWarnings(ReadMaterialJson(path), path);
+}
+
+Material LoadArcSimMaterial(const std::string& path, const MaterialMultipliers& mult) {
+  const nlohmann::json j = ReadMaterialJson(path);
+  WarnOnce(IgnoredKeyWarnings(j, path));
   auto number = [&](const nlohmann::json& v, const std::string& field) {
     if (!v.is_number())
       throw std::runtime_error(path + ": field '" + field + "' must be a number, got " + v.dump());

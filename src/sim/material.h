@@ -70,8 +70,17 @@ Material MakeMaterial(double density, const Eigen::Matrix<double, 6, 4>& stretch
 // Inputs:
 //   path  the JSON file
 //   mult  multipliers as in an ArcSim scene's material entry
+// Keys other than density, stretching and bending are ignored with a warning (ArcSim's damping,
+// strain_limits, yield_curv and weakening are not simulated; anything else is likely misspelt),
+// printed to stderr once per file and key in a process: a dataset run loads one material for
+// every simulation.
 // Throws std::runtime_error naming the file and the missing/bad field and what was expected.
 Material LoadArcSimMaterial(const std::string& path, const MaterialMultipliers& mult = {});
+
+// The warnings LoadArcSimMaterial gives for the material file `path` (for tests and callers that
+// report them their own way): one line per ignored key, "<path>: key 'k' ...". Throws as
+// LoadArcSimMaterial when the file cannot be read or parsed.
+std::vector<std::string> ArcSimMaterialWarnings(const std::string& path);
 
 }  // namespace clothwind::sim
 

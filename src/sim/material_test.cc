@@ -116,6 +116,24 @@ TEST(MaterialTest, BadFilesFailNamingFileAndField) {
   MaterialMultipliers bad;
   bad.thicken = 0;
   ExpectThrowContaining([&] { LoadArcSimMaterial(commented, bad); }, "thicken must be finite and > 0");
+  const std::string unclosed = WriteText("unclosed.json", "{\"density\": 0.1 /* never closed\n}");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(unclosed); }, unclosed + ": ");
+}
+
+TEST(MaterialTest, IgnoredKeysAreNamed) {
+  // A misspelt key ("bendng") or one of ArcSim's that is not simulated here loads with a warning
+  // naming the file and key; the three read keys warn of nothing.
+  const std::string rows = "[[1,2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4]]";
+  const std::string bend = "[[1,2,3,4,5],[1,2,3,4,5],[1,2,3,4,5]]";
+  const std::string plain = WriteText("plain.json", "{\"density\": 0.1, \"stretching\": " + rows + ", \"bending\": " + bend + "}");
+  EXPECT_TRUE(ArcSimMaterialWarnings(plain).empty());
+  const std::string extra = WriteText("extra.json", "{\"density\": 0.1, \"stretching\": " + rows + ", \"bending\": " + bend +
+                                                        ", \"bendng\": 2, \"yield_curv\": 3}");
+  EXPECT_NO_THROW(LoadArcSimMaterial(extra));
+  const std::vector<std::string> w = ArcSimMaterialWarnings(extra);
+  ASSERT_EQ(w.size(), 2u);
+  EXPECT_EQ(w[0], extra + ": key 'bendng' is not a material field (density, stretching, bending), ignored");
+  EXPECT_EQ(w[1], extra + ": key 'yield_curv' is ArcSim's but not simulated here, ignored");
 }
 
 TEST(MaterialTest, EveryArcSimMaterialLoadsWithSaneValues) {

@@ -103,6 +103,7 @@ Mesh ReadObj(const std::string& path) {
   std::vector<Eigen::Vector2d> texcoords;
   std::vector<Eigen::Vector3i> faces;
   std::vector<Eigen::Vector3i> face_tex;  // -1 when a corner has no vt
+  std::vector<int> face_lines;            // the line of each triangle's f
   std::string line;
   int line_no = 0;
   auto read_numbers = [&](std::istringstream& s, int n, double* out, const char* what) {
@@ -156,6 +157,7 @@ Mesh ReadObj(const std::string& path) {
       for (size_t k = 2; k < vi.size(); ++k) {  // fan triangulation of polygons
         faces.emplace_back(vi[0], vi[k - 1], vi[k]);
         face_tex.emplace_back(ti[0], ti[k - 1], ti[k]);
+        face_lines.push_back(line_no);
       }
     }
     // Other keywords (vn, g, o, s, usemtl, ArcSim's nv/ny/...) carry nothing we simulate.
@@ -193,7 +195,7 @@ Mesh ReadObj(const std::string& path) {
       mesh.U.row(v) = texcoords[vt_of[v]].transpose();
     }
   }
-  ValidateMesh(mesh, path);
+  ValidateMesh(mesh, path, face_lines);
   return mesh;
 }
 
@@ -226,7 +228,13 @@ void WriteObj(const std::string& path, const Mesh& mesh) {
   }
 }
 
-void ValidateMesh(const Mesh& mesh, const std::string& what) {
+void ValidateMesh(const Mesh& mesh, const std::string& what, const std::vector<int>& obj_lines) {
+  // An OBJ's reader knows each triangle's line and numbers vertices from 1, as the file does.
+  const bool obj = !obj_lines.empty() && static_cast<int>(obj_lines.size()) == mesh.F.rows();
+  auto vertex = [&](int i) { return "vertex " + std::to_string(obj ? i + 1 : i); };
+  auto face = [&](int f) {
+    return obj ? ":" + std::to_string(obj_lines[f]) + ": face" : ": face " + std::to_string(f);
+  };
   const int nv = static_cast<int>(mesh.V.rows());
   if (nv == 0) throw std::invalid_argument(what + ": mesh has no vertices");
   if (mesh.F.rows() == 0) throw std::invalid_argument(what + ": mesh has no faces");
@@ -235,11 +243,9 @@ void ValidateMesh(const Mesh& mesh, const std::string& what) {
                                 " rows, expected one per vertex (" + std::to_string(nv) + ")");
   for (int i = 0; i < nv; ++i) {
     if (!mesh.V.row(i).allFinite())
-      throw std::invalid_argument(what + ": vertex " + std::to_string(i) +
-                                  " has a non-finite position (NaN or inf)");
+      throw std::invalid_argument(what + ": " + vertex(i) + " has a non-finite position (NaN or inf)");
     if (!mesh.U.row(i).allFinite())
-      throw std::invalid_argument(what + ": vertex " + std::to_string(i) +
-                                  " has a non-finite material coordinate (NaN or inf)");
+      throw std::invalid_argument(what + ": " + vertex(i) + " has a non-finite material coordinate (NaN or inf)");
   }
   const double scale = std::max(1e-300, (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).norm());
   const double uscale = std::max(1e-300, (mesh.U.colwise().maxCoeff() - mesh.U.colwise().minCoeff()).norm());
@@ -247,20 +253,38 @@ void ValidateMesh(const Mesh& mesh, const std::string& what) {
     const Eigen::Vector3i t = mesh.F.row(f).transpose();
     for (int c = 0; c < 3; ++c)
       if (t[c] < 0 || t[c] >= nv)
-        throw std::invalid_argument(what + ": face " + std::to_string(f) + " has vertex index " +
-                                    std::to_string(t[c]) + " out of range [0, " +
-                                    std::to_string(nv) + ")");
+        throw std::invalid_argument(what + face(f) + " has vertex index " + std::to_string(t[c]) +
+                                    " out of range [0, " + std::to_string(nv) + ")");
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
-      throw std::invalid_argument(what + ": face " + std::to_string(f) + " repeats a vertex");
+      throw std::invalid_argument(what + face(f) + " repeats a vertex");
     const double a = TriangleArea3(mesh.V.row(t[0]), mesh.V.row(t[1]), mesh.V.row(t[2]));
     if (!(a > 1e-12 * scale * scale))
-      throw std::invalid_argument(what + ": face " + std::to_string(f) +
-                                  " is degenerate (zero area in world space)");
+      throw std::invalid_argument(what + face(f) + " is degenerate (zero area in world space)");
     const double ua = TriangleArea2(mesh.U.row(t[0]), mesh.U.row(t[1]), mesh.U.row(t[2]));
     if (!(ua > 1e-12 * uscale * uscale))
-      throw std::invalid_argument(what + ": face " + std::to_string(f) +
-                                  " is degenerate in material space (zero rest area)");
+      throw std::invalid_argument(what + face(f) + " is degenerate in material space (zero rest area)");
   }
+  // Topology, which the simulator needs and reported late (after refinement, in refined indices,
+  // naming no file): every vertex in a face (a vertex in none has no mass), and every edge used
+  // at most once in each direction (a face turned the other way round, or an edge of three faces,
+  // leaves no consistent hinge).
+  std::vector<bool> used(nv, false);
+  std::map<std::pair<int, int>, int> directed;  // (from, to) -> the face that uses it
+  for (int f = 0; f < mesh.F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      const int a = mesh.F(f, c), b = mesh.F(f, (c + 1) % 3);
+      used[a] = true;
+      const auto [it, fresh] = directed.emplace(std::make_pair(a, b), f);
+      if (!fresh)
+        throw std::invalid_argument(what + face(f) + " runs from " + vertex(a) + " to " + vertex(b) + " as " +
+                                    (obj ? "the face on line " + std::to_string(obj_lines[it->second])
+                                         : "face " + std::to_string(it->second)) +
+                                    " does: the faces are oriented inconsistently, or the edge has more than "
+                                    "two faces");
+    }
+  }
+  for (int i = 0; i < nv; ++i)
+    if (!used[i]) throw std::invalid_argument(what + ": " + vertex(i) + " belongs to no face (it would have no mass)");
 }
 
 Mesh RefineMesh(const Mesh& input, double max_edge) {

@@ -2,6 +2,7 @@
 #define CLOTHWIND_SIM_MESH_H_
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -35,12 +36,17 @@ Mesh ReadObj(const std::string& path);
 void WriteObj(const std::string& path, const Mesh& mesh);
 
 // Checks: V, F, U shapes agree; no NaN/inf; indices in range; no repeated index in a face; no
-// degenerate triangle (world and material area > 1e-12 m^2 relative to the squared edge scale).
+// degenerate triangle (world and material area > 1e-12 m^2 relative to the squared edge scale);
+// every vertex in a face; every edge used at most once in each direction (faces consistently
+// oriented, no edge of more than two faces).
 // Inputs:
-//   mesh  mesh to check
-//   what  name used in the error message (e.g. the file name)
-// Throws std::invalid_argument naming `what`, the offending vertex/face index and the problem.
-void ValidateMesh(const Mesh& mesh, const std::string& what = "mesh");
+//   mesh       mesh to check
+//   what       name used in the error message (e.g. the file name)
+//   obj_lines  optional, one per face: the OBJ line it came from; then errors give the line and
+//              number vertices from 1, as the file does ("flag.obj:59: face runs from vertex 8
+//              to vertex 4 as the face on line 60 does: ...")
+// Throws std::invalid_argument naming `what`, the offending vertex/face and the problem.
+void ValidateMesh(const Mesh& mesh, const std::string& what = "mesh", const std::vector<int>& obj_lines = {});
 
 // Uniform 1-to-4 midpoint subdivision, repeated until every edge (in world space and in material
 // space) is at most max_edge. New vertices are edge midpoints in both V and U, so area, boundary

@@ -91,7 +91,7 @@ TEST(ObjTest, BadInputsFailWithFileAndLine) {
   const std::string nan = WriteText("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
   ExpectThrowContaining([&] { ReadObj(nan); }, nan + ":2: non-finite");
   const std::string degenerate = WriteText("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
-  ExpectThrowContaining([&] { ReadObj(degenerate); }, "face 0 is degenerate");
+  ExpectThrowContaining([&] { ReadObj(degenerate); }, degenerate + ":4: face is degenerate");
   ExpectThrowContaining([&] { ReadObj(TempPath("does_not_exist.obj")); }, "cannot open");
   const std::string short_face = WriteText("short.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n");
   ExpectThrowContaining([&] { ReadObj(short_face); }, short_face + ":3: a face needs at least 3");
@@ -111,6 +111,26 @@ TEST(ValidateMeshTest, RejectsNaNRangeAndDegenerate) {
   m.U.resize(3, 2);
   ExpectThrowContaining([&] { ValidateMesh(m); }, "U has 3 rows");
   EXPECT_NO_THROW(ValidateMesh(Rectangle()));
+}
+
+TEST(ValidateMeshTest, TopologyErrorsNameTheObjLineAndItsVertexNumbers) {
+  // Two triangles of a square, consistently oriented: fine.
+  const std::string square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
+  EXPECT_NO_THROW(ReadObj(WriteText("square.obj", square)));
+  // The second face turned round runs over the diagonal 1 -> 3 as the first does.
+  const std::string flipped = WriteText("flipped.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 4 3\n");
+  ExpectThrowContaining([&] { ReadObj(flipped); },
+                        flipped + ":6: face runs from vertex 3 to vertex 1 as the face on line 5 does");
+  // A third face on the diagonal: an edge of three faces.
+  const std::string fin = WriteText("fin.obj", square + "v 0.8 0.2 1\nf 1 3 5\n");
+  ExpectThrowContaining([&] { ReadObj(fin); }, fin + ":8: face runs from vertex 1 to vertex 3");
+  // A vertex no face uses (it would have no mass), numbered as in the file.
+  const std::string stray = WriteText("stray.obj", square + "v 9 9 0\n");
+  ExpectThrowContaining([&] { ReadObj(stray); }, stray + ": vertex 5 belongs to no face");
+  // Without lines (a mesh built in code), 0-based indices.
+  Mesh m = Rectangle();
+  m.F.row(1) = m.F.row(1).reverse().eval();
+  ExpectThrowContaining([&] { ValidateMesh(m, "rect"); }, "rect: face 1 runs from");
 }
 
 TEST(RefineMeshTest, PreservesAreaAndBoundaryAndBoundsEdges) {

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "sim/json_comments.h"
+#include "sim/strain_limiter.h"
 
 namespace clothwind::sim {
 namespace {
@@ -156,8 +157,8 @@ SceneMaterial ParseMaterial(const Reader& r, const json& j, const std::string& p
   if (j.contains("damping")) m.damping = r.NonNegative(j["damping"], path + ".damping");
   if (j.contains("strain_limits")) {
     const auto v = r.Numbers(j["strain_limits"], path + ".strain_limits", 2, 2);
-    if (!(v[0] > 0 && v[0] <= 1 && v[1] >= 1)) {
-      r.Fail(path + ".strain_limits", "expected [min, max] with 0 < min <= 1 <= max");
+    if (!StrainLimitsAreValid(v[0], v[1])) {
+      r.Fail(path + ".strain_limits", std::string("expected [min, max] with ") + kStrainLimitsRule);
     }
     m.strain_min = v[0];
     m.strain_max = v[1];
@@ -412,6 +413,19 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
   }
   if (j.contains("gravity")) s.gravity = r.Vector3(j["gravity"], "gravity");
   if (j.contains("wind")) s.wind = ParseWind(r, j["wind"], "wind");
+  // Gusts are drawn up to their horizon (an hour unless given) and none come after it: a longer
+  // scene draws them to its end, and a horizon given shorter than the scene says so.
+  GustParams& gusts = s.wind.gusts;
+  if (gusts.rate > 0 && gusts.amplitude != 0 && gusts.horizon < s.duration) {
+    if (j["wind"]["gusts"].contains("horizon")) {
+      r.Warn("wind.gusts.horizon", "gusts end at " + std::to_string(gusts.horizon) + " s, before the scene's end (" +
+                                       std::to_string(s.duration) + " s)");
+    } else {
+      gusts.horizon = s.duration;
+      if (gusts.rate * gusts.horizon > 1e6)
+        r.Fail("wind.gusts.rate", "rate x duration must be at most 1e6 gusts (gusts are drawn over the whole scene)");
+    }
+  }
   if (j.contains("magic")) {
     const json& m = j["magic"];
     r.ExpectObject(m, "magic");

@@ -1,6 +1,7 @@
 #include "sim/scene_builder.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
@@ -53,6 +54,19 @@ SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
       ValidateMesh(mesh, sc.mesh);
     } catch (const std::exception& e) {
       fail(key + ".mesh", e.what());
+    }
+    // The rest shape is the OBJ's vt read in metres (ArcSim's rule), not texture coordinates in
+    // 0..1 as most exporters write them: such a cloth starts stretched many times over and ran
+    // silently, 70 times slower, as something else (a 6 m^2 flag at rest over 1 m^2).
+    const double stretch = SurfaceArea(mesh) / RestArea(mesh);
+    if (!(stretch >= 1.0 / kMaxInitialAreaRatio && stretch <= kMaxInitialAreaRatio)) {
+      char what[256];
+      std::snprintf(what, sizeof what,
+                    "the cloth's area (%.4g m^2 after the transform) is %.3g times its rest area (%.4g m^2): "
+                    "the rest shape comes from the OBJ's vt in metres (ArcSim's rule), not texture "
+                    "coordinates in 0..1; expected a ratio in [%.2g, %.2g]",
+                    SurfaceArea(mesh), stretch, RestArea(mesh), 1.0 / kMaxInitialAreaRatio, kMaxInitialAreaRatio);
+      fail(key + ".mesh", sc.mesh + ": " + what);
     }
     cloth.original_vertices = static_cast<int>(mesh.V.rows());
     const double uniform = options.max_edge > 0 ? options.max_edge : DefaultUniformEdge(sc.remeshing);

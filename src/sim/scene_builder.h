@@ -51,13 +51,19 @@ struct BuildOptions {
   double split_edge = 0.0;
 };
 
+// A cloth's area after the scene transform over its rest area (the OBJ's vt in metres) beyond
+// this ratio, or below its inverse, is refused: a cloth starts near its rest shape, and vt
+// written as texture coordinates in 0..1 make it start stretched many times over.
+constexpr double kMaxInitialAreaRatio = 2.0;
+
 // Loads meshes and materials and derives simulator settings.
 // Inputs:
 //   scene    parsed scene (LoadScene)
 //   options  resolution
 // Returns the setup. Throws std::runtime_error naming the scene file and the key (e.g.
 // "cloths[0].mesh", "handles[0].nodes[1]") when a mesh or material cannot be read or is invalid
-// (degenerate triangles, NaN), or a handle node is out of range.
+// (degenerate triangles, NaN, faces oriented inconsistently, unused vertices, an area more than
+// kMaxInitialAreaRatio from the rest area), or a handle node is out of range.
 SceneSetup BuildScene(const Scene& scene, const BuildOptions& options = {});
 
 // The default resolution BuildScene picks for a remeshing block (see BuildOptions::max_edge):

@@ -233,6 +233,23 @@ TEST_F(SceneFiles, WrongTypesNameTheJsonPathAndFile) {
   ExpectErrorNaming([&] { LoadScene(l); }, {l, "wind.gusts.rate", "at most 1e6 gusts"});
 }
 
+TEST_F(SceneFiles, StrainLimitsFollowTheSimulatorsRule) {
+  // One rule with the simulator's (strain_limiter.h): an upper limit alone ([0, 1.05]) is taken,
+  // equal limits ([1, 1], which the simulator refuses) are refused here, naming the key.
+  auto with_limits = [&](const std::string& name, const std::string& limits) {
+    std::string text = SceneText();
+    text.replace(text.find("\"thicken\": 2"), 12, "\"thicken\": 2, \"strain_limits\": " + limits);
+    return Write("conf/" + name + ".json", text);
+  };
+  const Scene upper = LoadScene(with_limits("upper", "[0, 1.05]"));
+  EXPECT_EQ(upper.cloths[0].materials[0].strain_min, 0.0);
+  EXPECT_EQ(upper.cloths[0].materials[0].strain_max, 1.05);
+  const std::string rigid = with_limits("rigid", "[1, 1]");
+  ExpectErrorNaming([&] { LoadScene(rigid); }, {rigid, "cloths[0].materials[0].strain_limits", "min < max"});
+  const std::string inverted = with_limits("inverted", "[1.05, 0.95]");
+  ExpectErrorNaming([&] { LoadScene(inverted); }, {inverted, "strain_limits", "0 <= min <= 1 <= max"});
+}
+
 TEST_F(SceneFiles, NaNIsRejectedNamingFileLineAndKey) {
   std::string text = SceneText();
   text.replace(text.find("0.04"), 4, "NaN");
@@ -261,6 +278,22 @@ TEST_F(SceneFiles, DegenerateTrianglesAndBadMeshesNameTheMeshKey) {
   ExpectErrorNaming([&] { BuildScene(s); }, {path, "cloths[0].mesh", "quad.obj"});
   Write("meshes/quad.obj", "v 0 0 0\nv 1 0 nan\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
   ExpectErrorNaming([&] { BuildScene(LoadScene(path)); }, {path, "cloths[0].mesh"});
+  // A face turned round: named by the OBJ's line, before any refinement.
+  Write("meshes/quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 4 3\n");
+  ExpectErrorNaming([&] { BuildScene(LoadScene(path)); }, {path, "cloths[0].mesh", "quad.obj:6: face"});
+}
+
+TEST_F(SceneFiles, ARestShapeFarFromTheClothsShapeIsRefused) {
+  // A 3 m x 2 m cloth whose vt are texture coordinates in 0..1 (as exporters write them), not its
+  // rest shape in metres: 6 m^2 over a rest area of 1 m^2, refused naming the ratio.
+  Write("meshes/quad.obj",
+        "v 0 0 0\nv 3 0 0\nv 3 2 0\nv 0 2 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+  const std::string path = Write("conf/uv.json", SceneText());
+  ExpectErrorNaming([&] { BuildScene(LoadScene(path)); }, {path, "cloths[0].mesh", "is 6 times its rest area"});
+  // The same vt in metres: fine.
+  Write("meshes/quad.obj",
+        "v 0 0 0\nv 3 0 0\nv 3 2 0\nv 0 2 0\nvt 0 0\nvt 3 0\nvt 3 2\nvt 0 2\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+  EXPECT_NO_THROW(BuildScene(LoadScene(path)));
 }
 
 TEST(ResolveScenePath, AbsoluteNextToSceneThenParentThenWorkingDirectory) {

@@ -9,6 +9,17 @@
 
 namespace clothwind::sim {
 
+// The principal-stretch limits a scene (ArcSim's strain_limits) and the simulator accept: one
+// rule for both (the scene reader once refused [0, 1.05], which the simulator takes as "no lower
+// limit", and passed [1, 1], which the simulator refused naming no file).
+// Inputs: min, max  the limits (max may be infinite: no upper limit; min 0: no lower one).
+// Returns whether 0 <= min <= 1 <= max and min < max.
+inline bool StrainLimitsAreValid(double min, double max) {
+  return min >= 0 && min <= 1 && max >= 1 && min < max;
+}
+constexpr const char* kStrainLimitsRule =
+    "0 <= min <= 1 <= max and min < max (min 0: no lower limit; max inf: no upper one)";
+
 // Keeps every face's principal stretches (the singular values of its deformation gradient) within
 // [strain_min, strain_max], as ArcSim's strain limiting does, but by a few Gauss-Seidel sweeps of
 // per-face projections instead of ArcSim's global constrained optimisation (43 % of its run time):

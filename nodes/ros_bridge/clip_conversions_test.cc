@@ -1,0 +1,82 @@
+#include "ros_bridge/clip_conversions.h"
+
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+#include <sensor_msgs/image_encodings.h>
+
+namespace clothwind::ros_bridge {
+namespace {
+
+sensor_msgs::Image Uniform(const std::string& encoding, int bytes_per_pixel, std::vector<uint8_t> pixel) {
+  sensor_msgs::Image msg;
+  msg.width = 8;
+  msg.height = 6;
+  msg.encoding = encoding;
+  msg.step = msg.width * bytes_per_pixel;
+  for (uint32_t i = 0; i < msg.width * msg.height * bytes_per_pixel / pixel.size(); ++i)
+    msg.data.insert(msg.data.end(), pixel.begin(), pixel.end());
+  return msg;
+}
+
+TEST(ImageViewTest, TheCoreLayoutsAreViewedWithoutACopy) {
+  const sensor_msgs::Image msg = Uniform("rgb8", 3, {10, 20, 30});
+  cv::Mat view;
+  sensors::ClipSourceEncoding encoding;
+  ImageView(msg, &view, &encoding);
+  EXPECT_EQ(encoding, sensors::ClipSourceEncoding::kRgb8);
+  EXPECT_EQ(view.data, msg.data.data());
+  EXPECT_EQ(view.at<cv::Vec3b>(5, 7), cv::Vec3b(10, 20, 30));
+}
+
+TEST(ImageViewTest, CameraLayoutsTheCoreDoesNotReadAreConvertedToBgr) {
+  cv::Mat view;
+  sensors::ClipSourceEncoding encoding;
+  // A UVC camera's YUV 4:2:2 (U Y V Y): mid grey, no colour.
+  ImageView(Uniform("yuv422", 2, {128, 100, 128, 100}), &view, &encoding);
+  EXPECT_EQ(encoding, sensors::ClipSourceEncoding::kBgr8);
+  ASSERT_EQ(view.type(), CV_8UC3);
+  ASSERT_EQ(view.size(), cv::Size(8, 6));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(view.at<cv::Vec3b>(3, 4)[c], 100, 2);
+  // An industrial camera's Bayer mosaic (R G / G B) of one colour: R 200, G 100, B 50.
+  sensor_msgs::Image bayer = Uniform("bayer_rggb8", 1, {0});
+  for (uint32_t y = 0; y < bayer.height; ++y)
+    for (uint32_t x = 0; x < bayer.width; ++x)
+      bayer.data[y * bayer.step + x] = (y % 2 == 0 && x % 2 == 0) ? 200 : (y % 2 == 1 && x % 2 == 1) ? 50 : 100;
+  ImageView(bayer, &view, &encoding);
+  ASSERT_EQ(view.type(), CV_8UC3);
+  const cv::Vec3b inner = view.at<cv::Vec3b>(3, 3);  // B G R
+  EXPECT_NEAR(inner[0], 50, 2);
+  EXPECT_NEAR(inner[1], 100, 2);
+  EXPECT_NEAR(inner[2], 200, 2);
+  // The copy outlives the message.
+  const cv::Mat kept = view;
+  bayer.data.assign(bayer.data.size(), 0);
+  EXPECT_EQ(kept.at<cv::Vec3b>(3, 3), inner);
+}
+
+TEST(ImageViewTest, BadImagesAreNamed) {
+  cv::Mat view;
+  sensors::ClipSourceEncoding encoding;
+  auto what = [&](const sensor_msgs::Image& msg) -> std::string {
+    try {
+      ImageView(msg, &view, &encoding);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_NE(what(Uniform("mpeg4", 1, {0})).find("image encoding 'mpeg4' not supported"), std::string::npos);
+  sensor_msgs::Image short_data = Uniform("mono8", 1, {7});
+  short_data.data.resize(10);
+  EXPECT_NE(what(short_data).find("image data has 10 bytes"), std::string::npos) << what(short_data);
+  sensor_msgs::Image short_bayer = Uniform("bayer_rggb8", 1, {7});
+  short_bayer.data.resize(10);
+  EXPECT_NE(what(short_bayer).find("bayer_rggb8"), std::string::npos) << what(short_bayer);
+  sensor_msgs::Image empty = Uniform("mono8", 1, {7});
+  empty.width = 0;
+  EXPECT_NE(what(empty).find("image is empty"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace clothwind::ros_bridge

@@ -1,0 +1,89 @@
+#include "ros_bridge/sdn_conversions.h"
+
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+namespace clothwind::ros_bridge {
+namespace {
+
+clothwind::Clip GreyClip(uint32_t frames = 30, uint32_t side = 8) {
+  clothwind::Clip clip;
+  clip.header.stamp = ros::Time(100.0);
+  clip.header.frame_id = "camera_optical";
+  clip.frame_rate = 25.0;
+  clip.num_frames = frames;
+  clip.width = clip.height = side;
+  clip.encoding = "mono8";
+  clip.data.assign(static_cast<size_t>(frames) * side * side, 7);
+  return clip;
+}
+
+std::string Refusal(const clothwind::Clip& clip) {
+  try {
+    ClipFrames(clip);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+TEST(ClipFramesTest, AGoodClipIsViewedFrameByFrame) {
+  const clothwind::Clip clip = GreyClip();
+  const std::vector<cv::Mat> frames = ClipFrames(clip);
+  ASSERT_EQ(frames.size(), 30u);
+  EXPECT_EQ(frames[29].data, clip.data.data() + 29 * 64);
+  EXPECT_EQ(frames[0].size(), cv::Size(8, 8));
+}
+
+TEST(ClipFramesTest, SizesWhoseProductWrapsAreRefusedBeforeTheyAreMultiplied) {
+  // 1923865 x 1718039348 x 5581 = 2^64 + 4: four bytes of data once passed the size check, and
+  // reading the frames crashed the node.
+  clothwind::Clip clip = GreyClip();
+  clip.width = 1923865;
+  clip.height = 1718039348;
+  clip.num_frames = 5581;
+  clip.data.assign(4, 1);
+  EXPECT_NE(Refusal(clip).find("at most 16384 px"), std::string::npos) << Refusal(clip);
+  clothwind::Clip many = GreyClip();
+  many.num_frames = kMaxClipFrames + 1;
+  EXPECT_NE(Refusal(many).find("num_frames at most 100000"), std::string::npos) << Refusal(many);
+  clothwind::Clip edge = GreyClip(2, 1);  // the largest side passes
+  edge.width = kMaxClipSide;
+  edge.data.assign(2 * kMaxClipSide, 7);
+  EXPECT_EQ(Refusal(edge), "accepted");
+}
+
+TEST(ClipFramesTest, AClipStampedZeroIsRefused) {
+  clothwind::Clip clip = GreyClip();
+  clip.header.stamp = ros::Time();
+  EXPECT_NE(Refusal(clip).find("Clip.header.stamp is 0"), std::string::npos) << Refusal(clip);
+  // With frame stamps, the first frame's is the clip's.
+  clip.header.stamp = ros::Time(100.0);
+  for (uint32_t i = 0; i < clip.num_frames; ++i) clip.frame_stamps.push_back(ros::Time(i * 0.04));
+  EXPECT_NE(Refusal(clip).find("Clip.frame_stamps[0] is 0"), std::string::npos) << Refusal(clip);
+  for (auto& s : clip.frame_stamps) s += ros::Duration(50.0);
+  EXPECT_EQ(Refusal(clip), "accepted");
+}
+
+TEST(ToWindEstimateTest, TheEstimateSpansTheFramesTheModelRead) {
+  learn::Prediction p;
+  p.speed = 3.0;
+  p.speed_std = 0.5;
+  clothwind::Clip clip = GreyClip(40);
+  // Without frame stamps: the last 30 of 40 frames at 25 fps start 10 periods after the first.
+  clothwind::WindEstimate e = ToWindEstimate(clip, p, 0.01, "m", 30);
+  EXPECT_NEAR((e.clip_start - clip.header.stamp).toSec(), 0.4, 1e-6);
+  EXPECT_NEAR((e.clip_end - clip.header.stamp).toSec(), 39 * 0.04, 1e-6);
+  EXPECT_EQ(e.header.stamp, e.clip_end);
+  EXPECT_EQ(ToWindEstimate(clip, p, 0.01, "m", 0).clip_start, clip.header.stamp);   // all frames
+  EXPECT_EQ(ToWindEstimate(clip, p, 0.01, "m", 50).clip_start, clip.header.stamp);  // fewer than read
+  // With frame stamps, the first frame read's own.
+  for (uint32_t i = 0; i < clip.num_frames; ++i) clip.frame_stamps.push_back(ros::Time(200.0 + i * 0.05));
+  e = ToWindEstimate(clip, p, 0.01, "m", 30);
+  EXPECT_EQ(e.clip_start, clip.frame_stamps[10]);
+  EXPECT_EQ(e.clip_end, clip.frame_stamps[39]);
+}
+
+}  // namespace
+}  // namespace clothwind::ros_bridge

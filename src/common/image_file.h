@@ -1,0 +1,71 @@
+// Reading an image file whole or not at all. Why: libjpeg decodes a JPEG cut short (a copy
+// interrupted, a recording cut by a power loss, a USB transfer lost) with grey rows where the
+// data ends and only prints a warning, so cv::imread hands back an image that is partly made up;
+// a dataset reader or a replay that takes it trains on, or publishes, the made-up part. A JPEG
+// must therefore carry its start- and end-of-image markers. Header-only (OpenCV's imgcodecs).
+#ifndef CLOTHWIND_COMMON_IMAGE_FILE_H_
+#define CLOTHWIND_COMMON_IMAGE_FILE_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+namespace clothwind::common {
+
+// Whether `data` (n bytes) starts like a JPEG (the start-of-image marker FF D8).
+inline bool LooksLikeJpeg(const uint8_t* data, size_t n) {
+  return n >= 2 && data[0] == 0xFF && data[1] == 0xD8;
+}
+
+// Checks that a JPEG's bytes are whole: the start-of-image marker first and the end-of-image
+// marker (FF D9) last, zero padding after it allowed (some cameras pad their buffers).
+// Inputs: data, n  the encoded bytes. Output: "" when whole, else why not (for an error message).
+inline std::string JpegWholeness(const uint8_t* data, size_t n) {
+  if (n < 4 || !LooksLikeJpeg(data, n)) return "no start-of-image marker (" + std::to_string(n) + " bytes)";
+  size_t end = n;
+  while (end > 2 && data[end - 1] == 0x00) --end;
+  if (end < 4 || data[end - 2] != 0xFF || data[end - 1] != 0xD9)
+    return "truncated: no end-of-image marker (" + std::to_string(n) + " bytes)";
+  return "";
+}
+
+// Reads and decodes an image file as cv::imread(path, flags) does, refusing a JPEG that is not
+// whole (JpegWholeness) and catching OpenCV's exceptions (a header claiming more pixels than it
+// allows throws).
+// Inputs: path  the file; flags  cv::IMREAD_* as for cv::imread.
+// Outputs: the image, or an empty cv::Mat with *error (when not null) saying why: "cannot read",
+//   "JPEG truncated: ...", "not a readable image".
+inline cv::Mat ReadImageFile(const std::filesystem::path& path, int flags, std::string* error) {
+  auto fail = [&](const std::string& why) {
+    if (error) *error = why;
+    return cv::Mat();
+  };
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return fail("cannot read");
+  const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return fail("cannot read");
+  if (bytes.empty()) return fail("not a readable image (empty file)");
+  if (LooksLikeJpeg(bytes.data(), bytes.size())) {
+    const std::string why = JpegWholeness(bytes.data(), bytes.size());
+    if (!why.empty()) return fail("JPEG " + why);
+  }
+  cv::Mat image;
+  try {
+    image = cv::imdecode(bytes, flags);
+  } catch (const cv::Exception& e) {
+    return fail("not a readable image (" + e.err + ")");
+  }
+  if (image.empty()) return fail("not a readable image");
+  return image;
+}
+
+}  // namespace clothwind::common
+
+#endif  // CLOTHWIND_COMMON_IMAGE_FILE_H_

@@ -1,0 +1,82 @@
+#include "common/image_file.h"
+
+#include <unistd.h>
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+namespace clothwind::common {
+namespace {
+namespace fs = std::filesystem;
+
+class ImageFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("clothwind_image_file_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    image_ = cv::Mat(48, 64, CV_8UC3);
+    cv::randu(image_, 0, 255);
+    cv::imencode(".jpg", image_, jpeg_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path Write(const std::string& name, const std::vector<uint8_t>& bytes) {
+    std::ofstream(dir_ / name, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    return dir_ / name;
+  }
+  fs::path dir_;
+  cv::Mat image_;
+  std::vector<uint8_t> jpeg_;
+};
+
+TEST_F(ImageFileTest, AWholeJpegReadsAsImreadReadsIt) {
+  const fs::path p = Write("whole.jpg", jpeg_);
+  for (const int flags : {cv::IMREAD_COLOR, cv::IMREAD_GRAYSCALE, cv::IMREAD_UNCHANGED}) {
+    std::string why;
+    const cv::Mat read = ReadImageFile(p, flags, &why);
+    const cv::Mat expected = cv::imread(p.string(), flags);
+    ASSERT_FALSE(read.empty()) << why;
+    EXPECT_EQ(read.type(), expected.type());
+    EXPECT_EQ(cv::norm(read, expected, cv::NORM_INF), 0.0);
+  }
+}
+
+TEST_F(ImageFileTest, AJpegCutShortIsRefusedWhereImreadMakesRowsUp) {
+  std::vector<uint8_t> cut(jpeg_.begin(), jpeg_.begin() + jpeg_.size() / 2);
+  const fs::path p = Write("cut.jpg", cut);
+  ASSERT_FALSE(cv::imread(p.string()).empty()) << "this libjpeg no longer decodes a cut JPEG: the check is moot";
+  std::string why;
+  EXPECT_TRUE(ReadImageFile(p, cv::IMREAD_COLOR, &why).empty());
+  EXPECT_NE(why.find("JPEG truncated"), std::string::npos) << why;
+  // Zeros after the end marker (padding) are whole.
+  std::vector<uint8_t> padded = jpeg_;
+  padded.resize(padded.size() + 64, 0);
+  EXPECT_FALSE(ReadImageFile(Write("padded.jpg", padded), cv::IMREAD_COLOR, &why).empty()) << why;
+}
+
+TEST_F(ImageFileTest, OtherFormatsAndBadFilesSayWhy) {
+  std::vector<uint8_t> png;
+  cv::imencode(".png", image_, png);
+  std::string why;
+  const cv::Mat read = ReadImageFile(Write("a.png", png), cv::IMREAD_COLOR, &why);
+  ASSERT_FALSE(read.empty()) << why;
+  EXPECT_EQ(cv::norm(read, image_, cv::NORM_INF), 0.0);  // lossless
+  EXPECT_TRUE(ReadImageFile(dir_ / "missing.png", cv::IMREAD_COLOR, &why).empty());
+  EXPECT_EQ(why, "cannot read");
+  EXPECT_TRUE(ReadImageFile(Write("empty.png", {}), cv::IMREAD_COLOR, &why).empty());
+  EXPECT_NE(why.find("empty file"), std::string::npos) << why;
+  const std::string text = "not an image at all";
+  EXPECT_TRUE(ReadImageFile(Write("text.png", std::vector<uint8_t>(text.begin(), text.end())), cv::IMREAD_COLOR, &why)
+                  .empty());
+  EXPECT_NE(why.find("not a readable image"), std::string::npos) << why;
+  // A PGM header claiming more pixels than OpenCV allows throws inside OpenCV: an error, not a crash.
+  const std::string bomb = "P5\n100000 100000\n255\n";
+  EXPECT_TRUE(ReadImageFile(Write("bomb.pgm", std::vector<uint8_t>(bomb.begin(), bomb.end())), cv::IMREAD_GRAYSCALE,
+                            &why).empty());
+  EXPECT_NE(why.find("not a readable image"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace clothwind::common
