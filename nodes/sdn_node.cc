@@ -319,31 +319,33 @@ class SdnNode {
     // Before the first estimate, the time since the model loaded: a node whose clips never come (a
     // wrong remap, no clip buffer) said OK "estimating" for ever.
     const double idle = estimates_ > 0 ? now - last_estimate_wall_ : predictor_ ? now - loaded_wall_ : 0.0;
+    // An ERROR says one thing; every WARN that holds is said, joined (the idle WARN once hid the
+    // others, and a node waiting for clips said nothing of its missing fly judge).
+    const auto warn = diagnostic_msgs::DiagnosticStatus::WARN;
     if (!predictor_) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no model: " + load_error_);
     } else if (!clip_error_.empty()) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, clip_error_);
-    } else if (idle > 10.0) {
-      char what[112];
-      std::snprintf(what, sizeof what, "%s for %.0f s (is the clip buffer, camera or bag running?)",
-                    estimates_ > 0 ? "no clip" : "no clip received yet", idle);
-      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, what);
-    } else if (!judge_error_.empty()) {
-      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "estimating; ~fly_judge did not load: " + judge_error_);
-    } else if (!predictor_->fly_judge_error().empty()) {
-      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "estimating; " + predictor_->fly_judge_error());
-    } else if (!parameter_errors_.empty()) {
-      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-                   "estimating with a default for a parameter out of range: " + parameter_errors_.front());
-    } else if (!predictor_->config().flips_in_training &&
-               predictor_->flag_flies() == clothwind::learn::FlagFlies::kAuto && !predictor_->fly_judge()) {
-      // A model trained without flips misreads a flag flying left by ~2.5 m/s, and the clip's own
-      // motion misjudges the way of 7-9 % of FlagSim's clips (docs/sdn.md, "Flags that fly left").
-      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-                   "estimating; the model knows only flags flying right and, with no fly judge, judges each "
-                   "clip's way from its motion: set ~fly_judge, or ~flag_flies to right, left or wind");
     } else {
       stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "estimating");
+      if (idle > 10.0) {
+        char what[112];
+        std::snprintf(what, sizeof what, "%s for %.0f s (is the clip buffer, camera or bag running?)",
+                      estimates_ > 0 ? "no clip" : "no clip received yet", idle);
+        stat.mergeSummary(warn, what);
+      }
+      if (!judge_error_.empty()) stat.mergeSummary(warn, "estimating; ~fly_judge did not load: " + judge_error_);
+      if (!predictor_->fly_judge_error().empty()) stat.mergeSummary(warn, "estimating; " + predictor_->fly_judge_error());
+      if (!parameter_errors_.empty())
+        stat.mergeSummary(warn, "estimating with a default for a parameter out of range: " + parameter_errors_.front());
+      if (!predictor_->config().flips_in_training &&
+          predictor_->flag_flies() == clothwind::learn::FlagFlies::kAuto && !predictor_->fly_judge()) {
+        // A model trained without flips misreads a flag flying left by ~2.5 m/s, and the clip's own
+        // motion misjudges the way of 7-9 % of FlagSim's clips (docs/sdn.md, "Flags that fly left").
+        stat.mergeSummary(warn,
+                          "estimating; the model knows only flags flying right and, with no fly judge, judges each "
+                          "clip's way from its motion: set ~fly_judge, or ~flag_flies to right, left or wind");
+      }
     }
     stat.add("model", model_name_.empty() ? model_path_ : model_name_);
     stat.add("device", predictor_ ? predictor_->device() : std::string("-"));

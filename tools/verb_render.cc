@@ -88,16 +88,27 @@ int Run(const RenderArgs& a) {
   if (a.format != "jpg" && a.format != "png") throw std::invalid_argument("--format: jpg or png");
   std::string what;
   const data::ClothAnimation anim = LoadInput(a, &what);
-  if (a.start < 0 || a.start > anim.duration())
+  // NaN passed a range check written as (start < 0 || start > duration), and a frame count
+  // computed from it or from a huge rate overflowed int: nothing rendered, the earlier run's
+  // frames deleted, exit 0.
+  if (!(a.start >= 0 && a.start <= anim.duration()))
     throw std::invalid_argument("--start " + std::to_string(a.start) + " s is outside the animation's " +
                                 std::to_string(anim.duration()) + " s");
-  const int available = static_cast<int>(std::floor((anim.duration() - a.start) * a.fps + 1e-9)) + 1;
+  const double frames_in_animation = std::floor((anim.duration() - a.start) * a.fps + 1e-9) + 1;
+  if (!(frames_in_animation >= 1 && frames_in_animation <= 1e6))
+    throw std::invalid_argument("--fps " + std::to_string(a.fps) + " gives " + std::to_string(frames_in_animation) +
+                                " frames from --start; expected 1 to 1e6");
+  const int available = static_cast<int>(frames_in_animation);
   const int count = a.count > 0 ? a.count : available;
   if (count > available)
     throw std::invalid_argument("--count " + std::to_string(count) + ": only " + std::to_string(available) +
                                 " frames at " + std::to_string(a.fps) + " fps from --start");
+  // The folder's zeta.json says its frames are whole and this run's: it goes before the first
+  // frame is written and comes back after the last, so a run killed or failing half way leaves
+  // no zeta.json beside a mix of its frames and an earlier run's (a rerun with another seed left
+  // frames of two designs under the new one's zeta.json).
   fs::create_directories(a.out);
-  sim::WriteFileAtomically((fs::path(a.out) / "zeta.json").string(), render::ToJson(zeta).dump(2) + "\n");
+  fs::remove(fs::path(a.out) / "zeta.json");
 
   render::RenderOptions ro;
   ro.threads = a.threads;
@@ -118,6 +129,7 @@ int Run(const RenderArgs& a) {
     bar.Update(k + 1, count);
   }
   bar.Finish();
+  sim::WriteFileAtomically((fs::path(a.out) / "zeta.json").string(), render::ToJson(zeta).dump(2) + "\n");
   // Frames of an earlier run beyond this one's (or in the other format) would read as its own.
   const int stale = RemoveStaleFrames(a.out, [&](const std::string& name) {
     for (const char* ext : {".jpg", ".png"}) {
@@ -149,7 +161,7 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
   sub->add_option("--count", a->count, "frames to render (0: to the end)")
       ->check(CLI::Range(0, 1000000))
       ->capture_default_str();
-  sub->add_option("--fps", a->fps, "output frame rate")->capture_default_str();
+  sub->add_option("--fps", a->fps, "output frame rate [Hz]")->check(CLI::Range(1e-3, 1000.0))->capture_default_str();
   sub->add_option("--frame-time", a->frame_time, "time between OBJ frames [s]")->capture_default_str();
   sub->add_option("--cloth", a->cloth, "which cloth (the CC of NNNN_CC.obj)")->capture_default_str();
   sub->add_flag("--obj", a->obj, "read the folder's OBJ frames even if it has a trajectory");

@@ -63,7 +63,11 @@ cv::Mat MakeContactSheet(const std::string& dir, const nlohmann::json& index,
     items.push_back({name, has_wind ? c["wind_speed"].get<double>() : NAN});
   }
   if (items.empty()) return cv::Mat();
-  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.wind < b.wind; });
+  // Clips without a wind (a recording's unlabelled ones) last: `<` on NaN is no ordering at all.
+  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
+    if (std::isnan(a.wind) || std::isnan(b.wind)) return !std::isnan(a.wind) && std::isnan(b.wind);
+    return a.wind < b.wind;
+  });
   // Evenly spaced over the sorted list: the slowest and the fastest are always shown.
   std::vector<Item> shown;
   const int n = std::min<int>(o.max_tiles, static_cast<int>(items.size()));
@@ -85,7 +89,10 @@ cv::Mat MakeContactSheet(const std::string& dir, const nlohmann::json& index,
     cv::Mat tile;
     cv::resize(frame, tile, cv::Size(o.tile, o.tile), 0, 0, cv::INTER_AREA);
     char wind[32];
-    std::snprintf(wind, sizeof(wind), "%.1f m/s", shown[k].wind);
+    if (std::isnan(shown[k].wind))
+      std::snprintf(wind, sizeof(wind), "no wind");
+    else
+      std::snprintf(wind, sizeof(wind), "%.1f m/s", shown[k].wind);
     Label(tile, wind, 16, 0.5);
     Label(tile, shown[k].name, o.tile - 4, 0.35);
     tile.copyTo(sheet(cv::Rect((k % cols) * o.tile, (k / cols) * o.tile, o.tile, o.tile)));

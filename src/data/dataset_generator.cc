@@ -55,21 +55,23 @@ void ValidateOptions(const DatasetOptions& o) {
   Check(!o.out.empty(), "--out is required");
   Check(o.shards >= 1 && o.shard >= 0 && o.shard < o.shards, "--shard i/N needs 0 <= i < N");
   Check(o.jobs >= 0, "--jobs must be >= 0");
-  Check(o.warmup >= 0, "--warmup must be >= 0 s");
+  // Finite as well: infinity passed ">= 0", ran as a warm-up of 0 (lround(inf)) and went into the
+  // header as null, which every later run was then refused against.
+  Check(std::isfinite(o.warmup) && o.warmup >= 0 && o.warmup <= 3600, "--warmup must be in 0..3600 s");
   Check(o.frames >= 1, "--frames must be >= 1");
-  Check(o.fps > 0, "--fps must be > 0");
+  Check(std::isfinite(o.fps) && o.fps > 0 && o.fps <= 1000, "--fps must be in (0, 1000] Hz");
   Check(o.samples >= 0, "--samples must be >= 0");
   Check(o.size >= 16 && o.size <= 4096, "--size must be in 16..4096 px");
   Check(o.frame_ext == "jpg" || o.frame_ext == "png" || o.frame_ext == "pgm",
         "frame format must be jpg, png or pgm");
   Check(o.jpeg_quality >= 1 && o.jpeg_quality <= 100, "--jpeg-quality must be in 1..100");
-  Check(o.max_edge >= 0, "--max-edge must be >= 0 m");
+  Check(std::isfinite(o.max_edge) && o.max_edge >= 0, "--max-edge must be a finite length >= 0 m");
   Check(!o.add_tracks || o.tracks, "--add-tracks needs the grid of the tracks (--tracks COLSxROWS)");
   Check(o.split.empty() || o.split == "train" || o.split == "val" || o.split == "test",
         "--split must be train, val or test");
   // Checked before the index's header records them: a run refused for them later would leave a
   // folder whose header every corrected run is refused against.
-  Check(o.val_fraction >= 0 && o.test_fraction >= 0 && o.val_fraction + o.test_fraction <= 1,
+  Check(o.val_fraction >= 0 && o.test_fraction >= 0 && o.val_fraction + o.test_fraction <= 1,  // NaN fails too
         "--val and --test must be fractions >= 0 that add up to at most 1 (got " + std::to_string(o.val_fraction) +
             " and " + std::to_string(o.test_fraction) + ")");
 }
@@ -254,12 +256,25 @@ nlohmann::json IndexHeader(const DatasetOptions& o, const nlohmann::json& settin
           {"clips", nlohmann::json::array()}};
 }
 
-// Throws when DIR already holds a dataset whose settings differ from this run's.
-void CheckCompatible(const std::string& dir, const nlohmann::json& settings) {
+// Throws when DIR already holds a dataset whose settings differ from this run's, either way: a
+// setting of the folder's that this run lacks counts too (a dataset made with --tracks resumed
+// without them made examples without tracks.json and dropped "tracks" from the header).
+// `ignored`: a key compared on neither side (--add-tracks gives examples theirs).
+void CheckCompatible(const std::string& dir, const nlohmann::json& settings, const std::string& ignored = "") {
   const nlohmann::json existing = ReadIndex(dir);
   if (existing.is_null() || !existing.contains("dataset")) return;
   const nlohmann::json& old = existing["dataset"];
+  for (auto it = old.begin(); it != old.end(); ++it) {
+    if (it.key() == ignored || settings.contains(it.key())) continue;
+    const bool grid = it.key() == "tracks" && it.value().is_array() && it.value().size() == 2;
+    throw std::runtime_error((fs::path(dir) / "index.json").string() + ": field 'dataset." + it.key() + "' is " +
+                             it.value().dump() + " but this run has none (" +
+                             (grid ? "resume with --tracks " + it.value()[0].dump() + "x" + it.value()[1].dump()
+                                   : std::string("resume with the same settings, or use another --out")) +
+                             ")");
+  }
   for (auto it = settings.begin(); it != settings.end(); ++it) {
+    if (it.key() == ignored) continue;
     if (!old.contains(it.key()) || old[it.key()] != it.value())
       throw std::runtime_error((fs::path(dir) / "index.json").string() + ": field 'dataset." + it.key() +
                                "' is " + (old.contains(it.key()) ? old[it.key()].dump() : "missing") +
@@ -343,9 +358,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   fs::create_directories(o.out);
   if (o.add_tracks) {
     // The examples were made without tracks: every other setting must be theirs.
-    nlohmann::json made = settings;
-    made.erase("tracks");
-    CheckCompatible(o.out, made);
+    CheckCompatible(o.out, settings, "tracks");
   } else {
     CheckCompatible(o.out, settings);
   }

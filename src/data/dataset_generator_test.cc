@@ -7,6 +7,8 @@
 #include <map>
 #include <sstream>
 
+#include <limits>
+
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -490,6 +492,22 @@ TEST_F(DatasetGeneratorTest, AddTracksGivesADatasetTheTracksItWouldHaveBeenMadeW
     EXPECT_NE(std::string(e.what()).find("'dataset.tracks'"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("--add-tracks"), std::string::npos) << e.what();
   }
+  // The other way: a dataset made with tracks resumed without them would make examples without
+  // tracks.json and drop "tracks" from its header. Refused, saying which grid to resume with.
+  const fs::path tracked = root_ / "tracked-resumed-without";
+  fs::copy(root_ / "with-tracks", tracked, fs::copy_options::recursive);
+  const std::string header_before = Bytes(tracked / "index.json");
+  DatasetOptions without = Tiny(tracked.string());
+  without.count += 1;
+  try {
+    GenerateDataset(without);
+    ADD_FAILURE() << "a dataset with tracks was resumed without them";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("'dataset.tracks' is [4,3] but this run has none (resume with --tracks 4x3)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(Bytes(tracked / "index.json"), header_before);
 }
 
 TEST_F(DatasetGeneratorTest, AddTracksRefusesAnExampleWhoseFramesItsReplayDoesNotShow) {
@@ -599,6 +617,16 @@ TEST(DatasetOptionsTest, BadOptionsAreRejected) {
     ADD_FAILURE() << "--val 0.9 --test 0.5 was accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("--val and --test"), std::string::npos) << e.what();
+  }
+  o.val_fraction = 0.1;
+  o.test_fraction = 0.1;
+  // Infinite values passed ">= 0" checks, ran as something else (lround(inf) = 0 s of warm-up)
+  // and went into the header as null, which every corrected run was refused against.
+  for (const char* which : {"warmup", "fps", "max_edge"}) {
+    DatasetOptions bad = o;
+    const double inf = std::numeric_limits<double>::infinity();
+    (std::string(which) == "warmup" ? bad.warmup : std::string(which) == "fps" ? bad.fps : bad.max_edge) = inf;
+    EXPECT_THROW(GenerateDataset(bad), std::invalid_argument) << which;
   }
   EXPECT_FALSE(fs::exists(o.out));
 }

@@ -25,13 +25,15 @@ double LogUniform(Rng& rng, double factor) {
 }  // namespace
 
 void ValidateRanges(const SamplingRanges& r) {
-  if (!(r.wind_min >= 0 && r.wind_max >= r.wind_min))
-    throw std::invalid_argument("sampling ranges: expected 0 <= wind_min <= wind_max, got " +
+  if (!(r.wind_min >= 0 && r.wind_max >= r.wind_min && std::isfinite(r.wind_max)))
+    throw std::invalid_argument("sampling ranges: expected 0 <= wind_min <= wind_max, finite [m/s], got " +
                                 std::to_string(r.wind_min) + ", " + std::to_string(r.wind_max));
-  if (!(r.cloth_area_weight_min > 0 && r.cloth_area_weight_max >= r.cloth_area_weight_min))
-    throw std::invalid_argument("sampling ranges: expected 0 < cloth area weight min <= max");
-  if (!(r.area_weight_factor >= 1 && r.bending_factor >= 1 && r.bending_jitter >= 1))
-    throw std::invalid_argument("sampling ranges: perturbation factors must be >= 1");
+  if (!(r.cloth_area_weight_min > 0 && r.cloth_area_weight_max >= r.cloth_area_weight_min &&
+        std::isfinite(r.cloth_area_weight_max)))
+    throw std::invalid_argument("sampling ranges: expected 0 < cloth area weight min <= max, finite");
+  if (!(r.area_weight_factor >= 1 && r.bending_factor >= 1 && r.bending_jitter >= 1 &&
+        std::isfinite(r.area_weight_factor) && std::isfinite(r.bending_factor) && std::isfinite(r.bending_jitter)))
+    throw std::invalid_argument("sampling ranges: perturbation factors must be finite and >= 1");
   render::ValidateCameraRanges(r.camera);
 }
 

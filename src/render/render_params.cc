@@ -45,10 +45,12 @@ void ValidateCameraRanges(const CameraRanges& r) {
       throw std::invalid_argument(m.str());
     }
   };
-  check(r.height_min > 0 && r.height_max >= r.height_min, "camera height", r.height_min, r.height_max,
-        "0 < min <= max [m]");
-  check(r.radius_min > 0 && r.radius_max >= r.radius_min, "camera radius", r.radius_min, r.radius_max,
-        "0 < min <= max [m]");
+  // Finite: an infinite maximum passed "max >= min", failed every simulation with a misleading
+  // camera error and went into a dataset's header as null.
+  check(r.height_min > 0 && r.height_max >= r.height_min && std::isfinite(r.height_max), "camera height",
+        r.height_min, r.height_max, "0 < min <= max, finite [m]");
+  check(r.radius_min > 0 && r.radius_max >= r.radius_min && std::isfinite(r.radius_max), "camera radius",
+        r.radius_min, r.radius_max, "0 < min <= max, finite [m]");
   check(r.angle_max_deg >= 0 && r.angle_max_deg < 90, "camera angle", -r.angle_max_deg, r.angle_max_deg,
         "a half-range in [0, 90) deg");
 }
@@ -267,7 +269,7 @@ void ValidateRenderParams(const RenderParams& p) {
   Require(p.mesh_aspect_ratio > 0, "mesh_aspect_ratio", "> 0", p.mesh_aspect_ratio);
   Require(p.width > 0 && p.width <= 8192, "width", "in [1, 8192]", p.width);
   Require(p.height > 0 && p.height <= 8192, "height", "in [1, 8192]", p.height);
-  Require(p.fps > 0, "fps", "> 0", p.fps);
+  Require(std::isfinite(p.fps) && p.fps > 0 && p.fps <= 1000, "fps", "in (0, 1000] Hz", p.fps);
   if (p.texture_kind == "flag")
     FlagDesignFromName(p.texture_name);
   else if (p.texture_kind == "fabric")

@@ -1,5 +1,7 @@
 #include "render/render_params.h"
 
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include <set>
@@ -110,6 +112,10 @@ TEST(RenderParams, BadCameraRangesNameTheRange) {
   r = CameraRanges();
   r.radius_min = 0;
   EXPECT_NE(message(r).find("camera radius"), std::string::npos) << message(r);
+  r = CameraRanges();
+  r.radius_max = std::numeric_limits<double>::infinity();  // passed max >= min; a header's null
+  EXPECT_NE(message(r).find("camera radius is [") , std::string::npos) << message(r);
+  EXPECT_NE(message(r).find("finite"), std::string::npos) << message(r);
   r = CameraRanges();
   r.angle_max_deg = 90;
   EXPECT_NE(message(r).find("camera angle"), std::string::npos) << message(r);

@@ -59,6 +59,13 @@ def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encod
     return clip
 
 
+def loaded(status):
+    """Whether a diagnostic says the node's model loaded: OK, or the WARN of a loaded node that has
+    had no clip for 10 s (no ERROR "no model")."""
+    return status.level == DiagnosticStatus.OK or (
+        status.level == DiagnosticStatus.WARN and "no clip received yet" in status.message)
+
+
 class SdnNodeTest(unittest.TestCase):
     def setUp(self):
         self.lock = threading.Lock()
@@ -151,8 +158,7 @@ class SdnNodeTest(unittest.TestCase):
         frequency = rospy.get_param("~stripe_frequency", 5.0)
         # The node subscribes once its model is loaded and warmed up (it is made first).
         self.wait_for(lambda: self.pub.get_num_connections() > 0, 120, "sdn_node to subscribe to clips")
-        self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.statuses), 60,
-                      "an OK diagnostic (model loaded)")
+        self.wait_for(lambda: any(loaded(s) for s in self.statuses), 60, "a diagnostic saying the model loaded")
         # Wait until the node sees our image subscribers, so it computes the maps.
         rospy.sleep(1.0)
         start = rospy.Time(1700000000, 0)
@@ -240,8 +246,8 @@ class SdnNodeTest(unittest.TestCase):
         the clip buffer's ~colour parameter (the grey cannot be coloured back)."""
         size = rospy.get_param("~size", 300)
         self.wait_for(lambda: self.colour_pub.get_num_connections() > 0, 120, "the colour sdn_node to subscribe")
-        self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.colour_statuses), 60,
-                      "an OK diagnostic from the colour node (model loaded)")
+        self.wait_for(lambda: any(loaded(s) for s in self.colour_statuses), 60,
+                      "a diagnostic from the colour node saying the model loaded")
         start = rospy.Time(1700000000, 0)
         self.colour_pub.publish(make_clip(0, start, size, 3.0, 4.0))
         self.wait_for(lambda: any(s.level == DiagnosticStatus.ERROR and "~colour" in s.message
@@ -278,13 +284,15 @@ class SdnNodeTest(unittest.TestCase):
         is turned round, and a wind along the optical axis keeps the way last known."""
         size = 256
         self.wait_for(lambda: self.wind_pub.get_num_connections() > 0, 120, "the wind-told sdn_node to subscribe")
-        self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.wind_statuses), 60,
-                      "an OK diagnostic from the wind-told node (no WARN: it is told the way)")
         start = rospy.Time(1700000000, 0)
         for seq, flag, direction in ((0, "right", 0.0), (1, "left", math.pi), (2, "left", math.pi / 2)):
             self.wind_pub.publish(make_clip(seq, start + rospy.Duration.from_sec(2.0 * seq), size, 3.0, 4.0,
                                             flag=flag, wind_direction=direction))
         self.wait_for(lambda: len(self.wind_estimates) >= 3, 30, "estimates of the three clips")
+        with self.lock:
+            del self.wind_statuses[:]
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.wind_statuses), 30,
+                      "an OK diagnostic from the wind-told node (no WARN: it is told the way)")
         values = self.wait_for_turned(self.wind_statuses, 2)
         with self.lock:
             speeds = {e.clip_sequence: e.speed for e in self.wind_estimates}
@@ -298,12 +306,17 @@ class SdnNodeTest(unittest.TestCase):
         the judge named in the diagnostics, and a clip of a flag flying left turned round."""
         size = 256
         self.wait_for(lambda: self.judge_pub.get_num_connections() > 0, 120, "the judged sdn_node to subscribe")
-        self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.judge_statuses), 60,
-                      "an OK diagnostic from the node with a fly judge")
+        # Loaded for over 10 s and no clip yet: a WARN that says so (it said OK "estimating").
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.WARN and "no clip received yet" in s.message
+                                  for s in self.judge_statuses), 60, "a WARN that no clip has come yet")
         start = rospy.Time(1700000000, 0)
         self.judge_pub.publish(make_clip(0, start, size, 3.0, 4.0, flag="right"))
         self.judge_pub.publish(make_clip(1, start + rospy.Duration.from_sec(2.0), size, 3.0, 4.0, flag="left"))
         self.wait_for(lambda: len(self.judge_estimates) >= 2, 30, "estimates of both clips")
+        with self.lock:
+            del self.judge_statuses[:]
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.judge_statuses), 30,
+                      "an OK diagnostic from the node with a fly judge once clips come")
         values = self.wait_for_turned(self.judge_statuses, 1)
         with self.lock:
             speeds = {e.clip_sequence: e.speed for e in self.judge_estimates}

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# CLI test of `clothwind render` on a rerun into a used --out: a bad --start or --fps is refused
+# before anything is touched (NaN passed the range check, the frame count overflowed, and the
+# earlier run's frames were deleted with exit 0), and zeta.json, the mark of a whole run, is
+# written last. Usage: render_cli_test.sh CLOTHWIND_BINARY SOURCE_DIR
+set -euo pipefail
+bin="$1"
+src="$2"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+fail() { echo "render_cli_test: FAIL: $*" >&2; exit 1; }
+
+"$bin" simulate "$src/config/scenes/flag.json" --out "$work/sim" --duration 0.2 --max-edge 1 --no-obj >/dev/null
+"$bin" render "$work/sim" --out "$work/fr" --count 3 --samples 1 --threads 1 >/dev/null 2>&1
+[ -f "$work/fr/000.jpg" ] && [ -f "$work/fr/002.jpg" ] && [ -f "$work/fr/zeta.json" ] || fail "first run incomplete"
+before="$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")"
+
+for bad in "--start nan" "--start inf" "--start -1" "--fps 1e300" "--fps nan"; do
+  # shellcheck disable=SC2086
+  if "$bin" render "$work/sim" --out "$work/fr" $bad --samples 1 --threads 1 >"$work/out.txt" 2>&1; then
+    fail "render $bad exited 0: $(cat "$work/out.txt")"
+  fi
+  [ "$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")" = "$before" ] || fail "render $bad changed the earlier run's files"
+done
+
+# A rerun that fails after it starts writing (frame 1 cannot take its place: a folder holds its
+# name) leaves no zeta.json beside its new frame 0 and the earlier run's frame 2.
+rm "$work/fr/001.jpg"
+mkdir "$work/fr/001.jpg"
+if "$bin" render "$work/sim" --out "$work/fr" --seed 2 --count 3 --samples 1 --threads 1 >"$work/out.txt" 2>&1; then
+  fail "a rerun that could not write frame 1 exited 0"
+fi
+[ ! -e "$work/fr/zeta.json" ] || fail "a failed rerun left zeta.json beside a mix of two runs' frames"
+echo "render_cli_test: OK"
