@@ -106,7 +106,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_flag("--cache-frames", o.cache_frames,
                 "keep every frame decoded at the input size in memory after its first read: the same samples, "
                 "no rereading of a dataset larger than the page cache (needs --crop-scales 1; clips x frames x "
-                "size^2 bytes, 4.7 GB for flagsim-e5 at 64 px)");
+                "size^2 bytes of the training split, 4.1 GB for flagsim-e5 at 64 px)");
   sub->add_option("--aux-tracks", o.aux_tracks,
                   "weight of an auxiliary loss (0: off): a second head regresses each clip's grid of material "
                   "points (position and low-frequency motion, from the dataset's tracks.json: make-dataset "
