@@ -132,12 +132,14 @@ int main(int argc, char** argv) {
       diagnostic_updater::FrequencyStatusParam(&min_rate, &max_rate, 0.1, 10),
       diagnostic_updater::TimeStampStatusParam(-0.05, 0.5));
   uint64_t published = 0, read_errors = 0, last_drops_seen = 0, last_errors_seen = 0;
+  uint64_t unsubscribed = 0;  // frames read while nobody subscribed (no message built)
   std::string last_error;
   bool opened = false, ended = false;
   updater.add("camera source", [&](diagnostic_updater::DiagnosticStatusWrapper& stat) {
     const auto status = source->Status();
     for (const auto& kv : status) stat.add(kv.first, kv.second);
     stat.add("published", published);
+    stat.add("read with no subscriber (not published)", unsubscribed);
     stat.add("read errors", read_errors);
     stat.add("frame_id", frame_id);
     const auto state = status.count("state") ? status.at("state") : std::string("?");
@@ -198,7 +200,12 @@ int main(int argc, char** argv) {
     } else {
       Frame frame;
       const ReadStatus status = source->Read(&frame, 0.1);
-      if (status == ReadStatus::kFrame) {
+      if (status == ReadStatus::kFrame && publisher.getNumSubscribers() == 0) {
+        // The frame is read and decoded (the driver's buffers must keep moving) and counted at the
+        // camera's rate, but no message is built for nobody.
+        topic_diagnostic.tick(clothwind::ros_bridge::RosTimeFromNs(frame.stamp_ns));
+        ++unsubscribed;
+      } else if (status == ReadStatus::kFrame) {
         try {
           sensor_msgs::ImagePtr image = clothwind::ros_bridge::ToImageMsg(frame, frame_id);
           bool mismatch = false;

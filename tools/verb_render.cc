@@ -108,11 +108,20 @@ int Run(const RenderArgs& a) {
   // no zeta.json beside a mix of its frames and an earlier run's (a rerun with another seed left
   // frames of two designs under the new one's zeta.json).
   fs::create_directories(a.out);
-  fs::remove(fs::path(a.out) / "zeta.json");
 
   render::RenderOptions ro;
   ro.threads = a.threads;
-  render::Renderer renderer(zeta, ro);
+  render::Renderer renderer(zeta, ro);  // may still refuse ζ: the earlier run stays whole
+  fs::remove(fs::path(a.out) / "zeta.json");
+  // Frames of an earlier run beyond this one's (or in the other format) would read as its own.
+  const int stale = RemoveStaleFrames(a.out, [&](const std::string& name) {
+    for (const char* ext : {".jpg", ".png"}) {
+      const auto n = FrameNumber(name, 3, ext);
+      if (n && (*n >= count || a.format != std::string(ext + 1))) return true;
+    }
+    return false;
+  });
+  if (stale > 0) std::fprintf(stderr, "render: removed %d frames left by an earlier run\n", stale);
   ProgressBar::Options bo;
   bo.label = "render";
   bo.unit = "frames";
@@ -130,15 +139,6 @@ int Run(const RenderArgs& a) {
   }
   bar.Finish();
   sim::WriteFileAtomically((fs::path(a.out) / "zeta.json").string(), render::ToJson(zeta).dump(2) + "\n");
-  // Frames of an earlier run beyond this one's (or in the other format) would read as its own.
-  const int stale = RemoveStaleFrames(a.out, [&](const std::string& name) {
-    for (const char* ext : {".jpg", ".png"}) {
-      const auto n = FrameNumber(name, 3, ext);
-      if (n && (*n >= count || a.format != std::string(ext + 1))) return true;
-    }
-    return false;
-  });
-  if (stale > 0) std::fprintf(stderr, "render: removed %d frames left by an earlier run\n", stale);
   std::printf("render: %d frames -> %s (%.1f ms/frame), zeta in %s/zeta.json\n", count, a.out.c_str(),
               1e3 * bar.Elapsed() / count, a.out.c_str());
   return 0;

@@ -12,6 +12,7 @@
 #include <cctype>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -49,14 +50,9 @@ std::string Token(std::istream& in) {
   return token;
 }
 
-}  // namespace
-
-// Reads a binary PGM (P5, maxval <= 255): one channel, or three equal ones with IMREAD_COLOR as
-// the real imread gives them. Empty Mat if the file cannot be read, as imread.
-Mat imread(const String& filename, int flags) {
-  if (!IsPgm(filename)) Refuse("imread " + filename);
-  std::ifstream in(filename, std::ios::binary);
-  if (!in) return Mat();
+// Decodes a binary PGM stream (P5, maxval <= 255): one channel, or three equal ones with
+// IMREAD_COLOR as the real decoder gives them. Empty Mat when it is not one, as imread.
+Mat DecodePgm(std::istream& in, int flags) {
   if (Token(in) != "P5") return Mat();
   int width = 0, height = 0, maxval = 0;
   try {
@@ -78,6 +74,29 @@ Mat imread(const String& filename, int flags) {
   return grey;
 }
 
+}  // namespace
+
+Mat imread(const String& filename, int flags) {
+  if (!IsPgm(filename)) Refuse("imread " + filename);
+  std::ifstream in(filename, std::ios::binary);
+  if (!in) return Mat();
+  return DecodePgm(in, flags);
+}
+
+// Decodes PGM bytes (clothwind reads its frames whole, then decodes: common/image_file.h).
+Mat imdecode(InputArray buf, int flags) {
+  const Mat bytes = buf.getMat();
+  const std::string data(reinterpret_cast<const char*>(bytes.data), bytes.total() * bytes.elemSize());
+  if (data.size() < 2 || data[0] != 'P' || data[1] != '5') Refuse("imdecode of a buffer that is not a binary PGM");
+  std::istringstream in(data);
+  return DecodePgm(in, flags);
+}
+Mat imdecode(InputArray buf, int flags, Mat* dst) {
+  Mat m = imdecode(buf, flags);
+  if (dst) *dst = m;
+  return m;
+}
+
 // Writes an 8-bit single-channel image as binary PGM.
 bool imwrite(const String& filename, InputArray img, const std::vector<int>& /*params*/) {
   if (!IsPgm(filename)) Refuse("imwrite " + filename);
@@ -93,8 +112,6 @@ bool imwrite(const String& filename, InputArray img, const std::vector<int>& /*p
 bool haveImageReader(const String& filename) { return IsPgm(filename); }
 bool haveImageWriter(const String& filename) { return IsPgm(filename); }
 
-Mat imdecode(InputArray /*buf*/, int /*flags*/) { Refuse("imdecode"); }
-Mat imdecode(InputArray /*buf*/, int /*flags*/, Mat* /*dst*/) { Refuse("imdecode"); }
 
 // Encodes an 8-bit single-channel image as binary PGM (make-dataset encodes, then writes and
 // fsyncs the bytes itself).

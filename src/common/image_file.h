@@ -24,16 +24,21 @@ inline bool LooksLikeJpeg(const uint8_t* data, size_t n) {
   return n >= 2 && data[0] == 0xFF && data[1] == 0xD8;
 }
 
-// Checks that a JPEG's bytes are whole: the start-of-image marker first and the end-of-image
-// marker (FF D9) last, zero padding after it allowed (some cameras pad their buffers).
+// Checks that a JPEG's bytes are whole: the start-of-image marker first, and the end-of-image
+// marker (FF D9) after the start of its last scan (FF DA). Inside a scan's entropy-coded data an
+// FF byte is always followed by 00 or a restart marker, so neither marker appears there; an
+// embedded thumbnail's scan and end come before the main image's scan. Anything may follow the
+// end (cameras pad their buffers with zeros; phones append trailers).
 // Inputs: data, n  the encoded bytes. Output: "" when whole, else why not (for an error message).
 inline std::string JpegWholeness(const uint8_t* data, size_t n) {
   if (n < 4 || !LooksLikeJpeg(data, n)) return "no start-of-image marker (" + std::to_string(n) + " bytes)";
-  size_t end = n;
-  while (end > 2 && data[end - 1] == 0x00) --end;
-  if (end < 4 || data[end - 2] != 0xFF || data[end - 1] != 0xD9)
-    return "truncated: no end-of-image marker (" + std::to_string(n) + " bytes)";
-  return "";
+  size_t last_scan = 0;
+  for (size_t i = 2; i + 1 < n; ++i)
+    if (data[i] == 0xFF && data[i + 1] == 0xDA) last_scan = i;
+  if (last_scan == 0) return "no image data: no start-of-scan marker (" + std::to_string(n) + " bytes)";
+  for (size_t i = last_scan + 2; i + 1 < n; ++i)
+    if (data[i] == 0xFF && data[i + 1] == 0xD9) return "";
+  return "truncated: no end-of-image marker after its last scan (" + std::to_string(n) + " bytes)";
 }
 
 // Reads and decodes an image file as cv::imread(path, flags) does, refusing a JPEG that is not

@@ -54,6 +54,20 @@ TEST_F(ImageFileTest, AJpegCutShortIsRefusedWhereImreadMakesRowsUp) {
   std::vector<uint8_t> padded = jpeg_;
   padded.resize(padded.size() + 64, 0);
   EXPECT_FALSE(ReadImageFile(Write("padded.jpg", padded), cv::IMREAD_COLOR, &why).empty()) << why;
+  // Nor is a trailer after it (phones append their own data), which imread reads whole too.
+  std::vector<uint8_t> trailed = jpeg_;
+  const std::string trailer = "SEFHDR\xFF\xD8 more vendor data";
+  trailed.insert(trailed.end(), trailer.begin(), trailer.end());
+  ASSERT_FALSE(cv::imread(Write("trailed.jpg", trailed).string()).empty());
+  EXPECT_FALSE(ReadImageFile(dir_ / "trailed.jpg", cv::IMREAD_COLOR, &why).empty()) << why;
+  // A cut that keeps a thumbnail's end marker ahead of the main scan is still cut: the marker
+  // must follow the last scan.
+  std::vector<uint8_t> early_end(jpeg_.begin(), jpeg_.begin() + 2);
+  const uint8_t thumbnail_like[] = {0xFF, 0xD9};
+  early_end.insert(early_end.end(), thumbnail_like, thumbnail_like + 2);
+  early_end.insert(early_end.end(), jpeg_.begin() + 2, jpeg_.begin() + jpeg_.size() / 2);
+  EXPECT_TRUE(ReadImageFile(Write("early_end.jpg", early_end), cv::IMREAD_COLOR, &why).empty());
+  EXPECT_NE(why.find("after its last scan"), std::string::npos) << why;
 }
 
 TEST_F(ImageFileTest, OtherFormatsAndBadFilesSayWhy) {

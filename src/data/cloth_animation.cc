@@ -57,7 +57,7 @@ ClothAnimation ReadObjSequence(const std::string& folder, int cloth, double fram
     std::snprintf(name, sizeof(name), "%04d_%02d.obj", f, cloth);
     const fs::path path = fs::path(folder) / name;
     if (!fs::exists(path)) break;
-    const sim::Mesh m = sim::ReadObj(path.string());
+    const sim::Mesh m = sim::ReadObj(path.string(), /*topology=*/false);  // drawn, not simulated
     const Eigen::MatrixXd U = m.U;
     if (f == 0) Bounds(U, &lo, &hi);
     ClothFrame frame;

@@ -75,6 +75,11 @@ Dataset ReadDataset(const fs::path& dir) {
   if (!index.contains("clips") || !index["clips"].is_array()) {
     throw std::runtime_error(index_path.string() + ": missing field \"clips\" (an array)");
   }
+  // scripts/dataset-variant --split-by-clip re-splits a dataset clip by clip in its index alone
+  // (the labels are hard links to the source's): there the index's split is the one, and one
+  // simulation in several splits is the point (the leak that variant measures).
+  const bool split_by_clip = index.contains("dataset") && index["dataset"].is_object() &&
+                             index["dataset"].value("variant", std::string()) == "split_by_clip";
   std::map<std::string, size_t> seen;  // name -> its first entry
   std::map<int, std::pair<std::string, std::string>> simulation_split;  // simulation -> (split, a clip's name)
   for (size_t i = 0; i < index["clips"].size(); ++i) {
@@ -151,7 +156,7 @@ Dataset ReadDataset(const fs::path& dir) {
       throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
                                "].split must be \"train\", \"val\" or \"test\", got \"" + clip.split + "\"");
     }
-    if (entry.contains("split") && label.contains("split") && label["split"] != entry["split"]) {
+    if (!split_by_clip && entry.contains("split") && label.contains("split") && label["split"] != entry["split"]) {
       throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) + "].split is " +
                                entry["split"].dump() + " but " + label_path.string() + " says " +
                                label["split"].dump());
@@ -159,7 +164,7 @@ Dataset ReadDataset(const fs::path& dir) {
     // The views of one simulation share its flag's motion: in two splits, a test clip's motion is
     // trained on (the leak docs/sdn.md measures). The generator splits by simulation; a merged or
     // re-indexed dataset might not.
-    if (clip.simulation >= 0) {
+    if (clip.simulation >= 0 && !split_by_clip) {
       const auto [it, fresh] = simulation_split.emplace(clip.simulation, std::make_pair(clip.split, clip.name));
       if (!fresh && it->second.first != clip.split) {
         throw std::runtime_error(index_path.string() + ": simulation " + std::to_string(clip.simulation) +

@@ -284,6 +284,16 @@ TEST_F(DatasetTest, ReadsEachClipsSimulation) {
   } catch (const std::runtime_error& e) {
     EXPECT_THAT(e.what(), HasSubstr("simulation 7 has clips in two splits (\"toy-00000\" in train, \"toy-00001\" in test)"));
   }
+  // Unless the index says it was split clip by clip on purpose (scripts/dataset-variant
+  // --split-by-clip, which measures that leak): then its splits hold.
+  EditJson(leak / "index.json", [&](nlohmann::json& j) {
+    j["dataset"] = {{"variant", "split_by_clip"}};
+    j["clips"][0]["split"] = "test";
+    j["clips"][1]["split"] = "train";
+  });
+  const Dataset variant = ReadDataset(leak);
+  EXPECT_EQ(variant.clips[0].split, "test");
+  EXPECT_EQ(variant.clips[1].split, "train");
   // The index and a label naming different splits for one clip: which holds is a guess.
   const fs::path two = Copy("two_splits");
   std::string listed;

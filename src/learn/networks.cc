@@ -304,8 +304,7 @@ void CheckConfigMatchesWeights(const ModelConfig& config, const std::filesystem:
   if (!differences.empty()) {
     throw std::runtime_error(config_path.string() + " does not describe the network whose weights are in " +
                              weights.string() + ": " + differences +
-                             " (a model.json is written with its weights; restore it, or export the model "
-                             "again with clothwind export-model)");
+                             " (a model.json is written with its weights: restore the one written with them)");
   }
 }
 

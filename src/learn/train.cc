@@ -334,7 +334,8 @@ TrainResult Train(const TrainOptions& o) {
     // A resumed run must keep the schedule it ran under: a cosine run resumed with other --epochs
     // (or any run with another --lr, --lr-schedule or --lr-decay-epoch) would silently become a
     // different run from the one its log describes.
-    for (const EpochRecord& e : result.log) {
+    // (Runs that record their schedule are checked against it below, every epoch of it.)
+    for (const EpochRecord& e : state.contains("epochs") ? std::vector<EpochRecord>{} : result.log) {
       const double expected = LearningRateAt(o, e.epoch);
       if (std::abs(expected - e.lr) > 1e-9 * std::max(std::abs(e.lr), 1e-12)) {
         std::ostringstream what;
@@ -392,13 +393,13 @@ TrainResult Train(const TrainOptions& o) {
     if (state.contains("lr")) RefuseChangedOnResume(state_path, "--lr", state["lr"].get<double>(), o.lr);
     if (state.contains("lr_schedule"))
       RefuseChangedOnResume(state_path, "--lr-schedule", state["lr_schedule"].get<std::string>(), o.lr_schedule);
-    if (state.contains("lr_decay_epoch"))
-      RefuseChangedOnResume(state_path, "--lr-decay-epoch", state["lr_decay_epoch"].get<int>(), o.lr_decay_epoch);
-    // Other --epochs only where they leave every epoch's rate as the run's own schedule gives it
-    // (a step run with its decay epoch given may go on for longer; a cosine run may not).
-    if (state.contains("epochs")) {
+    // Other --epochs or --lr-decay-epoch only where they leave every epoch's rate as the run's own
+    // schedule gives it (a step run may go on for longer with its decay epoch given, its default
+    // one resolved from the epochs it started with; a cosine run may not).
+    if (state.contains("epochs") && state.contains("lr_decay_epoch")) {
       TrainOptions started = o;
       started.epochs = state["epochs"].get<int>();
+      started.lr_decay_epoch = state["lr_decay_epoch"].get<int>();
       // The started schedule read past its end: a step run's rate stays decayed, a cosine run's
       // is 0 (so a cosine run is never extended).
       for (int e = 1; e <= o.epochs; ++e) {
@@ -406,8 +407,11 @@ TrainResult Train(const TrainOptions& o) {
         std::ostringstream what;
         what << state_path.string() << ": the run started with --epochs " << started.epochs << ", whose "
              << o.lr_schedule << " schedule runs epoch " << e << " at " << LearningRateAt(started, e)
-             << "; --epochs " << o.epochs << " gives " << LearningRateAt(o, e)
-             << " (resume with the --epochs the run started with, or give --lr-decay-epoch to extend a step run)";
+             << "; --epochs " << o.epochs << " --lr-decay-epoch " << o.lr_decay_epoch << " give "
+             << LearningRateAt(o, e)
+             << " (resume with the --epochs the run started with, or extend a step run with --lr-decay-epoch "
+             << (started.lr_decay_epoch < 0 ? std::max(1, started.epochs / 2) : started.lr_decay_epoch)
+             << ", its decay epoch)";
         throw std::runtime_error(what.str());
       }
     }

@@ -807,7 +807,19 @@ TEST_F(TrainTest, CosineScheduleIsWhatTrainingUses) {
   Train(started);
   started.epochs = 4;
   started.resume = true;
-  ExpectTrainRefused(started, "a cosine run resumed with other --epochs", {"--epochs 1", "--epochs 4 gives"});
+  ExpectTrainRefused(started, "a cosine run resumed with other --epochs", {"--epochs 1", "--epochs 4 --lr-decay-epoch"});
+  // A step run with the default decay (half its epochs) extended: --epochs alone moves the decay
+  // and is refused, naming the decay epoch that extends it; given that, it goes on.
+  TrainOptions step = Options("sdn", "step_extended");
+  step.epochs = 2;
+  Train(step);
+  step.epochs = 4;
+  step.resume = true;
+  ExpectTrainRefused(step, "a step run whose decay --epochs moves", {"extend a step run with --lr-decay-epoch 1"});
+  step.lr_decay_epoch = 1;
+  const TrainResult extended = Train(step);
+  ASSERT_EQ(extended.log.size(), 4u);
+  EXPECT_DOUBLE_EQ(extended.log[3].lr, step.lr / step.lr_decay_factor);
   t.lr_schedule = "warm";
   t.out = *root_ / "cosine_bad";
   ExpectTrainRefused(t, "unknown schedule accepted", {"warm"});
@@ -971,8 +983,19 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   w.lr_schedule = "cosine";
   const auto log_before = fs::last_write_time(*root_ / "resume" / "state.json");
   ExpectTrainRefused(w, "a resume under another schedule was accepted",
-                     {"state.json: epoch 2 ran at learning rate", "--lr-schedule cosine"});
+                     {"state.json: the run trained with --lr-schedule step, these options give cosine"});
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
+  // A run from before the schedule was recorded is checked against its log's rates.
+  fs::copy(*root_ / "resume", *root_ / "resume_unrecorded", fs::copy_options::recursive);
+  {
+    nlohmann::json state = ReadJson(*root_ / "resume_unrecorded" / "state.json");
+    for (const char* key : {"epochs", "lr", "lr_schedule", "lr_decay_epoch"}) state.erase(key);
+    std::ofstream(*root_ / "resume_unrecorded" / "state.json") << state.dump(2);
+  }
+  w.out = *root_ / "resume_unrecorded";
+  ExpectTrainRefused(w, "an unrecorded run resumed under another schedule",
+                     {"state.json: epoch 2 ran at learning rate", "--lr-schedule cosine"});
+  w.out = *root_ / "resume";
 
   // So is a resume with other crop scales: its augmentation would differ from the log's epochs.
   TrainOptions x = Options("sdn", "resume");

@@ -162,9 +162,13 @@ TEST(PixelFormatTest, MjpegDecodesToBgrAndReportsGarbage) {
   padded.resize(jpeg.size() + 300, 0x00);
   EXPECT_TRUE(ConvertToImage(PixelFormat::kMjpeg, padded.data(), padded.size(), 64, 48, 0, &image, &error))
       << error;
-  // A start marker followed by garbage still fails in the decoder.
+  // A start and an end marker around garbage: no scan, no image.
   std::vector<uint8_t> headed = {0xFF, 0xD8, 0x12, 0x34, 0x56, 0xFF, 0xD9};
   EXPECT_FALSE(ConvertToImage(PixelFormat::kMjpeg, headed.data(), headed.size(), 64, 48, 0, &image, &error));
+  EXPECT_NE(error.find("no start-of-scan marker"), std::string::npos) << error;
+  // With a scan marker, garbage still fails in the decoder.
+  std::vector<uint8_t> scanned = {0xFF, 0xD8, 0xFF, 0xDA, 0x12, 0x34, 0x56, 0xFF, 0xD9};
+  EXPECT_FALSE(ConvertToImage(PixelFormat::kMjpeg, scanned.data(), scanned.size(), 64, 48, 0, &image, &error));
   EXPECT_NE(error.find("MJPEG decode failed"), std::string::npos) << error;
 }
 

@@ -14,6 +14,9 @@ struct GustParams {
   double amplitude_spread = 0.5;  // peak ~ Uniform(amplitude (1 - s), amplitude (1 + s))
   double duration = 2.0;          // rise and fall time of one gust [s]
   double horizon = 3600.0;        // gusts are drawn for t in [0, horizon) [s]
+  // Whether the scene set the horizon. When it did not, Simulate draws gusts over the whole run
+  // (warm-up and --duration included): an hour's default once ended the gusts of longer runs.
+  bool horizon_given = false;
   uint64_t seed = 0;
 };
 

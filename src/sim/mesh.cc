@@ -96,7 +96,7 @@ class EdgeMidpoints {
 
 }  // namespace
 
-Mesh ReadObj(const std::string& path) {
+Mesh ReadObj(const std::string& path, bool topology) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open OBJ file");
   std::vector<Eigen::Vector3d> positions;
@@ -195,7 +195,7 @@ Mesh ReadObj(const std::string& path) {
       mesh.U.row(v) = texcoords[vt_of[v]].transpose();
     }
   }
-  ValidateMesh(mesh, path, face_lines);
+  ValidateMesh(mesh, path, face_lines, topology);
   return mesh;
 }
 
@@ -228,7 +228,7 @@ void WriteObj(const std::string& path, const Mesh& mesh) {
   }
 }
 
-void ValidateMesh(const Mesh& mesh, const std::string& what, const std::vector<int>& obj_lines) {
+void ValidateMesh(const Mesh& mesh, const std::string& what, const std::vector<int>& obj_lines, bool topology) {
   // An OBJ's reader knows each triangle's line and numbers vertices from 1, as the file does.
   const bool obj = !obj_lines.empty() && static_cast<int>(obj_lines.size()) == mesh.F.rows();
   auto vertex = [&](int i) { return "vertex " + std::to_string(obj ? i + 1 : i); };
@@ -264,6 +264,7 @@ void ValidateMesh(const Mesh& mesh, const std::string& what, const std::vector<i
     if (!(ua > 1e-12 * uscale * uscale))
       throw std::invalid_argument(what + face(f) + " is degenerate in material space (zero rest area)");
   }
+  if (!topology) return;
   // Topology, which the simulator needs and reported late (after refinement, in refined indices,
   // naming no file): every vertex in a face (a vertex in none has no mass), and every edge used
   // at most once in each direction (a face turned the other way round, or an edge of three faces,

@@ -25,7 +25,10 @@ struct Mesh {
 // Inputs:
 //   path  file to read
 // Returns the mesh. Throws std::runtime_error naming path:line and what was expected on bad input.
-Mesh ReadObj(const std::string& path);
+// topology: also check what the simulator needs of a cloth (ValidateMesh's topology checks);
+// false for meshes that are only drawn (an OBJ frame sequence to render: exporters leave loose
+// vertices and mixed winding, which a renderer does not mind).
+Mesh ReadObj(const std::string& path, bool topology = true);
 
 // Writes `v` (positions), `vt` (material coordinates) and `f a/a b/b c/c` lines, atomically
 // (temporary file then rename), with full double precision so ReadObj(WriteObj(m)) == m.
@@ -46,7 +49,9 @@ void WriteObj(const std::string& path, const Mesh& mesh);
 //              number vertices from 1, as the file does ("flag.obj:59: face runs from vertex 8
 //              to vertex 4 as the face on line 60 does: ...")
 // Throws std::invalid_argument naming `what`, the offending vertex/face and the problem.
-void ValidateMesh(const Mesh& mesh, const std::string& what = "mesh", const std::vector<int>& obj_lines = {});
+//   topology   false: skip the last two checks (a mesh only drawn, not simulated)
+void ValidateMesh(const Mesh& mesh, const std::string& what = "mesh", const std::vector<int>& obj_lines = {},
+                  bool topology = true);
 
 // Uniform 1-to-4 midpoint subdivision, repeated until every edge (in world space and in material
 // space) is at most max_edge. New vertices are edge midpoints in both V and U, so area, boundary

@@ -307,7 +307,10 @@ GustParams ParseGusts(const Reader& r, const json& j, const std::string& path) {
     if (g.amplitude_spread > 1) r.Fail(path + ".amplitude_spread", "expected a number in [0, 1]");
   }
   if (j.contains("duration")) g.duration = r.Positive(j["duration"], path + ".duration");
-  if (j.contains("horizon")) g.horizon = r.Positive(j["horizon"], path + ".horizon");
+  if (j.contains("horizon")) {
+    g.horizon = r.Positive(j["horizon"], path + ".horizon");
+    g.horizon_given = true;
+  }
   // The gusts are drawn up front, rate x horizon of them: bounded, so a typo cannot ask for 1e300.
   if (g.rate * g.horizon > 1e6) r.Fail(path + ".rate", "rate x horizon must be at most 1e6 gusts");
   if (j.contains("seed")) g.seed = Seed(r, j["seed"], path + ".seed");
@@ -413,19 +416,15 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
   }
   if (j.contains("gravity")) s.gravity = r.Vector3(j["gravity"], "gravity");
   if (j.contains("wind")) s.wind = ParseWind(r, j["wind"], "wind");
-  // Gusts are drawn up to their horizon (an hour unless given) and none come after it: a longer
-  // scene draws them to its end, and a horizon given shorter than the scene says so.
-  GustParams& gusts = s.wind.gusts;
-  if (gusts.rate > 0 && gusts.amplitude != 0 && gusts.horizon < s.duration) {
-    if (j["wind"]["gusts"].contains("horizon")) {
-      r.Warn("wind.gusts.horizon", "gusts end at " + std::to_string(gusts.horizon) + " s, before the scene's end (" +
-                                       std::to_string(s.duration) + " s)");
-    } else {
-      gusts.horizon = s.duration;
-      if (gusts.rate * gusts.horizon > 1e6)
-        r.Fail("wind.gusts.rate", "rate x duration must be at most 1e6 gusts (gusts are drawn over the whole scene)");
-    }
+  // Gusts are drawn up to their horizon and none come after it: unless the scene sets one,
+  // Simulate draws them over the whole run; a horizon set shorter than the scene says so.
+  const GustParams& gusts = s.wind.gusts;
+  if (gusts.rate > 0 && gusts.amplitude != 0 && gusts.horizon_given && gusts.horizon < s.duration) {
+    r.Warn("wind.gusts.horizon", "gusts end at " + std::to_string(gusts.horizon) + " s, before the scene's end (" +
+                                     std::to_string(s.duration) + " s)");
   }
+  if (gusts.rate * std::max(s.duration, gusts.horizon) > 1e6)
+    r.Fail("wind.gusts.rate", "rate x duration must be at most 1e6 gusts (they are drawn up front)");
   if (j.contains("magic")) {
     const json& m = j["magic"];
     r.ExpectObject(m, "magic");

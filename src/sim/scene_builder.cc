@@ -60,11 +60,12 @@ SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
     // silently, 70 times slower, as something else (a 6 m^2 flag at rest over 1 m^2).
     const double stretch = SurfaceArea(mesh) / RestArea(mesh);
     if (!(stretch >= 1.0 / kMaxInitialAreaRatio && stretch <= kMaxInitialAreaRatio)) {
-      char what[256];
+      char what[512];
       std::snprintf(what, sizeof what,
                     "the cloth's area (%.4g m^2 after the transform) is %.3g times its rest area (%.4g m^2): "
-                    "the rest shape comes from the OBJ's vt in metres (ArcSim's rule), not texture "
-                    "coordinates in 0..1; expected a ratio in [%.2g, %.2g]",
+                    "the rest shape is the OBJ's vt in metres, or without vt the x, y of its positions "
+                    "(ArcSim's rule), so vt written as texture coordinates in 0..1, or a cloth modelled "
+                    "steeply out of its x-y plane, start stretched; expected a ratio in [%.2g, %.2g]",
                     SurfaceArea(mesh), stretch, RestArea(mesh), 1.0 / kMaxInitialAreaRatio, kMaxInitialAreaRatio);
       fail(key + ".mesh", sc.mesh + ": " + what);
     }

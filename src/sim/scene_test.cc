@@ -233,6 +233,24 @@ TEST_F(SceneFiles, WrongTypesNameTheJsonPathAndFile) {
   ExpectErrorNaming([&] { LoadScene(l); }, {l, "wind.gusts.rate", "at most 1e6 gusts"});
 }
 
+TEST_F(SceneFiles, AGustHorizonShorterThanTheSceneWarns) {
+  Warnings w;
+  const std::string path = Write("conf/gusts.json", SceneText(", \"duration\": 20, \"wind\": {\"velocity\": [5, 0, 0], "
+                                                               "\"gusts\": {\"rate\": 0.1, \"amplitude\": 2, \"horizon\": 10}}"));
+  const Scene s = LoadScene(path, w.sink());
+  EXPECT_TRUE(s.wind.gusts.horizon_given);
+  ASSERT_EQ(w.list.size(), 1u);
+  EXPECT_NE(w.list[0].find("wind.gusts.horizon"), std::string::npos) << w.list[0];
+  EXPECT_NE(w.list[0].find("before the scene's end"), std::string::npos) << w.list[0];
+  // Without a horizon: no warning, and none set (Simulate draws them over the run).
+  Warnings none;
+  const Scene d = LoadScene(Write("conf/gusts2.json", SceneText(", \"duration\": 20, \"wind\": {\"velocity\": [5, 0, 0], "
+                                                                 "\"gusts\": {\"rate\": 0.1, \"amplitude\": 2}}")),
+                            none.sink());
+  EXPECT_FALSE(d.wind.gusts.horizon_given);
+  EXPECT_TRUE(none.list.empty()) << none.list.front();
+}
+
 TEST_F(SceneFiles, StrainLimitsFollowTheSimulatorsRule) {
   // One rule with the simulator's (strain_limiter.h): an upper limit alone ([0, 1.05]) is taken,
   // equal limits ([1, 1], which the simulator refuses) are refused here, naming the key.

@@ -38,6 +38,8 @@ Trajectory SimulateTrajectory(const SceneSetup& setup, const Theta& theta,
   }
   const int warmup_frames = static_cast<int>(std::lround(options.warmup / frame_time));
   const int total = warmup_frames + frames;
+  // Gusts over the whole run, warm-up and --duration included, unless the scene set a horizon.
+  if (!wind.gusts.horizon_given) wind.gusts.horizon = std::max(wind.gusts.horizon, total * frame_time + 1.0);
 
   SimOptions sim_options = cloth.options;
   sim_options.wind_density = wind.density;  // the setup's wind may have been edited

@@ -136,6 +136,27 @@ TEST(SimulateTrajectory, WindHookReceivesThetasWindAndItsFieldIsUsed) {
   EXPECT_TRUE(Identical(hooked, SimulateTrajectory(still, theta, o)));
 }
 
+TEST(SimulateTrajectory, GustsLastTheWholeRunUnlessTheSceneSetsTheirHorizon) {
+  // An hour's default horizon ended the gusts of longer runs (a day-long scene, or an hour's
+  // warm-up). The hook sees the spec the run's field is made from; it stops the run there.
+  const SceneSetup setup = SmallFlag();
+  SimulateOptions o;
+  o.duration = 0.04;
+  o.warmup = 4000.0;
+  double horizon = 0;
+  o.make_wind = [&](const WindSpec& spec) -> std::shared_ptr<const WindField> {
+    horizon = spec.gusts.horizon;
+    throw std::runtime_error("seen");
+  };
+  EXPECT_THROW(SimulateTrajectory(setup, SceneTheta(setup), o), std::runtime_error);
+  EXPECT_GE(horizon, 4000.04);
+  SceneSetup given = setup;
+  given.wind.gusts.horizon = 100.0;
+  given.wind.gusts.horizon_given = true;
+  EXPECT_THROW(SimulateTrajectory(given, SceneTheta(given), o), std::runtime_error);
+  EXPECT_EQ(horizon, 100.0);
+}
+
 TEST(SimulateTrajectory, HangingClothIsBlownDownwindAndLiftedByItsDiagonalWind) {
   BuildOptions b;
   b.max_edge = 0.3;
