@@ -93,6 +93,17 @@ void ExpectTrainRefused(const TrainOptions& o, const std::string& accepted, cons
   }
 }
 
+// Trains `o` to its o.epochs in two goes into o.out: stopped after `first` epochs, then resumed
+// (what a run stopped by a VM restart does).
+TrainResult TrainStoppedAndResumed(TrainOptions o, int first) {
+  const int epochs = o.epochs;
+  o.epochs = first;
+  Train(o);
+  o.epochs = epochs;
+  o.resume = true;
+  return Train(o);
+}
+
 // A network built from `config` reads `clips` [1, C, N_t, H, W] into one (speed, log variance) pair.
 void ExpectOneEstimatePerClip(const ModelConfig& config, const at::Tensor& clips) {
   WindNet net(config);
@@ -834,11 +845,7 @@ TEST_F(TrainTest, AResumedRunWithDropoutRepeatsTheUninterruptedOne) {
   const TrainResult uninterrupted = Train(whole);
   TrainOptions part = whole;
   part.out = *root_ / "dropout_resumed";
-  part.epochs = 1;
-  Train(part);
-  part.epochs = 2;
-  part.resume = true;
-  const TrainResult resumed = Train(part);
+  const TrainResult resumed = TrainStoppedAndResumed(part, 1);
   ASSERT_EQ(resumed.log.size(), 2u);
   EXPECT_NEAR(resumed.log[1].train_loss, uninterrupted.log[1].train_loss, 1e-6);
   EXPECT_NEAR(resumed.log[1].val_rmse, uninterrupted.log[1].val_rmse, 1e-6);
@@ -1086,11 +1093,9 @@ TEST_F(TrainTest, WeightAverageIsWhatModelHoldsAndResumes) {
 
   TrainOptions u = Options("sdn", "average_resumed");
   u.weight_average = 0.9;
-  u.epochs = 2;
-  Train(u);
   u.epochs = 3;
+  const TrainResult resumed = TrainStoppedAndResumed(u, 2);
   u.resume = true;
-  const TrainResult resumed = Train(u);
   ASSERT_EQ(resumed.log.size(), 3u);
   EXPECT_NEAR(resumed.log[2].val_rmse, r.log[2].val_rmse, 1e-5);
   EXPECT_NEAR(resumed.log[2].raw_val_rmse, r.log[2].raw_val_rmse, 1e-5);
