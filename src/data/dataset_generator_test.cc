@@ -582,8 +582,17 @@ TEST_F(DatasetGeneratorTest, ContactSheetStaysInsideTheDataset) {
   o.tile = 32;
   const cv::Mat sheet = MakeContactSheet(Ref().string(), index, o);
   EXPECT_FALSE(sheet.empty());
+  // A clip without a wind (a recording's unlabelled one) is shown, last: the third of the 2x2
+  // sheet's tiles is the one a sheet of that clip alone shows.
   index["clips"][0].erase("wind_speed");
-  EXPECT_FALSE(MakeContactSheet(Ref().string(), index, o).empty());
+  const cv::Mat with_unlabelled = MakeContactSheet(Ref().string(), index, o);
+  ASSERT_EQ(with_unlabelled.size(), cv::Size(64, 64));
+  nlohmann::json alone = index;
+  alone["clips"] = nlohmann::json::array({index["clips"][0]});
+  const cv::Mat single = MakeContactSheet(Ref().string(), alone, o);
+  ASSERT_EQ(single.size(), cv::Size(32, 32));
+  EXPECT_EQ(cv::norm(with_unlabelled(cv::Rect(0, 32, 32, 32)), single, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(with_unlabelled(cv::Rect(0, 0, 32, 32)), single, cv::NORM_INF), 0.0);
   for (const char* bad : {"../reference", "/tmp"}) {
     index["clips"][1]["name"] = bad;
     try {

@@ -68,14 +68,21 @@ TEST(FrameResamplerTest, JitteredStampsStillPickNearest) {
   const double t0 = 100.0;
   std::vector<double> stamps;
   for (int i = 0; i < 90; ++i) stamps.push_back(t0 + i / 30.0 + ((i * 7919) % 11 - 5) * 0.0005);
+  std::vector<int64_t> indices;
   for (size_t i = 0; i < stamps.size(); ++i) {
     for (const auto& tick : r.Push(stamps[i]).ticks) {
+      indices.push_back(tick.index);
       double best = stamps[0];
       for (size_t j = 0; j <= i; ++j)
         if (std::fabs(stamps[j] - tick.stamp) < std::fabs(best - tick.stamp)) best = stamps[j];
       EXPECT_DOUBLE_EQ(tick.source_stamp, best) << "tick " << tick.index;
     }
   }
+  // Every tick of the ~2.97 s at 25 fps came, once each and in order (a resampler that emitted
+  // none would pass the loop above).
+  ASSERT_GE(indices.size(), 74u);
+  ASSERT_LE(indices.size(), 75u);
+  for (size_t k = 1; k < indices.size(); ++k) EXPECT_EQ(indices[k], indices[k - 1] + 1);
 }
 
 TEST(FrameResamplerTest, GapRestartsTheGrid) {

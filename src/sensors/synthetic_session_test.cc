@@ -118,6 +118,11 @@ TEST(SyntheticSessionTest, WindDriftsButStaysPlausible) {
   EXPECT_LT(hi, 15.0);
   EXPECT_GT(hi - lo, 0.5);  // it does change
   EXPECT_NEAR(w.MeanSpeed(10.0, 10.0), w.Speed(10.0), 1e-12);
+  // The window mean every anemometer reading carries, against a fine Riemann sum of the speed.
+  double sum = 0;
+  const int n = 30000;
+  for (int k = 0; k < n; ++k) sum += w.Speed(10.0 + 3.0 * (k + 0.5) / n);
+  EXPECT_NEAR(w.MeanSpeed(10.0, 13.0), sum / n, 1e-3);
   EXPECT_GT(w.FlutterPhase(10.0), w.FlutterPhase(5.0));
 }
 

@@ -598,6 +598,24 @@ ClothEnergy ClothSimulator::Energy() const {
   return impl_->Energy();
 }
 
+Eigen::MatrixX3d ClothSimulator::ForceJacobianTimes(const Eigen::MatrixX3d& dx) const {
+  Impl& s = *impl_;
+  if (dx.rows() != s.nv) throw std::invalid_argument("ForceJacobianTimes: expected " + std::to_string(s.nv) + " rows");
+  const bool repel = s.options.self_collision && s.options.repulsion_thickness > 0 &&
+                     s.options.collision_stiffness > 0;
+  const StepStats kept = s.stats;
+  if (repel) s.proximity->Update(s.x, s.options.repulsion_thickness);
+  s.ComputeForces(/*with_jacobian=*/true, repel);
+  s.stats = kept;
+  // The same blocks the step's conjugate gradients multiply by (Solve's pattern and side list).
+  Eigen::MatrixX3d out = Eigen::MatrixX3d::Zero(s.nv, 3);
+  for (int i = 0; i < s.nv; ++i)
+    for (int k = s.row_start[i]; k < s.row_start[i + 1]; ++k)
+      out.row(i) += (s.J[k] * dx.row(s.col[k]).transpose()).transpose();
+  for (const auto& e : s.extra) out.row(e.row) += (e.J * dx.row(e.col).transpose()).transpose();
+  return out;
+}
+
 Eigen::MatrixX3d ClothSimulator::Forces() const {
   Impl& s = *impl_;
   const bool repel = s.options.self_collision && s.options.repulsion_thickness > 0 &&

@@ -131,6 +131,12 @@ class ClothSimulator {
   // and diagnostics (handles included, not zeroed).
   Eigen::MatrixX3d Forces() const;
 
+  // The force Jacobian the implicit step assembles, applied to a displacement: (df/dx) dx at the
+  // current state (#V by 3 in, #V by 3 out) [N]. Stretching in its positive-definite form,
+  // bending only when implicit (and Gauss-Newton: exact where the hinges are flat), repulsion
+  // with its Gauss-Newton blocks. For tests (finite differences of Forces()) and diagnostics.
+  Eigen::MatrixX3d ForceJacobianTimes(const Eigen::MatrixX3d& dx) const;
+
   const StepStats& last_step_stats() const;
 
  private:
