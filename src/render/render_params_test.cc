@@ -23,6 +23,26 @@ TEST(RenderParams, JsonRoundTripKeepsEveryField) {
     EXPECT_EQ(q.background_image, p.background_image);
     EXPECT_EQ(q.scene, kind);
   }
+  // Fields sampling leaves at their defaults, set to others: each must be read back, not
+  // defaulted again (comparing the JSON of a default-valued field proves nothing).
+  RenderParams p = SampleRenderParams(SceneKind::kFlag, 78);
+  p.fps = 30;
+  p.camera_fov_deg = 52.5;
+  p.has_look_at = true;
+  p.look_at[0] = 1.5, p.look_at[1] = -0.25, p.look_at[2] = 3.75;
+  p.width = 320;
+  p.height = 240;
+  p.samples = 7;
+  const RenderParams q = RenderParamsFromJson(nlohmann::json::parse(ToJson(p).dump()));
+  EXPECT_EQ(q.fps, 30);
+  EXPECT_EQ(q.camera_fov_deg, 52.5);
+  EXPECT_TRUE(q.has_look_at);
+  EXPECT_EQ(q.look_at[0], 1.5);
+  EXPECT_EQ(q.look_at[1], -0.25);
+  EXPECT_EQ(q.look_at[2], 3.75);
+  EXPECT_EQ(q.width, 320);
+  EXPECT_EQ(q.height, 240);
+  EXPECT_EQ(q.samples, 7);
 }
 
 TEST(RenderParams, MissingOrMistypedFieldIsNamed) {
