@@ -21,7 +21,11 @@ while [ $# -gt 0 ] && [ "$1" != "--" ]; do opts+=("$1"); shift; done
 [ $# -gt 0 ] && shift  # the "--"
 
 source "$(dirname "$0")/clothwind_cli.sh"
-if [ ! -f "$model" ] || [ "$cli" -nt "$model" ] || [ "$0" -nt "$model" ]; then
+# The model is made again when the CLI or this script is newer, or when it was made with other
+# options (a .test file edited without a rebuild would otherwise run against the old model).
+recipe="toy=$toy half=$half ${opts[*]}"
+made_with="$(cat "$model.recipe" 2>/dev/null || true)"
+if [ ! -f "$model" ] || [ "$cli" -nt "$model" ] || [ "$0" -nt "$model" ] || [ "$made_with" != "$recipe" ]; then
   if [ -n "$toy" ]; then
     "$cli" make-toy-dataset --out "$toy" --clips 100 --frames 60 --size 32 --seed 1 >&2
     if [ "$half" = 1 ]; then
@@ -34,5 +38,6 @@ if [ ! -f "$model" ] || [ "$cli" -nt "$model" ] || [ "$0" -nt "$model" ]; then
   else
     "$cli" train --overwrite --init-only --out "$(dirname "$model")" "${opts[@]}" >&2
   fi
+  echo "$recipe" > "$model.recipe"
 fi
 exec "$@"
