@@ -99,7 +99,10 @@ double FlutterCrossingsPerSecond(double speed) {
 
 TEST(SyntheticSessionTest, FlagFluttersFasterInStrongerWind) {
   const double slow = FlutterCrossingsPerSecond(2.0), fast = FlutterCrossingsPerSecond(8.0);
-  // Expected flutter: 1.2 Hz at 2 m/s, 3.3 Hz at 8 m/s -> about 2.4 and 6.6 crossings per second.
+  // Expected flutter: 1.2 Hz at 2 m/s, 3.3 Hz at 8 m/s (0.5 + 0.35 v Hz, docs/clips.md) -> about
+  // 2.4 and 6.6 crossings per second.
+  EXPECT_NEAR(SyntheticWind::FlutterFrequency(2.0), 1.2, 1e-12);
+  EXPECT_NEAR(SyntheticWind::FlutterFrequency(8.0), 3.3, 1e-12);
   EXPECT_NEAR(slow, 2.0 * SyntheticWind::FlutterFrequency(2.0), 1.0);
   EXPECT_NEAR(fast, 2.0 * SyntheticWind::FlutterFrequency(8.0), 1.5);
   EXPECT_GT(fast, 1.8 * slow);

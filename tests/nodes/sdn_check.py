@@ -228,6 +228,9 @@ class SdnNodeTest(unittest.TestCase):
         # Every pixel oscillates at the same frequency: the frequency image is one colour.
         pixels = set(bytes(freq_img.data[i:i + 3]) for i in range(0, len(freq_img.data), 3))
         self.assertEqual(len(pixels), 1, "uniform stripe frequency gives a uniform frequency map")
+        # ...and not the colour of 0 Hz or of Nyquist (a map of zeros, or of garbage clipped to the
+        # top, is uniform too): OpenCV's jet is (128, 0, 0) BGR at 0 and (0, 0, 128) at the top.
+        self.assertNotIn(pixels.pop(), (bytes([128, 0, 0]), bytes([0, 0, 128])), "the frequency map's colour")
         status = [s for s in self.statuses][-1]
         keys = {kv.key: kv.value for kv in status.values}
         self.assertIn("latency mean [s]", keys)
