@@ -84,8 +84,10 @@ inline void WriteFileAtomically(const std::string& path, const void* data, size_
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw std::runtime_error("cannot rename " + tmp + " to " + path + ": " + ec.message());
+    const std::string why = ec.message();  // before remove() reuses an error code ("Success")
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw std::runtime_error("cannot rename " + tmp + " to " + path + ": " + why);
   }
   SyncDirectory(std::filesystem::path(path).parent_path().string());
 }

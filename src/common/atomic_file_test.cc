@@ -42,6 +42,17 @@ TEST_F(AtomicFileTest, ReplacesTheContentWhole) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("missing/b.json"), std::string::npos) << e.what();
   }
+  // A folder where the file should go: the rename fails, and the error gives its real reason
+  // (it said "Success": the error code was reused by the temporary's removal).
+  std::filesystem::create_directories(dir_ / "adir");
+  try {
+    WriteFileAtomically((dir_ / "adir").string(), std::string("x"));
+    ADD_FAILURE() << "a file was written over a folder";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot rename"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("Success"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(Entries(), 2u);  // a.json and the folder: no temporary left
 }
 
 // A disk that fills up mid-write (RLIMIT_FSIZE stands in: it fails writes for root too): the
