@@ -8,6 +8,7 @@
 #include "learn/track_head_eval.h"
 #include "learn/view_breakdown.h"
 #include "progress_bar.h"
+#include "output_paths.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -88,6 +89,10 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
                 << a->flag_flies << "\n";
       return 2;
     }
+    const std::vector<std::filesystem::path> inputs = {a->model, learn::ConfigPathFor(a->model),
+                                                        std::filesystem::path(a->data) / "index.json", a->fly_judge};
+    RefuseOutputOverInput("--json", a->json, inputs);
+    RefuseOutputOverInput("--plot", a->plot, inputs);
     ProgressBar::Options b;
     b.label = "eval";
     b.unit = "clips";

@@ -14,6 +14,7 @@
 #include "learn/networks.h"
 #include "learn/weights_io.h"
 #include "progress_bar.h"
+#include "output_paths.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -44,6 +45,16 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
       std::cerr << "export-model: --out must differ from --model (" << a->out << ")\n";
       return 2;
     }
+    // The weights and their .json beside them: neither may land on an input, nor on each other.
+    const std::filesystem::path out_config = learn::ConfigPathFor(a->out);
+    const std::vector<std::filesystem::path> inputs = {
+        a->model, learn::ConfigPathFor(a->model),
+        a->calibrate_data.empty() ? std::filesystem::path() : std::filesystem::path(a->calibrate_data) / "index.json"};
+    RefuseOutputOverInput("--out", a->out, inputs);
+    RefuseOutputOverInput("--out's .json", out_config, inputs);
+    if (SameFile(a->out, out_config))
+      throw std::invalid_argument("--out " + a->out + ": the weights' configuration is written beside them with "
+                                  "the extension .json, so --out needs another (e.g. .pt)");
     // As `train --out`, the output's folder is made when missing, before the minute of loading and
     // calibrating rather than at the write after it.
     const std::filesystem::path folder = std::filesystem::path(a->out).parent_path();

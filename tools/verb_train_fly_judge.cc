@@ -15,6 +15,7 @@
 #include "learn/fly_judge_train.h"
 #include "learn/model_config.h"
 #include "progress_bar.h"
+#include "output_paths.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -70,6 +71,17 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
   sub->add_option("--seed", a->train.seed, "initialisation and order")->capture_default_str();
   sub->add_option("--threads", a->threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   return [a]() {
+    {
+      // The weights and their card beside them: on neither the dataset's index nor each other,
+      // checked before the training, not after it.
+      const std::filesystem::path card = learn::ConfigPathFor(a->out);
+      const std::filesystem::path index = std::filesystem::path(a->data) / "index.json";
+      if (SameFile(a->out, card))
+        throw std::invalid_argument("--out " + a->out + ": the judge's card is written beside it with the "
+                                    "extension .json, so --out needs another (e.g. .pt)");
+      RefuseOutputOverInput("--out", a->out, {index});
+      RefuseOutputOverInput("--out's card", card, {index});
+    }
     at::set_num_threads(a->threads);
     const learn::Dataset dataset = learn::ReadDataset(a->data);
     const learn::MotionMaps train = Collect(dataset, "train", a->frames, a->windows);

@@ -1,0 +1,36 @@
+// Refusing an output path that would overwrite one of a verb's inputs. Why: `eval --plot
+// run/model.pt`, `--json run/model.json` or `--json data/index.json`, and `export-model --out`
+// or `train-fly-judge --out` whose card lands on an input's, exited 0 having replaced the
+// user's model, its configuration or a dataset's index.
+#ifndef CLOTHWIND_TOOLS_OUTPUT_PATHS_H_
+#define CLOTHWIND_TOOLS_OUTPUT_PATHS_H_
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace clothwind::tools {
+
+// Whether two paths name one file: equivalent when both exist, else equal once made absolute and
+// normal (an output not written yet).
+inline bool SameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code ec;
+  if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) return std::filesystem::equivalent(a, b, ec);
+  return std::filesystem::absolute(a).lexically_normal() == std::filesystem::absolute(b).lexically_normal();
+}
+
+// Throws std::invalid_argument naming `option` and the input when `output` (empty: none) is one
+// of `inputs` (the files the verb reads: a model, its .json, a dataset's index.json, ...).
+inline void RefuseOutputOverInput(const std::string& option, const std::filesystem::path& output,
+                                  const std::vector<std::filesystem::path>& inputs) {
+  if (output.empty()) return;
+  for (const auto& input : inputs)
+    if (!input.empty() && SameFile(output, input))
+      throw std::invalid_argument(option + " " + output.string() + " is an input (" + input.string() +
+                                  "); write it elsewhere");
+}
+
+}  // namespace clothwind::tools
+
+#endif  // CLOTHWIND_TOOLS_OUTPUT_PATHS_H_

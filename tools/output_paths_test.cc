@@ -1,0 +1,39 @@
+#include "output_paths.h"
+
+#include <unistd.h>
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+namespace clothwind::tools {
+namespace {
+namespace fs = std::filesystem;
+
+TEST(OutputPathsTest, AnOutputThatIsAnInputIsRefusedHoweverSpelt) {
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_output_paths_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "run");
+  std::ofstream(dir / "run" / "model.pt") << "weights";
+  std::ofstream(dir / "run" / "model.json") << "{}";
+  const std::vector<fs::path> inputs = {dir / "run" / "model.pt", dir / "run" / "model.json"};
+  // The same file through another spelling (eval --plot run/../run/model.pt replaced the model).
+  try {
+    RefuseOutputOverInput("--plot", dir / "run" / ".." / "run" / "model.pt", inputs);
+    ADD_FAILURE() << "the model was accepted as the plot";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--plot"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("is an input"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(RefuseOutputOverInput("--json", dir / "run" / "model.json", inputs), std::invalid_argument);
+  // Outputs not written yet, other files and no output at all pass.
+  EXPECT_NO_THROW(RefuseOutputOverInput("--json", dir / "run" / "eval.json", inputs));
+  EXPECT_NO_THROW(RefuseOutputOverInput("--json", fs::path(), inputs));
+  EXPECT_NO_THROW(RefuseOutputOverInput("--json", dir / "run" / "eval.json", {fs::path()}));
+  // An output not written yet that names an input not there either: the same path is refused.
+  EXPECT_THROW(RefuseOutputOverInput("--out", dir / "new.pt", {dir / "." / "new.pt"}), std::invalid_argument);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace clothwind::tools
