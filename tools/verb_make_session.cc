@@ -62,7 +62,12 @@ sensor_msgs::CameraInfo MakeCameraInfo(int width, int height) {
 }
 
 int Run(const MakeSessionArgs& a) {
-  if (a.minutes <= 0.0) throw std::invalid_argument("--minutes must be > 0");
+  // Bounded and long enough for a clip and a reading: infinity (cast to a frame count, undefined)
+  // and a few milliseconds both wrote an empty bag and exited 0.
+  if (!(a.minutes >= 0.05 && a.minutes <= 1440.0))
+    throw std::invalid_argument("--minutes must be in 0.05..1440 (3 s to a day), got " + std::to_string(a.minutes));
+  if (!(std::isfinite(a.wind_mean) && a.wind_mean >= 0 && a.wind_mean <= 60))
+    throw std::invalid_argument("--wind-mean must be in 0..60 m/s, got " + std::to_string(a.wind_mean));
   sensors::SyntheticSessionOptions o;
   o.duration = a.minutes * 60.0;
   o.seed = a.seed;

@@ -124,4 +124,18 @@ TEST(SessionBagTest, ProceduralSessionStillWorks) {
   fs::remove_all(fs::path(bag).parent_path());
 }
 
+TEST(SessionBagTest, ADurationThatMakesNoSessionIsRefused) {
+  // Infinity (a frame count of undefined size) and a few milliseconds wrote an empty bag, exit 0.
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_session_bad_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  for (const char* minutes : {"inf", "nan", "0.0001", "1e30"}) {
+    const fs::path bag = dir / "bad.bag";
+    const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes " + minutes + " --out " +
+                            bag.string() + " > " + (dir / "log").string() + " 2>&1";
+    EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
+    EXPECT_FALSE(fs::exists(bag)) << minutes;
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
