@@ -40,7 +40,7 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--batch", a->batch, "clips per forward pass")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--windows", a->windows,
                   "average this many evenly spaced frame windows per clip (1: the centred one, Table 1)")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1, 1000))  // a huge count hung (windows rebuilt per window)
       ->capture_default_str();
   sub->add_flag("--mirror", a->mirror,
                "also predict each window's mirror image (horizontal flip) and average the two (Table 1: off)");

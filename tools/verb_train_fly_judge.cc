@@ -60,7 +60,7 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
   sub->add_option("--out", a->out, "weights file, e.g. models/fly_judge.pt (its card .json is written beside it)")
       ->required();
   sub->add_option("--windows", a->windows, "evenly spaced training windows per clip (val and test: the centred one)")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1, 1000))  // a huge count hung (windows rebuilt per window)
       ->capture_default_str();
   sub->add_option("--frames", a->frames, "frames per window (the models')")->check(CLI::Range(2, 10000))->capture_default_str();
   sub->add_option("--hidden", a->train.hidden, "hidden units")->check(CLI::PositiveNumber)->capture_default_str();
