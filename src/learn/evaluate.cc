@@ -327,7 +327,13 @@ bool RunGnuplot(const std::string& script, const fs::path& png, std::string* err
     fs::remove(tmp);
     return false;
   }
-  fs::rename(tmp, png);
+  std::error_code ec;
+  fs::rename(tmp, png, ec);
+  if (ec) {  // e.g. a folder of that name: the finished temporary must not stay behind
+    if (error) *error = "cannot write " + png.string() + ": " + ec.message();
+    fs::remove(tmp, ec);
+    return false;
+  }
   fs::remove(script_path.string() + ".err");
   return true;
   });

@@ -298,6 +298,13 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
   // quote in it is quoted for the shell and for gnuplot.
   EXPECT_FALSE(PlotPredictions(e, r.model.parent_path() / "missing" / "p.png", &error));
   EXPECT_NE(error.find("missing/p.png"), std::string::npos) << error;
+  // A folder where the PNG should go: reported, and gnuplot's finished temporary not left behind.
+  const fs::path folder = r.model.parent_path() / "plot_folder.png";
+  fs::create_directories(folder);
+  EXPECT_FALSE(PlotPredictions(e, folder, &error));
+  EXPECT_NE(error.find("plot_folder.png"), std::string::npos) << error;
+  for (const auto& entry : fs::directory_iterator(r.model.parent_path()))
+    EXPECT_EQ(entry.path().filename().string().find("plot_folder.png.tmp"), std::string::npos) << entry.path();
   const fs::path quoted = r.model.parent_path() / "it's here.png";
   ASSERT_TRUE(PlotPredictions(e, quoted, &error)) << error;
   EXPECT_GT(fs::file_size(quoted), 1000u);
