@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -53,7 +54,25 @@ void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance) {
   ++s.count;
 }
 
+int Check(const BagCheckArgs& a);
+
+// The bag's errors name it and what to do: rosbag's own ("Error reading from file: wanted 4
+// bytes, read 0 bytes") named neither the file nor, for a recording cut short, the repair.
 int Run(const BagCheckArgs& a) {
+  if (!(a.gap_tolerance > 0 && a.gap_tolerance <= 3600))  // NaN passed CLI's range checks
+    throw std::invalid_argument("--gap-tolerance must be in (0, 3600] s, got " + std::to_string(a.gap_tolerance));
+  try {
+    return Check(a);
+  } catch (const rosbag::BagException& e) {
+    const std::string what = e.what();
+    throw std::runtime_error(a.bag + ": not a readable bag (" + what + ")" +
+                             (what.find("unindexed") != std::string::npos
+                                  ? "; a recording cut short can be repaired with `rosbag reindex`"
+                                  : ""));
+  }
+}
+
+int Check(const BagCheckArgs& a) {
   rosbag::Bag bag;
   bag.open(a.bag, rosbag::bagmode::Read);
   rosbag::View view(bag);

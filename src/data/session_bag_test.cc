@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <string>
 #include <vector>
@@ -135,6 +137,33 @@ TEST(SessionBagTest, ADurationThatMakesNoSessionIsRefused) {
     EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
     EXPECT_FALSE(fs::exists(bag)) << minutes;
   }
+  fs::remove_all(dir);
+}
+
+TEST(SessionBagTest, BagCheckNamesADamagedBag) {
+  // A bag cut short and an empty file: exit 1 with an error naming the bag (rosbag's own named
+  // neither); a NaN gap tolerance is refused (it counted no holes).
+  const std::string bag = MakeSession("", "whole.bag");
+  const fs::path dir = fs::path(bag).parent_path();
+  fs::copy_file(bag, dir / "cut.bag");
+  fs::resize_file(dir / "cut.bag", 4096);
+  std::ofstream(dir / "empty.bag").close();
+  auto check = [&](const std::string& args, const std::string& name) {
+    const std::string log = (dir / (name + ".check.log")).string();
+    const int rc = std::system((std::string(CLOTHWIND_BIN) + " bag-check " + args + " > " + log + " 2>&1").c_str());
+    std::ifstream in(log);
+    const std::string out((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return std::make_pair(rc, out);
+  };
+  for (const char* name : {"cut.bag", "empty.bag"}) {
+    const auto [rc, out] = check((dir / name).string(), name);
+    EXPECT_NE(rc, 0) << name;
+    EXPECT_NE(out.find((dir / name).string() + ": not a readable bag"), std::string::npos) << out;
+  }
+  const auto [rc, out] = check(bag + " --gap-tolerance nan", "nan");
+  EXPECT_NE(rc, 0);
+  EXPECT_NE(out.find("--gap-tolerance"), std::string::npos) << out;
+  EXPECT_EQ(check(bag, "whole").first, 0);
   fs::remove_all(dir);
 }
 
