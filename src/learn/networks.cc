@@ -265,8 +265,9 @@ void SaveWindNet(WindNet& net, const std::filesystem::path& weights, WeightPreci
   // The configuration goes into the weights file as well as beside it: most of it (input size,
   // frames, frame rate, label scale, ...) shapes no tensor, so weights loaded under another
   // model.json would load without complaint and answer wrongly.
-  SaveModuleWeights(*net, weights, precision, ToJson(net->config()).dump());
-  WriteFileAtomically(ConfigPathFor(weights), ToJson(net->config()).dump(2) + "\n");
+  const nlohmann::json config = ToJson(net->config());
+  SaveModuleWeights(*net, weights, precision, config.dump());
+  WriteFileAtomically(ConfigPathFor(weights), config.dump(2) + "\n");
 }
 
 WindNet WithoutAuxHead(WindNet& net) {

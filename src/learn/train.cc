@@ -162,6 +162,9 @@ fs::path CheckpointDir(const fs::path& out) { return CheckpointDirOf(ReadState(o
 
 namespace {
 
+// The step schedule's last epoch at the full rate: lr_decay_epoch, or half the epochs for -1.
+int StepDecayEpoch(const TrainOptions& o) { return o.lr_decay_epoch < 0 ? std::max(1, o.epochs / 2) : o.lr_decay_epoch; }
+
 // An option's value as the refusal below names it: a flag on or off, a number as it is.
 std::string OptionValue(bool v) { return v ? "on" : "off"; }
 std::string OptionValue(const std::string& v) { return v; }
@@ -248,8 +251,7 @@ at::Tensor PointScale(const TargetScale& scale, int points, bool std) {
 
 double LearningRateAt(const TrainOptions& o, int epoch) {
   if (o.lr_schedule == "step") {
-    const int decay_epoch = o.lr_decay_epoch < 0 ? std::max(1, o.epochs / 2) : o.lr_decay_epoch;
-    return epoch > decay_epoch ? o.lr / o.lr_decay_factor : o.lr;
+    return epoch > StepDecayEpoch(o) ? o.lr / o.lr_decay_factor : o.lr;
   }
   if (o.lr_schedule == "cosine") {
     const double progress = static_cast<double>(epoch - 1) / std::max(1, o.epochs);
@@ -335,7 +337,8 @@ TrainResult Train(const TrainOptions& o) {
     // (or any run with another --lr, --lr-schedule or --lr-decay-epoch) would silently become a
     // different run from the one its log describes.
     // (Runs that record their schedule are checked against it below, every epoch of it.)
-    for (const EpochRecord& e : state.contains("epochs") ? std::vector<EpochRecord>{} : result.log) {
+    for (const EpochRecord& e : result.log) {
+      if (state.contains("epochs")) break;
       const double expected = LearningRateAt(o, e.epoch);
       if (std::abs(expected - e.lr) > 1e-9 * std::max(std::abs(e.lr), 1e-12)) {
         std::ostringstream what;
@@ -410,7 +413,7 @@ TrainResult Train(const TrainOptions& o) {
              << "; --epochs " << o.epochs << " --lr-decay-epoch " << o.lr_decay_epoch << " give "
              << LearningRateAt(o, e)
              << " (resume with the --epochs the run started with, or extend a step run with --lr-decay-epoch "
-             << (started.lr_decay_epoch < 0 ? std::max(1, started.epochs / 2) : started.lr_decay_epoch)
+             << StepDecayEpoch(started)
              << ", its decay epoch)";
         throw std::runtime_error(what.str());
       }

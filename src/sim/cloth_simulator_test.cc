@@ -50,6 +50,16 @@ Mesh HangingSheet(double w, double h, double edge) {
   return Sheet(w, h, edge, [h](double u, double v) { return Eigen::Vector3d(u, 0, v - h); });
 }
 
+// A material whose stiffness tables are constant (every stretching row and bending entry the
+// same): its stretching force is exactly an energy's gradient, as ArcSim freezes the table lookup.
+Material ConstantStiffnessMaterial() {
+  Eigen::Matrix<double, 6, 4> s;
+  for (int r = 0; r < 6; ++r) s.row(r) << 60, 10, 90, 30;
+  Eigen::Matrix<double, 3, 5> b;
+  b.setConstant(3e-3);
+  return MakeMaterial(0.3, s, b);
+}
+
 SimOptions QuietOptions() {
   SimOptions o;
   o.wind_density = 0;  // no air at all (still air would still drag a moving cloth)
@@ -320,11 +330,7 @@ TEST(ClothSimulatorTest, AssembledForcesAreMinusTheEnergysGradient) {
   // assembly (bending is written inline in the force loop, in both bending modes) against central
   // differences of Energy() on a curved, stretched sheet. The stiffness tables are constant, so
   // the stretching force is exactly an energy's gradient (ArcSim freezes the table lookup).
-  Eigen::Matrix<double, 6, 4> s;
-  for (int r = 0; r < 6; ++r) s.row(r) << 60, 10, 90, 30;
-  Eigen::Matrix<double, 3, 5> b;
-  b.setConstant(3e-3);
-  const Material material = MakeMaterial(0.3, s, b);
+  const Material material = ConstantStiffnessMaterial();
   const Mesh m = Sheet(0.4, 0.3, 0.12, [](double u, double v) { return Eigen::Vector3d(u, v, 0); });
   Eigen::MatrixX3d x = m.V;
   for (int i = 0; i < x.rows(); ++i) {
@@ -363,11 +369,7 @@ TEST(ClothSimulatorTest, AssembledJacobianIsTheForcesDerivativeWhereItsFormIsExa
   // uniformly (3 % along u, 2 % along v) the positive-definite stretching Jacobian and the
   // Gauss-Newton bending one are exact (every hinge at 0), so (dF/dx) dx must equal the central
   // difference of Forces() along random dx, for every node at once.
-  Eigen::Matrix<double, 6, 4> s;
-  for (int r = 0; r < 6; ++r) s.row(r) << 60, 10, 90, 30;
-  Eigen::Matrix<double, 3, 5> b;
-  b.setConstant(3e-3);
-  const Material material = MakeMaterial(0.3, s, b);
+  const Material material = ConstantStiffnessMaterial();
   const Mesh m = Sheet(0.4, 0.3, 0.12, [](double u, double v) { return Eigen::Vector3d(1.03 * u, 1.02 * v, 0); });
   SimOptions o = QuietOptions();
   o.bending_solve = BendingSolve::kImplicit;

@@ -58,7 +58,8 @@ SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
     // The rest shape is the OBJ's vt read in metres (ArcSim's rule), not texture coordinates in
     // 0..1 as most exporters write them: such a cloth starts stretched many times over and ran
     // silently, 70 times slower, as something else (a 6 m^2 flag at rest over 1 m^2).
-    const double stretch = SurfaceArea(mesh) / RestArea(mesh);
+    const double area = SurfaceArea(mesh), rest_area = RestArea(mesh);
+    const double stretch = area / rest_area;
     if (!(stretch >= 1.0 / kMaxInitialAreaRatio && stretch <= kMaxInitialAreaRatio)) {
       char what[512];
       std::snprintf(what, sizeof what,
@@ -66,7 +67,7 @@ SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
                     "the rest shape is the OBJ's vt in metres, or without vt the x, y of its positions "
                     "(ArcSim's rule), so vt written as texture coordinates in 0..1, or a cloth modelled "
                     "steeply out of its x-y plane, start stretched; expected a ratio in [%.2g, %.2g]",
-                    SurfaceArea(mesh), stretch, RestArea(mesh), 1.0 / kMaxInitialAreaRatio, kMaxInitialAreaRatio);
+                    area, stretch, rest_area, 1.0 / kMaxInitialAreaRatio, kMaxInitialAreaRatio);
       fail(key + ".mesh", sc.mesh + ": " + what);
     }
     cloth.original_vertices = static_cast<int>(mesh.V.rows());
