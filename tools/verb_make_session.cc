@@ -4,12 +4,15 @@
 // --frames procedural (default, fast: an OpenCV-drawn flag) or rendered (the flag simulated in the
 // session's wind and rendered by render/, with the anemometer's sentences from its sensor model
 // sampling the same wind field: data/rendered_flag_generator.h).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 #include <rosbag/bag.h>
@@ -68,10 +71,26 @@ int Run(const MakeSessionArgs& a) {
     throw std::invalid_argument("--minutes must be in 0.05..1440 (3 s to a day), got " + std::to_string(a.minutes));
   if (!(std::isfinite(a.wind_mean) && a.wind_mean >= 0 && a.wind_mean <= 60))
     throw std::invalid_argument("--wind-mean must be in 0..60 m/s, got " + std::to_string(a.wind_mean));
+  if (a.zeta_seed < -1)
+    throw std::invalid_argument("--zeta-seed must be >= 0 (or -1: the session's --seed), got " +
+                                std::to_string(a.zeta_seed));
+  // Checked before the long work, where a bad name used to be ignored after it (imwrite's result).
+  std::string preview_extension;
+  if (!a.preview.empty()) {
+    preview_extension = std::filesystem::path(a.preview).extension().string();
+    if (preview_extension.empty() || !cv::haveImageWriter(a.preview))
+      throw std::invalid_argument("--preview " + a.preview +
+                                  ": expected an image file name OpenCV can write (.png, .jpg, .ppm, ...)");
+    const std::filesystem::path folder = std::filesystem::path(a.preview).parent_path();
+    if (!folder.empty() && !std::filesystem::is_directory(folder))
+      throw std::invalid_argument("--preview " + a.preview + ": folder " + folder.string() + " does not exist");
+  }
   sensors::SyntheticSessionOptions o;
   o.duration = a.minutes * 60.0;
   o.seed = a.seed;
   o.fps = a.fps;
+  // The camera's jitter (2 ms at 30 fps) scaled to faster rates, which the default refused.
+  if (a.fps > 0) o.frame_jitter = std::min(o.frame_jitter, 0.06 / a.fps);
   o.width = a.width;
   o.height = a.height;
   o.wind_base = a.wind_mean;
@@ -136,7 +155,12 @@ int Run(const MakeSessionArgs& a) {
       if (frame_next) {
         const ros::Time t(stamps[fi]);
         const cv::Mat img = session.RenderFrame(fi);
-        if (fi == 0 && !a.preview.empty()) cv::imwrite(a.preview, img);
+        if (fi == 0 && !a.preview.empty()) {
+          std::vector<uchar> bytes;
+          if (!cv::imencode(preview_extension, img, bytes))
+            throw std::runtime_error("--preview " + a.preview + ": OpenCV could not encode the frame");
+          WriteFileAtomically(a.preview, bytes.data(), bytes.size());
+        }
         sensor_msgs::Image msg;
         msg.header.seq = static_cast<uint32_t>(fi);
         msg.header.stamp = t;

@@ -2,6 +2,7 @@
 // for the rendered flag (simulated + rendered, anemometer sensor model) and the procedural one.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -121,8 +123,17 @@ TEST(SessionBagTest, RenderedSessionHasTheLiveNodesTopicsRatesAndStamps) {
 }
 
 TEST(SessionBagTest, ProceduralSessionStillWorks) {
-  const std::string bag = MakeSession("--frames procedural", "procedural.bag");
-  CheckSession(ReadBag(bag), 180);
+  const fs::path preview = fs::temp_directory_path() / ("clothwind_preview_" + std::to_string(::getpid()) + ".png");
+  const std::string bag = MakeSession("--frames procedural --preview " + preview.string(), "procedural.bag");
+  const BagContents c = ReadBag(bag);
+  CheckSession(c, 180);
+  // The preview is the bag's first frame.
+  const cv::Mat first = cv::imread(preview.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(first.empty()) << preview;
+  ASSERT_FALSE(c.images.empty());
+  ASSERT_EQ(first.cols * 3, static_cast<int>(c.images.front().step));
+  EXPECT_TRUE(std::equal(first.data, first.data + first.total() * 3, c.images.front().data.begin()));
+  fs::remove(preview);
   fs::remove_all(fs::path(bag).parent_path());
 }
 
@@ -136,6 +147,27 @@ TEST(SessionBagTest, ADurationThatMakesNoSessionIsRefused) {
                             bag.string() + " > " + (dir / "log").string() + " 2>&1";
     EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
     EXPECT_FALSE(fs::exists(bag)) << minutes;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(SessionBagTest, APreviewOrZetaSeedItCannotUseIsRefusedBeforeTheWork) {
+  // A preview OpenCV cannot write was ignored after the whole session (imwrite's result was not
+  // read); a negative --zeta-seed was taken as "the session's seed".
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_session_opts_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string bag = (dir / "bad.bag").string(), log = (dir / "log").string();
+  for (const std::string args : {"--preview " + (dir / "first.notanimage").string(),
+                                 "--preview " + (dir / "no_such_folder" / "first.png").string(),
+                                 std::string("--frames rendered --zeta-seed -5")}) {
+    const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes 0.05 --out " + bag + " " + args +
+                            " > " + log + " 2>&1";
+    EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
+    EXPECT_FALSE(fs::exists(bag)) << args;
+    std::ifstream in(log);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find(args.find("preview") != std::string::npos ? "--preview" : "--zeta-seed"), std::string::npos)
+        << text;
   }
   fs::remove_all(dir);
 }

@@ -133,8 +133,14 @@ std::string FormatMwvSentence(double angle_deg, double speed_mps) {
 SyntheticSession::SyntheticSession(const SyntheticSessionOptions& o,
                                    std::shared_ptr<const FlagFrameGenerator> generator)
     : options_(o), wind_(o), generator_(std::move(generator)) {
-  Check(o.fps > 0.0, "fps must be > 0");
-  Check(o.width >= 16 && o.height >= 16, "image must be at least 16x16 px");
+  // Bounded, so that nonsense fails here and not as an allocation of 10^12 frames, images of
+  // gigabytes (the Clip message's limit, see sdn_node) or stamps outside ROS time's 32 bits.
+  Check(o.fps > 0.0 && o.fps <= 1000.0, "fps must be in (0, 1000] Hz, got " + std::to_string(o.fps));
+  Check(o.width >= 16 && o.height >= 16 && o.width <= 16384 && o.height <= 16384,
+        "image must be 16..16384 px a side, got " + std::to_string(o.width) + "x" + std::to_string(o.height));
+  Check(o.start_time > 0.0 && o.start_time + o.duration + 10.0 < 4294967295.0,
+        "start time must be > 0 s and end before 2106 (ROS time is 32-bit seconds), got " +
+            std::to_string(o.start_time) + " s");
   Check(o.anemometer_rate > 0.0, "anemometer rate must be > 0 Hz");
   Check(o.frame_jitter >= 0.0 && o.frame_jitter < 0.25 / o.fps, "frame jitter must be in [0, 1/(4 fps))");
   Check(o.drop_probability >= 0.0 && o.drop_probability < 1.0, "drop probability must be in [0, 1)");

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -127,6 +129,36 @@ TEST(SyntheticSessionTest, WindDriftsButStaysPlausible) {
   for (int k = 0; k < n; ++k) sum += w.Speed(10.0 + 3.0 * (k + 0.5) / n);
   EXPECT_NEAR(w.MeanSpeed(10.0, 13.0), sum / n, 1e-3);
   EXPECT_GT(w.FlutterPhase(10.0), w.FlutterPhase(5.0));
+}
+
+// Each of these used to be taken: a huge rate or image tried to allocate it, and a start
+// before the epoch or after 2106 failed later inside rosbag ("Time is out of dual 32-bit range").
+TEST(SyntheticSessionTest, RefusesRatesSizesAndStartTimesOutOfRange) {
+  auto refused = [](auto change, const std::string& names) {
+    SyntheticSessionOptions o;
+    o.duration = 3.0;
+    change(o);
+    try {
+      SyntheticSession session(o);
+      return ::testing::AssertionFailure() << "accepted";
+    } catch (const std::invalid_argument& e) {
+      if (std::string(e.what()).find(names) == std::string::npos)
+        return ::testing::AssertionFailure() << "message '" << e.what() << "' lacks '" << names << "'";
+      return ::testing::AssertionSuccess();
+    }
+  };
+  EXPECT_TRUE(refused([](SyntheticSessionOptions& o) { o.fps = 1e12; }, "fps"));
+  EXPECT_TRUE(refused([](SyntheticSessionOptions& o) { o.fps = std::nan(""); }, "fps"));
+  EXPECT_TRUE(refused([](SyntheticSessionOptions& o) { o.width = 100000; }, "100000x"));
+  EXPECT_TRUE(refused([](SyntheticSessionOptions& o) { o.start_time = -5; }, "start time"));
+  EXPECT_TRUE(refused([](SyntheticSessionOptions& o) { o.start_time = 0; }, "start time"));
+  EXPECT_TRUE(refused([](SyntheticSessionOptions& o) { o.start_time = 4294967290.0; }, "start time"));
+  SyntheticSessionOptions fine;
+  fine.duration = 3.0;
+  fine.fps = 1000.0;
+  fine.frame_jitter = 0.0002;
+  fine.width = fine.height = 16;
+  EXPECT_NO_THROW(SyntheticSession{fine});
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "sim/scene_builder.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
@@ -30,6 +31,11 @@ Eigen::MatrixX3d ApplyTransform(const SceneTransform& t, const Eigen::MatrixX3d&
 
 SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
   if (options.frame_steps < 0) throw std::invalid_argument("BuildOptions.frame_steps must be >= 0");
+  // NaN and negative lengths used to fall through the "> 0" tests below as "the scene's default".
+  for (const auto& [name, value] : {std::pair{"max_edge", options.max_edge}, std::pair{"split_edge", options.split_edge}})
+    if (!(std::isfinite(value) && value >= 0))
+      throw std::invalid_argument(std::string("BuildOptions.") + name + " must be a finite length >= 0 m (0: the "
+                                  "scene's default), got " + std::to_string(value));
   SceneSetup setup;
   setup.scene = scene;
   if (options.frame_steps > 0) setup.scene.frame_steps = options.frame_steps;

@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include <unistd.h>
 
@@ -164,6 +165,22 @@ TEST(LoadScene, ReadsOurFlagAndClothScenes) {
   EXPECT_LE(MaxEdgeLength(c.cloths[0].mesh), 0.25 + 1e-9);
   // Handles 2 and 3 are the top corners (z = 1).
   for (int n : c.cloths[0].options.handles) EXPECT_NEAR(c.cloths[0].mesh.V(n, 2), 1.0, 1e-9);
+}
+
+TEST(BuildScene, RefusesANegativeOrNotANumberEdgeLength) {
+  const Scene flag = LoadScene(SourceDir() + "/config/scenes/flag.json");
+  for (double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    for (int which = 0; which < 2; ++which) {
+      BuildOptions o;
+      (which == 0 ? o.max_edge : o.split_edge) = bad;
+      try {
+        BuildScene(flag, o);
+        ADD_FAILURE() << "edge length " << bad << " accepted";
+      } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find(which == 0 ? "max_edge" : "split_edge"), std::string::npos) << e.what();
+      }
+    }
+  }
 }
 
 TEST_F(SceneFiles, ValidSceneWithCommentsTransformAndExtensions) {
