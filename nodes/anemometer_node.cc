@@ -313,7 +313,7 @@ class AnemometerNode {
     else if (age > stale_timeout_) stat.summary(DiagnosticStatus::WARN, "valid readings stale");
     else if (new_errors) stat.summary(DiagnosticStatus::WARN, "receiving, with bad records");
     else stat.summary(DiagnosticStatus::OK, "receiving");
-    // The instrument's own word on its latest reading (Gill "04 blocked path", NMEA status V, a
+    // The instrument's own word on its latest reading (Gill "04 axis 1 and 2 failed", a blocked path, NMEA status V, a
     // station that lost its outdoor sensor) says why readings are void; "stale" alone does not.
     if (connected && last_reading_void_)
       stat.mergeSummary(DiagnosticStatus::WARN, "instrument flags its readings void: " + last_status_);

@@ -45,9 +45,11 @@ bool ParseFineOffsetRecord(const std::vector<uint8_t>& b, FineOffsetRecord* r, s
   r->temperature_out = t * 0.1;
   const int p = b[7] | (b[8] << 8);
   r->pressure_abs = p == 0xFFFF ? kNaN : p * 0.1;
-  // 12-bit speeds: the low byte plus a nibble of byte 11; a low byte of 0xFF means no value.
-  if (b[9] != 0xFF) r->wind_average = ((b[9] | ((b[11] & 0x0F) << 8))) * 0.1;
-  if (b[10] != 0xFF) r->wind_gust = ((b[10] | ((b[11] & 0xF0) << 4))) * 0.1;
+  // 12-bit speeds: the low byte plus a nibble of byte 11; all twelve bits set (0xFFF) mean no
+  // value, as in pywws. (A low byte 0xFF alone is 25.5 or 51.1 m/s, a gale, not "no data".)
+  const int average = b[9] | ((b[11] & 0x0F) << 8), gust = b[10] | ((b[11] & 0xF0) << 4);
+  if (average != 0xFFF) r->wind_average = average * 0.1;
+  if (gust != 0xFFF) r->wind_gust = gust * 0.1;
   r->direction_index = (b[12] & 0x80) ? -1 : (b[12] & 0x0F);
   if ((b[12] & 0x80) == 0 && b[12] > 15) r->direction_index = -1;
   r->lost_contact = (b[15] & 0x40) != 0;
@@ -68,7 +70,10 @@ WindReading FineOffsetToReading(const FineOffsetRecord& r) {
     w.reference = AngleReference::kEarth;
   }
   w.valid = !r.lost_contact && std::isfinite(r.wind_average);
-  w.status = r.lost_contact ? "lost contact with outdoor sensor" : (r.direction_index < 0 ? "direction invalid" : "ok");
+  w.status = r.lost_contact                      ? "lost contact with outdoor sensor"
+             : !std::isfinite(r.wind_average) ? "no wind average"
+             : r.direction_index < 0          ? "direction invalid"
+                                              : "ok";
   return w;
 }
 

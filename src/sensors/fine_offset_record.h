@@ -7,7 +7,7 @@
 //   - history records start at 0x0100, 16 bytes each (WH3080 class: 20, same first 16 bytes).
 // Record bytes used here:
 //   0      minutes since the previous stored record
-//   9      wind average, low 8 bits     } value * 0.1 m/s; a low byte of 0xFF means "no data"
+//   9      wind average, low 8 bits     } value * 0.1 m/s; the 12-bit value 0xFFF means "no data"
 //   10     wind gust, low 8 bits        }
 //   11     high nibbles: bits 0-3 average bits 8-11, bits 4-7 gust bits 8-11
 //   12     wind direction 0..15 (* 22.5 deg clockwise from north); bit 7 set = invalid

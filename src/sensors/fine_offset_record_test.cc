@@ -65,10 +65,23 @@ TEST(FineOffsetRecord, InvalidFlags) {
   EXPECT_FALSE(FineOffsetToReading(r).valid);
 
   b = kRecord;
-  b[9] = 0xFF;  // no average
+  b[9] = 0xFF;  // no average: all twelve bits set
+  b[11] = 0x1F;
   ASSERT_TRUE(ParseFineOffsetRecord(b, &r, &err));
   EXPECT_TRUE(std::isnan(r.wind_average));
+  EXPECT_NEAR(r.wind_gust, (0x2A + 0x100) * 0.1, 1e-9);
   EXPECT_FALSE(FineOffsetToReading(r).valid);
+  EXPECT_EQ(FineOffsetToReading(r).status, "no wind average");
+
+  // A low byte 0xFF alone is a gale, 25.5 m/s (0x0FF) or 51.1 (0x1FF), not "no data" (it was).
+  b = kRecord;
+  b[9] = 0xFF;
+  b[10] = 0xFF;
+  b[11] = 0x10;
+  ASSERT_TRUE(ParseFineOffsetRecord(b, &r, &err));
+  EXPECT_NEAR(r.wind_average, 25.5, 1e-9);
+  EXPECT_NEAR(r.wind_gust, 51.1, 1e-9);
+  EXPECT_TRUE(FineOffsetToReading(r).valid);
 
   b = kRecord;
   b[9] = 0x00;  // calm: the vane's position means nothing

@@ -91,6 +91,12 @@ ParseResult ParseGillWindSonic(const std::string& record) {
   bool status_ok = false;
   w.status = status + " " + GillStatusText(status, &status_ok);
   w.valid = status_ok;
+  // A failed measurement (e.g. 04, a blocked path) pads its fields with 9s in fixed-field mode:
+  // a void reading, not a malformed record, so diagnostics can say what the instrument said.
+  if (!status_ok) {
+    r.status = ParseStatus::kOk;
+    return r;
+  }
   double a, b;
   std::string err;
   if (!ParseOptionalNumber(f[1], &a, &err)) return Fail(ParseStatus::kMalformed, "field 2: " + err);
@@ -109,7 +115,7 @@ ParseResult ParseGillWindSonic(const std::string& record) {
     }
   } else {
     if (std::isfinite(a) && (a < 0.0 || a > 360.0))
-      return Fail(ParseStatus::kMalformed, "field 2 (direction): expected 0..359 deg, got '" + f[1] + "'");
+      return Fail(ParseStatus::kMalformed, "field 2 (direction): expected 0..360 deg, got '" + f[1] + "'");
     if (!std::isfinite(b)) {
       if (status_ok) return Fail(ParseStatus::kMalformed, "field 3 (speed) empty with status " + status);
     } else {

@@ -60,6 +60,12 @@ TEST(GillWindSonic, StatusCodes) {
   r = ParseGillWindSonic(FrameGillRecord("Q,,,M,04,"));
   ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
   EXPECT_FALSE(r.reading.valid);
+  // Fixed-field mode pads a failed measurement with 9s: a void reading, not a malformed record.
+  r = ParseGillWindSonic(FrameGillRecord("Q,999,999.99,M,04,"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_FALSE(r.reading.valid);
+  EXPECT_NE(r.reading.status.find("04"), std::string::npos);
+  EXPECT_TRUE(std::isnan(r.reading.speed));
   r = ParseGillWindSonic(FrameGillRecord("Q,229,002.74,M,0A,"));
   EXPECT_FALSE(r.reading.valid);
   r = ParseGillWindSonic(FrameGillRecord("Q,229,002.74,M,51,"));

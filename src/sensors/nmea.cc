@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "sensors/gill_windsonic.h"
 #include "sensors/protocol_fields.h"
 
 namespace clothwind::sensors {
@@ -36,10 +37,20 @@ ParseResult ParseMwv(const NmeaSentence& s) {
   WindReading& w = r.reading;
   w.source = "nmea_mwv";
   const std::string& status = s.fields[4];
-  if (status != "A" && status != "V")
-    return Fail(ParseStatus::kMalformed, where + " field 5 (status): expected A or V, got '" + status + "'");
-  w.valid = status == "A";
-  w.status = status;
+  // A Gill WindSonic in its NMEA mode with status codes sends its two-digit code here instead.
+  const bool gill_code = status.size() == 2 && std::isxdigit(static_cast<unsigned char>(status[0])) &&
+                         std::isxdigit(static_cast<unsigned char>(status[1]));
+  if (status != "A" && status != "V" && !gill_code)
+    return Fail(ParseStatus::kMalformed,
+                where + " field 5 (status): expected A, V or a two-digit Gill code, got '" + status + "'");
+  if (gill_code) {
+    bool ok = false;
+    w.status = status + " " + GillStatusText(status, &ok);
+    w.valid = ok;
+  } else {
+    w.valid = status == "A";
+    w.status = status;
+  }
   const std::string& ref = s.fields[1];
   if (ref != "R" && ref != "T")
     return Fail(ParseStatus::kMalformed, where + " field 2 (reference): expected R or T, got '" + ref + "'");
@@ -59,8 +70,9 @@ ParseResult ParseMwv(const NmeaSentence& s) {
     return Fail(ParseStatus::kMalformed,
                 where + " field 4 (unit): expected K, M, N or S, got '" + s.fields[3] + "'");
   if (std::isfinite(speed)) w.speed = SpeedToMetresPerSecond(speed, unit);
-  if (w.valid && (!std::isfinite(speed) || !std::isfinite(angle)))
-    return Fail(ParseStatus::kMalformed, where + ": status A but angle or speed empty");
+  // Calm air has no direction (a WindSonic leaves it empty below 0.05 m/s); a speed it must have.
+  if (w.valid && !std::isfinite(speed))
+    return Fail(ParseStatus::kMalformed, where + " field 3 (speed): empty with status " + status);
   w.from_angle_deg = angle;
   w.reference = std::isfinite(angle) ? AngleReference::kInstrument : AngleReference::kNone;
   r.status = ParseStatus::kOk;
@@ -97,8 +109,11 @@ ParseResult ParseMwd(const NmeaSentence& s) {
     w.from_angle_deg = v[1];
     w.status = "magnetic";
   }
-  if (std::isfinite(w.from_angle_deg) && (w.from_angle_deg < 0.0 || w.from_angle_deg > 360.0))
-    return Fail(ParseStatus::kMalformed, where + ": direction expected 0..360 deg");
+  if (std::isfinite(w.from_angle_deg) && (w.from_angle_deg < 0.0 || w.from_angle_deg > 360.0)) {
+    const bool true_bearing = w.status == "true";
+    return Fail(ParseStatus::kMalformed, where + (true_bearing ? " field 1 (true direction)" : " field 3 (magnetic direction)") +
+                                             ": expected 0..360 deg, got " + s.fields[true_bearing ? 0 : 2]);
+  }
   w.reference = !std::isfinite(w.from_angle_deg) ? AngleReference::kNone
                 : w.status == "true"              ? AngleReference::kEarth
                                                   : AngleReference::kMagnetic;
@@ -140,6 +155,13 @@ ParseResult ParseXdr(const NmeaSentence& s) {
                   where + " quadruplet '" + s.fields[q + 3] + "' field " + std::to_string(q + 2) + ": " + err);
     if (!std::isfinite(value)) continue;
     const std::string& units = s.fields[q + 2];
+    // A name like WINDCHILL in degrees Celsius is no wind quantity: skipped, as other XDR
+    // quadruplets are, where it used to void the sentence's wind. (WSPD, WGUST and names with
+    // DIR or SPEED are wind whatever their units, which are then checked.)
+    SpeedUnit unused;
+    const bool surely_wind = name.rfind("WSPD", 0) == 0 || name.rfind("WGUST", 0) == 0 ||
+                             name.find("DIR") != std::string::npos || name.find("SPEED") != std::string::npos;
+    if (!surely_wind && units != "D" && !NmeaSpeedUnit(units, &unused)) continue;
     if (name.find("DIR") != std::string::npos) {
       if (units != "D")
         return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] +

@@ -1,6 +1,6 @@
 // NMEA 0183 wind sentences: MWV (wind speed and angle), MWD (wind direction and speed) and XDR
 // (transducer measurements, where a quadruplet names a wind quantity). Sentences are taken as
-// one record without its line terminator, e.g. "$IIMWV,229.0,R,5.8,N,A*3B".
+// one record without its line terminator, e.g. "$IIMWV,229.0,R,5.8,N,A*39".
 #ifndef CLOTHWIND_SENSORS_NMEA_H_
 #define CLOTHWIND_SENSORS_NMEA_H_
 

@@ -61,6 +61,39 @@ TEST(Nmea, MwvStatusVoidIsAnInvalidReading) {
   EXPECT_TRUE(std::isnan(WindDirection(r.reading)));
 }
 
+TEST(Nmea, MwvWithAGillStatusCodeIsReadAsTheGillCode) {
+  // A WindSonic in NMEA mode with Gill status codes (its manual's "$IIMWV,120,R,002.10,M,00"):
+  // every record was refused as "expected A or V".
+  ParseResult r = ParseNmea("$IIMWV,120,R,002.10,M,00*51");
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_TRUE(r.reading.valid);
+  EXPECT_DOUBLE_EQ(r.reading.speed, 2.10);
+  EXPECT_DOUBLE_EQ(r.reading.from_angle_deg, 120.0);
+  EXPECT_EQ(r.reading.status, "00 ok");
+  r = ParseNmea(WithNmeaChecksum("IIMWV,120,R,002.10,M,04"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_FALSE(r.reading.valid);
+  EXPECT_NE(r.reading.status.find("axis 1 and 2 failed"), std::string::npos) << r.reading.status;
+  EXPECT_EQ(ParseNmea(WithNmeaChecksum("IIMWV,120,R,002.10,M,0G")).status, ParseStatus::kMalformed);
+}
+
+TEST(Nmea, MwvInCalmAirHasASpeedAndNoDirection) {
+  // The WindSonic leaves the angle empty below 0.05 m/s; so do marine instruments in calm air.
+  // These were parse errors, and calm spells published nothing.
+  for (const char* sentence : {"$IIMWV,,R,000.02,M,A*22", "$IIMWV,,R,1.4,N,A*16"}) {
+    const ParseResult r = ParseNmea(sentence);
+    ASSERT_EQ(r.status, ParseStatus::kOk) << sentence << ": " << r.error;
+    EXPECT_TRUE(r.reading.valid);
+    EXPECT_TRUE(std::isfinite(r.reading.speed));
+    EXPECT_EQ(r.reading.reference, AngleReference::kNone);
+    EXPECT_TRUE(std::isnan(WindDirection(r.reading)));
+  }
+  // A valid reading still needs its speed.
+  const ParseResult r = ParseNmea(WithNmeaChecksum("IIMWV,120,R,,M,A"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("field 3"), std::string::npos) << r.error;
+}
+
 TEST(Nmea, BadChecksumIsRejected) {
   const ParseResult r = ParseNmea("$IIMWV,229.0,R,5.8,N,A*38");
   EXPECT_EQ(r.status, ParseStatus::kChecksumError);
@@ -142,6 +175,26 @@ TEST(Nmea, XdrWindQuadruplets) {
   EXPECT_EQ(ParseNmea(WithNmeaChecksum("WIXDR,A,225.0,R,WINDDIR,N,7.5,M,WINDSPEED")).status,
             ParseStatus::kMalformed);
   EXPECT_EQ(ParseNmea(WithNmeaChecksum("WIXDR,A,225.0,D")).status, ParseStatus::kMalformed);
+  // A wind chill in degrees Celsius beside the wind: it voided the whole sentence.
+  r = ParseNmea("$WIXDR,C,-3.2,C,WINDCHILL,A,120,D,WDIR,S,5.0,M,WSPD*1F");
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_DOUBLE_EQ(r.reading.speed, 5.0);
+  EXPECT_DOUBLE_EQ(r.reading.from_angle_deg, 120.0);
+  // WSPD is wind whatever its units, so wrong ones are still an error.
+  r = ParseNmea(WithNmeaChecksum("WIXDR,S,5.0,C,WSPD"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("WSPD"), std::string::npos) << r.error;
+}
+
+TEST(Nmea, MwdDirectionOutOfRangeNamesTheFieldAndValue) {
+  ParseResult r = ParseNmea("$WIMWD,400.0,T,,M,10.0,N,5.1,M*45");
+  ASSERT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("field 1"), std::string::npos) << r.error;
+  EXPECT_NE(r.error.find("400.0"), std::string::npos) << r.error;
+  r = ParseNmea(WithNmeaChecksum("WIMWD,,T,-7,M,10.0,N,5.1,M"));
+  ASSERT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("field 3"), std::string::npos) << r.error;
+  EXPECT_NE(r.error.find("-7"), std::string::npos) << r.error;
 }
 
 }  // namespace
