@@ -9,6 +9,7 @@
 
 #include "common/parse_pair.h"
 #include "data/dataset_generator.h"
+#include "render/background.h"
 #include "progress_bar.h"
 #include "verb_registry.h"
 
@@ -77,15 +78,8 @@ int Run(MakeDatasetArgs& a) {
     if (a.camera_angle >= 0) r.camera.angle_max_deg = a.camera_angle;
     o.ranges = r;
   }
-  if (!a.backgrounds.empty()) {
-    for (const auto& e : fs::directory_iterator(a.backgrounds)) {
-      const std::string ext = e.path().extension().string();
-      if (ext == ".jpg" || ext == ".jpeg" || ext == ".png") o.background_images.push_back(e.path().string());
-    }
-    std::sort(o.background_images.begin(), o.background_images.end());
-    if (o.background_images.empty())
-      throw std::invalid_argument("--backgrounds " + a.backgrounds + ": no .jpg/.png image in it");
-  }
+  // The renderer's own listing (any case, .bmp too, files only): this verb's copy refused .JPG.
+  if (!a.backgrounds.empty()) o.background_images = render::ListBackgroundImages(a.backgrounds);
 
   ProgressBar::Options bar_options;
   bar_options.label = "make-dataset";
@@ -132,21 +126,21 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
                                  "label; resumable, parallel, shardable");
   sub->add_option("--kind", a->kind, "flag (FlagSim) or cloth (ClothSim)")
       ->check(CLI::IsMember({"flag", "cloth"}))->capture_default_str();
-  sub->add_option("--count", a->o.count, "number of simulations (examples = count x views)");
+  sub->add_option("--count", a->o.count, "number of simulations (examples = count x views); required unless --reindex");
   sub->add_option("--out", a->o.out, "dataset folder")->required();
   sub->add_option("--seed", a->o.seed, "global seed")->capture_default_str();
   sub->add_option("--shard", a->shard, "i/N: do the simulations with index % N == i")->capture_default_str();
   sub->add_option("--jobs", a->o.jobs, "parallel simulations (0: all cores)")->capture_default_str();
-  sub->add_option("--views", a->o.views, "camera poses rendered per simulation")->capture_default_str();
+  sub->add_option("--views", a->o.views, "camera poses rendered per simulation (1..64)")->capture_default_str();
   sub->add_option("--materials", a->o.materials_dir,
                   "ClothSim fabrics folder (default: $CLOTHWIND_SHARED_DIR/arcsim/materials, else config/materials)");
   sub->add_option("--scene", a->o.scene, "scene file (default: config/scenes/<kind>.json)");
   sub->add_option("--max-edge", a->o.max_edge, "mesh resolution [m] (0: the scene's default)")->capture_default_str();
-  sub->add_option("--warmup", a->o.warmup, "simulated seconds before the first kept frame")->capture_default_str();
-  sub->add_option("--frames", a->o.frames, "frames per example")->capture_default_str();
+  sub->add_option("--warmup", a->o.warmup, "simulated time before the first kept frame [s] (0..3600)")->capture_default_str();
+  sub->add_option("--frames", a->o.frames, "frames per example (>= 1)")->capture_default_str();
   sub->add_option("--samples", a->o.samples, "anti-aliasing samples per pixel (0: zeta's default, 4)")
       ->capture_default_str();
-  sub->add_option("--size", a->o.size, "frame width = height [px]")->capture_default_str();
+  sub->add_option("--size", a->o.size, "frame width = height [px] (16..4096)")->capture_default_str();
   sub->add_option("--format", a->format,
                   "frame format (pgm: 8-bit grey as the SDN reads it, lossless, readable without an image codec)")
       ->check(CLI::IsMember({"jpg", "jpeg", "png", "pgm"}))
@@ -177,9 +171,10 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
   sub->add_option("--camera-angle", a->camera_angle,
                   "camera angle off side-on, +-DEG (default: flag 15, cloth 5)")
       ->check(CLI::Range(0.0, 89.9));
-  sub->add_option("--val", a->o.val_fraction, "fraction of simulations in the val split")->capture_default_str();
-  sub->add_option("--test", a->o.test_fraction, "fraction of simulations in the test split")->capture_default_str();
-  sub->add_option("--backgrounds", a->backgrounds, "folder of background images (default: procedural)");
+  sub->add_option("--val", a->o.val_fraction, "fraction of simulations in the val split (val + test <= 1)")->capture_default_str();
+  sub->add_option("--test", a->o.test_fraction, "fraction of simulations in the test split (val + test <= 1)")->capture_default_str();
+  sub->add_option("--backgrounds", a->backgrounds,
+                  "folder of background images, .jpg .jpeg .png .bmp in any case (default: procedural)");
   sub->add_flag("--reindex", a->reindex,
                 "only rebuild index.json and the contact sheet from the example folders (merge shards)");
   sub->add_flag("--no-contact-sheet", a->no_contact_sheet, "skip contact_sheet.png");

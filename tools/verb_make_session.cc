@@ -211,14 +211,14 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
   auto args = std::make_shared<MakeSessionArgs>();
   auto* sub = app.add_subcommand("make-session",
                                  "Write a synthetic field session (camera + NMEA anemometer) as a rosbag");
-  sub->add_option("--minutes", args->minutes, "session length [min]")->capture_default_str();
+  sub->add_option("--minutes", args->minutes, "session length [min] (0.05..1440)")->capture_default_str();
   sub->add_option("--out", args->out, "output bag")->required();
   sub->add_option("--seed", args->seed, "random seed")->capture_default_str();
-  sub->add_option("--fps", args->fps, "camera rate [Hz]")->capture_default_str();
-  sub->add_option("--width", args->width, "image width [px]")->capture_default_str();
-  sub->add_option("--height", args->height, "image height [px]")->capture_default_str();
-  sub->add_option("--wind-mean", args->wind_mean, "long-term mean wind [m/s]")->capture_default_str();
-  sub->add_option("--drop-probability", args->drop_probability, "chance a frame is lost")->capture_default_str();
+  sub->add_option("--fps", args->fps, "camera rate [Hz] (up to 1000)")->capture_default_str();
+  sub->add_option("--width", args->width, "image width [px] (16..16384)")->capture_default_str();
+  sub->add_option("--height", args->height, "image height [px] (16..16384)")->capture_default_str();
+  sub->add_option("--wind-mean", args->wind_mean, "long-term mean wind [m/s] (0..60)")->capture_default_str();
+  sub->add_option("--drop-probability", args->drop_probability, "chance a frame is lost, in [0, 1)")->capture_default_str();
   sub->add_option("--start-time", args->start_time, "stamp of the session start [s since epoch]")
       ->capture_default_str();
   // Checked when parsed: a bad value used to leave the temporary bag behind.

@@ -189,7 +189,7 @@ const VerbRegistrar kRegistrar{"simulate", [](CLI::App& app) -> std::function<in
                   "refine uniformly to this edge length [m] (default: the scene's: uniformly to the upper end of its "
                   "remeshing size range, then edges over 0.4 of it split)");
   sub->add_option("--frame-steps", args->frame_steps,
-                  "time steps per frame (default: the scene's; fewer is faster but damps flapping)")
+                  "time steps per frame (0, the default: the scene's; fewer is faster but damps flapping)")
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--warmup", args->warmup,
                   "simulated seconds before the first written frame (the release transient) [s]")

@@ -32,7 +32,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--frames", args->frames, "input frames N_t (Table 1: 1, 10, 20 for resnet18; 20, 30 for sdn)")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
-  sub->add_option("--data", args->data, "dataset folder (index.json + examples)");
+  sub->add_option("--data", args->data, "dataset folder (index.json + examples); required unless --init-only");
   sub->add_option("--out", args->out, "run folder (model.pt/json, checkpoints, log.tsv, learning_curve.png)")
       ->required();
   sub->add_option("--epochs", o.epochs, "epochs (the seed: ~40)")->check(CLI::PositiveNumber)->capture_default_str();
@@ -175,7 +175,8 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
       }
       std::ostringstream note;
       if (p.step > 0) note << "loss " << std::setprecision(4) << p.loss;
-      if (p.val_total > 0) note << ", validating " << p.val_done << "/" << p.val_total << " clips";
+      // Not "clips": with --weight-average each val clip is run twice (the model and its average).
+      if (p.val_total > 0) note << ", validating " << p.val_done << "/" << p.val_total << " clip runs";
       bar->Update(p.step, p.steps, note.str());
     };
     o.epoch_done = [&](const learn::EpochRecord& e) {

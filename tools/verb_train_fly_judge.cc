@@ -45,7 +45,9 @@ std::string Row(const std::string& split, const learn::FlyJudgeAccuracy& a) {
   std::snprintf(line, sizeof line, "%-6s %7d %7d %9.2f %%", split.c_str(), a.count, a.right, 100 * a.accuracy());
   std::string row = line;
   for (const auto& b : a.bands) {
-    std::snprintf(line, sizeof line, " %8.2f", b.count > 0 ? 100.0 * b.right / b.count : 0.0);
+    // An empty band has no accuracy: "-" (as eval's JSON has null), not 0 %, which reads as a failure.
+    if (b.count > 0) std::snprintf(line, sizeof line, " %8.2f", 100.0 * b.right / b.count);
+    else std::snprintf(line, sizeof line, " %8s", "-");
     row += line;
   }
   return row + "\n";

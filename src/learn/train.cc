@@ -291,7 +291,7 @@ TrainResult Train(const TrainOptions& o) {
                                  "; --resume continues it, --overwrite starts it again (or choose another --out)");
     }
   }
-  fs::create_directories(o.out);
+  if (o.data.empty() && !o.init_only) throw std::runtime_error("training needs --data");
   TrainResult result;
   result.device = device.is_cuda() ? "cuda" : "cpu";
   result.model = o.out / "model.pt";
@@ -305,9 +305,9 @@ TrainResult Train(const TrainOptions& o) {
       throw std::runtime_error((o.data / "index.json").string() + ": no examples in split train");
     }
     if (val.empty()) val = train;  // a dataset without a validation split validates on train
-  } else if (!o.init_only) {
-    throw std::runtime_error("training needs --data");
   }
+  // Made once the data is known good: a refused --data used to leave an empty folder behind.
+  fs::create_directories(o.out);
 
   ModelConfig config = o.model;
   CheckClipsSuitModel(train, config.frame_rate, config.colour);

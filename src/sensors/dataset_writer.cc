@@ -178,7 +178,9 @@ size_t DatasetWriter::RecoverLeftovers() {
     const std::string file = entry.path().filename().string();
     size_t at = 0;
     if (!IsTemporaryOfStoppedProcess(file, &at)) continue;  // not a temporary, or still being written
-    const bool old_copy = file.size() > 5 && file.compare(at - 4, 4, ".old") == 0 && file[0] == '.';
+    // at >= 5: room for "." and ".old" before ".tmp-" (a shorter stray name threw out_of_range,
+    // and the writer never started).
+    const bool old_copy = at >= 5 && file[0] == '.' && file.compare(at - 4, 4, ".old") == 0;
     const std::string clip = old_copy ? file.substr(1, at - 5) : "";
     if (old_copy && !fs::exists(root_ + "/" + clip)) {
       fs::rename(entry.path(), root_ + "/" + clip, ec);  // a crash between the two renames

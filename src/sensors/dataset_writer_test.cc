@@ -214,9 +214,10 @@ TEST_F(DatasetWriterTest, OpeningClearsADeadWritersLeftovers) {
   fs::rename(root_ / clip1, root_ / ("." + clip1 + ".old" + dead + "2"));
   const std::string live = "index.json.tmp-" + std::to_string(::getpid()) + "-7";
   std::ofstream(root_ / live) << "{";
+  std::ofstream(root_ / ("a" + dead + "3")) << "x";  // a stray short name: threw out_of_range
 
   DatasetWriter again(root_.string());
-  EXPECT_EQ(again.recovered(), 3u);
+  EXPECT_EQ(again.recovered(), 4u);
   EXPECT_FALSE(fs::exists(root_ / ("index.json" + dead + "1")));
   EXPECT_EQ(Read(root_ / clip1 / "label.json")["sequence"], 1);
   EXPECT_EQ(Hidden(), std::set<std::string>{live});  // the live writer's, left alone
