@@ -43,6 +43,7 @@ using clothwind::sensors::ReadStatus;
 class RosClock : public clothwind::sensors::SystemClock {
  public:
   int64_t RosNs() override { return static_cast<int64_t>(ros::Time::now().toNSec()); }
+  bool RosTimeIsSimulated() override { return ros::Time::isSimTime(); }
 };
 
 FrameSourceOptions ReadOptions(ros::NodeHandle& pnh) {
@@ -153,6 +154,10 @@ int main(int argc, char** argv) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, state + ": " + last_error);
     } else {
       stat.summary(diagnostic_msgs::DiagnosticStatus::OK, state + ": " + source->Describe());
+      // Recordings are paced on /clock under use_sim_time (FramePacer): none comes before it.
+      if (ros::Time::isSimTime() && ros::Time::now().isZero())
+        stat.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN,
+                          "use_sim_time is set and no /clock has come yet: frames wait for it");
       if (drops > last_drops_seen)
         stat.mergeSummaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu frames dropped since last report",
                            static_cast<unsigned long long>(drops - last_drops_seen));

@@ -246,6 +246,11 @@ class ClipBufferNode {
     // hour ago is not a fault now.
     if (SecondsSince(last_error_time_) < kErrorHold) stat.mergeSummary(DiagnosticStatus::ERROR, last_error_);
     if (s.frames_in == 0) stat.mergeSummary(DiagnosticStatus::WARN, "no camera frames yet");
+    // Frames arriving and no clip made: stamps that do not increase, or a camera too slow for
+    // gap_tolerance (both used to stay OK). Counted from the last report that saw a new clip.
+    if (s.clips_made != stall_base_.clips_made) stall_base_ = s;
+    const std::string stalled = sensors::ClipStallReason(stall_base_, s, pipeline_->options());
+    if (!stalled.empty()) stat.mergeSummary(DiagnosticStatus::WARN, stalled);
     if (s.unlabelled_run > 0)
       stat.mergeSummaryf(DiagnosticStatus::WARN, "the last %lu clip(s) have no anemometer reading in their %.0f s window",
                          static_cast<unsigned long>(s.unlabelled_run), pipeline_->options().label_window);
@@ -289,6 +294,7 @@ class ClipBufferNode {
   ros::NodeHandle nh_;
   std::mutex mutex_;
   std::unique_ptr<sensors::ClipPipeline> pipeline_;
+  sensors::ClipPipelineStats stall_base_;  // the counters when a clip was last seen made
   std::unique_ptr<sensors::AsyncDatasetWriter> writer_;
   sensors::ClipSourceInfo source_;
   std::string frame_id_;

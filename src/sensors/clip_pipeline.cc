@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -176,6 +177,33 @@ std::vector<LabelledClip> ClipPipeline::Flush() {
     pending_.pop_front();
   }
   return ready;
+}
+
+std::string ClipStallReason(const ClipPipelineStats& since, const ClipPipelineStats& now,
+                            const ClipPipelineOptions& options) {
+  const uint64_t in = now.frames_in - since.frames_in;
+  if (now.clips_made != since.clips_made || in < 2 * static_cast<uint64_t>(options.num_frames)) return "";
+  // Frames refused as from the future have their own WARN; the rest of the drops are stamps that
+  // do not increase (or bad images, which are errors of their own).
+  const uint64_t not_after = (now.frames_dropped - since.frames_dropped) - (now.frames_future - since.frames_future);
+  const uint64_t gaps = now.gaps - since.gaps;
+  char text[320];
+  if (2 * not_after >= in) {
+    std::snprintf(text, sizeof text,
+                  "no clip from the last %llu camera frames: %llu were not stamped after the frame before "
+                  "(header.stamp 0, or a camera clock that stands still?)",
+                  static_cast<unsigned long long>(in), static_cast<unsigned long long>(not_after));
+    return text;
+  }
+  if (2 * gaps >= in) {
+    std::snprintf(text, sizeof text,
+                  "no clip from the last %llu camera frames: %llu intervals were longer than gap_tolerance %.3g s "
+                  "(last %.3g s; a camera below %.3g fps?)",
+                  static_cast<unsigned long long>(in), static_cast<unsigned long long>(gaps), options.gap_tolerance,
+                  now.last_gap, 1.0 / options.gap_tolerance);
+    return text;
+  }
+  return "";
 }
 
 }  // namespace clothwind::sensors

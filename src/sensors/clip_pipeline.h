@@ -74,6 +74,18 @@ struct ClipPipelineStats {
   double last_gap = 0.0;          // length of the last gap [s]
 };
 
+// Why camera frames keep arriving but make no clip, for diagnostics: most of them dropped as not
+// after the previous frame (stamped 0, or a clock standing still), or most intervals longer than
+// gap_tolerance (a camera slower than 1 / gap_tolerance fps). Both kept the node at OK, making
+// nothing.
+// Inputs:
+//   since    the counters when the last clip was made (or at start)
+//   now      the counters now
+//   options  the pipeline's options (gap_tolerance, num_frames)
+// Returns the reason, or "" while clips are made or too few frames (2 x num_frames) came to tell.
+std::string ClipStallReason(const ClipPipelineStats& since, const ClipPipelineStats& now,
+                            const ClipPipelineOptions& options);
+
 // The ROS-free clip buffer: camera frames and anemometer readings in (each by stamp), labelled
 // clips out. Frames go through FrameResampler (nearest frame by stamp onto a 25 fps grid),
 // PreprocessClipFrame (crop, grey or colour, resize) and ClipAssembler (N_t frames every stride, broken at

@@ -51,6 +51,33 @@ TEST(ClipPipelineTest, SixtyFpsStreamBecomesTwentyFiveFpsClips) {
   EXPECT_EQ(p.stats().clips_made, 7u);
 }
 
+TEST(ClipPipelineTest, StallReasonNamesStampsThatDoNotIncreaseAndASlowCamera) {
+  const ClipPipelineOptions o = SmallOptions();  // 10 frames a clip: reasons after 20 frames
+  const ClipPipelineStats start;
+  {
+    ClipPipeline healthy(o);
+    for (int i = 0; i < 90; ++i) healthy.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+    EXPECT_EQ(ClipStallReason(start, healthy.stats(), o), "");
+  }
+  {
+    ClipPipeline unstamped(o);  // a driver that leaves header.stamp 0
+    for (int i = 0; i < 90; ++i) unstamped.AddFrame(0.0, Numbered(i), ClipSourceEncoding::kMono8);
+    EXPECT_EQ(unstamped.stats().clips_made, 0u);
+    const std::string why = ClipStallReason(start, unstamped.stats(), o);
+    EXPECT_NE(why.find("89 were not stamped after"), std::string::npos) << why;
+  }
+  {
+    ClipPipeline slow(o);  // 7.5 fps, every interval over the 0.1 s gap tolerance
+    for (int i = 0; i < 15; ++i) slow.AddFrame(kT0 + i / 7.5, Numbered(i), ClipSourceEncoding::kMono8);
+    EXPECT_EQ(ClipStallReason(start, slow.stats(), o), "");  // too few frames to tell
+    for (int i = 15; i < 90; ++i) slow.AddFrame(kT0 + i / 7.5, Numbered(i), ClipSourceEncoding::kMono8);
+    EXPECT_EQ(slow.stats().clips_made, 0u);
+    const std::string why = ClipStallReason(start, slow.stats(), o);
+    EXPECT_NE(why.find("longer than gap_tolerance 0.1 s"), std::string::npos) << why;
+    EXPECT_NE(why.find("below 10 fps"), std::string::npos) << why;
+  }
+}
+
 TEST(ClipPipelineTest, GapBreaksTheClip) {
   ClipPipeline p(SmallOptions());
   int i = 0;

@@ -10,6 +10,7 @@ namespace {
 // A recording that fell this far behind its schedule (node stalled, debugger) restarts the
 // schedule instead of bursting frames out to catch up.
 constexpr int64_t kMaxLagNs = 500000000LL;
+constexpr int64_t kNoClockPollNs = 10000000LL;  // how often to look for /clock [ns]
 
 }  // namespace
 
@@ -18,30 +19,38 @@ FramePacer::FramePacer(Clock* clock, double rate_hz) : clock_(clock), rate_hz_(r
 void FramePacer::Restart() { started_ = false; }
 
 bool FramePacer::WaitNext(double max_wait_s, int64_t* stamp_ns) {
+  const bool simulated = clock_->RosTimeIsSimulated();
+  const int64_t max_wait_ns = static_cast<int64_t>(std::max(0.0, max_wait_s) * 1e9);
+  const auto pace_now = [&] { return simulated ? clock_->RosNs() : clock_->MonotonicNs(); };
+  if (simulated && clock_->RosNs() <= 0) {  // no /clock yet: wait for it rather than stamp 1970
+    clock_->SleepNs(std::min(max_wait_ns, kNoClockPollNs));
+    return false;
+  }
   if (!started_) {
-    start_mono_ns_ = clock_->MonotonicNs();
-    start_ros_ns_ = clock_->RosNs();
+    start_pace_ns_ = pace_now();
+    start_ros_ns_ = simulated ? start_pace_ns_ : clock_->RosNs();
     index_ = 0;
     started_ = true;
   }
   const auto due_after_start = [this](int64_t k) {
     return static_cast<int64_t>(std::llround(static_cast<double>(k) * 1e9 / rate_hz_));
   };
-  int64_t due = start_mono_ns_ + due_after_start(index_);
-  int64_t now = clock_->MonotonicNs();
-  if (now - due > kMaxLagNs) {
-    start_ros_ns_ += now - start_mono_ns_;
-    start_mono_ns_ = now;
+  int64_t due = start_pace_ns_ + due_after_start(index_);
+  int64_t now = pace_now();
+  // A long stall (or simulated time jumping back: a looped bag) restarts the schedule from now.
+  if (now - due > kMaxLagNs || (simulated && now < start_pace_ns_)) {
+    start_ros_ns_ = simulated ? now : start_ros_ns_ + (now - start_pace_ns_);
+    start_pace_ns_ = now;
     index_ = 0;
     due = now;
   }
   if (due > now) {
-    const int64_t max_wait_ns = static_cast<int64_t>(std::max(0.0, max_wait_s) * 1e9);
+    // Simulated time may run slower than the sleep: then not due yet, and the caller asks again.
     clock_->SleepNs(std::min(due - now, max_wait_ns));
-    now = clock_->MonotonicNs();
+    now = pace_now();
     if (now < due) return false;
   }
-  *stamp_ns = start_ros_ns_ + (due - start_mono_ns_);
+  *stamp_ns = start_ros_ns_ + (due - start_pace_ns_);
   ++index_;
   return true;
 }

@@ -73,6 +73,10 @@ class FrameSource {
 
 // Paces a recording at its native rate: frame k is due at start + k / rate. The due instant,
 // mapped to ROS time, is the frame's stamp, so stamps are evenly spaced even if a read is late.
+// Paced on the monotonic clock; under simulated ROS time (Clock::RosTimeIsSimulated) on ROS time
+// itself, so frames follow a replay's /clock when it runs slower (rosbag play -r 0.5), pauses or
+// loops, and none comes before /clock has started (ROS time 0). Paced on the wall clock, stamps
+// drifted ahead of a slowed replay until the clip buffer refused them as from the future.
 class FramePacer {
  public:
   // Inputs:
@@ -95,7 +99,7 @@ class FramePacer {
   Clock* clock_;
   double rate_hz_;
   bool started_ = false;
-  int64_t start_mono_ns_ = 0;
+  int64_t start_pace_ns_ = 0;  // the schedule's start on the pacing clock (see WaitNext)
   int64_t start_ros_ns_ = 0;
   int64_t index_ = 0;
 };

@@ -53,6 +53,57 @@ TEST(FramePacerTest, LateReadsKeepTheScheduleButLongStallsRestartIt) {
   ASSERT_FALSE(pacer.WaitNext(0, &stamp));
 }
 
+// ROS time from /clock: 0 until Start (no /clock yet), then `rate` x the monotonic clock from
+// `ros_ns`; Start again sets it back (a looped bag).
+class SimulatedClock : public FakeClock {
+ public:
+  bool RosTimeIsSimulated() override { return true; }
+  int64_t RosNs() override {
+    if (!running_) return 0;
+    return ros_at_start_ + static_cast<int64_t>(rate_ * static_cast<double>(MonotonicNs() - mono_at_start_));
+  }
+  void Start(int64_t ros_ns, double rate) {
+    running_ = true;
+    ros_at_start_ = ros_ns;
+    mono_at_start_ = MonotonicNs();
+    rate_ = rate;
+  }
+
+ private:
+  bool running_ = false;
+  int64_t ros_at_start_ = 0, mono_at_start_ = 0;
+  double rate_ = 1.0;
+};
+
+TEST(FramePacerTest, UnderSimulatedTimeFramesWaitForTheClockAndFollowItsRate) {
+  SimulatedClock clock;
+  FramePacer pacer(&clock, 10.0);
+  int64_t stamp = 0;
+  // No /clock yet: no frame (they were stamped 0, in 1970, and every later one 1970 + k / rate).
+  for (int i = 0; i < 5; ++i) EXPECT_FALSE(pacer.WaitNext(0.05, &stamp));
+  const int64_t start = 1700000000LL * 1000000000LL;
+  clock.Start(start, 0.5);  // rosbag play --clock -r 0.5
+  ASSERT_TRUE(pacer.WaitNext(0.05, &stamp));
+  EXPECT_EQ(stamp, start);
+  // Each frame is stamped at its due instant in ROS time and released once ROS time reaches it,
+  // so 20 frames take 4 s of wall time (2 s of ROS time at half speed). On the wall clock they
+  // ran ahead of /clock by 0.5 s every second.
+  const int64_t wall_start = clock.MonotonicNs();
+  for (int k = 1; k <= 20; ++k) {
+    while (!pacer.WaitNext(0.05, &stamp)) {
+    }
+    EXPECT_EQ(stamp, start + k * 100 * kMs);
+    EXPECT_LE(stamp, clock.RosNs());
+    EXPECT_GE(stamp, clock.RosNs() - kMs);
+  }
+  EXPECT_NEAR(static_cast<double>(clock.MonotonicNs() - wall_start), 4e9, 2e7);
+  // The bag loops: ROS time goes back 2 s, and the schedule restarts there.
+  clock.Start(start, 1.0);
+  while (!pacer.WaitNext(0.05, &stamp)) {
+  }
+  EXPECT_EQ(stamp, clock.RosNs());
+}
+
 }  // namespace
 }  // namespace sensors
 }  // namespace clothwind

@@ -19,6 +19,9 @@ class Clock {
   virtual int64_t RosNs() = 0;
   // Blocks for duration_ns [ns] (a fake clock advances instead). Non-positive: returns at once.
   virtual void SleepNs(int64_t duration_ns) = 0;
+  // Whether ROS time is simulated (use_sim_time: /clock from rosbag play --clock), so that it may
+  // run slower or faster than the monotonic clock, stop, start at 0 or jump back.
+  virtual bool RosTimeIsSimulated() { return false; }
 };
 
 // The real clocks: CLOCK_MONOTONIC, CLOCK_REALTIME, nanosleep.
