@@ -31,6 +31,19 @@ inline void RefuseOutputOverInput(const std::string& option, const std::filesyst
                                   "); write it elsewhere");
 }
 
+// Throws std::invalid_argument naming `option` unless `output` (empty: none) could be written: its
+// folder exists and it is not a folder itself. Checked before the work, which used to run to its
+// end (a whole evaluation) and then fail to write or, for a plot, exit 0.
+inline void RefuseUnwritableOutput(const std::string& option, const std::filesystem::path& output) {
+  if (output.empty()) return;
+  std::error_code ec;
+  const std::filesystem::path folder = output.has_parent_path() ? output.parent_path() : ".";
+  if (!std::filesystem::is_directory(folder, ec))
+    throw std::invalid_argument(option + " " + output.string() + ": folder " + folder.string() + " does not exist");
+  if (std::filesystem::is_directory(output, ec))
+    throw std::invalid_argument(option + " " + output.string() + " is a folder; expected a file name");
+}
+
 }  // namespace clothwind::tools
 
 #endif  // CLOTHWIND_TOOLS_OUTPUT_PATHS_H_

@@ -35,5 +35,23 @@ TEST(OutputPathsTest, AnOutputThatIsAnInputIsRefusedHoweverSpelt) {
   fs::remove_all(dir);
 }
 
+TEST(OutputPathsTest, AnOutputInAMissingFolderOrOnAFolderIsRefusedBeforeTheWork) {
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_output_writable_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "sub");
+  for (const fs::path& bad : {dir / "no_such_folder" / "e.json", dir / "sub"}) {
+    try {
+      RefuseUnwritableOutput("--json", bad);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("--json " + bad.string()), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(RefuseUnwritableOutput("--json", dir / "sub" / "e.json"));
+  EXPECT_NO_THROW(RefuseUnwritableOutput("--json", "e.json"));  // the working folder
+  EXPECT_NO_THROW(RefuseUnwritableOutput("--json", fs::path()));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace clothwind::tools

@@ -7,6 +7,7 @@
 
 #include "data/contact_sheet.h"
 #include "data/dataset_index.h"
+#include "output_paths.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -23,6 +24,20 @@ int Run(const ContactSheetArgs& a) {
   if (index.is_null()) throw std::runtime_error(a.dir + "/index.json not found: not a dataset folder");
   const std::string out =
       a.out.empty() ? (std::filesystem::path(a.dir) / "contact_sheet.png").string() : a.out;
+  // Not over the dataset: `--out DIR/<clip>/003.jpg` replaced a clip's frame with the sheet.
+  const std::filesystem::path dir(a.dir);
+  RefuseOutputOverInput("--out", out, {dir / "index.json"});
+  const std::filesystem::path out_folder =
+      std::filesystem::path(out).has_parent_path() ? std::filesystem::path(out).parent_path() : ".";
+  for (const auto& clip : index["clips"]) {
+    const std::string name = clip.value("name", std::string());
+    if (name.empty()) continue;
+    const std::filesystem::path folder = dir / name;
+    if (SameFile(out_folder, folder))
+      throw std::invalid_argument("--out " + out + " is inside the example folder " + folder.string() +
+                                  "; write it elsewhere");
+  }
+  RefuseUnwritableOutput("--out", out);
   if (!data::WriteContactSheet(a.dir, index, out, a.options)) {
     std::printf("contact-sheet: %s has no clips\n", a.dir.c_str());
     return 1;

@@ -93,6 +93,16 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
                                                         std::filesystem::path(a->data) / "index.json", a->fly_judge};
     RefuseOutputOverInput("--json", a->json, inputs);
     RefuseOutputOverInput("--plot", a->plot, inputs);
+    const std::filesystem::path plot =
+        a->plot.empty() ? std::filesystem::path(a->model).parent_path() / ("eval_" + a->split + ".png")
+                        : std::filesystem::path(a->plot);
+    // The plot and its gnuplot data file replaced the JSON written just before them.
+    for (const std::filesystem::path& drawn : {plot, std::filesystem::path(plot.string() + ".dat")})
+      if (!a->json.empty() && SameFile(a->json, drawn))
+        throw std::invalid_argument("--json " + a->json + " is where the plot goes (" + drawn.string() +
+                                    "); write one of them elsewhere");
+    RefuseUnwritableOutput("--json", a->json);
+    RefuseUnwritableOutput("--plot", a->plot);
     ProgressBar::Options b;
     b.label = "eval";
     b.unit = "clips";
@@ -138,25 +148,24 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
         std::cout << "track head rows: " << a->track_head_rows << "\n";
       }
     }
-    const std::filesystem::path plot =
-        a->plot.empty() ? std::filesystem::path(a->model).parent_path() / ("eval_" + a->split + ".png")
-                        : std::filesystem::path(a->plot);
     // The figures first: a plot that cannot be written (a read-only model folder) costs only itself.
     if (!a->json.empty()) {
       learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
       std::cout << "json: " << a->json << "\n";
     }
     std::string error;
+    bool plot_failed = false;
     if (learn::PlotPredictions(r, plot, &error)) {
       std::cout << "plot: " << plot.string() << "\n";
     } else {
       std::cerr << "plot not drawn: " << error << "\n";
+      plot_failed = !a->plot.empty();  // the default plot is a courtesy; an asked-for one is a result
     }
     if (!by_view_error.empty()) {
       std::cerr << "clothwind eval: --by-view: " << by_view_error << "\n";
       return 1;
     }
-    return 0;
+    return plot_failed ? 1 : 0;
   };
 });
 

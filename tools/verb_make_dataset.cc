@@ -63,19 +63,22 @@ int Run(MakeDatasetArgs& a) {
   o.frame_ext = a.format == "jpeg" ? "jpg" : a.format;
   o.contact_sheet = !a.no_contact_sheet;
   if (!a.tracks.empty()) o.tracks = data::ParseTrackGrid("--tracks", a.tracks);
-  if (a.wind_min >= 0 || a.wind_max >= 0 || a.area_weight_spread >= 0 || a.bending_spread >= 0 ||
-      a.bending_jitter >= 0 || !a.camera_height.empty() || !a.camera_radius.empty() || a.camera_angle >= 0) {
+  // -1 (the default) is "not given"; anything else, NaN included, goes to the ranges to be checked
+  // there (a NaN used to read as "not given", and the default was used without a word).
+  const auto given = [](double v) { return v != -1; };
+  if (given(a.wind_min) || given(a.wind_max) || given(a.area_weight_spread) || given(a.bending_spread) ||
+      given(a.bending_jitter) || !a.camera_height.empty() || !a.camera_radius.empty() || given(a.camera_angle)) {
     data::SamplingRanges r = data::DefaultRanges(o.kind);
-    if (a.wind_min >= 0) r.wind_min = a.wind_min;
-    if (a.wind_max >= 0) r.wind_max = a.wind_max;
-    if (a.area_weight_spread >= 0) r.area_weight_factor = a.area_weight_spread;
-    if (a.bending_spread >= 0) r.bending_factor = a.bending_spread;
-    if (a.bending_jitter >= 0) r.bending_jitter = a.bending_jitter;
+    if (given(a.wind_min)) r.wind_min = a.wind_min;
+    if (given(a.wind_max)) r.wind_max = a.wind_max;
+    if (given(a.area_weight_spread)) r.area_weight_factor = a.area_weight_spread;
+    if (given(a.bending_spread)) r.bending_factor = a.bending_spread;
+    if (given(a.bending_jitter)) r.bending_jitter = a.bending_jitter;
     if (!a.camera_height.empty())
       ParseRange("--camera-height", a.camera_height, &r.camera.height_min, &r.camera.height_max);
     if (!a.camera_radius.empty())
       ParseRange("--camera-radius", a.camera_radius, &r.camera.radius_min, &r.camera.radius_max);
-    if (a.camera_angle >= 0) r.camera.angle_max_deg = a.camera_angle;
+    if (given(a.camera_angle)) r.camera.angle_max_deg = a.camera_angle;
     o.ranges = r;
   }
   // The renderer's own listing (any case, .bmp too, files only): this verb's copy refused .JPG.

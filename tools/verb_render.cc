@@ -166,7 +166,10 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
   sub->add_option("--cloth", a->cloth, "which cloth (the CC of NNNN_CC.obj)")->capture_default_str();
   sub->add_flag("--obj", a->obj, "read the folder's OBJ frames even if it has a trajectory");
   sub->add_option("--samples", a->samples, "anti-aliasing samples per pixel (0: zeta's)")->capture_default_str();
-  sub->add_option("--threads", a->threads, "render threads (0: all)")->capture_default_str();
+  // Bounded: 99999999 threads threw bad_alloc after the old render's zeta.json was removed.
+  sub->add_option("--threads", a->threads, "render threads (0: all cores; at most 1024)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
   return [a] { return Run(*a); };
 }};
 

@@ -189,8 +189,8 @@ const VerbRegistrar kRegistrar{"simulate", [](CLI::App& app) -> std::function<in
                   "refine uniformly to this edge length [m] (default: the scene's: uniformly to the upper end of its "
                   "remeshing size range, then edges over 0.4 of it split)");
   sub->add_option("--frame-steps", args->frame_steps,
-                  "time steps per frame (0, the default: the scene's; fewer is faster but damps flapping)")
-      ->check(CLI::NonNegativeNumber);
+                  "time steps per frame, 0..10000 (0, the default: the scene's; fewer is faster but damps flapping)")
+      ->check(CLI::Range(0, 10000));
   sub->add_option("--warmup", args->warmup,
                   "simulated seconds before the first written frame (the release transient) [s]")
       ->check(CLI::NonNegativeNumber);

@@ -65,7 +65,7 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
       ->check(CLI::Range(1, 1000))  // a huge count hung (windows rebuilt per window)
       ->capture_default_str();
   sub->add_option("--frames", a->frames, "frames per window (the models')")->check(CLI::Range(2, 10000))->capture_default_str();
-  sub->add_option("--hidden", a->train.hidden, "hidden units")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--hidden", a->train.hidden, "hidden units (1..4096)")->check(CLI::Range(1, 4096))->capture_default_str();
   sub->add_option("--epochs", a->train.epochs, "passes over the training maps")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--batch", a->train.batch, "maps per Adam step")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--lr", a->train.learning_rate, "Adam's learning rate")->check(CLI::PositiveNumber)->capture_default_str();

@@ -52,6 +52,9 @@ inline cv::Mat ReadImageFile(const std::filesystem::path& path, int flags, std::
     if (error) *error = why;
     return cv::Mat();
   };
+  // A folder opens as a stream and then threw "basic_filebuf::underflow ... Is a directory".
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return fail("is a folder, not an image");
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail("cannot read");
   const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

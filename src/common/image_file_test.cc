@@ -81,6 +81,10 @@ TEST_F(ImageFileTest, OtherFormatsAndBadFilesSayWhy) {
   EXPECT_EQ(why, "cannot read");
   EXPECT_TRUE(ReadImageFile(Write("empty.png", {}), cv::IMREAD_COLOR, &why).empty());
   EXPECT_NE(why.find("empty file"), std::string::npos) << why;
+  // A folder where a frame should be: it threw "basic_filebuf::underflow" naming no file.
+  std::filesystem::create_directories(dir_ / "000.jpg");
+  EXPECT_TRUE(ReadImageFile(dir_ / "000.jpg", cv::IMREAD_COLOR, &why).empty());
+  EXPECT_EQ(why, "is a folder, not an image");
   const std::string text = "not an image at all";
   EXPECT_TRUE(ReadImageFile(Write("text.png", std::vector<uint8_t>(text.begin(), text.end())), cv::IMREAD_COLOR, &why)
                   .empty());

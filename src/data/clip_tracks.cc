@@ -11,9 +11,10 @@ namespace clothwind::data {
 TrackGrid ParseTrackGrid(const std::string& option, const std::string& text) {
   TrackGrid g;
   const auto stoi = [](const std::string& t, size_t* n) { return std::stoi(t, n); };
-  if (!ParsePair(text, 'x', stoi, &g.cols, &g.rows) || g.cols < 1 || g.rows < 2)
-    throw std::invalid_argument(option + ": expected COLSxROWS with COLS >= 1 and ROWS >= 2 (e.g. 8x6), got '" +
-                                text + "'");
+  // At most 256 a side: 3000x3000 points ran for minutes on a 63-vertex mesh.
+  if (!ParsePair(text, 'x', stoi, &g.cols, &g.rows) || g.cols < 1 || g.rows < 2 || g.cols > 256 || g.rows > 256)
+    throw std::invalid_argument(option + ": expected COLSxROWS with 1 <= COLS <= 256 and 2 <= ROWS <= 256 (e.g. 8x6), "
+                                "got '" + text + "'");
   return g;
 }
 

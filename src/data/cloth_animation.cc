@@ -72,6 +72,21 @@ ClothAnimation ReadObjSequence(const std::string& folder, int cloth, double fram
     throw std::runtime_error("OBJ sequence: " + (fs::path(folder) / name).string() +
                              " not found (expected frames NNNN_CC.obj from 0000)");
   }
+  // A frame missing in the middle ended the sequence there, and the frames after it were
+  // dropped without a word.
+  const int found = static_cast<int>(a.frames.size());
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(folder, ec)) {
+    const std::string file = e.path().filename().string();
+    int f = -1, c = -1;
+    char tail = 0;
+    if (std::sscanf(file.c_str(), "%d_%d.ob%c", &f, &c, &tail) == 3 && tail == 'j' && c == cloth && f > found) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "%04d_%02d.obj", found, cloth);
+      throw std::runtime_error("OBJ sequence: " + (fs::path(folder) / name).string() + " is missing, but " +
+                               file + " comes later (frames NNNN_CC.obj must be numbered without gaps)");
+    }
+  }
   // Frames that keep the first frame's topology share its faces and texture coordinates.
   a.F = a.frames[0].F;
   a.UV = a.frames[0].UV;

@@ -113,5 +113,20 @@ TEST(ClothAnimationTest, MissingObjSequenceIsReportedByName) {
   EXPECT_THROW(AnimationFromTrajectory(ShortFlag(), 3, 100), std::out_of_range);
 }
 
+TEST(ClothAnimationTest, AFrameMissingInTheMiddleIsReportedByName) {
+  // The sequence used to end at the hole, the later frames dropped without a word.
+  const sim::Trajectory t = ShortFlag();
+  const fs::path dir = WriteObjs(t, "hole");
+  ASSERT_GE(t.num_frames(), 3);
+  fs::remove(dir / "0001_00.obj");
+  try {
+    ReadObjSequence(dir.string(), 0, t.frame_time);
+    ADD_FAILURE() << "a sequence with a hole was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("0001_00.obj is missing"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace clothwind::data

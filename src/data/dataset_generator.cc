@@ -60,7 +60,7 @@ void ValidateOptions(const DatasetOptions& o) {
   Check(std::isfinite(o.warmup) && o.warmup >= 0 && o.warmup <= 3600, "--warmup must be in 0..3600 s");
   Check(o.frames >= 1, "--frames must be >= 1");
   Check(std::isfinite(o.fps) && o.fps > 0 && o.fps <= 1000, "--fps must be in (0, 1000] Hz");
-  Check(o.samples >= 0, "--samples must be >= 0");
+  Check(o.samples >= 0 && o.samples <= 1024, "--samples must be in 0..1024 (0: zeta's default)");
   Check(o.size >= 16 && o.size <= 4096, "--size must be in 16..4096 px");
   Check(o.frame_ext == "jpg" || o.frame_ext == "png" || o.frame_ext == "pgm",
         "frame format must be jpg, png or pgm");

@@ -16,7 +16,8 @@ namespace clothwind::data {
 RenderedFlagGenerator::RenderedFlagGenerator(const sensors::SyntheticSessionOptions& session,
                                              const RenderedSessionOptions& options)
     : session_(session), options_(options) {
-  if (!(options.warmup >= 0)) throw std::invalid_argument("rendered session: warmup must be >= 0 s");
+  if (!(options.warmup >= 0 && options.warmup <= 3600))  // 1e8 s simulated for hours
+    throw std::invalid_argument("rendered session: --warmup must be in 0..3600 s, got " + std::to_string(options.warmup));
   // ζ: the dataset's flag scene sampling (sun, sky, backdrop, design), seen by the field camera.
   zeta_ = render::SampleRenderParams(render::SceneKind::kFlag, options.zeta_seed);
   zeta_.camera_radius = options.camera_radius;

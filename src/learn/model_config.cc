@@ -3,6 +3,7 @@
 #include "common/atomic_file.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -170,7 +171,8 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.point_maps = j.contains("point_maps") ? j.at("point_maps").get<int>() : 0;
     // Absent in models written before the option existed: a linear wind head.
     c.head_hidden = j.contains("head_hidden") ? j.at("head_hidden").get<int>() : 0;
-    if (c.head_hidden < 0) throw std::runtime_error(where + ": field \"head_hidden\" must be >= 0");
+    if (c.head_hidden < 0 || c.head_hidden > 4096)
+      throw std::runtime_error(where + ": field \"head_hidden\" must be in 0..4096, got " + std::to_string(c.head_hidden));
     // Absent in models written before train --no-flip existed: they were trained with flips.
     c.flips_in_training = j.contains("flips_in_training") ? j.at("flips_in_training").get<bool>() : true;
     c.frame_rate = need("frame_rate").get<double>();
@@ -191,6 +193,17 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
       !(c.frame_rate > 0) || !(c.label_std > 0) || !(c.std_scale > 0)) {
     throw std::runtime_error(where + ": frames, channels, width, k must be >= 1, input_size >= 16, "
                              "frame_rate, label_std and std_scale > 0");
+  }
+  // Upper bounds far above any model here, so a typo fails here and not as an allocation of
+  // terabytes (width 100000 asked for 360 GB).
+  if (c.frames > 1000 || c.width > 512 || c.input_size > 1024 || c.k > 64 || c.flow_size > 1024 ||
+      !(c.frame_rate <= 1000) || !std::isfinite(c.label_mean) || !std::isfinite(c.label_std) ||
+      !std::isfinite(c.std_scale)) {
+    throw std::runtime_error(where + ": expected frames <= 1000, width <= 512, input_size <= 1024, k <= 64, "
+                             "flow_size <= 1024, frame_rate <= 1000 and finite label_mean, label_std, std_scale; "
+                             "got frames " + std::to_string(c.frames) + ", width " + std::to_string(c.width) +
+                             ", input_size " + std::to_string(c.input_size) + ", k " + std::to_string(c.k) +
+                             ", flow_size " + std::to_string(c.flow_size));
   }
   if (!c.ColourIsValid()) {
     throw std::runtime_error(where + ": field \"colour\" must be false with \"flow\" (the flow is the grey frames')");

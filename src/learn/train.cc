@@ -249,6 +249,18 @@ at::Tensor PointScale(const TargetScale& scale, int points, bool std) {
 
 }  // namespace
 
+// torch::load onto the CPU, its errors (a checkpoint cut short: "PytorchStreamReader failed
+// reading zip archive", with a backtrace) prefixed with the file and what to do.
+template <typename T>
+void LoadNamingTheFile(T& into, const fs::path& file) {
+  try {
+    torch::load(into, file.string(), at::Device(at::kCPU));
+  } catch (const c10::Error& e) {
+    throw std::runtime_error(file.string() + ": cannot read this checkpoint (" + e.what_without_backtrace() +
+                             "); a run stopped while writing it? Train again with --overwrite");
+  }
+}
+
 double LearningRateAt(const TrainOptions& o, int epoch) {
   if (o.lr_schedule == "step") {
     return epoch > StepDecayEpoch(o) ? o.lr / o.lr_decay_factor : o.lr;
@@ -282,6 +294,20 @@ TrainResult Train(const TrainOptions& o) {
   if (o.lr_schedule != "step" && o.lr_schedule != "cosine") {
     throw std::runtime_error("lr schedule must be step or cosine, got \"" + o.lr_schedule + "\"");
   }
+  // NaN passes CLI11's range checks; these ran a run to its end (NaN dropout, gradient clip), or
+  // failed deep in libtorch with a backtrace naming no option (NaN lr, weight decay).
+  const auto require = [](bool ok, const char* option, const char* expected, double value) {
+    if (!ok) throw std::runtime_error(std::string(option) + " must be " + expected + ", got " + std::to_string(value));
+  };
+  require(std::isfinite(o.lr) && o.lr > 0 && o.lr <= 10, "--lr", "in (0, 10]", o.lr);
+  require(std::isfinite(o.lr_decay_factor) && o.lr_decay_factor > 0, "--lr-decay-factor", "finite and > 0",
+          o.lr_decay_factor);
+  require(o.lr_decay_epoch >= -1, "--lr-decay-epoch", ">= 0 (or -1: --epochs / 2)", o.lr_decay_epoch);
+  require(std::isfinite(o.weight_decay) && o.weight_decay >= 0, "--weight-decay", "finite and >= 0", o.weight_decay);
+  require(std::isfinite(o.grad_clip), "--grad-clip", "finite (0: off, < 0: the seed's)", o.grad_clip);
+  require(std::isfinite(o.aux_tracks) && o.aux_tracks >= 0, "--aux-tracks", "finite and >= 0", o.aux_tracks);
+  require(o.weight_average >= 0 && o.weight_average < 1, "--weight-average", "in [0, 1)", o.weight_average);
+  require(o.model.dropout >= 0 && o.model.dropout < 1, "--dropout", "in [0, 1)", o.model.dropout);
   const at::Device device = (o.device != "cpu" && torch::cuda::is_available()) ? at::Device(at::kCUDA)
                                                                                  : at::Device(at::kCPU);
   if (!o.resume && !o.overwrite) {
@@ -306,8 +332,6 @@ TrainResult Train(const TrainOptions& o) {
     }
     if (val.empty()) val = train;  // a dataset without a validation split validates on train
   }
-  // Made once the data is known good: a refused --data used to leave an empty folder behind.
-  fs::create_directories(o.out);
 
   ModelConfig config = o.model;
   CheckClipsSuitModel(train, config.frame_rate, config.colour);
@@ -323,6 +347,11 @@ TrainResult Train(const TrainOptions& o) {
     const double var = sum2 / train.size() - config.label_mean * config.label_mean;
     config.label_std = var > 1e-12 ? std::sqrt(var) : 1.0;
   }
+  // The checks every model.json gets when read, before any work: a model eval could not load
+  // (or one of 10^12 weights) used to be trained first.
+  if (!o.resume) ModelConfigFromJson(ToJson(config), "the model options");
+  // Made once the options and data are known good: a refusal used to leave an empty folder.
+  fs::create_directories(o.out);
   const fs::path state_path = o.out / "state.json";
   nlohmann::json state;
   if (o.resume) {
@@ -376,10 +405,6 @@ TrainResult Train(const TrainOptions& o) {
   if (o.point_maps && o.aux_tracks <= 0)
     throw std::runtime_error("point_maps: the points are found on maps only with an auxiliary loss (--aux-tracks W > 0)");
   if (o.resume) RefuseChangedOnResume(state_path, "--point-maps", state.value("point_maps", false), o.point_maps);
-  if (!(o.weight_average >= 0 && o.weight_average < 1)) {
-    throw std::runtime_error("weight_average: the average's decay must lie in [0, 1), got " +
-                             std::to_string(o.weight_average));
-  }
   if (o.resume) {
     RefuseChangedOnResume(state_path, "--weight-average", state.value("weight_average", 0.0), o.weight_average);
     // The sampling order, batches and optimiser a resumed run repeats (runs before 2026-12-05
@@ -441,8 +466,8 @@ TrainResult Train(const TrainOptions& o) {
   const fs::path resume_from = o.resume ? CheckpointDirOf(state, o.out) : fs::path();
   if (o.resume) {
     // Loaded onto the CPU whatever device wrote them, then moved with the network.
-    torch::load(net, (resume_from / "last.pt").string(), at::Device(at::kCPU));
-    torch::load(optimizer, (resume_from / "last_optim.pt").string(), at::Device(at::kCPU));
+    LoadNamingTheFile(net, resume_from / "last.pt");
+    LoadNamingTheFile(optimizer, resume_from / "last_optim.pt");
   }
   // The weight average starts at the initial weights and lives beside them on the device.
   const fs::path raw_model = o.out / "raw_model.pt";
@@ -452,7 +477,7 @@ TrainResult Train(const TrainOptions& o) {
     average = WindNet(config);
     CopyWeights(*net, *average);
     if (o.resume) {
-      torch::load(average, (resume_from / "last_average.pt").string(), at::Device(at::kCPU));
+      LoadNamingTheFile(average, resume_from / "last_average.pt");
       average_steps = state.value("average_steps", int64_t{0});
     }
     average->to(device);

@@ -1125,6 +1125,31 @@ TEST_F(TrainTest, CropScalesOutsideTheFrameAreRefused) {
   }
 }
 
+// NaN passes CLI11's range checks: a NaN dropout or gradient clip trained to the end and saved a
+// run eval and --resume could not read; a NaN lr failed in libtorch naming no option; a huge
+// width asked for terabytes. Each is refused before the run folder is made.
+TEST_F(TrainTest, NotANumberOrHugeOptionsAreRefusedBeforeTheRunFolder) {
+  const double nan = std::nan("");
+  const std::vector<std::pair<std::function<void(TrainOptions&)>, std::string>> cases = {
+      {[&](TrainOptions& t) { t.model.dropout = nan; }, "--dropout"},
+      {[&](TrainOptions& t) { t.grad_clip = nan; }, "--grad-clip"},
+      {[&](TrainOptions& t) { t.lr = nan; }, "--lr"},
+      {[&](TrainOptions& t) { t.lr = 1e300; }, "--lr"},
+      {[&](TrainOptions& t) { t.weight_decay = nan; }, "--weight-decay"},
+      {[&](TrainOptions& t) { t.aux_tracks = nan; }, "--aux-tracks"},
+      {[&](TrainOptions& t) { t.lr_decay_epoch = -5; }, "--lr-decay-epoch"},
+      {[&](TrainOptions& t) { t.model.width = 100000; }, "width 100000"},
+      {[&](TrainOptions& t) { t.model.head_hidden = 2147483647; }, "head_hidden"},
+  };
+  for (const auto& [change, names] : cases) {
+    TrainOptions t = Options("sdn", "bad_numbers");
+    t.epochs = 1;
+    change(t);
+    ExpectTrainRefused(t, names + " was accepted", {names});
+    EXPECT_FALSE(fs::exists(*root_ / "bad_numbers")) << names;
+  }
+}
+
 TEST_F(TrainTest, FlowChannelsTrainRoundTripAndAreRefusedWhenInconsistent) {
   TrainOptions t = Options("sdn", "flow");
   t.model.flow = true;

@@ -47,10 +47,11 @@ void ValidateCameraRanges(const CameraRanges& r) {
   };
   // Finite: an infinite maximum passed "max >= min", failed every simulation with a misleading
   // camera error and went into a dataset's header as null.
-  check(r.height_min > 0 && r.height_max >= r.height_min && std::isfinite(r.height_max), "camera height",
-        r.height_min, r.height_max, "0 < min <= max, finite [m]");
-  check(r.radius_min > 0 && r.radius_max >= r.radius_min && std::isfinite(r.radius_max), "camera radius",
-        r.radius_min, r.radius_max, "0 < min <= max, finite [m]");
+  // Bounded too: a radius of 1e308 m failed every simulation as "viewing direction is vertical".
+  check(r.height_min > 0 && r.height_max >= r.height_min && r.height_max <= 100, "camera height", r.height_min,
+        r.height_max, "0 < min <= max <= 100 [m]");
+  check(r.radius_min > 0 && r.radius_max >= r.radius_min && r.radius_max <= 1000, "camera radius", r.radius_min,
+        r.radius_max, "0 < min <= max <= 1000 [m]");
   check(r.angle_max_deg >= 0 && r.angle_max_deg < 90, "camera angle", -r.angle_max_deg, r.angle_max_deg,
         "a half-range in [0, 90) deg");
 }

@@ -135,7 +135,9 @@ TEST(RenderParams, BadCameraRangesNameTheRange) {
   r = CameraRanges();
   r.radius_max = std::numeric_limits<double>::infinity();  // passed max >= min; a header's null
   EXPECT_NE(message(r).find("camera radius is [") , std::string::npos) << message(r);
-  EXPECT_NE(message(r).find("finite"), std::string::npos) << message(r);
+  EXPECT_NE(message(r).find("<= 1000 [m]"), std::string::npos) << message(r);
+  r.radius_max = 1e308;  // finite, and every view failed as "viewing direction is vertical"
+  EXPECT_NE(message(r).find("camera radius is ["), std::string::npos) << message(r);
   r = CameraRanges();
   r.angle_max_deg = 90;
   EXPECT_NE(message(r).find("camera angle"), std::string::npos) << message(r);

@@ -33,8 +33,9 @@ Trajectory SimulateTrajectory(const SceneSetup& setup, const Theta& theta,
   const double frame_time = setup.scene.frame_time;
   const int steps_per_frame = setup.scene.frame_steps;
   const int frames = static_cast<int>(std::lround(duration / frame_time));
-  if (!(options.warmup >= 0) || !std::isfinite(options.warmup)) {
-    throw std::invalid_argument("SimulateOptions.warmup must be >= 0 [s]");
+  // At most an hour (as make-dataset's): 1e8 s overflowed the frame count and ran no warm-up.
+  if (!(options.warmup >= 0 && options.warmup <= 3600)) {
+    throw std::invalid_argument("warmup must be in 0..3600 s, got " + std::to_string(options.warmup));
   }
   const int warmup_frames = static_cast<int>(std::lround(options.warmup / frame_time));
   const int total = warmup_frames + frames;

@@ -1,6 +1,7 @@
 #include "sim/simulate.h"
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <thread>
 
@@ -81,8 +82,11 @@ TEST(SimulateTrajectory, WarmupDropsLeadingFramesOfTheSameRun) {
   ASSERT_EQ(warm.num_frames(), 7);
   EXPECT_EQ(warm.steps, full.steps);
   for (int f = 0; f < warm.num_frames(); ++f) EXPECT_EQ(warm.frames[f], full.frames[f + 4]) << f;
-  o.warmup = -1;
-  EXPECT_THROW(SimulateTrajectory(setup, SceneTheta(setup), o), std::invalid_argument);
+  // Negative, NaN and beyond an hour are refused (1e8 s overflowed the frame count: no warm-up).
+  for (double bad : {-1.0, std::nan(""), 1e8}) {
+    o.warmup = bad;
+    EXPECT_THROW(SimulateTrajectory(setup, SceneTheta(setup), o), std::invalid_argument) << bad;
+  }
 }
 
 TEST(SimulateTrajectory, ProgressCanStopEarly) {
@@ -141,15 +145,15 @@ TEST(SimulateTrajectory, GustsLastTheWholeRunUnlessTheSceneSetsTheirHorizon) {
   // warm-up). The hook sees the spec the run's field is made from; it stops the run there.
   const SceneSetup setup = SmallFlag();
   SimulateOptions o;
-  o.duration = 0.04;
-  o.warmup = 4000.0;
+  o.duration = 600.0;
+  o.warmup = 3600.0;
   double horizon = 0;
   o.make_wind = [&](const WindSpec& spec) -> std::shared_ptr<const WindField> {
     horizon = spec.gusts.horizon;
     throw std::runtime_error("seen");
   };
   EXPECT_THROW(SimulateTrajectory(setup, SceneTheta(setup), o), std::runtime_error);
-  EXPECT_GE(horizon, 4000.04);
+  EXPECT_GE(horizon, 4200.0);
   SceneSetup given = setup;
   given.wind.gusts.horizon = 100.0;
   given.wind.gusts.horizon_given = true;
