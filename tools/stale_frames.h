@@ -4,6 +4,7 @@
 #ifndef CLOTHWIND_TOOLS_STALE_FRAMES_H_
 #define CLOTHWIND_TOOLS_STALE_FRAMES_H_
 
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -27,16 +28,23 @@ inline int RemoveStaleFrames(const std::filesystem::path& dir, const std::functi
   return removed;
 }
 
-// The frame number of a name made of `digits` digits, then `suffix` ("0012_00.obj": 4, "_00.obj"
-// gives 12); nullopt for any other name.
+// The frame number of a name printf's "%0<digits>d" followed by `suffix` gives ("0012_00.obj":
+// 4, "_00.obj" gives 12; "1000.png": 3, ".png" gives 1000, as frame 1000 is named); nullopt for
+// any other name. (Names of 1000 frames and more used to be missed, and left behind as stale.)
 inline std::optional<int> FrameNumber(const std::string& name, int digits, const std::string& suffix) {
-  if (name.size() != static_cast<size_t>(digits) + suffix.size() || name.compare(digits, suffix.size(), suffix) != 0)
+  if (name.size() < static_cast<size_t>(digits) + suffix.size() ||
+      name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
     return std::nullopt;
+  const std::string number = name.substr(0, name.size() - suffix.size());
+  if (number.size() > 9) return std::nullopt;
   int n = 0;
-  for (int i = 0; i < digits; ++i) {
-    if (name[i] < '0' || name[i] > '9') return std::nullopt;
-    n = n * 10 + (name[i] - '0');
+  for (char c : number) {
+    if (c < '0' || c > '9') return std::nullopt;
+    n = n * 10 + (c - '0');
   }
+  char printed[16];
+  std::snprintf(printed, sizeof printed, "%0*d", digits, n);
+  if (number != printed) return std::nullopt;  // "0012.jpg" is no frame of "%03d"
   return n;
 }
 

@@ -17,6 +17,11 @@ TEST(StaleFramesTest, FrameNumberReadsOnlyItsOwnPattern) {
   EXPECT_EQ(FrameNumber("00a2_00.obj", 4, "_00.obj"), std::nullopt);
   EXPECT_EQ(FrameNumber("007.jpg", 3, ".jpg"), 7);
   EXPECT_EQ(FrameNumber("zeta.json", 3, ".jpg"), std::nullopt);
+  // Past the width printf pads to, as frames 1000 and 10000 are named (they were missed).
+  EXPECT_EQ(FrameNumber("1000.png", 3, ".png"), 1000);
+  EXPECT_EQ(FrameNumber("12345_00.obj", 4, "_00.obj"), 12345);
+  EXPECT_EQ(FrameNumber("0012.jpg", 3, ".jpg"), std::nullopt);  // no "%03d" name
+  EXPECT_EQ(FrameNumber(".jpg", 3, ".jpg"), std::nullopt);
 }
 
 // A shorter rerun: frames past its count go, its own frames and other files stay.

@@ -1112,7 +1112,7 @@ TEST_F(TrainTest, WeightAverageIsWhatModelHoldsAndResumes) {
                      {"state.json: the run trained with --weight-average", "--weight-average"});
   TrainOptions w = Options("sdn", "average_bad");
   w.weight_average = 1.0;
-  ExpectTrainRefused(w, "a weight average that never moves was accepted", {"weight_average", "[0, 1)"});
+  ExpectTrainRefused(w, "a weight average that never moves was accepted", {"--weight-average", "[0, 1)"});
 }
 
 TEST_F(TrainTest, CropScalesOutsideTheFrameAreRefused) {

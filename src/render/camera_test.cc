@@ -110,7 +110,7 @@ TEST(FrameClip, HangingFlagStaysInTheFrame) {
     for (int i = 0; i < V.rows(); ++i) {
       Eigen::Vector2d px;
       const Eigen::Vector3d w = V.row(i).transpose() + Eigen::Vector3d(0, 0, q.mesh_height);
-      if (!c.Project(w, &px) || px.x() < 0 || px.x() > 300 || px.y() < 0 || px.y() > 300)
+      if (!c.Project(w, &px) || px.x() < 0 || px.x() > q.width || px.y() < 0 || px.y() > q.height)
         return false;
     }
     return true;
@@ -138,6 +138,14 @@ TEST(FrameClip, HangingFlagStaysInTheFrame) {
   EXPECT_DOUBLE_EQ(back.look_at[0], framed.look_at[0]);
   EXPECT_DOUBLE_EQ(back.look_at[2], framed.look_at[2]);
   EXPECT_THROW(FrameClip({}, &framed), std::invalid_argument);
+  // A frame wider than tall: the field of view is horizontal, so the hanging flag needs more of
+  // it (the vertical tangent was taken for the horizontal one: the flag overflowed 400x200).
+  RenderParams wide = p;
+  wide.width = 400;
+  wide.height = 200;
+  FrameClip({V, V * 0.9}, &wide);
+  EXPECT_TRUE(all_in_view(wide));
+  EXPECT_GT(wide.camera_fov_deg, framed.camera_fov_deg);
 }
 
 }  // namespace

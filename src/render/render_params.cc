@@ -162,7 +162,10 @@ void FrameClip(const std::vector<Eigen::MatrixXd>& frames, RenderParams* p) {
                             ((corner & 4) ? hi.z() : lo.z()) + p->mesh_height);
     const Eigen::Vector3d d = q - cam.position;
     const double z = std::max(d.dot(cam.forward), 1e-3);
-    need = std::max({need, std::abs(d.dot(cam.right)) / z, std::abs(d.dot(cam.down)) / z});
+    // camera_fov_deg is horizontal: a frame H px tall spans H / W of its tangent vertically (a
+    // hanging flag overflowed a 400x200 frame top and bottom).
+    need = std::max({need, std::abs(d.dot(cam.right)) / z,
+                     std::abs(d.dot(cam.down)) / z * p->width / static_cast<double>(p->height)});
   }
   const double fov = 2.0 * std::atan(need / 0.95) * 180.0 / M_PI;
   p->camera_fov_deg = std::min(std::max(p->camera_fov_deg, fov), 120.0);
@@ -271,6 +274,28 @@ void ValidateRenderParams(const RenderParams& p) {
   Require(p.width > 0 && p.width <= 8192, "width", "in [1, 8192]", p.width);
   Require(p.height > 0 && p.height <= 8192, "height", "in [1, 8192]", p.height);
   Require(std::isfinite(p.fps) && p.fps > 0 && p.fps <= 1000, "fps", "in (0, 1000] Hz", p.fps);
+  // Upper bounds, far beyond any scene: a value past float range (JSON takes 1e39) made infinite
+  // rays that crashed Embree with the earlier render's zeta.json already removed, a huge sun
+  // height rendered black frames with exit 0, and the static cache (68 B a sample) took 6 GB.
+  Require(std::abs(p.background_offset) <= 1000, "background_offset", "in [-1000, 1000] m", p.background_offset);
+  Require(p.background_scale <= 100, "background_scale", "<= 100", p.background_scale);
+  Require(p.sun_height <= 1e4 && p.sun_radius <= 1e4, "sun_height", "<= 1e4 m, as sun_radius",
+          std::max(p.sun_height, p.sun_radius));
+  Require(std::isfinite(p.sun_azimuth_deg), "sun_azimuth_deg", "finite", p.sun_azimuth_deg);
+  Require(p.sun_strength <= 1e4, "sun_strength", "<= 1e4", p.sun_strength);
+  Require(p.sky_strength <= 1e3, "sky_strength", "<= 1e3", p.sky_strength);
+  Require(p.camera_height <= 1e4 && p.camera_radius <= 1e4, "camera_height", "<= 1e4 m, as camera_radius",
+          std::max(p.camera_height, p.camera_radius));
+  Require(std::isfinite(p.camera_angle_deg), "camera_angle_deg", "finite", p.camera_angle_deg);
+  Require(p.mesh_height <= 1e3 && p.mesh_width <= 1e3, "mesh_width", "<= 1000 m, as mesh_height",
+          std::max(p.mesh_width, p.mesh_height));
+  Require(p.mesh_aspect_ratio >= 0.1 && p.mesh_aspect_ratio <= 10, "mesh_aspect_ratio", "in [0.1, 10]",
+          p.mesh_aspect_ratio);
+  if (p.has_look_at)
+    for (double c : p.look_at) Require(std::abs(c) <= 1e4, "look_at", "coordinates in [-1e4, 1e4] m", c);
+  const double pixel_samples = static_cast<double>(p.width) * p.height * p.samples;
+  Require(pixel_samples <= (1 << 24), "samples", "at most 2^24 = 16.8M for width x height x samples (the cache "
+          "holds 68 B each)", p.samples);
   if (p.texture_kind == "flag")
     FlagDesignFromName(p.texture_name);
   else if (p.texture_kind == "fabric")

@@ -1,8 +1,11 @@
 #include "render/sensor_model.h"
 
-#include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/random.h"
@@ -107,7 +110,7 @@ TEST(SensorModel, JsonRoundTripAndErrors) {
 }
 
 TEST(FrameFiles, WrittenAtomicallyAndReadBackExactly) {
-  const std::string dir = testing::TempDir() + "/render_frame_test";
+  const std::string dir = testing::TempDir() + "/render_frame_test_" + std::to_string(::getpid());
   std::filesystem::create_directories(dir);
   const cv::Mat f = Develop(TestRadiance());
   WriteFrameAtomic(dir + "/f.png", f);

@@ -54,9 +54,11 @@ void ClipPipeline::Reset() {
   previous_.release();
   pending_.clear();
   released_at_jump_.clear();
+  held_.clear();
   labeller_ = WindLabeller(options_.label_window);
   data_time_ = kNegInf;
   released_end_ = kNegInf;
+  last_frame_ = 0.0;
 }
 
 bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncoding encoding, double now) {
@@ -104,6 +106,9 @@ bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
     data_time_ = kNegInf;
     released_end_ = kNegInf;
   }
+  // Held readings belong to this frame's timeline: the new one after a jump, else late ones.
+  for (const LabelReading& reading : held_) TakeReading(reading);
+  held_.clear();
   for (const auto& tick : r.ticks) Emit(tick, tick.from_previous ? previous_ : processed);
   previous_ = processed;
   last_frame_ = stamp;
@@ -125,11 +130,27 @@ bool ClipPipeline::AddReading(const LabelReading& reading, double now) {
     ++stats_.readings_future;
     return false;
   }
-  if (!labeller_.Add(reading)) return false;
+  if (!(std::isfinite(reading.stamp) && std::isfinite(reading.speed))) return false;
   ++stats_.readings_in;
+  // Before every window still open (the waiting clips' and the one being assembled), with a
+  // second to spare: no use to this timeline, and maybe the first of the next one (a bag that
+  // looped). Such a reading labelled the old timeline's last clips at the jump and was then
+  // forgotten with them; it is held until the next frame tells.
+  const double open_from =
+      (pending_.empty() ? last_frame_ : std::min(last_frame_, pending_.front().frames.back().stamp)) -
+      options_.label_window - 1.0;
+  if (last_frame_ > 0 && reading.stamp < open_from) {
+    held_.push_back(reading);
+    return true;
+  }
+  TakeReading(reading);
+  return true;
+}
+
+void ClipPipeline::TakeReading(const LabelReading& reading) {
+  labeller_.Add(reading);
   if (reading.stamp <= released_end_) ++stats_.readings_late;
   data_time_ = std::max(data_time_, reading.stamp);
-  return true;
 }
 
 LabelledClip ClipPipeline::Release(AssembledClip clip) {

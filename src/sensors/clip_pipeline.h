@@ -127,6 +127,7 @@ class ClipPipeline {
  private:
   void Emit(const FrameResampler::Tick& tick, const cv::Mat& image);
   LabelledClip Release(AssembledClip clip);
+  void TakeReading(const LabelReading& reading);  // into the labeller, counted late if it is
   bool StampedInFuture(double stamp, double now);
 
   ClipPipelineOptions options_;
@@ -141,6 +142,9 @@ class ClipPipeline {
   double released_end_;         // end of the last released clip [s]
   std::deque<AssembledClip> pending_;
   std::vector<LabelledClip> released_at_jump_;  // labelled at a time jump, not taken yet
+  // Readings stamped before every window this timeline can still label, held until the next
+  // frame says whose they are: a looped bag's first reading arrives before its first frame.
+  std::vector<LabelReading> held_;
   ClipPipelineStats stats_;
 };
 

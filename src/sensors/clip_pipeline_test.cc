@@ -119,8 +119,10 @@ TEST(ClipPipelineTest, LabelWaitsForLateReadingsByStamp) {
   EXPECT_DOUBLE_EQ(last.label.mean, (2.0 * 3 + 8.0) / 4);
   EXPECT_NEAR(last.label.std, std::sqrt((3 * 1.5 * 1.5 + 4.5 * 4.5) / 4), 1e-12);
   EXPECT_EQ(p.stats().readings_late, 0u);
-  // A reading stamped inside an already released window is counted as late.
+  // A reading stamped inside an already released window is counted as late, once the next frame
+  // shows it was not the first of a new timeline (a looped bag).
   p.AddReading({kT0 + 1.0, 1.0, 0.0});
+  p.AddFrame(kT0 + 9.1, Numbered(273), ClipSourceEncoding::kMono8);
   EXPECT_EQ(p.stats().readings_late, 1u);
 }
 
@@ -151,6 +153,40 @@ TEST(ClipPipelineTest, TimeJumpingBackStartsOver) {
   EXPECT_EQ(clips[0].label.count, 1u);  // the first pass's readings are forgotten
   EXPECT_DOUBLE_EQ(clips[0].label.mean, 1.0);
   EXPECT_EQ(p.stats().clips_made, p.stats().clips_released);  // no clip lost
+}
+
+// A looped bag's first reading arrives before its first frame. It labelled the old timeline's
+// last clips at the jump (a 5 m/s reading among 4 m/s ones) and was then forgotten, so the new
+// timeline's first clips had one reading fewer than the same clips the first time round.
+TEST(ClipPipelineTest, ANewTimelinesReadingBeforeItsFirstFrameLabelsTheNewTimeline) {
+  const ClipPipelineOptions o = SmallOptions();  // label window 5 s
+  ClipPipeline p(o);
+  for (int i = 0; i <= 12 * 30; ++i) {
+    if (i % 30 == 0) p.AddReading({kT0 + i / 30, 4.0, 0.0});
+    p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  }
+  p.TakeReady();
+  ASSERT_GT(p.pending(), 0u);
+  p.AddReading({kT0 + 0.5, 5.0, 0.0});  // the loop's first reading, then its frames
+  for (int i = 0; i <= 3 * 30; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  EXPECT_EQ(p.stats().time_jumps, 1u);
+  std::vector<LabelledClip> clips = p.TakeReady();
+  for (auto& c : p.Flush()) clips.push_back(std::move(c));
+  int old_timeline = 0, new_timeline = 0;
+  for (const auto& c : clips) {
+    const double end = c.clip.frames.back().stamp - kT0;
+    if (end > 3.5) {  // the first time round: its own readings only
+      ++old_timeline;
+      EXPECT_DOUBLE_EQ(c.label.mean, 4.0) << end;
+    } else if (end >= 0.5) {  // the loop's, after its reading
+      ++new_timeline;
+      EXPECT_EQ(c.label.count, 1u) << end;
+      EXPECT_DOUBLE_EQ(c.label.mean, 5.0) << end;
+    }
+  }
+  EXPECT_GT(old_timeline, 0);
+  EXPECT_GT(new_timeline, 0);
+  EXPECT_EQ(p.stats().readings_late, 0u);
 }
 
 // One reading from a clock an hour ahead: without the check it moves the pipeline's time an hour

@@ -1,5 +1,7 @@
 #include "sim/material.h"
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -81,7 +83,7 @@ TEST(MaterialTest, BendingInterpolatesDirectionAndCurvature) {
 }
 
 std::string WriteText(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/clothwind_material_test_" + name;
+  const std::string path = ::testing::TempDir() + "/clothwind_material_test_" + std::to_string(::getpid()) + "_" + name;
   std::ofstream(path) << text;
   return path;
 }

@@ -1,5 +1,7 @@
 #include "sim/mesh.h"
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -17,7 +19,7 @@ namespace clothwind::sim {
 namespace {
 
 std::string TempPath(const std::string& name) {
-  return ::testing::TempDir() + "/clothwind_mesh_test_" + name;
+  return ::testing::TempDir() + "/clothwind_mesh_test_" + std::to_string(::getpid()) + "_" + name;
 }
 
 std::string WriteText(const std::string& name, const std::string& text) {
