@@ -490,6 +490,16 @@ Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t s
 
 std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions& o) {
   fs::create_directories(dir);
+  // The old index goes first and the new one comes last: a run stopped over an earlier dataset
+  // left the old index over a mix of both runs' examples, which readers took as whole. Examples
+  // of a larger earlier run are removed too.
+  fs::remove(dir / "index.json");
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string file = e.path().filename().string();
+    int number = -1;
+    char rest = 0;
+    if (std::sscanf(file.c_str(), "toy-%d%c", &number, &rest) == 1 && number >= o.clips) fs::remove_all(e.path());
+  }
   std::mt19937_64 rng(o.seed);
   nlohmann::json clips = nlohmann::json::array();
   std::vector<double> frequencies;

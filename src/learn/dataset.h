@@ -220,7 +220,9 @@ struct ToyDatasetOptions {
   double frequency_per_speed = 0.5;   // [Hz per m/s]
   uint64_t seed = 1;
 };
-// Writes the dataset into `dir` (created; examples are replaced). Splits: 60% train, 20% val,
+// Writes the dataset into `dir` (created; examples are replaced; an earlier index.json and
+// examples beyond `clips` are removed first, so a stopped run leaves no index over a mix of
+// runs, and the new index is written last). Splits: 60% train, 20% val,
 // 20% test, by the example's seed. Returns the frequency of each example [Hz], in index order.
 std::vector<double> WriteToyDataset(const std::filesystem::path& dir, const ToyDatasetOptions& options);
 

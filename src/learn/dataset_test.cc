@@ -463,6 +463,23 @@ std::vector<cv::Mat> FlagFlyingRight(int frames) {
   return out;
 }
 
+// A smaller toy dataset over a larger one: the old index and the examples beyond the new count
+// go (a run stopped half way used to leave the old index over both runs' examples).
+TEST_F(DatasetTest, AToyDatasetOverAnotherReplacesItWhole) {
+  const fs::path copy = Copy("toy_over");
+  ToyDatasetOptions o;
+  o.clips = 3;
+  o.frames = 4;
+  o.size = 16;
+  o.seed = 9;
+  WriteToyDataset(copy, o);
+  const Dataset d = ReadDataset(copy);
+  EXPECT_EQ(d.clips.size(), 3u);
+  EXPECT_FALSE(fs::exists(copy / "toy-00003"));
+  EXPECT_FALSE(fs::exists(copy / "toy-00009"));
+  for (const ClipInfo& c : d.clips) EXPECT_EQ(c.num_frames, 4);
+}
+
 TEST(MakeSample, FlagFliesTurnsAFlagFlyingLeftToFlyRight) {
   // As a model trained without flips reads a flag: mirrored clips (mirror_clip, a flag flying
   // left) come back to the as-filmed sample, by --flag-flies left always, by auto from the motion.
