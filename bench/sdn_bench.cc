@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
         mean /= ms.size();
         const std::string name = p.config().Name() + " " + cl::FlagFliesName(way);
         std::printf("%-28s %7d %5s %10.1f %10.1f %10.1f %14.1f\n", name.c_str(), threads,
-                    channels_last ? "nhwc" : "nchw", mean, ms[std::min(ms.size() - 1, ms.size() * 9 / 10)], ms.front(),
+                    channels_last ? "nhwc" : "nchw", mean, ms[(9 * ms.size() + 9) / 10 - 1], ms.front(),
                     cpu);
         std::fflush(stdout);
       }

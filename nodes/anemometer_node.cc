@@ -20,6 +20,7 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
+#include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wind_conversions.h"
 #include "sensors/anemometer_protocol.h"
 #include "sensors/anemometer_stream.h"
@@ -143,7 +144,7 @@ class AnemometerNode {
       else if (input_ == "usb") StepUsb();
       else ros::WallDuration(0.02).sleep();
       ros::spinOnce();
-      updater_.update();
+      wall_diagnostics_.Update();
     }
     // Release the device on SIGINT (roscpp's handler ends ros::ok()).
     if (port_.is_open()) ROS_INFO("anemometer_node: closing %s", serial_.port.c_str());
@@ -362,6 +363,7 @@ class AnemometerNode {
   ros::Publisher raw_pub_, wind_pub_;
   ros::Subscriber raw_sub_;
   diagnostic_updater::Updater updater_;
+  clothwind::ros_bridge::WallDiagnostics wall_diagnostics_{&updater_};  // every wall second
   std::string input_, frame_id_, earth_frame_id_, state_, last_error_, last_status_;
   double magnetic_declination_ = std::numeric_limits<double>::quiet_NaN();  // [deg] east; NaN: unknown
   bool last_reading_void_ = false, saw_earth_ = false, saw_instrument_ = false, saw_magnetic_ = false;

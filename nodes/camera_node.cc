@@ -26,6 +26,7 @@
 #include <ros/ros.h>
 
 #include "ros_bridge/image_conversions.h"
+#include "ros_bridge/wall_diagnostics.h"
 #include "sensors/frame_source.h"
 #include "sensors/frame_source_factory.h"
 #include "sensors/frame_timestamp.h"
@@ -125,6 +126,7 @@ int main(int argc, char** argv) {
   image_transport::CameraPublisher publisher = transport.advertiseCamera("camera/image_raw", 1);
 
   diagnostic_updater::Updater updater;
+  clothwind::ros_bridge::WallDiagnostics wall_diagnostics(&updater);  // every wall second
   updater.setHardwareID(options.source == "v4l2" ? options.path : options.source + ":" + options.path);
   double min_rate = options.fps, max_rate = options.fps;  // the nominal rate, once known
   // Stamps are capture instants: a little in the past (latency), never in the future.
@@ -180,7 +182,7 @@ int main(int argc, char** argv) {
       // keep running while the device is away (a single sleep of up to 5 s stalled them).
       if (ros::WallTime::now() < next_open) {
         ros::WallDuration(std::min(0.1, (next_open - ros::WallTime::now()).toSec())).sleep();
-        updater.update();
+        wall_diagnostics.Update();
         ros::spinOnce();
         continue;
       }
@@ -193,7 +195,7 @@ int main(int argc, char** argv) {
       } else {
         last_error = source->error();
         ROS_ERROR_STREAM_THROTTLE(5.0, "camera_node: " << last_error << " (retrying)");
-        updater.update();
+        wall_diagnostics.Update();
         next_open = ros::WallTime::now() + ros::WallDuration(open_backoff_s);
         open_backoff_s = std::min(open_backoff_s * 2.0, 5.0);
         ros::spinOnce();
@@ -248,7 +250,7 @@ int main(int argc, char** argv) {
                         << " frames (set ~loop to repeat)");
       }
     }
-    updater.update();
+    wall_diagnostics.Update();
     ros::spinOnce();
   }
   // SIGINT/shutdown: STREAMOFF, munmap, close before exiting.

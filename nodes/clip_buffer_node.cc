@@ -128,6 +128,12 @@ class ClipBufferNode {
   void OnImage(const sensor_msgs::ImageConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     last_input_ = ros::WallTime::now();
+    // An unstamped frame is dropped before it touches anything: taken as a bag loop, one frame
+    // stamped 0 forgot the minute of readings the labels need (and lent the clips its frame_id).
+    if (msg->header.stamp.isZero()) {
+      NoteError("frame dropped: header.stamp is 0 (unstamped camera driver?)");
+      return;
+    }
     if (frame_id_.empty() || frame_id_from_msg_) {
       frame_id_ = msg->header.frame_id;
       frame_id_from_msg_ = true;
@@ -150,6 +156,10 @@ class ClipBufferNode {
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     last_input_ = ros::WallTime::now();
+    if (msg->header.stamp.isZero()) {
+      NoteError("anemometer reading dropped: header.stamp is 0");
+      return;
+    }
     const uint64_t future_before = pipeline_->stats().readings_future;
     pipeline_->AddReading(ros_bridge::ToLabelReading(*msg), Now());
     if (pipeline_->stats().readings_future > future_before) {

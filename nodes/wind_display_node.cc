@@ -255,8 +255,11 @@ class WindDisplayNode {
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "wind_display");
+  // Held outside the try: the last NodeHandle going out of scope shuts ROS down, and the FATAL
+  // naming a bad parameter was then never printed (exit 1, silent).
+  ros::NodeHandle nh, pnh("~");
   try {
-    WindDisplayNode node(ros::NodeHandle(), ros::NodeHandle("~"));
+    WindDisplayNode node(nh, pnh);
     ros::spin();
   } catch (const std::exception& e) {
     ROS_FATAL("wind_display: %s", e.what());

@@ -1,5 +1,6 @@
 #include "ros_bridge/clip_conversions.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -27,9 +28,23 @@ bool ReadAsItIs(const sensor_msgs::Image& msg) {
 
 void ImageView(const sensor_msgs::Image& msg, cv::Mat* view, sensors::ClipSourceEncoding* encoding) {
   if (msg.width == 0 || msg.height == 0) throw std::invalid_argument("image is empty (width or height 0)");
+  // Sizes checked in 64 bits before anything reads the data: cv_bridge checks height * step in
+  // 32 bits, which wraps (65537 x 65536 is 65536), and a crafted Bayer image then read 4 GB past
+  // its buffer (clip_buffer died with SIGSEGV).
+  if (msg.data.size() < static_cast<size_t>(msg.step) * msg.height)
+    throw std::invalid_argument("image data has " + std::to_string(msg.data.size()) + " bytes, expected step * height = " +
+                                std::to_string(static_cast<size_t>(msg.step) * msg.height));
   if (!ReadAsItIs(msg)) {
-    // cv_bridge's conversions (debayering, YUV, depth and byte order) rather than our own; its
-    // own checks of step and size stand in for the ones below.
+    // cv_bridge's conversions (debayering, YUV, depth and byte order) rather than our own.
+    int bytes_per_pixel = 1;  // an encoding sensor_msgs does not know: cv_bridge refuses it below
+    try {
+      bytes_per_pixel = std::max(1, sensor_msgs::image_encodings::numChannels(msg.encoding) *
+                                        sensor_msgs::image_encodings::bitDepth(msg.encoding) / 8);
+    } catch (const std::exception&) {
+    }
+    if (msg.step < static_cast<size_t>(msg.width) * std::max(1, bytes_per_pixel))
+      throw std::invalid_argument("image step " + std::to_string(msg.step) + " < width * pixel size " +
+                                  std::to_string(static_cast<size_t>(msg.width) * bytes_per_pixel));
     try {
       *view = cv_bridge::toCvCopy(msg, sensor_msgs::image_encodings::BGR8)->image;
     } catch (const cv_bridge::Exception& e) {
@@ -48,9 +63,6 @@ void ImageView(const sensor_msgs::Image& msg, cv::Mat* view, sensors::ClipSource
   if (msg.step < row_bytes)
     throw std::invalid_argument("image step " + std::to_string(msg.step) + " < width * pixel size " +
                                 std::to_string(row_bytes));
-  if (msg.data.size() < static_cast<size_t>(msg.step) * msg.height)
-    throw std::invalid_argument("image data has " + std::to_string(msg.data.size()) + " bytes, expected step * height = " +
-                                std::to_string(static_cast<size_t>(msg.step) * msg.height));
   *view = cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width), type,
                   const_cast<uint8_t*>(msg.data.data()), msg.step);
 }
@@ -58,7 +70,9 @@ void ImageView(const sensor_msgs::Image& msg, cv::Mat* view, sensors::ClipSource
 sensors::LabelReading ToLabelReading(const clothwind::WindMeasurement& msg) {
   sensors::LabelReading r;
   r.stamp = msg.header.stamp.toSec();
-  r.speed = msg.valid ? msg.speed : std::numeric_limits<double>::quiet_NaN();
+  // A speed WindMeasurement does not allow (negative, or beyond any wind: -50 and 1e300 were
+  // averaged into a minute of labels) is skipped as an invalid reading is.
+  r.speed = msg.valid && msg.speed >= 0 && msg.speed <= 150 ? msg.speed : std::numeric_limits<double>::quiet_NaN();
   r.direction = msg.direction;
   return r;
 }

@@ -1,5 +1,6 @@
 #include "ros_bridge/clip_conversions.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -72,10 +73,34 @@ TEST(ImageViewTest, BadImagesAreNamed) {
   EXPECT_NE(what(short_data).find("image data has 10 bytes"), std::string::npos) << what(short_data);
   sensor_msgs::Image short_bayer = Uniform("bayer_rggb8", 1, {7});
   short_bayer.data.resize(10);
-  EXPECT_NE(what(short_bayer).find("bayer_rggb8"), std::string::npos) << what(short_bayer);
+  EXPECT_NE(what(short_bayer).find("image data has 10 bytes"), std::string::npos) << what(short_bayer);
+  // height x step wraps to 65536 in 32 bits, cv_bridge's arithmetic: it read 4 GB past the data.
+  sensor_msgs::Image wrapped = Uniform("bayer_rggb8", 1, {7});
+  wrapped.width = wrapped.step = 65536;
+  wrapped.height = 65537;
+  wrapped.data.assign(65536, 0);
+  EXPECT_NE(what(wrapped).find("expected step * height = 4295032832"), std::string::npos) << what(wrapped);
+  sensor_msgs::Image narrow = Uniform("yuv422", 2, {128, 60});
+  narrow.step = narrow.width;  // 1 byte a pixel where yuv422 has 2
+  EXPECT_NE(what(narrow).find("image step 8 < width * pixel size 16"), std::string::npos) << what(narrow);
   sensor_msgs::Image empty = Uniform("mono8", 1, {7});
   empty.width = 0;
   EXPECT_NE(what(empty).find("image is empty"), std::string::npos);
+}
+
+TEST(ToLabelReadingTest, SpeedsAWindMeasurementCannotHaveAreSkipped) {
+  // -50 and 1e300 m/s were averaged into a minute of clip labels.
+  clothwind::WindMeasurement m;
+  m.header.stamp = ros::Time(1700000000.0);
+  m.valid = true;
+  for (double bad : {-50.0, 1e300}) {
+    m.speed = bad;
+    EXPECT_TRUE(std::isnan(ToLabelReading(m).speed)) << bad;
+  }
+  m.speed = 7.5;
+  EXPECT_EQ(ToLabelReading(m).speed, 7.5);
+  m.valid = false;
+  EXPECT_TRUE(std::isnan(ToLabelReading(m).speed));
 }
 
 }  // namespace

@@ -1,0 +1,35 @@
+// Diagnostics published once a wall second whatever ROS time does. Why: Updater::update() waits
+// for ROS time to pass its next due time, and under use_sim_time ROS time does not run before
+// /clock and never again passes a looped or ended bag's old end: anemometer_node and camera_node
+// then published no diagnostics at all (a WARN about the missing /clock included).
+#ifndef CLOTHWIND_NODES_ROS_BRIDGE_WALL_DIAGNOSTICS_H_
+#define CLOTHWIND_NODES_ROS_BRIDGE_WALL_DIAGNOSTICS_H_
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/time.h>
+
+namespace clothwind::ros_bridge {
+
+// Call Update() as often as convenient (each loop of a node's own spin); it publishes the
+// updater's status when `period` wall seconds have passed since it last did.
+class WallDiagnostics {
+ public:
+  explicit WallDiagnostics(diagnostic_updater::Updater* updater, double period = 1.0)
+      : updater_(updater), period_(period) {}
+
+  void Update() {
+    const ros::WallTime now = ros::WallTime::now();
+    if (now < next_) return;
+    updater_->force_update();
+    next_ = now + ros::WallDuration(period_);
+  }
+
+ private:
+  diagnostic_updater::Updater* updater_;
+  double period_;
+  ros::WallTime next_;
+};
+
+}  // namespace clothwind::ros_bridge
+
+#endif  // CLOTHWIND_NODES_ROS_BRIDGE_WALL_DIAGNOSTICS_H_
