@@ -4,6 +4,14 @@ set(CLOTHWIND_SRC_DIR ${CMAKE_CURRENT_LIST_DIR}/../src)
 get_filename_component(CLOTHWIND_SRC_DIR ${CLOTHWIND_SRC_DIR} ABSOLUTE)
 set(CLOTHWIND_TEST_RESULTS ${CMAKE_BINARY_DIR}/test_results/clothwind)
 
+# The main() of every GoogleTest binary: gtest's, plus exit code 77 (CTest: "Skipped") when all
+# its tests skipped themselves (tests/gtest_main.cc).
+set(CLOTHWIND_GTEST_SKIP_CODE 77)
+if(NOT TARGET clothwind_gtest_main)
+  add_library(clothwind_gtest_main STATIC ${CMAKE_CURRENT_LIST_DIR}/../tests/gtest_main.cc)
+  target_link_libraries(clothwind_gtest_main PUBLIC GTest::gtest)
+endif()
+
 # clothwind_capability(<cap> [DEPS <targets...>] [TEST_DEPS <targets...>])
 #
 # Builds library clothwind_<cap> from src/<cap>/*.cc (all but *_test.cc) and one GoogleTest
@@ -34,11 +42,12 @@ function(clothwind_capability cap)
     get_filename_component(_name ${t} NAME_WE)
     set(_target ${cap}_${_name})
     add_executable(${_target} ${t})
-    target_link_libraries(${_target} PRIVATE clothwind_${cap} ${C_TEST_DEPS} GTest::gmock GTest::gtest_main)
+    target_link_libraries(${_target} PRIVATE clothwind_${cap} ${C_TEST_DEPS} GTest::gmock clothwind_gtest_main)
     add_test(NAME ${_target}
              COMMAND ${_target} --gtest_output=xml:${CLOTHWIND_TEST_RESULTS}/${_target}.xml)
     set_tests_properties(${_target} PROPERTIES
       LABELS "unit;${cap}"
+      SKIP_RETURN_CODE ${CLOTHWIND_GTEST_SKIP_CODE}
       ENVIRONMENT "CLOTHWIND_SOURCE_DIR=${CMAKE_SOURCE_DIR};CLOTHWIND_SHARED_DIR=${CMAKE_SOURCE_DIR}/../shared")
   endforeach()
 endfunction()

@@ -9,6 +9,7 @@
 // are recorded on a thread of their own (sensors::AsyncDatasetWriter), so a slow disk never holds
 // up the camera callback.
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -27,6 +28,7 @@
 #include "sensors/async_dataset_writer.h"
 #include "sensors/clip_pipeline.h"
 #include "sensors/dataset_writer.h"
+#include "sensors/wind_direction_frame.h"
 
 namespace clothwind {
 namespace {
@@ -55,6 +57,9 @@ class ClipBufferNode {
     }
     pnh.param("flush_after", flush_after_, 3.0);
     pnh.param("frame_id", frame_id_, std::string());
+    std::string wind_frame_id;
+    pnh.param("wind_frame_id", wind_frame_id, wind_frame_id);
+    wind_frame_ = sensors::WindDirectionFrameGate(wind_frame_id);
     int queue = 60;
     pnh.param("queue_size", queue, queue);
     pnh.param("jpeg_quality", jpeg_quality_, jpeg_quality_);
@@ -161,7 +166,16 @@ class ClipBufferNode {
       return;
     }
     const uint64_t future_before = pipeline_->stats().readings_future;
-    pipeline_->AddReading(ros_bridge::ToLabelReading(*msg), Now());
+    sensors::LabelReading reading = ros_bridge::ToLabelReading(*msg);
+    // Directions in another frame than the labels' are left out of the mean (speeds are kept). A
+    // reading the labels skip (void, or no speed) neither counts nor picks the frame.
+    if (std::isfinite(reading.speed) && !wind_frame_.Admit(msg->header.frame_id, reading.direction)) {
+      reading.direction = std::numeric_limits<double>::quiet_NaN();
+      ROS_WARN_THROTTLE(10.0, "clip_buffer: wind direction in frame '%s' left out of the labels, which average "
+                        "directions in '%s' (~wind_frame_id)", msg->header.frame_id.c_str(),
+                        wind_frame_.frame_id().c_str());
+    }
+    pipeline_->AddReading(reading, Now());
     if (pipeline_->stats().readings_future > future_before) {
       last_future_ = ros::WallTime::now();
       ROS_WARN_THROTTLE(5.0, "clip_buffer: anemometer reading stamped %.1f s after the clock refused",
@@ -209,7 +223,7 @@ class ClipBufferNode {
       if (c.label.count == 0)
         ROS_WARN_THROTTLE(10.0, "clip_buffer: clip %lu has no anemometer reading in its %.0f s window",
                           static_cast<unsigned long>(c.clip.sequence), c.label.window);
-      auto msg = boost::make_shared<clothwind::Clip>(ros_bridge::ToClipMsg(c, frame_id_));
+      auto msg = boost::make_shared<clothwind::Clip>(ros_bridge::ToClipMsg(c, frame_id_, wind_frame_.frame_id()));
       if (preview_pub_.getNumSubscribers() > 0) {
         const auto& middle = c.clip.frames[c.clip.frames.size() / 2];
         std_msgs::Header h = msg->header;
@@ -228,6 +242,7 @@ class ClipBufferNode {
       return;
     }
     source_.frame_id = frame_id_;
+    source_.wind_frame_id = wind_frame_.frame_id();
     writer_->Enqueue(c, source_);  // a full queue is counted by the writer, reported by OnTimer
   }
 
@@ -286,6 +301,10 @@ class ClipBufferNode {
     stat.add("readings in", s.readings_in);
     stat.add("readings too late", s.readings_late);
     stat.add("readings stamped in the future", s.readings_future);
+    stat.add("wind direction frame", wind_frame_.frame_id());
+    stat.add("directions in another frame (left out)", wind_frame_.rejected());
+    if (wind_frame_.rejected() > 0)
+      stat.add("last other direction frame", wind_frame_.last_rejected_frame());
     stat.add("record folder", record_dir_.empty() ? "(not recording)" : record_dir_);
     const auto r = writer_ ? writer_->stats() : sensors::AsyncDatasetWriter::Stats();
     stat.add("clips recorded", r.written);
@@ -309,6 +328,7 @@ class ClipBufferNode {
   sensors::ClipSourceInfo source_;
   std::string frame_id_;
   bool frame_id_from_msg_ = false;
+  sensors::WindDirectionFrameGate wind_frame_;
   double flush_after_ = 3.0;
   ros::WallTime last_input_;
   std::string record_dir_;

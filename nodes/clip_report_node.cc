@@ -106,7 +106,8 @@ class ClipReport {
     if (estimate_plot_path_.empty() || estimates_.empty()) return true;
     try {
       std::vector<uchar> png;
-      cv::imencode(".png", cs::DrawEstimatePlot(estimates_, t0, 800, 360), png);
+      if (!cv::imencode(".png", cs::DrawEstimatePlot(estimates_, t0, 800, 360), png) || png.empty())
+        throw std::runtime_error("PNG encoding failed");
       cs::WriteFileAtomically(estimate_plot_path_, std::string(png.begin(), png.end()));
       std::printf("estimate plot: %s\n", estimate_plot_path_.c_str());
       return true;
@@ -131,6 +132,9 @@ class ClipReport {
       Print(wall);
       ros::shutdown();
     } else if ((clock_started_ && idle > idle_timeout_) || (max_wall_ > 0 && wall > max_wall_)) {
+      if (!(clock_started_ && idle > idle_timeout_))
+        std::printf("clip_report: stopped after ~max_wall = %.0f s, the replay still running: the report covers "
+                    "only what came before\n", max_wall_);
       Print(wall);
       ros::shutdown();
     }

@@ -114,6 +114,7 @@ class SdnNode {
     std::string name;
     pnh.param("flag_flies", name, std::string());
     pnh.param("camera_heading", camera_heading_, std::numeric_limits<double>::quiet_NaN());
+    pnh.param("camera_heading_frame", camera_heading_frame_, std::string());
     double end_on_deg = 20.0;
     pnh.param("end_on_angle", end_on_deg, 20.0);
     if (!(end_on_deg >= 0 && end_on_deg <= 90)) {
@@ -199,7 +200,15 @@ class SdnNode {
         throw MalformedClip(e.what());
       }
       CountSequence(clip->sequence);
-      if (follow_wind_) FollowTheWind(clip->wind_direction_mean);  // a clip that passed the checks only
+      if (follow_wind_) {  // a clip that passed the checks only
+        // ~camera_heading is an angle in one frame: a direction in another says nothing of the way.
+        const bool same_frame = camera_heading_frame_.empty() || clip->wind_direction_frame_id == camera_heading_frame_;
+        if (!same_frame)
+          ROS_WARN_THROTTLE(30.0, "sdn_node: the clips' wind direction is in frame '%s', ~camera_heading in '%s': "
+                            "the way the flag flies is kept as last known",
+                            clip->wind_direction_frame_id.c_str(), camera_heading_frame_.c_str());
+        FollowTheWind(same_frame ? clip->wind_direction_mean : std::numeric_limits<double>::quiet_NaN());
+      }
       const std::vector<cv::Mat> frames =
           clothwind::learn::CameraFramesForModel(camera_frames, predictor_->config().colour);
       const bool want_maps = power_pub_.getNumSubscribers() > 0 || frequency_pub_.getNumSubscribers() > 0;
@@ -389,6 +398,7 @@ class SdnNode {
   std::string fly_judge_path_, judge_error_;  // ~fly_judge and why it did not load
   std::optional<clothwind::learn::FlagFlies> told_flag_flies_;  // ~flag_flies right, left or auto
   bool follow_wind_ = false;                                     // ~flag_flies wind
+  std::string camera_heading_frame_;  // the frame ~camera_heading is in ("": the clips' own)
   double camera_heading_ = 0, end_on_ = 0;                       // [rad], for follow_wind_
   int threads_ = 2;
   std::unique_ptr<clothwind::learn::Predictor> predictor_;

@@ -14,9 +14,12 @@
 // ~fixed_frame ("" = none): when set, a latched /tf_static places the display frame at this
 // frame with the identity transform, so rviz has a fixed frame without a robot's TF tree (the
 // monitor does not know where the anemometer is; leave it empty when a real TF tree exists).
-// ~stale_after [s] (10): an estimate older than this (by ROS time) is shown as "--", and the
-// anemometer's mean and arrow go when no reading is left in ~mean_window; the plot scrolls with
-// the clock while inputs pause. /diagnostics says how old each input is. Messages stamped 0 are
+// ~stale_after [s] (10): an estimate older than this (by ROS time, or received longer ago than
+// this by the wall clock: a bag that ended stops /clock) is shown as "--", and the anemometer's
+// mean and arrow go when no reading is left in ~mean_window (either clock); the plot scrolls with
+// the clock while inputs pause. The display frame is ~frame_id, else the frame of the first
+// valid reading: readings in another frame (MWD's earth frame beside MWV's instrument frame)
+// add their speeds and no arrow, so neither the arrow's convention nor /tf_static flips. /diagnostics says how old each input is. Messages stamped 0 are
 // dropped (counted): they would stamp the displays 0 and empty the plot.
 // Drawing and averaging are the ROS-free sensors/wind_plot.
 #include <cmath>
@@ -34,6 +37,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "sensors/wind_direction_frame.h"
 #include "sensors/wind_plot.h"
 
 namespace {
@@ -72,8 +76,10 @@ class WindDisplayNode {
     if (!fixed_frame_.empty()) tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf_static", 1, true);
     estimate_sub_ = nh.subscribe("wind/estimate", 10, &WindDisplayNode::OnEstimate, this);
     wind_sub_ = nh.subscribe("anemometer/wind", 50, &WindDisplayNode::OnWind, this);
-    // Redraw on a timer, not per message: the plot scrolls with time even when inputs pause.
-    timer_ = nh.createTimer(ros::Duration(1.0 / rate), &WindDisplayNode::Publish, this);
+    frame_gate_ = clothwind::sensors::WindDirectionFrameGate(frame_id_param_);
+    // Redraw on a timer, not per message: the plot scrolls with time even when inputs pause. A wall
+    // timer: a ROS timer stops with /clock when a bag ends, and the last estimate stayed "live".
+    timer_ = nh.createWallTimer(ros::WallDuration(1.0 / rate), &WindDisplayNode::Publish, this);
     updater_.setHardwareID("wind_display");
     updater_.add("wind display", this, &WindDisplayNode::Diagnose);
     diagnostics_timer_ = nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
@@ -89,6 +95,7 @@ class WindDisplayNode {
     }
     estimates_.Add({msg->header.stamp.toSec(), msg->speed, msg->speed_std});
     last_estimate_ = *msg;
+    last_estimate_wall_ = ros::WallTime::now();
     have_estimate_ = true;
     Touch(msg->header.stamp);
   }
@@ -101,7 +108,19 @@ class WindDisplayNode {
     if (!msg->valid) return;
     anemometer_.Add({msg->header.stamp.toSec(), msg->speed, 0.0});
     last_wind_ = *msg;
+    last_wind_wall_ = ros::WallTime::now();
     have_wind_ = true;
+    // The arrow only from readings in the display frame (a speed has no frame, a vector has).
+    const bool has_vector = std::isfinite(msg->velocity.x) && std::isfinite(msg->velocity.y);
+    if (frame_gate_.Admit(msg->header.frame_id, has_vector ? 0.0 : std::nan(""))) {
+      if (has_vector) {
+        last_vector_ = *msg;
+        have_vector_ = true;
+      }
+    } else {
+      ROS_WARN_THROTTLE(30.0, "wind_display: reading in frame '%s' left out of the arrow, drawn in '%s' "
+                        "(~frame_id)", msg->header.frame_id.c_str(), frame_gate_.frame_id().c_str());
+    }
     Touch(msg->header.stamp);
   }
 
@@ -124,6 +143,12 @@ class WindDisplayNode {
   static double Age(bool have, const ros::Time& stamp, const ros::Time& now) {
     return have ? (now - stamp).toSec() : std::numeric_limits<double>::infinity();
   }
+  // Whether an input is recent enough to show: by its stamp against the display's now, and by the
+  // wall clock since it arrived (the display's now stands still when a bag has ended).
+  static bool Live(bool have, const ros::Time& stamp, const ros::WallTime& arrived, const ros::Time& now,
+                   double limit) {
+    return Age(have, stamp, now) <= limit && (ros::WallTime::now() - arrived).toSec() <= limit;
+  }
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
     using diagnostic_msgs::DiagnosticStatus;
@@ -131,9 +156,9 @@ class WindDisplayNode {
     const double est_age = Age(have_estimate_, last_estimate_.header.stamp, now);
     const double wind_age = Age(have_wind_, last_wind_.header.stamp, now);
     stat.summary(DiagnosticStatus::OK, "showing estimate and anemometer");
-    if (!(est_age <= stale_after_))
+    if (!Live(have_estimate_, last_estimate_.header.stamp, last_estimate_wall_, now, stale_after_))
       stat.mergeSummary(DiagnosticStatus::WARN, have_estimate_ ? "estimate stale (shown as --)" : "no estimate yet");
-    if (!(wind_age <= mean_window_))
+    if (!Live(have_wind_, last_wind_.header.stamp, last_wind_wall_, now, mean_window_))
       stat.mergeSummary(DiagnosticStatus::WARN,
                         have_wind_ ? "no anemometer reading in the mean window" : "no anemometer reading yet");
     if (unstamped_ > 0) stat.mergeSummary(DiagnosticStatus::WARN, "messages stamped 0 dropped");
@@ -141,24 +166,28 @@ class WindDisplayNode {
     stat.addf("anemometer age [s]", "%.1f", wind_age);
     stat.add("messages stamped 0 dropped", unstamped_);
     stat.add("frame", FrameId());
+    stat.add("readings in another frame (no arrow)", frame_gate_.rejected());
+    stat.addf("estimate received [s ago, wall]", "%.1f",
+              have_estimate_ ? (ros::WallTime::now() - last_estimate_wall_).toSec() : -1.0);
   }
 
+  // The display frame: ~frame_id, else the first valid reading's, else "anemometer".
   std::string FrameId() const {
-    if (!frame_id_param_.empty()) return frame_id_param_;
-    if (have_wind_ && !last_wind_.header.frame_id.empty()) return last_wind_.header.frame_id;
+    if (!frame_gate_.frame_id().empty()) return frame_gate_.frame_id();
     return "anemometer";
   }
 
-  void Publish(const ros::TimerEvent&) {
+  void Publish(const ros::WallTimerEvent&) {
     if (!have_estimate_ && !have_wind_) return;  // nothing to show yet
     const std::string frame = FrameId();
     if (!fixed_frame_.empty() && frame != tf_child_ && frame != fixed_frame_) PublishFixedFrame(frame);
     const ros::Time stamp = DisplayNow();
     const double t_now = stamp.toSec();
-    const double mean = anemometer_.Mean(t_now, mean_window_);
     // A value older than it should be is not shown as if live (sdn_node died, the bag ended).
-    const bool est_live = Age(have_estimate_, last_estimate_.header.stamp, stamp) <= stale_after_;
-    const bool wind_live = Age(have_wind_, last_wind_.header.stamp, stamp) <= mean_window_;
+    const bool est_live = Live(have_estimate_, last_estimate_.header.stamp, last_estimate_wall_, stamp, stale_after_);
+    const bool wind_live = Live(have_wind_, last_wind_.header.stamp, last_wind_wall_, stamp, mean_window_);
+    const bool vector_live = Live(have_vector_, last_vector_.header.stamp, last_wind_wall_, stamp, mean_window_);
+    const double mean = wind_live ? anemometer_.Mean(t_now, mean_window_) : std::nan("");
     const double est = est_live ? last_estimate_.speed : std::nan("");
     const double est_std = est_live ? last_estimate_.speed_std : std::nan("");
 
@@ -190,13 +219,13 @@ class WindDisplayNode {
     arrow.id = 0;
     arrow.type = visualization_msgs::Marker::ARROW;
     arrow.pose.orientation.w = 1.0;
-    const bool has_vector = wind_live && std::isfinite(last_wind_.velocity.x) && std::isfinite(last_wind_.velocity.y);
+    const bool has_vector = vector_live;
     arrow.action = has_vector ? visualization_msgs::Marker::ADD : visualization_msgs::Marker::DELETE;
     if (has_vector) {
       geometry_msgs::Point tail, tip;
-      tip.x = last_wind_.velocity.x;  // 1 m per m/s
-      tip.y = last_wind_.velocity.y;
-      tip.z = last_wind_.velocity.z;
+      tip.x = last_vector_.velocity.x;  // 1 m per m/s
+      tip.y = last_vector_.velocity.y;
+      tip.z = std::isfinite(last_vector_.velocity.z) ? last_vector_.velocity.z : 0.0;
       arrow.points = {tail, tip};
       arrow.scale.x = 0.1;  // shaft diameter [m]
       arrow.scale.y = 0.25; // head diameter
@@ -243,12 +272,15 @@ class WindDisplayNode {
   std::string frame_id_param_, fixed_frame_, tf_child_;
   WindHistory estimates_, anemometer_;
   clothwind::WindEstimate last_estimate_;
-  clothwind::WindMeasurement last_wind_;
-  bool have_estimate_ = false, have_wind_ = false;
+  clothwind::WindMeasurement last_wind_, last_vector_;  // the newest valid reading; the newest with a
+                                                       // vector in the display frame
+  ros::WallTime last_estimate_wall_, last_wind_wall_;  // when they arrived
+  clothwind::sensors::WindDirectionFrameGate frame_gate_;
+  bool have_estimate_ = false, have_wind_ = false, have_vector_ = false;
   ros::Time latest_stamp_;
   ros::Publisher markers_pub_, plot_pub_, tf_pub_;
   ros::Subscriber estimate_sub_, wind_sub_;
-  ros::Timer timer_;
+  ros::WallTimer timer_;
 };
 
 }  // namespace

@@ -33,7 +33,9 @@ struct TopicStats {
   std::string type;
   size_t count = 0;
   double first = NAN, last = NAN, previous = NAN;
-  size_t backwards = 0;       // header stamp not after the previous one
+  size_t backwards = 0;       // header stamp before the previous one
+  size_t repeated = 0;        // header stamp equal to the previous one (records of one serial read
+                              // share it; camera frames must not: the clip buffer drops them)
   size_t bag_time_off = 0;    // |bag time - header stamp| > 1 ms
   size_t holes = 0;           // header stamp intervals > gap tolerance
   double widest = 0.0;        // largest interval [s]
@@ -44,7 +46,8 @@ void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance) {
   if (s.count == 0) s.first = stamp;
   if (s.count > 0) {
     const double dt = stamp - s.previous;
-    if (dt <= 0) ++s.backwards;
+    if (dt < 0) ++s.backwards;
+    if (dt == 0) ++s.repeated;
     if (dt > gap_tolerance) ++s.holes;
     s.widest = std::max(s.widest, dt);
   }
@@ -99,22 +102,24 @@ int Check(const BagCheckArgs& a) {
   }
   bag.close();
   std::printf("%s\n", a.bag.c_str());
-  std::printf("  %-22s %-28s %7s %8s %8s %6s %6s %6s  %s\n", "topic", "type", "count", "rate Hz", "span s",
-              "back", "holes", "bagt", "first");
+  std::printf("  %-22s %-28s %7s %8s %8s %6s %6s %6s %6s  %s\n", "topic", "type", "count", "rate Hz", "span s",
+              "back", "same", "holes", "bagt", "first");
   bool ok = true;
   for (const auto& [name, s] : topics) {
     const double span = s.count > 1 ? s.last - s.first : 0.0;
-    std::printf("  %-22s %-28s %7zu %8.2f %8.2f %6zu %6zu %6zu  %s\n", name.c_str(), s.type.c_str(), s.count,
-                span > 0 ? (s.count - 1) / span : 0.0, span, s.backwards, s.holes, s.bag_time_off,
+    std::printf("  %-22s %-28s %7zu %8.2f %8.2f %6zu %6zu %6zu %6zu  %s\n", name.c_str(), s.type.c_str(), s.count,
+                span > 0 ? (s.count - 1) / span : 0.0, span, s.backwards, s.repeated, s.holes, s.bag_time_off,
                 s.first_data.c_str());
-    ok = ok && s.backwards == 0;
+    const bool camera = name.find("image") != std::string::npos;
+    ok = ok && s.backwards == 0 && (!camera || s.repeated == 0);
   }
   for (const char* required : {"camera/image_raw", "anemometer/raw"}) {
     const bool found = topics.count(required) || topics.count(std::string("/") + required);
     if (!found) std::printf("  missing: %s (replay.launch needs it)\n", required);
     ok = ok && found;
   }
-  std::printf("  (back: header stamps not increasing; holes: camera intervals > %.3f s, which break clips; "
+  std::printf("  (back: header stamps going back; same: equal to the previous (fine for anemometer records of "
+              "one serial read, not for camera frames); holes: camera intervals > %.3f s, which break clips; "
               "bagt: bag time != header stamp)\n  %s\n",
               a.gap_tolerance, ok ? "ok for replay" : "NOT ok for replay");
   return ok ? 0 : 1;

@@ -117,6 +117,10 @@ int Run(MakeDatasetArgs& a) {
   }
   std::printf("  index: %s (%lld examples in the folder)\n", s.index_path.c_str(),
               static_cast<long long>(s.examples_in_index));
+  if (s.examples_without_tracks > 0)
+    std::printf("  %lld example(s) still without tracks.json: the index records no tracks grid until a later "
+                "--add-tracks run gives them theirs\n",
+                static_cast<long long>(s.examples_without_tracks));
   if (!s.contact_sheet_path.empty()) std::printf("  contact sheet: %s\n", s.contact_sheet_path.c_str());
   for (const auto& e : s.errors) std::fprintf(stderr, "make-dataset: FAILED %s\n", e.c_str());
   return s.failed > 0 ? 1 : 0;

@@ -32,6 +32,7 @@ struct RenderArgs {
   std::string kind = "flag";
   uint64_t seed = 1;
   std::string zeta;        // JSON file (a ζ object, or a label.json with "zeta")
+  std::string backgrounds; // folder a relative background_image of --zeta is found in
   std::string format = "jpg";
   int jpeg_quality = 95;
   double start = 0.0;      // [s] into the animation
@@ -82,6 +83,11 @@ int Run(const RenderArgs& a) {
   render::RenderParams zeta = a.zeta.empty()
                                   ? render::SampleRenderParams(render::SceneKindFromName(a.kind), a.seed)
                                   : LoadZeta(a.zeta);
+  // A dataset example's label names its background photo by file name alone (labels are the same
+  // on every machine); the folder it is in comes from here.
+  if (!a.backgrounds.empty() && !zeta.background_image.empty() &&
+      std::filesystem::path(zeta.background_image).is_relative())
+    zeta.background_image = (std::filesystem::path(a.backgrounds) / zeta.background_image).string();
   if (a.samples > 0) zeta.samples = a.samples;
   zeta.fps = a.fps;
   render::ValidateRenderParams(zeta);
@@ -155,6 +161,8 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
       ->check(CLI::IsMember({"flag", "cloth"}))->capture_default_str();
   sub->add_option("--seed", a->seed, "seed of the render parameters zeta")->capture_default_str();
   sub->add_option("--zeta", a->zeta, "zeta JSON file (or an example's label.json) instead of --seed");
+  sub->add_option("--backgrounds", a->backgrounds,
+                  "folder of the background photo a --zeta names by file name (make-dataset --backgrounds)");
   sub->add_option("--format", a->format, "jpg or png")->capture_default_str();
   sub->add_option("--jpeg-quality", a->jpeg_quality, "JPEG quality")->check(CLI::Range(1, 100))->capture_default_str();
   sub->add_option("--start", a->start, "first frame's time in the animation [s]")->capture_default_str();

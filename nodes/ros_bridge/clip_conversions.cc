@@ -77,7 +77,8 @@ sensors::LabelReading ToLabelReading(const clothwind::WindMeasurement& msg) {
   return r;
 }
 
-clothwind::Clip ToClipMsg(const sensors::LabelledClip& c, const std::string& frame_id) {
+clothwind::Clip ToClipMsg(const sensors::LabelledClip& c, const std::string& frame_id,
+                          const std::string& wind_frame_id) {
   clothwind::Clip msg;
   const auto& frames = c.clip.frames;
   if (frames.empty()) throw std::invalid_argument("clip has no frames");
@@ -115,6 +116,7 @@ clothwind::Clip ToClipMsg(const sensors::LabelledClip& c, const std::string& fra
   msg.wind_std = c.label.std;
   msg.wind_count = c.label.count;
   msg.wind_direction_mean = c.label.direction_mean;
+  msg.wind_direction_frame_id = wind_frame_id;
   return msg;
 }
 

@@ -36,8 +36,10 @@ sensors::LabelReading ToLabelReading(const clothwind::WindMeasurement& msg);
 // A labelled clip as a clothwind/Clip message.
 // Inputs:
 //   clip      labelled clip (num_frames frames of size x size, all mono8 or all bgr8)
-//   frame_id  the camera's optical frame
-clothwind::Clip ToClipMsg(const sensors::LabelledClip& clip, const std::string& frame_id);
+//   frame_id       the camera's optical frame
+//   wind_frame_id  the frame of the label's mean direction (sensors::WindDirectionFrameGate)
+clothwind::Clip ToClipMsg(const sensors::LabelledClip& clip, const std::string& frame_id,
+                          const std::string& wind_frame_id = "");
 
 // A clip frame as an Image message holding a copy of it: mono8 for CV_8UC1, bgr8 for CV_8UC3.
 sensor_msgs::Image ClipFrameImageMsg(const cv::Mat& image, const std_msgs::Header& header);

@@ -103,5 +103,39 @@ TEST(ToLabelReadingTest, SpeedsAWindMeasurementCannotHaveAreSkipped) {
   EXPECT_TRUE(std::isnan(ToLabelReading(m).speed));
 }
 
+// Round trip of the layout: frame-major, row-major; stamps, crop and label carried, the label's
+// direction with the frame it is in.
+TEST(ToClipMsgTest, FramesStampsAndLabelAreCarriedWithTheDirectionsFrame) {
+  sensors::LabelledClip c;
+  for (int i = 0; i < 3; ++i) {
+    sensors::ClipFrame f;
+    f.stamp = 100.0 + 0.04 * i;
+    f.image = cv::Mat(4, 5, CV_8UC1);
+    for (int r = 0; r < 4; ++r)
+      for (int col = 0; col < 5; ++col) f.image.at<uint8_t>(r, col) = static_cast<uint8_t>(100 * i + 10 * r + col);
+    c.clip.frames.push_back(f);
+  }
+  c.clip.sequence = 7;
+  c.roi = {10, 20, 300};
+  c.label.mean = 4.5;
+  c.label.count = 12;
+  c.label.direction_mean = -1.25;
+  const clothwind::Clip msg = ToClipMsg(c, "camera_optical", "anemometer");
+  EXPECT_EQ(msg.header.frame_id, "camera_optical");
+  EXPECT_DOUBLE_EQ(msg.header.stamp.toSec(), 100.0);
+  ASSERT_EQ(msg.frame_stamps.size(), 3u);
+  EXPECT_NEAR(msg.frame_stamps[2].toSec(), 100.08, 1e-9);
+  EXPECT_EQ(msg.width, 5u);
+  EXPECT_EQ(msg.height, 4u);
+  EXPECT_EQ(msg.encoding, "mono8");
+  ASSERT_EQ(msg.data.size(), 3u * 4 * 5);
+  EXPECT_EQ(msg.data[2 * 20 + 3 * 5 + 4], 200 + 30 + 4);  // frame 2, row 3, column 4
+  EXPECT_EQ(msg.roi.x_offset, 10u);
+  EXPECT_EQ(msg.roi.width, 300u);
+  EXPECT_EQ(msg.wind_count, 12u);
+  EXPECT_DOUBLE_EQ(msg.wind_direction_mean, -1.25);
+  EXPECT_EQ(msg.wind_direction_frame_id, "anemometer");
+}
+
 }  // namespace
 }  // namespace clothwind::ros_bridge

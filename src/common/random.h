@@ -1,6 +1,8 @@
 #ifndef CLOTHWIND_COMMON_RANDOM_H_
 #define CLOTHWIND_COMMON_RANDOM_H_
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <initializer_list>
 
@@ -28,6 +30,12 @@ class Rng {
   double Uniform(double a, double b) { return a + (b - a) * Uniform(); }
   // Uniform integer in [0, n); n > 0.
   int UniformInt(int n) { return static_cast<int>(Uniform() * n) % n; }
+  // Standard normal (Box-Muller from two uniforms, the first kept above 0 so the log is finite);
+  // the same on every platform up to libm's last bits, unlike std::normal_distribution.
+  double Normal() {
+    const double u1 = std::max(Uniform(), 1e-300), u2 = Uniform();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+  }
   // Uniform float in [0, 1) from the top 24 bits, for per-pixel sampling.
   float UniformF() { return static_cast<float>(Next() >> 40) * 0x1.0p-24f; }
 

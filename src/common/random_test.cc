@@ -36,6 +36,32 @@ TEST(RngTest, UniformStaysInRangeWithTheRightMeanAndVariance) {
   EXPECT_NEAR(var, 1.0 / 12, 2e-3);
 }
 
+// Moments of the normal draws: mean 0, variance 1, kurtosis 3 (a uniform or a triangular
+// mistake would keep the first two and miss the third), and two draws use two uniforms.
+TEST(RngTest, NormalDrawsHaveTheStandardNormalsMoments) {
+  Rng g(5);
+  const int n = 200000;
+  double m1 = 0, m2 = 0, m4 = 0;
+  for (int i = 0; i < n; ++i) {
+    const double x = g.Normal();
+    ASSERT_TRUE(std::isfinite(x));
+    m1 += x;
+    m2 += x * x;
+    m4 += x * x * x * x;
+  }
+  m1 /= n;
+  m2 /= n;
+  m4 /= n;
+  EXPECT_NEAR(m1, 0.0, 5 / std::sqrt(n));
+  EXPECT_NEAR(m2, 1.0, 5 * std::sqrt(2.0 / n));
+  EXPECT_NEAR(m4 / (m2 * m2), 3.0, 0.1);  // standard error of the kurtosis ~ sqrt(24 / n) = 0.011
+  Rng a(9), b(9);
+  a.Normal();
+  b.Next();
+  b.Next();
+  EXPECT_EQ(a.Next(), b.Next());
+}
+
 TEST(RngTest, ScaledUniformIntegerAndFloatDrawsStayInRange) {
   Rng g(11);
   std::set<int> seen;

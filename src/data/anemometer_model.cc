@@ -8,14 +8,6 @@
 
 namespace clothwind::data {
 
-namespace {
-// Standard normal from two uniforms (Box-Muller): fixed by the seed on every platform.
-double Gaussian(Rng& rng) {
-  const double u1 = std::max(rng.Uniform(), 1e-300), u2 = rng.Uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
-}  // namespace
-
 std::vector<sensors::SyntheticReading> SimulateAnemometer(const sim::WindField& field,
                                                           const AnemometerModelParams& p,
                                                           double start_time, double duration) {
@@ -53,7 +45,7 @@ std::vector<sensors::SyntheticReading> SimulateAnemometer(const sim::WindField& 
     }
     sensors::SyntheticReading r;
     double reading = sum / per_interval;
-    reading += (p.noise_std + p.noise_relative * reading) * Gaussian(rng);
+    reading += (p.noise_std + p.noise_relative * reading) * rng.Normal();
     r.speed = std::round(std::max(0.0, reading) * 100.0) / 100.0;
     const double phi = std::atan2(vane.y(), vane.x()) * 180.0 / M_PI;
     double angle = std::fmod(p.direction_from - phi, 360.0);

@@ -82,6 +82,16 @@ TEST(ClipTracksTest, FramesBetweenAnimationFramesAreInterpolatedAsTheRendererDra
   p.fps = 50;
   const ClipTracks t = ProjectTracks(FlatFlag(9, 7, 3, 0.2), p, TrackGrid{2, 2}, 5);
   for (int i = 0; i < t.xy.cols(); ++i) EXPECT_NEAR(t.xy(1, i), 0.5 * (t.xy(0, i) + t.xy(2, i)), 1e-3);
+  // The flag moves linearly, so the midpoint alone holds for any linear time mapping: frame 2 at
+  // 50 fps (t = 0.04 s) must also be frame 1 at 25 fps, and frame 4 frame 2.
+  render::RenderParams p25 = p;
+  p25.fps = 25;
+  const ClipTracks t25 = ProjectTracks(FlatFlag(9, 7, 3, 0.2), p25, TrackGrid{2, 2}, 3);
+  for (int i = 0; i < t.xy.cols(); ++i) {
+    EXPECT_NEAR(t.xy(2, i), t25.xy(1, i), 1e-6);
+    EXPECT_NEAR(t.xy(4, i), t25.xy(2, i), 1e-6);
+  }
+  EXPECT_GT(std::abs(t.xy(2, 0) - t.xy(0, 0)), 1.0);  // the points move between those frames
 }
 
 TEST(ClipTracksTest, APointBehindTheCameraIsAnError) {

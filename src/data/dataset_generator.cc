@@ -332,6 +332,9 @@ nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<st
           {"background_images", backgrounds},
           {"generator_version", kGeneratorVersion}};
   if (o.tracks) settings["tracks"] = {o.tracks->cols, o.tracks->rows};
+  // ClothSim's wind has one direction since 2026-12-06; a folder made with directions over the
+  // circle lacks this and is refused on resume rather than mixed.
+  if (o.kind == render::SceneKind::kCloth) settings["wind_direction_deg"] = kClothWindAzimuth * 180 / M_PI;
   return settings;
 }
 
@@ -502,6 +505,15 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
 
   // Every run rebuilds the index from the folders present: shards and resumed runs converge.
   nlohmann::json index = BuildIndex(o.out, IndexHeader(o, settings));
+  if (o.add_tracks) {
+    // The header's "tracks" says every example has its tracks.json: not while a replay failed or
+    // another split still waits for its tracks (a later --add-tracks run completes it; a run with
+    // --tracks alone is then refused, pointing at --add-tracks, instead of leaving those without).
+    for (const auto& clip : index["clips"])
+      if (!fs::exists(fs::path(o.out) / clip.value("name", std::string()) / "tracks.json"))
+        ++summary.examples_without_tracks;
+    if (summary.examples_without_tracks > 0) index["dataset"].erase("tracks");
+  }
   WriteIndex(o.out, index);
   summary.examples_in_index = static_cast<int64_t>(index["clips"].size());
   summary.index_path = (fs::path(o.out) / "index.json").string();

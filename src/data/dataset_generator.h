@@ -91,6 +91,8 @@ struct DatasetSummary {
   int64_t examples_written = 0;  // example folders written now (--add-tracks: tracks.json files)
   int64_t failed = 0;            // simulations that failed (see errors)
   int64_t examples_in_index = 0; // examples in DIR/index.json after this run (all shards)
+  int64_t examples_without_tracks = 0;  // --add-tracks: indexed examples still without tracks.json
+                                        // (the header then records no "tracks")
   std::vector<std::string> errors;
   double wall_seconds = 0;
   double simulate_seconds = 0;   // summed over workers

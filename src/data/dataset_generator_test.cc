@@ -466,6 +466,15 @@ TEST_F(DatasetGeneratorTest, AddTracksGivesADatasetTheTracksItWouldHaveBeenMadeW
   }
   EXPECT_EQ(t.examples_written, trained);
   EXPECT_GT(trained, 0);
+  // The other splits still lack theirs: the header does not claim the grid until they have them.
+  EXPECT_EQ(t.examples_without_tracks, static_cast<int64_t>(index["clips"].size()) - trained);
+  EXPECT_FALSE(index["dataset"].contains("tracks"));
+  DatasetOptions rest = add;
+  rest.out = some.string();
+  const DatasetSummary completed = GenerateDataset(rest);
+  ASSERT_TRUE(completed.errors.empty()) << completed.errors[0];
+  EXPECT_EQ(completed.examples_without_tracks, 0);
+  EXPECT_EQ(ReadIndex(some.string())["dataset"]["tracks"], nlohmann::json({4, 3}));
   EXPECT_EQ(ReadIndex((root_ / "with-tracks").string())["dataset"]["tracks"], nlohmann::json({4, 3}));
   // Again: nothing left to do.
   EXPECT_EQ(GenerateDataset(add).simulated, 0);
@@ -527,6 +536,10 @@ TEST_F(DatasetGeneratorTest, AddTracksRefusesAnExampleWhoseFramesItsReplayDoesNo
   EXPECT_NE(s.errors[0].find(last.string()), std::string::npos) << s.errors[0];
   EXPECT_NE(s.errors[0].find("grey levels"), std::string::npos) << s.errors[0];
   EXPECT_FALSE(fs::exists(last.parent_path() / "tracks.json"));
+  // One example without its tracks: the header records no grid, so training or a resume with
+  // --tracks are not told every example has them.
+  EXPECT_EQ(s.examples_without_tracks, 1);
+  EXPECT_FALSE(ReadIndex(dir.string())["dataset"].contains("tracks"));
   EXPECT_TRUE(fs::exists(dir / ExampleName(render::SceneKind::kFlag, 0, 0) / "tracks.json"));
   EXPECT_TRUE(fs::exists(dir / ExampleName(render::SceneKind::kFlag, 2, 0) / "tracks.json"));
   // Other settings than the dataset's are refused before anything runs.

@@ -39,7 +39,12 @@ nlohmann::json SimExampleLabel(const std::string& name, const SimulationSample& 
   j["theta_names"] = names;
   j["theta_units"] = units;
   j["wind_velocity"] = {s.wind_velocity.x(), s.wind_velocity.y(), s.wind_velocity.z()};
-  j["zeta"] = render::ToJson(zeta);
+  // The background photo by its file name (as the settings list them): the folder it was read
+  // from differs between machines, and labels are byte-identical on every one.
+  render::RenderParams recorded = zeta;
+  if (!recorded.background_image.empty())
+    recorded.background_image = fs::path(recorded.background_image).filename().string();
+  j["zeta"] = render::ToJson(recorded);
   j["seed"] = s.seed;
   j["dataset_seed"] = info.dataset_seed;
   j["simulation"] = s.index;

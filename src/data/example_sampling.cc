@@ -85,9 +85,8 @@ SimulationSample SampleClothSimulation(const std::vector<Fabric>& fabrics, uint6
     for (int c = 0; c < 5; ++c) s.theta[sim::kBendingIndex + 5 * d + c] = f.material.bending[d][c];
   Rng wind(HashSeed(s.seed, kWind));
   const double speed = wind.Uniform(ranges.wind_min, ranges.wind_max);
-  const double azimuth = wind.Uniform(-M_PI, M_PI);
   s.theta[sim::kWindSpeedIndex] = speed;
-  s.wind_velocity = Eigen::Vector3d(speed * std::cos(azimuth), speed * std::sin(azimuth), 0);
+  s.wind_velocity = Eigen::Vector3d(speed * std::cos(kClothWindAzimuth), speed * std::sin(kClothWindAzimuth), 0);
   return s;
 }
 

@@ -98,7 +98,7 @@ TEST(ExampleSamplingTest, ClothDrawsFabricAreaWeightAndHorizontalWind) {
   }
   const SamplingRanges r = DefaultRanges(render::SceneKind::kCloth);
   std::set<int> used;
-  double azimuth_spread = 0;
+  double speed_min = 5, speed_max = 0;
   for (int i = 0; i < 500; ++i) {
     const SimulationSample s = SampleClothSimulation(fabrics, 11, i, r);
     used.insert(s.fabric_index);
@@ -109,10 +109,17 @@ TEST(ExampleSamplingTest, ClothDrawsFabricAreaWeightAndHorizontalWind) {
     EXPECT_EQ(s.wind_velocity.z(), 0.0);
     EXPECT_NEAR(s.wind_velocity.norm(), s.theta[16], 1e-12);
     EXPECT_LE(s.theta[16], 5.0);
-    azimuth_spread = std::max(azimuth_spread, std::abs(std::atan2(s.wind_velocity.y(), s.wind_velocity.x())));
+    // One direction, the paper's [s, s, 0]: away from the camera on -x, 45° to the cloth's normal.
+    if (s.theta[16] > 0) {
+      EXPECT_NEAR(s.wind_velocity.x(), s.wind_velocity.y(), 1e-12);
+      EXPECT_GT(s.wind_velocity.x(), 0);
+    }
+    speed_min = std::min(speed_min, s.theta[16]);
+    speed_max = std::max(speed_max, s.theta[16]);
   }
   EXPECT_EQ(used.size(), 3u);
-  EXPECT_GT(azimuth_spread, 3.0);  // directions cover the circle
+  EXPECT_LT(speed_min, 0.1);  // speeds cover the range
+  EXPECT_GT(speed_max, 4.9);
   EXPECT_THROW(SampleClothSimulation({}, 1, 0, r), std::invalid_argument);
 }
 

@@ -17,6 +17,7 @@
 
 #include "common/dataset_names.h"
 #include "common/image_file.h"
+#include "common/random.h"
 #include "learn/fly_judge.h"
 #include "learn/model_config.h"
 
@@ -71,7 +72,10 @@ Dataset ReadDataset(const fs::path& dir) {
   }
   Dataset dataset;
   dataset.root = dir;
-  dataset.kind = Field<std::string>(index, "kind", index_path, "\"flag\", \"cloth\" or \"real\"");
+  dataset.kind = Field<std::string>(index, "kind", index_path, "\"flag\", \"cloth\", \"real\" or \"toy\"");
+  if (dataset.kind != "flag" && dataset.kind != "cloth" && dataset.kind != "real" && dataset.kind != "toy")
+    throw std::runtime_error(index_path.string() + ": field \"kind\" is \"" + dataset.kind +
+                             "\", expected \"flag\", \"cloth\", \"real\" or \"toy\"");
   if (!index.contains("clips") || !index["clips"].is_array()) {
     throw std::runtime_error(index_path.string() + ": missing field \"clips\" (an array)");
   }
@@ -500,21 +504,21 @@ std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions
     char rest = 0;
     if (std::sscanf(file.c_str(), "toy-%d%c", &number, &rest) == 1 && number >= o.clips) fs::remove_all(e.path());
   }
-  std::mt19937_64 rng(o.seed);
   nlohmann::json clips = nlohmann::json::array();
   std::vector<double> frequencies;
   for (int i = 0; i < o.clips; ++i) {
     const uint64_t seed = o.seed * 1000003ULL + static_cast<uint64_t>(i);
-    std::mt19937_64 clip_rng(seed);
-    const double speed = std::uniform_real_distribution<double>(0, o.max_speed)(clip_rng);
+    // common::Rng, not <random>'s distributions (implementation-defined): the toy dataset, and the
+    // tests that train on it, are the same with every standard library.
+    Rng clip_rng(seed);
+    const double speed = clip_rng.Uniform(0, o.max_speed);
     const double f = o.base_frequency + o.frequency_per_speed * speed;
     frequencies.push_back(f);
-    const double phase = std::uniform_real_distribution<double>(0, 2 * M_PI)(clip_rng);
+    const double phase = clip_rng.Uniform(0, 2 * M_PI);
     const int patch = 3 * o.size / 4;
-    const int x0 = std::uniform_int_distribution<int>(1, o.size - patch - 1)(clip_rng);
-    const int y0 = std::uniform_int_distribution<int>(1, o.size - patch - 1)(clip_rng);
+    const int x0 = 1 + clip_rng.UniformInt(o.size - patch - 1);
+    const int y0 = 1 + clip_rng.UniformInt(o.size - patch - 1);
     const double wavelength = patch / 3.0;  // [px] three stripes across the patch
-    std::normal_distribution<double> noise(0.0, 3.0);
     const uint64_t hash = (seed * 0x9E3779B97F4A7C15ULL) >> 33;
     const std::string split = hash % 5 < 3 ? "train" : (hash % 5 == 3 ? "val" : "test");
     char name[32];
@@ -530,7 +534,7 @@ std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions
           if (x >= x0 && x < x0 + patch && y >= y0 && y < y0 + patch) {
             v = 140 + 60 * std::sin(2 * M_PI * (f * t / o.frame_rate - (x - x0) / wavelength) + phase);
           }
-          frame.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(v + noise(clip_rng));
+          frame.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(v + 3.0 * clip_rng.Normal());
         }
       }
       char file[32];
@@ -540,7 +544,7 @@ std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions
       }
     }
     nlohmann::json label = {{"format", "clothwind-clip"}, {"version", 1},       {"name", name},
-                            {"kind", "sim"},              {"num_frames", o.frames},
+                            {"kind", "toy"},              {"num_frames", o.frames},
                             {"frame_rate", o.frame_rate}, {"width", o.size},   {"height", o.size},
                             {"encoding", "mono8"},        {"frame_pattern", "%03d.jpg"},
                             {"wind_speed", speed},        {"seed", seed},      {"split", split},
@@ -551,7 +555,7 @@ std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions
     fs::rename(tmp, dir / name);
     clips.push_back({{"name", name}, {"wind_speed", speed}, {"split", split}});
   }
-  nlohmann::json index = {{"format", "clothwind-dataset"}, {"version", 1}, {"kind", "flag"}, {"clips", clips}};
+  nlohmann::json index = {{"format", "clothwind-dataset"}, {"version", 1}, {"kind", "toy"}, {"clips", clips}};
   WriteFileAtomically(dir / "index.json", index.dump(2));
   return frequencies;
 }

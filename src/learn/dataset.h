@@ -37,7 +37,7 @@ struct ClipInfo {
 
 struct Dataset {
   std::filesystem::path root;
-  std::string kind;  // "flag", "cloth" or "real"
+  std::string kind;  // "flag", "cloth", "real" or "toy" (make-toy-dataset); others are refused
   std::vector<ClipInfo> clips;
 };
 

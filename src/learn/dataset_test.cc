@@ -59,7 +59,7 @@ void EditJson(const fs::path& file, const std::function<void(nlohmann::json&)>& 
 TEST_F(DatasetTest, ReadsIndexLabelsAndFrames) {
   const Dataset d = ReadDataset(*dir_);
   ASSERT_EQ(d.clips.size(), 10u);
-  EXPECT_EQ(d.kind, "flag");
+  EXPECT_EQ(d.kind, "toy");
   int per_split[3] = {0, 0, 0};
   for (const ClipInfo& c : d.clips) {
     EXPECT_EQ(c.num_frames, 40);
@@ -115,6 +115,11 @@ TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
     const fs::path d = Copy("format");
     EditJson(d / "index.json", [](nlohmann::json& j) { j["format"] = "something"; });
     expect_error(d, (d / "index.json").string(), "\"format\"");
+  }
+  {
+    const fs::path d = Copy("kind");
+    EditJson(d / "index.json", [](nlohmann::json& j) { j["kind"] = "flags"; });
+    expect_error(d, (d / "index.json").string(), "\"kind\" is \"flags\"");
   }
   {
     const fs::path d = Copy("speed");

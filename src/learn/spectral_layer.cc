@@ -14,10 +14,17 @@ namespace clothwind::learn {
 
 namespace {
 
-// ε of the phase steps' normalisation: 1e-6 of the mean |X|² over all bins of the one-sided
-// spectra [N_b C H W, F] (complex), so that still pixels read ~0.
-double PhaseStepEps(const at::Tensor& spectrum) {
-  return 1e-6 * (at::real(spectrum).square() + at::imag(spectrum).square()).mean().item<double>() + 1e-30;
+// ε of the phase steps' normalisation, one per example: 1e-6 of the mean |X|² over all bins of
+// its C H W one-sided spectra (rows n·CHW .. (n+1)·CHW - 1 of [N_b C H W, F], complex), so that
+// still pixels read ~0. Per example, not per batch: a clip's maps must not depend on the clips
+// batched with it (a calm clip's ε was set by a flapping one's power in training and eval, and by
+// its own in sdn_node's batches of one).
+std::vector<double> PhaseStepEps(const at::Tensor& spectrum, int64_t nb) {
+  const at::Tensor mean =
+      (at::real(spectrum).square() + at::imag(spectrum).square()).reshape({nb, -1}).mean(1).to(at::kDouble).cpu();
+  std::vector<double> eps(nb);
+  for (int64_t n = 0; n < nb; ++n) eps[n] = 1e-6 * mean[n].item<double>() + 1e-30;
+  return eps;
 }
 
 // Phase steps over each of `distances` pixels from the one-sided spectra [N_b C H W, F] (complex)
@@ -30,7 +37,12 @@ at::Tensor PhaseSteps(const at::Tensor& spectrum, const at::Tensor& bin, int64_t
   at::Tensor re = at::real(spectrum).reshape({nb, c, h, w, f});
   at::Tensor im = at::imag(spectrum).reshape({nb, c, h, w, f});
   at::Tensor index = bin.reshape({nb, c, h, w, 1});
-  const double eps = PhaseStepEps(spectrum);
+  // [N_b, 1, 1, 1, 1] in the spectrum's real type: the same rounding as the one-pass path's.
+  const std::vector<double> eps_per_example = PhaseStepEps(spectrum, nb);
+  const at::Tensor eps = at::tensor(eps_per_example, at::TensorOptions().dtype(at::kDouble))
+                             .to(re.scalar_type())
+                             .to(re.device())
+                             .reshape({nb, 1, 1, 1, 1});
   // One step along spatial dimension `dim` (2: y, down; 3: x, right): pixel p's bin read at p and
   // at the pixel d further, then their normalised cross product.
   auto step = [&](int64_t dim, int64_t d) {
@@ -142,7 +154,7 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
                         !options.mode_shape && !(at::GradMode::is_enabled() && x.requires_grad());
   if (one_pass) {
     spectrum = spectrum.contiguous();
-    const double eps = options.phase_steps ? PhaseStepEps(spectrum) : 0.0;
+    const std::vector<double> eps = options.phase_steps ? PhaseStepEps(spectrum, nb) : std::vector<double>();
     SpectralPeaks peaks = SpectralPeaksCpu(spectrum, window.square().sum(), first, candidates, k,
                                            frame_rate / static_cast<double>(length), nb, c, h, w, distances, eps);
     return SpectralMaps{peaks.power, peaks.frequency, peaks.phase, at::Tensor()};

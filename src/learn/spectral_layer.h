@@ -53,7 +53,7 @@ struct SpectralMaps {
   // With SpectralOptions::phase_steps, else undefined: [N_b, 4C, H, W], per input channel c the
   // channels 4c..4c+3 = cos, sin of the step to the right (x+1), cos, sin of the step down (y+1):
   // with X(p) the DFT of pixel p at p's strongest selected bin, and X(q) that of the neighbour q
-  // at the same bin, X(p)·conj(X(q)) / (|X(p)||X(q)| + ε), ε = 1e-6 · the clip's mean |X|²
+  // at the same bin, X(p)·conj(X(q)) / (|X(p)||X(q)| + ε), ε = 1e-6 · the clip's mean |X|² (each clip its own, whatever it is batched with)
   // (so still pixels read ~0). A wave e^{i(ωt − κx)} reads (cos κ, sin κ). The last column's
   // right step and the last row's down step are 0. With phase_step_far = D, [N_b, 8C, H, W]:
   // channels 4C + 4c..4C + 4c+3 are the same steps to x+D and y+D (a wave reads (cos κD, sin κD)),

@@ -295,6 +295,31 @@ TEST(SpectralLayer, PhaseStepsReadATravellingWavesWavenumber) {
   EXPECT_FALSE(SpectralDecomposition(still, 2, kFps).phase.defined());
 }
 
+TEST(SpectralLayer, PhaseStepsOfAClipDoNotDependOnItsBatch) {
+  // A calm clip (amplitude 1e-3) batched with a violent one (1e3): with ε taken over the batch
+  // (1e-6 of the mean |X|², set by the violent clip) the calm clip's steps shrank to ~0; each
+  // clip's own ε leaves them at (cos κ, sin κ) as when the calm clip is alone (sdn_node's batch
+  // of one). Both selection paths.
+  const double kx = 0.4, ky = -0.25;
+  const at::Tensor calm = 1e-3 * TravellingWave(30, 4, 5, 2.5, kx, ky, 0.7);
+  const at::Tensor violent = 1e3 * TravellingWave(30, 4, 5, 2.5, -kx, ky, 1.3);
+  const at::Tensor batch = at::cat({calm, violent}, 0);
+  for (const bool one_pass : {true, false}) {
+    SCOPED_TRACE(one_pass ? "one pass" : "tensor path");
+    SpectralOptions o;
+    o.k = 2;
+    o.phase_steps = true;
+    o.one_pass = one_pass;
+    const at::Tensor alone = SpectralDecomposition(calm, o).phase;
+    const at::Tensor batched = SpectralDecomposition(batch, o).phase;
+    EXPECT_TRUE(at::allclose(batched.narrow(0, 0, 1), alone, 1e-12, 1e-12));
+    EXPECT_NEAR(batched.index({0, 0, 0, 0}).item<double>(), std::cos(kx), 1e-4);
+    EXPECT_NEAR(batched.index({0, 1, 0, 0}).item<double>(), std::sin(kx), 1e-4);
+    EXPECT_NEAR(batched.index({1, 1, 0, 0}).item<double>(), -std::sin(kx), 1e-4);
+    EXPECT_TRUE(at::allclose(batched.narrow(0, 1, 1), SpectralDecomposition(violent, o).phase, 1e-12, 1e-12));
+  }
+}
+
 TEST(SpectralLayer, FarPhaseStepsTurnByTheWavenumberTimesTheDistance) {
   // Over 3 pixels the same wave turns by 3κ: channels 4..7 read (cos 3κx, sin 3κx, cos 3κy,
   // sin 3κy) where the pixel 3 further exists, 0 elsewhere; channels 0..3 are the near steps.

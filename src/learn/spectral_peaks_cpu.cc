@@ -83,7 +83,7 @@ std::pair<scalar_t, scalar_t> PhaseStep(const c10::complex<scalar_t>& a, const c
 template <typename scalar_t>
 void Select(const at::Tensor& spectrum, scalar_t weight_sum, int64_t first, int64_t candidates, int k,
             scalar_t bin_hz, int64_t nb, int64_t c, int64_t h, int64_t w, const std::vector<int64_t>& distances,
-            scalar_t eps, SpectralPeaks& out) {
+            const std::vector<double>& eps_per_example, SpectralPeaks& out) {
   using acc_t = at::acc_type<scalar_t, /*is_cuda=*/false>;
   const int64_t f = spectrum.size(1), hw = h * w, pixels = nb * c * hw;
   const int64_t blocks = static_cast<int64_t>(distances.size());
@@ -113,6 +113,7 @@ void Select(const at::Tensor& spectrum, scalar_t weight_sum, int64_t first, int6
       }
       if (blocks == 0) continue;
       const int64_t bin = top[0].second + first, n = plane / c, ci = plane % c;
+      const scalar_t eps = static_cast<scalar_t>(eps_per_example[n]);
       const int64_t y = pixel / w, x = pixel % w;
       for (int64_t b = 0; b < blocks; ++b) {
         const int64_t d = distances[b];
@@ -137,7 +138,8 @@ void Select(const at::Tensor& spectrum, scalar_t weight_sum, int64_t first, int6
 
 SpectralPeaks SpectralPeaksCpu(const at::Tensor& spectrum, const at::Tensor& weight_sum, int64_t first,
                                int64_t candidates, int k, double bin_hz, int64_t nb, int64_t c, int64_t h,
-                               int64_t w, const std::vector<int64_t>& distances, double eps) {
+                               int64_t w, const std::vector<int64_t>& distances,
+                               const std::vector<double>& eps) {
   if (!spectrum.device().is_cpu() || !spectrum.is_contiguous() || spectrum.dim() != 2 ||
       spectrum.size(0) != nb * c * h * w || !spectrum.is_complex()) {
     throw std::invalid_argument("SpectralPeaksCpu: expected a contiguous complex CPU tensor [N_b·C·H·W, F]");
@@ -147,6 +149,9 @@ SpectralPeaks SpectralPeaksCpu(const at::Tensor& spectrum, const at::Tensor& wei
                                 std::to_string(first + candidates) + ") and k = " + std::to_string(k) +
                                 " do not fit " + std::to_string(spectrum.size(1)) + " bins");
   }
+  if (!distances.empty() && static_cast<int64_t>(eps.size()) != nb)
+    throw std::invalid_argument("SpectralPeaksCpu: expected one phase-step eps per example (" + std::to_string(nb) +
+                                "), got " + std::to_string(eps.size()));
   const at::ScalarType real_type = c10::toRealValueType(spectrum.scalar_type());
   const at::TensorOptions options = at::TensorOptions().dtype(real_type);
   SpectralPeaks out;
@@ -155,7 +160,7 @@ SpectralPeaks SpectralPeaksCpu(const at::Tensor& spectrum, const at::Tensor& wei
   if (!distances.empty()) out.phase = at::zeros({nb, 4 * c * static_cast<int64_t>(distances.size()), h, w}, options);
   AT_DISPATCH_FLOATING_TYPES(real_type, "SpectralPeaksCpu", [&] {
     Select<scalar_t>(spectrum, weight_sum.item<scalar_t>(), first, candidates, k, static_cast<scalar_t>(bin_hz),
-                     nb, c, h, w, distances, static_cast<scalar_t>(eps), out);
+                     nb, c, h, w, distances, eps, out);
   });
   return out;
 }

@@ -26,7 +26,8 @@ namespace clothwind::learn {
 //   bin_hz      frequency of one bin [Hz] (frame_rate / DFT length)
 //   nb, c, h, w the batch's shape
 //   distances   phase-step distances in pixels (empty: no phase steps), each >= 1
-//   eps         ε of the phase steps' normalisation (SpectralMaps::phase)
+//   eps         ε of the phase steps' normalisation (SpectralMaps::phase), one per example (nb;
+//               empty without phase steps)
 // Outputs:
 //   power       [N_b, kC, H, W] the k largest I_j of each pixel in descending order, channel c·k + i
 //   frequency   [N_b, kC, H, W] their frequencies (j · bin_hz)
@@ -40,7 +41,8 @@ struct SpectralPeaks {
 };
 SpectralPeaks SpectralPeaksCpu(const at::Tensor& spectrum, const at::Tensor& weight_sum, int64_t first,
                                int64_t candidates, int k, double bin_hz, int64_t nb, int64_t c, int64_t h,
-                               int64_t w, const std::vector<int64_t>& distances, double eps);
+                               int64_t w, const std::vector<int64_t>& distances,
+                               const std::vector<double>& eps);
 
 }  // namespace clothwind::learn
 

@@ -83,14 +83,14 @@ TEST(SpectralPeaksCpu, StillPixelsReadTheTensorPathsBinsAndZeroPhase) {
 TEST(SpectralPeaksCpu, RefusesSpectraThatDoNotFitTheShape) {
   at::Tensor spectrum = at::zeros({12, 16}, at::kComplexFloat);
   at::Tensor weight_sum = at::ones({}, at::kFloat);
-  EXPECT_NO_THROW(SpectralPeaksCpu(spectrum, weight_sum, 1, 15, 3, 25.0 / 30, 1, 1, 3, 4, {1}, 1e-9));
-  EXPECT_THROW(SpectralPeaksCpu(spectrum, weight_sum, 1, 15, 3, 25.0 / 30, 1, 1, 3, 5, {1}, 1e-9),
+  EXPECT_NO_THROW(SpectralPeaksCpu(spectrum, weight_sum, 1, 15, 3, 25.0 / 30, 1, 1, 3, 4, {1}, {1e-9}));
+  EXPECT_THROW(SpectralPeaksCpu(spectrum, weight_sum, 1, 15, 3, 25.0 / 30, 1, 1, 3, 5, {1}, {1e-9}),
                std::invalid_argument);  // 15 pixels asked of 12 rows
-  EXPECT_THROW(SpectralPeaksCpu(spectrum, weight_sum, 1, 16, 3, 25.0 / 30, 1, 1, 3, 4, {1}, 1e-9),
+  EXPECT_THROW(SpectralPeaksCpu(spectrum, weight_sum, 1, 16, 3, 25.0 / 30, 1, 1, 3, 4, {1}, {1e-9}),
                std::invalid_argument);  // bins 1..16 of 16
-  EXPECT_THROW(SpectralPeaksCpu(spectrum, weight_sum, 1, 15, 16, 25.0 / 30, 1, 1, 3, 4, {1}, 1e-9),
+  EXPECT_THROW(SpectralPeaksCpu(spectrum, weight_sum, 1, 15, 16, 25.0 / 30, 1, 1, 3, 4, {1}, {1e-9}),
                std::invalid_argument);  // k above the candidates
-  EXPECT_THROW(SpectralPeaksCpu(at::zeros({12, 16}), weight_sum, 1, 15, 3, 25.0 / 30, 1, 1, 3, 4, {1}, 1e-9),
+  EXPECT_THROW(SpectralPeaksCpu(at::zeros({12, 16}), weight_sum, 1, 15, 3, 25.0 / 30, 1, 1, 3, 4, {1}, {1e-9}),
                std::invalid_argument);  // real, not a spectrum
 }
 

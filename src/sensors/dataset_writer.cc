@@ -72,6 +72,7 @@ nlohmann::json ClipLabelJson(const LabelledClip& c, const ClipSourceInfo& source
   j["wind"] = {{"window", l.window},          {"end", l.end},
                {"mean", Number(l.mean)},      {"std", Number(l.std)},
                {"count", l.count},            {"direction_mean", Number(l.direction_mean)},
+               {"direction_frame_id", source.wind_frame_id},
                {"first_stamp", Number(l.first_stamp)}, {"last_stamp", Number(l.last_stamp)}};
   return j;
 }

@@ -17,6 +17,7 @@ struct ClipSourceInfo {
   std::string description;  // e.g. "clip_buffer_node /camera/image_raw"
   nlohmann::json camera;    // optional camera_info summary (K, D, size); null when unknown
   std::string split = "test";  // dataset split (docs/dataset.md); real clips evaluate, as FlagReal
+  std::string wind_frame_id;  // frame of the label's mean direction (WindDirectionFrameGate)
 };
 
 // Folder name of a recorded clip: "clip-<UTC yyyymmdd-hhmmss.mmm of its first frame>-<seq>", so

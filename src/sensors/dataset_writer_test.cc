@@ -59,7 +59,8 @@ class DatasetWriterTest : public ::testing::Test {
 
 TEST_F(DatasetWriterTest, WritesFramesLabelAndIndex) {
   DatasetWriter w(root_.string(), 95);
-  const std::string dir = w.Write(MakeClip(3, 1700000000.5), {"camera_optical_frame", "test", nullptr});
+  const std::string dir =
+      w.Write(MakeClip(3, 1700000000.5), {"camera_optical_frame", "test", nullptr, "test", "anemometer"});
   EXPECT_EQ(fs::path(dir).filename().string(), "clip-20231114-221320.500-000003");
   for (int i = 0; i < 4; ++i) {
     char name[16];
@@ -76,6 +77,7 @@ TEST_F(DatasetWriterTest, WritesFramesLabelAndIndex) {
   EXPECT_DOUBLE_EQ(label["wind_speed"].get<double>(), 4.0);
   EXPECT_DOUBLE_EQ(label["wind"]["std"].get<double>(), 1.0);
   EXPECT_EQ(label["wind"]["count"], 2);
+  EXPECT_EQ(label["wind"]["direction_frame_id"], "anemometer");
   EXPECT_EQ(label["roi"]["x"], 40);
   EXPECT_EQ(label["source"]["frame_id"], "camera_optical_frame");
   EXPECT_NEAR(label["frame_stamps"][3].get<double>() - label["frame_stamps"][0].get<double>(), 0.12, 1e-6);

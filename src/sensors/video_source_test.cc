@@ -20,7 +20,8 @@ class VideoSourceTest : public ::testing::Test {
  protected:
   void SetUp() override {
     std::string tmpl = (fs::temp_directory_path() / "clothwind_video_XXXXXX").string();
-    dir_ = mkdtemp(tmpl.data());
+    ASSERT_NE(mkdtemp(tmpl.data()), nullptr) << tmpl;
+    dir_ = tmpl;
     path_ = dir_ + "/clip.avi";
     // Motion-JPEG in AVI: OpenCV writes this without external codecs.
     cv::VideoWriter writer(path_, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 12.5,

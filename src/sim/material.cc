@@ -162,15 +162,21 @@ nlohmann::json ReadMaterialJson(const std::string& path) {
 
 std::vector<std::string> IgnoredKeyWarnings(const nlohmann::json& j, const std::string& path) {
   static const std::set<std::string> kRead = {"density", "stretching", "bending"};
-  // Read by ArcSim's material loader, not modelled here (damping comes from the scene's material
-  // entry instead; no plasticity, no strain limiting).
-  static const std::set<std::string> kArcSimOnly = {"damping", "strain_limits", "yield_curv", "weakening"};
+  // Fields of a scene's material entry, which ArcSim does not read from a material file either:
+  // damping and strain_limits are simulated from the scene's entry, yield_curv and weakening
+  // (plasticity) are not simulated at all.
+  static const std::set<std::string> kSceneEntry = {"damping", "strain_limits"};
+  static const std::set<std::string> kNotSimulated = {"yield_curv", "weakening"};
   std::vector<std::string> warnings;
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (kRead.count(it.key())) continue;
     warnings.push_back(path + ": key '" + it.key() + "' " +
-                       (kArcSimOnly.count(it.key()) ? "is ArcSim's but not simulated here, ignored"
-                                                    : "is not a material field (density, stretching, bending), ignored"));
+                       (kSceneEntry.count(it.key())
+                            ? "belongs in the scene's materials[] entry (ArcSim ignores it in a material file "
+                              "too), ignored here"
+                        : kNotSimulated.count(it.key())
+                            ? "belongs in the scene's materials[] entry, and plasticity is not simulated here, ignored"
+                            : "is not a material field (density, stretching, bending), ignored"));
   }
   return warnings;
 }

@@ -70,8 +70,9 @@ Material MakeMaterial(double density, const Eigen::Matrix<double, 6, 4>& stretch
 // Inputs:
 //   path  the JSON file
 //   mult  multipliers as in an ArcSim scene's material entry
-// Keys other than density, stretching and bending are ignored with a warning (ArcSim's damping,
-// strain_limits, yield_curv and weakening are not simulated; anything else is likely misspelt),
+// Keys other than density, stretching and bending are ignored with a warning (damping and
+// strain_limits belong in the scene's material entry, where they are simulated; yield_curv and
+// weakening too, not simulated; anything else is likely misspelt),
 // printed to stderr once per file and key in a process: a dataset run loads one material for
 // every simulation.
 // Throws std::runtime_error naming the file and the missing/bad field and what was expected.

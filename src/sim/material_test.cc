@@ -130,12 +130,16 @@ TEST(MaterialTest, IgnoredKeysAreNamed) {
   const std::string plain = WriteText("plain.json", "{\"density\": 0.1, \"stretching\": " + rows + ", \"bending\": " + bend + "}");
   EXPECT_TRUE(ArcSimMaterialWarnings(plain).empty());
   const std::string extra = WriteText("extra.json", "{\"density\": 0.1, \"stretching\": " + rows + ", \"bending\": " + bend +
-                                                        ", \"bendng\": 2, \"yield_curv\": 3}");
+                                                        ", \"bendng\": 2, \"yield_curv\": 3, \"damping\": 0.1}");
   EXPECT_NO_THROW(LoadArcSimMaterial(extra));
   const std::vector<std::string> w = ArcSimMaterialWarnings(extra);
-  ASSERT_EQ(w.size(), 2u);
+  ASSERT_EQ(w.size(), 3u);
   EXPECT_EQ(w[0], extra + ": key 'bendng' is not a material field (density, stretching, bending), ignored");
-  EXPECT_EQ(w[1], extra + ": key 'yield_curv' is ArcSim's but not simulated here, ignored");
+  // damping is simulated, from the scene's material entry: the warning says where it goes.
+  EXPECT_EQ(w[1], extra + ": key 'damping' belongs in the scene's materials[] entry (ArcSim ignores it in a "
+                          "material file too), ignored here");
+  EXPECT_EQ(w[2], extra + ": key 'yield_curv' belongs in the scene's materials[] entry, and plasticity is not "
+                          "simulated here, ignored");
 }
 
 TEST(MaterialTest, EveryArcSimMaterialLoadsWithSaneValues) {

@@ -180,7 +180,12 @@ SceneRemeshing ParseRemeshing(const Reader& r, const json& j, const std::string&
     m.refine_velocity = r.NonNegative(j["refine_velocity"], path + ".refine_velocity");
   }
   if (j.contains("aspect_min")) m.aspect_min = r.NonNegative(j["aspect_min"], path + ".aspect_min");
-  if (!j.contains("size")) r.Fail(path + ".size", "missing ([min, max] edge length, m)");
+  if (!j.contains("size")) {
+    // ArcSim's default size is [-inf, inf]: no edge is ever refined.
+    r.Warn(path + ".size", "missing: ArcSim's default [-inf, inf] refines nothing, so the mesh is used as it is");
+    m.present = false;
+    return m;
+  }
   const auto v = r.Numbers(j["size"], path + ".size", 2, 2);
   if (!(v[0] > 0 && v[1] >= v[0])) r.Fail(path + ".size", "expected [min, max] with 0 < min <= max [m]");
   m.size_min = v[0];
@@ -217,6 +222,9 @@ SceneHandle ParseHandle(const Reader& r, const json& j, const std::string& path,
     const std::string type = r.String(j["type"], path + ".type");
     if (type != "node") r.Fail(path + ".type", "only node handles are supported, got '" + type + "'");
   }
+  if (!j.contains("nodes") && j.contains("label"))
+    r.Fail(path + ".label", "label handles (the nodes an OBJ file labels) are not supported: list the node indices "
+                            "to pin in nodes");
   if (!j.contains("nodes")) r.Fail(path + ".nodes", "missing (node indices to pin)");
   r.ExpectArray(j["nodes"], path + ".nodes");
   for (size_t i = 0; i < j["nodes"].size(); ++i) {
@@ -369,40 +377,98 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
   }
   r.ExpectObject(j, "(top level)");
   r.CheckKeys(j, "",
-              {"frame_time", "frame_steps", "duration", "end_time", "end_frame", "cloths", "motions",
-               "handles", "gravity", "wind", "magic"},
-              {"obstacles", "morphs", "friction", "obs_friction", "disable"});
+              {"frame_time", "frame_steps", "duration", "end_time", "end_frame", "timestep", "save_frames",
+               "cloths", "motions", "handles", "gravity", "wind", "magic", "disable"},
+              {"obstacles", "morphs", "friction", "obs_friction"});
   Scene s;
   s.path = abs_path;
-  if (j.contains("frame_time")) s.frame_time = r.Positive(j["frame_time"], "frame_time");
-  if (j.contains("frame_steps")) {
-    s.frame_steps = r.Integer(j["frame_steps"], "frame_steps");
-    if (s.frame_steps < 1 || s.frame_steps > 10000) r.Fail("frame_steps", "expected an integer in 1..10000");
-  }
-  if (j.contains("duration") && j.contains("end_time")) {
-    r.Warn("end_time", "both duration and end_time given; using end_time");
-  }
-  if (j.contains("duration")) s.duration = r.Positive(j["duration"], "duration");
-  if (j.contains("end_time")) s.duration = r.Positive(j["end_time"], "end_time");
-  if (j.contains("end_frame")) {
-    s.duration = r.Integer(j["end_frame"], "end_frame") * s.frame_time;
-    if (!(s.duration > 0)) r.Fail("end_frame", "expected an integer >= 1");
+  // ArcSim's two timing forms (conf.cpp): frame_time + frame_steps, ending at end_time or
+  // end_frame, whichever comes first (this simulator also reads duration there); or timestep +
+  // save_frames (the steps per saved frame), ending at duration.
+  std::string end_key = "duration";
+  if (j.contains("frame_time") || !j.contains("timestep")) {
+    if (j.contains("timestep")) r.Warn("timestep", "ignored beside frame_time, as ArcSim does");
+    if (j.contains("save_frames")) r.Warn("save_frames", "ignored beside frame_time, as ArcSim does");
+    if (j.contains("frame_time")) s.frame_time = r.Positive(j["frame_time"], "frame_time");
+    if (j.contains("frame_steps")) {
+      s.frame_steps = r.Integer(j["frame_steps"], "frame_steps");
+      if (s.frame_steps < 1 || s.frame_steps > 10000) r.Fail("frame_steps", "expected an integer in 1..10000");
+    }
+    if (j.contains("duration")) s.duration = r.Positive(j["duration"], "duration");
+    if ((j.contains("end_time") || j.contains("end_frame")) && j.contains("duration"))
+      r.Warn("duration", "ignored beside end_time/end_frame, as ArcSim does");
+    if (j.contains("end_time")) {
+      s.duration = r.Positive(j["end_time"], "end_time");
+      end_key = "end_time";
+    }
+    if (j.contains("end_frame")) {
+      const int frames = r.Integer(j["end_frame"], "end_frame");
+      if (frames < 1) r.Fail("end_frame", "expected an integer >= 1, got " + std::to_string(frames));
+      if (!j.contains("end_time") || frames * s.frame_time < s.duration) {
+        s.duration = frames * s.frame_time;
+        end_key = "end_frame";
+      }
+    }
+  } else {
+    for (const char* key : {"frame_steps", "end_time", "end_frame"})
+      if (j.contains(key)) r.Warn(key, "ignored in the timestep form, as ArcSim does (use save_frames, duration)");
+    const double step = r.Positive(j["timestep"], "timestep");
+    if (j.contains("save_frames")) {
+      s.frame_steps = r.Integer(j["save_frames"], "save_frames");
+      if (s.frame_steps < 1 || s.frame_steps > 10000) r.Fail("save_frames", "expected an integer in 1..10000");
+    }
+    s.frame_time = step * s.frame_steps;
+    if (j.contains("duration")) s.duration = r.Positive(j["duration"], "duration");
   }
   // A day of simulated time at most, in at most a million frames (the frame count is an int and
   // its frames are reserved up front: 1e8 s failed in vector::reserve, 1e300 ran nothing, exit 0).
-  if (!(s.duration <= 86400)) r.Fail("duration", "expected at most 86400 s, got " + std::to_string(s.duration));
+  if (!(s.duration <= 86400)) r.Fail(end_key, "expected at most 86400 s, got " + std::to_string(s.duration));
   if (!(s.duration / s.frame_time <= 1e6))
-    r.Fail("frame_time", "expected at most 1e6 frames over the duration, got " +
-                             std::to_string(s.duration / s.frame_time));
+    r.Fail(j.contains("frame_time") || !j.contains("timestep") ? "frame_time" : "timestep",
+           "expected at most 1e6 frames over the duration, got " + std::to_string(s.duration / s.frame_time));
   if (j.contains("motions")) {
-    r.ExpectArray(j["motions"], "motions");
-    for (const auto& m : j["motions"]) s.motions.push_back(m);
+    // Moving handles are not simulated: a motion file ({"motfile": ...}) or a list is kept as given.
+    if (j["motions"].is_object()) {
+      r.Warn("motions", "a motion file is not read here (moving handles are not simulated)");
+      s.motions.push_back(j["motions"]);
+    } else {
+      r.ExpectArray(j["motions"], "motions");
+      for (const auto& m : j["motions"]) s.motions.push_back(m);
+    }
+  }
+  // ArcSim's `disable`: modules switched off. Those this simulator has are switched off too; the
+  // others it never runs.
+  std::set<std::string> disabled;
+  if (j.contains("disable")) {
+    const json& d = j["disable"].is_string() ? json::array({j["disable"]}) : j["disable"];
+    r.ExpectArray(d, "disable");
+    for (size_t i = 0; i < d.size(); ++i) {
+      const std::string name = r.String(d[i], Reader::Index("disable", i));
+      if (name == "proximity") {
+        s.self_collision = false;
+      } else if (name == "collision") {
+        s.crossing_correction = false;
+      } else if (name == "strainlimiting" || name == "remeshing") {
+        disabled.insert(name);
+      } else if (name == "popfilter" || name == "plasticity" || name == "separation") {
+        r.Warn(Reader::Index("disable", i), "'" + name + "': a module this simulator does not have");
+      } else if (name == "physics") {
+        r.Fail(Reader::Index("disable", i), "'physics' cannot be switched off here (the cloth would not move)");
+      } else {
+        r.Fail(Reader::Index("disable", i), "unknown module '" + name + "' (ArcSim's: proximity, physics, "
+                                            "strainlimiting, collision, remeshing, separation, popfilter, "
+                                            "plasticity)");
+      }
+    }
   }
   if (!j.contains("cloths")) r.Fail("cloths", "missing (at least one cloth)");
   r.ExpectArray(j["cloths"], "cloths");
   if (j["cloths"].empty()) r.Fail("cloths", "expected at least one cloth");
   for (size_t i = 0; i < j["cloths"].size(); ++i) {
     s.cloths.push_back(ParseCloth(r, j["cloths"][i], Reader::Index("cloths", i)));
+    if (disabled.count("remeshing")) s.cloths.back().remeshing.present = false;
+    if (disabled.count("strainlimiting"))
+      for (SceneMaterial& m : s.cloths.back().materials) m.has_strain_limits = false;
   }
   if (j.contains("handles")) {
     r.ExpectArray(j["handles"], "handles");

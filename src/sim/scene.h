@@ -73,7 +73,13 @@ struct Scene {
   std::string path;        // absolute path of the scene file
   double frame_time = 0.04;  // [s]
   int frame_steps = 1;       // time steps per frame
-  double duration = 20.0;    // `duration` or `end_time` [s]
+  double duration = 20.0;    // [s] `end_time` or `end_frame` x frame_time (the first reached, as
+                             // ArcSim), else `duration` (ArcSim's end in the `timestep` form)
+  // ArcSim's `disable` list: "proximity" turns the vertex-face repulsion (and with it the crossing
+  // correction) off, "collision" the crossing correction; "strainlimiting" and "remeshing" clear
+  // the cloths' strain limits and remeshing blocks when parsed.
+  bool self_collision = true;
+  bool crossing_correction = true;
   std::vector<SceneCloth> cloths;
   std::vector<SceneHandle> handles;
   std::vector<nlohmann::json> motions;  // kept as given; only fixed handles are simulated

@@ -114,6 +114,8 @@ SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
     }
     o.repulsion_thickness = scene.magic.repulsion_thickness;
     o.collision_stiffness = scene.magic.collision_stiffness;
+    o.self_collision = scene.self_collision;
+    if (!scene.crossing_correction) o.crossing_sweeps = 0;
     setup.cloths.push_back(std::move(cloth));
   }
   // Handles index the ORIGINAL mesh; RefineMesh keeps original vertices first, so the indices

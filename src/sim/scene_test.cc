@@ -221,6 +221,72 @@ TEST_F(SceneFiles, UnknownKeysWarnNamingKeyAndFile) {
   EXPECT_NE(w.list[1].find("not supported"), std::string::npos);
 }
 
+TEST_F(SceneFiles, ArcSimsTimingFormsEndAtTheFirstLimitReached) {
+  auto scene = [&](const std::string& name, const std::string& timing) {
+    return Write("conf/" + name, "{" + timing + ", \"cloths\": [{\"mesh\": \"meshes/quad.obj\", \"materials\": "
+                                 "[{\"data\": \"" + material_ + "\"}]}]}");
+  };
+  // ArcSim's other form: a time step, the steps per saved frame, and the duration.
+  Warnings w;
+  const Scene a = LoadScene(scene("a.json", "\"timestep\": 0.005, \"save_frames\": 8, \"duration\": 2"), w.sink());
+  EXPECT_TRUE(w.list.empty()) << w.list[0];
+  EXPECT_DOUBLE_EQ(a.time_step(), 0.005);  // was the default frame time 0.04: 8x too coarse
+  EXPECT_EQ(a.frame_steps, 8);
+  EXPECT_DOUBLE_EQ(a.frame_time, 0.04);
+  EXPECT_DOUBLE_EQ(a.duration, 2);
+  // end_time and end_frame: whichever comes first (end_frame alone used to win).
+  EXPECT_NEAR(LoadScene(scene("b.json", "\"frame_time\": 0.04, \"end_time\": 0.08, \"end_frame\": 1000")).duration,
+              0.08, 1e-12);
+  EXPECT_NEAR(LoadScene(scene("c.json", "\"frame_time\": 0.04, \"end_time\": 5, \"end_frame\": 10")).duration, 0.4,
+              1e-12);
+  // A limit out of range is named by the key that set it.
+  const std::string d = scene("d.json", "\"frame_time\": 0.04, \"end_frame\": 3000000");
+  ExpectErrorNaming([&] { LoadScene(d); }, {d, "end_frame", "at most 86400 s"});
+}
+
+TEST_F(SceneFiles, DisabledArcSimModulesAreSwitchedOffOrNamed) {
+  Warnings w;
+  std::string text = SceneText(", \"disable\": [\"strainlimiting\", \"remeshing\", \"proximity\", \"popfilter\"]",
+                               "\"remeshing\": {\"size\": [0.1, 0.3]},");
+  text.replace(text.find("\"thicken\": 2"), 12, "\"thicken\": 2, \"strain_limits\": [0.95, 1.05]");
+  const std::string path = Write("conf/s.json", text);
+  const Scene s = LoadScene(path, w.sink());
+  ASSERT_EQ(w.list.size(), 1u);
+  EXPECT_NE(w.list[0].find("disable[3]"), std::string::npos) << w.list[0];
+  EXPECT_FALSE(s.cloths[0].materials[0].has_strain_limits);
+  EXPECT_FALSE(s.cloths[0].remeshing.present);
+  const SceneSetup setup = BuildScene(s);
+  EXPECT_FALSE(setup.cloths[0].options.self_collision);
+  EXPECT_EQ(setup.cloths[0].options.strain_min, SimOptions().strain_min);
+  EXPECT_EQ(setup.cloths[0].options.strain_max, SimOptions().strain_max);
+  EXPECT_EQ(setup.cloths[0].mesh.V.rows(), 4);  // not refined
+  // Without the list the same scene keeps them.
+  const Scene kept = LoadScene(Write("conf/kept.json", SceneText("", "\"remeshing\": {\"size\": [0.1, 0.3]},")));
+  EXPECT_TRUE(kept.cloths[0].remeshing.present);
+  EXPECT_TRUE(BuildScene(kept).cloths[0].options.self_collision);
+  const Scene collision = LoadScene(Write("conf/col.json", SceneText(", \"disable\": [\"collision\"]")));
+  EXPECT_EQ(BuildScene(collision).cloths[0].options.crossing_sweeps, 0);
+  const std::string bad = Write("conf/bad.json", SceneText(", \"disable\": [\"colision\"]"));
+  ExpectErrorNaming([&] { LoadScene(bad); }, {bad, "disable[0]", "unknown module 'colision'"});
+}
+
+TEST_F(SceneFiles, ArcSimScenesThisSimulatorReadsDifferentlySaySo) {
+  // A remeshing block without size (ArcSim's default [-inf, inf] refines nothing), motions from a
+  // file, and a handle by label: the first two load with a warning, the last is named.
+  Warnings w;
+  const Scene s = LoadScene(Write("conf/s.json", SceneText(", \"motions\": {\"motfile\": \"m.txt\", \"fps\": 30}",
+                                                           "\"remeshing\": {\"refine_angle\": 0.3},")),
+                            w.sink());
+  ASSERT_EQ(w.list.size(), 2u);
+  EXPECT_NE(w.list[0].find("motions"), std::string::npos) << w.list[0];
+  EXPECT_NE(w.list[1].find("remeshing.size"), std::string::npos) << w.list[1];
+  EXPECT_FALSE(s.cloths[0].remeshing.present);
+  std::string labelled = SceneText();
+  labelled.replace(labelled.find("\"nodes\": [0, 3]"), 15, "\"label\": 1");
+  const std::string label = Write("conf/label.json", labelled);
+  ExpectErrorNaming([&] { LoadScene(label); }, {label, "handles[0].label", "not supported"});
+}
+
 TEST_F(SceneFiles, WrongTypesNameTheJsonPathAndFile) {
   const std::string a = Write("conf/a.json", SceneText(", \"wind\": {\"velocity\": [1, \"x\", 0]}"));
   ExpectErrorNaming([&] { LoadScene(a); }, {a, "wind.velocity[1]", "expected a number"});

@@ -96,11 +96,19 @@ class ClipBufferFaultsTest(unittest.TestCase):
         self.assertTrue(first)
         for c in first:
             self.assertGreater(c.wind_count, 0, "clip %d unlabelled" % c.sequence)
+            self.assertEqual(c.wind_direction_frame_id, "anemometer")
 
-        # 2. A reading an hour ahead of the clock is refused; later clips keep their labels.
+        # 2. A reading an hour ahead of the clock is refused; later clips keep their labels. A
+        # direction in another frame (true wind in ENU beside the instrument's) is left out of the
+        # mean direction, its speed kept.
         def future(frame, stamp):
             if frame == self.frame_at_future:
                 self.wind_pub.publish(reading(stamp + rospy.Duration(3600), 50.0))
+            if frame == self.frame_at_future + 1:
+                other = reading(stamp, 4.0)
+                other.header.frame_id = "enu"
+                other.direction = 1.5
+                self.wind_pub.publish(other)
         self.frame_at_future = self.frame + 5
         with self.lock:
             before = len(self.clips)
@@ -109,6 +117,8 @@ class ClipBufferFaultsTest(unittest.TestCase):
                                           "the future reading counted")
         self.assertIn("after the clock refused", status.message)
         self.assertIn("3600", status.message)
+        self.assertEqual(values["directions in another frame (left out)"], "1")
+        self.assertEqual(values["wind direction frame"], "anemometer")
         deadline = rospy.get_time() + 10
         while rospy.get_time() < deadline:
             with self.lock:
@@ -120,6 +130,7 @@ class ClipBufferFaultsTest(unittest.TestCase):
         for c in later:
             self.assertGreater(c.wind_count, 0, "clip %d unlabelled" % c.sequence)
             self.assertAlmostEqual(c.wind_mean, 4.0, places=5)
+            self.assertAlmostEqual(c.wind_direction_mean, 0.0, places=9)
 
         # 3. Time goes back 30 s (a bag looped): the waiting clips are labelled, not dropped.
         self.stream(0.6)  # leaves clips waiting for their label (delay 0.5 s)

@@ -11,9 +11,15 @@ while [ $# -gt 0 ] && [ "$1" != "--" ]; do opts+=("$1"); shift; done
 source "$(dirname "$0")/clothwind_cli.sh"
 # Made again when the CLI or this script is newer, or when made with other options (a .test file
 # edited without a rebuild would otherwise replay the old bag).
+# Under a lock: two runs of one test in one build (ctest --repeat, a second terminal) would
+# otherwise write the same bag at once, and one would replay the other's half-written file.
 recipe="${opts[*]}"
-if [ ! -f "$bag" ] || [ "$cli" -nt "$bag" ] || [ "$0" -nt "$bag" ] || [ "$(cat "$bag.recipe" 2>/dev/null || true)" != "$recipe" ]; then
-  "$cli" make-session --out "$bag" "${opts[@]}"
-  echo "$recipe" > "$bag.recipe"
-fi
+(
+  flock 9
+  if [ ! -f "$bag" ] || [ "$cli" -nt "$bag" ] || [ "$0" -nt "$bag" ] || [ "$(cat "$bag.recipe" 2>/dev/null || true)" != "$recipe" ]; then
+    rm -f "$bag.recipe"  # the recipe is written last: a run stopped midway is made again
+    "$cli" make-session --out "$bag" "${opts[@]}"
+    echo "$recipe" > "$bag.recipe"
+  fi
+) 9> "$bag.lock"
 exec "$@"

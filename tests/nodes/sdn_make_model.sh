@@ -23,9 +23,14 @@ while [ $# -gt 0 ] && [ "$1" != "--" ]; do opts+=("$1"); shift; done
 source "$(dirname "$0")/clothwind_cli.sh"
 # The model is made again when the CLI or this script is newer, or when it was made with other
 # options (a .test file edited without a rebuild would otherwise run against the old model).
+# Under a lock: two runs of one test in one build would otherwise train into the same folder at once.
 recipe="toy=$toy half=$half ${opts[*]}"
+mkdir -p "$(dirname "$model")"
+exec 9> "$model.lock"
+flock 9
 made_with="$(cat "$model.recipe" 2>/dev/null || true)"
 if [ ! -f "$model" ] || [ "$cli" -nt "$model" ] || [ "$0" -nt "$model" ] || [ "$made_with" != "$recipe" ]; then
+  rm -f "$model.recipe"  # written last: a run stopped midway is made again
   if [ -n "$toy" ]; then
     "$cli" make-toy-dataset --out "$toy" --clips 100 --frames 60 --size 32 --seed 1 >&2
     if [ "$half" = 1 ]; then
@@ -40,4 +45,5 @@ if [ ! -f "$model" ] || [ "$cli" -nt "$model" ] || [ "$0" -nt "$model" ] || [ "$
   fi
   echo "$recipe" > "$model.recipe"
 fi
+exec 9>&-  # the node does not hold the lock
 exec "$@"

@@ -1,0 +1,36 @@
+#include "data/dataset_index.h"
+
+#include <gtest/gtest.h>
+
+#include "render/render_params.h"
+
+namespace clothwind::data {
+namespace {
+
+// A label is the same on every machine: a background photo read from /mnt/a/photos or
+// /home/b/photos is recorded by its file name, and the label's ζ reads back as the one rendered
+// but for that folder.
+TEST(SimExampleLabelTest, RecordsTheBackgroundPhotoByItsFileNameAlone) {
+  SimulationSample s;
+  s.theta.fill(0.5);
+  render::RenderParams zeta = render::SampleRenderParams(render::SceneKind::kFlag, 3);
+  ClipInfo info;
+  info.dataset = "flag";
+  info.split = "train";
+  zeta.background_image = "/mnt/a/photos/meadow.jpg";
+  const nlohmann::json a = SimExampleLabel("flag-000001-v0", s, zeta, info);
+  zeta.background_image = "/home/b/photos/meadow.jpg";
+  const nlohmann::json b = SimExampleLabel("flag-000001-v0", s, zeta, info);
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(a["zeta"]["background_image"], "meadow.jpg");
+  render::RenderParams back = LabelZeta(a);
+  EXPECT_EQ(back.background_image, "meadow.jpg");
+  back.background_image = zeta.background_image;
+  EXPECT_EQ(render::ToJson(back), render::ToJson(zeta));
+  // Procedural backdrops name none.
+  zeta.background_image.clear();
+  EXPECT_EQ(SimExampleLabel("flag-000001-v0", s, zeta, info)["zeta"]["background_image"], "");
+}
+
+}  // namespace
+}  // namespace clothwind::data

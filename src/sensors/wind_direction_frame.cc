@@ -1,0 +1,24 @@
+#include "sensors/wind_direction_frame.h"
+
+#include <cmath>
+#include <utility>
+
+namespace clothwind::sensors {
+
+WindDirectionFrameGate::WindDirectionFrameGate(std::string frame_id)
+    : frame_id_(std::move(frame_id)), adopt_(frame_id_.empty()) {}
+
+bool WindDirectionFrameGate::Admit(const std::string& frame_id, double direction) {
+  if (std::isnan(direction)) return true;
+  if (adopt_) {
+    frame_id_ = frame_id;
+    adopt_ = false;
+    return true;
+  }
+  if (frame_id == frame_id_) return true;
+  ++rejected_;
+  last_rejected_frame_ = frame_id;
+  return false;
+}
+
+}  // namespace clothwind::sensors
