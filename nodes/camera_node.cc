@@ -25,6 +25,7 @@
 #include <image_transport/image_transport.h>
 #include <ros/ros.h>
 
+#include "ros_bridge/bool_param.h"
 #include "ros_bridge/image_conversions.h"
 #include "ros_bridge/wall_diagnostics.h"
 #include "sensors/frame_source.h"
@@ -62,20 +63,9 @@ FrameSourceOptions ReadOptions(ros::NodeHandle& pnh) {
   if (o.source == "folder") pnh.param("rate", o.fps, o.fps);
   pnh.param("buffers", o.buffers, 4);
   pnh.param("timeout", o.timeout_s, 2.0);
-  pnh.param("loop", o.loop, false);
-  if (pnh.hasParam("auto_exposure")) {
-    // `_auto_exposure:=0` arrives as an int, which getParam(bool) refuses (leaving it on): read
-    // either kind.
-    XmlRpc::XmlRpcValue v;
-    pnh.getParam("auto_exposure", v);
-    if (v.getType() == XmlRpc::XmlRpcValue::TypeBoolean) {
-      o.auto_exposure = static_cast<bool>(v) ? 1 : 0;
-    } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt && (static_cast<int>(v) == 0 || static_cast<int>(v) == 1)) {
-      o.auto_exposure = static_cast<int>(v);
-    } else {
-      throw std::invalid_argument("~auto_exposure must be true/false or 1/0");
-    }
-  }
+  o.loop = clothwind::ros_bridge::BoolParam(pnh, "loop", false);
+  if (pnh.hasParam("auto_exposure"))  // unset: the camera's own setting (-1)
+    o.auto_exposure = clothwind::ros_bridge::BoolParam(pnh, "auto_exposure", false) ? 1 : 0;
   pnh.param("exposure_absolute", o.exposure_absolute, -1);
   pnh.param("gain", o.gain, -1);
   return o;

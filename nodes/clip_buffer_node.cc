@@ -24,6 +24,7 @@
 #include <clothwind/Clip.h>
 #include <clothwind/WindMeasurement.h>
 
+#include "ros_bridge/bool_param.h"
 #include "ros_bridge/clip_conversions.h"
 #include "sensors/async_dataset_writer.h"
 #include "sensors/clip_pipeline.h"
@@ -41,7 +42,7 @@ class ClipBufferNode {
     pnh.param("num_frames", o.num_frames, o.num_frames);
     pnh.param("stride", o.stride, o.stride);
     pnh.param("size", o.size, o.size);
-    pnh.param("colour", o.colour, o.colour);
+    o.colour = ros_bridge::BoolParam(pnh, "colour", o.colour);
     pnh.param("gap_tolerance", o.gap_tolerance, o.gap_tolerance);
     pnh.param("label_window", o.label_window, o.label_window);
     pnh.param("label_delay", o.label_delay, o.label_delay);

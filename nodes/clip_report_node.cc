@@ -24,6 +24,7 @@
 #include <clothwind/WindEstimate.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "ros_bridge/bool_param.h"
 #include "sensors/dataset_writer.h"
 #include "sensors/estimate_report.h"
 
@@ -45,7 +46,7 @@ class ClipReport {
     pnh.param("max_wall", max_wall_, 0.0);
     pnh.param("start_timeout", start_timeout_, 60.0);
     pnh.param("summary", summary_path_, std::string());
-    pnh.param("estimates", want_estimates_, false);
+    want_estimates_ = clothwind::ros_bridge::BoolParam(pnh, "estimates", false);
     pnh.param("estimate_plot", estimate_plot_path_, std::string());
     auto finite = [](double v) { return std::isfinite(v); };
     if (!(finite(idle_timeout_) && idle_timeout_ > 0))

@@ -45,7 +45,10 @@ std::vector<sensors::SyntheticReading> SimulateAnemometer(const sim::WindField& 
     }
     sensors::SyntheticReading r;
     double reading = sum / per_interval;
-    reading += (p.noise_std + p.noise_relative * reading) * rng.Normal();
+    // Noise only while the cups turn: stopped cups read 0 (noise clamped at 0 gave calm air a
+    // +0.02 m/s bias). Drawn either way, so the stream, and every later reading, stays the same.
+    const double noise = (p.noise_std + p.noise_relative * reading) * rng.Normal();
+    if (reading > 0) reading += noise;
     r.speed = std::round(std::max(0.0, reading) * 100.0) / 100.0;
     const double phi = std::atan2(vane.y(), vane.x()) * 180.0 / M_PI;
     double angle = std::fmod(p.direction_from - phi, 360.0);

@@ -93,13 +93,15 @@ std::string EstimateTable(const std::vector<EstimateRow>& rows, double t0) {
                 "error", "latency");
   out += line;
   for (const EstimateRow& r : SortedByEnd(rows)) {
+    // 14 characters on screen either way, under the heading's 14 ("±" is two bytes, so the
+    // column is written as it is rather than padded by printf, which counts bytes).
     char estimate[40];
     if (std::isfinite(r.speed_std)) {
-      std::snprintf(estimate, sizeof estimate, "%6.2f \xC2\xB1%5.2f", r.speed, r.speed_std);
+      std::snprintf(estimate, sizeof estimate, "%6.2f \xC2\xB1%6.2f", r.speed, r.speed_std);
     } else {
-      std::snprintf(estimate, sizeof estimate, "%6.2f       ", r.speed);
+      std::snprintf(estimate, sizeof estimate, "%6.2f        ", r.speed);
     }
-    std::snprintf(line, sizeof line, "%5llu  %10.2f  %16s  %10.2f  %+9.2f  %6.1fms\n",
+    std::snprintf(line, sizeof line, "%5llu  %10.2f  %s  %10.2f  %+9.2f  %6.1fms\n",
                   static_cast<unsigned long long>(r.sequence), r.end - t0, estimate, r.reference,
                   r.speed - r.reference, r.latency * 1e3);
     out += line;

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -80,6 +82,26 @@ TEST(EstimateReportTest, TableSortedByTimeWithSummary) {
   EXPECT_NE(table.find("+1.00"), std::string::npos) << table;  // error of clip 7
   EXPECT_NE(table.find("RMSE 0.791 m/s"), std::string::npos) << table;  // sqrt((1 + 0.25) / 2)
   EXPECT_NE(table.find("Acc@0.5 0.500"), std::string::npos) << table;
+}
+
+// Columns line up on screen: every row as wide as the heading in characters (UTF-8 "±" is two
+// bytes and one character), with and without a std.
+TEST(EstimateReportTest, TableColumnsLineUpOnScreen) {
+  const std::vector<EstimateRow> rows = {{1, 101.0, 5.0, 0.25, 4.0, 0.02}, {2, 102.0, 3.0, kNaN, 3.5, 0.02}};
+  const std::string table = EstimateTable(rows, 100.0);
+  auto characters = [](const std::string& line) {
+    size_t n = 0;
+    for (unsigned char c : line) n += (c & 0xC0) != 0x80;  // count all but continuation bytes
+    return n;
+  };
+  std::vector<std::string> lines;
+  size_t start = 0;
+  for (size_t end; (end = table.find('\n', start)) != std::string::npos; start = end + 1)
+    lines.push_back(table.substr(start, end - start));
+  ASSERT_GE(lines.size(), 3u) << table;
+  EXPECT_EQ(characters(lines[1]), characters(lines[0])) << table;
+  EXPECT_EQ(characters(lines[2]), characters(lines[0])) << table;
+  EXPECT_NE(lines[1].find("\xC2\xB1"), std::string::npos) << table;
 }
 
 TEST(EstimateReportTest, JsonRoundTripsAndWritesNaNAsNull) {

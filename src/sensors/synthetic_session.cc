@@ -3,19 +3,21 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <random>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
+
+#include "common/random.h"
 
 namespace clothwind::sensors {
 namespace {
 
 // One exact Ornstein-Uhlenbeck step of length dt towards mean mu.
-double OuStep(double x, double mu, double sigma, double tau, double dt, std::mt19937_64& rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
+// The project's Rng, not <random>'s distributions (implementation-defined): a session is the
+// same with every standard library.
+double OuStep(double x, double mu, double sigma, double tau, double dt, Rng& rng) {
   const double a = std::exp(-dt / tau);
-  return mu + (x - mu) * a + sigma * std::sqrt(std::max(0.0, 1.0 - a * a)) * n(rng);
+  return mu + (x - mu) * a + sigma * std::sqrt(std::max(0.0, 1.0 - a * a)) * rng.Normal();
 }
 
 void Check(bool ok, const std::string& what) {
@@ -27,7 +29,7 @@ void Check(bool ok, const std::string& what) {
 SyntheticWind::SyntheticWind(const SyntheticSessionOptions& o) : dt_(0.02) {
   Check(o.duration > 0.0, "duration must be > 0 s");
   Check(o.wind_drift_tau > 0.0 && o.turbulence_tau > 0.0, "correlation times must be > 0 s");
-  std::mt19937_64 rng(o.seed);
+  Rng rng(o.seed);
   const size_t n = static_cast<size_t>(std::ceil((o.duration + 5.0) / dt_)) + 1;
   speed_.resize(n);
   angle_.resize(n);
@@ -146,13 +148,12 @@ SyntheticSession::SyntheticSession(const SyntheticSessionOptions& o,
   Check(o.drop_probability >= 0.0 && o.drop_probability < 1.0, "drop probability must be in [0, 1)");
   if (!generator_) generator_ = std::make_shared<ProceduralFlagGenerator>();
   // Frame stamps use their own random stream so changing the wind settings keeps the timing.
-  std::mt19937_64 rng(o.seed * 0x9E3779B97F4A7C15ull + 1);
-  std::normal_distribution<double> jitter(0.0, o.frame_jitter > 0.0 ? o.frame_jitter : 1.0);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  Rng rng(o.seed * 0x9E3779B97F4A7C15ull + 1);
   const auto frames = static_cast<size_t>(std::floor(o.duration * o.fps));
   for (size_t i = 0; i < frames; ++i) {
-    const double j = o.frame_jitter > 0.0 ? std::clamp(jitter(rng), -2 * o.frame_jitter, 2 * o.frame_jitter) : 0.0;
-    const bool drop = uniform(rng) < o.drop_probability;
+    const double jitter = o.frame_jitter * rng.Normal();  // drawn either way: the stream stays in step
+    const double j = o.frame_jitter > 0.0 ? std::clamp(jitter, -2 * o.frame_jitter, 2 * o.frame_jitter) : 0.0;
+    const bool drop = rng.Uniform() < o.drop_probability;
     if (!drop) frame_stamps_.push_back(o.start_time + i / o.fps + j);
   }
   const auto sentences = static_cast<size_t>(std::floor(o.duration * o.anemometer_rate));

@@ -173,26 +173,33 @@ Mesh ReadObj(const std::string& path, bool topology) {
   for (size_t f = 0; f < faces.size(); ++f) mesh.F.row(f) = faces[f].transpose();
   // Material coordinates: the vt of each vertex when all its corners agree, else ArcSim's x,y.
   mesh.U = mesh.V.leftCols(2);
+  // A vertex no face uses (exporters leave them; ValidateMesh names them where they matter) keeps
+  // its x,y; the errors name the `f` line where a vertex's corners disagree or lack a vt.
   bool any_tex = false;
-  std::vector<int> vt_of(nv, -1);
+  std::vector<int> vt_of(nv, -1), vt_line(nv, 0), bare_line(nv, 0);
   for (size_t f = 0; f < faces.size(); ++f) {
     for (int c = 0; c < 3; ++c) {
       const int t = face_tex[f][c], v = faces[f][c];
-      if (t < 0) continue;
+      if (t < 0) {
+        if (bare_line[v] == 0) bare_line[v] = face_lines[f];
+        continue;
+      }
       any_tex = true;
       if (vt_of[v] >= 0 && (texcoords[vt_of[v]] - texcoords[t]).norm() > 1e-12)
-        throw std::runtime_error(path + ": vertex " + std::to_string(v + 1) +
-                                 " has different texture coordinates in different faces "
-                                 "(texture seams are not supported)");
+        ObjError(path, face_lines[f], "vertex " + std::to_string(v + 1) + " has texture coordinate " +
+                                          std::to_string(t + 1) + " here and " + std::to_string(vt_of[v] + 1) +
+                                          " on line " + std::to_string(vt_line[v]) +
+                                          " (texture seams are not supported)");
+      if (vt_of[v] < 0) vt_line[v] = face_lines[f];
       vt_of[v] = t;
     }
   }
   if (any_tex) {
     for (int v = 0; v < nv; ++v) {
-      if (vt_of[v] < 0)
-        throw std::runtime_error(path + ": vertex " + std::to_string(v + 1) +
-                                 " has no texture coordinate while others do");
-      mesh.U.row(v) = texcoords[vt_of[v]].transpose();
+      if (bare_line[v] > 0)
+        ObjError(path, bare_line[v], "vertex " + std::to_string(v + 1) +
+                                         " has no texture coordinate here while other corners have one");
+      if (vt_of[v] >= 0) mesh.U.row(v) = texcoords[vt_of[v]].transpose();
     }
   }
   ValidateMesh(mesh, path, face_lines, topology);

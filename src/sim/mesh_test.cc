@@ -132,6 +132,21 @@ TEST(ValidateMeshTest, TopologyErrorsNameTheObjLineAndItsVertexNumbers) {
   // A mesh only drawn (an OBJ frame to render) is not held to what the simulator needs.
   EXPECT_NO_THROW(ReadObj(flipped, /*topology=*/false));
   EXPECT_NO_THROW(ReadObj(stray, /*topology=*/false));
+  // With texture coordinates: a stray vertex is still named as one (it was "has no texture
+  // coordinate while others do"), and a drawn mesh keeps it; seams and corners without a vt
+  // name the f line.
+  const std::string textured = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 2 0\nvt 2 2\nvt 0 2\n"
+                               "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+  const Mesh tex = ReadObj(WriteText("tex.obj", textured));
+  EXPECT_EQ(tex.U(2, 0), 2.0);
+  const std::string tex_stray = WriteText("tex_stray.obj", textured + "v 9 9 0\n");
+  ExpectThrowContaining([&] { ReadObj(tex_stray); }, tex_stray + ": vertex 5 belongs to no face");
+  EXPECT_EQ(ReadObj(tex_stray, /*topology=*/false).U(4, 0), 9.0);
+  const std::string seam = WriteText("seam.obj", textured + "vt 5 5\nf 1/5 4/4 3/3\n");
+  ExpectThrowContaining([&] { ReadObj(seam, false); }, seam + ":12: vertex 1 has texture coordinate 5 here and 1 on line 9");
+  const std::string bare = WriteText("bare.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                                                 "f 1/1 2/2 3/3\nf 1 3 4\n");
+  ExpectThrowContaining([&] { ReadObj(bare); }, bare + ":9: vertex 1 has no texture coordinate here");
   // Without lines (a mesh built in code), 0-based indices.
   Mesh m = Rectangle();
   m.F.row(1) = m.F.row(1).reverse().eval();
