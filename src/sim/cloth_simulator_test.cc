@@ -356,6 +356,42 @@ TEST(ClothSimulatorTest, ForcesIncludeGravityAndArcSimWind) {
   EXPECT_NEAR(sim.masses().sum(), 0.284 * area, 1e-12);
 }
 
+// The central difference of the simulator's forces along dx at x (at rest), step h: what the
+// force Jacobian times dx must be where its form is exact.
+Eigen::MatrixX3d ForcesCentralDifference(ClothSimulator& sim, const Eigen::MatrixX3d& x, const Eigen::MatrixX3d& dx,
+                                         double h) {
+  const Eigen::MatrixX3d still = Eigen::MatrixX3d::Zero(x.rows(), 3);
+  sim.SetState(x + h * dx, still);
+  const Eigen::MatrixX3d plus = sim.Forces();
+  sim.SetState(x - h * dx, still);
+  const Eigen::MatrixX3d minus = sim.Forces();
+  sim.SetState(x, still);
+  return (plus - minus) / (2 * h);
+}
+
+// Expects the simulator's forces at x (at rest) to be minus the central-difference gradient of
+// `potential` (the terms of Energy() that have a force), coordinate by coordinate, step h [m].
+void ExpectForcesAreMinusTheGradient(ClothSimulator& sim, const Eigen::MatrixX3d& x,
+                                     const std::function<double(const ClothEnergy&)>& potential, double h) {
+  const Eigen::MatrixX3d still = Eigen::MatrixX3d::Zero(x.rows(), 3);
+  sim.SetState(x, still);
+  const Eigen::MatrixX3d f = sim.Forces();
+  auto at = [&](const Eigen::MatrixX3d& y) {
+    sim.SetState(y, still);
+    return potential(sim.Energy());
+  };
+  Eigen::MatrixX3d g(x.rows(), 3);
+  for (int i = 0; i < x.rows(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      Eigen::MatrixX3d a = x, z = x;
+      a(i, c) += h;
+      z(i, c) -= h;
+      g(i, c) = -(at(a) - at(z)) / (2 * h);
+    }
+  EXPECT_LT((f - g).norm(), 1e-6 * f.norm()) << "|F| " << f.norm() << ", |F + dE/dx| " << (f - g).norm();
+  sim.SetState(x, still);
+}
+
 TEST(ClothSimulatorTest, AssembledForcesAreMinusTheEnergysGradient) {
   // The element tests check each force against its own energy; this checks the simulator's
   // assembly (bending is written inline in the force loop, in both bending modes) against central
@@ -373,24 +409,8 @@ TEST(ClothSimulatorTest, AssembledForcesAreMinusTheEnergysGradient) {
     SimOptions o = QuietOptions();
     o.bending_solve = mode;
     ClothSimulator sim(m, material, o, nullptr);
-    const Eigen::MatrixX3d still = Eigen::MatrixX3d::Zero(x.rows(), 3);
-    sim.SetState(x, still);
-    const Eigen::MatrixX3d f = sim.Forces();
-    auto potential = [&](const Eigen::MatrixX3d& y) {
-      sim.SetState(y, still);
-      const ClothEnergy e = sim.Energy();
-      return e.gravitational + e.stretching + e.bending;
-    };
-    Eigen::MatrixX3d g(x.rows(), 3);
-    const double h = 1e-6;
-    for (int i = 0; i < x.rows(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        Eigen::MatrixX3d a = x, z = x;
-        a(i, c) += h;
-        z(i, c) -= h;
-        g(i, c) = -(potential(a) - potential(z)) / (2 * h);
-      }
-    EXPECT_LT((f - g).norm(), 1e-6 * f.norm()) << "|F| " << f.norm() << ", |F + dE/dx| " << (f - g).norm();
+    ExpectForcesAreMinusTheGradient(
+        sim, x, [](const ClothEnergy& e) { return e.gravitational + e.stretching + e.bending; }, 1e-6);
   }
 }
 
@@ -411,12 +431,7 @@ TEST(ClothSimulatorTest, AssembledJacobianIsTheForcesDerivativeWhereItsFormIsExa
     for (int c = 0; c < 3; ++c) dx(i, c) = std::sin(12.9898 * i + 78.233 * c);  // fixed, unstructured
   sim.SetState(x, still);
   const Eigen::MatrixX3d jdx = sim.ForceJacobianTimes(dx);
-  const double h = 1e-7;
-  sim.SetState(x + h * dx, still);
-  const Eigen::MatrixX3d plus = sim.Forces();
-  sim.SetState(x - h * dx, still);
-  const Eigen::MatrixX3d minus = sim.Forces();
-  const Eigen::MatrixX3d fd = (plus - minus) / (2 * h);
+  const Eigen::MatrixX3d fd = ForcesCentralDifference(sim, x, dx, 1e-7);
   EXPECT_LT((jdx - fd).norm(), 1e-5 * fd.norm()) << "|J dx| " << jdx.norm() << ", |FD| " << fd.norm();
   // Bending contributes (it is in the matrix, implicit): without it the match fails.
   o.bending_solve = BendingSolve::kExplicit;
@@ -462,21 +477,9 @@ TEST(ClothSimulatorTest, RepulsionInTheAssembledForcesIsMinusItsEnergysGradient)
   apart.bottomRows(x.rows() / 2).col(2).array() += 2e-3;
   sim.SetState(apart, still);
   EXPECT_LT(sim.Energy().repulsion, repulsion);
-  auto potential = [&](const Eigen::MatrixX3d& y) {
-    sim.SetState(y, still);
-    const ClothEnergy e = sim.Energy();
-    return e.stretching + e.bending + e.repulsion;
-  };
-  Eigen::MatrixX3d g(x.rows(), 3);
-  const double h = 1e-7;  // far below the distances at which a pair switches on or off
-  for (int i = 0; i < x.rows(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      Eigen::MatrixX3d a = x, z = x;
-      a(i, c) += h;
-      z(i, c) -= h;
-      g(i, c) = -(potential(a) - potential(z)) / (2 * h);
-    }
-  EXPECT_LT((f - g).norm(), 1e-6 * f.norm()) << "|F| " << f.norm() << ", |F + dE/dx| " << (f - g).norm();
+  // A step far below the distances at which a pair switches on or off.
+  ExpectForcesAreMinusTheGradient(
+      sim, x, [](const ClothEnergy& e) { return e.stretching + e.bending + e.repulsion; }, 1e-7);
   // Without the repulsion the forces differ: the check above is not about the sheets alone.
   SimOptions apart_options = o;
   apart_options.self_collision = false;
@@ -502,12 +505,7 @@ TEST(ClothSimulatorTest, AssembledRepulsionJacobianIsTheForcesDerivativeAlongThe
   dx.bottomRows(x.rows() / 2).col(2).setOnes();
   sim.SetState(x, still);
   const Eigen::MatrixX3d jdx = sim.ForceJacobianTimes(dx);
-  const double h = 1e-7;
-  sim.SetState(x + h * dx, still);
-  const Eigen::MatrixX3d plus = sim.Forces();
-  sim.SetState(x - h * dx, still);
-  const Eigen::MatrixX3d minus = sim.Forces();
-  const Eigen::MatrixX3d fd = (plus - minus) / (2 * h);
+  const Eigen::MatrixX3d fd = ForcesCentralDifference(sim, x, dx, 1e-7);
   ASSERT_GT(fd.norm(), 1.0) << "the sheets are not in contact";
   EXPECT_LT((jdx - fd).norm(), 1e-5 * fd.norm()) << "|J dx| " << jdx.norm() << ", |FD| " << fd.norm();
   // The lower sheet is pushed too (through the blocks between a vertex and another sheet's face).
