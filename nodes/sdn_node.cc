@@ -79,13 +79,16 @@ class SdnNode {
     // paused and jumps back when it restarts.
     diag_timer_ =
         nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { updater_.force_update(); });
+    // Subscribed before the model loads (libtorch, the weights and the warm-up take seconds):
+    // clips that come meanwhile wait in the queue, as callbacks run only once spin() starts, rather
+    // than going to no subscriber at all (a replay starts as soon as the bag's topics have theirs).
+    clip_sub_ = nh.subscribe("clips", queue_size, &SdnNode::OnClip, this);
     TryLoad();
     if (!predictor_) {
       load_timer_ = nh.createWallTimer(ros::WallDuration(2.0), [this](const ros::WallTimerEvent&) {
         if (!predictor_) TryLoad();
       });
     }
-    clip_sub_ = nh.subscribe("clips", queue_size, &SdnNode::OnClip, this);
   }
 
  private:
@@ -121,6 +124,12 @@ class SdnNode {
       end_on_deg = ParameterError("~end_on_angle must be 0 to 90 degrees, got " + std::to_string(end_on_deg), 20);
     }
     end_on_ = end_on_deg * M_PI / 180.0;
+    if (std::isfinite(camera_heading_) && std::abs(camera_heading_) > 2 * M_PI) {
+      ParameterError("~camera_heading is " + std::to_string(camera_heading_) +
+                         ", beyond 2 pi: it is in radians (degrees given?); ~flag_flies wind is not followed",
+                     0);
+      camera_heading_ = std::numeric_limits<double>::quiet_NaN();
+    }
     if (name == "wind") {
       follow_wind_ = std::isfinite(camera_heading_);
       if (!follow_wind_) {
@@ -225,6 +234,7 @@ class SdnNode {
       if (want_maps && !maps.power.empty()) PublishMaps(*clip, maps);
       ++estimates_;
       turned_ += p.turned;
+      undecided_ += p.undecided;
       latencies_.push_back(latency);
       if (latencies_.size() > 50) latencies_.pop_front();
       last_estimate_wall_ = ros::WallTime::now().toSec();
@@ -374,6 +384,7 @@ class SdnNode {
     }
     if (follow_wind_) stat.add("clips with the wind end-on or unknown", wind_unknown_);
     stat.add("clips turned round (flag flying left)", turned_);
+    stat.add("clips the fly judge could not tell (the last way kept)", undecided_);
     stat.add("trailing mean [m/s]", trailing_.Mean());
     stat.add("clips in the trailing mean", trailing_.Count());
     stat.add("malformed clips", errors_);
@@ -405,7 +416,8 @@ class SdnNode {
   std::deque<double> latencies_, stamps_, ages_;  // ages_: [s] ROS time from clip end to its estimate
   clothwind::sensors::TrailingMean trailing_;
   std::deque<std::pair<double, ros::Time>> starts_;  // (clip end [s], clip start) of the averaged clips
-  uint64_t estimates_ = 0, errors_ = 0, model_errors_ = 0, dropped_ = 0, turned_ = 0, wind_unknown_ = 0;
+  uint64_t estimates_ = 0, errors_ = 0, model_errors_ = 0, dropped_ = 0, turned_ = 0, undecided_ = 0,
+           wind_unknown_ = 0;
   uint64_t missing_ = 0, mean_restarts_ = 0, last_sequence_ = 0;
   bool have_sequence_ = false;
   double last_estimate_wall_ = 0;                  // [s] wall time of the last estimate

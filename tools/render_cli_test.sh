@@ -16,10 +16,14 @@ fail() { echo "render_cli_test: FAIL: $*" >&2; exit 1; }
 before="$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")"
 
 for bad in "--start nan" "--start inf" "--start -1" "--fps 1e300" "--fps nan"; do
+  status=0
   # shellcheck disable=SC2086
-  if "$bin" render "$work/sim" --out "$work/fr" $bad --samples 1 --threads 1 >"$work/out.txt" 2>&1; then
-    fail "render $bad exited 0: $(cat "$work/out.txt")"
-  fi
+  "$bin" render "$work/sim" --out "$work/fr" $bad --samples 1 --threads 1 >"$work/out.txt" 2>&1 || status=$?
+  # Refused, not crashed (a signal is 128 + its number), with a message naming the option.
+  [ "$status" -ne 0 ] || fail "render $bad exited 0: $(cat "$work/out.txt")"
+  [ "$status" -lt 128 ] || fail "render $bad died with status $status: $(cat "$work/out.txt")"
+  option="${bad%% *}"
+  grep -q -- "${option#--}" "$work/out.txt" || fail "render $bad: the message does not name ${option#--}: $(cat "$work/out.txt")"
   [ "$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")" = "$before" ] || fail "render $bad changed the earlier run's files"
 done
 

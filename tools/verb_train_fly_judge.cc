@@ -5,6 +5,7 @@
 // ~flag_flies auto (docs/sdn.md, "Flags that fly left").
 #include <ATen/Parallel.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -24,6 +25,7 @@ namespace {
 struct JudgeArgs {
   std::string data, out;
   int windows = 3, frames = 30, threads = 2;
+  double margin = 1.0;  // scores closer to 0 tell nothing (FlyJudge::margin)
   learn::FlyJudgeTrainOptions train;
 };
 
@@ -72,7 +74,14 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
   sub->add_option("--weight-decay", a->train.weight_decay, "Adam's L2 term")->check(CLI::NonNegativeNumber)->capture_default_str();
   sub->add_option("--seed", a->train.seed, "initialisation and order")->capture_default_str();
   sub->add_option("--threads", a->threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
+  sub->add_option("--margin", a->margin,
+                  "scores closer to 0 than this tell nothing (a calm or featureless clip: camera noise scores ~0.4, "
+                  "a flying flag 5-12); 0..100")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
   return [a]() {
+    // CLI11's range lets NaN through: refused here, before the training, not after it.
+    if (!std::isfinite(a->margin)) throw std::invalid_argument("--margin must be a number in 0..100, got nan");
     {
       // The weights and their card beside them: on neither the dataset's index nor each other,
       // checked before the training, not after it.
@@ -100,10 +109,11 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
     b.unit = "epochs";
     b.rate_unit = "epochs/s";
     ProgressBar bar(b);
-    const learn::FlyJudge judge = learn::TrainFlyJudge(train.maps, a->train, [&](int epoch, int epochs, double loss) {
+    learn::FlyJudge judge = learn::TrainFlyJudge(train.maps, a->train, [&](int epoch, int epochs, double loss) {
       bar.Update(epoch, epochs, "loss " + std::to_string(loss));
     });
     bar.Finish();
+    judge.set_margin(a->margin);
 
     nlohmann::json accuracy;
     std::ostringstream table;

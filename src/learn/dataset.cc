@@ -328,15 +328,16 @@ namespace {
 
 // Whether options.flag_flies turns the clip (its first options.frames frames, cropped to `crop`)
 // round, so that its flag flies right; `score` receives the judge's (or EstimateFlyDirection's)
-// score with kAuto.
-// The frames are judged as the model will see them: cropped, resized, mirrored by mirror_clip,
-// grey (the Y of colour frames). With kAuto `resized` receives the cropped, resized frames (not
+// score with kAuto, `undecided` whether the judge could not tell (options.undecided_turns then).
+// The frames are judged as the model will see them: cropped, resized (the judge: straight to its
+// map side, as it was trained), mirrored by mirror_clip, grey (the Y of colour frames). With kAuto `resized` receives the cropped, resized frames (not
 // mirrored), which MakeSample then uses rather than resize them twice (at 300 px the resizing
 // costs more than the judging). Frames MakeSample would refuse are not judged (false, `resized`
 // left empty): its own checks then name them.
 bool TurnsToFlyRight(const std::vector<cv::Mat>& frames, const cv::Rect& crop, const SampleOptions& options,
-                     double* score, std::vector<cv::Mat>* resized) {
+                     double* score, bool* undecided, std::vector<cv::Mat>* resized) {
   *score = 0;
+  *undecided = false;
   resized->clear();
   if (options.flag_flies == FlagFlies::kRight) return false;
   if (options.flag_flies == FlagFlies::kLeft) return true;
@@ -349,13 +350,29 @@ bool TurnsToFlyRight(const std::vector<cv::Mat>& frames, const cv::Rect& crop, c
   resized->resize(options.frames);
   for (int t = 0; t < options.frames; ++t) {
     ResizeCrop(frames[t], crop, options.input_size, (*resized)[t]);
+    if (options.fly_judge) continue;  // it reads its own resizing, below
     // The grey (or Y) plane, mirrored into new data: `resized` must stay as it was cropped.
     cv::Mat g = (*resized)[t];
     if (g.channels() > 1) cv::extractChannel(g, g, 0);
     if (options.mirror_clip) cv::flip(g, grey[t], 1);
     else grey[t] = g;
   }
-  if (options.fly_judge) return options.fly_judge->Judge(grey, score) == FlyDirection::kLeft;
+  if (options.fly_judge) {
+    // The judge reads the crop resized straight to its map side, as it was trained
+    // (CollectMotionMaps), not the model's input resized again (96 px, rounded to 8 bits, then to
+    // 64: not the inputs its figures were measured on).
+    std::vector<cv::Mat> judged(options.frames);
+    for (int t = 0; t < options.frames; ++t) {
+      cv::Mat g;
+      ResizeCrop(frames[t], crop, kMotionMapSide, g);
+      if (g.channels() > 1) cv::extractChannel(g, g, 0);
+      if (options.mirror_clip) cv::flip(g, judged[t], 1);
+      else judged[t] = g;
+    }
+    const std::optional<FlyDirection> way = options.fly_judge->Judge(judged, score);
+    *undecided = !way;
+    return way ? *way == FlyDirection::kLeft : options.undecided_turns;
+  }
   const FlyDirectionCues cues = EstimateFlyDirection(grey);
   *score = cues.score;
   return cues.direction == FlyDirection::kLeft;
@@ -389,7 +406,7 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
     sample.flipped = std::uniform_int_distribution<int>(0, 1)(rng) == 1 && options.flip;
   } else {
     sample.crop = CentreSquare(w, h);
-    sample.turned = TurnsToFlyRight(frames, sample.crop, options, &sample.fly_score, &judged);
+    sample.turned = TurnsToFlyRight(frames, sample.crop, options, &sample.fly_score, &sample.undecided, &judged);
     sample.flipped = (options.mirror_clip != sample.turned) != options.mirror;
   }
   const int s = options.input_size;

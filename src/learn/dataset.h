@@ -106,6 +106,10 @@ struct SampleOptions {
   // With kAuto: the learned judge that decides (fly_judge.h; shared, it is only read). Null: the
   // clip's motion cues (EstimateFlyDirection), right for only ~91 % of FlagSim's clips.
   std::shared_ptr<const FlyJudge> fly_judge;
+  // With kAuto and a judge: whether a clip it cannot tell (FlyJudge::Judge's margin: a calm or
+  // featureless clip) is turned round. False: read as filmed; the node's Predictor passes the way
+  // it last knew (a calm spell keeps the flag's side rather than a coin's).
+  bool undecided_turns = false;
   bool flow = false;      // two more channels: each frame's optical flow from the one before (FrameFlow)
   // Side [px] the crop is resized to for the flow, which is then resized to input_size and
   // scaled with it (0: input_size). A finer flow reads the cloth's sub-pixel motion more exactly.
@@ -136,6 +140,7 @@ struct Sample {
   bool flipped = false;       // the pixels are mirrored relative to the frames given
   bool turned = false;        // SampleOptions::flag_flies mirrored the clip (its flag flies left)
   double fly_score = 0;       // with flag_flies kAuto: the fly judge's (or motion cues') score (> 0: right)
+  bool undecided = false;     // with kAuto: the judge could not tell (turned by undecided_turns)
 };
 
 // The frame window of a clip: options.first_frame when set, else uniformly random when augmenting,

@@ -183,7 +183,10 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
       for (const Sample& s : samples) pointers.push_back(&s);
       const std::vector<Prediction> predictions = predictor.Predict(pointers);
       if (pass % (mirror ? 2 : 1) == 0) {
-        for (const Sample& sample : samples) r.turned += sample.turned;
+        for (const Sample& sample : samples) {
+          r.turned += sample.turned;
+          r.undecided += sample.undecided;
+        }
       }
       for (size_t j = 0; j < samples.size(); ++j) {
         sum[j] += predictions[j].speed;
@@ -231,6 +234,7 @@ nlohmann::json EvalJson(const EvalResult& r) {
           {"model", r.config.Name()}, {"arch", r.config.arch},    {"modality", r.config.Modality()},
           {"split", r.split},         {"windows", r.windows},     {"mirror", r.mirror},
           {"mirror_clips", r.mirror_clips}, {"flag_flies", FlagFliesName(r.flag_flies)}, {"turned", r.turned},
+          {"undecided", r.undecided},
           {"fly_judge", r.fly_judge.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.fly_judge)},
           {"seconds", r.seconds},
           {"std_within_1", Number(StdCoverage(r, 1))}, {"std_within_2", Number(StdCoverage(r, 2))},
@@ -263,6 +267,7 @@ std::string EvalTable(const EvalResult& r) {
     s << ", turned round by " << (r.fly_judge.rfind("motion cues", 0) == 0 ? "their motion" + r.fly_judge.substr(11)
                                                                 : "the judge " + r.fly_judge) << ": "
       << r.turned << " of " << r.metrics.count * r.windows << " windows";
+    if (r.undecided > 0) s << ", " << r.undecided << " it could not tell read as filmed";
   }
   s << ")\n";
   if (!r.predicted_std.empty()) {

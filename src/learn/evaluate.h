@@ -74,6 +74,7 @@ struct EvalResult {
   bool mirror_clips = false;  // every clip mirrored first, as if its flag flew left
   FlagFlies flag_flies = FlagFlies::kRight;  // how each clip was turned before the model read it
   int turned = 0;  // windows that flag_flies turned round (mirrored: their flag flew left)
+  int undecided = 0;  // windows the fly judge could not tell (read as filmed: eval's clips are apart)
   // With flag_flies kAuto: the judge's file, or "motion cues" without one (empty otherwise).
   std::string fly_judge;
   Metrics metrics;

@@ -149,7 +149,8 @@ FlyDirectionCues EstimateFlyDirection(const std::vector<cv::Mat>& frames) {
 }
 
 std::optional<FlyDirection> FlyDirectionFromWind(double wind_direction, double camera_heading, double end_on) {
-  if (!std::isfinite(wind_direction) || !std::isfinite(camera_heading)) return std::nullopt;
+  // A NaN end-on angle clamps to NaN, compares false and would make no wind end-on: none known.
+  if (!std::isfinite(wind_direction) || !std::isfinite(camera_heading) || std::isnan(end_on)) return std::nullopt;
   // The wind's component along the picture's right, heading - 90 deg: cos(wind - heading + 90 deg).
   const double across = std::sin(camera_heading - wind_direction);
   if (std::abs(across) <= std::sin(std::clamp(end_on, 0.0, M_PI / 2))) return std::nullopt;

@@ -155,6 +155,8 @@ TEST(FlyDirectionTest, FromTheWindAFlagFliesTowardThePictureSideTheAirMovesTo) {
   // No reading (NaN) or no heading: nothing.
   EXPECT_EQ(FlyDirectionFromWind(std::nan(""), north, end_on), std::nullopt);
   EXPECT_EQ(FlyDirectionFromWind(0.0, std::nan(""), end_on), std::nullopt);
+  // Nor with no end-on window (NaN compared false: every wind, even along the axis, had a side).
+  EXPECT_EQ(FlyDirectionFromWind(north, north, std::nan("")), std::nullopt);
 }
 
 }  // namespace

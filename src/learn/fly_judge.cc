@@ -97,6 +97,13 @@ FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
                              std::to_string(kMotionMapGrid) + " and " + std::to_string(kMotionMapSide) +
                              " (the motion map this build computes)");
   }
+  double margin = 0;
+  if (card.contains("margin")) {
+    if (!card["margin"].is_number() || !std::isfinite(card["margin"].get<double>()) || card["margin"].get<double>() < 0)
+      throw std::runtime_error(card_path.string() + ": field \"margin\" must be a finite score >= 0, got " +
+                               card["margin"].dump());
+    margin = card["margin"].get<double>();
+  }
   const int h = card["hidden"].get<int>();
   JudgeModule module(h);
   LoadModuleWeights(module, path);
@@ -107,9 +114,17 @@ FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
   Eigen::MatrixXf hidden_weights =
       Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(w1.data_ptr<float>(), h,
                                                                                                kMapSize);
-  return FlyJudge(std::move(hidden_weights), Eigen::Map<const Eigen::VectorXf>(b1.data_ptr<float>(), h),
-                  Eigen::Map<const Eigen::VectorXf>(w2.data_ptr<float>(), h),
-                  module.output->bias.detach().item<float>());
+  FlyJudge judge(std::move(hidden_weights), Eigen::Map<const Eigen::VectorXf>(b1.data_ptr<float>(), h),
+                 Eigen::Map<const Eigen::VectorXf>(w2.data_ptr<float>(), h),
+                 module.output->bias.detach().item<float>());
+  judge.set_margin(margin);
+  return judge;
+}
+
+void FlyJudge::set_margin(double margin) {
+  if (!(std::isfinite(margin) && margin >= 0))
+    throw std::invalid_argument("FlyJudge: margin must be a finite score >= 0, got " + std::to_string(margin));
+  margin_ = margin;
 }
 
 void FlyJudge::Save(const std::filesystem::path& path, nlohmann::json card) const {
@@ -128,6 +143,7 @@ void FlyJudge::Save(const std::filesystem::path& path, nlohmann::json card) cons
   card["hidden"] = h;
   card["grid"] = kMotionMapGrid;
   card["side"] = kMotionMapSide;
+  card["margin"] = margin_;
   WriteFileAtomically(ConfigPathFor(path), card.dump(2) + "\n");
 }
 
@@ -142,9 +158,10 @@ double FlyJudge::Score(const cv::Mat& map) const {
   return Logit(Flattened(map)) - Logit(Flattened(mirrored));
 }
 
-FlyDirection FlyJudge::Judge(const std::vector<cv::Mat>& frames, double* score) const {
+std::optional<FlyDirection> FlyJudge::Judge(const std::vector<cv::Mat>& frames, double* score) const {
   const double s = Score(MotionMap(frames));
   if (score != nullptr) *score = s;
+  if (std::abs(s) < margin_ || s == 0) return std::nullopt;
   return s < 0 ? FlyDirection::kLeft : FlyDirection::kRight;
 }
 

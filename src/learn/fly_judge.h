@@ -15,6 +15,7 @@
 #define CLOTHWIND_LEARN_FLY_JUDGE_H_
 
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -48,11 +49,12 @@ class FlyJudge {
            float output_bias);
 
   // Reads a judge written by Save: `path` (the weights, weights_io.h) and the card beside it
-  // (ConfigPathFor(path), `path` with extension .json: its "hidden" units and map "grid").
+  // (ConfigPathFor(path), `path` with extension .json: its "hidden" units, map "grid", and the
+  // optional "margin").
   // Throws std::runtime_error naming the file and what is missing or of the wrong shape.
   static FlyJudge Load(const std::filesystem::path& path);
   // Writes the weights (float32) to `path` and `card` plus the shape ("hidden", "grid", "side")
-  // to `path` with extension .json, each atomically (temporary file, then rename).
+  // and the margin to `path` with extension .json, each atomically (temporary file, then rename).
   void Save(const std::filesystem::path& path, nlohmann::json card = nlohmann::json::object()) const;
 
   int hidden() const { return static_cast<int>(hidden_bias_.size()); }
@@ -61,9 +63,16 @@ class FlyJudge {
   // antisymmetric under mirroring the map.
   double Score(const cv::Mat& map) const;
 
-  // The way a clip's flag flies (Score of its MotionMap; 0, a still clip, flies right as filmed).
-  // `score` (may be null) receives the score. Throws as MotionMap.
-  FlyDirection Judge(const std::vector<cv::Mat>& frames, double* score = nullptr) const;
+  // The way a clip's flag flies (Score of its MotionMap), or nothing when |score| < margin(): a
+  // calm or featureless clip (camera noise scores ~0.4, a flying flag 5-12) would otherwise be
+  // turned round on a coin's throw. `score` (may be null) receives the score. Throws as MotionMap.
+  std::optional<FlyDirection> Judge(const std::vector<cv::Mat>& frames, double* score = nullptr) const;
+
+  // Scores closer to 0 than this decide nothing (the card's "margin"; 0 when it has none: only a
+  // still clip's exact 0).
+  double margin() const { return margin_; }
+  // Throws std::invalid_argument unless margin is finite and >= 0.
+  void set_margin(double margin);
 
   const Eigen::MatrixXf& hidden_weights() const { return hidden_weights_; }
   const Eigen::VectorXf& hidden_bias() const { return hidden_bias_; }
@@ -77,6 +86,7 @@ class FlyJudge {
   Eigen::VectorXf hidden_bias_;
   Eigen::VectorXf output_weights_;
   float output_bias_ = 0;
+  double margin_ = 0;
 };
 
 }  // namespace clothwind::learn

@@ -107,12 +107,47 @@ TEST(MotionMapTest, ResizesAnySideToItsOwn) {
   EXPECT_LT(cv::norm(MotionMap(big), MotionMap(clip), cv::NORM_INF), 1e-4);
 }
 
-TEST(MotionMapTest, StillClipHasNoShapeAndFliesRightAsFilmed) {
+TEST(MotionMapTest, StillClipHasNoShapeAndTheJudgeTellsNothing) {
   const std::vector<cv::Mat> still(kFrames, cv::Mat(kSide, kSide, CV_8UC1, cv::Scalar(120)));
   EXPECT_EQ(cv::countNonZero(MotionMap(still)), 0);
   double score = 1;
-  EXPECT_EQ(RandomJudge(8, 3).Judge(still, &score), FlyDirection::kRight);
+  EXPECT_EQ(RandomJudge(8, 3).Judge(still, &score), std::nullopt);
   EXPECT_EQ(score, 0.0);
+}
+
+TEST(FlyJudgeTest, ScoresInsideTheMarginDecideNothingAndTheMarginTravelsWithTheCard) {
+  FlyJudge judge = RandomJudge(16, 4);
+  std::mt19937_64 rng(5);
+  const std::vector<cv::Mat> clip = Clip(FlagClip{}, rng);
+  double score = 0;
+  const std::optional<FlyDirection> way = judge.Judge(clip, &score);
+  ASSERT_TRUE(way.has_value());
+  ASSERT_GT(std::abs(score), 0.0);
+  judge.set_margin(std::abs(score) * 1.01);  // just beyond this clip's score: it tells nothing
+  EXPECT_EQ(judge.Judge(clip), std::nullopt);
+  EXPECT_EQ(judge.Judge(Mirrored(clip)), std::nullopt);
+  judge.set_margin(std::abs(score) * 0.99);
+  EXPECT_EQ(judge.Judge(clip), way);
+  EXPECT_THROW(judge.set_margin(-1), std::invalid_argument);
+  EXPECT_THROW(judge.set_margin(std::nan("")), std::invalid_argument);
+  // Saved and loaded with its card; a card's bad margin is refused naming it.
+  const fs::path dir = fs::temp_directory_path() / ("fly_judge_margin_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  judge.Save(dir / "judge.pt");
+  EXPECT_DOUBLE_EQ(FlyJudge::Load(dir / "judge.pt").margin(), judge.margin());
+  nlohmann::json card = ReadJson(dir / "judge.json");
+  card["margin"] = -0.5;
+  WriteFileAtomically(dir / "judge.json", card.dump());
+  try {
+    FlyJudge::Load(dir / "judge.pt");
+    ADD_FAILURE() << "a negative margin loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("\"margin\""), std::string::npos) << e.what();
+  }
+  card.erase("margin");  // cards written before margins: 0
+  WriteFileAtomically(dir / "judge.json", card.dump());
+  EXPECT_EQ(FlyJudge::Load(dir / "judge.pt").margin(), 0.0);
+  fs::remove_all(dir);
 }
 
 TEST(MotionMapTest, RefusesNamingTheFrame) {
@@ -135,7 +170,7 @@ TEST(FlyJudgeTest, ScoreIsExactlyAntisymmetricUnderMirroring) {
     c.x0 = 2 + trial * 3;
     const std::vector<cv::Mat> clip = Clip(c, rng);
     double right = 0, left = 0;
-    const FlyDirection a = judge.Judge(clip, &right), b = judge.Judge(Mirrored(clip), &left);
+    const std::optional<FlyDirection> a = judge.Judge(clip, &right), b = judge.Judge(Mirrored(clip), &left);
     EXPECT_NEAR(left, -right, 1e-5 * (1 + std::abs(right)));  // the maps agree to float rounding
     if (std::abs(right) > 1e-3) {
       EXPECT_NE(a, b);

@@ -1,6 +1,7 @@
 #include "learn/fly_judge_train.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <random>
 #include <stdexcept>
@@ -101,10 +102,11 @@ FlyJudgeAccuracy MeasureFlyJudge(const FlyJudge& judge, const MotionMaps& maps, 
   for (int b = 0; b < bands; ++b) a.bands.push_back({b * band_width, (b + 1) * band_width, 0, 0});
   for (size_t i = 0; i < maps.maps.size(); ++i) {
     const double score = judge.Score(maps.maps[i]);
-    const bool right = score > 0;
+    const bool undecided = score == 0 || std::abs(score) < judge.margin();
+    const bool right = score > 0 && !undecided;
     ++a.count;
     a.right += right;
-    a.undecided += score == 0;
+    a.undecided += undecided;
     const int b = std::clamp(static_cast<int>(maps.wind_speeds[i] / band_width), 0, bands - 1);
     ++a.bands[b].count;
     a.bands[b].right += right;

@@ -54,8 +54,8 @@ FlyJudge TrainFlyJudge(const std::vector<cv::Mat>& maps, const FlyJudgeTrainOpti
 // score is antisymmetric) about their mirror images.
 struct FlyJudgeAccuracy {
   int count = 0;
-  int right = 0;      // score > 0
-  int undecided = 0;  // score == 0 (a still clip): right as filmed, wrong when mirrored; not counted right
+  int right = 0;      // score >= the judge's margin (and > 0)
+  int undecided = 0;  // |score| < margin, or 0 (a still clip): the judge tells nothing; not counted right
   double accuracy() const { return count > 0 ? static_cast<double>(right) / count : 0.0; }
   // Per 2 m/s band of wind speed [0, 2), [2, 4), ..., the last band open above.
   struct Band {

@@ -109,6 +109,7 @@ Sample Predictor::Prepare(const std::vector<cv::Mat>& frames) const {
   SampleOptions options = c.Sampling();
   options.flag_flies = flag_flies_;
   options.fly_judge = fly_judge_;
+  options.undecided_turns = last_turned_;
   std::vector<cv::Mat> last(frames.end() - c.frames, frames.end());
   std::mt19937_64 unused(0);
   return MakeSample(last, options, unused);
@@ -118,6 +119,8 @@ Prediction Predictor::PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps
   Sample sample = Prepare(frames);
   Prediction p = Predict({&sample})[0];
   p.turned = sample.turned;
+  p.undecided = sample.undecided;
+  if (flag_flies_ == FlagFlies::kAuto && !sample.undecided) last_turned_ = sample.turned;
   const ModelConfig& c = config();
   if (maps != nullptr && c.arch == "sdn") {
     // The grey channel's maps (channel 0; flow channels, when the model has them, follow it).

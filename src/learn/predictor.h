@@ -19,6 +19,7 @@ struct Prediction {
   double speed = 0;      // [m/s]
   double speed_std = 0;  // [m/s] predicted standard deviation (the network's uncertainty)
   bool turned = false;   // PredictFrames mirrored the clip first: its flag flies left (flag_flies())
+  bool undecided = false;  // with flag_flies auto: the judge could not tell; the last way it knew was kept
 };
 
 // The strongest spectral peak of every pixel of a clip (SDN models only), at input resolution.
@@ -69,7 +70,9 @@ class Predictor {
   std::vector<Prediction> Predict(const std::vector<const Sample*>& samples);
 
   // A raw greyscale clip as a node receives it: the last config().frames frames, centred square
-  // crop, resized and normalised as for evaluation. `maps` (may be null; SDN only) receives the
+  // crop, resized and normalised as for evaluation. With flag_flies auto a clip the judge cannot
+  // tell (a calm spell) is turned as the last clip it could tell was, as filmed until one was: a
+  // stream of clips keeps its flag's side instead of a coin's for each. `maps` (may be null; SDN only) receives the
   // strongest peak maps of the same input, oriented as the frames given (a clip turned round for
   // the model has its maps turned back).
   // Throws std::invalid_argument when there are too few frames or they are not equal CV_8UC1
@@ -77,13 +80,15 @@ class Predictor {
   Prediction PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps* maps = nullptr);
 
   // A clip with the evaluation preprocessing (no augmentation) from raw greyscale (or YCrCb)
-  // frames, turned as flag_flies() says (Sample::turned).
+  // frames, turned as flag_flies() says (Sample::turned; a clip the judge cannot tell as the last
+  // one PredictFrames saw it tell).
   Sample Prepare(const std::vector<cv::Mat>& frames) const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   FlagFlies flag_flies_ = FlagFlies::kRight;
+  bool last_turned_ = false;  // the way the judge last told (PredictFrames), for clips it cannot
   std::shared_ptr<const FlyJudge> fly_judge_;
   std::filesystem::path fly_judge_path_;
   std::string fly_judge_error_;

@@ -18,7 +18,7 @@ import unittest
 import rospy
 import rostest
 from clothwind.msg import RawSentence, WindMeasurement
-from diagnostic_msgs.msg import DiagnosticArray
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 
 KNOT = 1852.0 / 3600.0
 
@@ -67,8 +67,13 @@ class AnemometerPtySerialTest(unittest.TestCase):
         rospy.Subscriber('anemometer/wind', WindMeasurement, cls.on_wind, queue_size=100)
         rospy.Subscriber('anemometer/raw', RawSentence, cls.on_raw, queue_size=100)
         rospy.Subscriber('/diagnostics', DiagnosticArray, cls.on_diag, queue_size=10)
-        # Let the node try (and fail) to open a port that does not exist yet.
-        time.sleep(1.5)
+        # The node tries (and fails) to open a port that does not exist yet, and says so, before
+        # the device appears: the retry is what the test is about, so wait for the node to report
+        # it (a fixed sleep let a node that started late open the port at its first try).
+        deadline = time.time() + 60.0
+        while time.time() < deadline and not cls.serial_status_says('not connected: waiting'):
+            time.sleep(0.1)
+        assert cls.serial_status_says('not connected: waiting'), 'the node never reported waiting for the port'
         cls.dev = FakeInstrument(cls.port)
 
     @classmethod
@@ -90,10 +95,17 @@ class AnemometerPtySerialTest(unittest.TestCase):
 
     @classmethod
     def on_diag(cls, m):
+        # The serial node's statuses only (its hardware id is the port; the usb node's and the
+        # replay nodes' are not).
         for s in m.status:
-            if 'anemometer' in s.name and 'replay' not in s.name:
+            if 'anemometer' in s.name and s.hardware_id == cls.port:
                 with cls.lock:
                     cls.diags.append(s)
+
+    @classmethod
+    def serial_status_says(cls, text, level=DiagnosticStatus.ERROR):
+        with cls.lock:
+            return any(s.level == level and text in s.message for s in cls.diags)
 
     def clear(self):
         with self.lock:
@@ -189,13 +201,30 @@ class AnemometerPtySerialTest(unittest.TestCase):
 
     def test_3_reconnects_after_device_vanishes(self):
         self.dev.vanish()
-        time.sleep(1.0)
+        # "Says so": an ERROR naming the lost device, before it comes back.
+        with self.lock:
+            del self.diags[:]
+        deadline = time.time() + 20.0
+        while time.time() < deadline and not self.serial_status_says('not connected'):
+            time.sleep(0.1)
+        self.assertTrue(self.serial_status_says('not connected'), 'no ERROR after the device vanished')
         self.clear()
         self.dev = type(self).dev = FakeInstrument(self.port)
         probe = nmea('IIMWV,010.0,R,3.0,M,A')
         self.assertTrue(self.wait_for_wind(probe, 20.0), 'node did not reconnect')
         with self.lock:
             self.assertAlmostEqual(self.winds[-1].speed, 3.0, places=6)
+        # ...and counts the disconnection (connected twice, once lost).
+        deadline = time.time() + 10.0
+        values = {}
+        while time.time() < deadline:
+            with self.lock:
+                values = {kv.key: kv.value for kv in self.diags[-1].values} if self.diags else {}
+            if int(values.get('connects', 0)) >= 2:
+                break
+            time.sleep(0.2)
+        self.assertGreaterEqual(int(values.get('disconnects', 0)), 1, values)
+        self.assertGreaterEqual(int(values.get('connects', 0)), 2, values)
 
     def test_4_gill_after_nmea_is_rejected_until_proven(self):
         # The decoder locked onto NMEA: a lone Gill record is treated as noise, not a reading.

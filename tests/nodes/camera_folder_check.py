@@ -102,7 +102,17 @@ class CameraFolderTest(unittest.TestCase):
         rospy.Subscriber("/diagnostics", DiagnosticArray, lambda m: cls.diagnostics.append(m))
         cls.colour = Collector("/")
         cls.grey = Collector("/mono/")
-        time.sleep(1.0)  # the nodes are polling for folders that do not exist yet
+        # The nodes poll for folders that do not exist yet and say so; the folders are made only
+        # once both have said it, so the retry is what is tested (a fixed sleep let a node that
+        # started late find them at its first try).
+        def waiting(folder):
+            return any(st.level == DiagnosticStatus.ERROR and "cannot open" in st.message and
+                       st.hardware_id.endswith(folder)
+                       for m in list(cls.diagnostics) for st in m.status)
+        deadline = time.time() + 60.0
+        while time.time() < deadline and not (waiting(cls.colour_folder) and waiting(cls.grey_folder)):
+            time.sleep(0.1)
+        assert waiting(cls.colour_folder) and waiting(cls.grey_folder), "the nodes never reported the missing folders"
         write_folder(cls.colour_folder, 40, 30, 3, colour_value)
         write_folder(cls.grey_folder, 24, 16, 1, grey_value)
 

@@ -145,7 +145,9 @@ class ClipBufferFaultsTest(unittest.TestCase):
         bad.data = bad.data[:100]
         self.image_pub.publish(bad)
         status, values = self.wait_status(lambda s, v: v["errors"] == "1", 5, "the bad frame")
+        # In the summary because it is recent (the level is ERROR anyway: the folder never opened).
         self.assertIn("frame dropped", status.message)
+        self.assertLess(float(values["last error age [s]"]), 10.0)
         self.stream(11.0, offset=-30.0)
         status, values = self.wait_status(lambda s, v: float(v["last error age [s]"]) > 10.0, 5, "the error to age")
         self.assertNotIn("frame dropped", status.message)

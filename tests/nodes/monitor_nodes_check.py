@@ -10,7 +10,7 @@ import unittest
 import rospy
 import rostest
 from clothwind.msg import WindEstimate, WindMeasurement
-from diagnostic_msgs.msg import DiagnosticArray
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from visualization_msgs.msg import MarkerArray
 
 
@@ -99,6 +99,9 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertIn("estimate stale", status.message)
         self.assertIn("no anemometer reading in the mean window", status.message)
         self.assertEqual(values["messages stamped 0 dropped"], "2")
+        # "Says so": a WARN, naming each cause.
+        self.assertEqual(status.level, DiagnosticStatus.WARN, status.message)
+        self.assertIn("messages stamped 0 dropped", status.message)
 
         # The report ends after max_wall (30 s; wall time never idles) and writes its summary
         # although the plot's path lies under a file.

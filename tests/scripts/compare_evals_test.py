@@ -131,13 +131,16 @@ class CommandTest(unittest.TestCase):
             self.assertIn(f'{bad}:3: expected 4 fields', r.stderr)
             with open(bad, 'w') as f:
                 f.write('1.0 x 0.3 flag-000000-v0\n')
-            self.assertIn(f'{bad}:1: true and predicted speed must be numbers', self.run_script(good, bad).stderr)
+            # Each refused: a failing exit, the message naming what is wrong.
+            def refused(r, text):
+                self.assertNotEqual(r.returncode, 0, r.stdout)
+                self.assertIn(text, r.stderr)
+            refused(self.run_script(good, bad), f'{bad}:1: true and predicted speed must be numbers')
             write_dat(bad, [('flag-000000-v0', 1.0, 1.1)])
-            r = self.run_script(good, bad)
-            self.assertIn(f'1 clips of {good} are not in {bad} (first: flag-000000-v1)', r.stderr)
+            refused(self.run_script(good, bad), f'1 clips of {good} are not in {bad} (first: flag-000000-v1)')
             write_dat(bad, [('flag-000000-v0', 1.0, 1.1), ('flag-000000-v1', 2.0, 0.9)])
-            self.assertIn('clip flag-000000-v1: true speed 1.0', self.run_script(good, bad).stderr)
-            self.assertIn('missing.dat', self.run_script(good, os.path.join(d, 'missing.dat')).stderr)
+            refused(self.run_script(good, bad), 'clip flag-000000-v1: true speed 1.0')
+            refused(self.run_script(good, os.path.join(d, 'missing.dat')), 'missing.dat')
 
 
 if __name__ == '__main__':

@@ -171,6 +171,7 @@ class HeadOracleTest(unittest.TestCase):
         with open(path, 'w') as f:
             f.write('name wind\n')
         done = self.run_oracle()
+        self.assertNotEqual(done.returncode, 0)
         self.assertIn(f'{path}:1: expected the header', done.stderr)
         self.assertNotIn('Traceback', done.stderr)
 

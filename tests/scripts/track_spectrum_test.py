@@ -100,6 +100,7 @@ class TrackSpectrumTest(unittest.TestCase):
         self.assertNotEqual(r.returncode, 0)
         self.assertIn('tracks.json: 40 frames, window [20, 50) does not fit', r.stderr)
         r = self.run_script('--window', '2')
+        self.assertNotEqual(r.returncode, 0)
         self.assertIn('--window 2: expected at least 4 frames', r.stderr)
         r = self.run_script('--split', 'val')
         self.assertNotEqual(r.returncode, 0)
