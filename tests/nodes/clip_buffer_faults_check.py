@@ -154,6 +154,30 @@ class ClipBufferFaultsTest(unittest.TestCase):
         self.assertIn("frame dropped", values["last error"])
         self.assertIn("not recording", status.message)  # still true: the folder never opened
 
+        # 5. An unstamped frame and reading (a driver leaving header.stamp 0): dropped and said so,
+        # not taken for a bag loop (which would forget the minute of readings the labels need).
+        jumps = values["time jumps back"]
+        with self.lock:
+            before = len(self.clips)
+        self.image_pub.publish(image(rospy.Time(0), 0))
+        self.wind_pub.publish(reading(rospy.Time(0), 9.0))
+        status, values = self.wait_status(lambda s, v: v["errors"] == "3", 5, "the unstamped frame and reading")
+        self.assertIn("header.stamp is 0", status.message)
+        self.assertIn("header.stamp is 0", values["last error"])
+        self.stream(2.0, offset=-30.0)
+        status, values = self.wait_status(lambda s, v: int(v["clips published"]) > 0, 5, "clips after them")
+        self.assertEqual(values["time jumps back"], jumps)
+        deadline = rospy.get_time() + 5
+        while rospy.get_time() < deadline:
+            with self.lock:
+                after = self.clips[before:]
+            if after:
+                break
+            rospy.sleep(0.1)
+        self.assertTrue(after, "no clip after the unstamped frame")
+        for c in after:
+            self.assertGreater(c.wind_count, 0, "clip %d lost its label" % c.sequence)
+
 
 if __name__ == "__main__":
     rospy.init_node("clip_buffer_faults_check")
