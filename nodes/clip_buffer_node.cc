@@ -166,18 +166,27 @@ class ClipBufferNode {
       NoteError("anemometer reading dropped: header.stamp is 0");
       return;
     }
-    const uint64_t future_before = pipeline_->stats().readings_future;
+    const sensors::ClipPipelineStats before = pipeline_->stats();
     sensors::LabelReading reading = ros_bridge::ToLabelReading(*msg);
+    const double direction = reading.direction;
     // Directions in another frame than the labels' are left out of the mean (speeds are kept). A
-    // reading the labels skip (void, or no speed) neither counts nor picks the frame.
-    if (std::isfinite(reading.speed) && !wind_frame_.Admit(msg->header.frame_id, reading.direction)) {
+    // reading the labels skip (void, or no speed) neither counts nor picks the frame, nor does one
+    // the pipeline refuses (stamped in the future, or too late): the frame is adopted only with
+    // a reading the labels take.
+    const bool labelled = std::isfinite(reading.speed);
+    const bool same_frame = wind_frame_.Accepts(msg->header.frame_id, direction);
+    if (labelled && !same_frame) {
+      wind_frame_.Admit(msg->header.frame_id, direction);  // counted
       reading.direction = std::numeric_limits<double>::quiet_NaN();
       ROS_WARN_THROTTLE(10.0, "clip_buffer: wind direction in frame '%s' left out of the labels, which average "
                         "directions in '%s' (~wind_frame_id)", msg->header.frame_id.c_str(),
                         wind_frame_.frame_id().c_str());
     }
     pipeline_->AddReading(reading, Now());
-    if (pipeline_->stats().readings_future > future_before) {
+    const bool refused = pipeline_->stats().readings_future > before.readings_future ||
+                         pipeline_->stats().readings_late > before.readings_late;
+    if (labelled && same_frame && !refused) wind_frame_.Admit(msg->header.frame_id, direction);
+    if (pipeline_->stats().readings_future > before.readings_future) {
       last_future_ = ros::WallTime::now();
       ROS_WARN_THROTTLE(5.0, "clip_buffer: anemometer reading stamped %.1f s after the clock refused",
                         pipeline_->stats().last_future_lead);

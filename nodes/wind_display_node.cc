@@ -18,9 +18,10 @@
 // this by the wall clock: a bag that ended stops /clock) is shown as "--", and the anemometer's
 // mean and arrow go when no reading is left in ~mean_window (either clock); the plot scrolls with
 // the clock while inputs pause. The display frame is ~frame_id, else the frame of the first
-// valid reading: readings in another frame (MWD's earth frame beside MWV's instrument frame)
-// add their speeds and no arrow, so neither the arrow's convention nor /tf_static flips. /diagnostics says how old each input is. Messages stamped 0 are
-// dropped (counted): they would stamp the displays 0 and empty the plot.
+// valid reading with a velocity (else of the first valid one): readings in another frame (MWD's
+// earth frame beside MWV's instrument frame) add their speeds and no arrow, so neither the arrow's
+// convention nor /tf_static flips. /diagnostics says how old each input is. Messages stamped 0
+// are dropped (counted): they would stamp the displays 0 and empty the plot.
 // Drawing and averaging are the ROS-free sensors/wind_plot.
 #include <cmath>
 #include <limits>
@@ -109,12 +110,14 @@ class WindDisplayNode {
     anemometer_.Add({msg->header.stamp.toSec(), msg->speed, 0.0});
     last_wind_ = *msg;
     last_wind_wall_ = ros::WallTime::now();
+    if (!have_wind_) first_wind_frame_ = msg->header.frame_id;
     have_wind_ = true;
     // The arrow only from readings in the display frame (a speed has no frame, a vector has).
     const bool has_vector = std::isfinite(msg->velocity.x) && std::isfinite(msg->velocity.y);
     if (frame_gate_.Admit(msg->header.frame_id, has_vector ? 0.0 : std::nan(""))) {
       if (has_vector) {
         last_vector_ = *msg;
+        last_vector_wall_ = last_wind_wall_;
         have_vector_ = true;
       }
     } else {
@@ -171,9 +174,11 @@ class WindDisplayNode {
               have_estimate_ ? (ros::WallTime::now() - last_estimate_wall_).toSec() : -1.0);
   }
 
-  // The display frame: ~frame_id, else the first valid reading's, else "anemometer".
+  // The display frame: ~frame_id, else the first valid reading's with a velocity (the arrow's),
+  // else the first valid reading's (a speed-only instrument's text), else "anemometer".
   std::string FrameId() const {
     if (!frame_gate_.frame_id().empty()) return frame_gate_.frame_id();
+    if (!first_wind_frame_.empty()) return first_wind_frame_;
     return "anemometer";
   }
 
@@ -186,7 +191,7 @@ class WindDisplayNode {
     // A value older than it should be is not shown as if live (sdn_node died, the bag ended).
     const bool est_live = Live(have_estimate_, last_estimate_.header.stamp, last_estimate_wall_, stamp, stale_after_);
     const bool wind_live = Live(have_wind_, last_wind_.header.stamp, last_wind_wall_, stamp, mean_window_);
-    const bool vector_live = Live(have_vector_, last_vector_.header.stamp, last_wind_wall_, stamp, mean_window_);
+    const bool vector_live = Live(have_vector_, last_vector_.header.stamp, last_vector_wall_, stamp, mean_window_);
     const double mean = wind_live ? anemometer_.Mean(t_now, mean_window_) : std::nan("");
     const double est = est_live ? last_estimate_.speed : std::nan("");
     const double est_std = est_live ? last_estimate_.speed_std : std::nan("");
@@ -274,7 +279,8 @@ class WindDisplayNode {
   clothwind::WindEstimate last_estimate_;
   clothwind::WindMeasurement last_wind_, last_vector_;  // the newest valid reading; the newest with a
                                                        // vector in the display frame
-  ros::WallTime last_estimate_wall_, last_wind_wall_;  // when they arrived
+  ros::WallTime last_estimate_wall_, last_wind_wall_, last_vector_wall_;  // when they arrived
+  std::string first_wind_frame_;  // header.frame_id of the first valid reading
   clothwind::sensors::WindDirectionFrameGate frame_gate_;
   bool have_estimate_ = false, have_wind_ = false, have_vector_ = false;
   ros::Time latest_stamp_;

@@ -36,6 +36,9 @@ std::vector<sensors::SyntheticReading> SimulateAnemometer(const sim::WindField& 
       const double tau = p.distance_constant / std::max(speed, 0.5);
       const double target = speed < p.threshold && cups < p.threshold ? 0.0 : speed;
       cups = target + (cups - target) * std::exp(-dt / tau);
+      // Below the starting speed, with the wind below it too, friction stops the cups (the decay
+      // alone would only approach 0, and a calm after a gust kept reading noise).
+      if (target == 0.0 && cups < p.threshold) cups = 0.0;
       if (speed > 1e-9) {
         const double a = std::exp(-dt / p.vane_tau);
         vane = a * vane + (1 - a) * (h / speed);

@@ -509,8 +509,10 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
     // The header's "tracks" says every example has its tracks.json: not while a replay failed or
     // another split still waits for its tracks (a later --add-tracks run completes it; a run with
     // --tracks alone is then refused, pointing at --add-tracks, instead of leaving those without).
+    // Counted as the run counts them done: a tracks.json without the points' positions (an old
+    // one whose replay failed) is not the grid's either.
     for (const auto& clip : index["clips"])
-      if (!fs::exists(fs::path(o.out) / clip.value("name", std::string()) / "tracks.json"))
+      if (!TracksHaveWorld(fs::path(o.out) / clip.value("name", std::string()) / "tracks.json"))
         ++summary.examples_without_tracks;
     if (summary.examples_without_tracks > 0) index["dataset"].erase("tracks");
   }

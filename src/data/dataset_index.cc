@@ -89,8 +89,8 @@ nlohmann::json ReadLabel(const std::string& path) {
   Require(j, "format", has("format") && j["format"] == "clothwind-clip", path, "\"clothwind-clip\"");
   Require(j, "version", has("version") && j["version"] == kFormatVersion, path, "1");
   Require(j, "name", has("name") && j["name"].is_string(), path, "a string");
-  Require(j, "kind", has("kind") && (j["kind"] == "sim" || j["kind"] == "real"), path,
-          "\"sim\" or \"real\"");
+  Require(j, "kind", has("kind") && (j["kind"] == "sim" || j["kind"] == "real" || j["kind"] == "toy"), path,
+          "\"sim\", \"real\" or \"toy\"");
   Require(j, "num_frames", has("num_frames") && j["num_frames"].is_number_integer() && j["num_frames"] > 0,
           path, "a positive integer");
   Require(j, "frame_rate", has("frame_rate") && j["frame_rate"].is_number() && j["frame_rate"] > 0,

@@ -82,6 +82,18 @@ TEST(AnemometerModelTest, CupsFollowAStepWithTheirDistanceConstant) {
   EXPECT_EQ(SimulateAnemometer(calm, p, 0.0, 5.0)[2].speed, 0.0);
 }
 
+TEST(AnemometerModelTest, ACalmAfterWindReadsZeroWithTheInstrumentsNoise) {
+  // 6 m/s, then air below the starting speed from t = 10 s: the cups run down and stop, and a
+  // stopped instrument reads 0 whatever its noise (the decay alone only approached 0, so noise
+  // clamped at 0 read calm air ~+0.02 m/s for the rest of the session).
+  const StepWind wind(6.0, 0.1, 10.0);
+  AnemometerModelParams p;  // the default noise
+  const auto r = SimulateAnemometer(wind, p, 0.0, 60.0);
+  ASSERT_GE(r.size(), 50u);
+  EXPECT_GT(r[5].speed, 5.5);
+  for (size_t k = 30; k < r.size(); ++k) EXPECT_EQ(r[k].speed, 0.0) << "interval " << k;
+}
+
 TEST(AnemometerModelTest, VaneReportsTheDirectionTheWindComesFrom) {
   AnemometerModelParams p;
   // Blowing towards +y (counter-clockwise 90 deg from the mean direction +x): MWV 270 - 90.

@@ -21,4 +21,8 @@ bool WindDirectionFrameGate::Admit(const std::string& frame_id, double direction
   return false;
 }
 
+bool WindDirectionFrameGate::Accepts(const std::string& frame_id, double direction) const {
+  return std::isnan(direction) || adopt_ || frame_id == frame_id_;
+}
+
 }  // namespace clothwind::sensors

@@ -30,6 +30,10 @@ class WindDirectionFrameGate {
   // set yet); false otherwise, counting the reading in rejected().
   bool Admit(const std::string& frame_id, double direction);
 
+  // Whether Admit would take the reading, without adopting a frame or counting: a caller that may
+  // still refuse the reading (a stamp in the future) adopts the frame only with one it keeps.
+  bool Accepts(const std::string& frame_id, double direction) const;
+
   // The frame of admitted directions; "" until one is known.
   const std::string& frame_id() const { return frame_id_; }
   // Readings whose direction was refused, and the frame of the latest one.

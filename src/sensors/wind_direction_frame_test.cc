@@ -26,6 +26,17 @@ TEST(WindDirectionFrameGate, AdoptsTheFirstFrameThatComesWithADirection) {
   EXPECT_EQ(gate.frame_id(), "anemometer");
 }
 
+TEST(WindDirectionFrameGate, AcceptsAsksWithoutAdoptingOrCounting) {
+  WindDirectionFrameGate gate;
+  EXPECT_TRUE(gate.Accepts("enu", 1.0));  // any frame while none is adopted...
+  EXPECT_EQ(gate.frame_id(), "");         // ...and asking adopts none
+  EXPECT_TRUE(gate.Admit("anemometer", 1.0));
+  EXPECT_FALSE(gate.Accepts("enu", 1.0));
+  EXPECT_TRUE(gate.Accepts("enu", kNoDirection));
+  EXPECT_TRUE(gate.Accepts("anemometer", 0.5));
+  EXPECT_EQ(gate.rejected(), 0u);
+}
+
 TEST(WindDirectionFrameGate, AFixedFrameRefusesEveryOtherOneFromTheStart) {
   WindDirectionFrameGate gate("enu");
   EXPECT_FALSE(gate.Admit("anemometer", 1.0));

@@ -182,7 +182,7 @@ SceneRemeshing ParseRemeshing(const Reader& r, const json& j, const std::string&
   if (j.contains("aspect_min")) m.aspect_min = r.NonNegative(j["aspect_min"], path + ".aspect_min");
   if (!j.contains("size")) {
     // ArcSim's default size is [-inf, inf]: no edge is ever refined.
-    r.Warn(path + ".size", "missing: ArcSim's default [-inf, inf] refines nothing, so the mesh is used as it is");
+    r.Warn(path + ".size", "missing: without a size range this simulator uses the mesh as it is (no remeshing)");
     m.present = false;
     return m;
   }

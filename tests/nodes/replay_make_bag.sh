@@ -14,6 +14,7 @@ source "$(dirname "$0")/clothwind_cli.sh"
 # Under a lock: two runs of one test in one build (ctest --repeat, a second terminal) would
 # otherwise write the same bag at once, and one would replay the other's half-written file.
 recipe="${opts[*]}"
+mkdir -p "$(dirname "$bag")"
 (
   flock 9
   if [ ! -f "$bag" ] || [ "$cli" -nt "$bag" ] || [ "$0" -nt "$bag" ] || [ "$(cat "$bag.recipe" 2>/dev/null || true)" != "$recipe" ]; then
