@@ -86,8 +86,12 @@ FlyJudge::FlyJudge(Eigen::MatrixXf hidden_weights, Eigen::VectorXf hidden_bias, 
 FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
   const std::filesystem::path card_path = ConfigPathFor(path);
   const nlohmann::json card = ReadJson(card_path);
-  if (!card.contains("hidden") || !card["hidden"].is_number_integer() || card["hidden"].get<int>() < 1) {
-    throw std::runtime_error(card_path.string() + ": field \"hidden\" must be the judge's hidden units (an integer >= 1)");
+  // Bounded as train-fly-judge bounds it: the module is built from the card before the weights'
+  // shapes are checked, and a card saying 1e9 units asked for a terabyte.
+  if (!card.contains("hidden") || !card["hidden"].is_number_integer() || card["hidden"].get<int64_t>() < 1 ||
+      card["hidden"].get<int64_t>() > 4096) {
+    throw std::runtime_error(card_path.string() +
+                             ": field \"hidden\" must be the judge's hidden units (an integer in 1..4096)");
   }
   const auto is_int = [&card](const char* key, int expected) {
     return card.contains(key) && card[key].is_number_integer() && card[key].get<int>() == expected;
@@ -161,7 +165,9 @@ double FlyJudge::Score(const cv::Mat& map) const {
 std::optional<FlyDirection> FlyJudge::Judge(const std::vector<cv::Mat>& frames, double* score) const {
   const double s = Score(MotionMap(frames));
   if (score != nullptr) *score = s;
-  if (std::abs(s) < margin_ || s == 0) return std::nullopt;
+  // Inside the margin, a still clip's exact 0, or a score that is not a number (damaged weights):
+  // nothing told.
+  if (!(std::abs(s) >= margin_) || s == 0) return std::nullopt;
   return s < 0 ? FlyDirection::kLeft : FlyDirection::kRight;
 }
 

@@ -128,6 +128,11 @@ TEST(FlyJudgeTest, ScoresInsideTheMarginDecideNothingAndTheMarginTravelsWithTheC
   EXPECT_EQ(judge.Judge(Mirrored(clip)), std::nullopt);
   judge.set_margin(std::abs(score) * 0.99);
   EXPECT_EQ(judge.Judge(clip), way);
+  // Damaged weights (a NaN) tell nothing rather than "right".
+  const FlyJudge broken(judge.hidden_weights(), judge.hidden_bias(), judge.output_weights(), std::nanf(""));
+  double nan_score = 0;
+  EXPECT_EQ(broken.Judge(clip, &nan_score), std::nullopt);
+  EXPECT_TRUE(std::isnan(nan_score));
   EXPECT_THROW(judge.set_margin(-1), std::invalid_argument);
   EXPECT_THROW(judge.set_margin(std::nan("")), std::invalid_argument);
   // Saved and loaded with its card; a card's bad margin is refused naming it.
@@ -204,6 +209,14 @@ TEST(FlyJudgeTest, SaveLoadRoundTripKeepsScoresAndCard) {
     FAIL() << "a 12-unit file loaded as 5 units";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("judge.pt"), std::string::npos) << e.what();
+  }
+  // A card asking for more units than training allows is refused before anything is allocated.
+  WriteFileAtomically(dir / "judge.json", nlohmann::json{{"hidden", 1000000000}, {"grid", 16}, {"side", 64}}.dump());
+  try {
+    FlyJudge::Load(dir / "judge.pt");
+    FAIL() << "a card of 1e9 hidden units loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("1..4096"), std::string::npos) << e.what();
   }
   WriteFileAtomically(dir / "judge.json", nlohmann::json{{"hidden", 12}, {"grid", 8}, {"side", 64}}.dump());
   EXPECT_THROW(FlyJudge::Load(dir / "judge.pt"), std::runtime_error);
