@@ -82,7 +82,7 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertIn("anemometer 3.0 m/s", text)
         self.assertEqual(arrow, 0)  # ADD
 
-        # Past stale_after (2 s) and mean_window (3 s): polled, since markers come at 5 Hz and
+        # Past stale_after (4 s) and mean_window (3 s): polled, since markers come at 5 Hz and
         # diagnostics once a second on a machine that may be busy.
         deadline = time.time() + 15.0
         while time.time() < deadline:
