@@ -183,10 +183,10 @@ class ClipBufferNode {
                         wind_frame_.frame_id().c_str());
     }
     pipeline_->AddReading(reading, Now());
-    const bool refused = pipeline_->stats().readings_future > before.readings_future ||
-                         pipeline_->stats().readings_late > before.readings_late;
+    const bool future = pipeline_->stats().readings_future > before.readings_future;
+    const bool refused = future || pipeline_->stats().readings_late > before.readings_late;
     if (labelled && same_frame && !refused) wind_frame_.Admit(msg->header.frame_id, direction);
-    if (pipeline_->stats().readings_future > before.readings_future) {
+    if (future) {
       last_future_ = ros::WallTime::now();
       ROS_WARN_THROTTLE(5.0, "clip_buffer: anemometer reading stamped %.1f s after the clock refused",
                         pipeline_->stats().last_future_lead);

@@ -350,26 +350,19 @@ bool TurnsToFlyRight(const std::vector<cv::Mat>& frames, const cv::Rect& crop, c
   resized->resize(options.frames);
   for (int t = 0; t < options.frames; ++t) {
     ResizeCrop(frames[t], crop, options.input_size, (*resized)[t]);
-    if (options.fly_judge) continue;  // it reads its own resizing, below
+    // The judge reads the crop resized straight to its map side, as it was trained
+    // (CollectMotionMaps), not the model's input resized again (96 px, rounded to 8 bits, then to
+    // 64: not the inputs its figures were measured on); the motion cues read the model's input.
+    cv::Mat g;
+    if (options.fly_judge) ResizeCrop(frames[t], crop, kMotionMapSide, g);
+    else g = (*resized)[t];
     // The grey (or Y) plane, mirrored into new data: `resized` must stay as it was cropped.
-    cv::Mat g = (*resized)[t];
     if (g.channels() > 1) cv::extractChannel(g, g, 0);
     if (options.mirror_clip) cv::flip(g, grey[t], 1);
     else grey[t] = g;
   }
   if (options.fly_judge) {
-    // The judge reads the crop resized straight to its map side, as it was trained
-    // (CollectMotionMaps), not the model's input resized again (96 px, rounded to 8 bits, then to
-    // 64: not the inputs its figures were measured on).
-    std::vector<cv::Mat> judged(options.frames);
-    for (int t = 0; t < options.frames; ++t) {
-      cv::Mat g;
-      ResizeCrop(frames[t], crop, kMotionMapSide, g);
-      if (g.channels() > 1) cv::extractChannel(g, g, 0);
-      if (options.mirror_clip) cv::flip(g, judged[t], 1);
-      else judged[t] = g;
-    }
-    const std::optional<FlyDirection> way = options.fly_judge->Judge(judged, score);
+    const std::optional<FlyDirection> way = options.fly_judge->Judge(grey, score);
     *undecided = !way;
     return way ? *way == FlyDirection::kLeft : options.undecided_turns;
   }

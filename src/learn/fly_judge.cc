@@ -165,10 +165,14 @@ double FlyJudge::Score(const cv::Mat& map) const {
 std::optional<FlyDirection> FlyJudge::Judge(const std::vector<cv::Mat>& frames, double* score) const {
   const double s = Score(MotionMap(frames));
   if (score != nullptr) *score = s;
+  return Decide(s);
+}
+
+std::optional<FlyDirection> FlyJudge::Decide(double score) const {
   // Inside the margin, a still clip's exact 0, or a score that is not a number (damaged weights):
   // nothing told.
-  if (!(std::abs(s) >= margin_) || s == 0) return std::nullopt;
-  return s < 0 ? FlyDirection::kLeft : FlyDirection::kRight;
+  if (!(std::abs(score) >= margin_) || score == 0) return std::nullopt;
+  return score < 0 ? FlyDirection::kLeft : FlyDirection::kRight;
 }
 
 }  // namespace clothwind::learn

@@ -67,6 +67,9 @@ class FlyJudge {
   // calm or featureless clip (camera noise scores ~0.4, a flying flag 5-12) would otherwise be
   // turned round on a coin's throw. `score` (may be null) receives the score. Throws as MotionMap.
   std::optional<FlyDirection> Judge(const std::vector<cv::Mat>& frames, double* score = nullptr) const;
+  // What a score tells: nothing inside the margin, at exactly 0 or for NaN (damaged weights);
+  // else right for > 0, left for < 0. Judge's rule, for callers that hold scores.
+  std::optional<FlyDirection> Decide(double score) const;
 
   // Scores closer to 0 than this decide nothing (the card's "margin"; 0 when it has none: only a
   // still clip's exact 0).

@@ -102,8 +102,9 @@ FlyJudgeAccuracy MeasureFlyJudge(const FlyJudge& judge, const MotionMaps& maps, 
   for (int b = 0; b < bands; ++b) a.bands.push_back({b * band_width, (b + 1) * band_width, 0, 0});
   for (size_t i = 0; i < maps.maps.size(); ++i) {
     const double score = judge.Score(maps.maps[i]);
-    const bool undecided = score == 0 || std::abs(score) < judge.margin();
-    const bool right = score > 0 && !undecided;
+    const std::optional<FlyDirection> way = judge.Decide(score);
+    const bool undecided = !way;
+    const bool right = way == FlyDirection::kRight;
     ++a.count;
     a.right += right;
     a.undecided += undecided;

@@ -9,16 +9,16 @@ WindDirectionFrameGate::WindDirectionFrameGate(std::string frame_id)
     : frame_id_(std::move(frame_id)), adopt_(frame_id_.empty()) {}
 
 bool WindDirectionFrameGate::Admit(const std::string& frame_id, double direction) {
-  if (std::isnan(direction)) return true;
-  if (adopt_) {
+  if (!Accepts(frame_id, direction)) {
+    ++rejected_;
+    last_rejected_frame_ = frame_id;
+    return false;
+  }
+  if (adopt_ && !std::isnan(direction)) {
     frame_id_ = frame_id;
     adopt_ = false;
-    return true;
   }
-  if (frame_id == frame_id_) return true;
-  ++rejected_;
-  last_rejected_frame_ = frame_id;
-  return false;
+  return true;
 }
 
 bool WindDirectionFrameGate::Accepts(const std::string& frame_id, double direction) const {

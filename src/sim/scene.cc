@@ -181,7 +181,6 @@ SceneRemeshing ParseRemeshing(const Reader& r, const json& j, const std::string&
   }
   if (j.contains("aspect_min")) m.aspect_min = r.NonNegative(j["aspect_min"], path + ".aspect_min");
   if (!j.contains("size")) {
-    // ArcSim's default size is [-inf, inf]: no edge is ever refined.
     r.Warn(path + ".size", "missing: without a size range this simulator uses the mesh as it is (no remeshing)");
     m.present = false;
     return m;
@@ -386,14 +385,17 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
   // end_frame, whichever comes first (this simulator also reads duration there); or timestep +
   // save_frames (the steps per saved frame), ending at duration.
   std::string end_key = "duration";
-  if (j.contains("frame_time") || !j.contains("timestep")) {
+  const bool frame_time_form = j.contains("frame_time") || !j.contains("timestep");
+  auto steps = [&](const char* key) {  // time steps per frame
+    const int n = r.Integer(j[key], key);
+    if (n < 1 || n > 10000) r.Fail(key, "expected an integer in 1..10000");
+    return n;
+  };
+  if (frame_time_form) {
     if (j.contains("timestep")) r.Warn("timestep", "ignored beside frame_time, as ArcSim does");
     if (j.contains("save_frames")) r.Warn("save_frames", "ignored beside frame_time, as ArcSim does");
     if (j.contains("frame_time")) s.frame_time = r.Positive(j["frame_time"], "frame_time");
-    if (j.contains("frame_steps")) {
-      s.frame_steps = r.Integer(j["frame_steps"], "frame_steps");
-      if (s.frame_steps < 1 || s.frame_steps > 10000) r.Fail("frame_steps", "expected an integer in 1..10000");
-    }
+    if (j.contains("frame_steps")) s.frame_steps = steps("frame_steps");
     if (j.contains("duration")) s.duration = r.Positive(j["duration"], "duration");
     if ((j.contains("end_time") || j.contains("end_frame")) && j.contains("duration"))
       r.Warn("duration", "ignored beside end_time/end_frame, as ArcSim does");
@@ -413,10 +415,7 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
     for (const char* key : {"frame_steps", "end_time", "end_frame"})
       if (j.contains(key)) r.Warn(key, "ignored in the timestep form, as ArcSim does (use save_frames, duration)");
     const double step = r.Positive(j["timestep"], "timestep");
-    if (j.contains("save_frames")) {
-      s.frame_steps = r.Integer(j["save_frames"], "save_frames");
-      if (s.frame_steps < 1 || s.frame_steps > 10000) r.Fail("save_frames", "expected an integer in 1..10000");
-    }
+    if (j.contains("save_frames")) s.frame_steps = steps("save_frames");
     s.frame_time = step * s.frame_steps;
     if (j.contains("duration")) s.duration = r.Positive(j["duration"], "duration");
   }
@@ -424,7 +423,7 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
   // its frames are reserved up front: 1e8 s failed in vector::reserve, 1e300 ran nothing, exit 0).
   if (!(s.duration <= 86400)) r.Fail(end_key, "expected at most 86400 s, got " + std::to_string(s.duration));
   if (!(s.duration / s.frame_time <= 1e6))
-    r.Fail(j.contains("frame_time") || !j.contains("timestep") ? "frame_time" : "timestep",
+    r.Fail(frame_time_form ? "frame_time" : "timestep",
            "expected at most 1e6 frames over the duration, got " + std::to_string(s.duration / s.frame_time));
   if (j.contains("motions")) {
     // Moving handles are not simulated: a motion file ({"motfile": ...}) or a list is kept as given.
