@@ -33,6 +33,8 @@ function(clothwind_capability cap)
     add_library(clothwind_${cap} ${_lib_sources})
     target_include_directories(clothwind_${cap} PUBLIC ${CLOTHWIND_SRC_DIR})
     target_link_libraries(clothwind_${cap} PUBLIC ${C_DEPS})
+    install(TARGETS clothwind_${cap} LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+                                     ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
   else()  # headers only (so far)
     add_library(clothwind_${cap} INTERFACE)
     target_include_directories(clothwind_${cap} INTERFACE ${CLOTHWIND_SRC_DIR})
