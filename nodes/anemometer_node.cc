@@ -27,6 +27,7 @@
 #include "sensors/fine_offset_record.h"
 #include "sensors/fine_offset_usb.h"
 #include "sensors/serial_port.h"
+#include "sensors/usb_read_health.h"
 
 namespace {
 
@@ -203,7 +204,9 @@ class AnemometerNode {
       std::string error;
       if (usb_.Open(&error)) {
         ROS_INFO("anemometer_node: opened Fine Offset station");
-        backoff_.Reset();
+        // The back-off restarts when the station answers a read, not when it opens: one that
+        // opens and stays silent is reopened ever more slowly instead of every 0.1 s.
+        usb_health_.Opened();
         state_ = "connected";
         ++connects_;
         next_poll_ = now;
@@ -227,24 +230,23 @@ class AnemometerNode {
     std::string error;
     if (!usb_.ReadCurrentRecord(&record, &address, &error)) {
       ++usb_read_errors_;
-      ++usb_errors_in_row_;
       last_error_ = error;
       ROS_WARN_THROTTLE(30.0, "anemometer_node: %s", error.c_str());
       // A station that stays open but answers nothing (a wedged HID endpoint, a hub that lost
       // power) only recovers by being opened again.
-      if (usb_.is_open() && usb_errors_in_row_ >= kUsbErrorsBeforeReopen) {
-        ROS_WARN("anemometer_node: %d USB reads in a row failed; reopening the station", usb_errors_in_row_);
+      if (usb_health_.ReadFailed(error) && usb_.is_open()) {
+        ROS_WARN("anemometer_node: %d USB reads in a row failed; reopening the station", usb_health_.errors_in_row());
         usb_.Close();
       }
       if (!usb_.is_open()) {
-        usb_errors_in_row_ = 0;
         state_ = "disconnected: " + error;
         ++disconnects_;
         next_attempt_ = now + ros::WallDuration(backoff_.Next());
       }
       return;
     }
-    usb_errors_in_row_ = 0;
+    usb_health_.ReadSucceeded();
+    backoff_.Reset();
     // The station rewrites the current record when its sensor transmits (every 48 s), when its
     // delay byte counts another minute, or when a new history slot starts: publish on change, at
     // the device's own rate (steady weather still changes the record once a minute).
@@ -316,6 +318,12 @@ class AnemometerNode {
     else stat.summary(DiagnosticStatus::OK, "receiving");
     // The instrument's own word on its latest reading (Gill "04 axis 1 and 2 failed", a blocked path, NMEA status V, a
     // station that lost its outdoor sensor) says why readings are void; "stale" alone does not.
+    // Open is not answering: failed USB reads warn, and a reopen that brought no answer is an error.
+    if (input_ == "usb" && usb_health_.level() != clothwind::sensors::UsbReadHealth::Level::kOk)
+      stat.mergeSummary(usb_health_.level() == clothwind::sensors::UsbReadHealth::Level::kError
+                            ? DiagnosticStatus::ERROR
+                            : DiagnosticStatus::WARN,
+                        usb_health_.message());
     if (connected && last_reading_void_)
       stat.mergeSummary(DiagnosticStatus::WARN, "instrument flags its readings void: " + last_status_);
     if (saw_magnetic_ && !std::isfinite(magnetic_declination_))
@@ -367,8 +375,7 @@ class AnemometerNode {
   std::string input_, frame_id_, earth_frame_id_, state_, last_error_, last_status_;
   double magnetic_declination_ = std::numeric_limits<double>::quiet_NaN();  // [deg] east; NaN: unknown
   bool last_reading_void_ = false, saw_earth_ = false, saw_instrument_ = false, saw_magnetic_ = false;
-  static constexpr int kUsbErrorsBeforeReopen = 3;
-  int usb_errors_in_row_ = 0;
+  clothwind::sensors::UsbReadHealth usb_health_{3};  // reopen after 3 failed reads in a row
   clothwind::sensors::SerialConfig serial_;
   clothwind::sensors::SerialPort port_;
   clothwind::sensors::FineOffsetUsb usb_;

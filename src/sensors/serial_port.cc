@@ -77,7 +77,10 @@ void ConfigureTermios(const SerialConfig& c, termios* tio_ptr) {
   BaudToSpeed(c.baud, &speed);
   ::cfsetispeed(&tio, speed);
   ::cfsetospeed(&tio, speed);
-  tio.c_cflag &= ~(CSIZE | PARENB | PARODD | CSTOPB | CRTSCTS);
+  // Linux keeps a port's termios between opens: clear every framing bit a previous program may
+  // have left, CMSPAR included (with it, parity 'E' would put space parity on the wire).
+  tio.c_cflag &= ~(CSIZE | PARENB | PARODD | CMSPAR | CSTOPB | CRTSCTS);
+  tio.c_iflag &= ~INPCK;
   switch (c.data_bits) {
     case 5: tio.c_cflag |= CS5; break;
     case 6: tio.c_cflag |= CS6; break;
@@ -170,8 +173,11 @@ SerialPort::ReadStatus SerialPort::Read(uint8_t* buffer, size_t capacity, int ti
     return ReadStatus::kData;
   }
   if (got < 0 && (errno == EAGAIN || errno == EINTR)) return ReadStatus::kTimeout;
-  // read() == 0 after POLLIN/POLLHUP, or EIO: the device went away (USB adapter unplugged,
-  // pseudo-terminal master closed).
+  // With VMIN = VTIME = 0, read() returns 0 on a live tty whose bytes were taken between poll()
+  // and read() (another program that opened the port before us, which TIOCEXCL cannot refuse).
+  // Only with POLLHUP or POLLERR does 0 mean the device went away (USB adapter unplugged,
+  // pseudo-terminal master closed); EIO always does.
+  if (got == 0 && !(p.revents & (POLLHUP | POLLERR))) return ReadStatus::kTimeout;
   *error = got == 0 ? "read " + path_ + ": device hung up" : Errno("read " + path_);
   Close();
   return ReadStatus::kFailed;

@@ -1,5 +1,7 @@
 // A serial port configured through termios: raw bytes, no flow control, non-blocking reads with
-// a timeout. Opened exclusively (TIOCEXCL) so a second program cannot interleave reads.
+// a timeout. Opened exclusively (TIOCEXCL), so a program that tries to open it after us is
+// refused; one that opened it before us still shares its bytes (the kernel cannot say), and its
+// reads show here as timeouts, not as a hang-up.
 #ifndef CLOTHWIND_SENSORS_SERIAL_PORT_H_
 #define CLOTHWIND_SENSORS_SERIAL_PORT_H_
 

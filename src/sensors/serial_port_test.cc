@@ -6,7 +6,10 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -92,6 +95,16 @@ TEST(SerialPort, ConfigureTermiosSetsLineSettings) {
   EXPECT_FALSE(t.c_cflag & CSTOPB);
   ConfigureTermios({"x", 9600, 8, 'N', 1}, &t);
   EXPECT_FALSE(t.c_cflag & PARENB);
+  // Mark/space parity and parity checking left by a previous program: Linux keeps a port's
+  // termios between opens, and with CMSPAR still set, 'E' would be space parity on the wire.
+  t.c_cflag |= CMSPAR | PARENB;
+  t.c_iflag |= INPCK;
+  ConfigureTermios({"x", 9600, 8, 'E', 1}, &t);
+  EXPECT_FALSE(t.c_cflag & CMSPAR);
+  EXPECT_TRUE(t.c_cflag & PARENB);
+  EXPECT_TRUE(t.c_iflag & INPCK);
+  ConfigureTermios({"x", 9600, 8, 'N', 1}, &t);
+  EXPECT_FALSE(t.c_iflag & INPCK);
 }
 
 TEST(SerialPort, OpenAppliesSpeedAndRawModeToTheDevice) {
@@ -139,6 +152,48 @@ TEST(SerialPort, VanishedDeviceIsReportedAndClosed) {
   EXPECT_EQ(s, SerialPort::ReadStatus::kFailed);
   EXPECT_FALSE(err.empty());
   EXPECT_FALSE(port.is_open());
+}
+
+TEST(SerialPort, AReaderThatOpenedThePortFirstIsNotAHangUp) {
+  // Another program (a ModemManager probe, a forgotten minicom) opened the port before us, which
+  // TIOCEXCL cannot refuse: it takes bytes between our poll() and read(), and read() returns 0
+  // on the live tty. That used to close the port as "device hung up".
+  Pty pty;
+  const int other = ::open(pty.path().c_str(), O_RDONLY | O_NOCTTY | O_NONBLOCK);
+  ASSERT_GE(other, 0);
+  SerialPort port;
+  std::string err;
+  ASSERT_TRUE(port.Open({pty.path(), 9600, 8, 'N', 1}, &err)) << err;
+  std::atomic<bool> done{false};
+  std::thread thief([&] {
+    char b[64];
+    while (!done) {
+      pollfd p{other, POLLIN, 0};
+      if (::poll(&p, 1, 1) > 0) (void)!::read(other, b, sizeof(b));
+    }
+  });
+  std::thread instrument([&] {
+    for (int i = 0; i < 3000 && !done; ++i) {
+      (void)!::write(pty.master(), "x", 1);
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+  });
+  uint8_t buf[64];
+  size_t n = 0, received = 0;
+  int failed = 0;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(700);
+  while (std::chrono::steady_clock::now() < end && failed == 0) {
+    const SerialPort::ReadStatus s = port.Read(buf, sizeof(buf), 5, &n, &err);
+    if (s == SerialPort::ReadStatus::kFailed) ++failed;
+    if (s == SerialPort::ReadStatus::kData) received += n;
+  }
+  done = true;
+  instrument.join();
+  thief.join();
+  ::close(other);
+  EXPECT_EQ(failed, 0) << err;
+  EXPECT_TRUE(port.is_open());
+  EXPECT_GT(received, 0u);  // the bytes are shared, not all lost
 }
 
 TEST(SerialPort, OpenErrorsNameTheProblem) {
