@@ -116,15 +116,25 @@ void ClothSimulator::Impl::Build() {
   if (!(options.dt > 0) || !std::isfinite(options.dt))
     throw std::invalid_argument("SimOptions.dt must be finite and > 0, got " + std::to_string(options.dt));
   if (!options.gravity.allFinite()) throw std::invalid_argument("SimOptions.gravity must be finite");
-  if (!(options.wind_density >= 0) || !(options.wind_drag >= 0))
-    throw std::invalid_argument("SimOptions.wind_density and wind_drag must be >= 0");
+  // Each check also refuses NaN and +inf (an infinite stiffness or density only failed later, as
+  // a non-finite force naming neither).
+  auto finite_at_least_0 = [](double x) { return x >= 0 && std::isfinite(x); };
+  if (!finite_at_least_0(options.wind_density) || !finite_at_least_0(options.wind_drag))
+    throw std::invalid_argument("SimOptions.wind_density and wind_drag must be finite and >= 0");
   if (!StrainLimitsAreValid(options.strain_min, options.strain_max))
     throw std::invalid_argument("SimOptions strain limits [" + std::to_string(options.strain_min) + ", " +
                                 std::to_string(options.strain_max) + "] must satisfy " + kStrainLimitsRule);
-  if (!(options.repulsion_thickness >= 0) || !(options.collision_stiffness >= 0))
-    throw std::invalid_argument("SimOptions.repulsion_thickness and collision_stiffness must be >= 0");
-  if (!(options.cg_tolerance > 0) || options.cg_max_iterations < 1)
-    throw std::invalid_argument("SimOptions.cg_tolerance must be > 0 and cg_max_iterations >= 1");
+  if ((options.strain_min > 0 || std::isfinite(options.strain_max)) && options.strain_limit_iterations < 1)
+    throw std::invalid_argument("SimOptions.strain_limit_iterations must be >= 1 when a strain limit is set, got " +
+                                std::to_string(options.strain_limit_iterations));
+  if (!finite_at_least_0(options.repulsion_thickness) || !finite_at_least_0(options.collision_stiffness))
+    throw std::invalid_argument("SimOptions.repulsion_thickness and collision_stiffness must be finite and >= 0");
+  // The solve starts at dv = 0, whose relative residual is exactly 1: a tolerance of 1 or more
+  // would end every solve before its first iteration, and the cloth would never move.
+  if (!(options.cg_tolerance > 0 && options.cg_tolerance < 1) || options.cg_max_iterations < 1)
+    throw std::invalid_argument("SimOptions.cg_tolerance must be in (0, 1) and cg_max_iterations >= 1, got " +
+                                std::to_string(options.cg_tolerance) + " and " +
+                                std::to_string(options.cg_max_iterations));
   if (!(options.max_speed > 0)) throw std::invalid_argument("SimOptions.max_speed must be > 0 [m/s]");
   if (!(material.density > 0) || material.stretching_samples.empty())
     throw std::invalid_argument("ClothSimulator: material is not initialised (use MakeMaterial/LoadArcSimMaterial)");

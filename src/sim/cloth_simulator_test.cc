@@ -552,6 +552,22 @@ TEST(ClothSimulatorTest, BadInputsFailClearly) {
   Mesh flipped = good;
   flipped.F.row(0) = Eigen::RowVector3i(good.F(0, 0), good.F(0, 2), good.F(0, 1));
   ExpectThrowContaining([&] { ClothSimulator(flipped, TestMaterial(), SimOptions{}, nullptr); }, "oriented inconsistently");
+  // A tolerance the first residual (exactly 1) already meets: the cloth would never move.
+  for (double tol : {1.0, 2.0, std::nan("")}) {
+    SimOptions o_tol;
+    o_tol.cg_tolerance = tol;
+    ExpectThrowContaining([&] { ClothSimulator(good, TestMaterial(), o_tol, nullptr); }, "cg_tolerance must be in (0, 1)");
+  }
+  SimOptions o_inf;
+  o_inf.collision_stiffness = std::numeric_limits<double>::infinity();
+  ExpectThrowContaining([&] { ClothSimulator(good, TestMaterial(), o_inf, nullptr); }, "collision_stiffness must be finite");
+  o_inf = SimOptions{};
+  o_inf.wind_density = std::numeric_limits<double>::infinity();
+  ExpectThrowContaining([&] { ClothSimulator(good, TestMaterial(), o_inf, nullptr); }, "wind_density and wind_drag must be finite");
+  SimOptions o_sweeps;
+  o_sweeps.strain_max = 1.1;
+  o_sweeps.strain_limit_iterations = 0;  // the limit would be silently off
+  ExpectThrowContaining([&] { ClothSimulator(good, TestMaterial(), o_sweeps, nullptr); }, "strain_limit_iterations must be >= 1");
   ClothSimulator sim(good, TestMaterial(), SimOptions{}, nullptr);
   ExpectThrowContaining([&] { sim.SetState(Eigen::MatrixX3d::Zero(2, 3), Eigen::MatrixX3d::Zero(2, 3)); }, "SetState");
 }

@@ -1,6 +1,8 @@
 #include "sim/json_comments.h"
 
+#include <set>
 #include <stdexcept>
+#include <vector>
 
 namespace clothwind::sim {
 
@@ -47,6 +49,56 @@ std::string StripJsonComments(const std::string& text) {
     }
   }
   return out;
+}
+
+nlohmann::json ParseJsonWithComments(const std::string& text) {
+  using json = nlohmann::json;
+  // One entry per open object or array, outermost first: its keys so far (objects), its element
+  // count (arrays) and the key or index it sits at in its parent, to name it in the error.
+  struct Open {
+    bool object;
+    std::set<std::string> keys;
+    int elements = 0;
+    std::string at;
+  };
+  std::vector<Open> open;
+  std::string last_key;
+  auto where = [&] {
+    std::string path;
+    for (size_t i = 1; i < open.size(); ++i) path += open[i].at;
+    return path.empty() ? std::string("the top-level object") : path;
+  };
+  auto position_in_parent = [&]() -> std::string {
+    if (open.empty()) return "";
+    if (open.back().object) return (open.size() > 1 ? "." : "") + last_key;
+    return "[" + std::to_string(open.back().elements++) + "]";
+  };
+  const json::parser_callback_t check = [&](int, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start: {
+        std::string at = position_in_parent();
+        open.push_back({event == json::parse_event_t::object_start, {}, 0, std::move(at)});
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        if (!open.empty()) open.pop_back();
+        break;
+      case json::parse_event_t::key:
+        last_key = parsed.get<std::string>();
+        if (!open.back().keys.insert(last_key).second)
+          throw std::runtime_error("key \"" + last_key + "\" is given twice in " + where() +
+                                   " (JSON keeps only the last silently); give it once");
+        break;
+      case json::parse_event_t::value:
+        // A scalar element of an array takes an index; one under a key needs nothing.
+        if (!open.empty() && !open.back().object) ++open.back().elements;
+        break;
+    }
+    return true;
+  };
+  return json::parse(StripJsonComments(text), check);
 }
 
 }  // namespace clothwind::sim

@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 namespace clothwind::sim {
 
 // Removes `// ...` line comments and `/* ... */` block comments that lie outside JSON strings,
@@ -15,6 +17,17 @@ namespace clothwind::sim {
 // Returns the same text with comments blanked out.
 // Throws std::runtime_error if a block comment is not closed (naming the line where it opened).
 std::string StripJsonComments(const std::string& text);
+
+// Parses a hand-written JSON file's text (comments allowed, as StripJsonComments) and refuses a
+// key given twice in one object: a strict parser keeps the last silently, so a file that says
+// "frame_steps": 8 and later "frame_steps": 1000 would run with the second, unseen by its author.
+//
+// Inputs:
+//   text  JSON text, possibly with comments
+// Returns the parsed value.
+// Throws nlohmann::json::parse_error on invalid JSON (its byte offset points into `text`), and
+// std::runtime_error naming the repeated key and the object holding it (e.g. `cloths[0]`).
+nlohmann::json ParseJsonWithComments(const std::string& text);
 
 }  // namespace clothwind::sim
 

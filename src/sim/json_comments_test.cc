@@ -38,5 +38,23 @@ TEST(StripJsonComments, PlainJsonUnchanged) {
   EXPECT_EQ(StripJsonComments(text), text);
 }
 
+TEST(ParseJsonWithComments, RefusesAKeyGivenTwiceInOneObjectNamingWhere) {
+  EXPECT_EQ(ParseJsonWithComments("{\"a\": 1, // note\n \"b\": [1, {\"a\": 2}]}")["b"][1]["a"], 2);
+  auto error_of = [](const std::string& text) {
+    try {
+      ParseJsonWithComments(text);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of("{\"a\": 1, \"a\": 2}").find("\"a\" is given twice in the top-level object"), std::string::npos)
+      << error_of("{\"a\": 1, \"a\": 2}");
+  const std::string nested = "{\"c\": [3, {\"x\": 1}, {\"m\": {\"k\": 1, \"k\": 1}}]}";
+  EXPECT_NE(error_of(nested).find("\"k\" is given twice in c[2].m"), std::string::npos) << error_of(nested);
+  // Invalid JSON is still the parser's own error, with its byte offset.
+  EXPECT_THROW(ParseJsonWithComments("{\"a\": }"), nlohmann::json::parse_error);
+}
+
 }  // namespace
 }  // namespace clothwind::sim

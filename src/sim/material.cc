@@ -150,7 +150,7 @@ nlohmann::json ReadMaterialJson(const std::string& path) {
   ss << in.rdbuf();
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(StripJsonComments(ss.str()));
+    j = ParseJsonWithComments(ss.str());
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(path + ": not valid JSON: " + e.what());
   } catch (const std::runtime_error& e) {  // an unclosed block comment

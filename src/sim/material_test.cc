@@ -118,6 +118,10 @@ TEST(MaterialTest, BadFilesFailNamingFileAndField) {
   MaterialMultipliers bad;
   bad.thicken = 0;
   ExpectThrowContaining([&] { LoadArcSimMaterial(commented, bad); }, "thicken must be finite and > 0");
+  // A density given twice ran with the second (100 times heavier), without a word.
+  const std::string twice = WriteText("twice.json", "{\"density\": 0.135, \"stretching\": " + rows +
+                                                        ", \"bending\": " + bend + ", \"density\": 13.5}");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(twice); }, twice + ": key \"density\" is given twice");
   const std::string unclosed = WriteText("unclosed.json", "{\"density\": 0.1 /* never closed\n}");
   ExpectThrowContaining([&] { LoadArcSimMaterial(unclosed); }, unclosed + ": ");
 }

@@ -107,6 +107,9 @@ class Reader {
     const std::string found = ResolveScenePath(file_, rel);
     if (found.empty()) {
       const fs::path dir = fs::path(file_).parent_path();
+      std::error_code ec;
+      if (fs::path(rel).is_absolute())
+        Fail(path, "file '" + rel + "' " + (fs::is_directory(rel, ec) ? "is a folder; expected a file" : "not found"));
       Fail(path, "file '" + rel + "' not found (looked next to the scene in " + dir.string() +
                      ", in " + dir.parent_path().string() + " and in the working directory)");
     }
@@ -342,7 +345,7 @@ WindSpec ParseWind(const Reader& r, const json& j, const std::string& path) {
 std::string ResolveScenePath(const std::string& scene_path, const std::string& relative) {
   std::error_code ec;
   const fs::path rel(relative);
-  if (rel.is_absolute()) return fs::exists(rel, ec) ? rel.lexically_normal().string() : "";
+  if (rel.is_absolute()) return fs::is_regular_file(rel, ec) ? rel.lexically_normal().string() : "";
   const fs::path dir = fs::absolute(fs::path(scene_path), ec).parent_path();
   for (const fs::path& base : {dir, dir.parent_path(), fs::current_path(ec)}) {
     const fs::path candidate = base / rel;
@@ -358,7 +361,7 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
   const Reader r(abs_path, sink);
   json j;
   try {
-    j = json::parse(StripJsonComments(text));
+    j = ParseJsonWithComments(text);
   } catch (const json::parse_error& e) {
     // Name the line (and show it: it usually holds the key) rather than only a byte offset.
     const size_t at = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());

@@ -110,7 +110,7 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
 // Resolves a path written in a scene the way ArcSim users expect: absolute paths as they are;
 // relative ones first next to the scene file, then in the scene folder's parent (ArcSim's
 // root, where `conf/` and `meshes/` are siblings), then in the working directory.
-// Returns the first that exists, or "" if none does.
+// Returns the first that is a file (a folder does not count), or "" if none is.
 std::string ResolveScenePath(const std::string& scene_path, const std::string& relative);
 
 }  // namespace clothwind::sim

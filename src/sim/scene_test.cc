@@ -78,6 +78,14 @@ class SceneFiles : public ::testing::Test {
            "  \"gravity\": [0, 0, -9.8]" + extra + "\n}\n";
   }
 
+  // `text` with its one `from` replaced by `to` (a key changed in place, not given twice).
+  static std::string Replace(std::string text, const std::string& from, const std::string& to) {
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    EXPECT_EQ(text.find(from, at + 1), std::string::npos) << from << " is not unique";
+    return at == std::string::npos ? text : text.replace(at, from.size(), to);
+  }
+
   fs::path root_;
   std::string material_;
 };
@@ -294,7 +302,7 @@ TEST_F(SceneFiles, WrongTypesNameTheJsonPathAndFile) {
   text.replace(text.find("\"" + material_ + "\""), material_.size() + 2, "42");
   const std::string b = Write("conf/b.json", text);
   ExpectErrorNaming([&] { LoadScene(b); }, {b, "cloths[0].materials[0].data", "expected a string"});
-  const std::string c = Write("conf/c.json", SceneText(", \"frame_steps\": 2.5").replace(0, 0, ""));
+  const std::string c = Write("conf/c.json", Replace(SceneText(), "\"frame_steps\": 4", "\"frame_steps\": 2.5"));
   ExpectErrorNaming([&] { LoadScene(c); }, {c, "frame_steps"});
   const std::string d = Write("conf/d.json", SceneText("", "\"transform\": {\"rotate\": [90, 1, 1]},"));
   ExpectErrorNaming([&] { LoadScene(d); }, {d, "cloths[0].transform.rotate", "4 numbers"});
@@ -304,11 +312,11 @@ TEST_F(SceneFiles, WrongTypesNameTheJsonPathAndFile) {
   ExpectErrorNaming([&] { LoadScene(f); }, {f, "wind.density", ">= 0"});
   // Integers get<int> would wrap (4294967297 read as 1) and counts or spans that would allocate
   // without bound or overflow the frame count: each refused naming its key.
-  const std::string g = Write("conf/g.json", SceneText(", \"frame_steps\": 4294967297"));
+  const std::string g = Write("conf/g.json", Replace(SceneText(), "\"frame_steps\": 4", "\"frame_steps\": 4294967297"));
   ExpectErrorNaming([&] { LoadScene(g); }, {g, "frame_steps", "int's range", "4294967297"});
-  const std::string h = Write("conf/h.json", SceneText(", \"frame_steps\": 2000000000"));
+  const std::string h = Write("conf/h.json", Replace(SceneText(), "\"frame_steps\": 4", "\"frame_steps\": 2000000000"));
   ExpectErrorNaming([&] { LoadScene(h); }, {h, "frame_steps", "1..10000"});
-  const std::string i = Write("conf/i.json", SceneText(", \"duration\": 1e8"));
+  const std::string i = Write("conf/i.json", Replace(SceneText(), "\"duration\": 1,", "\"duration\": 1e8,"));
   ExpectErrorNaming([&] { LoadScene(i); }, {i, "duration", "at most 86400 s"});
   const std::string k = Write("conf/k.json", SceneText(", \"wind\": {\"turbulence\": {\"modes\": 2000000000}}"));
   ExpectErrorNaming([&] { LoadScene(k); }, {k, "wind.turbulence.modes", "1..10000"});
@@ -316,10 +324,26 @@ TEST_F(SceneFiles, WrongTypesNameTheJsonPathAndFile) {
   ExpectErrorNaming([&] { LoadScene(l); }, {l, "wind.gusts.rate", "at most 1e6 gusts"});
 }
 
+TEST_F(SceneFiles, AKeyGivenTwiceIsRefusedNamingItsObject) {
+  // A strict parser keeps the last of two: the scene ran with frame_steps 1000, unseen.
+  const std::string a = Write("conf/a.json", SceneText(", \"frame_steps\": 1000"));
+  ExpectErrorNaming([&] { LoadScene(a); }, {a, "\"frame_steps\" is given twice", "top-level object"});
+  const std::string b = Write("conf/b.json", SceneText("", "\"mesh\": \"meshes/quad.obj\","));
+  ExpectErrorNaming([&] { LoadScene(b); }, {b, "\"mesh\" is given twice", "cloths[0]"});
+  // The same key in two objects is not a repeat.
+  EXPECT_NO_THROW(LoadScene(Write("conf/c.json", SceneText(", \"wind\": {\"density\": 1}"))));
+}
+
+TEST_F(SceneFiles, AFolderNamedAsTheMeshIsRefusedAsAFolder) {
+  const std::string a = Write("conf/a.json", Replace(SceneText(), "meshes/quad.obj", (root_ / "meshes").string()));
+  ExpectErrorNaming([&] { LoadScene(a); }, {a, "cloths[0].mesh", "is a folder; expected a file"});
+}
+
 TEST_F(SceneFiles, AGustHorizonShorterThanTheSceneWarns) {
   Warnings w;
-  const std::string path = Write("conf/gusts.json", SceneText(", \"duration\": 20, \"wind\": {\"velocity\": [5, 0, 0], "
-                                                               "\"gusts\": {\"rate\": 0.1, \"amplitude\": 2, \"horizon\": 10}}"));
+  const std::string path = Write("conf/gusts.json", Replace(SceneText(", \"wind\": {\"velocity\": [5, 0, 0], "
+                                                                       "\"gusts\": {\"rate\": 0.1, \"amplitude\": 2, \"horizon\": 10}}"),
+                                                             "\"duration\": 1,", "\"duration\": 20,"));
   const Scene s = LoadScene(path, w.sink());
   EXPECT_TRUE(s.wind.gusts.horizon_given);
   ASSERT_EQ(w.list.size(), 1u);
@@ -327,8 +351,9 @@ TEST_F(SceneFiles, AGustHorizonShorterThanTheSceneWarns) {
   EXPECT_NE(w.list[0].find("before the scene's end"), std::string::npos) << w.list[0];
   // Without a horizon: no warning, and none set (Simulate draws them over the run).
   Warnings none;
-  const Scene d = LoadScene(Write("conf/gusts2.json", SceneText(", \"duration\": 20, \"wind\": {\"velocity\": [5, 0, 0], "
-                                                                 "\"gusts\": {\"rate\": 0.1, \"amplitude\": 2}}")),
+  const Scene d = LoadScene(Write("conf/gusts2.json", Replace(SceneText(", \"wind\": {\"velocity\": [5, 0, 0], "
+                                                                         "\"gusts\": {\"rate\": 0.1, \"amplitude\": 2}}"),
+                                                               "\"duration\": 1,", "\"duration\": 20,")),
                             none.sink());
   EXPECT_FALSE(d.wind.gusts.horizon_given);
   EXPECT_TRUE(none.list.empty()) << none.list.front();
@@ -407,6 +432,9 @@ TEST(ResolveScenePath, AbsoluteNextToSceneThenParentThenWorkingDirectory) {
   EXPECT_EQ(ResolveScenePath(scene, "far.obj"), (root / "far.obj").string());
   EXPECT_EQ(ResolveScenePath(scene, (root / "far.obj").string()), (root / "far.obj").string());
   EXPECT_EQ(ResolveScenePath(scene, "missing.obj"), "");
+  // A folder is not a file, by absolute path as by relative (it failed later as "no vertices").
+  EXPECT_EQ(ResolveScenePath(scene, (root / "conf").string()), "");
+  EXPECT_EQ(ResolveScenePath(scene, "conf"), "");
   fs::remove_all(root);
 }
 

@@ -85,8 +85,16 @@ int StrainLimiter::Project(double strain_min, double strain_max, int iterations,
       // Eigenvectors of C: e_hi, e_lo = perp(e_hi).
       double eh0, eh1;
       if (std::abs(c01) > 1e-300) {
-        eh0 = l_hi - c11;
-        eh1 = c01;
+        // Either row of (C - l_hi I) v = 0 gives the direction; take the one whose entries are
+        // not a difference of nearly equal numbers (with c01 at round-off size, l_hi - c11 is
+        // pure rounding noise when the face stretches most along v).
+        if (c00 >= c11) {
+          eh0 = l_hi - c11;
+          eh1 = c01;
+        } else {
+          eh0 = c01;
+          eh1 = l_hi - c00;
+        }
         const double inv = 1.0 / std::sqrt(eh0 * eh0 + eh1 * eh1);
         eh0 *= inv;
         eh1 *= inv;
