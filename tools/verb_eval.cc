@@ -94,7 +94,9 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     RefuseOutputOverInput("--json", a->json, inputs);
     RefuseOutputOverInput("--plot", a->plot, inputs);
     const std::filesystem::path plot =
-        a->plot.empty() ? std::filesystem::path(a->model).parent_path() / ("eval_" + a->split + ".png")
+        a->plot.empty() ? std::filesystem::path(a->model).parent_path() /
+                              ("eval_" + a->split +
+                               learn::EvalProtocolSuffix(a->windows, a->mirror, a->mirror_clips, a->flag_flies) + ".png")
                         : std::filesystem::path(a->plot);
     // The plot and its gnuplot data file replaced the JSON written just before them.
     for (const std::filesystem::path& drawn : {plot, std::filesystem::path(plot.string() + ".dat")})

@@ -85,7 +85,8 @@ Dataset ReadDataset(const fs::path& dir) {
   const bool split_by_clip = index.contains("dataset") && index["dataset"].is_object() &&
                              index["dataset"].value("variant", std::string()) == "split_by_clip";
   std::map<std::string, size_t> seen;  // name -> its first entry
-  std::map<int, std::pair<std::string, std::string>> simulation_split;  // simulation -> (split, a clip's name)
+  std::map<int, std::pair<std::string, std::string>> simulation_split;
+  std::map<int, std::pair<double, std::string>> simulation_wind;  // wind, first clip  // simulation -> (split, a clip's name)
   for (size_t i = 0; i < index["clips"].size(); ++i) {
     const nlohmann::json& entry = index["clips"][i];
     ClipInfo clip;
@@ -168,6 +169,18 @@ Dataset ReadDataset(const fs::path& dir) {
     // The views of one simulation share its flag's motion: in two splits, a test clip's motion is
     // trained on (the leak docs/sdn.md measures). The generator splits by simulation; a merged or
     // re-indexed dataset might not.
+    // Its views film one flag in one wind: two winds under one simulation index are a merge or
+    // re-index gone wrong, and the per-simulation figures of eval would mean nothing (eval used
+    // to find it only after predicting every clip).
+    if (clip.simulation >= 0) {
+      const auto [it, fresh] = simulation_wind.emplace(clip.simulation, std::make_pair(clip.wind_speed, clip.name));
+      if (!fresh && std::abs(it->second.first - clip.wind_speed) > 1e-9) {
+        throw std::runtime_error(index_path.string() + ": simulation " + std::to_string(clip.simulation) +
+                                 " has clips of two winds (\"" + it->second.second + "\" " +
+                                 std::to_string(it->second.first) + " m/s, \"" + clip.name + "\" " +
+                                 std::to_string(clip.wind_speed) + " m/s): its views film one wind");
+      }
+    }
     if (clip.simulation >= 0 && !split_by_clip) {
       const auto [it, fresh] = simulation_split.emplace(clip.simulation, std::make_pair(clip.split, clip.name));
       if (!fresh && it->second.first != clip.split) {
@@ -182,8 +195,14 @@ Dataset ReadDataset(const fs::path& dir) {
   return dataset;
 }
 
-void CheckClipsSuitModel(const std::vector<ClipInfo>& clips, double model_rate, bool colour) {
+void CheckClipsSuitModel(const std::vector<ClipInfo>& clips, double model_rate, bool colour, int frames) {
   for (const ClipInfo& c : clips) {
+    // Checked before any work: a short clip used to fail when its turn came to be read (after a
+    // whole training epoch), naming neither the clip nor its file.
+    if (c.num_frames < frames)
+      throw std::runtime_error((c.dir / "label.json").string() + ": field \"num_frames\" is " +
+                               std::to_string(c.num_frames) + ", the model reads " + std::to_string(frames) +
+                               " frames per clip");
     if (colour && c.encoding == "mono8")
       throw std::runtime_error((c.dir / "label.json").string() +
                                ": field \"encoding\" is \"mono8\", the model reads colour (rgb8) clips");

@@ -55,8 +55,9 @@ std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& spl
 // `model_rate` [Hz] by more than 1 %: the SDN reads frequencies in Hz at its own rate, so a clip
 // at another rate gives a wrong wind without any other sign (sdn_node refuses them too). With
 // `colour` (a model that reads Y Cr Cb), also the first clip whose encoding is "mono8": its frames
-// would read as colourless, two of the model's three channels constant.
-void CheckClipsSuitModel(const std::vector<ClipInfo>& clips, double model_rate, bool colour);
+// would read as colourless, two of the model's three channels constant. And the first clip with
+// fewer than `frames` frames (the model's N_t), naming its field num_frames.
+void CheckClipsSuitModel(const std::vector<ClipInfo>& clips, double model_rate, bool colour, int frames);
 
 // Frames first..first+count-1 of a clip as greyscale CV_8UC1 images (colour JPEGs converted) or,
 // with `colour`, as CV_8UC3 images in YCrCb order (OpenCV's BGR2YCrCb: Y is the grey of the

@@ -2,6 +2,7 @@
 // input, and the augmentations (shapes, determinism by seed, what each one does).
 #include "learn/dataset.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <numeric>
@@ -206,19 +207,44 @@ TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
     EditJson(d / "toy-00002" / "label.json", [](nlohmann::json& j) { j["frame_rate"] = 5.0; });
     const Dataset data = ReadDataset(d);
     try {
-      CheckClipsSuitModel(data.clips, 25.0, false);
+      CheckClipsSuitModel(data.clips, 25.0, false, 1);
       ADD_FAILURE() << "a 5 Hz clip was accepted for a 25 Hz model";
     } catch (const std::runtime_error& e) {
       EXPECT_THAT(e.what(), HasSubstr((d / "toy-00002" / "label.json").string()));
       EXPECT_THAT(e.what(), HasSubstr("the model reads clips at 25"));
     }
-    EXPECT_NO_THROW(CheckClipsSuitModel(ReadDataset(Copy("rate_ok")).clips, 25.1, false));  // within 1 %
+    EXPECT_NO_THROW(CheckClipsSuitModel(ReadDataset(Copy("rate_ok")).clips, 25.1, false, 1));  // within 1 %
+  }
+  {
+    // A clip shorter than the model's window: refused up front by name (it failed when its turn
+    // came, after a training epoch, naming no clip).
+    const fs::path d = Copy("short");
+    const Dataset data = ReadDataset(d);
+    const int frames = data.clips[3].num_frames;
+    EditJson(d / "toy-00003" / "label.json", [&](nlohmann::json& j) { j["num_frames"] = frames - 1; });
+    try {
+      CheckClipsSuitModel(ReadDataset(d).clips, 25.0, false, frames);
+      ADD_FAILURE() << "a clip of " << frames - 1 << " frames was accepted for a " << frames << "-frame model";
+    } catch (const std::runtime_error& e) {
+      EXPECT_THAT(e.what(), HasSubstr((d / "toy-00003" / "label.json").string() + ": field \"num_frames\""));
+    }
+    EXPECT_NO_THROW(CheckClipsSuitModel(data.clips, 25.0, false, frames));
+  }
+  {
+    // Two winds under one simulation index (a merge gone wrong): refused when read, naming both
+    // clips, not after eval has predicted every clip.
+    const fs::path d = Copy("simulation_winds");
+    EditJson(d / "index.json", [](nlohmann::json& j) {
+      j["clips"][0]["simulation"] = 7;
+      j["clips"][4]["simulation"] = 7;
+    });
+    expect_error(d, (d / "index.json").string() + ": simulation 7 has clips of two winds", "toy-00004");
   }
   {
     // Grey clips for a colour model: refused by name (two of its three channels would be constant).
     const fs::path d = Copy("grey_for_colour");
     try {
-      CheckClipsSuitModel(ReadDataset(d).clips, 25.0, true);
+      CheckClipsSuitModel(ReadDataset(d).clips, 25.0, true, 1);
       ADD_FAILURE() << "mono8 clips were accepted for a colour model";
     } catch (const std::runtime_error& e) {
       EXPECT_THAT(e.what(), HasSubstr("label.json: field \"encoding\" is \"mono8\""));
@@ -228,7 +254,7 @@ TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
     });
     for (const ClipInfo& c : ReadDataset(d).clips)
       EditJson(c.dir / "label.json", [](nlohmann::json& j) { j["encoding"] = "rgb8"; });
-    EXPECT_NO_THROW(CheckClipsSuitModel(ReadDataset(d).clips, 25.0, true));
+    EXPECT_NO_THROW(CheckClipsSuitModel(ReadDataset(d).clips, 25.0, true, 1));
   }
   {
     // The index and a label disagreeing on a clip's wind: refused naming both files.
@@ -252,6 +278,24 @@ TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
   }
 }
 
+// Gives clip i the wind of clip i - 1 (index and label) for each odd i in `odd` (all odd clips
+// when empty): the views of one simulation film one wind.
+void ShareWindsInPairs(const fs::path& d, const std::vector<size_t>& odd) {
+  nlohmann::json index;
+  std::ifstream(d / "index.json") >> index;
+  for (size_t i = 1; i < index["clips"].size(); i += 2) {
+    if (!odd.empty() && std::find(odd.begin(), odd.end(), i) == odd.end()) continue;
+    const std::string first = index["clips"][i - 1]["name"], second = index["clips"][i]["name"];
+    nlohmann::json label;
+    std::ifstream(d / first / "label.json") >> label;
+    const double wind = label["wind_speed"];
+    EditJson(d / second / "label.json", [&](nlohmann::json& j) { j["wind_speed"] = wind; });
+    EditJson(d / "index.json", [&](nlohmann::json& j) {
+      if (j["clips"][i].contains("wind_speed")) j["clips"][i]["wind_speed"] = wind;
+    });
+  }
+}
+
 TEST_F(DatasetTest, ReadsEachClipsSimulation) {
   // A simulated dataset's index names each clip's simulation; its views share it.
   // Pairs of clips, each pair in its first clip's split (index and label agreeing).
@@ -268,6 +312,7 @@ TEST_F(DatasetTest, ReadsEachClipsSimulation) {
     const std::string name = n.substr(0, n.find('=')), split = n.substr(n.find('=') + 1);
     EditJson(d / name / "label.json", [&](nlohmann::json& j) { j["split"] = split; });
   }
+  ShareWindsInPairs(d, {});
   const Dataset dataset = ReadDataset(d);
   ASSERT_EQ(dataset.clips.size(), 10u);
   for (size_t i = 0; i < dataset.clips.size(); ++i) EXPECT_EQ(dataset.clips[i].simulation, static_cast<int>(i / 2));
@@ -281,6 +326,7 @@ TEST_F(DatasetTest, ReadsEachClipsSimulation) {
     j["clips"][0]["simulation"] = 7;
     j["clips"][1]["simulation"] = 7;
   });
+  ShareWindsInPairs(leak, {1});
   EditJson(leak / "toy-00000" / "label.json", [](nlohmann::json& j) { j["split"] = "train"; });
   EditJson(leak / "toy-00001" / "label.json", [](nlohmann::json& j) { j["split"] = "test"; });
   try {

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "learn/dataset.h"
+#include "learn/fly_direction.h"
 #include "learn/predictor.h"
 
 namespace clothwind::learn {
@@ -142,7 +143,7 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   if (clips.empty()) throw std::runtime_error((data / "index.json").string() + ": no examples in split " + split);
   EvalResult r;
   r.config = predictor.config();
-  CheckClipsSuitModel(clips, r.config.frame_rate, r.config.colour);
+  CheckClipsSuitModel(clips, r.config.frame_rate, r.config.colour, r.config.frames);
   r.split = split;
   r.windows = windows;
   r.mirror = mirror;
@@ -344,11 +345,33 @@ bool RunGnuplot(const std::string& script, const fs::path& png, std::string* err
   });
 }
 
+std::string EvalProtocol(int windows, bool mirror, bool mirror_clips, const std::string& flag_flies) {
+  return "windows " + std::to_string(windows) + " mirror " + (mirror ? "1" : "0") + " mirror_clips " +
+         (mirror_clips ? "1" : "0") + " flag_flies " + flag_flies;
+}
+
+std::string EvalProtocol(const EvalResult& r) {
+  return EvalProtocol(r.windows, r.mirror, r.mirror_clips, FlagFliesName(r.flag_flies));
+}
+
+std::string EvalProtocolSuffix(int windows, bool mirror, bool mirror_clips, const std::string& flag_flies) {
+  std::string suffix;
+  if (windows != 1) suffix += "_w" + std::to_string(windows);
+  if (mirror) suffix += "_mirror";
+  if (mirror_clips) suffix += "_mirrored";
+  if (flag_flies != "right") suffix += "_flies-" + flag_flies;
+  return suffix;
+}
+
 bool PlotPredictions(const EvalResult& r, const fs::path& png, std::string* error) {
   return Plotting(error, [&] {
   const fs::path data = png.string() + ".dat";
+  const std::string protocol = EvalProtocol(r);
+  // Table 1's reading is one centred window of each clip as filmed; any other says so, in the
+  // title and the data file (scripts/compare-evals refuses to pair two protocols).
+  const bool table1 = protocol == EvalProtocol(1, false, false, "right");
   std::ostringstream d;
-  d << "# true_speed predicted_speed predicted_std name\n" << std::setprecision(6);
+  d << "# protocol " << protocol << "\n# true_speed predicted_speed predicted_std name\n" << std::setprecision(6);
   for (size_t i = 0; i < r.truth.size(); ++i) {
     d << r.truth[i] << " " << r.predicted[i] << " " << r.predicted_std[i] << " " << r.names[i] << "\n";
   }
@@ -358,7 +381,8 @@ bool PlotPredictions(const EvalResult& r, const fs::path& png, std::string* erro
   hi = std::ceil(hi + 0.5);
   std::ostringstream s;
   s << std::setprecision(4) << "set title '" << r.config.Name() << " on " << r.split << ": RMSE "
-    << r.metrics.rmse << " m/s, Acc@0.5 " << r.metrics.acc05 << " (" << r.metrics.count << ")'\n"
+    << r.metrics.rmse << " m/s, Acc@0.5 " << r.metrics.acc05 << " (" << r.metrics.count << ")"
+    << (table1 ? "" : "; " + protocol) << "'\n"
     << "set xlabel 'true wind speed [m/s]'\nset ylabel 'predicted wind speed [m/s]'\n"
     << "set xrange [0:" << hi << "]\nset yrange [0:" << hi << "]\nset size square\nset key top left\nset grid\n"
     << "plot x+0.5 with lines dt 2 lc 'grey' title '±0.5 m/s', x-0.5 with lines dt 2 lc 'grey' notitle, "

@@ -118,8 +118,21 @@ nlohmann::json EvalJson(const EvalResult& result);
 // per non-empty speed band (RMSE, Acc@0.5, bias, count) and one for the per-simulation split.
 std::string EvalTable(const EvalResult& result);
 
+// How an evaluation read its clips, in words a file can carry: "windows 1 mirror 0 mirror_clips 0
+// flag_flies right" is Table 1's reading (one centred window, as filmed).
+// Inputs: the eval options of the same names (flag_flies: "right", "left" or "auto").
+std::string EvalProtocol(int windows, bool mirror, bool mirror_clips, const std::string& flag_flies);
+// The same, of a result.
+std::string EvalProtocol(const EvalResult& result);
+// A file-name suffix that tells an evaluation read otherwise from Table 1's ("" for Table 1's;
+// e.g. "_w3_mirror" for three windows, each with its mirror image), so that eval's default plot
+// of one protocol does not replace another's.
+std::string EvalProtocolSuffix(int windows, bool mirror, bool mirror_clips, const std::string& flag_flies);
+
 // Predicted against true wind speed, with the identity line and ±0.5 m/s band, as a PNG via
-// gnuplot (written atomically). Returns false (and says why in *error) if gnuplot fails.
+// gnuplot (written atomically), and beside it <png>.dat: a "# protocol ..." line (EvalProtocol),
+// then true speed, predicted speed, predicted std and clip name per line. The title names the
+// protocol when it is not Table 1's. Returns false (and says why in *error) if gnuplot fails.
 bool PlotPredictions(const EvalResult& result, const std::filesystem::path& png, std::string* error);
 
 // The factor k by which predicted standard deviations must be multiplied so that the errors,

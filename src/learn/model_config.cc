@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <limits>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -132,52 +133,60 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     }
     return j.at(key);
   };
+  // A whole number within int's range: get<int>() read 16.7 as 16 and 4294967326 as 30, and the
+  // copy stored in the weights, read the same way, agreed.
+  auto as_int = [&](const char* key, const nlohmann::json& v) {
+    if (!v.is_number_integer() || v.get<int64_t>() < std::numeric_limits<int>::min() ||
+        v.get<int64_t>() > std::numeric_limits<int>::max())
+      throw std::runtime_error(where + ": field \"" + key + "\" must be an integer, got " + v.dump());
+    return v.get<int>();
+  };
   ModelConfig c;
   try {
     if (need("format").get<std::string>() != "clothwind-model") {
       throw std::runtime_error(where + ": field \"format\" must be \"clothwind-model\"");
     }
     c.arch = need("arch").get<std::string>();
-    c.frames = need("frames").get<int>();
-    c.channels = need("channels").get<int>();
+    c.frames = as_int("frames", need("frames"));
+    c.channels = as_int("channels", need("channels"));
     // Absent in models written before flow channels existed: greyscale only.
     c.flow = j.contains("flow") ? j.at("flow").get<bool>() : false;
-    c.flow_size = j.contains("flow_size") ? j.at("flow_size").get<int>() : 0;
+    c.flow_size = j.contains("flow_size") ? as_int("flow_size", j.at("flow_size")) : 0;
     // Absent in models written before colour input existed: greyscale.
     c.colour = j.contains("colour") ? j.at("colour").get<bool>() : false;
-    c.k = need("k").get<int>();
+    c.k = as_int("k", need("k"));
     c.include_dc = need("include_dc").get<bool>();
     // Absent in models written before the mean map existed: they had none.
     c.mean_map = j.contains("mean_map") ? j.at("mean_map").get<bool>() : false;
     // Absent in models written before padding and peak picking existed: Algorithm 1's bins.
-    c.dft_size = j.contains("dft_size") ? j.at("dft_size").get<int>() : 0;
+    c.dft_size = j.contains("dft_size") ? as_int("dft_size", j.at("dft_size")) : 0;
     c.local_peaks = j.contains("local_peaks") ? j.at("local_peaks").get<bool>() : false;
     c.phase_steps = j.contains("phase_steps") ? j.at("phase_steps").get<bool>() : false;
-    c.phase_step_far = j.contains("phase_step_far") ? j.at("phase_step_far").get<int>() : 0;
+    c.phase_step_far = j.contains("phase_step_far") ? as_int("phase_step_far", j.at("phase_step_far")) : 0;
     c.mode_shape = j.contains("mode_shape") ? j.at("mode_shape").get<bool>() : false;
-    c.spectral_pool = j.contains("spectral_pool") ? j.at("spectral_pool").get<int>() : 1;
+    c.spectral_pool = j.contains("spectral_pool") ? as_int("spectral_pool", j.at("spectral_pool")) : 1;
     // Absent in models written before the option existed: they pooled after the stem.
     c.stem_pool = j.contains("stem_pool") ? j.at("stem_pool").get<bool>() : true;
     // Absent in models written before the option existed: no coordinate channels.
     c.coord_maps = j.contains("coord_maps") ? j.at("coord_maps").get<bool>() : false;
     // Absent in models written before the option existed: the spectral maps alone.
-    c.frame_channels = j.contains("frame_channels") ? j.at("frame_channels").get<int>() : 0;
+    c.frame_channels = j.contains("frame_channels") ? as_int("frame_channels", j.at("frame_channels")) : 0;
     if (c.frame_channels < 0) throw std::runtime_error(where + ": field \"frame_channels\" must be >= 0");
     c.dropout = j.contains("dropout") ? j.at("dropout").get<double>() : 0.0;
     // Absent in models written before auxiliary targets existed: no second head.
-    c.aux_outputs = j.contains("aux_outputs") ? j.at("aux_outputs").get<int>() : 0;
+    c.aux_outputs = j.contains("aux_outputs") ? as_int("aux_outputs", j.at("aux_outputs")) : 0;
     if (c.aux_outputs < 0) throw std::runtime_error(where + ": field \"aux_outputs\" must be >= 0");
     // Absent in models written before the option existed: the linear head finds the points.
-    c.point_maps = j.contains("point_maps") ? j.at("point_maps").get<int>() : 0;
+    c.point_maps = j.contains("point_maps") ? as_int("point_maps", j.at("point_maps")) : 0;
     // Absent in models written before the option existed: a linear wind head.
-    c.head_hidden = j.contains("head_hidden") ? j.at("head_hidden").get<int>() : 0;
+    c.head_hidden = j.contains("head_hidden") ? as_int("head_hidden", j.at("head_hidden")) : 0;
     if (c.head_hidden < 0 || c.head_hidden > 4096)
       throw std::runtime_error(where + ": field \"head_hidden\" must be in 0..4096, got " + std::to_string(c.head_hidden));
     // Absent in models written before train --no-flip existed: they were trained with flips.
     c.flips_in_training = j.contains("flips_in_training") ? j.at("flips_in_training").get<bool>() : true;
     c.frame_rate = need("frame_rate").get<double>();
-    c.width = need("width").get<int>();
-    c.input_size = need("input_size").get<int>();
+    c.width = as_int("width", need("width"));
+    c.input_size = as_int("input_size", need("input_size"));
     c.label_mean = need("label_mean").get<double>();
     c.label_std = need("label_std").get<double>();
     // Absent in models written before calibration existed: the std as trained.

@@ -34,18 +34,28 @@ Tracks ReadTracks(const std::filesystem::path& file) {
     if (!j.contains(key)) throw std::runtime_error(where + "'" + key + "' is missing");
     return j[key];
   };
-  if (j.value("format", "") != "clothwind-tracks")
+  // Checked before any value is read: nlohmann's own errors (value() of an array, a string
+  // version) named neither the file nor the field.
+  if (!j.is_object()) throw std::runtime_error(file.string() + ": expected a JSON object at the top level");
+  if (!(j.contains("format") && j["format"] == "clothwind-tracks"))
     throw std::runtime_error(where + "'format' must be \"clothwind-tracks\"");
-  if (j.value("version", 0) != 1) throw std::runtime_error(where + "'version' must be 1");
+  if (!(j.contains("version") && j["version"].is_number_integer() && j["version"] == 1))
+    throw std::runtime_error(where + "'version' must be the integer 1");
+  // A whole number in 1..2^20 (a float like 8.5 would be truncated by get<int>).
+  auto count = [&](const nlohmann::json& v, const std::string& name) {
+    if (!v.is_number_integer() || v.get<int64_t>() < 1 || v.get<int64_t>() > (1 << 20))
+      throw std::runtime_error(where + "'" + name + "' must be a positive integer, got " + v.dump());
+    return v.get<int>();
+  };
   Tracks t;
   try {
-    const auto grid = need("grid").get<std::vector<int>>();
-    if (grid.size() != 2 || grid[0] < 1 || grid[1] < 1)
-      throw std::runtime_error(where + "'grid' must be [cols, rows] of positive integers");
-    t.cols = grid[0];
-    t.rows = grid[1];
-    t.width = need("width").get<int>();
-    t.height = need("height").get<int>();
+    const nlohmann::json& grid = need("grid");
+    if (!grid.is_array() || grid.size() != 2)
+      throw std::runtime_error(where + "'grid' must be [cols, rows] of positive integers, got " + grid.dump());
+    t.cols = count(grid[0], "grid[0]");
+    t.rows = count(grid[1], "grid[1]");
+    t.width = count(need("width"), "width");
+    t.height = count(need("height"), "height");
     const nlohmann::json& xy = need("xy");
     if (!xy.is_array() || xy.empty()) throw std::runtime_error(where + "'xy' must be a non-empty array of frames");
     t.frames = static_cast<int>(xy.size());

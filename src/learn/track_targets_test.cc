@@ -313,6 +313,18 @@ TEST_F(TracksFileTest, ErrorsNameTheFileAndTheField) {
   EXPECT_NE(message(j).find("'world[0]'"), std::string::npos);
   j["world"] = {{0, 0, 1, 2, 0, 1}, {0, 0, 1, 2, 0, 1}};  // 2 frames of 1
   EXPECT_NE(message(j).find("'world'"), std::string::npos);
+  // Each of these escaped as nlohmann's own error, naming neither the file nor the field.
+  m = message(nlohmann::json::array({1, 2}));
+  EXPECT_NE(m.find(path_.string() + ": expected a JSON object"), std::string::npos) << m;
+  j = good;
+  j["version"] = "1";
+  EXPECT_NE(message(j).find("'version' must be the integer 1"), std::string::npos) << message(j);
+  j = good;
+  j["grid"] = {8.5, 6};  // was read as 8
+  EXPECT_NE(message(j).find("'grid[0]' must be a positive integer, got 8.5"), std::string::npos) << message(j);
+  j = good;
+  j["height"] = 4294967304;  // wrapped to 8
+  EXPECT_NE(message(j).find("'height' must be a positive integer"), std::string::npos) << message(j);
 }
 
 }  // namespace

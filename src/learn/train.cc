@@ -162,6 +162,39 @@ fs::path CheckpointDir(const fs::path& out) { return CheckpointDirOf(ReadState(o
 
 namespace {
 
+// Deletes what a run writes in `out` (state, checkpoints, models, log, learning curve), leaving
+// anything else there alone.
+void RemoveRun(const fs::path& out) {
+  for (const auto& entry : fs::directory_iterator(out)) {
+    const std::string name = entry.path().filename().string();
+    const bool run_file = name == "state.json" || name == "log.tsv" || name.rfind("checkpoint-e", 0) == 0 ||
+                          name.rfind("last", 0) == 0 || name.rfind("model.", 0) == 0 ||
+                          name.rfind("raw_model.", 0) == 0 || name.rfind("learning_curve.", 0) == 0;
+    if (run_file) fs::remove_all(entry.path());
+  }
+}
+
+// The model options a resumed run must be given as it started: they shape the network, and the
+// state's were used silently whatever these said (--model resnet18 --width 8 resumed an SDN of
+// width 4 without a word).
+void RefuseChangedModelOnResume(const fs::path& state_path, const ModelConfig& ran, const ModelConfig& given) {
+  const nlohmann::json a = ToJson(ran), b = ToJson(given);
+  static const std::pair<const char*, const char*> kOptions[] = {
+      {"arch", "--model"},           {"frames", "--frames"},         {"input_size", "--input-size"},
+      {"width", "--width"},          {"k", "--k"},                   {"include_dc", "--include-dc"},
+      {"dft_size", "--dft-size"},    {"local_peaks", "--local-peaks"}, {"dropout", "--dropout"},
+      {"phase_steps", "--phase-steps"}, {"phase_step_far", "--phase-step-far"}, {"mode_shape", "--mode-shape"},
+      {"spectral_pool", "--spectral-pool"}, {"stem_pool", "--no-stem-pool"}, {"coord_maps", "--coord-maps"},
+      {"flow", "--flow"},            {"flow_size", "--flow-size"},   {"colour", "--colour"},
+      {"head_hidden", "--head-hidden"}, {"frame_channels", "--frame-channels"}, {"mean_map", "--mean-map"}};
+  for (const auto& [key, flag] : kOptions) {
+    if (a[key] == b[key]) continue;
+    throw std::runtime_error(state_path.string() + ": the run started with " + flag + " " + a[key].dump() +
+                             " (model field \"" + key + "\"), these options give " + b[key].dump() +
+                             "; resume with the model options the run started with");
+  }
+}
+
 // The step schedule's last epoch at the full rate: lr_decay_epoch, or half the epochs for -1.
 int StepDecayEpoch(const TrainOptions& o) { return o.lr_decay_epoch < 0 ? std::max(1, o.epochs / 2) : o.lr_decay_epoch; }
 
@@ -285,6 +318,12 @@ TrainResult Train(const TrainOptions& o) {
     throw std::runtime_error("device cuda requested but libtorch finds no CUDA device");
   }
   if (o.epochs < 1 || o.batch < 1) throw std::runtime_error("epochs and batch must be at least 1");
+  // Batch normalisation normalises each channel over the batch: one clip leaves nothing to
+  // normalise over once the trunk's feature map is 1x1, and libtorch failed mid-epoch with a
+  // backtrace naming no option.
+  if (o.batch < 2 && !o.init_only)
+    throw std::runtime_error("--batch must be at least 2 to train (batch normalisation needs two clips), got " +
+                             std::to_string(o.batch));
   if (o.crop_scales.empty()) throw std::runtime_error("crop_scales: expected at least one scale in (0, 1]");
   for (double s : o.crop_scales) {
     if (!(s > 0 && s <= 1)) {
@@ -334,8 +373,8 @@ TrainResult Train(const TrainOptions& o) {
   }
 
   ModelConfig config = o.model;
-  CheckClipsSuitModel(train, config.frame_rate, config.colour);
-  CheckClipsSuitModel(val, config.frame_rate, config.colour);
+  CheckClipsSuitModel(train, config.frame_rate, config.colour, config.frames);
+  CheckClipsSuitModel(val, config.frame_rate, config.colour, config.frames);
   config.channels = config.ChannelsForInput();  // greyscale, as the seed (+ flow x, y), or Y Cr Cb
   if (!train.empty()) {
     double sum = 0, sum2 = 0;
@@ -350,14 +389,13 @@ TrainResult Train(const TrainOptions& o) {
   // The checks every model.json gets when read, before any work: a model eval could not load
   // (or one of 10^12 weights) used to be trained first.
   if (!o.resume) ModelConfigFromJson(ToJson(config), "the model options");
-  // Made once the options and data are known good: a refusal used to leave an empty folder.
-  fs::create_directories(o.out);
   const fs::path state_path = o.out / "state.json";
   nlohmann::json state;
   if (o.resume) {
     state = ReadState(state_path);
     try {
       config = ModelConfigFromJson(state.at("model"), state_path.string());
+      RefuseChangedModelOnResume(state_path, config, o.model);
       for (const auto& e : state.at("log")) result.log.push_back(EpochFromJson(e));
     } catch (const nlohmann::json::exception& e) {
       throw std::runtime_error(state_path.string() + ": " + e.what());
@@ -489,6 +527,13 @@ TrainResult Train(const TrainOptions& o) {
     state.exp_avg_sq(state.exp_avg_sq().to(device));
     if (state.max_exp_avg_sq().defined()) state.max_exp_avg_sq(state.max_exp_avg_sq().to(device));
   }
+  // Made once the options, the data and the network are known good: a refusal used to leave an
+  // empty folder.
+  fs::create_directories(o.out);
+  // --overwrite starts again here, not when epoch 1 replaces the files: a run that failed in its
+  // first epoch left the old run's state for --resume to continue, and files the new run does not
+  // write (raw_model.* without a weight average) stayed for good.
+  if (o.overwrite && !o.resume) RemoveRun(o.out);
   if (o.init_only) {
     SaveWindNet(net, result.model);
     return result;
@@ -564,7 +609,8 @@ TrainResult Train(const TrainOptions& o) {
       optimizer.zero_grad();
       const WindNetImpl::Outputs outputs = net->ForwardWithAux(x);
       const at::Tensor& out = outputs.wind;
-      at::Tensor loss = WindLoss(out, y);
+      const at::Tensor wind_loss = WindLoss(out, y);
+      at::Tensor loss = wind_loss;
       if (aux) {
         at::Tensor aux_loss = AuxLoss(outputs.aux, batch.aux.to(device));
         aux_sum += aux_loss.item<double>() * x.size(0);
@@ -575,7 +621,8 @@ TrainResult Train(const TrainOptions& o) {
       optimizer.step();
       if (!average.is_empty()) BlendWeights(*net, *average, AverageDecayAt(o.weight_average, average_steps++));
       const int64_t n = x.size(0);
-      loss_sum += loss.item<double>() * n;
+      // The wind's loss alone, as validation's (the auxiliary loss has its own column).
+      loss_sum += wind_loss.item<double>() * n;
       se_sum += ((out.select(1, 0).detach() - y).square().sum()).item<double>() * config.label_std * config.label_std;
       seen += n;
       if (o.progress) o.progress({epoch, o.epochs, step + 1, steps, loss_sum / seen});

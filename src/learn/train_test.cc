@@ -294,6 +294,23 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
   std::string error;
   const fs::path png = r.model.parent_path() / "eval_val.png";
   ASSERT_TRUE(PlotPredictions(e, png, &error)) << error;
+  // The data file says how the clips were read, so a three-window run is not mistaken for (nor
+  // paired with) Table 1's one window.
+  auto first_line = [](const fs::path& p) {
+    std::ifstream in(p);
+    std::string line;
+    std::getline(in, line);
+    return line;
+  };
+  EXPECT_EQ(first_line(png.string() + ".dat"), "# protocol windows 1 mirror 0 mirror_clips 0 flag_flies right");
+  EvalResult three = e;
+  three.windows = 3;
+  three.flag_flies = FlagFlies::kAuto;
+  ASSERT_TRUE(PlotPredictions(three, r.model.parent_path() / "eval_w3.png", &error)) << error;
+  EXPECT_EQ(first_line(r.model.parent_path() / "eval_w3.png.dat"),
+            "# protocol windows 3 mirror 0 mirror_clips 0 flag_flies auto");
+  EXPECT_EQ(EvalProtocolSuffix(1, false, false, "right"), "");
+  EXPECT_EQ(EvalProtocolSuffix(3, true, true, "auto"), "_w3_mirror_mirrored_flies-auto");
   // A plot that cannot be written is reported, not thrown (eval keeps its JSON); a path with a
   // quote in it is quoted for the shell and for gnuplot.
   EXPECT_FALSE(PlotPredictions(e, r.model.parent_path() / "missing" / "p.png", &error));
@@ -659,6 +676,24 @@ TEST(ModelConfig, AHiddenHeadLayerIsReluUnitsBeforeTheOutputAndOlderFilesHaveNon
   }
 }
 
+TEST(ModelConfig, IntegerFieldsMustBeWholeNumbersWithinRange) {
+  // get<int>() read these as 30, 16 and 2, and the copy stored in the weights agreed with them.
+  const nlohmann::json good = ToJson(TinySdn());
+  EXPECT_NO_THROW(ModelConfigFromJson(good, "m.json"));
+  for (const auto& [key, value] : std::vector<std::pair<std::string, nlohmann::json>>{
+           {"frames", 4294967326LL}, {"input_size", 16.7}, {"k", 2.9}, {"head_hidden", "8"}}) {
+    nlohmann::json j = good;
+    j[key] = value;
+    try {
+      ModelConfigFromJson(j, "m.json");
+      ADD_FAILURE() << key << " = " << value.dump() << " was accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("m.json: field \"" + key + "\" must be an integer"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST(ModelConfig, CoordMapsAreEachPixelsColumnAndRowAfterEveryArchitecturesImages) {
   at::manual_seed(5);
   const at::Tensor clips = at::randn({2, 1, 30, 16, 16});
@@ -937,14 +972,12 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   ASSERT_EQ(resumed.log.size(), 3u);
   EXPECT_EQ(resumed.log[2].epoch, 3);
   EXPECT_DOUBLE_EQ(resumed.log[1].val_rmse, first.log[1].val_rmse);
-  // Resuming the same run with a fresh process reproduces epoch 3 exactly (same data order,
-  // same augmentations, same optimiser state).
-  fs::copy(*root_ / "resume", *root_ / "resume2", fs::copy_options::recursive);
+  // A second run stopped after epoch 2 and resumed (another Train call, which keeps nothing of
+  // the first in memory: it reads state.json and the checkpoint) reproduces epoch 3 (same data
+  // order, same augmentations, same optimiser state).
   TrainOptions u = Options("sdn", "resume2");
   u.epochs = 3;
   u.resume = true;
-  // Roll resume2 back to its 2-epoch state: redo from a 2-epoch copy.
-  fs::remove_all(*root_ / "resume2");
   TrainOptions v = Options("sdn", "resume2");
   v.epochs = 2;
   Train(v);
@@ -980,6 +1013,49 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
                      {"model.pt: a run is already in"});
   fresh.overwrite = true;
   EXPECT_NO_THROW(Train(fresh));
+  // --overwrite clears the old run before training, not when epoch 1 ends: a new run that fails
+  // in its first epoch left the old state.json for --resume to continue (log and all), and
+  // raw_model.pt, which a run without a weight average does not write, stayed for good.
+  {
+    TrainOptions old_run = Options("sdn", "overwritten_then_failed");
+    old_run.epochs = 1;
+    old_run.weight_average = 0.5;
+    Train(old_run);
+    ASSERT_TRUE(fs::exists(old_run.out / "raw_model.pt"));
+    std::ofstream(old_run.out / "notes.txt") << "the user's own file";
+    TrainOptions again_run = old_run;
+    again_run.overwrite = true;
+    again_run.weight_average = 0;
+    again_run.progress = [](const TrainProgress&) { throw std::runtime_error("stopped in epoch 1"); };
+    EXPECT_THROW(Train(again_run), std::runtime_error);
+    for (const char* gone : {"state.json", "model.pt", "raw_model.pt", "log.tsv"})
+      EXPECT_FALSE(fs::exists(old_run.out / gone)) << gone;
+    EXPECT_TRUE(fs::exists(old_run.out / "notes.txt"));
+    TrainOptions resume_it = again_run;
+    resume_it.overwrite = false;
+    resume_it.resume = true;
+    resume_it.progress = nullptr;
+    ExpectTrainRefused(resume_it, "the failed --overwrite run resumed the old one", {"nothing to resume"});
+  }
+  // The model options are the network's shape: resuming with others is refused naming the option
+  // (they were ignored, the state's used without a word).
+  {
+    TrainOptions changed = Options("sdn", "resume");
+    changed.epochs = 3;
+    changed.resume = true;
+    changed.model.width = 16;
+    ExpectTrainRefused(changed, "--width changed on resume", {"--width 8", "these options give 16"});
+    changed.model.width = 8;
+    changed.model.arch = "resnet18";
+    ExpectTrainRefused(changed, "--model changed on resume", {"--model \"sdn\""});
+  }
+  // A batch of one clip cannot be batch-normalised: refused naming --batch, and no folder made.
+  {
+    TrainOptions single = Options("sdn", "batch_of_one");
+    single.batch = 1;
+    ExpectTrainRefused(single, "a batch of 1 was trained", {"--batch must be at least 2"});
+    EXPECT_FALSE(fs::exists(single.out));
+  }
   // A run of the layout before checkpoint folders (no "checkpoint" in state.json) resumes from
   // the files beside state.json.
   const fs::path legacy = *root_ / "legacy_layout";

@@ -142,6 +142,25 @@ class CommandTest(unittest.TestCase):
             refused(self.run_script(good, bad), 'clip flag-000000-v1: true speed 1.0')
             refused(self.run_script(good, os.path.join(d, 'missing.dat')), 'missing.dat')
 
+    def test_evaluations_read_two_ways_are_not_paired(self):
+        # One window against three windows per clip: the protocol, not the model, would differ.
+        with tempfile.TemporaryDirectory() as d:
+            rows = [('flag-000000-v0', 1.0, 1.1), ('flag-000000-v1', 1.0, 0.9), ('flag-000001-v0', 2.0, 2.2)]
+            one, three, old = (os.path.join(d, n) for n in ('one.dat', 'three.dat', 'old.dat'))
+            for path, protocol in ((one, 'windows 1 mirror 0 mirror_clips 0 flag_flies right'),
+                                   (three, 'windows 3 mirror 0 mirror_clips 0 flag_flies right')):
+                write_dat(path, rows)
+                with open(path) as f:
+                    text = f.read()
+                with open(path, 'w') as f:
+                    f.write(f'# protocol {protocol}\n' + text)
+            write_dat(old, rows)  # written before eval recorded its protocol
+            r = self.run_script(one, three, '--resamples', '100')
+            self.assertNotEqual(r.returncode, 0, r.stdout)
+            self.assertIn('"windows 3 mirror 0 mirror_clips 0 flag_flies right"', r.stderr)
+            self.assertEqual(self.run_script(one, one, '--resamples', '100').returncode, 0)
+            self.assertEqual(self.run_script(one, old, '--resamples', '100').returncode, 0)
+
 
 if __name__ == '__main__':
     unittest.main()
