@@ -22,6 +22,7 @@
 
 #include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wind_conversions.h"
+#include "ros_bridge/wall_throttle.h"
 #include "sensors/anemometer_protocol.h"
 #include "sensors/anemometer_stream.h"
 #include "sensors/fine_offset_record.h"
@@ -170,7 +171,7 @@ class AnemometerNode {
         ++connects_;
       } else {
         const double delay = backoff_.Next();
-        ROS_WARN_THROTTLE(10.0, "anemometer_node: %s; retrying (every <= %.1f s)", error.c_str(), delay);
+        WALL_WARN_THROTTLE(10.0, "anemometer_node: %s; retrying (every <= %.1f s)", error.c_str(), delay);
         state_ = "waiting: " + error;
         next_attempt_ = now + ros::WallDuration(delay);
       }
@@ -213,7 +214,7 @@ class AnemometerNode {
       } else {
         // USB stations are unplugged for long stretches: back off to the poll period.
         const double delay = std::max(backoff_.Next(), 1.0);
-        ROS_WARN_THROTTLE(30.0, "anemometer_node: %s; retrying", error.c_str());
+        WALL_WARN_THROTTLE(30.0, "anemometer_node: %s; retrying", error.c_str());
         state_ = "waiting: " + error;
         next_attempt_ = now + ros::WallDuration(delay);
       }
@@ -231,7 +232,7 @@ class AnemometerNode {
     if (!usb_.ReadCurrentRecord(&record, &address, &error)) {
       ++usb_read_errors_;
       last_error_ = error;
-      ROS_WARN_THROTTLE(30.0, "anemometer_node: %s", error.c_str());
+      WALL_WARN_THROTTLE(30.0, "anemometer_node: %s", error.c_str());
       // A station that stays open but answers nothing (a wedged HID endpoint, a hub that lost
       // power) only recovers by being opened again.
       if (usb_health_.ReadFailed(error) && usb_.is_open()) {

@@ -28,6 +28,7 @@
 #include "ros_bridge/bool_param.h"
 #include "ros_bridge/image_conversions.h"
 #include "ros_bridge/wall_diagnostics.h"
+#include "ros_bridge/wall_throttle.h"
 #include "sensors/frame_source.h"
 #include "sensors/frame_source_factory.h"
 #include "sensors/frame_timestamp.h"
@@ -184,7 +185,7 @@ int main(int argc, char** argv) {
                         << publisher.getTopic() << " in frame " << frame_id);
       } else {
         last_error = source->error();
-        ROS_ERROR_STREAM_THROTTLE(5.0, "camera_node: " << last_error << " (retrying)");
+        WALL_ERROR_STREAM_THROTTLE(5.0, "camera_node: " << last_error << " (retrying)");
         wall_diagnostics.Update();
         next_open = ros::WallTime::now() + ros::WallDuration(open_backoff_s);
         open_backoff_s = std::min(open_backoff_s * 2.0, 5.0);
@@ -224,12 +225,12 @@ int main(int argc, char** argv) {
         } catch (const std::exception& e) {
           ++read_errors;
           last_error = e.what();
-          ROS_ERROR_STREAM_THROTTLE(2.0, "camera_node: " << last_error);
+          WALL_ERROR_STREAM_THROTTLE(2.0, "camera_node: " << last_error);
         }
       } else if (status == ReadStatus::kError) {
         ++read_errors;
         last_error = source->error();
-        ROS_WARN_STREAM_THROTTLE(2.0, "camera_node: " << last_error);
+        WALL_WARN_STREAM_THROTTLE(2.0, "camera_node: " << last_error);
         if (!source->IsOpen()) {  // a recording that became unreadable: Open again, with backoff
           opened = false;
           open_backoff_s = 0.25;

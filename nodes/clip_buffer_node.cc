@@ -26,6 +26,7 @@
 
 #include "ros_bridge/bool_param.h"
 #include "ros_bridge/clip_conversions.h"
+#include "ros_bridge/wall_throttle.h"
 #include "sensors/async_dataset_writer.h"
 #include "sensors/clip_pipeline.h"
 #include "sensors/dataset_writer.h"
@@ -150,7 +151,7 @@ class ClipBufferNode {
       ros_bridge::ImageView(*msg, &view, &encoding);
       if (!pipeline_->AddFrame(msg->header.stamp.toSec(), view, encoding, Now())) {
         last_future_ = ros::WallTime::now();
-        ROS_WARN_THROTTLE(5.0, "clip_buffer: frame stamped %.1f s after the clock refused (camera clock?)",
+        WALL_WARN_THROTTLE(5.0, "clip_buffer: frame stamped %.1f s after the clock refused (camera clock?)",
                           pipeline_->stats().last_future_lead);
       }
     } catch (const std::exception& e) {
@@ -178,7 +179,7 @@ class ClipBufferNode {
     if (labelled && !same_frame) {
       wind_frame_.Admit(msg->header.frame_id, direction);  // counted
       reading.direction = std::numeric_limits<double>::quiet_NaN();
-      ROS_WARN_THROTTLE(10.0, "clip_buffer: wind direction in frame '%s' left out of the labels, which average "
+      WALL_WARN_THROTTLE(10.0, "clip_buffer: wind direction in frame '%s' left out of the labels, which average "
                         "directions in '%s' (~wind_frame_id)", msg->header.frame_id.c_str(),
                         wind_frame_.frame_id().c_str());
     }
@@ -188,7 +189,7 @@ class ClipBufferNode {
     if (labelled && same_frame && !refused) wind_frame_.Admit(msg->header.frame_id, direction);
     if (future) {
       last_future_ = ros::WallTime::now();
-      ROS_WARN_THROTTLE(5.0, "clip_buffer: anemometer reading stamped %.1f s after the clock refused",
+      WALL_WARN_THROTTLE(5.0, "clip_buffer: anemometer reading stamped %.1f s after the clock refused",
                         pipeline_->stats().last_future_lead);
     }
     Publish(pipeline_->TakeReady());
@@ -231,7 +232,7 @@ class ClipBufferNode {
   void Publish(const std::vector<sensors::LabelledClip>& clips) {
     for (const auto& c : clips) {
       if (c.label.count == 0)
-        ROS_WARN_THROTTLE(10.0, "clip_buffer: clip %lu has no anemometer reading in its %.0f s window",
+        WALL_WARN_THROTTLE(10.0, "clip_buffer: clip %lu has no anemometer reading in its %.0f s window",
                           static_cast<unsigned long>(c.clip.sequence), c.label.window);
       auto msg = boost::make_shared<clothwind::Clip>(ros_bridge::ToClipMsg(c, frame_id_, wind_frame_.frame_id()));
       if (preview_pub_.getNumSubscribers() > 0) {
@@ -266,7 +267,7 @@ class ClipBufferNode {
     ++errors_;
     last_error_ = what;
     last_error_time_ = ros::WallTime::now();
-    ROS_ERROR_THROTTLE(5.0, "clip_buffer: %s", what.c_str());
+    WALL_ERROR_THROTTLE(5.0, "clip_buffer: %s", what.c_str());
   }
 
   double SecondsSince(const ros::WallTime& t) const { return t.isZero() ? 1e9 : (ros::WallTime::now() - t).toSec(); }

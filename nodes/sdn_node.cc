@@ -48,6 +48,7 @@
 
 #include "learn/predictor.h"
 #include "ros_bridge/sdn_conversions.h"
+#include "ros_bridge/wall_throttle.h"
 #include "sensors/trailing_mean.h"
 
 namespace {
@@ -213,7 +214,7 @@ class SdnNode {
         // ~camera_heading is an angle in one frame: a direction in another says nothing of the way.
         const bool same_frame = camera_heading_frame_.empty() || clip->wind_direction_frame_id == camera_heading_frame_;
         if (!same_frame)
-          ROS_WARN_THROTTLE(30.0, "sdn_node: the clips' wind direction is in frame '%s', ~camera_heading in '%s': "
+          WALL_WARN_THROTTLE(30.0, "sdn_node: the clips' wind direction is in frame '%s', ~camera_heading in '%s': "
                             "the way the flag flies is kept as last known",
                             clip->wind_direction_frame_id.c_str(), camera_heading_frame_.c_str());
         FollowTheWind(same_frame ? clip->wind_direction_mean : std::numeric_limits<double>::quiet_NaN());
@@ -248,7 +249,7 @@ class SdnNode {
       ++(malformed ? errors_ : model_errors_);
       last_error_ = "clip " + std::to_string(clip->sequence) + ": " + e.what();
       clip_error_ = (malformed ? "malformed clip: " : "the model failed on a clip: ") + last_error_;
-      ROS_ERROR_THROTTLE(5.0, "sdn_node: %s", clip_error_.c_str());
+      WALL_ERROR_THROTTLE(5.0, "sdn_node: %s", clip_error_.c_str());
       updater_.force_update();
     }
   }

@@ -40,6 +40,7 @@
 
 #include "sensors/wind_direction_frame.h"
 #include "sensors/wind_plot.h"
+#include "ros_bridge/wall_throttle.h"
 
 namespace {
 
@@ -121,7 +122,7 @@ class WindDisplayNode {
         have_vector_ = true;
       }
     } else {
-      ROS_WARN_THROTTLE(30.0, "wind_display: reading in frame '%s' left out of the arrow, drawn in '%s' "
+      WALL_WARN_THROTTLE(30.0, "wind_display: reading in frame '%s' left out of the arrow, drawn in '%s' "
                         "(~frame_id)", msg->header.frame_id.c_str(), frame_gate_.frame_id().c_str());
     }
     Touch(msg->header.stamp);

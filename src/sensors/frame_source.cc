@@ -37,8 +37,11 @@ bool FramePacer::WaitNext(double max_wait_s, int64_t* stamp_ns) {
   };
   int64_t due = start_pace_ns_ + due_after_start(index_);
   int64_t now = pace_now();
-  // A long stall (or simulated time jumping back: a looped bag) restarts the schedule from now.
-  if (now - due > kMaxLagNs || (simulated && now < start_pace_ns_)) {
+  // A long stall, or simulated time going back (a looped bag), restarts the schedule from now.
+  // Back means before the last frame's due instant, which time had reached to release it (a
+  // rosbag --loop returns to exactly the bag's start, where the schedule may have started too).
+  const int64_t last_due = start_pace_ns_ + due_after_start(std::max<int64_t>(index_ - 1, 0));
+  if (now - due > kMaxLagNs || (simulated && now < last_due)) {
     start_ros_ns_ = simulated ? now : start_ros_ns_ + (now - start_pace_ns_);
     start_pace_ns_ = now;
     index_ = 0;
