@@ -206,13 +206,21 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
   // Upper bounds far above any model here, so a typo fails here and not as an allocation of
   // terabytes (width 100000 asked for 360 GB).
   if (c.frames > 1000 || c.width > 512 || c.input_size > 1024 || c.k > 64 || c.flow_size > 1024 ||
+      c.dft_size > 100000 || c.aux_outputs > 100000 || c.point_maps > 10000 ||
       !(c.frame_rate <= 1000) || !std::isfinite(c.label_mean) || !std::isfinite(c.label_std) ||
       !std::isfinite(c.std_scale)) {
     throw std::runtime_error(where + ": expected frames <= 1000, width <= 512, input_size <= 1024, k <= 64, "
-                             "flow_size <= 1024, frame_rate <= 1000 and finite label_mean, label_std, std_scale; "
+                             "flow_size <= 1024, dft_size <= 100000, aux_outputs <= 100000, point_maps <= 10000, "
+                             "frame_rate <= 1000 and finite label_mean, label_std, std_scale; "
                              "got frames " + std::to_string(c.frames) + ", width " + std::to_string(c.width) +
                              ", input_size " + std::to_string(c.input_size) + ", k " + std::to_string(c.k) +
-                             ", flow_size " + std::to_string(c.flow_size));
+                             ", flow_size " + std::to_string(c.flow_size) + ", dft_size " + std::to_string(c.dft_size) +
+                             ", aux_outputs " + std::to_string(c.aux_outputs) + ", point_maps " +
+                             std::to_string(c.point_maps));
+  }
+  if (const std::string field = c.SpectralOptionOffSdn(); !field.empty()) {
+    throw std::runtime_error(where + ": field \"" + field + "\" is an option of the spectral layer, which \"arch\" \"" +
+                             c.arch + "\" does not have");
   }
   if (!c.ColourIsValid()) {
     throw std::runtime_error(where + ": field \"colour\" must be false with \"flow\" (the flow is the grey frames')");

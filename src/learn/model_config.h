@@ -95,6 +95,18 @@ struct ModelConfig {
   // mode_shape is off, or on an SDN without include_dc (undetrended, the still image would be
   // the dominant mode; SpectralOptions::mode_shape).
   bool ModeShapeIsValid() const { return !mode_shape || (arch == "sdn" && !include_dc); }
+  // The first of the spectral layer's own options (mean_map, phase_steps, include_dc, dft_size,
+  // local_peaks) that is set on a model without one (resnet18, lstm), by its field name; "" when
+  // none is. Why: a baseline given them was built without them while its model.json said otherwise.
+  std::string SpectralOptionOffSdn() const {
+    if (arch == "sdn") return "";
+    if (mean_map) return "mean_map";
+    if (phase_steps) return "phase_steps";
+    if (include_dc) return "include_dc";
+    if (dft_size != 0) return "dft_size";
+    if (local_peaks) return "local_peaks";
+    return "";
+  }
   // spectral_pool is >= 1, divides input_size, and is 1 unless the model is an SDN.
   bool SpectralPoolIsValid() const;
   // frame_channels is 0, or 1..frames on an SDN.

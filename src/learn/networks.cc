@@ -101,6 +101,10 @@ WindNetImpl::WindNetImpl(const ModelConfig& config) : config_(config) {
     throw std::invalid_argument("WindNet: phase_step_far " + std::to_string(config.phase_step_far) +
                                 " must be 0, or a distance of at least 2 pixels on an SDN with phase steps");
   }
+  if (const std::string field = config.SpectralOptionOffSdn(); !field.empty()) {
+    throw std::invalid_argument("WindNet: " + field + " is an option of the spectral layer, which " + config.Name() +
+                                " does not have");
+  }
   if (!config.ModeShapeIsValid()) {
     throw std::invalid_argument("WindNet: mode_shape is an option of an SDN without include_dc, not of " + config.Name());
   }

@@ -555,6 +555,8 @@ TEST(ModelConfig, PaddedDftAndLocalPeaksRoundTripAndChangeThePrediction) {
   baseline["arch"] = "resnet18";
   baseline["phase_step_far"] = 0;
   baseline["phase_steps"] = false;
+  baseline["dft_size"] = 0;  // (the spectral layer's other options are refused on a baseline too)
+  baseline["local_peaks"] = false;
   ExpectFieldRefused(baseline, "mode_shape");
   nlohmann::json undetrended = ToJson(c);
   undetrended["include_dc"] = true;
@@ -690,6 +692,44 @@ TEST(ModelConfig, IntegerFieldsMustBeWholeNumbersWithinRange) {
     } catch (const std::runtime_error& e) {
       EXPECT_NE(std::string(e.what()).find("m.json: field \"" + key + "\" must be an integer"), std::string::npos)
           << e.what();
+    }
+  }
+}
+
+TEST(ModelConfig, CountsThatWouldAllocateTerabytesAreRefusedNamingTheFile) {
+  // aux_outputs 2^31 - 1 asked libtorch for 2 TB before the weights' own config was compared.
+  for (const auto& [key, value] : std::vector<std::pair<std::string, int64_t>>{
+           {"aux_outputs", 2147483647}, {"dft_size", 2000000000}, {"point_maps", 1000000}}) {
+    nlohmann::json j = ToJson(TinySdn());
+    j[key] = value;
+    try {
+      ModelConfigFromJson(j, "m.json");
+      ADD_FAILURE() << key << " = " << value << " was accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("m.json: expected"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(key + " <= "), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(ModelConfig, TheSpectralLayersOptionsAreRefusedOnABaseline) {
+  // A resnet18 given --mean-map was built without it while its model.json said it had one.
+  for (const char* field : {"mean_map", "phase_steps", "include_dc", "dft_size", "local_peaks"}) {
+    ModelConfig c = TinySdn();
+    c.arch = "resnet18";
+    c.mean_map = std::string(field) == "mean_map";
+    c.phase_steps = std::string(field) == "phase_steps";
+    c.include_dc = std::string(field) == "include_dc";
+    c.dft_size = std::string(field) == "dft_size" ? 64 : 0;
+    c.local_peaks = std::string(field) == "local_peaks";
+    EXPECT_EQ(c.SpectralOptionOffSdn(), field);
+    EXPECT_THROW(WindNet{c}, std::invalid_argument) << field;
+    try {
+      ModelConfigFromJson(ToJson(c), "m.json");
+      ADD_FAILURE() << field << " was accepted on a resnet18";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("field \"") + field + "\" is an option of the spectral layer"),
+                std::string::npos) << e.what();
     }
   }
 }
