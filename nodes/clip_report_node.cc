@@ -72,7 +72,9 @@ class ClipReport {
     r.start = c->frame_stamps.empty() ? NAN : c->frame_stamps.front().toSec();
     r.end = c->frame_stamps.empty() ? NAN : c->frame_stamps.back().toSec();
     for (size_t i = 1; i < c->frame_stamps.size(); ++i) {
-      const double dt = (c->frame_stamps[i] - c->frame_stamps[i - 1]).toSec();
+      // In double seconds: ros::Time arithmetic throws beyond 32 bits, and one corrupt stamp
+      // (TIME_MAX) ended the node before it printed or wrote anything of the good clips.
+      const double dt = c->frame_stamps[i].toSec() - c->frame_stamps[i - 1].toSec();
       r.max_spacing_error = std::max(r.max_spacing_error, std::fabs(dt - 1.0 / c->frame_rate));
     }
     r.mean = c->wind_mean;
@@ -82,7 +84,7 @@ class ClipReport {
     r.width = c->width;
     r.height = c->height;
     rate_ = c->frame_rate;
-    window_ = c->label_window;
+    if (std::isfinite(c->label_window) && c->label_window > 0) window_ = c->label_window;
     rows_.push_back(r);
   }
 
@@ -92,13 +94,17 @@ class ClipReport {
                           e->latency});
   }
 
+  // The trailing mean's window: the clips' label window, 60 s before any clip came.
+  double TrailingWindow() const { return window_ > 0 ? window_ : 60.0; }
+
   // The estimates' table, summary and plot (with ~estimates); adds them to the summary JSON.
   void PrintEstimates(double t0, nlohmann::json* summary) {
     namespace cs = clothwind::sensors;
     std::printf("\nestimate_report: %zu estimate(s) from the replay (label: the clip's anemometer mean)\n",
                 estimates_.size());
-    std::printf("%s", cs::EstimateTable(estimates_, t0).c_str());
-    (*summary)["estimates"] = cs::EstimateJson(estimates_);
+    // The trailing mean over the clips' own label window: like with like.
+    std::printf("%s", cs::EstimateTable(estimates_, t0, TrailingWindow()).c_str());
+    (*summary)["estimates"] = cs::EstimateJson(estimates_, TrailingWindow());
   }
 
   // The plot after the summary: a plot that cannot be drawn or written costs only itself.
@@ -107,7 +113,7 @@ class ClipReport {
     if (estimate_plot_path_.empty() || estimates_.empty()) return true;
     try {
       std::vector<uchar> png;
-      if (!cv::imencode(".png", cs::DrawEstimatePlot(estimates_, t0, 800, 360), png) || png.empty())
+      if (!cv::imencode(".png", cs::DrawEstimatePlot(estimates_, t0, 800, 360, TrailingWindow()), png) || png.empty())
         throw std::runtime_error("PNG encoding failed");
       cs::WriteFileAtomically(estimate_plot_path_, std::string(png.begin(), png.end()));
       std::printf("estimate plot: %s\n", estimate_plot_path_.c_str());

@@ -21,7 +21,10 @@
 // valid reading with a velocity (else of the first valid one): readings in another frame (MWD's
 // earth frame beside MWV's instrument frame) add their speeds and no arrow, so neither the arrow's
 // convention nor /tf_static flips. /diagnostics says how old each input is. Messages stamped 0
-// are dropped (counted): they would stamp the displays 0 and empty the plot.
+// are dropped (counted): they would stamp the displays 0 and empty the plot; so are messages
+// stamped more than ~max_future [s] (5) ahead of a running clock. When the clock or the inputs go
+// back by more than 5 s (a replay restarted), everything shown is dropped and the display starts
+// afresh (counted in diagnostics).
 // Drawing and averaging are the ROS-free sensors/wind_plot.
 #include <cmath>
 #include <limits>
@@ -60,19 +63,21 @@ class WindDisplayNode {
     double rate;
     pnh.param("rate", rate, 2.0);
     pnh.param("stale_after", stale_after_, 10.0);
+    pnh.param("max_future", max_future_, 5.0);
     auto positive = [](double v) { return std::isfinite(v) && v > 0; };
     if (!positive(mean_window_) || !positive(plot_window_) || !positive(rate) || !positive(stale_after_) ||
+        !positive(max_future_) ||
         plot_width_ < 160 || plot_height_ < 120 || plot_width_ > 4096 || plot_height_ > 4096) {
       char what[320];
       std::snprintf(what, sizeof what,
-                    "~mean_window, ~plot_window, ~rate and ~stale_after must be finite and > 0, ~plot_width x "
-                    "~plot_height from 160x120 to 4096x4096 (got %g, %g, %g, %g, %dx%d)",
-                    mean_window_, plot_window_, rate, stale_after_, plot_width_, plot_height_);
+                    "~mean_window, ~plot_window, ~rate, ~stale_after and ~max_future must be finite and > 0, ~plot_width x "
+                    "~plot_height from 160x120 to 4096x4096 (got %g, %g, %g, %g, %g, %dx%d)",
+                    mean_window_, plot_window_, rate, stale_after_, max_future_, plot_width_, plot_height_);
       throw std::invalid_argument(what);
     }
-    const double span = std::max(mean_window_, plot_window_) + 10.0;
-    estimates_ = WindHistory(span);
-    anemometer_ = WindHistory(span);
+    span_ = std::max(mean_window_, plot_window_) + 10.0;
+    estimates_ = WindHistory(span_);
+    anemometer_ = WindHistory(span_);
     markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("monitor/wind_markers", 1, true);
     plot_pub_ = nh.advertise<sensor_msgs::Image>("monitor/wind_plot", 1, true);
     if (!fixed_frame_.empty()) tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf_static", 1, true);
@@ -91,23 +96,16 @@ class WindDisplayNode {
 
  private:
   void OnEstimate(const clothwind::WindEstimate::ConstPtr& msg) {
-    if (msg->header.stamp.isZero()) {
-      ++unstamped_;
-      return;
-    }
+    if (!AdmitStamp(msg->header.stamp)) return;
     estimates_.Add({msg->header.stamp.toSec(), msg->speed, msg->speed_std});
     last_estimate_ = *msg;
     last_estimate_wall_ = ros::WallTime::now();
     have_estimate_ = true;
-    Touch(msg->header.stamp);
   }
 
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
-    if (msg->header.stamp.isZero()) {
-      ++unstamped_;
-      return;
-    }
     if (!msg->valid) return;
+    if (!AdmitStamp(msg->header.stamp)) return;
     anemometer_.Add({msg->header.stamp.toSec(), msg->speed, 0.0});
     last_wind_ = *msg;
     last_wind_wall_ = ros::WallTime::now();
@@ -125,13 +123,39 @@ class WindDisplayNode {
       WALL_WARN_THROTTLE(30.0, "wind_display: reading in frame '%s' left out of the arrow, drawn in '%s' "
                         "(~frame_id)", msg->header.frame_id.c_str(), frame_gate_.frame_id().c_str());
     }
-    Touch(msg->header.stamp);
   }
 
-  // The displays are stamped with the newest input stamp (bag time on replay, so rviz on sim time
-  // shows them in step with the images); a stamp going back means the replay restarted.
-  void Touch(const ros::Time& stamp) {
-    if (stamp > latest_stamp_ || stamp + ros::Duration(5.0) < latest_stamp_) latest_stamp_ = stamp;
+  // Whether an input's stamp may be shown; keeps the newest input stamp, with which the displays
+  // are stamped (bag time on replay, so rviz on sim time shows them in step with the images).
+  // Refused (counted): stamp 0 (it would stamp the displays 0 and empty the plot), and a stamp more
+  // than ~max_future ahead of a running clock (one reading stamped TIME_MAX made every later age
+  // a Duration out of range, which killed the node; one 100 s ahead moved the display's now and
+  // wiped the history). A stamp more than kRestartAfter behind the newest means the replay
+  // restarted: everything shown is from the previous pass and is dropped.
+  // All in double seconds: ros::Time arithmetic throws on results beyond 32 bits.
+  bool AdmitStamp(const ros::Time& stamp) {
+    if (stamp.isZero()) {
+      ++unstamped_;
+      return false;
+    }
+    const double now = ros::Time::now().toSec(), t = stamp.toSec();
+    if (now > 0 && t > now + max_future_) {
+      ++future_stamped_;
+      WALL_WARN_THROTTLE(10.0, "wind_display: input stamped %.1f s ahead of the clock dropped", t - now);
+      return false;
+    }
+    if (t + WindHistory::kRestartAfter < latest_stamp_.toSec()) Restart();
+    if (t > latest_stamp_.toSec() || latest_stamp_.isZero()) latest_stamp_ = stamp;
+    return true;
+  }
+
+  // Forgets what is shown: the clock or the inputs went back (a replay restarted).
+  void Restart() {
+    estimates_ = WindHistory(span_);
+    anemometer_ = WindHistory(span_);
+    have_estimate_ = have_wind_ = have_vector_ = false;
+    latest_stamp_ = ros::Time();
+    ++restarts_;
   }
 
   // The display's "now": ROS time (so the plot scrolls and old values age while inputs pause), but
@@ -139,19 +163,21 @@ class WindDisplayNode {
   // has just gone back (a replay restarting, until its first message moves latest_stamp_ back).
   ros::Time DisplayNow() const {
     const ros::Time now = ros::Time::now();
-    if (now.isZero() || now + ros::Duration(WindHistory::kRestartAfter) < latest_stamp_) return latest_stamp_;
+    if (now.isZero() || now.toSec() + WindHistory::kRestartAfter < latest_stamp_.toSec()) return latest_stamp_;
     return std::max(now, latest_stamp_);
   }
 
   // Age of an input [s] at `now` (the display's); infinity when there was none.
   static double Age(bool have, const ros::Time& stamp, const ros::Time& now) {
-    return have ? (now - stamp).toSec() : std::numeric_limits<double>::infinity();
+    return have ? now.toSec() - stamp.toSec() : std::numeric_limits<double>::infinity();
   }
   // Whether an input is recent enough to show: by its stamp against the display's now, and by the
   // wall clock since it arrived (the display's now stands still when a bag has ended).
   static bool Live(bool have, const ros::Time& stamp, const ros::WallTime& arrived, const ros::Time& now,
                    double limit) {
-    return Age(have, stamp, now) <= limit && (ros::WallTime::now() - arrived).toSec() <= limit;
+    const double age = Age(have, stamp, now);
+    // A value from the display's future (before a clock jump back was noticed) is not live either.
+    return age <= limit && age >= -WindHistory::kRestartAfter && (ros::WallTime::now() - arrived).toSec() <= limit;
   }
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
@@ -166,9 +192,13 @@ class WindDisplayNode {
       stat.mergeSummary(DiagnosticStatus::WARN,
                         have_wind_ ? "no anemometer reading in the mean window" : "no anemometer reading yet");
     if (unstamped_ > 0) stat.mergeSummary(DiagnosticStatus::WARN, "messages stamped 0 dropped");
+    if (future_stamped_ > 0) stat.mergeSummary(DiagnosticStatus::WARN, "messages stamped in the future dropped");
+    if (!publish_error_.empty()) stat.mergeSummary(DiagnosticStatus::ERROR, "cannot draw: " + publish_error_);
     stat.addf("estimate age [s]", "%.1f", est_age);
     stat.addf("anemometer age [s]", "%.1f", wind_age);
     stat.add("messages stamped 0 dropped", unstamped_);
+    stat.add("messages stamped more than ~max_future ahead dropped", future_stamped_);
+    stat.add("restarts (clock or inputs went back)", restarts_);
     stat.add("frame", FrameId());
     stat.add("readings in another frame (no arrow)", frame_gate_.rejected());
     stat.addf("estimate received [s ago, wall]", "%.1f",
@@ -183,7 +213,24 @@ class WindDisplayNode {
     return "anemometer";
   }
 
-  void Publish(const ros::WallTimerEvent&) {
+  void Publish(const ros::WallTimerEvent& event) {
+    // The clock went back (a replay restarted) before any input of the new pass came: what is
+    // shown is the previous pass's.
+    const double clock = ros::Time::now().toSec();
+    if (clock > 0 && last_clock_ > 0 && clock + WindHistory::kRestartAfter < last_clock_) Restart();
+    if (clock > 0) last_clock_ = clock;
+    // A drawing failure is said in diagnostics and the next tick tries again; it must not end
+    // the node (an exception out of a timer callback leaves ros::spin and main).
+    try {
+      Draw();
+      publish_error_.clear();
+    } catch (const std::exception& e) {
+      publish_error_ = e.what();
+      WALL_ERROR_THROTTLE(10.0, "wind_display: %s", e.what());
+    }
+  }
+
+  void Draw() {
     if (!have_estimate_ && !have_wind_) return;  // nothing to show yet
     const std::string frame = FrameId();
     if (!fixed_frame_.empty() && frame != tf_child_ && frame != fixed_frame_) PublishFixedFrame(frame);
@@ -270,8 +317,10 @@ class WindDisplayNode {
     tf_child_ = frame;
   }
 
-  double mean_window_ = 60.0, plot_window_ = 180.0, stale_after_ = 10.0;
-  uint64_t unstamped_ = 0;
+  double mean_window_ = 60.0, plot_window_ = 180.0, stale_after_ = 10.0, max_future_ = 5.0, span_ = 1.0;
+  uint64_t unstamped_ = 0, future_stamped_ = 0, restarts_ = 0;
+  double last_clock_ = 0;          // ROS time at the last draw [s]
+  std::string publish_error_;      // why the last draw failed ("" when it did not)
   diagnostic_updater::Updater updater_;
   ros::WallTimer diagnostics_timer_;
   int plot_width_ = 640, plot_height_ = 320;

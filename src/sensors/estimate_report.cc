@@ -86,7 +86,7 @@ EstimateSummary SummariseEstimates(const std::vector<EstimateRow>& rows, double 
   return s;
 }
 
-std::string EstimateTable(const std::vector<EstimateRow>& rows, double t0) {
+std::string EstimateTable(const std::vector<EstimateRow>& rows, double t0, double window) {
   std::string out;
   char line[200];
   std::snprintf(line, sizeof line, "%5s  %10s  %14s  %10s  %9s  %8s\n", "seq", "end [s]", "estimate m/s", "label m/s",
@@ -106,16 +106,16 @@ std::string EstimateTable(const std::vector<EstimateRow>& rows, double t0) {
                   r.speed - r.reference, r.latency * 1e3);
     out += line;
   }
-  return out + SummaryLine(SummariseEstimates(rows)) + "\n";
+  return out + SummaryLine(SummariseEstimates(rows, window)) + "\n";
 }
 
-nlohmann::json EstimateJson(const std::vector<EstimateRow>& rows) {
+nlohmann::json EstimateJson(const std::vector<EstimateRow>& rows, double window) {
   nlohmann::json list = nlohmann::json::array();
   for (const EstimateRow& r : SortedByEnd(rows)) {
     list.push_back({{"sequence", r.sequence}, {"end", r.end}, {"speed", Number(r.speed)},
                     {"speed_std", Number(r.speed_std)}, {"reference", Number(r.reference)}, {"latency", r.latency}});
   }
-  const EstimateSummary s = SummariseEstimates(rows);
+  const EstimateSummary s = SummariseEstimates(rows, window);
   return {{"estimates", list},       {"count", s.count},         {"compared", s.compared},
           {"rmse", Number(s.rmse)},  {"acc05", Number(s.acc05)}, {"bias", Number(s.bias)},
           {"mean_label", Number(s.mean_label)}, {"mean_latency", s.mean_latency}, {"max_latency", s.max_latency},
@@ -123,7 +123,8 @@ nlohmann::json EstimateJson(const std::vector<EstimateRow>& rows) {
           {"window_acc05", Number(s.window_acc05)}, {"window_bias", Number(s.window_bias)}};
 }
 
-cv::Mat DrawEstimatePlot(const std::vector<EstimateRow>& rows, double t0, int width, int height) {
+cv::Mat DrawEstimatePlot(const std::vector<EstimateRow>& rows, double t0, int width, int height,
+                         double window) {
   if (rows.empty()) throw std::invalid_argument("DrawEstimatePlot: no estimates to plot");
   // An estimate without a time (a clip stamped 0) would stretch the axis over decades: left out.
   std::vector<EstimateRow> sorted;
@@ -138,9 +139,11 @@ cv::Mat DrawEstimatePlot(const std::vector<EstimateRow>& rows, double t0, int wi
     estimate.Add({r.end, r.speed, r.speed_std});
     label.Add({r.end, r.reference, 0.0});
   }
-  cv::Mat img = DrawWindPlot(estimate, label, t_end, span, width, height, t0);
+  char reference[64];
+  std::snprintf(reference, sizeof reference, "label (anemometer %.0f s mean)", window);
+  cv::Mat img = DrawWindPlot(estimate, label, t_end, span, width, height, t0, reference);
   // The session's figures under the legend, where DrawWindPlot leaves the top margin free.
-  const EstimateSummary s = SummariseEstimates(rows);
+  const EstimateSummary s = SummariseEstimates(rows, window);
   char text[160];
   std::snprintf(text, sizeof text, "RMSE %.2f m/s  Acc@0.5 %.2f  (%d clips)", s.rmse, s.acc05, s.compared);
   cv::putText(img, text, {std::max(4, width - 300), 14}, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(60, 60, 60), 1,

@@ -47,19 +47,22 @@ EstimateSummary SummariseEstimates(const std::vector<EstimateRow>& rows, double 
 
 // A fixed-width table, one line per row sorted by `end`: sequence, time since t0, estimate ± std,
 // label, error; then one "estimates:" line with the summary.
-// Inputs: rows; t0 [s] the time printed as 0 (e.g. the first clip's start).
-std::string EstimateTable(const std::vector<EstimateRow>& rows, double t0);
+// Inputs: rows; t0 [s] the time printed as 0 (e.g. the first clip's start); window [s] of the
+// trailing mean, the clips' label window (> 0; compare like with like).
+std::string EstimateTable(const std::vector<EstimateRow>& rows, double t0, double window = 60);
 
 // The rows and the summary as JSON ({"estimates": [...], "rmse", "acc05", "bias", "compared", ...};
 // NaN written as null).
-nlohmann::json EstimateJson(const std::vector<EstimateRow>& rows);
+nlohmann::json EstimateJson(const std::vector<EstimateRow>& rows, double window = 60);
 
 // Estimate (± std band) and anemometer label over the whole session, time since t0 on x: the
 // monitor's DrawWindPlot over a window that spans every row, with the summary as a title line.
 // Inputs: rows (at least one with a time: rows whose end is 0 or not finite are left out); t0 [s]
-//         (0 or not finite: the first row's end); width, height [px] (at least 160 by 120).
+//         (0 or not finite: the first row's end); width, height [px] (at least 160 by 120);
+//         window [s] the clips' label window (the reference series is the anemometer's mean over it).
 // Returns a CV_8UC3 image. Throws std::invalid_argument for no rows with a time or a size too small.
-cv::Mat DrawEstimatePlot(const std::vector<EstimateRow>& rows, double t0, int width, int height);
+cv::Mat DrawEstimatePlot(const std::vector<EstimateRow>& rows, double t0, int width, int height,
+                         double window = 60);
 
 }  // namespace clothwind::sensors
 

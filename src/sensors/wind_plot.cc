@@ -107,7 +107,7 @@ int WindPlotRow(double speed, double y_max, int height) {
 }
 
 cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer, double t_now, double window,
-                     int width, int height, double t_origin) {
+                     int width, int height, double t_origin, const std::string& reference_name) {
   if (width < 160 || height < 120) {
     throw std::invalid_argument("DrawWindPlot: image " + std::to_string(width) + "x" + std::to_string(height) +
                                 " too small (expected at least 160x120)");
@@ -161,7 +161,7 @@ cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer,
   cv::line(img, {kLeft, 10}, {kLeft + 18, 10}, kEstimateColour, 2);
   cv::putText(img, "estimate", {kLeft + 22, 14}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1, cv::LINE_AA);
   cv::line(img, {kLeft + 100, 10}, {kLeft + 118, 10}, kAnemometerColour, 2);
-  cv::putText(img, "anemometer", {kLeft + 122, 14}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1, cv::LINE_AA);
+  cv::putText(img, reference_name, {kLeft + 122, 14}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1, cv::LINE_AA);
   return img;
 }
 

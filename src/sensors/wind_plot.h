@@ -76,10 +76,13 @@ const cv::Scalar kPlotBackground(255, 255, 255);
 //   width, height  image size [px] (at least 160 by 120)
 //   t_origin    [s] NaN (default): time labelled as seconds before now (the live monitor);
 //               finite: time labelled as seconds since t_origin (a report over a session)
+//   reference_name  the legend's name of the second series ("anemometer"; a report of clip
+//               labels calls it what it is, the anemometer's mean over each clip's window)
 // Returns a CV_8UC3 (bgr8) image height by width.
 // Throws std::invalid_argument for a size too small or a window <= 0.
 cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer, double t_now, double window,
-                     int width, int height, double t_origin = std::numeric_limits<double>::quiet_NaN());
+                     int width, int height, double t_origin = std::numeric_limits<double>::quiet_NaN(),
+                     const std::string& reference_name = "anemometer");
 
 // The pixel row of a speed in a plot DrawWindPlot drew (for tests and overlays).
 // Inputs: speed [m/s], y_max [m/s] top of the axis, height [px] image height

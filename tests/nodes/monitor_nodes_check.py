@@ -9,7 +9,7 @@ import unittest
 
 import rospy
 import rostest
-from clothwind.msg import WindEstimate, WindMeasurement
+from clothwind.msg import Clip, WindEstimate, WindMeasurement
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from visualization_msgs.msg import MarkerArray
 
@@ -23,6 +23,7 @@ class MonitorNodesTest(unittest.TestCase):
         rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics, queue_size=50)
         self.est_pub = rospy.Publisher("wind/estimate", WindEstimate, queue_size=20)
         self.wind_pub = rospy.Publisher("anemometer/wind", WindMeasurement, queue_size=20)
+        self.clip_pub = rospy.Publisher("clips", Clip, queue_size=5)
         deadline = time.time() + 20
         while time.time() < deadline and (self.est_pub.get_num_connections() < 2 or
                                           self.wind_pub.get_num_connections() < 1):
@@ -75,6 +76,23 @@ class MonitorNodesTest(unittest.TestCase):
         zero_wind = WindMeasurement()
         zero_wind.speed, zero_wind.valid = 3.0, True
         self.wind_pub.publish(zero_wind)
+        # Stamped TIME_MAX (a "no time" value some drivers use): dropped by the display, which it
+        # used to kill (every later age was a Duration out of 32-bit range); and a clip whose last
+        # frame is stamped so, which killed the report before it wrote anything.
+        far = rospy.Time(4294967295, 999999999)
+        far_wind = WindMeasurement()
+        far_wind.header.stamp, far_wind.header.frame_id = far, "anemometer"
+        far_wind.speed, far_wind.valid = 9.0, True
+        self.wind_pub.publish(far_wind)
+        far_estimate = WindEstimate()
+        far_estimate.header.stamp, far_estimate.clip_sequence = far, 10
+        far_estimate.speed, far_estimate.reference_speed = 9.0, float("nan")
+        self.est_pub.publish(far_estimate)
+        clip = Clip()
+        clip.header.stamp = rospy.Time.now()
+        clip.sequence, clip.num_frames, clip.frame_rate, clip.label_window = 1, 2, 25.0, 10.0
+        clip.frame_stamps = [rospy.Time.now(), far]
+        self.clip_pub.publish(clip)
         time.sleep(0.3)
         text, arrow = self.text()
         self.assertIsNotNone(text, "no markers")
@@ -99,6 +117,7 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertIn("estimate stale", status.message)
         self.assertIn("no anemometer reading in the mean window", status.message)
         self.assertEqual(values["messages stamped 0 dropped"], "2")
+        self.assertEqual(values["messages stamped more than ~max_future ahead dropped"], "2")
         # "Says so": a WARN, naming each cause.
         self.assertEqual(status.level, DiagnosticStatus.WARN, status.message)
         self.assertIn("messages stamped 0 dropped", status.message)
@@ -112,9 +131,12 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertTrue(os.path.exists(summary), "no summary written")
         with open(summary) as f:
             j = json.load(f)
-        # Five estimates, all with a label: the one stamped 0 is compared (it has no time, not no
-        # label), 47 m/s off.
-        self.assertEqual(j["estimates"]["count"], 5)
+        # The one stamped 0 is compared (it has no time, not no label), 47 m/s off.
+        self.assertEqual(j["total_clips"], 1)
+        self.assertEqual(j["label_window"], 10.0)
+        self.assertEqual(j["estimates"]["window"], 10.0)  # the clips' label window, not 60 s
+        # Six estimates: the one stamped TIME_MAX has no label, so five are compared.
+        self.assertEqual(j["estimates"]["count"], 6)
         self.assertEqual(j["estimates"]["compared"], 5)
         self.assertAlmostEqual(j["estimates"]["rmse"], ((4 * 1.0 + 47.0 ** 2) / 5) ** 0.5, places=6)
 
