@@ -1,7 +1,11 @@
-// clothwind bag-check: is a recorded session bag fit for replay? Per topic: message count, rate,
-// span, header stamps monotonic and equal to bag times; camera holes longer than the clip buffer's
-// gap tolerance; anemometer sentences parsed. Exit status 1 when a required topic is missing or
-// stamps go backwards.
+// clothwind bag-check: is a recorded session bag fit for replay (launch/replay.launch)? Per topic:
+// message count, rate, span, header stamps monotonic and near their bag times; camera holes
+// longer than the clip buffer's gap tolerance; anemometer sentences decoded. Exit status 1 when
+// the replay would make no labelled clip or would not start: a required topic missing, stamps
+// going back, stamped 0 or far from the bag's time (the replay's clock), camera and anemometer
+// stamps that do not overlap, no sentence that decodes, no stretch of video without holes long
+// enough for a clip, or a topic no replay node reads (replay.launch waits for a subscriber on
+// every topic unless wait:=false).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +23,7 @@
 
 #include <clothwind/RawSentence.h>
 
+#include "sensors/anemometer_protocol.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -26,8 +31,19 @@ namespace {
 
 struct BagCheckArgs {
   std::string bag;
-  double gap_tolerance = 0.1;
+  double gap_tolerance = 0.1;  // clip_buffer's ~gap_tolerance [s]
+  double max_future = 5.0;     // clip_buffer's ~max_future [s]
+  double clip_duration = 1.16; // a clip's first to last frame [s]: 30 frames at 25 fps
+  double label_window = 60.0;  // clip_buffer's ~label_window [s]
 };
+
+// The topics replay.launch's nodes read (clip_buffer: the camera's two; the anemometer node in
+// topic mode: the raw sentences), by their names without a leading slash.
+const char* const kReplayTopics[] = {"camera/image_raw", "camera/camera_info", "anemometer/raw"};
+
+std::string WithoutLeadingSlash(const std::string& topic) {
+  return !topic.empty() && topic[0] == '/' ? topic.substr(1) : topic;
+}
 
 struct TopicStats {
   std::string type;
@@ -37,21 +53,34 @@ struct TopicStats {
   size_t repeated = 0;        // header stamp equal to the previous one (records of one serial read
                               // share it; camera frames must not: the clip buffer drops them)
   size_t bag_time_off = 0;    // |bag time - header stamp| > 1 ms
+  size_t far_from_bag_time = 0;  // |bag time - header stamp| > max_future: the replay's clock is
+                                 // the bag time, and clip_buffer refuses stamps that far ahead
+  size_t zero = 0;            // header stamp 0
+  double longest_run = 0.0;   // longest span of stamps without a hole [s]
+  double run_start = NAN;
+  size_t decoded = 0, undecoded = 0;  // anemometer sentences that give a reading, and that do not
+  std::string first_error;
   size_t holes = 0;           // header stamp intervals > gap tolerance
   double widest = 0.0;        // largest interval [s]
   std::string first_data;     // first raw sentence / image encoding and size
 };
 
-void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance) {
-  if (s.count == 0) s.first = stamp;
+void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, double max_future) {
+  if (stamp == 0) ++s.zero;
+  if (s.count == 0) s.first = s.run_start = stamp;
   if (s.count > 0) {
     const double dt = stamp - s.previous;
     if (dt < 0) ++s.backwards;
     if (dt == 0) ++s.repeated;
-    if (dt > gap_tolerance) ++s.holes;
+    if (dt > gap_tolerance || dt < 0) {
+      ++s.holes;
+      s.run_start = stamp;
+    }
     s.widest = std::max(s.widest, dt);
   }
+  s.longest_run = std::max(s.longest_run, stamp - s.run_start);
   if (std::fabs(bag_time - stamp) > 1e-3) ++s.bag_time_off;
+  if (std::fabs(bag_time - stamp) > max_future) ++s.far_from_bag_time;
   s.previous = stamp;
   s.last = std::max(std::isnan(s.last) ? stamp : s.last, stamp);
   ++s.count;
@@ -62,8 +91,15 @@ int Check(const BagCheckArgs& a);
 // The bag's errors name it and what to do: rosbag's own ("Error reading from file: wanted 4
 // bytes, read 0 bytes") named neither the file nor, for a recording cut short, the repair.
 int Run(const BagCheckArgs& a) {
-  if (!(a.gap_tolerance > 0 && a.gap_tolerance <= 3600))  // NaN passed CLI's range checks
+  auto in = [](double v, double hi) { return v > 0 && v <= hi; };  // NaN passed CLI's range checks
+  if (!in(a.gap_tolerance, 3600))
     throw std::invalid_argument("--gap-tolerance must be in (0, 3600] s, got " + std::to_string(a.gap_tolerance));
+  if (!in(a.max_future, 86400))
+    throw std::invalid_argument("--max-future must be in (0, 86400] s, got " + std::to_string(a.max_future));
+  if (!in(a.clip_duration, 3600))
+    throw std::invalid_argument("--clip-duration must be in (0, 3600] s, got " + std::to_string(a.clip_duration));
+  if (!in(a.label_window, 86400))
+    throw std::invalid_argument("--label-window must be in (0, 86400] s, got " + std::to_string(a.label_window));
   try {
     return Check(a);
   } catch (const rosbag::BagException& e) {
@@ -79,25 +115,34 @@ int Check(const BagCheckArgs& a) {
   rosbag::Bag bag;
   bag.open(a.bag, rosbag::bagmode::Read);
   rosbag::View view(bag);
-  std::map<std::string, TopicStats> topics;
-  for (const auto* c : view.getConnections()) topics[c->topic].type = c->datatype;
+  std::map<std::string, TopicStats> topics;  // by name without a leading slash
+  for (const auto* c : view.getConnections()) topics[WithoutLeadingSlash(c->topic)].type = c->datatype;
+  sensors::AnemometerDecoder decoder;
   for (const rosbag::MessageInstance& m : view) {
-    TopicStats& s = topics[m.getTopic()];
+    TopicStats& s = topics[WithoutLeadingSlash(m.getTopic())];
     const double t = m.getTime().toSec();
     if (auto img = m.instantiate<sensor_msgs::Image>()) {
-      Note(s, img->header.stamp.toSec(), t, a.gap_tolerance);
+      Note(s, img->header.stamp.toSec(), t, a.gap_tolerance, a.max_future);
       if (s.first_data.empty())
         s.first_data = img->encoding + " " + std::to_string(img->width) + "x" + std::to_string(img->height) +
                        " frame " + img->header.frame_id;
     } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
-      Note(s, info->header.stamp.toSec(), t, 1e9);
+      Note(s, info->header.stamp.toSec(), t, 1e9, a.max_future);
       if (s.first_data.empty())
         s.first_data = std::to_string(info->width) + "x" + std::to_string(info->height) + " " + info->distortion_model;
     } else if (auto raw = m.instantiate<clothwind::RawSentence>()) {
-      Note(s, raw->header.stamp.toSec(), t, 1e9);
+      Note(s, raw->header.stamp.toSec(), t, 1e9, a.max_future);
       if (s.first_data.empty()) s.first_data = raw->data + " (" + raw->protocol + ")";
+      // As the anemometer node in topic mode reads them (a bad checksum labels no clip).
+      const sensors::ParseResult r = decoder.Decode(std::string(raw->data.begin(), raw->data.end()));
+      if (r.status == sensors::ParseStatus::kOk) {
+        ++s.decoded;
+      } else if (r.status != sensors::ParseStatus::kNotWind) {
+        ++s.undecoded;
+        if (s.first_error.empty()) s.first_error = r.error;
+      }
     } else {
-      Note(s, t, t, 1e9);  // any other message: bag time only
+      Note(s, t, t, 1e9, a.max_future);  // any other message: bag time only
     }
   }
   bag.close();
@@ -105,23 +150,54 @@ int Check(const BagCheckArgs& a) {
   std::printf("  %-22s %-28s %7s %8s %8s %6s %6s %6s %6s  %s\n", "topic", "type", "count", "rate Hz", "span s",
               "back", "same", "holes", "bagt", "first");
   bool ok = true;
+  std::vector<std::string> problems;
+  auto fail = [&](const std::string& why) {
+    problems.push_back(why);
+    ok = false;
+  };
   for (const auto& [name, s] : topics) {
     const double span = s.count > 1 ? s.last - s.first : 0.0;
     std::printf("  %-22s %-28s %7zu %8.2f %8.2f %6zu %6zu %6zu %6zu  %s\n", name.c_str(), s.type.c_str(), s.count,
                 span > 0 ? (s.count - 1) / span : 0.0, span, s.backwards, s.repeated, s.holes, s.bag_time_off,
                 s.first_data.c_str());
     const bool camera = name.find("image") != std::string::npos;
-    ok = ok && s.backwards == 0 && (!camera || s.repeated == 0);
+    if (s.backwards > 0) fail(name + ": " + std::to_string(s.backwards) + " header stamps go back");
+    if (camera && s.repeated > 0) fail(name + ": " + std::to_string(s.repeated) + " frames repeat a stamp");
+    const bool replayed = std::find(std::begin(kReplayTopics), std::end(kReplayTopics), name) != std::end(kReplayTopics);
+    if (!replayed) {
+      fail(name + ": no replay node reads it, and replay.launch waits for a subscriber on every topic "
+                  "(play it with wait:=false)");
+      continue;
+    }
+    if (s.zero > 0) fail(name + ": " + std::to_string(s.zero) + " messages stamped 0");
+    if (s.far_from_bag_time > 0)
+      fail(name + ": " + std::to_string(s.far_from_bag_time) + " header stamps more than " +
+           std::to_string(a.max_future) + " s from their bag time (the replay's clock; another time base?)");
   }
-  for (const char* required : {"camera/image_raw", "anemometer/raw"}) {
-    const bool found = topics.count(required) || topics.count(std::string("/") + required);
-    if (!found) std::printf("  missing: %s (replay.launch needs it)\n", required);
-    ok = ok && found;
-  }
+  const auto camera = topics.find("camera/image_raw"), wind = topics.find("anemometer/raw");
+  for (const char* required : {"camera/image_raw", "anemometer/raw"})
+    if (!topics.count(required)) fail(std::string("missing: ") + required + " (replay.launch needs it)");
+  if (camera != topics.end() && camera->second.count > 0 && camera->second.longest_run < a.clip_duration)
+    fail("camera/image_raw: no stretch of frames without a hole (> " + std::to_string(a.gap_tolerance) +
+         " s) lasts a clip's " + std::to_string(a.clip_duration) + " s (longest " +
+         std::to_string(camera->second.longest_run) + " s)");
+  if (wind != topics.end() && wind->second.count > 0 && wind->second.decoded == 0)
+    fail("anemometer/raw: no sentence gives a wind reading (" + std::to_string(wind->second.undecoded) +
+         " refused, the first: " + wind->second.first_error + ")");
+  if (camera != topics.end() && wind != topics.end() && camera->second.count > 0 && wind->second.count > 0 &&
+      (wind->second.first > camera->second.last + a.label_window ||
+       wind->second.last < camera->second.first - a.label_window))
+    fail("camera/image_raw and anemometer/raw stamps do not overlap within the label window (" +
+         std::to_string(a.label_window) + " s): no clip gets a label");
   std::printf("  (back: header stamps going back; same: equal to the previous (fine for anemometer records of "
               "one serial read, not for camera frames); holes: camera intervals > %.3f s, which break clips; "
-              "bagt: bag time != header stamp)\n  %s\n",
-              a.gap_tolerance, ok ? "ok for replay" : "NOT ok for replay");
+              "bagt: bag time != header stamp)\n",
+              a.gap_tolerance);
+  if (wind != topics.end() && wind->second.undecoded > 0)
+    std::printf("  anemometer/raw: %zu of %zu sentences refused (the first: %s)\n", wind->second.undecoded,
+                wind->second.count, wind->second.first_error.c_str());
+  for (const std::string& p : problems) std::printf("  NOT ok: %s\n", p.c_str());
+  std::printf("  %s\n", ok ? "ok for replay" : "NOT ok for replay");
   return ok ? 0 : 1;
 }
 
@@ -129,7 +205,16 @@ const VerbRegistrar kRegistrar{"bag-check", [](CLI::App& app) -> std::function<i
   auto args = std::make_shared<BagCheckArgs>();
   auto* sub = app.add_subcommand("bag-check", "Check a session bag for replay (topics, rates, stamps, holes)");
   sub->add_option("bag", args->bag, "session bag")->required()->check(CLI::ExistingFile);
-  sub->add_option("--gap-tolerance", args->gap_tolerance, "camera hole that breaks a clip [s]")
+  sub->add_option("--gap-tolerance", args->gap_tolerance, "camera hole that breaks a clip [s] (clip_buffer's)")
+      ->capture_default_str();
+  sub->add_option("--max-future", args->max_future,
+                  "largest |header stamp - bag time| [s] (clip_buffer refuses stamps this far ahead of the clock)")
+      ->capture_default_str();
+  sub->add_option("--clip-duration", args->clip_duration,
+                  "first to last frame of a clip [s]; some stretch without holes must last this long")
+      ->capture_default_str();
+  sub->add_option("--label-window", args->label_window,
+                  "camera and anemometer stamps must overlap within this [s] (clip_buffer's)")
       ->capture_default_str();
   return [args] { return Run(*args); };
 }};

@@ -71,6 +71,11 @@ int Run(const MakeSessionArgs& a) {
     throw std::invalid_argument("--minutes must be in 0.05..1440 (3 s to a day), got " + std::to_string(a.minutes));
   if (!(std::isfinite(a.wind_mean) && a.wind_mean >= 0 && a.wind_mean <= 60))
     throw std::invalid_argument("--wind-mean must be in 0..60 m/s, got " + std::to_string(a.wind_mean));
+  // The clip buffer's gap tolerance (0.1 s by default) makes every interval of a slower camera a
+  // hole: such a session replays into no clip at all (exit 0, an empty report).
+  if (!(a.fps >= 10.0))
+    throw std::invalid_argument("--fps must be at least 10 Hz (a slower camera's every frame interval is a hole "
+                                "to the clip buffer, and no clip forms), got " + std::to_string(a.fps));
   if (a.zeta_seed < -1)
     throw std::invalid_argument("--zeta-seed must be >= 0 (or -1: the session's --seed), got " +
                                 std::to_string(a.zeta_seed));
@@ -105,6 +110,12 @@ int Run(const MakeSessionArgs& a) {
     throw std::invalid_argument("--frames: expected procedural or rendered, got '" + a.frames + "'");
   }
   const sensors::SyntheticSession session(o, rendered);
+  // What was drawn must hold a clip (the clip buffer's 30 frames): a drop probability near 1 wrote
+  // a bag without images, exit 0.
+  if (session.frame_stamps().size() < 30)
+    throw std::invalid_argument("the session holds " + std::to_string(session.frame_stamps().size()) +
+                                " frames after --drop-probability " + std::to_string(a.drop_probability) +
+                                ", fewer than one clip's 30");
   // Rendered sessions: the anemometer's sensor model samples the wind field the flag flew in.
   const std::vector<sensors::SyntheticReading> model_readings =
       rendered ? rendered->AnemometerReadings() : std::vector<sensors::SyntheticReading>{};
@@ -134,13 +145,17 @@ int Run(const MakeSessionArgs& a) {
       fs::remove(e.path(), ec);
     }
   }
+  if (a.compression != "none" && a.compression != "lz4" && a.compression != "bz2")
+    throw std::invalid_argument("--compression: expected none, lz4 or bz2, got '" + a.compression + "'");
   const std::string tmp = TemporaryNameFor(a.out);
-  rosbag::Bag bag;
+  // Held by pointer: after a failed write (a full disk) the bag's close() throws again, and
+  // rosbag::Bag's destructor calls close(), which then ended the program (std::terminate) and left
+  // the temporary bag. On failure the object is abandoned instead (the verb is ending).
+  auto bag_owner = std::make_unique<rosbag::Bag>();
+  rosbag::Bag& bag = *bag_owner;
   bag.open(tmp, rosbag::bagmode::Write);
   if (a.compression == "lz4") bag.setCompression(rosbag::compression::LZ4);
   else if (a.compression == "bz2") bag.setCompression(rosbag::compression::BZ2);
-  else if (a.compression != "none")
-    throw std::invalid_argument("--compression: expected none, lz4 or bz2, got '" + a.compression + "'");
 
   sensor_msgs::CameraInfo info = MakeCameraInfo(a.width, a.height);
   info.header.frame_id = a.camera_frame;
@@ -171,10 +186,10 @@ int Run(const MakeSessionArgs& a) {
         msg.is_bigendian = 0;
         msg.step = img.cols * 3;
         msg.data.assign(img.data, img.data + img.total() * img.elemSize());
-        bag.write("camera/image_raw", t, msg);
+        bag.write("/camera/image_raw", t, msg);
         info.header.seq = msg.header.seq;
         info.header.stamp = t;
-        bag.write("camera/camera_info", t, info);
+        bag.write("/camera/camera_info", t, info);
         ++fi;
         if (bar) bar->Update(static_cast<int64_t>(fi), static_cast<int64_t>(stamps.size()));
       } else {
@@ -186,17 +201,26 @@ int Run(const MakeSessionArgs& a) {
         msg.header.frame_id = a.anemometer_frame;
         msg.data = r.sentence;
         msg.protocol = "nmea";
-        bag.write("anemometer/raw", t, msg);
+        bag.write("/anemometer/raw", t, msg);
         speed_sum += r.speed;
         ++ri;
       }
     }
     bag.close();
+    // Durable before it takes its name (as WriteFileAtomically): after a power cut the name must
+    // not point at an empty bag, which run-main would then reuse as the session.
+    SyncFile(tmp);
     fs::rename(tmp, out);
-  } catch (...) {
-    bag.close();
-    fs::remove(tmp);
-    throw;
+    SyncDirectory(out.has_parent_path() ? out.parent_path().string() : ".");
+  } catch (const std::exception& e) {
+    try {
+      bag.close();
+    } catch (...) {
+    }
+    (void)bag_owner.release();  // see above
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw std::runtime_error(a.out + ": " + e.what() + " (nothing written: the partial bag was removed)");
   }
   if (bar) bar->Finish();
   std::printf("make-session: %s: %s frames, %.1f s, %zu frames %dx%d bgr8 at %.1f fps, %zu MWV sentences at 1 Hz "

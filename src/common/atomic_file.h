@@ -46,6 +46,17 @@ inline void WriteFileDurably(const std::string& path, const void* data, size_t s
   }
 }
 
+// fsyncs a file written by other means (a library's own writer), before it is renamed into place.
+// Throws std::runtime_error naming it when that fails.
+inline void SyncFile(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error("cannot open " + path + " to sync it: " + std::strerror(errno));
+  const int rc = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  if (rc != 0) throw std::runtime_error("cannot sync " + path + ": " + std::strerror(err));
+}
+
 // fsyncs a folder, so the renames and new names in it survive a power cut.
 // Throws std::runtime_error naming it when that fails.
 inline void SyncDirectory(const std::string& dir) {

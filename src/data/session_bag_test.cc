@@ -11,7 +11,10 @@
 #include <iterator>
 #include <map>
 #include <string>
+#include <type_traits>
 #include <vector>
+
+#include <sys/wait.h>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -71,9 +74,11 @@ std::string MakeSession(const std::string& args, const std::string& name) {
 }
 
 void CheckSession(const BagContents& c, size_t frames) {
-  EXPECT_EQ(c.types.at("camera/image_raw"), "sensor_msgs/Image");
-  EXPECT_EQ(c.types.at("camera/camera_info"), "sensor_msgs/CameraInfo");
-  EXPECT_EQ(c.types.at("anemometer/raw"), "clothwind/RawSentence");
+  // Resolved names, as `rosbag record` (field.launch) stores them: `rosbag play --topics
+  // /camera/image_raw` and `rosbag filter` then treat both alike.
+  EXPECT_EQ(c.types.at("/camera/image_raw"), "sensor_msgs/Image");
+  EXPECT_EQ(c.types.at("/camera/camera_info"), "sensor_msgs/CameraInfo");
+  EXPECT_EQ(c.types.at("/anemometer/raw"), "clothwind/RawSentence");
   EXPECT_EQ(c.types.size(), 3u);
   EXPECT_TRUE(c.stamps_match_bag_time);
   // Camera: its native 30 fps with capture jitter, one camera_info per image.
@@ -148,6 +153,20 @@ TEST(SessionBagTest, ADurationThatMakesNoSessionIsRefused) {
     EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
     EXPECT_FALSE(fs::exists(bag)) << minutes;
   }
+  // A camera too slow for a clip (every interval a hole), nearly every frame dropped (no images),
+  // a start so early a frame's jitter put it before time 0 (failed mid-write for some seeds).
+  for (const char* args : {"--fps 8", "--drop-probability 0.9999", "--start-time 0.001 --seed 3"}) {
+    const fs::path bag = dir / "bad.bag";
+    const std::string log = (dir / "log").string();
+    const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes 0.1 " + args + " --out " +
+                            bag.string() + " > " + log + " 2>&1";
+    EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
+    EXPECT_FALSE(fs::exists(bag)) << args;
+    std::ifstream in(log);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_TRUE(text.find("--fps") != std::string::npos || text.find("frames") != std::string::npos ||
+                text.find("start time") != std::string::npos) << args << ": " << text;
+  }
   fs::remove_all(dir);
 }
 
@@ -157,7 +176,7 @@ TEST(SessionBagTest, APreviewOrZetaSeedItCannotUseIsRefusedBeforeTheWork) {
   const fs::path dir = fs::temp_directory_path() / ("clothwind_session_opts_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string bag = (dir / "bad.bag").string(), log = (dir / "log").string();
-  for (const std::string args : {"--preview " + (dir / "first.notanimage").string(),
+  for (const std::string& args : {"--preview " + (dir / "first.notanimage").string(),
                                  "--preview " + (dir / "no_such_folder" / "first.png").string(),
                                  std::string("--frames rendered --zeta-seed -5")}) {
     const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes 0.05 --out " + bag + " " + args +
@@ -168,6 +187,110 @@ TEST(SessionBagTest, APreviewOrZetaSeedItCannotUseIsRefusedBeforeTheWork) {
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     EXPECT_NE(text.find(args.find("preview") != std::string::npos ? "--preview" : "--zeta-seed"), std::string::npos)
         << text;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(SessionBagTest, AFullDiskIsAnErrorAndLeavesNoPartialBag) {
+  // A write that fails (file size limit: the disk full) threw again from the bag's close() in the
+  // cleanup and again from its destructor: std::terminate (exit 134) with the temporary bag left.
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_session_full_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path bag = dir / "full.bag";
+  const std::string cmd = "bash -c 'trap \"\" XFSZ; ulimit -f 2000; exec " + std::string(CLOTHWIND_BIN) +
+                          " make-session --minutes 0.5 --out " + bag.string() + "' > " + (dir / "log").string() +
+                          " 2>&1";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status)) << cmd;
+  EXPECT_EQ(WEXITSTATUS(status), 1) << cmd;
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_TRUE(e.path().filename() == "log") << "left behind: " << e.path();
+  std::ifstream in(dir / "log");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find(bag.string()), std::string::npos) << text;
+  fs::remove_all(dir);
+}
+
+// Writes `in` to `out` with each message passed through `edit` (which may change its stamp or
+// contents, or return false to leave it out); `extra` messages are added on topic /diagnostics.
+template <typename Edit>
+void RewriteBag(const std::string& in, const std::string& out, Edit edit, bool extra = false) {
+  rosbag::Bag src(in, rosbag::bagmode::Read), dst(out, rosbag::bagmode::Write);
+  for (const rosbag::MessageInstance& m : rosbag::View(src)) {
+    if (auto img = m.instantiate<sensor_msgs::Image>()) {
+      if (edit(*img)) dst.write(m.getTopic(), m.getTime(), *img);
+    } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
+      if (edit(*info)) dst.write(m.getTopic(), m.getTime(), *info);
+    } else if (auto raw = m.instantiate<clothwind::RawSentence>()) {
+      if (edit(*raw)) dst.write(m.getTopic(), m.getTime(), *raw);
+      if (extra) dst.write("/diagnostics", m.getTime(), *raw);
+    }
+  }
+}
+
+TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
+  // Each of these passed as "ok for replay", and the replay made no labelled clip (or hung).
+  const std::string good = MakeSession("", "good.bag");
+  const fs::path dir = fs::path(good).parent_path();
+  struct Case {
+    const char* name;
+    const char* says;
+  };
+  auto check = [&](const std::string& bag) {
+    const std::string log = bag + ".log";
+    const int rc = std::system((std::string(CLOTHWIND_BIN) + " bag-check " + bag + " > " + log + " 2>&1").c_str());
+    std::ifstream in(log);
+    return std::make_pair(rc, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+  };
+  ASSERT_EQ(check(good).first, 0) << check(good).second;
+  const std::string ahead = (dir / "ahead.bag").string(), zero = (dir / "zero.bag").string(),
+                    checksum = (dir / "checksum.bag").string(), extra = (dir / "extra.bag").string(),
+                    slow = (dir / "slow.bag").string(), apart = (dir / "apart.bag").string();
+  // Camera stamps a minute ahead of their bag times (the clip buffer refuses them as future).
+  RewriteBag(good, ahead, [](auto& m) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(m)>, sensor_msgs::Image>) m.header.stamp += ros::Duration(60);
+    return true;
+  });
+  // Anemometer sentences stamped 0.
+  RewriteBag(good, zero, [](auto& m) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(m)>, clothwind::RawSentence>) m.header.stamp = ros::Time();
+    return true;
+  });
+  // Every sentence with a wrong checksum.
+  RewriteBag(good, checksum, [](auto& m) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(m)>, clothwind::RawSentence>)
+      m.data = m.data.substr(0, m.data.find('*')) + "*00";
+    return true;
+  });
+  // A topic no replay node reads (rosbag record -a): replay.launch would wait for it for ever.
+  RewriteBag(good, extra, [](auto&) { return true; }, true);
+  // One camera frame in four kept: 7.5 fps, every interval (0.13 s) a hole to the clip buffer.
+  int k = 0;
+  RewriteBag(good, slow, [&](auto& m) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(m)>, sensor_msgs::Image>) return k++ % 4 == 0;
+    return true;
+  });
+  // Anemometer stamps on another time base, a day before the camera's (and their bag times too).
+  {
+    rosbag::Bag src(good, rosbag::bagmode::Read), dst(apart, rosbag::bagmode::Write);
+    for (const rosbag::MessageInstance& m : rosbag::View(src)) {
+      if (auto raw = m.instantiate<clothwind::RawSentence>()) {
+        raw->header.stamp -= ros::Duration(86400);
+        dst.write(m.getTopic(), raw->header.stamp, *raw);
+      } else if (auto img = m.instantiate<sensor_msgs::Image>()) {
+        dst.write(m.getTopic(), m.getTime(), *img);
+      } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
+        dst.write(m.getTopic(), m.getTime(), *info);
+      }
+    }
+  }
+  for (const Case& c : {Case{"ahead.bag", "from their bag time"}, Case{"zero.bag", "stamped 0"},
+                        Case{"checksum.bag", "no sentence gives a wind reading"},
+                        Case{"extra.bag", "wait:=false"}, Case{"slow.bag", "no stretch of frames without a hole"},
+                        Case{"apart.bag", "do not overlap within the label window"}}) {
+    const auto [rc, out] = check((dir / c.name).string());
+    EXPECT_EQ(rc, 1 << 8) << c.name << ": " << out;
+    EXPECT_NE(out.find(c.says), std::string::npos) << c.name << ": " << out;
   }
   fs::remove_all(dir);
 }

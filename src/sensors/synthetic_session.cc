@@ -140,8 +140,10 @@ SyntheticSession::SyntheticSession(const SyntheticSessionOptions& o,
   Check(o.fps > 0.0 && o.fps <= 1000.0, "fps must be in (0, 1000] Hz, got " + std::to_string(o.fps));
   Check(o.width >= 16 && o.height >= 16 && o.width <= 16384 && o.height <= 16384,
         "image must be 16..16384 px a side, got " + std::to_string(o.width) + "x" + std::to_string(o.height));
-  Check(o.start_time > 0.0 && o.start_time + o.duration + 10.0 < 4294967295.0,
-        "start time must be > 0 s and end before 2106 (ROS time is 32-bit seconds), got " +
+  // At least 1 s: a frame's jitter may place it before the start, and a start of a few
+  // milliseconds then failed mid-write for some seeds (a stamp before ROS time 0).
+  Check(o.start_time >= 1.0 && o.start_time + o.duration + 10.0 < 4294967295.0,
+        "start time must be >= 1 s and end before 2106 (ROS time is 32-bit seconds), got " +
             std::to_string(o.start_time) + " s");
   Check(o.anemometer_rate > 0.0, "anemometer rate must be > 0 Hz");
   Check(o.frame_jitter >= 0.0 && o.frame_jitter < 0.25 / o.fps, "frame jitter must be in [0, 1/(4 fps))");

@@ -152,6 +152,7 @@ TEST(SyntheticSessionTest, RefusesRatesSizesAndStartTimesOutOfRange) {
   EXPECT_TRUE(refused([](SyntheticSessionOptions& o) { o.width = 100000; }, "100000x"));
   EXPECT_TRUE(refused([](SyntheticSessionOptions& o) { o.start_time = -5; }, "start time"));
   EXPECT_TRUE(refused([](SyntheticSessionOptions& o) { o.start_time = 0; }, "start time"));
+  EXPECT_TRUE(refused([](SyntheticSessionOptions& o) { o.start_time = 0.001; }, "start time"));  // jitter < 0
   EXPECT_TRUE(refused([](SyntheticSessionOptions& o) { o.start_time = 4294967290.0; }, "start time"));
   SyntheticSessionOptions fine;
   fine.duration = 3.0;
