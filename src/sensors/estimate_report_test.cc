@@ -115,6 +115,20 @@ TEST(EstimateReportTest, JsonRoundTripsAndWritesNaNAsNull) {
   EXPECT_EQ(j["compared"], 1);
 }
 
+TEST(EstimateReportTest, TheTrailingMeanUsesTheWindowItIsGiven) {
+  // The report passes the clips' label window (clip_report used 60 s whatever the labels' were).
+  // Estimates alternate 1 and 3 m/s a second around a label of 2: over 1 s the trailing mean is
+  // each estimate itself (error 1), over 60 s it settles near 2.
+  std::vector<EstimateRow> rows;
+  for (int i = 0; i < 60; ++i) rows.push_back({static_cast<uint64_t>(i), 1000.0 + i, i % 2 ? 3.0 : 1.0, 0.1, 2.0, 0.01});
+  const nlohmann::json one = EstimateJson(rows, 1.0), sixty = EstimateJson(rows);
+  EXPECT_DOUBLE_EQ(one["window"].get<double>(), 1.0);
+  EXPECT_NEAR(one["window_rmse"].get<double>(), 1.0, 1e-9);
+  EXPECT_DOUBLE_EQ(sixty["window"].get<double>(), 60.0);
+  EXPECT_LT(sixty["window_rmse"].get<double>(), 0.3);
+  EXPECT_NE(EstimateTable(rows, 1000.0, 1.0), EstimateTable(rows, 1000.0));
+}
+
 TEST(EstimateReportTest, PlotShowsBothSeriesAtTheirSpeeds) {
   std::vector<EstimateRow> rows;
   for (int i = 0; i < 60; ++i) rows.push_back({static_cast<uint64_t>(i), 1000.0 + 1.2 * i, 7.0, 0.0, 2.0, 0.01});
