@@ -142,6 +142,19 @@ class CommandTest(unittest.TestCase):
             refused(self.run_script(good, bad), 'clip flag-000000-v1: true speed 1.0')
             refused(self.run_script(good, os.path.join(d, 'missing.dat')), 'missing.dat')
 
+    def test_non_finite_speeds_are_refused_naming_the_file_and_line(self):
+        # float() reads these: a nan or inf clip once gave "RMSE nan" and exit 0.
+        with tempfile.TemporaryDirectory() as d:
+            good, bad = os.path.join(d, 'good.dat'), os.path.join(d, 'bad.dat')
+            write_dat(good, [('flag-000000-v0', 1.0, 1.1), ('flag-000000-v1', 1.0, 0.9)])
+            for true, pred in (('1.0', 'nan'), ('1.0', 'inf'), ('-inf', '0.9'), ('NaN', '0.9')):
+                with open(bad, 'w') as f:
+                    f.write(f'# header\n1.0 1.1 0.3 flag-000000-v0\n{true} {pred} 0.3 flag-000000-v1\n')
+                for a, b in ((good, bad), (bad, good)):
+                    r = self.run_script(a, b, '--resamples', '100')
+                    self.assertNotEqual(r.returncode, 0, r.stdout)
+                    self.assertIn(f'{bad}:3: true and predicted speed must be finite, got {true} {pred}', r.stderr)
+
     def test_evaluations_read_two_ways_are_not_paired(self):
         # One window against three windows per clip: the protocol, not the model, would differ.
         with tempfile.TemporaryDirectory() as d:

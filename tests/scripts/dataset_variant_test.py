@@ -1,14 +1,22 @@
 #!/usr/bin/python3
 """Tests of scripts/dataset-variant on a toy dataset: per-clip splits, fewer training views, links,
 refusals."""
+import errno
+import importlib.machinery
+import importlib.util
 import json
 import os
 import subprocess
+import sys
 import tempfile
 import unittest
+from unittest import mock
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPT = os.path.join(ROOT, 'scripts', 'dataset-variant')
+_loader = importlib.machinery.SourceFileLoader('dataset_variant', SCRIPT)
+variant = importlib.util.module_from_spec(importlib.util.spec_from_loader('dataset_variant', _loader))
+_loader.exec_module(variant)
 
 
 def make_dataset(folder, sims, views=4):
@@ -125,6 +133,39 @@ class DatasetVariantTest(unittest.TestCase):
         r = run(self.src, os.path.join(self.tmp.name, 'out'))  # no change named
         self.assertNotEqual(r.returncode, 0)
         self.assertFalse(os.path.exists(os.path.join(self.tmp.name, 'out')))
+
+    def test_a_variant_is_not_a_source(self):
+        # Its header would name one change where the copy differs from the original by two.
+        dst, _ = self.resplit()
+        again = os.path.join(self.tmp.name, 'again')
+        r = run(dst, again, '--train-views', '1')
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn(f"{os.path.join(dst, 'index.json')}: dataset.variant is 'split_by_clip'", r.stderr)
+        self.assertFalse(os.path.exists(again) or os.path.exists(again + '.tmp'))
+
+    def test_a_copy_failing_half_way_leaves_nothing(self):
+        # A DST on another filesystem: hard links fail with EXDEV, here after a few have been made.
+        dst = os.path.join(self.tmp.name, 'elsewhere')
+        real_link, calls = os.link, []
+
+        def link(a, b, **kw):
+            calls.append(a)
+            if len(calls) > 5:
+                raise OSError(errno.EXDEV, os.strerror(errno.EXDEV), a, None, b)
+            return real_link(a, b, **kw)
+
+        with mock.patch.object(sys, 'argv', ['dataset-variant', self.src, dst, '--split-by-clip']), \
+                mock.patch.object(variant.os, 'link', link), self.assertRaises(SystemExit) as e:
+            variant.main()
+        message = str(e.exception.code)
+        self.assertIn(f'{calls[-1]} -> {os.path.join(dst + ".tmp", os.path.relpath(calls[-1], self.src))}', message)
+        self.assertIn("DST must be on SRC's filesystem", message)
+        self.assertIn(f'{dst}.tmp removed', message)
+        self.assertFalse(os.path.exists(dst) or os.path.exists(dst + '.tmp'))
+        # The source keeps every file.
+        self.assertEqual(sorted(os.listdir(os.path.join(self.src, 'flag-000000-v0'))), ['000.jpg', 'label.json'])
+        r = run(self.src, dst, '--split-by-clip')  # and a run that can link is not in its way
+        self.assertEqual(r.returncode, 0, r.stderr)
 
 
 if __name__ == '__main__':

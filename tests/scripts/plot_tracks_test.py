@@ -75,6 +75,39 @@ class PlotTracksTest(unittest.TestCase):
         self.assertIn(os.path.join(self.example, 'tracks.json'), r.stderr)
         self.assertFalse(os.path.exists(out))
 
+    def test_a_missing_folder_is_named(self):
+        # gnuplot could not open OUT there and wrote the PNG's bytes to stdout (a decoding traceback).
+        folder = os.path.join(self.tmp.name, 'no-such-folder')
+        r = subprocess.run([SCRIPT, self.example, os.path.join(folder, 'a.png')], capture_output=True)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn(f'no folder {folder}'.encode(), r.stderr)
+        self.assertNotIn(b'Traceback', r.stderr)
+        self.assertEqual(r.stdout, b'')
+        self.assertFalse(os.path.exists(folder))
+
+    def test_a_failed_plot_leaves_no_partial_picture(self):
+        out = os.path.join(self.tmp.name, 'c.png')
+        with open(out, 'w') as f:
+            f.write('an earlier picture')
+        with open(os.path.join(self.example, '001.png'), 'wb') as f:
+            f.write(b'not a PNG')  # gnuplot fails on the second panel, after opening its output
+        r = self.run_script(out)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn('gnuplot failed', r.stderr)
+        with open(out, 'rb') as f:
+            self.assertEqual(f.read(), b'an earlier picture')  # not a partial PNG
+        self.assertEqual(sorted(os.listdir(self.tmp.name)), ['c.png', 'flag-000000-v0'])  # no temporary left
+
+    def test_the_picture_gets_the_usual_permissions(self):
+        out = os.path.join(self.tmp.name, 'd.png')
+        old = os.umask(0o022)
+        try:
+            r = self.run_script(out)
+        finally:
+            os.umask(old)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(os.stat(out).st_mode & 0o777, 0o644)
+
 
 if __name__ == '__main__':
     unittest.main()

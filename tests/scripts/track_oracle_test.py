@@ -156,6 +156,39 @@ class TrackOracleTest(unittest.TestCase):
         self.assertIn('"width"', done.stderr)
         self.assertNotIn('Traceback', done.stderr)
 
+    def test_ragged_or_missing_tracks_and_incomplete_clips_are_named(self):
+        make_dataset(self.data, sims_per_split=(1, 1, 1), views=1)
+        path = os.path.join(self.data, 'flag-000002-v0', 'tracks.json')
+        t = read_json(path)
+        t['xy'][7] = t['xy'][7][:-2]  # one frame short of a point
+
+        def refused(text, *extra):
+            done = self.run_oracle(*extra)
+            self.assertNotEqual(done.returncode, 0)
+            self.assertIn(text, done.stderr)
+            self.assertNotIn('Traceback', done.stderr)
+
+        write_json(path, t)
+        refused(f'{path}: "xy": expected [frames][12] numbers, got rows of 10, 12 entries')
+        t['world'][3] = t['world'][3] + [1.0]
+        write_json(path, t)
+        refused(f'{path}: "world": expected [frames][18] numbers, got rows of 18, 19 entries', '--coords', 'world')
+        t['xy'][7] = ['x'] * 12
+        write_json(path, t)
+        refused(f'{path}: "xy": expected [frames][12] numbers, got entries that are not numbers')
+        del t['xy']
+        write_json(path, t)
+        refused(f'{path}: no "xy" field')
+        index_path = os.path.join(self.data, 'index.json')
+        index = read_json(index_path)
+        del index['clips'][1]['simulation']
+        write_json(index_path, index)
+        refused(f'{index_path}: clips[1] (flag-000001-v0): expected "simulation", an integer, got None')
+        index['clips'][1]['simulation'] = 1
+        index['clips'][2]['wind_speed'] = '3.5'
+        write_json(index_path, index)
+        refused(f"{index_path}: clips[2] (flag-000002-v0): expected \"wind_speed\", a number, got '3.5'")
+
     def test_a_dataset_without_a_split_is_refused(self):
         clips = make_dataset(self.data, sims_per_split=(1, 1, 0), views=1)
         self.assertFalse(any(c['split'] == 'test' for c in clips))

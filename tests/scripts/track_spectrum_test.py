@@ -1,6 +1,8 @@
 #!/usr/bin/python3
 """Tests of scripts/track-spectrum on tracks of known motion: a sine's frequency and amplitude come
 back, the window and split are the ones asked for, and bad input is refused naming what is wrong."""
+import importlib.machinery
+import importlib.util
 import json
 import math
 import os
@@ -11,6 +13,9 @@ import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPT = os.path.join(ROOT, 'scripts', 'track-spectrum')
+_loader = importlib.machinery.SourceFileLoader('track_spectrum', SCRIPT)
+spectrum = importlib.util.module_from_spec(importlib.util.spec_from_loader('track_spectrum', _loader))
+_loader.exec_module(spectrum)
 
 
 def png_size(path):
@@ -111,6 +116,46 @@ class TrackSpectrumTest(unittest.TestCase):
         self.assertNotEqual(r.returncode, 0)
         self.assertIn(os.path.join(folder, 'label.json'), r.stderr)
         self.assertFalse(os.path.exists(self.out))
+
+    def test_the_window_is_the_sdns_periodic_hann(self):
+        # learn/spectral_layer.cc: at::hann_window(n, periodic=true). Through it a sine on bin 2
+        # leaks a quarter of its amplitude into bins 1 and 3 and nothing elsewhere: powers 1:4:1,
+        # so the centroid is bin 2 exactly and bin 1 holds 1/6 (the symmetric window: 0.181).
+        f = spectrum.window_features(self.sine(60, 2 / 30, 4.0), 15, 30, 25.0)
+        self.assertAlmostEqual(f['centroid'], 2 * 25 / 30, places=9)
+        self.assertAlmostEqual(f['bin1'], 1 / 6, places=9)
+
+    def test_a_missing_folder_is_named_before_reading(self):
+        self.add('flag-000000-v0', 3.2, 'test', self.sine(60, 2 / 30, 4.0))
+        folder = os.path.join(self.tmp.name, 'no-such-folder')
+        r = subprocess.run([SCRIPT, self.data, os.path.join(folder, 'spectrum.png')], capture_output=True)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn(f'no folder {folder}'.encode(), r.stderr)
+        self.assertNotIn(b'Traceback', r.stderr)
+        self.assertNotIn(b'PNG', r.stdout)  # gnuplot wrote the picture to stdout once
+        self.assertFalse(os.path.exists(folder))
+
+    def test_a_failed_plot_leaves_no_partial_picture(self):
+        # A gnuplot that writes part of its output, then fails (a full disk, a killed process).
+        self.add('flag-000000-v0', 3.2, 'test', self.sine(60, 2 / 30, 4.0))
+        stub = os.path.join(self.tmp.name, 'bin')
+        os.makedirs(stub)
+        with open(os.path.join(stub, 'gnuplot'), 'w') as f:
+            f.write('#!/bin/sh\n'
+                    "out=$(sed -n \"s/^set output '\\(.*\\)'$/\\1/p\")\n"
+                    'printf \'\\211PNG partial\' >"$out"\n'
+                    'echo "stub gnuplot: failed" >&2; exit 1\n')
+        os.chmod(os.path.join(stub, 'gnuplot'), 0o755)
+        with open(self.out, 'w') as f:
+            f.write('an earlier picture')
+        r = subprocess.run([SCRIPT, self.data, self.out], capture_output=True, text=True,
+                           env=dict(os.environ, PATH=stub + os.pathsep + os.environ['PATH']))
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn('gnuplot failed', r.stderr)
+        self.assertIn('stub gnuplot: failed', r.stderr)
+        with open(self.out, 'rb') as f:
+            self.assertEqual(f.read(), b'an earlier picture')  # not a partial PNG
+        self.assertEqual(sorted(os.listdir(self.tmp.name)), ['bin', 'data', 'spectrum.png'])  # no temporary left
 
 
 if __name__ == '__main__':

@@ -1,9 +1,18 @@
 #!/usr/bin/python3
-"""Unit tests of scripts/window-oracle's geometry and window features (no simulation needed)."""
+"""Unit tests of scripts/window-oracle's geometry and window features, its reuse of earlier
+simulations and its stop at a failed one (no simulation needed)."""
+import argparse
 import importlib.machinery
 import importlib.util
+import json
 import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
 import unittest
+from unittest import mock
 
 import numpy as np
 
@@ -189,6 +198,101 @@ class ClipWindowsTest(unittest.TestCase):
                                     [2.3, 2.6, 1.9, 5.0, 4.4, 4.6])
         np.testing.assert_allclose([t for t, _ in errors], [2.0, 5.0])
         np.testing.assert_allclose([e for _, e in errors], [0.2667, -0.3333], atol=1e-3)
+
+
+class ReuseTest(unittest.TestCase):
+    """An earlier simulation in DIR is reused only when it is this call's: its wind, length, every
+    bending entry and mesh (the scene's when this call sets neither)."""
+
+    SPEED = 3.21
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        # window-oracle's defaults: 5 s warm-up, 19.2 s after it, the scene's mesh.
+        self.args = argparse.Namespace(out=self.tmp.name, warmup=5.0, seconds=19.2, max_edge=0.0)
+        theta = {f'bending_d{d}_c{c}': 1e-3 * (1 + d + 0.1 * c) for d in range(3) for c in range(5)}
+        self.base = {'theta': dict(theta, area_weight=1.0, wind_speed=0.0), 'max_edge_m': 0.3}
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def write_summary(self, bending_scale=1.0, edge=0.3, theta=None):
+        folder = os.path.join(self.tmp.name, 's0')
+        os.makedirs(folder, exist_ok=True)
+        theta = theta or {n: v * (bending_scale if n.startswith('bending_') else 1)
+                          for n, v in self.base['theta'].items()}
+        with open(os.path.join(folder, 'summary.json'), 'w') as f:
+            json.dump({'wind': {'velocity': [round(self.SPEED, 4), 0, 0]},
+                       'cloths': [{'simulated_seconds': self.args.warmup + self.args.seconds,
+                                   'max_edge_m': edge, 'theta': theta}]}, f)
+
+    def simulated(self, bending=None):
+        """Whether simulate() ran clothwind for simulation 0 (else it reused s0)."""
+        done = subprocess.CompletedProcess([], 0, '', '')
+        with mock.patch.object(oracle.subprocess, 'run', return_value=done) as run:
+            self.assertEqual(oracle.simulate(self.args, 0, self.SPEED, bending or {}, self.base),
+                             os.path.join(self.tmp.name, 's0'))
+        return run.called
+
+    def test_the_same_simulation_is_reused(self):
+        self.write_summary()
+        self.assertFalse(self.simulated())
+
+    def test_other_bending_is_simulated_again_without_a_spread(self):
+        # This call has the scene's bending (no --bending-spread): a run with bending x3.7 is not it.
+        self.write_summary(bending_scale=3.7)
+        self.assertTrue(self.simulated())
+
+    def test_another_mesh_is_simulated_again_without_max_edge(self):
+        # --max-edge 0: the scene's mesh (0.3 m here); a run made with --max-edge 0.2 is not it.
+        self.assertEqual(self.args.max_edge, 0)
+        self.write_summary(edge=0.2)
+        self.assertTrue(self.simulated())
+
+    def test_drawn_bending_must_match_every_entry(self):
+        drawn = {n: 2.0 * v for n, v in self.base['theta'].items() if n.startswith('bending_')}
+        self.write_summary(bending_scale=2.0)
+        self.assertFalse(self.simulated(drawn))
+        theta = {n: v * 2.0 for n, v in self.base['theta'].items()}
+        theta['bending_d2_c4'] *= 1.5  # one entry other than drawn
+        self.write_summary(theta=theta)
+        self.assertTrue(self.simulated(drawn))
+
+
+class MainTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def main(self, *argv):
+        with mock.patch.object(sys, 'argv', ['window-oracle', '--out', self.tmp.name, *argv]):
+            oracle.main()
+
+    def test_one_failed_simulation_stops_the_queued_ones(self):
+        calls, lock = [], threading.Lock()
+
+        def simulate(args, i, *_):
+            with lock:
+                calls.append(i)
+            if i == 0:
+                sys.exit('window-oracle: clothwind simulate failed')
+            time.sleep(0.5)  # long enough for the failure to be seen before the worker is free again
+            return os.path.join(args.out, f's{i}')
+
+        with mock.patch.object(oracle, 'simulate', simulate), self.assertRaises(SystemExit) as e:
+            self.main('--sims', '20', '--jobs', '1')
+        self.assertIn('failed', str(e.exception.code))
+        # The one worker may have taken the next simulation before the failure was seen; no more.
+        self.assertLessEqual(len(calls), 2, calls)
+
+    def test_folds_must_be_between_2_and_the_simulations(self):
+        for sims, folds in (('4', '8'), ('4', '1'), ('4', '0')):
+            with mock.patch.object(oracle, 'simulate') as simulate, self.assertRaises(SystemExit) as e:
+                self.main('--estimator', 'boost', '--features', 'motion', '--sims', sims, '--folds', folds)
+            self.assertIn(f'--folds: expected 2 .. --sims (4) with --estimator boost, got {folds}', str(e.exception.code))
+            self.assertFalse(simulate.called)  # refused before anything is simulated
 
 
 if __name__ == '__main__':
