@@ -228,7 +228,8 @@ class SdnNode {
       const clothwind::WindEstimate estimate = clothwind::ros_bridge::ToWindEstimate(
           *clip, p, latency, model_name_, static_cast<uint32_t>(predictor_->config().frames));
       // In ROS time, so a replay's is the bag's: the delay a reader of the estimate sees, queue included.
-      ages_.push_back((ros::Time::now() - estimate.clip_end).toSec());
+      // In double seconds: ros::Time arithmetic throws beyond 32 bits (a clip stamped TIME_MAX).
+      ages_.push_back(ros::Time::now().toSec() - estimate.clip_end.toSec());
       if (ages_.size() > 50) ages_.pop_front();
       estimate_pub_.publish(estimate);
       PublishMean(estimate);
