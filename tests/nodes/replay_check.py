@@ -76,13 +76,20 @@ class ReplayTest(unittest.TestCase):
         cls.clips, cls.previews = [], []
         rospy.Subscriber('clips', Clip, cls.clips.append, queue_size=100)
         rospy.Subscriber('clips/preview', Image, cls.previews.append, queue_size=10)
+        # The bag is read once the player plays it (/clock has started): a bag made again by the
+        # player's launch-prefix (the CLI was rebuilt) must not be read in its old version.
         deadline = time.time() + 120
-        while not os.path.exists(cls.bag_path) and time.time() < deadline:
+        while (not os.path.exists(cls.bag_path) or rospy.get_time() == 0) and time.time() < deadline:
             time.sleep(0.2)
         assert os.path.exists(cls.bag_path), 'bag %s never appeared' % cls.bag_path
+        assert rospy.get_time() > 0, 'the player never started /clock'
         cls.frame_stamps, cls.readings, cls.frames = [], [], {}
         with rosbag.Bag(cls.bag_path) as bag:
-            for topic, msg, t in bag.read_messages(topics=['camera/image_raw', 'anemometer/raw']):
+            # Topic names with or without their leading slash (make-session writes them resolved,
+            # as rosbag record does; older bags did not).
+            topics = ['camera/image_raw', 'anemometer/raw', '/camera/image_raw', '/anemometer/raw']
+            for topic, msg, t in bag.read_messages(topics=topics):
+                topic = topic.lstrip('/')
                 stamp = msg.header.stamp.to_sec()
                 assert abs(t.to_sec() - stamp) < 1e-6, 'bag time != header stamp on ' + topic
                 if topic == 'camera/image_raw':
