@@ -96,7 +96,7 @@ class WindDisplayNode {
 
  private:
   void OnEstimate(const clothwind::WindEstimate::ConstPtr& msg) {
-    if (!AdmitStamp(msg->header.stamp)) return;
+    if (!AdmitStamp(msg->header.stamp, &newest_estimate_)) return;
     estimates_.Add({msg->header.stamp.toSec(), msg->speed, msg->speed_std});
     last_estimate_ = *msg;
     last_estimate_wall_ = ros::WallTime::now();
@@ -105,7 +105,7 @@ class WindDisplayNode {
 
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
     if (!msg->valid) return;
-    if (!AdmitStamp(msg->header.stamp)) return;
+    if (!AdmitStamp(msg->header.stamp, &newest_wind_)) return;
     anemometer_.Add({msg->header.stamp.toSec(), msg->speed, 0.0});
     last_wind_ = *msg;
     last_wind_wall_ = ros::WallTime::now();
@@ -130,10 +130,11 @@ class WindDisplayNode {
   // Refused (counted): stamp 0 (it would stamp the displays 0 and empty the plot), and a stamp more
   // than ~max_future ahead of a running clock (one reading stamped TIME_MAX made every later age
   // a Duration out of range, which killed the node; one 100 s ahead moved the display's now and
-  // wiped the history). A stamp more than kRestartAfter behind the newest means the replay
-  // restarted: everything shown is from the previous pass and is dropped.
+  // wiped the history). A stamp more than kRestartAfter behind the newest of the same input means
+  // the replay restarted: everything shown is from the previous pass and is dropped. (Per input:
+  // estimates lag the readings by a clip's span and the model's queue, which is no restart.)
   // All in double seconds: ros::Time arithmetic throws on results beyond 32 bits.
-  bool AdmitStamp(const ros::Time& stamp) {
+  bool AdmitStamp(const ros::Time& stamp, double* newest_of_input) {
     if (stamp.isZero()) {
       ++unstamped_;
       return false;
@@ -144,7 +145,8 @@ class WindDisplayNode {
       WALL_WARN_THROTTLE(10.0, "wind_display: input stamped %.1f s ahead of the clock dropped", t - now);
       return false;
     }
-    if (t + WindHistory::kRestartAfter < latest_stamp_.toSec()) Restart();
+    if (t + WindHistory::kRestartAfter < *newest_of_input) Restart();
+    *newest_of_input = std::max(*newest_of_input, t);
     if (t > latest_stamp_.toSec() || latest_stamp_.isZero()) latest_stamp_ = stamp;
     return true;
   }
@@ -155,6 +157,7 @@ class WindDisplayNode {
     anemometer_ = WindHistory(span_);
     have_estimate_ = have_wind_ = have_vector_ = false;
     latest_stamp_ = ros::Time();
+    newest_estimate_ = newest_wind_ = 0;
     ++restarts_;
   }
 
@@ -320,6 +323,7 @@ class WindDisplayNode {
   double mean_window_ = 60.0, plot_window_ = 180.0, stale_after_ = 10.0, max_future_ = 5.0, span_ = 1.0;
   uint64_t unstamped_ = 0, future_stamped_ = 0, restarts_ = 0;
   double last_clock_ = 0;          // ROS time at the last draw [s]
+  double newest_estimate_ = 0, newest_wind_ = 0;  // each input's newest stamp [s]
   std::string publish_error_;      // why the last draw failed ("" when it did not)
   diagnostic_updater::Updater updater_;
   ros::WallTimer diagnostics_timer_;

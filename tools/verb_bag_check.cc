@@ -2,8 +2,8 @@
 // message count, rate, span, header stamps monotonic and near their bag times; camera holes
 // longer than the clip buffer's gap tolerance; anemometer sentences decoded. Exit status 1 when
 // the replay would make no labelled clip or would not start: a required topic missing, stamps
-// going back, stamped 0 or far from the bag's time (the replay's clock), camera and anemometer
-// stamps that do not overlap, no sentence that decodes, no stretch of video without holes long
+// going back, stamped 0 or far ahead of the bag's time (the replay's clock), no anemometer stamp
+// in any clip's label window, no sentence that decodes, no stretch of video without holes long
 // enough for a clip, or a topic no replay node reads (replay.launch waits for a subscriber on
 // every topic unless wait:=false).
 #include <algorithm>
@@ -53,8 +53,9 @@ struct TopicStats {
   size_t repeated = 0;        // header stamp equal to the previous one (records of one serial read
                               // share it; camera frames must not: the clip buffer drops them)
   size_t bag_time_off = 0;    // |bag time - header stamp| > 1 ms
-  size_t far_from_bag_time = 0;  // |bag time - header stamp| > max_future: the replay's clock is
-                                 // the bag time, and clip_buffer refuses stamps that far ahead
+  size_t far_from_bag_time = 0;  // header stamp > bag time + max_future: the replay's clock is the
+                                 // bag time, and clip_buffer refuses stamps that far ahead of it
+                                 // (stamps behind it are fine: a camera's latency)
   size_t zero = 0;            // header stamp 0
   double longest_run = 0.0;   // longest span of stamps without a hole [s]
   double run_start = NAN;
@@ -80,7 +81,7 @@ void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, do
   }
   s.longest_run = std::max(s.longest_run, stamp - s.run_start);
   if (std::fabs(bag_time - stamp) > 1e-3) ++s.bag_time_off;
-  if (std::fabs(bag_time - stamp) > max_future) ++s.far_from_bag_time;
+  if (stamp - bag_time > max_future) ++s.far_from_bag_time;
   s.previous = stamp;
   s.last = std::max(std::isnan(s.last) ? stamp : s.last, stamp);
   ++s.count;
@@ -172,7 +173,7 @@ int Check(const BagCheckArgs& a) {
     if (s.zero > 0) fail(name + ": " + std::to_string(s.zero) + " messages stamped 0");
     if (s.far_from_bag_time > 0)
       fail(name + ": " + std::to_string(s.far_from_bag_time) + " header stamps more than " +
-           std::to_string(a.max_future) + " s from their bag time (the replay's clock; another time base?)");
+           std::to_string(a.max_future) + " s ahead of their bag time (the replay's clock; another time base?)");
   }
   const auto camera = topics.find("camera/image_raw"), wind = topics.find("anemometer/raw");
   for (const char* required : {"camera/image_raw", "anemometer/raw"})
@@ -184,11 +185,13 @@ int Check(const BagCheckArgs& a) {
   if (wind != topics.end() && wind->second.count > 0 && wind->second.decoded == 0)
     fail("anemometer/raw: no sentence gives a wind reading (" + std::to_string(wind->second.undecoded) +
          " refused, the first: " + wind->second.first_error + ")");
+  // A clip ending at e is labelled by the readings in [e - label window, e]; clips end from the
+  // first frame + a clip's duration to the last frame.
   if (camera != topics.end() && wind != topics.end() && camera->second.count > 0 && wind->second.count > 0 &&
-      (wind->second.first > camera->second.last + a.label_window ||
-       wind->second.last < camera->second.first - a.label_window))
-    fail("camera/image_raw and anemometer/raw stamps do not overlap within the label window (" +
-         std::to_string(a.label_window) + " s): no clip gets a label");
+      (wind->second.first > camera->second.last ||
+       wind->second.last < camera->second.first + a.clip_duration - a.label_window))
+    fail("no anemometer/raw stamp falls in a clip's label window (the " + std::to_string(a.label_window) +
+         " s up to its last frame, over camera/image_raw's stamps): no clip gets a label");
   std::printf("  (back: header stamps going back; same: equal to the previous (fine for anemometer records of "
               "one serial read, not for camera frames); holes: camera intervals > %.3f s, which break clips; "
               "bagt: bag time != header stamp)\n",
@@ -208,13 +211,13 @@ const VerbRegistrar kRegistrar{"bag-check", [](CLI::App& app) -> std::function<i
   sub->add_option("--gap-tolerance", args->gap_tolerance, "camera hole that breaks a clip [s] (clip_buffer's)")
       ->capture_default_str();
   sub->add_option("--max-future", args->max_future,
-                  "largest |header stamp - bag time| [s] (clip_buffer refuses stamps this far ahead of the clock)")
+                  "largest header stamp - bag time [s] (clip_buffer refuses stamps this far ahead of the clock)")
       ->capture_default_str();
   sub->add_option("--clip-duration", args->clip_duration,
                   "first to last frame of a clip [s]; some stretch without holes must last this long")
       ->capture_default_str();
   sub->add_option("--label-window", args->label_window,
-                  "camera and anemometer stamps must overlap within this [s] (clip_buffer's)")
+                  "a clip is labelled by the anemometer readings this long [s] up to its last frame (clip_buffer's)")
       ->capture_default_str();
   return [args] { return Run(*args); };
 }};

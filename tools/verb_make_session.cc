@@ -116,6 +116,21 @@ int Run(const MakeSessionArgs& a) {
     throw std::invalid_argument("the session holds " + std::to_string(session.frame_stamps().size()) +
                                 " frames after --drop-probability " + std::to_string(a.drop_probability) +
                                 ", fewer than one clip's 30");
+  // And a stretch without holes as long as a clip (bag-check's rule, with the clip buffer's
+  // defaults: gaps over 0.1 s break clips of 30 frames at 25 fps, 1.16 s): at 10 fps the frames'
+  // jitter made half the intervals holes, and no clip formed.
+  {
+    const auto& t = session.frame_stamps();
+    double longest = 0, run_start = t.front();
+    for (size_t i = 1; i < t.size(); ++i) {
+      if (t[i] - t[i - 1] > 0.1) run_start = t[i];
+      longest = std::max(longest, t[i] - run_start);
+    }
+    if (longest < 1.16)
+      throw std::invalid_argument("--fps " + std::to_string(a.fps) + " with --drop-probability " +
+                                  std::to_string(a.drop_probability) + ": no stretch of frames without a gap over " +
+                                  "0.1 s lasts a clip's 1.16 s (longest " + std::to_string(longest) + " s)");
+  }
   // Rendered sessions: the anemometer's sensor model samples the wind field the flag flew in.
   const std::vector<sensors::SyntheticReading> model_readings =
       rendered ? rendered->AnemometerReadings() : std::vector<sensors::SyntheticReading>{};
@@ -220,7 +235,9 @@ int Run(const MakeSessionArgs& a) {
     (void)bag_owner.release();  // see above
     std::error_code ec;
     fs::remove(tmp, ec);
-    throw std::runtime_error(a.out + ": " + e.what() + " (nothing written: the partial bag was removed)");
+    // (A failure after the rename, syncing the folder, leaves the whole bag at its name.)
+    throw std::runtime_error(a.out + ": " + e.what() +
+                             (fs::exists(out, ec) ? "" : " (nothing written: the partial bag was removed)"));
   }
   if (bar) bar->Finish();
   std::printf("make-session: %s: %s frames, %.1f s, %zu frames %dx%d bgr8 at %.1f fps, %zu MWV sentences at 1 Hz "
@@ -238,12 +255,12 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
   sub->add_option("--minutes", args->minutes, "session length [min] (0.05..1440)")->capture_default_str();
   sub->add_option("--out", args->out, "output bag")->required();
   sub->add_option("--seed", args->seed, "random seed")->capture_default_str();
-  sub->add_option("--fps", args->fps, "camera rate [Hz] (up to 1000)")->capture_default_str();
+  sub->add_option("--fps", args->fps, "camera rate [Hz] (10 to 1000: a slower camera's intervals break every clip)")->capture_default_str();
   sub->add_option("--width", args->width, "image width [px] (16..16384)")->capture_default_str();
   sub->add_option("--height", args->height, "image height [px] (16..16384)")->capture_default_str();
   sub->add_option("--wind-mean", args->wind_mean, "long-term mean wind [m/s] (0..60)")->capture_default_str();
   sub->add_option("--drop-probability", args->drop_probability, "chance a frame is lost, in [0, 1)")->capture_default_str();
-  sub->add_option("--start-time", args->start_time, "stamp of the session start [s since epoch]")
+  sub->add_option("--start-time", args->start_time, "stamp of the session start [s since epoch, >= 1]")
       ->capture_default_str();
   // Checked when parsed: a bad value used to leave the temporary bag behind.
   sub->add_option("--compression", args->compression, "none | lz4 | bz2")

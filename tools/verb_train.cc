@@ -36,7 +36,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--out", args->out, "run folder (model.pt/json, checkpoints, log.tsv, learning_curve.png)")
       ->required();
   sub->add_option("--epochs", o.epochs, "epochs (the seed: ~40)")->check(CLI::PositiveNumber)->capture_default_str();
-  sub->add_option("--batch", o.batch, "clips per batch")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--batch", o.batch, "clips per batch (at least 2 to train: batch normalisation)")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--input-size", o.model.input_size, "input side [px] (224 as the seed, 112 on a CPU)")
       ->check(CLI::Range(16, 1024))
       ->capture_default_str();

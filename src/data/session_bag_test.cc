@@ -270,12 +270,14 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
     if constexpr (std::is_same_v<std::decay_t<decltype(m)>, sensor_msgs::Image>) return k++ % 4 == 0;
     return true;
   });
-  // Anemometer stamps on another time base, a day before the camera's (and their bag times too).
-  {
-    rosbag::Bag src(good, rosbag::bagmode::Read), dst(apart, rosbag::bagmode::Write);
+  // Anemometer stamps (and bag times) shifted: a day before the camera's (another time base),
+  // and 20 s after its last frame (each clip's label window ends at its last frame: a symmetric
+  // overlap check passed this one, which replayed into 25 clips, none labelled).
+  auto shift_anemometer = [&](const std::string& out, double seconds) {
+    rosbag::Bag src(good, rosbag::bagmode::Read), dst(out, rosbag::bagmode::Write);
     for (const rosbag::MessageInstance& m : rosbag::View(src)) {
       if (auto raw = m.instantiate<clothwind::RawSentence>()) {
-        raw->header.stamp -= ros::Duration(86400);
+        raw->header.stamp += ros::Duration(seconds);
         dst.write(m.getTopic(), raw->header.stamp, *raw);
       } else if (auto img = m.instantiate<sensor_msgs::Image>()) {
         dst.write(m.getTopic(), m.getTime(), *img);
@@ -283,11 +285,22 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
         dst.write(m.getTopic(), m.getTime(), *info);
       }
     }
-  }
-  for (const Case& c : {Case{"ahead.bag", "from their bag time"}, Case{"zero.bag", "stamped 0"},
+  };
+  shift_anemometer(apart, -86400);
+  shift_anemometer((dir / "after.bag").string(), 6 + 20);  // the session is 6 s long
+  // Every header stamp 10 s behind its bag time (a camera's and an instrument's latency): the
+  // clip buffer refuses only stamps ahead of the clock, and this bag replays into labelled clips.
+  const std::string lagging = (dir / "lagging.bag").string();
+  RewriteBag(good, lagging, [](auto& m) {
+    m.header.stamp -= ros::Duration(10);
+    return true;
+  });
+  EXPECT_EQ(check(lagging).first, 0) << check(lagging).second;
+  for (const Case& c : {Case{"ahead.bag", "ahead of their bag time"}, Case{"zero.bag", "stamped 0"},
                         Case{"checksum.bag", "no sentence gives a wind reading"},
                         Case{"extra.bag", "wait:=false"}, Case{"slow.bag", "no stretch of frames without a hole"},
-                        Case{"apart.bag", "do not overlap within the label window"}}) {
+                        Case{"apart.bag", "falls in a clip's label window"},
+                        Case{"after.bag", "falls in a clip's label window"}}) {
     const auto [rc, out] = check((dir / c.name).string());
     EXPECT_EQ(rc, 1 << 8) << c.name << ": " << out;
     EXPECT_NE(out.find(c.says), std::string::npos) << c.name << ": " << out;

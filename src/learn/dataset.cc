@@ -85,8 +85,8 @@ Dataset ReadDataset(const fs::path& dir) {
   const bool split_by_clip = index.contains("dataset") && index["dataset"].is_object() &&
                              index["dataset"].value("variant", std::string()) == "split_by_clip";
   std::map<std::string, size_t> seen;  // name -> its first entry
-  std::map<int, std::pair<std::string, std::string>> simulation_split;
-  std::map<int, std::pair<double, std::string>> simulation_wind;  // wind, first clip  // simulation -> (split, a clip's name)
+  std::map<int, std::pair<std::string, std::string>> simulation_split;  // simulation -> (split, a clip's name)
+  std::map<int, std::pair<double, std::string>> simulation_wind;        // simulation -> (wind, a clip's name)
   for (size_t i = 0; i < index["clips"].size(); ++i) {
     const nlohmann::json& entry = index["clips"][i];
     ClipInfo clip;

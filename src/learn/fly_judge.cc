@@ -94,7 +94,7 @@ FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
                              ": field \"hidden\" must be the judge's hidden units (an integer in 1..4096)");
   }
   const auto is_int = [&card](const char* key, int expected) {
-    return card.contains(key) && card[key].is_number_integer() && card[key].get<int>() == expected;
+    return card.contains(key) && card[key].is_number_integer() && card[key].get<int64_t>() == expected;
   };
   if (!is_int("grid", kMotionMapGrid) || !is_int("side", kMotionMapSide)) {
     throw std::runtime_error(card_path.string() + ": fields \"grid\" and \"side\" must be " +

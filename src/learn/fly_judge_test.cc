@@ -316,6 +316,18 @@ TEST(FlyJudgeTrainTest, CollectsOneMapPerWindowOfEachClip) {
     EXPECT_NEAR(cv::mean(m.maps[i])[0], 1.0, 1e-5);
     EXPECT_EQ(m.wind_speeds[i], clips[i / 3].wind_speed);
   }
+  // A clip shorter than a window: refused before any clip is read, naming its label.json.
+  std::vector<ClipInfo> short_clips = clips;
+  short_clips[2].num_frames = kFrames - 1;
+  calls = 0;
+  try {
+    CollectMotionMaps(short_clips, kFrames, 3, [&](int, int) { ++calls; });
+    ADD_FAILURE() << "a short clip was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find((clips[2].dir / "label.json").string() + ": field \"num_frames\""),
+              std::string::npos) << e.what();
+  }
+  EXPECT_EQ(calls, 0);
   fs::remove_all(dir);
 }
 

@@ -35,6 +35,12 @@ MotionMaps CollectMotionMaps(const std::vector<ClipInfo>& clips, int frames, int
                              const std::function<void(int, int)>& progress) {
   MotionMaps out;
   std::vector<cv::Mat> window(frames);
+  // Every clip checked before any is read: a short one failed midway, naming no clip or file.
+  for (const ClipInfo& clip : clips)
+    if (clip.num_frames < frames)
+      throw std::runtime_error((clip.dir / "label.json").string() + ": field \"num_frames\" is " +
+                               std::to_string(clip.num_frames) + ", the fly judge reads windows of " +
+                               std::to_string(frames) + " frames");
   for (size_t i = 0; i < clips.size(); ++i) {
     const ClipInfo& clip = clips[i];
     const std::vector<int> starts = EvenWindowStarts(clip.num_frames, frames, windows);

@@ -189,9 +189,9 @@ void RefuseChangedModelOnResume(const fs::path& state_path, const ModelConfig& r
       {"head_hidden", "--head-hidden"}, {"frame_channels", "--frame-channels"}, {"mean_map", "--mean-map"}};
   for (const auto& [key, flag] : kOptions) {
     if (a[key] == b[key]) continue;
-    throw std::runtime_error(state_path.string() + ": the run started with " + flag + " " + a[key].dump() +
-                             " (model field \"" + key + "\"), these options give " + b[key].dump() +
-                             "; resume with the model options the run started with");
+    throw std::runtime_error(state_path.string() + ": the run's model field \"" + key + "\" is " + a[key].dump() +
+                             ", these options give " + b[key].dump() + " (" + flag +
+                             "); resume with the model options the run started with");
   }
 }
 

@@ -1084,10 +1084,10 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
     changed.epochs = 3;
     changed.resume = true;
     changed.model.width = 16;
-    ExpectTrainRefused(changed, "--width changed on resume", {"--width 8", "these options give 16"});
+    ExpectTrainRefused(changed, "--width changed on resume", {"\"width\" is 8", "these options give 16 (--width)"});
     changed.model.width = 8;
     changed.model.arch = "resnet18";
-    ExpectTrainRefused(changed, "--model changed on resume", {"--model \"sdn\""});
+    ExpectTrainRefused(changed, "--model changed on resume", {"\"arch\" is \"sdn\"", "(--model)"});
   }
   // A batch of one clip cannot be batch-normalised: refused naming --batch, and no folder made.
   {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 #include <stdexcept>
 
@@ -195,7 +196,8 @@ uint64_t Unsigned(const nlohmann::json& j, const char* name) {
 }
 int Integer(const nlohmann::json& j, const char* name) {
   const auto& f = Field(j, name);
-  if (!f.is_number_integer())
+  // Within int's range: get<int>() wrapped 4294967344 to 48 (a zeta.json rendered 48x32).
+  if (!f.is_number_integer() || f.get<int64_t>() < INT32_MIN || f.get<int64_t>() > INT32_MAX)
     throw std::invalid_argument(std::string("render params: field '") + name +
                                 "' must be an integer, got " + f.dump());
   return f.get<int>();

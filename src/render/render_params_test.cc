@@ -63,6 +63,15 @@ TEST(RenderParams, MissingOrMistypedFieldIsNamed) {
   j = ToJson(SampleRenderParams(SceneKind::kFlag, 1));
   j["camera_radius"] = -1.0;
   EXPECT_THROW(RenderParamsFromJson(j), std::invalid_argument);
+  // An integer beyond int's range, which get<int>() wrapped (4294967344 read as 48).
+  j = ToJson(SampleRenderParams(SceneKind::kFlag, 1));
+  j["samples"] = 4294967300LL;
+  try {
+    RenderParamsFromJson(j);
+    FAIL() << "a wrapped integer was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'samples' must be an integer, got 4294967300"), std::string::npos) << e.what();
+  }
 }
 
 TEST(RenderParams, SamplesStayInTableTwoRanges) {

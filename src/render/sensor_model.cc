@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -45,7 +46,7 @@ SensorModelParams SensorModelParamsFromJson(const nlohmann::json& j) {
   };
   auto integer = [&](const char* name) {
     const auto& f = field(name);
-    if (!f.is_number_integer())
+    if (!f.is_number_integer() || f.get<int64_t>() < INT32_MIN || f.get<int64_t>() > INT32_MAX)
       throw std::invalid_argument(std::string("sensor model: field '") + name +
                                   "' must be an integer, got " + f.dump());
     return f.get<int>();

@@ -110,6 +110,9 @@ class Reader {
       std::error_code ec;
       if (fs::path(rel).is_absolute())
         Fail(path, "file '" + rel + "' " + (fs::is_directory(rel, ec) ? "is a folder; expected a file" : "not found"));
+      for (const fs::path& base : {dir, dir.parent_path(), fs::current_path(ec)})
+        if (fs::is_directory(base / rel, ec))
+          Fail(path, "'" + rel + "' is a folder (" + (base / rel).lexically_normal().string() + "); expected a file");
       Fail(path, "file '" + rel + "' not found (looked next to the scene in " + dir.string() +
                      ", in " + dir.parent_path().string() + " and in the working directory)");
     }

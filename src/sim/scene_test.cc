@@ -337,6 +337,9 @@ TEST_F(SceneFiles, AKeyGivenTwiceIsRefusedNamingItsObject) {
 TEST_F(SceneFiles, AFolderNamedAsTheMeshIsRefusedAsAFolder) {
   const std::string a = Write("conf/a.json", Replace(SceneText(), "meshes/quad.obj", (root_ / "meshes").string()));
   ExpectErrorNaming([&] { LoadScene(a); }, {a, "cloths[0].mesh", "is a folder; expected a file"});
+  // By a relative name too (found as a folder beside the scene's folder).
+  const std::string b = Write("conf/b.json", Replace(SceneText(), "meshes/quad.obj", "meshes"));
+  ExpectErrorNaming([&] { LoadScene(b); }, {b, "cloths[0].mesh", "'meshes' is a folder"});
 }
 
 TEST_F(SceneFiles, AGustHorizonShorterThanTheSceneWarns) {

@@ -100,6 +100,17 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertIn("anemometer 3.0 m/s", text)
         self.assertEqual(arrow, 0)  # ADD
 
+        # An estimate 6 s behind the readings (a clip's span and a backlogged model): no restart
+        # of the display (it used to wipe the anemometer's history and show "no reading yet").
+        lagging = WindEstimate()
+        lagging.header.stamp = rospy.Time.now() - rospy.Duration(6.0)
+        lagging.clip_sequence, lagging.speed, lagging.speed_std = 8, 4.0, 0.3
+        lagging.reference_speed = 3.0
+        self.est_pub.publish(lagging)
+        time.sleep(0.3)
+        text, arrow = self.text()
+        self.assertIn("anemometer 3.0 m/s", text)
+
         # Past stale_after (4 s) and mean_window (3 s): polled, since markers come at 5 Hz and
         # diagnostics once a second on a machine that may be busy.
         deadline = time.time() + 15.0
@@ -118,6 +129,7 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertIn("no anemometer reading in the mean window", status.message)
         self.assertEqual(values["messages stamped 0 dropped"], "2")
         self.assertEqual(values["messages stamped more than ~max_future ahead dropped"], "2")
+        self.assertEqual(values["restarts (clock or inputs went back)"], "0")
         # "Says so": a WARN, naming each cause.
         self.assertEqual(status.level, DiagnosticStatus.WARN, status.message)
         self.assertIn("messages stamped 0 dropped", status.message)
@@ -135,10 +147,10 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertEqual(j["total_clips"], 1)
         self.assertEqual(j["label_window"], 10.0)
         self.assertEqual(j["estimates"]["window"], 10.0)  # the clips' label window, not 60 s
-        # Six estimates: the one stamped TIME_MAX has no label, so five are compared.
-        self.assertEqual(j["estimates"]["count"], 6)
-        self.assertEqual(j["estimates"]["compared"], 5)
-        self.assertAlmostEqual(j["estimates"]["rmse"], ((4 * 1.0 + 47.0 ** 2) / 5) ** 0.5, places=6)
+        # Seven estimates: the one stamped TIME_MAX has no label, so six are compared.
+        self.assertEqual(j["estimates"]["count"], 7)
+        self.assertEqual(j["estimates"]["compared"], 6)
+        self.assertAlmostEqual(j["estimates"]["rmse"], ((5 * 1.0 + 47.0 ** 2) / 6) ** 0.5, places=6)
 
 
 if __name__ == "__main__":

@@ -87,7 +87,10 @@ class TrackOracleTest(unittest.TestCase):
             done = self.run_oracle('--coords', coords, '--windows', '3', '--predictions', predictions)
             self.assertEqual(done.returncode, 0, done.stderr)
             with open(predictions) as f:
+                first = f.readline()
                 rows = [line.split() for line in f if not line.startswith('#')]
+            # eval's protocol line: compare-evals refuses to pair it with a one-window evaluation.
+            self.assertEqual(first, '# protocol windows 3 mirror 0 mirror_clips 0 flag_flies right\n')
             test = [c for c in clips if c['split'] == 'test']
             self.assertEqual([r[3] for r in rows], [c['name'] for c in test])
             truth = np.array([float(r[0]) for r in rows])
