@@ -154,8 +154,11 @@ class HeadOracleTest(unittest.TestCase):
         self.assertEqual(done.returncode, 0, done.stderr)
         with open(out) as f:
             lines = f.read().splitlines()
-        self.assertEqual(len(lines), 1 + 30)
-        self.assertTrue(lines[1].endswith('flag-000150-v0'))
+        # eval's protocol line (one window: the head's rows are one window a clip), its header,
+        # then one line a clip.
+        self.assertEqual(lines[0], '# protocol windows 1 mirror 0 mirror_clips 0 flag_flies right')
+        self.assertEqual(len(lines), 2 + 30)
+        self.assertTrue(lines[2].endswith('flag-000150-v0'))
 
     def test_bad_rows_are_refused_naming_the_file_and_line(self):
         write_rows(self.dir, head_noise=0.0)
