@@ -14,7 +14,8 @@
 // unset: auto for a model trained without flips, which knows only flags flying right as FlagSim's
 // do, right, as filmed, for one trained with them; learn/fly_direction.h). wind: each clip's way
 // from its anemometer direction (wind_direction_mean) and ~camera_heading (the optical axis's angle
-// in the anemometer's frame [rad], required), a wind within ~end_on_angle (20 deg) of the axis
+// in the anemometer's frame [rad], required; ~camera_heading_frame names that frame, and a clip
+// whose direction is in another is not used), a wind within ~end_on_angle (20 deg) of the axis
 // keeping the way last known. auto asks ~fly_judge (a train-fly-judge file; unset: fly_judge.pt
 // beside the model when there is one, as models/ ships it, else the clip's motion cues).
 // Clips may be mono8 or bgr8; a model trained with --colour needs bgr8 (clip_buffer ~colour) and

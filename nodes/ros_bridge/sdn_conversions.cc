@@ -71,16 +71,31 @@ void CheckClipFrameRate(const clothwind::Clip& msg, double model_rate) {
   }
 }
 
+namespace {
+
+// header.stamp + offset [s], refused as a malformed clip (std::invalid_argument) when the sum is
+// outside ROS time's 32-bit seconds: ros::Time's own operator threw a runtime_error, which the
+// node counted as the model's failure.
+ros::Time StampAfter(const clothwind::Clip& clip, double offset) {
+  const double t = clip.header.stamp.toSec() + offset;
+  if (!(t >= 0 && t < 4294967295.0))
+    throw std::invalid_argument("Clip.header.stamp " + std::to_string(clip.header.stamp.toSec()) + " + " +
+                                std::to_string(offset) + " s is outside ROS time");
+  return ros::Time(t);
+}
+
+}  // namespace
+
 ros::Time ClipFrameStamp(const clothwind::Clip& clip, uint32_t i) {
   if (i < clip.frame_stamps.size()) return clip.frame_stamps[i];
-  return clip.header.stamp + ros::Duration(clip.frame_rate > 0 ? i / clip.frame_rate : 0.0);
+  return StampAfter(clip, clip.frame_rate > 0 ? i / clip.frame_rate : 0.0);
 }
 
 ros::Time ClipEnd(const clothwind::Clip& clip) {
   if (!clip.frame_stamps.empty()) return clip.frame_stamps.back();
   // header.stamp is the first frame's: the last one is num_frames - 1 periods later.
   const double span = clip.num_frames > 1 && clip.frame_rate > 0 ? (clip.num_frames - 1) / clip.frame_rate : 0.0;
-  return clip.header.stamp + ros::Duration(span);
+  return StampAfter(clip, span);
 }
 
 clothwind::WindEstimate ToWindEstimate(const clothwind::Clip& clip, const learn::Prediction& prediction,

@@ -37,6 +37,7 @@ ros::Time ClipFrameStamp(const clothwind::Clip& clip, uint32_t i);
 
 // The stamp of the clip's last frame: frame_stamps.back(), or, for a clip without frame_stamps,
 // header.stamp (its first frame's) plus (num_frames - 1) / frame_rate.
+// Both throw std::invalid_argument (a malformed clip) when that sum is outside ROS time.
 ros::Time ClipEnd(const clothwind::Clip& clip);
 
 // The estimate of one clip.

@@ -66,6 +66,18 @@ TEST(ClipFramesTest, AClipStampedZeroIsRefused) {
   EXPECT_EQ(Refusal(clip), "accepted");
 }
 
+TEST(ClipFramesTest, AClipWhoseFramesWouldEndBeyondRosTimeIsMalformed) {
+  // No frame stamps, a header stamp near TIME_MAX: its last frame's stamp is beyond 32-bit
+  // seconds. ros::Time's operator threw a runtime_error (counted as the model's failure).
+  clothwind::Clip clip = GreyClip();
+  clip.frame_stamps.clear();
+  clip.header.stamp = ros::Time(4294967295, 0);
+  EXPECT_THROW(ClipEnd(clip), std::invalid_argument);
+  EXPECT_THROW(ClipFrameStamp(clip, clip.num_frames - 1), std::invalid_argument);
+  clip.header.stamp = ros::Time(100, 0);
+  EXPECT_NEAR(ClipEnd(clip).toSec(), 100.0 + (clip.num_frames - 1) / clip.frame_rate, 1e-6);
+}
+
 TEST(ToWindEstimateTest, TheEstimateSpansTheFramesTheModelRead) {
   learn::Prediction p;
   p.speed = 3.0;
