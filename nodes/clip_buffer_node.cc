@@ -141,6 +141,13 @@ class ClipBufferNode {
       NoteError("frame dropped: header.stamp is 0 (unstamped camera driver?)");
       return;
     }
+    // Within ROS time with a clip's span to spare: a clip ending beyond 2^32 s could not be stamped
+    // (ros::Time threw), which ended the node when no clock could refuse the frame as future.
+    if (msg->header.stamp.toSec() > kLatestStamp) {
+      NoteError("frame dropped: header.stamp " + std::to_string(msg->header.stamp.toSec()) +
+                " s is beyond ROS time (TIME_MAX?)");
+      return;
+    }
     if (frame_id_.empty() || frame_id_from_msg_) {
       frame_id_ = msg->header.frame_id;
       frame_id_from_msg_ = true;
@@ -231,6 +238,18 @@ class ClipBufferNode {
 
   void Publish(const std::vector<sensors::LabelledClip>& clips) {
     for (const auto& c : clips) {
+      // One clip that cannot be converted (a stamp ROS time cannot hold) costs that clip, said in
+      // diagnostics, not the node (Publish also runs from the wall timer, outside any handler).
+      try {
+        PublishOne(c);
+      } catch (const std::exception& e) {
+        NoteError("clip " + std::to_string(c.clip.sequence) + " dropped: " + e.what());
+      }
+    }
+  }
+
+  void PublishOne(const sensors::LabelledClip& c) {
+    {
       if (c.label.count == 0)
         WALL_WARN_THROTTLE(10.0, "clip_buffer: clip %lu has no anemometer reading in its %.0f s window",
                           static_cast<unsigned long>(c.clip.sequence), c.label.window);
@@ -245,6 +264,8 @@ class ClipBufferNode {
       Record(c);
     }
   }
+
+  static constexpr double kLatestStamp = 4294967295.0 - 3600.0;  // [s] ROS time's end, less an hour
 
   void Record(const sensors::LabelledClip& c) {
     if (record_dir_.empty()) return;

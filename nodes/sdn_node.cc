@@ -263,8 +263,12 @@ class SdnNode {
 
   // Clips missing between two received ones (dropped by this node's queue when it lags, or
   // upstream); a sequence that starts again (a restarted buffer or bag) counts nothing.
+  // A jump of more than a day's clips (at 25 fps with a stride of 1) is a new numbering, not
+  // losses: sequence 2^63 then 0, 1, 2 read as 9.2e18 clips missing.
   void CountSequence(uint64_t sequence) {
-    if (have_sequence_ && sequence > last_sequence_ + 1) missing_ += sequence - last_sequence_ - 1;
+    constexpr uint64_t kMaxGap = 25ull * 86400;
+    if (have_sequence_ && sequence > last_sequence_ + 1 && sequence - last_sequence_ - 1 <= kMaxGap)
+      missing_ += sequence - last_sequence_ - 1;
     last_sequence_ = sequence;
     have_sequence_ = true;
   }

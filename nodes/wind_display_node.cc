@@ -96,6 +96,7 @@ class WindDisplayNode {
 
  private:
   void OnEstimate(const clothwind::WindEstimate::ConstPtr& msg) {
+    if (!Plausible(msg->speed)) return;
     if (!AdmitStamp(msg->header.stamp, &newest_estimate_)) return;
     estimates_.Add({msg->header.stamp.toSec(), msg->speed, msg->speed_std});
     last_estimate_ = *msg;
@@ -105,6 +106,7 @@ class WindDisplayNode {
 
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
     if (!msg->valid) return;
+    if (!Plausible(msg->speed)) return;
     if (!AdmitStamp(msg->header.stamp, &newest_wind_)) return;
     anemometer_.Add({msg->header.stamp.toSec(), msg->speed, 0.0});
     last_wind_ = *msg;
@@ -149,6 +151,14 @@ class WindDisplayNode {
     *newest_of_input = std::max(*newest_of_input, t);
     if (t > latest_stamp_.toSec() || latest_stamp_.isZero()) latest_stamp_ = stamp;
     return true;
+  }
+
+  // A speed an anemometer can read (0..100 m/s, as the clip labels take): others are dropped and
+  // counted (1e300 filled the text with 63 digits, -50 showed as a wind, with status OK).
+  bool Plausible(double speed) {
+    if (std::isfinite(speed) && speed >= 0 && speed <= 100) return true;
+    ++implausible_;
+    return false;
   }
 
   // Forgets what is shown: the clock or the inputs went back (a replay restarted).
@@ -196,12 +206,14 @@ class WindDisplayNode {
                         have_wind_ ? "no anemometer reading in the mean window" : "no anemometer reading yet");
     if (unstamped_ > 0) stat.mergeSummary(DiagnosticStatus::WARN, "messages stamped 0 dropped");
     if (future_stamped_ > 0) stat.mergeSummary(DiagnosticStatus::WARN, "messages stamped in the future dropped");
+    if (implausible_ > 0) stat.mergeSummary(DiagnosticStatus::WARN, "speeds outside 0..100 m/s dropped");
     if (!publish_error_.empty()) stat.mergeSummary(DiagnosticStatus::ERROR, "cannot draw: " + publish_error_);
     stat.addf("estimate age [s]", "%.1f", est_age);
     stat.addf("anemometer age [s]", "%.1f", wind_age);
     stat.add("messages stamped 0 dropped", unstamped_);
     stat.add("messages stamped more than ~max_future ahead dropped", future_stamped_);
     stat.add("restarts (clock or inputs went back)", restarts_);
+    stat.add("speeds outside 0..100 m/s dropped", implausible_);
     stat.add("frame", FrameId());
     stat.add("readings in another frame (no arrow)", frame_gate_.rejected());
     stat.addf("estimate received [s ago, wall]", "%.1f",
@@ -321,7 +333,7 @@ class WindDisplayNode {
   }
 
   double mean_window_ = 60.0, plot_window_ = 180.0, stale_after_ = 10.0, max_future_ = 5.0, span_ = 1.0;
-  uint64_t unstamped_ = 0, future_stamped_ = 0, restarts_ = 0;
+  uint64_t unstamped_ = 0, future_stamped_ = 0, restarts_ = 0, implausible_ = 0;
   double last_clock_ = 0;          // ROS time at the last draw [s]
   double newest_estimate_ = 0, newest_wind_ = 0;  // each input's newest stamp [s]
   std::string publish_error_;      // why the last draw failed ("" when it did not)

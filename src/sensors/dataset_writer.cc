@@ -120,7 +120,10 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
       WriteFileDurably(tmp_dir + file, jpeg.data(), jpeg.size());
     }
     const nlohmann::json label = ClipLabelJson(clip, source, name);
-    WriteFileAtomically(tmp_dir + "/label.json", label.dump(2) + "\n");
+    // Invalid UTF-8 (a camera's frame_id or distortion model of raw bytes) is written replaced
+    // (U+FFFD), not thrown: the throw stopped every later clip's recording.
+    WriteFileAtomically(tmp_dir + "/label.json",
+                        label.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
     if (fs::exists(final_dir)) {  // replayed again: replace the old folder
       // Two renames, not one: rename() cannot replace a non-empty folder. If the second fails the
       // old copy is put back, so the name never stays empty or hidden.
@@ -193,6 +196,9 @@ size_t DatasetWriter::RecoverLeftovers() {
   return handled;
 }
 
-void DatasetWriter::WriteIndex() { WriteFileAtomically(root_ + "/index.json", index_.dump(1) + "\n"); }
+void DatasetWriter::WriteIndex() {
+  WriteFileAtomically(root_ + "/index.json",
+                      index_.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+}
 
 }  // namespace clothwind::sensors

@@ -92,11 +92,22 @@ TEST_F(DatasetWriterTest, WritesFramesLabelAndIndex) {
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }
 
+TEST_F(DatasetWriterTest, InvalidUtf8InTheSourceIsWrittenReplacedNotThrown) {
+  // A camera's frame_id of raw bytes threw nlohmann's type_error 316 and stopped every later
+  // clip's recording.
+  DatasetWriter w(root_.string(), 95);
+  const std::string dir =
+      w.Write(MakeClip(4, 1700000001.0), {"cam\xff\xfe", "test", nullptr, "test", "anemometer"});
+  const auto label = Read(fs::path(dir) / "label.json");
+  EXPECT_EQ(label["source"]["frame_id"], "cam\xef\xbf\xbd\xef\xbf\xbd");  // U+FFFD twice
+  EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 1u);
+}
+
 TEST_F(DatasetWriterTest, ColourClipsAreColourJpegsLabelledRgb8) {
   LabelledClip c = MakeClip(5, 1700000000.5, 2);
   for (auto& f : c.clip.frames) f.image = cv::Mat(32, 32, CV_8UC3, cv::Scalar(30, 90, 200));
   DatasetWriter w(root_.string(), 95);
-  const std::string dir = w.Write(c, {"camera_optical_frame", "test", nullptr});
+  const std::string dir = w.Write(c, {"camera_optical_frame", "test", nullptr, "test", ""});
   const cv::Mat img = cv::imread((fs::path(dir) / "001.jpg").string(), cv::IMREAD_UNCHANGED);
   ASSERT_EQ(img.type(), CV_8UC3);
   const cv::Vec3b px = img.at<cv::Vec3b>(16, 16);
@@ -105,7 +116,7 @@ TEST_F(DatasetWriterTest, ColourClipsAreColourJpegsLabelledRgb8) {
   EXPECT_NEAR(px[2], 200, 3);
   // The dataset format's name for colour JPEG frames, as FlagSim's: what learn::ReadDataset takes.
   EXPECT_EQ(Read(fs::path(dir) / "label.json")["encoding"], "rgb8");
-  EXPECT_EQ(Read(fs::path(w.Write(MakeClip(6, 1700000010.5), {"", "test", nullptr})) / "label.json")["encoding"],
+  EXPECT_EQ(Read(fs::path(w.Write(MakeClip(6, 1700000010.5), {"", "test", nullptr, "test", ""})) / "label.json")["encoding"],
             "mono8");
 }
 

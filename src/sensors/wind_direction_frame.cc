@@ -14,7 +14,8 @@ bool WindDirectionFrameGate::Admit(const std::string& frame_id, double direction
     last_rejected_frame_ = frame_id;
     return false;
   }
-  if (adopt_ && !std::isnan(direction)) {
+  // A direction that is not finite (NaN: none; inf: a broken instrument's) names no frame.
+  if (adopt_ && std::isfinite(direction)) {
     frame_id_ = frame_id;
     adopt_ = false;
   }
@@ -22,7 +23,7 @@ bool WindDirectionFrameGate::Admit(const std::string& frame_id, double direction
 }
 
 bool WindDirectionFrameGate::Accepts(const std::string& frame_id, double direction) const {
-  return std::isnan(direction) || adopt_ || frame_id == frame_id_;
+  return !std::isfinite(direction) || adopt_ || frame_id == frame_id_;
 }
 
 }  // namespace clothwind::sensors

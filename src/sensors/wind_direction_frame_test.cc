@@ -26,6 +26,18 @@ TEST(WindDirectionFrameGate, AdoptsTheFirstFrameThatComesWithADirection) {
   EXPECT_EQ(gate.frame_id(), "anemometer");
 }
 
+TEST(WindDirectionFrameGate, AnInfiniteDirectionNamesNoFrame) {
+  // A broken instrument's first reading with direction +inf locked every clip's direction frame
+  // to its frame (and their mean to NaN).
+  WindDirectionFrameGate gate;
+  EXPECT_TRUE(gate.Admit("bogus", std::numeric_limits<double>::infinity()));
+  EXPECT_EQ(gate.frame_id(), "");
+  EXPECT_TRUE(gate.Admit("anemometer", 0.5));
+  EXPECT_EQ(gate.frame_id(), "anemometer");
+  EXPECT_TRUE(gate.Admit("bogus", -std::numeric_limits<double>::infinity()));  // no direction: no refusal
+  EXPECT_EQ(gate.rejected(), 0u);
+}
+
 TEST(WindDirectionFrameGate, AcceptsAsksWithoutAdoptingOrCounting) {
   WindDirectionFrameGate gate;
   EXPECT_TRUE(gate.Accepts("enu", 1.0));  // any frame while none is adopted...
