@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include <opencv2/imgproc.hpp>
 
@@ -13,6 +14,15 @@
 
 namespace clothwind::sensors {
 namespace {
+
+// printf into a string of whatever length the values need.
+template <typename... Args>
+std::string Formatted(const char* format, Args... args) {
+  const int n = std::snprintf(nullptr, 0, format, args...);
+  std::string text(n > 0 ? static_cast<size_t>(n) : 0, '\0');
+  if (n > 0) std::snprintf(text.data(), text.size() + 1, format, args...);
+  return text;
+}
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -24,14 +34,11 @@ std::vector<EstimateRow> SortedByEnd(std::vector<EstimateRow> rows) {
 }
 
 std::string SummaryLine(const EstimateSummary& s) {
-  char line[480];
-  std::snprintf(line, sizeof line,
-                "estimates: %d, %d with an anemometer label: RMSE %.3f m/s, Acc@0.5 %.3f, bias %+.3f m/s "
+  return Formatted("estimates: %d, %d with an anemometer label: RMSE %.3f m/s, Acc@0.5 %.3f, bias %+.3f m/s "
                 "(mean label %.3f m/s); latency mean %.1f ms, max %.1f ms\n"
                 "trailing %.0f s mean of the estimates against the label: RMSE %.3f m/s, Acc@0.5 %.3f, bias %+.3f m/s",
                 s.count, s.compared, s.rmse, s.acc05, s.bias, s.mean_label, s.mean_latency * 1e3, s.max_latency * 1e3,
                 s.window, s.window_rmse, s.window_acc05, s.window_bias);
-  return line;
 }
 
 }  // namespace
@@ -95,16 +102,13 @@ std::string EstimateTable(const std::vector<EstimateRow>& rows, double t0, doubl
   for (const EstimateRow& r : SortedByEnd(rows)) {
     // 14 characters on screen either way, under the heading's 14 ("±" is two bytes, so the
     // column is written as it is rather than padded by printf, which counts bytes).
-    char estimate[40];
-    if (std::isfinite(r.speed_std)) {
-      std::snprintf(estimate, sizeof estimate, "%6.2f \xC2\xB1%6.2f", r.speed, r.speed_std);
-    } else {
-      std::snprintf(estimate, sizeof estimate, "%6.2f        ", r.speed);
-    }
-    std::snprintf(line, sizeof line, "%5llu  %10.2f  %s  %10.2f  %+9.2f  %6.1fms\n",
-                  static_cast<unsigned long long>(r.sequence), r.end - t0, estimate, r.reference,
-                  r.speed - r.reference, r.latency * 1e3);
-    out += line;
+    // Formatted to their full length: a speed of 1e300 (301 digits) overflowed fixed buffers, and
+    // the row lost its end of line and the summary after it was cut short.
+    const std::string estimate =
+        std::isfinite(r.speed_std) ? Formatted("%6.2f \xC2\xB1%6.2f", r.speed, r.speed_std)
+                                   : Formatted("%6.2f        ", r.speed);
+    out += Formatted("%5llu  %10.2f  %s  %10.2f  %+9.2f  %6.1fms\n", static_cast<unsigned long long>(r.sequence),
+                     r.end - t0, estimate.c_str(), r.reference, r.speed - r.reference, r.latency * 1e3);
   }
   return out + SummaryLine(SummariseEstimates(rows, window)) + "\n";
 }

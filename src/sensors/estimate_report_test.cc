@@ -129,6 +129,21 @@ TEST(EstimateReportTest, TheTrailingMeanUsesTheWindowItIsGiven) {
   EXPECT_NE(EstimateTable(rows, 1000.0, 1.0), EstimateTable(rows, 1000.0));
 }
 
+TEST(EstimateReportTest, AnAbsurdSpeedKeepsItsRowWholeAndTheSummaryAfterIt) {
+  // 1e300 printed 301 digits into a 200-byte line: the row lost its end of line and the summary
+  // line after it was cut short.
+  const std::vector<EstimateRow> rows = {{1, 1000.0, 1e300, 0.3, 2.0, 0.01}, {2, 1001.0, 2.5, 0.3, 2.0, 0.01}};
+  const std::string table = EstimateTable(rows, 1000.0);
+  const size_t row = table.find("1e+300") != std::string::npos ? table.find("1e+300") : table.find("00000000000000");
+  ASSERT_NE(row, std::string::npos) << table;
+  const size_t end_of_row = table.find('\n', row);
+  ASSERT_NE(end_of_row, std::string::npos);
+  EXPECT_NE(table.find("    2  ", end_of_row), std::string::npos) << table;  // the next row follows
+  EXPECT_NE(table.find("estimates: 2"), std::string::npos) << table;
+  EXPECT_NE(table.find("trailing 60 s mean"), std::string::npos) << table;  // the summary's second line, whole
+  EXPECT_EQ(table.back(), '\n');
+}
+
 TEST(EstimateReportTest, PlotShowsBothSeriesAtTheirSpeeds) {
   std::vector<EstimateRow> rows;
   for (int i = 0; i < 60; ++i) rows.push_back({static_cast<uint64_t>(i), 1000.0 + 1.2 * i, 7.0, 0.0, 2.0, 0.01});
