@@ -249,20 +249,18 @@ class ClipBufferNode {
   }
 
   void PublishOne(const sensors::LabelledClip& c) {
-    {
-      if (c.label.count == 0)
-        WALL_WARN_THROTTLE(10.0, "clip_buffer: clip %lu has no anemometer reading in its %.0f s window",
-                          static_cast<unsigned long>(c.clip.sequence), c.label.window);
-      auto msg = boost::make_shared<clothwind::Clip>(ros_bridge::ToClipMsg(c, frame_id_, wind_frame_.frame_id()));
-      if (preview_pub_.getNumSubscribers() > 0) {
-        const auto& middle = c.clip.frames[c.clip.frames.size() / 2];
-        std_msgs::Header h = msg->header;
-        h.stamp = ros::Time(middle.stamp);
-        preview_pub_.publish(ros_bridge::ClipFrameImageMsg(middle.image, h));
-      }
-      clip_pub_.publish(msg);
-      Record(c);
+    if (c.label.count == 0)
+      WALL_WARN_THROTTLE(10.0, "clip_buffer: clip %lu has no anemometer reading in its %.0f s window",
+                        static_cast<unsigned long>(c.clip.sequence), c.label.window);
+    auto msg = boost::make_shared<clothwind::Clip>(ros_bridge::ToClipMsg(c, frame_id_, wind_frame_.frame_id()));
+    if (preview_pub_.getNumSubscribers() > 0) {
+      const auto& middle = c.clip.frames[c.clip.frames.size() / 2];
+      std_msgs::Header h = msg->header;
+      h.stamp = ros::Time(middle.stamp);
+      preview_pub_.publish(ros_bridge::ClipFrameImageMsg(middle.image, h));
     }
+    clip_pub_.publish(msg);
+    Record(c);
   }
 
   static constexpr double kLatestStamp = 4294967295.0 - 3600.0;  // [s] ROS time's end, less an hour

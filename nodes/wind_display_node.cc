@@ -127,8 +127,8 @@ class WindDisplayNode {
     }
   }
 
-  // Whether an input's stamp may be shown; keeps the newest input stamp, with which the displays
-  // are stamped (bag time on replay, so rviz on sim time shows them in step with the images).
+  // Whether an input's stamp may be shown; keeps each input's newest stamp (the newer of the two
+  // stamps the displays: bag time on replay, so rviz on sim time shows them in step with the images).
   // Refused (counted): stamp 0 (it would stamp the displays 0 and empty the plot), and a stamp more
   // than ~max_future ahead of a running clock (one reading stamped TIME_MAX made every later age
   // a Duration out of range, which killed the node; one 100 s ahead moved the display's now and
@@ -136,7 +136,7 @@ class WindDisplayNode {
   // the replay restarted: everything shown is from the previous pass and is dropped. (Per input:
   // estimates lag the readings by a clip's span and the model's queue, which is no restart.)
   // All in double seconds: ros::Time arithmetic throws on results beyond 32 bits.
-  bool AdmitStamp(const ros::Time& stamp, double* newest_of_input) {
+  bool AdmitStamp(const ros::Time& stamp, ros::Time* newest_of_input) {
     if (stamp.isZero()) {
       ++unstamped_;
       return false;
@@ -147,9 +147,8 @@ class WindDisplayNode {
       WALL_WARN_THROTTLE(10.0, "wind_display: input stamped %.1f s ahead of the clock dropped", t - now);
       return false;
     }
-    if (t + WindHistory::kRestartAfter < *newest_of_input) Restart();
-    *newest_of_input = std::max(*newest_of_input, t);
-    if (t > latest_stamp_.toSec() || latest_stamp_.isZero()) latest_stamp_ = stamp;
+    if (t + WindHistory::kRestartAfter < newest_of_input->toSec()) Restart();
+    *newest_of_input = std::max(*newest_of_input, stamp);
     return true;
   }
 
@@ -166,18 +165,17 @@ class WindDisplayNode {
     estimates_ = WindHistory(span_);
     anemometer_ = WindHistory(span_);
     have_estimate_ = have_wind_ = have_vector_ = false;
-    latest_stamp_ = ros::Time();
-    newest_estimate_ = newest_wind_ = 0;
+    newest_estimate_ = newest_wind_ = ros::Time();
     ++restarts_;
   }
 
   // The display's "now": ROS time (so the plot scrolls and old values age while inputs pause), but
   // never before the newest input (latency) and the newest input while time has not started or
-  // has just gone back (a replay restarting, until its first message moves latest_stamp_ back).
+  // has just gone back (a replay restarting, until its first message moves the newest stamp back).
   ros::Time DisplayNow() const {
-    const ros::Time now = ros::Time::now();
-    if (now.isZero() || now.toSec() + WindHistory::kRestartAfter < latest_stamp_.toSec()) return latest_stamp_;
-    return std::max(now, latest_stamp_);
+    const ros::Time now = ros::Time::now(), latest = std::max(newest_estimate_, newest_wind_);
+    if (now.isZero() || now.toSec() + WindHistory::kRestartAfter < latest.toSec()) return latest;
+    return std::max(now, latest);
   }
 
   // Age of an input [s] at `now` (the display's); infinity when there was none.
@@ -335,7 +333,7 @@ class WindDisplayNode {
   double mean_window_ = 60.0, plot_window_ = 180.0, stale_after_ = 10.0, max_future_ = 5.0, span_ = 1.0;
   uint64_t unstamped_ = 0, future_stamped_ = 0, restarts_ = 0, implausible_ = 0;
   double last_clock_ = 0;          // ROS time at the last draw [s]
-  double newest_estimate_ = 0, newest_wind_ = 0;  // each input's newest stamp [s]
+  ros::Time newest_estimate_, newest_wind_;  // each input's newest stamp since the last restart
   std::string publish_error_;      // why the last draw failed ("" when it did not)
   diagnostic_updater::Updater updater_;
   ros::WallTimer diagnostics_timer_;
@@ -349,7 +347,6 @@ class WindDisplayNode {
   std::string first_wind_frame_;  // header.frame_id of the first valid reading
   clothwind::sensors::WindDirectionFrameGate frame_gate_;
   bool have_estimate_ = false, have_wind_ = false, have_vector_ = false;
-  ros::Time latest_stamp_;
   ros::Publisher markers_pub_, plot_pub_, tf_pub_;
   ros::Subscriber estimate_sub_, wind_sub_;
   ros::WallTimer timer_;

@@ -9,20 +9,12 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "common/formatted.h"
 #include "sensors/trailing_mean.h"
 #include "sensors/wind_plot.h"
 
 namespace clothwind::sensors {
 namespace {
-
-// printf into a string of whatever length the values need.
-template <typename... Args>
-std::string Formatted(const char* format, Args... args) {
-  const int n = std::snprintf(nullptr, 0, format, args...);
-  std::string text(n > 0 ? static_cast<size_t>(n) : 0, '\0');
-  if (n > 0) std::snprintf(text.data(), text.size() + 1, format, args...);
-  return text;
-}
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 

@@ -9,6 +9,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "common/formatted.h"
+
 namespace clothwind::sensors {
 namespace {
 
@@ -21,12 +23,6 @@ int PlotBottom(int height) { return height - kBottom; }
 int Column(double t, double t_now, double window, int width) {
   const double x0 = kLeft, x1 = width - kRight;
   return static_cast<int>(std::lround(x1 - (t_now - t) / window * (x1 - x0)));
-}
-
-std::string Format(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
 }
 
 // Draws one series as a polyline (and its std band), clipped to the shown window.
@@ -82,16 +78,16 @@ std::string WindSummaryText(double estimate, double estimate_std, double anemome
                             double estimate_mean) {
   std::string text = "estimate ";
   if (std::isfinite(estimate)) {
-    text += Format("%.1f", estimate);
-    if (std::isfinite(estimate_std) && estimate_std > 0) text += Format(" \xC2\xB1 %.1f", estimate_std);
+    text += Formatted("%.1f", estimate);
+    if (std::isfinite(estimate_std) && estimate_std > 0) text += Formatted(" \xC2\xB1 %.1f", estimate_std);
     text += " m/s";
-    if (std::isfinite(estimate_mean)) text += Format(", %.0f s mean", window) + Format(" %.1f", estimate_mean);
+    if (std::isfinite(estimate_mean)) text += Formatted(", %.0f s mean %.1f", window, estimate_mean);
   } else {
     text += "--";
   }
   text += " | anemometer ";
-  text += std::isfinite(anemometer_mean) ? Format("%.1f m/s", anemometer_mean) : std::string("--");
-  text += Format(" (%.0f s mean)", window);
+  text += std::isfinite(anemometer_mean) ? Formatted("%.1f m/s", anemometer_mean) : std::string("--");
+  text += Formatted(" (%.0f s mean)", window);
   return text;
 }
 
@@ -132,7 +128,7 @@ cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer,
   for (double v = 0.0; v <= y_max + 1e-9; v += step) {
     const int y = WindPlotRow(v, y_max, height);
     cv::line(img, {kLeft, y}, {width - kRight, y}, grid, 1);
-    cv::putText(img, Format(step < 1 ? "%.1f" : "%.0f", v), {4, y + 4}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1,
+    cv::putText(img, Formatted(step < 1 ? "%.1f" : "%.0f", v), {4, y + 4}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1,
                 cv::LINE_AA);
   }
   // Vertical grid every 10 s (every 30 s or 60 s for long windows), labelled in seconds before now
@@ -146,8 +142,8 @@ cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer,
     const int x = Column(t, t_now, window, width);
     cv::line(img, {x, PlotTop()}, {x, PlotBottom(height)}, grid, 1);
     const bool right_edge = x > width - kRight - 30;  // its label kept inside the image
-    const std::string label = since_origin ? Format("%.0f s", t - t_origin) : a == 0.0 ? std::string("now")
-                                                                                      : Format("-%.0f s", a);
+    const std::string label = since_origin ? Formatted("%.0f s", t - t_origin) : a == 0.0 ? std::string("now")
+                                                                                      : Formatted("-%.0f s", a);
     cv::putText(img, label, {right_edge ? x - 30 : x - 14, height - 8}, cv::FONT_HERSHEY_SIMPLEX, font, ink, 1,
                 cv::LINE_AA);
   }
