@@ -128,6 +128,7 @@ int main(int argc, char** argv) {
   uint64_t published = 0, read_errors = 0, last_drops_seen = 0, last_errors_seen = 0;
   uint64_t unsubscribed = 0;  // frames read while nobody subscribed (no message built)
   std::string last_error;
+  std::string calibration_unused;  // why the calibration is left out of camera_info ("" if it is not)
   bool opened = false, ended = false;
   updater.add("camera source", [&](diagnostic_updater::DiagnosticStatusWrapper& stat) {
     const auto status = source->Status();
@@ -136,6 +137,9 @@ int main(int argc, char** argv) {
     stat.add("read with no subscriber (not published)", unsubscribed);
     stat.add("read errors", read_errors);
     stat.add("frame_id", frame_id);
+    stat.add("calibration", !calibration_unused.empty()         ? "left out: " + calibration_unused
+                            : info_manager.isCalibrated() ? std::string("published")
+                                                          : std::string("none (image size only)"));
     const auto state = status.count("state") ? status.at("state") : std::string("?");
     uint64_t drops = 0;
     if (status.count("dropped frames")) drops = std::stoull(status.at("dropped frames"));
@@ -151,6 +155,9 @@ int main(int argc, char** argv) {
       if (ros::Time::isSimTime() && ros::Time::now().isZero())
         stat.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN,
                           "use_sim_time is set and no /clock has come yet: frames wait for it");
+      if (!calibration_unused.empty())
+        stat.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN,
+                          "camera_info without calibration: " + calibration_unused);
       if (drops > last_drops_seen)
         stat.mergeSummaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu frames dropped since last report",
                            static_cast<unsigned long long>(drops - last_drops_seen));
@@ -166,7 +173,6 @@ int main(int argc, char** argv) {
 
   double open_backoff_s = 0.25;
   ros::WallTime next_open;
-  bool warned_size = false;
   while (ros::ok()) {
     if (!opened) {
       // Wait for the next attempt in short slices: diagnostics and services (set_camera_info)
@@ -206,16 +212,13 @@ int main(int argc, char** argv) {
       } else if (status == ReadStatus::kFrame) {
         try {
           sensor_msgs::ImagePtr image = clothwind::ros_bridge::ToImageMsg(frame, frame_id);
-          bool mismatch = false;
-          const sensor_msgs::CameraInfo calibration = info_manager.getCameraInfo();
+          std::string unused_reason;
           sensor_msgs::CameraInfoPtr info =
-              clothwind::ros_bridge::CameraInfoFor(calibration, *image, &mismatch);
-          if (mismatch && !warned_size) {
-            ROS_WARN_STREAM("camera_node: the calibration (" << calibration.width << "x"
-                            << calibration.height << ") is for another size than the images ("
-                            << image->width << "x" << image->height
-                            << "); publishing camera_info without it");
-            warned_size = true;
+              clothwind::ros_bridge::CameraInfoFor(info_manager.getCameraInfo(), *image, &unused_reason);
+          if (unused_reason != calibration_unused) {  // once per new reason (set_camera_info may change it)
+            if (!unused_reason.empty())
+              ROS_WARN_STREAM("camera_node: " << unused_reason << "; publishing camera_info without it");
+            calibration_unused = unused_reason;
           }
           publisher.publish(image, info);
           topic_diagnostic.tick(image->header.stamp);

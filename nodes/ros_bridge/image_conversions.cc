@@ -1,7 +1,9 @@
 #include "ros_bridge/image_conversions.h"
 
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <string>
 
 #include <boost/make_shared.hpp>
 
@@ -38,13 +40,44 @@ sensor_msgs::ImagePtr ToImageMsg(const sensors::Frame& frame, const std::string&
   return msg;
 }
 
+namespace {
+
+// "" when every value of the calibration's K, D, R and P is finite, else the first that is not.
+template <typename Values>
+std::string FirstNonFinite(const char* name, const Values& values) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) return std::string(name) + "[" + std::to_string(i) + "] is " + std::to_string(values[i]);
+  }
+  return "";
+}
+
+std::string NonFiniteValue(const sensor_msgs::CameraInfo& c) {
+  for (const std::string& found : {FirstNonFinite("K", c.K), FirstNonFinite("D", c.D), FirstNonFinite("R", c.R),
+                                   FirstNonFinite("P", c.P)}) {
+    if (!found.empty()) return found;
+  }
+  return "";
+}
+
+}  // namespace
+
 sensor_msgs::CameraInfoPtr CameraInfoFor(const sensor_msgs::CameraInfo& calibration,
-                                         const sensor_msgs::Image& image, bool* size_mismatch) {
+                                         const sensor_msgs::Image& image, std::string* unused_reason) {
   auto info = boost::make_shared<sensor_msgs::CameraInfo>();
-  const bool calibrated = calibration.width > 0 && calibration.height > 0;
-  const bool matches = calibration.width == image.width && calibration.height == image.height;
-  if (size_mismatch) *size_mismatch = calibrated && !matches;
-  if (calibrated && matches) *info = calibration;
+  std::string reason;
+  if (calibration.width > 0 && calibration.height > 0) {
+    const std::string non_finite = NonFiniteValue(calibration);
+    if (calibration.width != image.width || calibration.height != image.height) {
+      reason = "the calibration (" + std::to_string(calibration.width) + "x" + std::to_string(calibration.height) +
+               ") is for another size than the images (" + std::to_string(image.width) + "x" +
+               std::to_string(image.height) + ")";
+    } else if (!non_finite.empty()) {
+      reason = "the calibration's " + non_finite;
+    } else {
+      *info = calibration;
+    }
+  }
+  if (unused_reason) *unused_reason = reason;
   info->header = image.header;
   info->width = image.width;
   info->height = image.height;

@@ -23,15 +23,19 @@ ros::Time RosTimeFromNs(int64_t stamp_ns);
 // Throws std::invalid_argument if the image type does not match the encoding.
 sensor_msgs::ImagePtr ToImageMsg(const sensors::Frame& frame, const std::string& frame_id);
 
-// The camera_info to publish with an image: the calibration when its size matches the image,
-// otherwise an uncalibrated info (zero K, D, R, P) carrying only the image size.
+// The camera_info to publish with an image: the calibration when its size matches the image
+// and its K, D, R and P are finite, otherwise an uncalibrated info (zero K, D, R, P) carrying only
+// the image size. A calibration with NaN in it came through set_camera_info, which
+// camera_info_manager answers without checking values: passed on, it would poison every
+// consumer's projection.
 // Inputs:
 //   calibration  what camera_info_manager holds (width/height 0 when uncalibrated)
 //   image        the Image message it goes with (header and size are copied)
 // Outputs:
-//   size_mismatch  true when a calibration exists but is for another image size (may be null)
+//   unused_reason  why a calibration that exists was left out ("" when it is used or when there is
+//                  none; may be null)
 sensor_msgs::CameraInfoPtr CameraInfoFor(const sensor_msgs::CameraInfo& calibration,
-                                         const sensor_msgs::Image& image, bool* size_mismatch);
+                                         const sensor_msgs::Image& image, std::string* unused_reason);
 
 }  // namespace clothwind::ros_bridge
 

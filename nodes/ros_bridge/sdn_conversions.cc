@@ -69,6 +69,19 @@ void CheckClipFrameRate(const clothwind::Clip& msg, double model_rate) {
     throw std::invalid_argument("Clip.frame_rate is " + std::to_string(msg.frame_rate) + " Hz, the model reads " +
                                 std::to_string(model_rate) + " Hz clips (clip_buffer ~frame_rate)");
   }
+  // The spectra assume the frames are 1 / frame_rate apart: a clip whose own stamps say otherwise
+  // (a hand-made or edited clip; clip_buffer resamples to exact stamps) would be read at the wrong
+  // frequencies. Allowed: 10 % per gap (nanosecond rounding and a camera's jitter are far below).
+  const double period = 1.0 / msg.frame_rate;
+  for (size_t i = 1; i < msg.frame_stamps.size(); ++i) {
+    const double gap = (msg.frame_stamps[i] - msg.frame_stamps[i - 1]).toSec();
+    if (std::abs(gap - period) > 0.1 * period) {
+      throw std::invalid_argument("Clip.frame_stamps[" + std::to_string(i) + "] is " + std::to_string(gap) +
+                                  " s after frame " + std::to_string(i - 1) + ", Clip.frame_rate " +
+                                  std::to_string(msg.frame_rate) + " Hz says " + std::to_string(period) +
+                                  " s (within 10 %)");
+    }
+  }
 }
 
 namespace {

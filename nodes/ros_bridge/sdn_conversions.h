@@ -28,7 +28,8 @@ constexpr uint32_t kMaxClipFrames = 100000;
 std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg);
 
 // Throws std::invalid_argument naming Clip.frame_rate when it is not within 1 % of `model_rate`
-// [Hz], the rate the model was trained at (its spectra are in Hz).
+// [Hz], the rate the model was trained at (its spectra are in Hz), and naming Clip.frame_stamps
+// when two consecutive stamps are not 1 / frame_rate apart within 10 %.
 void CheckClipFrameRate(const clothwind::Clip& msg, double model_rate);
 
 // The stamp of the clip's frame i: frame_stamps[i], or, for a clip without frame_stamps,

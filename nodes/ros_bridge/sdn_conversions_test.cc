@@ -1,5 +1,6 @@
 #include "ros_bridge/sdn_conversions.h"
 
+#include <limits>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -76,6 +77,34 @@ TEST(ClipFramesTest, AClipWhoseFramesWouldEndBeyondRosTimeIsMalformed) {
   EXPECT_THROW(ClipFrameStamp(clip, clip.num_frames - 1), std::invalid_argument);
   clip.header.stamp = ros::Time(100, 0);
   EXPECT_NEAR(ClipEnd(clip).toSec(), 100.0 + (clip.num_frames - 1) / clip.frame_rate, 1e-6);
+}
+
+std::string RateRefusal(const clothwind::Clip& clip, double model_rate) {
+  try {
+    CheckClipFrameRate(clip, model_rate);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+TEST(CheckClipFrameRateTest, TheRateMustBeTheModelsAndTheStampsMustAgreeWithIt) {
+  clothwind::Clip clip = GreyClip();
+  EXPECT_EQ(RateRefusal(clip, 25.0), "accepted");
+  EXPECT_NE(RateRefusal(clip, 30.0).find("Clip.frame_rate is 25"), std::string::npos) << RateRefusal(clip, 30.0);
+  clip.frame_rate = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_NE(RateRefusal(clip, 25.0).find("Clip.frame_rate"), std::string::npos);
+  clip.frame_rate = 25.0;
+  // Stamps 1/25 s apart, as clip_buffer resamples them (nanosecond rounding included): accepted.
+  for (uint32_t i = 0; i < clip.num_frames; ++i) clip.frame_stamps.push_back(ros::Time(100.0 + i / 25.0));
+  EXPECT_EQ(RateRefusal(clip, 25.0), "accepted");
+  // Stamps 1/50 s apart under a 25 Hz rate: every frequency would be read at half its value.
+  for (uint32_t i = 0; i < clip.num_frames; ++i) clip.frame_stamps[i] = ros::Time(100.0 + i / 50.0);
+  EXPECT_NE(RateRefusal(clip, 25.0).find("Clip.frame_stamps[1] is 0.02"), std::string::npos)
+      << RateRefusal(clip, 25.0);
+  // One hole of a frame in otherwise good stamps.
+  for (uint32_t i = 0; i < clip.num_frames; ++i) clip.frame_stamps[i] = ros::Time(100.0 + (i + (i >= 12)) / 25.0);
+  EXPECT_NE(RateRefusal(clip, 25.0).find("Clip.frame_stamps[12]"), std::string::npos) << RateRefusal(clip, 25.0);
 }
 
 TEST(ToWindEstimateTest, TheEstimateSpansTheFramesTheModelRead) {

@@ -20,6 +20,7 @@ import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from sensor_msgs.msg import CameraInfo, Image
+from sensor_msgs.srv import SetCameraInfo
 
 N_FRAMES = 10
 
@@ -97,11 +98,13 @@ class CameraFolderTest(unittest.TestCase):
         rospy.init_node("camera_folder_check")
         cls.colour_folder = rospy.get_param("~colour_folder")
         cls.grey_folder = rospy.get_param("~grey_folder")
+        cls.calibration_file = rospy.get_param("~calibration_file")
         cls.diagnostics = []
         cls.started = time.time()
         rospy.Subscriber("/diagnostics", DiagnosticArray, lambda m: cls.diagnostics.append(m))
         cls.colour = Collector("/")
         cls.grey = Collector("/mono/")
+        cls.calibrated = Collector("/calib/")
         # The nodes poll for folders that do not exist yet and say so; the folders are made only
         # once both have said it, so the retry is what is tested (a fixed sleep let a node that
         # started late find them at its first try).
@@ -120,6 +123,8 @@ class CameraFolderTest(unittest.TestCase):
     def tearDownClass(cls):
         for folder in (cls.colour_folder, cls.grey_folder):
             shutil.rmtree(folder, ignore_errors=True)
+        if os.path.exists(cls.calibration_file):
+            os.remove(cls.calibration_file)
 
     def check_stream(self, collector, rate, width, height, encoding, channels, frame_id, expected, K):
         # Two full loops of the folder, plus some, after the first image.
@@ -199,6 +204,54 @@ class CameraFolderTest(unittest.TestCase):
         self.assertEqual(source["source"], "folder")
         self.assertEqual(source["images"], str(N_FRAMES))
         self.assertEqual(source["frame_id"], "test_camera_optical_frame")
+
+    def test_calibration_with_a_non_finite_value_is_left_out(self):
+        self.assertTrue(self.calibrated.wait_for(1, timeout=30.0))
+        rospy.wait_for_service("/calib/camera/set_camera_info", timeout=10.0)
+        set_info = rospy.ServiceProxy("/calib/camera/set_camera_info", SetCameraInfo)
+
+        def calibration(fy):
+            c = CameraInfo(width=24, height=16, distortion_model="plumb_bob", D=[0.0] * 5)
+            c.K = [30.0, 0.0, 11.5, 0.0, fy, 7.5, 0.0, 0.0, 1.0]
+            c.R = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+            c.P = [30.0, 0.0, 11.5, 0.0, 0.0, fy, 7.5, 0.0, 0.0, 0.0, 1.0, 0.0]
+            return c
+
+        def infos_after(t, count):
+            deadline = time.time() + 10.0
+            while time.time() < deadline:
+                with self.calibrated.lock:
+                    later = [m for m in self.calibrated.infos if m.header.stamp.to_sec() > t]
+                if len(later) >= count:
+                    return later
+                time.sleep(0.05)
+            self.fail("no camera_info after the calibration was set")
+
+        def source_status(t):
+            deadline = time.time() + 10.0
+            while time.time() < deadline:
+                for array in list(self.diagnostics):
+                    for s in array.status:
+                        if s.name == "calib/camera_node: camera source" and array.header.stamp.to_sec() > t:
+                            return s
+                time.sleep(0.1)
+            self.fail("no diagnostics from the calibrated node")
+
+        # camera_info_manager answers the service and stores NaN as it comes.
+        self.assertTrue(set_info(calibration(float("nan"))).success)
+        t = rospy.get_time() + 0.2
+        for info in infos_after(t, 3):
+            self.assertEqual(list(info.K), [0.0] * 9)
+        status = source_status(t)
+        self.assertEqual(status.level, DiagnosticStatus.WARN)
+        self.assertIn("K[4] is nan", status.message)
+        # A good calibration for the images' size is then published.
+        self.assertTrue(set_info(calibration(31.0)).success)
+        t = rospy.get_time() + 0.2
+        for info in infos_after(t, 3):
+            self.assertEqual(info.K[4], 31.0)
+        status = source_status(t + 1.0)
+        self.assertEqual(status.level, DiagnosticStatus.OK, status.message)
 
     def test_absent_v4l2_device_is_reported(self):
         deadline = time.time() + 15.0
