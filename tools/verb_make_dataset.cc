@@ -66,6 +66,18 @@ int Run(MakeDatasetArgs& a) {
   // -1 (the default) is "not given"; anything else, NaN included, goes to the ranges to be checked
   // there (a NaN used to read as "not given", and the default was used without a word).
   const auto given = [](double v) { return v != -1; };
+  // Each kind's own options: the other kind ran as if they were not given, and its header
+  // recorded them (a ClothSim header said area-weight spread 50 of a dataset drawn without one).
+  if (o.kind == render::SceneKind::kCloth) {
+    for (const auto& [name, value] : {std::pair<const char*, double>{"--area-weight-spread", a.area_weight_spread},
+                                      {"--bending-spread", a.bending_spread},
+                                      {"--bending-jitter", a.bending_jitter}})
+      if (given(value))
+        throw std::invalid_argument(std::string(name) + " is FlagSim's (--kind flag); ClothSim draws its fabrics "
+                                    "from --materials");
+  } else if (!o.materials_dir.empty()) {
+    throw std::invalid_argument("--materials is ClothSim's (--kind cloth); FlagSim's material is the scene's");
+  }
   if (given(a.wind_min) || given(a.wind_max) || given(a.area_weight_spread) || given(a.bending_spread) ||
       given(a.bending_jitter) || !a.camera_height.empty() || !a.camera_radius.empty() || given(a.camera_angle)) {
     data::SamplingRanges r = data::DefaultRanges(o.kind);
@@ -135,7 +147,7 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
       ->check(CLI::IsMember({"flag", "cloth"}))->capture_default_str();
   sub->add_option("--count", a->o.count, "number of simulations (examples = count x views); required unless --reindex");
   sub->add_option("--out", a->o.out, "dataset folder")->required();
-  sub->add_option("--seed", a->o.seed, "global seed")->capture_default_str();
+  sub->add_option("--seed", a->o.seed, "global seed (0..2^64-1)")->check(CLI::NonNegativeNumber)->capture_default_str();
   sub->add_option("--shard", a->shard, "i/N: do the simulations with index % N == i")->capture_default_str();
   sub->add_option("--jobs", a->o.jobs, "parallel simulations (0: all cores)")->capture_default_str();
   sub->add_option("--views", a->o.views, "camera poses rendered per simulation (1..64)")->capture_default_str();

@@ -60,6 +60,11 @@ void ValidateOptions(const DatasetOptions& o) {
   Check(std::isfinite(o.warmup) && o.warmup >= 0 && o.warmup <= 3600, "--warmup must be in 0..3600 s");
   Check(o.frames >= 1, "--frames must be >= 1");
   Check(std::isfinite(o.fps) && o.fps > 0 && o.fps <= 1000, "--fps must be in (0, 1000] Hz");
+  // The first kept frame is a whole frame: a warm-up between two was rounded without a word, and
+  // the header recorded the value asked for while the labels recorded the rounded one.
+  Check(std::abs(o.warmup * o.fps - std::round(o.warmup * o.fps)) < 1e-6,
+        "--warmup must be a whole number of frames (a multiple of 1/fps = " + std::to_string(1.0 / o.fps) +
+            " s), got " + std::to_string(o.warmup) + " s");
   Check(o.samples >= 0 && o.samples <= 1024, "--samples must be in 0..1024 (0: zeta's default)");
   Check(o.size >= 16 && o.size <= 4096, "--size must be in 16..4096 px");
   Check(o.frame_ext == "jpg" || o.frame_ext == "png" || o.frame_ext == "pgm",
@@ -103,7 +108,39 @@ struct Prepared {
   sim::Theta base_theta;
   SamplingRanges ranges;
   std::string scene_name;
+  std::string scene_files;  // SceneFilesFingerprint: the contents the examples were simulated from
 };
+
+// FNV-1a (64 bit) of the bytes of every file a simulation reads: the scene, its cloths' meshes and
+// materials, and ClothSim's fabrics, in that order, as "fnv1a64:<16 hex digits>". Why: the
+// settings named the scene file only, so a scene or material edited between two runs (or two
+// shards) mixed two physics in one dataset without a word. Any byte counts, comments included:
+// resuming is refused rather than trusted.
+std::string SceneFilesFingerprint(const sim::Scene& scene, const std::vector<std::string>& extra_files) {
+  uint64_t h = 14695981039346656037ull;
+  auto add = [&](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot read " + path + " (a file of the scene)");
+    char buffer[65536];
+    while (in.read(buffer, sizeof(buffer)) || in.gcount() > 0) {
+      for (std::streamsize k = 0; k < in.gcount(); ++k) {
+        h ^= static_cast<unsigned char>(buffer[k]);
+        h *= 1099511628211ull;
+      }
+    }
+    h ^= 0xff;  // a file boundary, so moving bytes between files changes the value
+    h *= 1099511628211ull;
+  };
+  add(scene.path);
+  for (const auto& cloth : scene.cloths) {
+    add(cloth.mesh);
+    for (const auto& m : cloth.materials) add(m.data);
+  }
+  for (const auto& f : extra_files) add(f);
+  char text[32];
+  std::snprintf(text, sizeof(text), "fnv1a64:%016llx", static_cast<unsigned long long>(h));
+  return text;
+}
 
 std::vector<std::string> FabricNames(const std::vector<Fabric>& fabrics) {
   std::vector<std::string> names;
@@ -143,6 +180,9 @@ Prepared Prepare(const DatasetOptions& o) {
   if (o.kind == render::SceneKind::kCloth)
     p.fabrics = LoadFabrics(o.materials_dir.empty() ? DefaultMaterialsDir() : o.materials_dir,
                             scene_path, o.exclude_fabrics);
+  std::vector<std::string> fabric_files;
+  for (const auto& f : p.fabrics) fabric_files.push_back(f.path);
+  p.scene_files = SceneFilesFingerprint(scene, fabric_files);
   return p;
 }
 
@@ -157,11 +197,12 @@ sim::SceneSetup SetupFor(const Prepared& p, const SimulationSample& s, render::S
 
 // Whether an example's tracks.json holds the points' positions ("world"; data/clip_tracks.h).
 // Files written before them, and unreadable ones, do not: --add-tracks makes them again.
-bool TracksHaveWorld(const fs::path& file) {
+// And whether they are of `grid`: --add-tracks with another grid made a dataset of two grids.
+bool TracksHaveWorld(const fs::path& file, const TrackGrid& grid) {
   std::ifstream in(file);
   if (!in) return false;
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  return j.is_object() && j.contains("world");
+  return j.is_object() && j.contains("world") && j.value("grid", nlohmann::json()) == nlohmann::json({grid.cols, grid.rows});
 }
 
 void CheckFinite(const sim::Trajectory& t) {
@@ -194,7 +235,15 @@ void WriteExample(const std::string& out, const std::string& name, const std::ve
     }
     if (!tracks.is_null()) sim::WriteFileAtomically((tmp / "tracks.json").string(), tracks.dump() + "\n");
     sim::WriteFileAtomically((tmp / "label.json").string(), label.dump(2) + "\n");
-    fs::rename(tmp, fs::path(out) / name);
+    // A folder of this name without label.json (written last) is an unfinished copy, e.g. an
+    // interrupted cp or rsync of a dataset: the rename failed on it ("Directory not empty") at
+    // every resume. It is incomplete by this writer's own rule, so it is replaced.
+    const fs::path target = fs::path(out) / name;
+    if (fs::exists(target) && !fs::exists(target / "label.json")) {
+      std::fprintf(stderr, "make-dataset: %s has no label.json (unfinished): made again\n", target.c_str());
+      fs::remove_all(target);
+    }
+    fs::rename(tmp, target);
     SyncDirectory(out);
   } catch (...) {
     std::error_code ec;
@@ -260,10 +309,17 @@ nlohmann::json IndexHeader(const DatasetOptions& o, const nlohmann::json& settin
 // setting of the folder's that this run lacks counts too (a dataset made with --tracks resumed
 // without them made examples without tracks.json and dropped "tracks" from the header).
 // `ignored`: a key compared on neither side (--add-tracks gives examples theirs).
+// Settings recorded since a later version ("scene_files"): a folder whose header lacks them was
+// made before and is taken as it is (the final index records them).
+// --add-tracks (`ignored` "tracks") still refuses another grid than the header's.
 void CheckCompatible(const std::string& dir, const nlohmann::json& settings, const std::string& ignored = "") {
   const nlohmann::json existing = ReadIndex(dir);
   if (existing.is_null() || !existing.contains("dataset")) return;
   const nlohmann::json& old = existing["dataset"];
+  if (ignored == "tracks" && old.contains("tracks") && settings.contains("tracks") && old["tracks"] != settings["tracks"])
+    throw std::runtime_error((fs::path(dir) / "index.json").string() + ": field 'dataset.tracks' is " +
+                             old["tracks"].dump() + " but this run adds " + settings["tracks"].dump() +
+                             " (a dataset holds one grid: --add-tracks with the header's, or another --out)");
   for (auto it = old.begin(); it != old.end(); ++it) {
     if (it.key() == ignored || settings.contains(it.key())) continue;
     const bool grid = it.key() == "tracks" && it.value().is_array() && it.value().size() == 2;
@@ -274,7 +330,7 @@ void CheckCompatible(const std::string& dir, const nlohmann::json& settings, con
                              ")");
   }
   for (auto it = settings.begin(); it != settings.end(); ++it) {
-    if (it.key() == ignored) continue;
+    if (it.key() == ignored || (it.key() == "scene_files" && !old.contains(it.key()))) continue;
     if (!old.contains(it.key()) || old[it.key()] != it.value())
       throw std::runtime_error((fs::path(dir) / "index.json").string() + ": field 'dataset." + it.key() +
                                "' is " + (old.contains(it.key()) ? old[it.key()].dump() : "missing") +
@@ -282,8 +338,74 @@ void CheckCompatible(const std::string& dir, const nlohmann::json& settings, con
                                (it.key() == "tracks" && !old.contains("tracks")
                                     ? " (the examples there were made without tracks: give them theirs with "
                                       "--add-tracks, then resume with --tracks)"
-                                    : " (resume with the same settings, or use another --out)"));
+                                    : it.key() == "scene_files"
+                                          ? " (the scene, a mesh or a material file changed since the dataset was "
+                                            "made: restore them, or use another --out)"
+                                          : " (resume with the same settings, or use another --out)"));
   }
+}
+
+// Throws unless DIR's index (`existing`, not null) is a make-dataset dataset of this run's kind
+// whose count is at most this run's. A recorded session's or a toy dataset's index was rewritten
+// as FlagSim's (their own fields dropped); a smaller --count left the header's count below the
+// simulations the index lists.
+void CheckIndexIsThisKind(const std::string& dir, const nlohmann::json& existing, const DatasetOptions& o) {
+  const std::string file = (fs::path(dir) / "index.json").string();
+  const std::string kind = render::SceneKindName(o.kind);
+  if (!existing.is_object() || !existing.contains("dataset"))
+    throw std::runtime_error(file + ": no field 'dataset': not a dataset make-dataset made (recordings and toy "
+                             "datasets keep their own index); use another --out");
+  if (existing.value("kind", nlohmann::json()) != kind)
+    throw std::runtime_error(file + ": field 'kind' is " + existing.value("kind", nlohmann::json()).dump() +
+                             ", this run makes \"" + kind + "\" (use another --out)");
+  const nlohmann::json count = existing.value("count", nlohmann::json());
+  if (count.is_number_integer() && count.get<int64_t>() > o.count)
+    throw std::runtime_error(file + ": field 'count' is " + count.dump() + " but this run asks for " +
+                             std::to_string(o.count) + " (resume with --count " + count.dump() +
+                             " or more: a smaller count would leave the header below the simulations listed)");
+}
+
+// Throws unless the example folder `name`'s label.json says it was made as this run would make
+// it: FlagSim or ClothSim, global and simulation seed, frames, size, format, rate, warm-up, scene
+// and mesh. Why: without an index (the e5 recipe copies another dataset's examples and drops its
+// index) nothing else compared them, and examples of other settings were counted complete.
+void CheckExampleLabel(const std::string& dir, const std::string& name, uint64_t simulation_seed,
+                       const DatasetOptions& o, const Prepared& p) {
+  const fs::path file = fs::path(dir) / name / "label.json";
+  std::ifstream in(file);
+  const nlohmann::json label = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (!label.is_object()) throw std::runtime_error(file.string() + ": not a JSON object (remove the folder to make it again)");
+  const nlohmann::json sim = label.value("simulation_settings", nlohmann::json::object());
+  const double frame_time = 1.0 / o.fps;
+  const std::vector<std::pair<std::string, std::pair<nlohmann::json, nlohmann::json>>> fields = {
+      {"dataset", {label.value("dataset", nlohmann::json()), render::SceneKindName(o.kind)}},
+      {"dataset_seed", {label.value("dataset_seed", nlohmann::json()), o.seed}},
+      {"seed", {label.value("seed", nlohmann::json()), simulation_seed}},
+      {"num_frames", {label.value("num_frames", nlohmann::json()), o.frames}},
+      {"width", {label.value("width", nlohmann::json()), o.size}},
+      {"height", {label.value("height", nlohmann::json()), o.size}},
+      {"frame_pattern", {label.value("frame_pattern", nlohmann::json()), "%03d." + o.frame_ext}},
+      {"simulation_settings.scene", {sim.value("scene", nlohmann::json()), p.scene_name}},
+      {"simulation_settings.vertices", {sim.value("vertices", nlohmann::json()), p.setup.cloths[0].mesh.V.rows()}},
+  };
+  for (const auto& [field, values] : fields) {
+    // A field the label lacks (a label of an older generator) is not compared.
+    if (!values.first.is_null() && values.first != values.second)
+      throw std::runtime_error(file.string() + ": field '" + field + "' is " + values.first.dump() + ", this run makes " +
+                               values.second.dump() + " (the example was made with other settings: resume with "
+                               "theirs, or use another --out)");
+  }
+  const auto near = [](const nlohmann::json& v, double expected) {
+    return v.is_number() && std::abs(v.get<double>() - expected) <= 1e-9 * std::max(1.0, std::abs(expected));
+  };
+  if (label.contains("frame_rate") && !near(label["frame_rate"], o.fps))
+    throw std::runtime_error(file.string() + ": field 'frame_rate' is " + label.value("frame_rate", nlohmann::json()).dump() +
+                             ", this run makes " + std::to_string(o.fps) + " Hz (resume with its settings, or use another --out)");
+  const double warmup = std::lround(o.warmup / frame_time) * frame_time;
+  if (sim.contains("warmup") && !near(sim["warmup"], warmup))
+    throw std::runtime_error(file.string() + ": field 'simulation_settings.warmup' is " +
+                             sim.value("warmup", nlohmann::json()).dump() + ", this run makes " + std::to_string(warmup) +
+                             " s (resume with its settings, or use another --out)");
 }
 
 }  // namespace
@@ -309,7 +431,8 @@ std::vector<Fabric> LoadFabrics(const std::string& folder, const std::string& sc
   return fabrics;
 }
 
-nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<std::string>& fabric_names) {
+nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<std::string>& fabric_names,
+                                   const std::string& scene_files) {
   const std::string scene_path = o.scene.empty() ? DefaultScenePath(o.kind) : o.scene;
   nlohmann::json backgrounds = nlohmann::json::array();
   for (const auto& b : o.background_images) backgrounds.push_back(fs::path(b).filename().string());
@@ -332,6 +455,7 @@ nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<st
           {"background_images", backgrounds},
           {"generator_version", kGeneratorVersion}};
   if (o.tracks) settings["tracks"] = {o.tracks->cols, o.tracks->rows};
+  if (!scene_files.empty()) settings["scene_files"] = scene_files;
   // ClothSim's wind has one direction since 2026-12-06; a folder made with directions over the
   // circle lacks this and is refused on resume rather than mixed.
   if (o.kind == render::SceneKind::kCloth) settings["wind_direction_deg"] = kClothWindAzimuth * 180 / M_PI;
@@ -354,10 +478,12 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   ValidateOptions(o);
   const auto start = Clock::now();
   const Prepared prep = Prepare(o);
-  const nlohmann::json settings = DatasetSettingsJson(o, FabricNames(prep.fabrics));
-  if (o.add_tracks && ReadIndex(o.out).is_null())
+  const nlohmann::json settings = DatasetSettingsJson(o, FabricNames(prep.fabrics), prep.scene_files);
+  const nlohmann::json existing = ReadIndex(o.out);
+  if (o.add_tracks && existing.is_null())
     throw std::runtime_error("--add-tracks: " + (fs::path(o.out) / "index.json").string() +
                              " not found: tracks are added to a dataset made before");
+  if (!existing.is_null()) CheckIndexIsThisKind(o.out, existing, o);
   fs::create_directories(o.out);
   if (o.add_tracks) {
     // The examples were made without tracks: every other setting must be theirs.
@@ -369,20 +495,16 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   DatasetSummary summary;
   summary.jobs = o.jobs > 0 ? o.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
-  // Left-overs of a killed run of this shard: its temporary folders (other shards' may be in
-  // use on other machines, so only ours are removed).
+  // Left-overs of a killed run of this shard: its temporary folders whose process has stopped
+  // (other shards' may be in use on other machines, and a run of another split into this folder
+  // may be writing this shard's: its folders were removed under it and its rename failed).
   for (const auto& e : fs::directory_iterator(o.out)) {
     const std::string name = e.path().filename().string();
     if (name.empty() || name[0] != '.' || name.find(".tmp-") == std::string::npos) continue;
     const int64_t i = IndexOfName(name, o.kind);
-    if (i >= 0 && i % o.shards == o.shard) fs::remove_all(e.path());
+    if (i >= 0 && i % o.shards == o.shard && IsTemporaryOfStoppedProcess(name)) fs::remove_all(e.path());
   }
 
-  // A new folder gets its index's header before the first simulation: a run killed midway (or
-  // stopped by a time limit) leaves a folder that says what it is, so a rerun with other settings
-  // is still refused, and `make-dataset --reindex` lists the examples it finished. (A folder that
-  // has an index keeps it until the end, which rebuilds it from the folders present.)
-  if (ReadIndex(o.out).is_null()) WriteIndex(o.out, IndexHeader(o, settings));
 
   // This shard's simulations that still miss a view (--add-tracks: a view's tracks).
   auto has = [&](int64_t i, int v, const char* file) {
@@ -390,7 +512,8 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   };
   auto view_done = [&](int64_t i, int v) {
     if (!o.add_tracks) return has(i, v, "label.json");
-    return !has(i, v, "label.json") || TracksHaveWorld(fs::path(o.out) / ExampleName(o.kind, i, v) / "tracks.json");
+    return !has(i, v, "label.json") ||
+           TracksHaveWorld(fs::path(o.out) / ExampleName(o.kind, i, v) / "tracks.json", *o.tracks);
   };
   std::vector<int64_t> todo;
   for (int64_t i = o.shard; i < o.count; i += o.shards) {
@@ -399,9 +522,18 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
     ++summary.assigned;
     bool complete = true;
     for (int v = 0; v < o.views && complete; ++v) complete = view_done(i, v);
+    for (int v = 0; v < o.views; ++v)  // every finished view is this run's, complete simulation or not
+      if (has(i, v, "label.json")) CheckExampleLabel(o.out, ExampleName(o.kind, i, v), SimulationSeed(o.seed, i), o, prep);
     if (complete) ++summary.skipped;
     else todo.push_back(i);
   }
+
+  // A new folder gets its index's header before the first simulation (after the examples found
+  // were checked: a refused run left its own settings there): a run killed midway (or
+  // stopped by a time limit) leaves a folder that says what it is, so a rerun with other settings
+  // is still refused, and `make-dataset --reindex` lists the examples it finished. (A folder that
+  // has an index keeps it until the end, which rebuilds it from the folders present.)
+  if (ReadIndex(o.out).is_null()) WriteIndex(o.out, IndexHeader(o, settings));
 
   std::mutex mutex;  // guards summary and progress
   DatasetProgress state;
@@ -512,7 +644,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
     // Counted as the run counts them done: a tracks.json without the points' positions (an old
     // one whose replay failed) is not the grid's either.
     for (const auto& clip : index["clips"])
-      if (!TracksHaveWorld(fs::path(o.out) / clip.value("name", std::string()) / "tracks.json"))
+      if (!TracksHaveWorld(fs::path(o.out) / clip.value("name", std::string()) / "tracks.json", *o.tracks))
         ++summary.examples_without_tracks;
     if (summary.examples_without_tracks > 0) index["dataset"].erase("tracks");
   }

@@ -111,8 +111,10 @@ DatasetSummary GenerateDataset(const DatasetOptions& options,
 
 // The settings block ("dataset") stored in index.json: everything that defines the examples'
 // content (not shard, jobs or count), so resumed runs and shards can check they agree.
+// `scene_files`: the fingerprint of the scene's files ("" leaves it out; GenerateDataset gives it).
 nlohmann::json DatasetSettingsJson(const DatasetOptions& options,
-                                   const std::vector<std::string>& fabric_names);
+                                   const std::vector<std::string>& fabric_names,
+                                   const std::string& scene_files = "");
 
 // Rebuilds DIR/index.json (and the contact sheet) from the example folders present, keeping the
 // existing header: the final merge after shards ran on several machines.

@@ -269,6 +269,131 @@ TEST_F(DatasetGeneratorTest, RefusesToMixSettingsInOneFolder) {
   EXPECT_EQ(s.examples_in_index, 4);
 }
 
+// What the runtime_error of GenerateDataset(o) says ("" when it ran).
+std::string GenerateError(const DatasetOptions& o) {
+  try {
+    GenerateDataset(o);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST_F(DatasetGeneratorTest, AResumeWithoutAnIndexChecksTheExamplesItFinds) {
+  // docs/datasets.md's recipe copies another dataset's examples and drops its index: the labels
+  // are then all that says how the examples were made (they were counted complete unchecked).
+  const fs::path dir = root_ / "no-index";
+  fs::copy(Ref(), dir, fs::copy_options::recursive);
+  fs::remove(dir / "index.json");
+  DatasetOptions o = Tiny(dir.string());
+  o.frames = 5;
+  std::string error = GenerateError(o);
+  EXPECT_NE(error.find((dir / "flag-000000-v0" / "label.json").string() + ": field 'num_frames' is 6, this run makes 5"),
+            std::string::npos)
+      << error;
+  o = Tiny(dir.string(), 2);
+  error = GenerateError(o);
+  EXPECT_NE(error.find("field 'dataset_seed' is 1, this run makes 2"), std::string::npos) << error;
+  o = Tiny(dir.string());
+  o.warmup = 0.8;
+  error = GenerateError(o);
+  EXPECT_NE(error.find("field 'simulation_settings.warmup' is 0.4"), std::string::npos) << error;
+  o = Tiny(dir.string());
+  o.max_edge = 0.5;  // another mesh
+  error = GenerateError(o);
+  EXPECT_NE(error.find("field 'simulation_settings.vertices'"), std::string::npos) << error;
+  EXPECT_FALSE(fs::exists(dir / "index.json"));  // the refused runs wrote no header of theirs
+  // The same settings resume it, with nothing to do, and the index is the reference's again.
+  const DatasetSummary s = GenerateDataset(Tiny(dir.string()));
+  EXPECT_EQ(s.skipped, 3);
+  EXPECT_EQ(Files(dir), Files(Ref()));
+}
+
+TEST_F(DatasetGeneratorTest, AnIndexOfAnotherKindOrALargerCountIsRefused) {
+  const fs::path dir = root_ / "other-index";
+  fs::copy(Ref(), dir, fs::copy_options::recursive);
+  const nlohmann::json index = nlohmann::json::parse(Bytes(dir / "index.json"));
+  auto write = [&](const nlohmann::json& j) { std::ofstream(dir / "index.json") << j.dump(2) << "\n"; };
+  nlohmann::json recorded = index;  // a recording's index: no "dataset", its own kind
+  recorded.erase("dataset");
+  recorded["kind"] = "real";
+  write(recorded);
+  EXPECT_NE(GenerateError(Tiny(dir.string())).find("index.json: no field 'dataset'"), std::string::npos);
+  nlohmann::json cloth = index;
+  cloth["kind"] = "cloth";
+  write(cloth);
+  EXPECT_NE(GenerateError(Tiny(dir.string())).find("field 'kind' is \"cloth\", this run makes \"flag\""),
+            std::string::npos);
+  write(index);
+  DatasetOptions fewer = Tiny(dir.string());
+  fewer.count = 2;
+  EXPECT_NE(GenerateError(fewer).find("field 'count' is 3 but this run asks for 2"), std::string::npos)
+      << GenerateError(fewer);
+  EXPECT_EQ(nlohmann::json::parse(Bytes(dir / "index.json")), index);
+}
+
+TEST_F(DatasetGeneratorTest, AnEditedSceneIsNotMixedIn) {
+  // A copy of the flag scene's files, laid out as config/ is.
+  const fs::path config = fs::path(DefaultScenePath(render::SceneKind::kFlag)).parent_path().parent_path();
+  const fs::path copy = root_ / "scene-copy";
+  for (const char* f : {"scenes/flag.json", "meshes/flag.obj", "materials/camel-ponte-roma.json"}) {
+    fs::create_directories((copy / f).parent_path());
+    fs::copy_file(config / f, copy / f);
+  }
+  const fs::path dir = root_ / "edited-scene";
+  DatasetOptions o = Tiny(dir.string());
+  o.count = 1;
+  o.scene = (copy / "scenes/flag.json").string();
+  ASSERT_EQ(GenerateError(o), "");
+  const nlohmann::json header = nlohmann::json::parse(Bytes(dir / "index.json"))["dataset"];
+  ASSERT_TRUE(header.contains("scene_files"));
+  // The same files: the same fingerprint as the default scene's (the reference's header).
+  EXPECT_EQ(header["scene_files"], nlohmann::json::parse(Bytes(Ref() / "index.json"))["dataset"]["scene_files"]);
+  // The material file edited (any byte counts: here a comment; a density would change the flag).
+  const std::string material = Bytes(copy / "materials/camel-ponte-roma.json") + "\n// edited\n";
+  std::ofstream(copy / "materials/camel-ponte-roma.json") << material;
+  o.count = 2;
+  const std::string error = GenerateError(o);
+  EXPECT_NE(error.find("field 'dataset.scene_files'"), std::string::npos) << error;
+  EXPECT_NE(error.find("a mesh or a material file changed"), std::string::npos) << error;
+  // A header made before the fingerprint was recorded is taken as it is.
+  nlohmann::json index = nlohmann::json::parse(Bytes(dir / "index.json"));
+  index["dataset"].erase("scene_files");
+  std::ofstream(dir / "index.json") << index.dump(2) << "\n";
+  EXPECT_EQ(GenerateError(o), "");
+  EXPECT_TRUE(nlohmann::json::parse(Bytes(dir / "index.json"))["dataset"].contains("scene_files"));
+}
+
+TEST_F(DatasetGeneratorTest, ALiveRunsTemporaryFolderIsLeftAlone) {
+  // A run of another split into the same folder may be writing this shard's simulations: its
+  // folders were removed under it (its rename then failed). Only a stopped process's go.
+  const fs::path dir = root_ / "live-temporary";
+  fs::copy(Ref(), dir, fs::copy_options::recursive);
+  const fs::path live = dir / (".flag-000001-v0.tmp-" + std::to_string(::getpid()) + "-3");
+  const fs::path stopped = dir / ".flag-000001-v0.tmp-999999-3";
+  for (const auto& t : {live, stopped}) {
+    fs::create_directories(t);
+    std::ofstream(t / "000.jpg") << "partial";
+  }
+  const DatasetSummary s = GenerateDataset(Tiny(dir.string()));
+  EXPECT_EQ(s.skipped, 3);
+  EXPECT_TRUE(fs::exists(live / "000.jpg"));
+  EXPECT_FALSE(fs::exists(stopped));
+}
+
+TEST_F(DatasetGeneratorTest, AnExampleFolderWithoutItsLabelIsMadeAgain) {
+  // An interrupted copy: the folder is there, its label (written last) is not. The rename onto
+  // it failed ("Directory not empty") at every resume.
+  const fs::path dir = root_ / "unfinished-copy";
+  fs::copy(Ref(), dir, fs::copy_options::recursive);
+  fs::remove(dir / "flag-000001-v0" / "label.json");
+  fs::remove(dir / "flag-000001-v0" / "005.jpg");
+  const DatasetSummary s = GenerateDataset(Tiny(dir.string()));
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  EXPECT_EQ(s.examples_written, 1);
+  EXPECT_EQ(Files(dir), Files(Ref()));
+}
+
 TEST_F(DatasetGeneratorTest, OtherCamerasAreRecordedAndNotMixedIn) {
   // Table 2's cameras leave the settings as they were before cameras were an option (so older
   // datasets resume); other ranges are recorded, and a resume with others is refused.
@@ -517,6 +642,27 @@ TEST_F(DatasetGeneratorTest, AddTracksGivesADatasetTheTracksItWouldHaveBeenMadeW
         << e.what();
   }
   EXPECT_EQ(Bytes(tracked / "index.json"), header_before);
+  // --add-tracks with another grid than the header's: refused (the header named the new grid
+  // over files of the old one).
+  DatasetOptions other_grid = Tiny(tracked.string());
+  other_grid.tracks = TrackGrid{5, 4};
+  other_grid.add_tracks = true;
+  EXPECT_NE(GenerateError(other_grid).find("field 'dataset.tracks' is [4,3] but this run adds [5,4]"),
+            std::string::npos)
+      << GenerateError(other_grid);
+  // A header without a grid (some examples still without tracks) and files of another grid:
+  // they are made again with this run's, so the dataset holds one grid.
+  nlohmann::json gridless = nlohmann::json::parse(Bytes(tracked / "index.json"));
+  gridless["dataset"].erase("tracks");
+  std::ofstream(tracked / "index.json") << gridless.dump(2) << "\n";
+  other_grid.tracks = TrackGrid{3, 4};
+  const DatasetSummary regridded = GenerateDataset(other_grid);
+  ASSERT_TRUE(regridded.errors.empty()) << regridded.errors[0];
+  EXPECT_EQ(regridded.examples_written, 3);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_EQ(nlohmann::json::parse(Bytes(tracked / ExampleName(render::SceneKind::kFlag, i, 0) / "tracks.json"))["grid"],
+              nlohmann::json({3, 4}));
+  EXPECT_EQ(nlohmann::json::parse(Bytes(tracked / "index.json"))["dataset"]["tracks"], nlohmann::json({3, 4}));
 }
 
 TEST_F(DatasetGeneratorTest, AddTracksRefusesAnExampleWhoseFramesItsReplayDoesNotShow) {
@@ -630,6 +776,11 @@ TEST(DatasetOptionsTest, BadOptionsAreRejected) {
   o.views = 1;
   o.frame_ext = "ppm";
   EXPECT_THROW(GenerateDataset(o), std::invalid_argument);
+  o.frame_ext = "jpg";
+  const double warmup = o.warmup;
+  o.warmup = 0.019;  // between frames 0 and 1 at 25 fps: was rounded to 0 without a word
+  EXPECT_THROW(GenerateDataset(o), std::invalid_argument);
+  o.warmup = warmup;
   o.frame_ext = "jpg";
   // Split fractions that cannot be: refused before the folder's header records them.
   o.val_fraction = 0.9;

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# CLI test of `clothwind make-dataset`'s options that belong to one kind or are out of range: each
+# is refused naming the option, before --out is made. FlagSim's material spreads given to ClothSim
+# (and ClothSim's --materials to FlagSim) ran as if not given while the header recorded them;
+# --seed -1 was taken as 2^64-1. Usage: make_dataset_cli_test.sh CLOTHWIND_BINARY
+set -euo pipefail
+bin="$1"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+fail() { echo "make_dataset_cli_test: FAIL: $*" >&2; exit 1; }
+
+refused() {  # refused OPTION_NAMED ARGS...: exits non-zero, names the option, makes no --out
+  local named="$1"
+  shift
+  local status=0
+  "$bin" make-dataset --count 1 --out "$work/out" "$@" >"$work/msg.txt" 2>&1 || status=$?
+  [ "$status" -ne 0 ] || fail "make-dataset $* exited 0"
+  [ "$status" -lt 128 ] || fail "make-dataset $* died with status $status: $(cat "$work/msg.txt")"
+  grep -q -- "$named" "$work/msg.txt" || fail "make-dataset $*: the message does not name $named: $(cat "$work/msg.txt")"
+  [ ! -e "$work/out" ] || fail "make-dataset $* made its --out folder"
+}
+
+refused --area-weight-spread --kind cloth --area-weight-spread 50
+refused --bending-spread --kind cloth --bending-spread 2
+refused --bending-jitter --kind cloth --bending-jitter 2
+refused --materials --kind flag --materials "$work"
+refused --seed --seed -1
+refused --warmup --warmup 0.019
+echo "make_dataset_cli_test: OK"
