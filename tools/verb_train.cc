@@ -195,6 +195,8 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
     }
     std::cout << "best validation RMSE " << std::setprecision(4) << r.best_val_rmse << " m/s; model "
               << r.model.string() << " (trained on " << r.device << ")\n";
+    if (r.validated_on != "val")
+      std::cout << "note: validated on " << r.validated_on << ": the RMSE above is not a held-out score\n";
     if (!r.plot_error.empty()) std::cerr << "learning curve not drawn: " << r.plot_error << "\n";
     return 0;
   };

@@ -13,6 +13,12 @@ FrameCache::FrameCache(const std::vector<ClipInfo>& clips, int input_size, bool 
 }
 
 bool FrameCache::Exact(const SampleOptions& options, const ClipInfo& clip, std::string* why) {
+  // The judge reads the file frame's crop resized to its own side; from the cache it would read
+  // the input square resized again, other pixels (a clip near the judge's margin could turn).
+  if (options.flag_flies == FlagFlies::kAuto && options.fly_judge) {
+    if (why) *why = "the fly judge (--flag-flies auto) reads the files' crops, not the cached squares";
+    return false;
+  }
   if (!options.augment) return true;  // evaluation: always the centre square
   for (double s : options.crop_scales) {
     if (s != 1.0) {

@@ -13,6 +13,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "learn/fly_judge.h"
 #include "learn/train.h"
 
 namespace clothwind::learn {
@@ -207,6 +208,14 @@ TEST_F(FrameCacheTest, SaysWhenItWouldChangeTheSamples) {
   EXPECT_THAT(why, ::testing::HasSubstr("64x48"));
   o.augment = false;  // evaluation takes the centre square of any frame
   EXPECT_TRUE(FrameCache::Exact(o, wide, &why));
+  // Unless a fly judge decides the turn: it reads the files' crops at its own side.
+  o.flag_flies = FlagFlies::kAuto;
+  EXPECT_TRUE(FrameCache::Exact(o, wide, &why));  // motion cues without a judge: the same pixels
+  const int cells = kMotionMapGrid * kMotionMapGrid;
+  o.fly_judge = std::make_shared<const FlyJudge>(Eigen::MatrixXf::Zero(2, cells), Eigen::VectorXf::Zero(2),
+                                                 Eigen::VectorXf::Zero(2), 0.0f);
+  EXPECT_FALSE(FrameCache::Exact(o, wide, &why));
+  EXPECT_THAT(why, ::testing::HasSubstr("fly judge"));
 
   FrameCache cache(*clips_, 24);
   EXPECT_THROW(LoadSample(cache, 0, Training(), 1), std::invalid_argument);  // 32 px asked of a 24 px cache

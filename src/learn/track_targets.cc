@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -21,7 +22,15 @@ void AppendFrameRows(const nlohmann::json& rows, const std::string& where, const
     if (!rows[k].is_array() || static_cast<int>(rows[k].size()) != per_row)
       throw std::runtime_error(where + "'" + name + "[" + std::to_string(k) + "]' must hold " +
                                std::to_string(per_row) + " coordinates (" + coordinates + " of each grid point)");
-    for (const auto& value : rows[k]) out.push_back(value.get<float>());
+    for (size_t c = 0; c < rows[k].size(); ++c) {
+      // Finite as a float: 1e300 became inf, and training ran on NaN losses to the end.
+      const nlohmann::json& value = rows[k][c];
+      const float f = value.is_number() ? value.get<float>() : std::numeric_limits<float>::quiet_NaN();
+      if (!std::isfinite(f))
+        throw std::runtime_error(where + "'" + name + "[" + std::to_string(k) + "][" + std::to_string(c) +
+                                 "]' must be a finite number (as a 32-bit float), got " + value.dump());
+      out.push_back(f);
+    }
   }
 }
 
@@ -54,6 +63,9 @@ Tracks ReadTracks(const std::filesystem::path& file) {
       throw std::runtime_error(where + "'grid' must be [cols, rows] of positive integers, got " + grid.dump());
     t.cols = count(grid[0], "grid[0]");
     t.rows = count(grid[1], "grid[1]");
+    // points() is an int: 65536 x 65536 wrapped to 0 points, which failed deep in libtorch.
+    if (static_cast<int64_t>(t.cols) * t.rows > (1 << 20))
+      throw std::runtime_error(where + "'grid' must hold at most 2^20 points, got " + grid.dump());
     t.width = count(need("width"), "width");
     t.height = count(need("height"), "height");
     const nlohmann::json& xy = need("xy");

@@ -325,6 +325,20 @@ TEST_F(TracksFileTest, ErrorsNameTheFileAndTheField) {
   j = good;
   j["height"] = 4294967304;  // wrapped to 8
   EXPECT_NE(message(j).find("'height' must be a positive integer"), std::string::npos) << message(j);
+  // A coordinate beyond a float became inf, and training ran on NaN losses to its end (exit 0).
+  j = good;
+  j["xy"][0][3] = 1e300;
+  EXPECT_NE(message(j).find("'xy[0][3]' must be a finite number"), std::string::npos) << message(j);
+  j = good;
+  j["xy"][0][1] = "2";
+  EXPECT_NE(message(j).find("'xy[0][1]' must be a finite number"), std::string::npos) << message(j);
+  j = good;
+  j["world"] = {{0, 0, 1, 2, -1e39, 1}};
+  EXPECT_NE(message(j).find("'world[0][4]' must be a finite number"), std::string::npos) << message(j);
+  // 65536 x 65536 points wrapped points() to 0, which failed inside libtorch naming no file.
+  j = good;
+  j["grid"] = {65536, 65536};
+  EXPECT_NE(message(j).find("'grid' must hold at most 2^20 points"), std::string::npos) << message(j);
 }
 
 }  // namespace

@@ -369,7 +369,13 @@ TrainResult Train(const TrainOptions& o) {
     if (!o.init_only && train.empty()) {
       throw std::runtime_error((o.data / "index.json").string() + ": no examples in split train");
     }
-    if (val.empty()) val = train;  // a dataset without a validation split validates on train
+    // A dataset without a validation split validates, and chooses model.pt, on the train split:
+    // said in the result (the CLI prints it) and in state.json, so its "validation RMSE" is not
+    // read as a held-out score.
+    if (val.empty()) {
+      val = train;
+      result.validated_on = "train (the dataset has no val split)";
+    }
   }
 
   ModelConfig config = o.model;
@@ -690,7 +696,8 @@ TrainResult Train(const TrainOptions& o) {
              {"weight_average", o.weight_average}, {"average_steps", average_steps},
              {"best_val_rmse", result.best_val_rmse}, {"checkpoint", checkpoint_name},
              {"batch", o.batch}, {"weight_decay", o.weight_decay}, {"grad_clip", o.grad_clip},
-             {"epochs", o.epochs}, {"lr", o.lr}, {"lr_schedule", o.lr_schedule}, {"lr_decay_epoch", o.lr_decay_epoch}};
+             {"epochs", o.epochs}, {"lr", o.lr}, {"lr_schedule", o.lr_schedule}, {"lr_decay_epoch", o.lr_decay_epoch},
+             {"validated_on", result.validated_on}};
     WriteFileAtomically(state_path, state.dump(2));
     // Older checkpoints (and the files of the layout before checkpoint folders) once state.json
     // names the new one.
@@ -706,6 +713,13 @@ TrainResult Train(const TrainOptions& o) {
     }
     if (o.epoch_done) o.epoch_done(record);
   }
+  // Every epoch's validation RMSE NaN or inf (a diverged run, a corrupt target): model.pt was
+  // never written, and the run used to end with exit 0 naming it.
+  if (!result.log.empty() && !std::isfinite(result.best_val_rmse))
+    throw std::runtime_error("no epoch gave a finite validation RMSE (the last: " +
+                             std::to_string(result.log.back().val_rmse) + ", train loss " +
+                             std::to_string(result.log.back().train_loss) + "): no " + result.model.string() +
+                             " was written; see " + (o.out / "log.tsv").string());
   return result;
 }
 

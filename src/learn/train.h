@@ -85,6 +85,7 @@ struct TrainResult {
   double best_val_rmse = 0;
   std::string device;                // where it trained
   std::string plot_error;            // why the learning curve could not be drawn, if so
+  std::string validated_on = "val";  // the split validation (and the choice of model.pt) used
 };
 
 // The learning rate of 1-based `epoch` under options.lr_schedule:

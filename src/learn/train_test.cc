@@ -1627,6 +1627,36 @@ TrainOptions InitOnly(const fs::path& out) {
   return t;
 }
 
+TEST_F(TrainTest, ADatasetWithoutAValSplitSaysItValidatedOnTrain) {
+  // The toy dataset with its val clips moved to train: validation (and the choice of model.pt)
+  // falls back to the train split, which the result and state.json now say.
+  const fs::path data = *root_ / "no-val";
+  fs::copy(*root_ / "data", data, fs::copy_options::recursive);
+  nlohmann::json index = ReadJson(data / "index.json");
+  int moved = 0;
+  for (auto& clip : index["clips"]) {
+    if (clip.value("split", "") != "val") continue;
+    clip["split"] = "train";
+    const fs::path label = data / clip["name"].get<std::string>() / "label.json";
+    nlohmann::json j = ReadJson(label);
+    j["split"] = "train";
+    std::ofstream(label) << j.dump(2);
+    ++moved;
+  }
+  ASSERT_GT(moved, 0);
+  std::ofstream(data / "index.json") << index.dump(2);
+  TrainOptions o = Options("sdn", "no-val-run");
+  o.data = data;
+  o.epochs = 1;
+  const TrainResult r = Train(o);
+  EXPECT_EQ(r.validated_on, "train (the dataset has no val split)");
+  EXPECT_EQ(ReadJson(o.out / "state.json").value("validated_on", ""), r.validated_on);
+  // With a val split, validation is on it.
+  o = Options("sdn", "val-run");
+  o.epochs = 1;
+  EXPECT_EQ(Train(o).validated_on, "val");
+}
+
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
   const TrainResult r = Train(InitOnly(*root_ / "init"));
   Predictor p(r.model, 1, "cpu");
