@@ -1,8 +1,12 @@
 // What telling the way a flag flies costs per clip, on the 30 frames of 64x64 grey a model reads:
-// the motion cues (learn/fly_direction.h) against the learned judge (learn/fly_judge.h).
+// the motion cues (learn/fly_direction.h) against the learned judge (learn/fly_judge.h), and the
+// judge as sdn_node runs it: from the clip's 300 px crops, each resized to the judge's own side
+// first (learn/dataset.cc TurnsToFlyRight), which costs more than judging.
 //   build/bin/learn_fly_judge_bench [--judge models/fly_judge.pt] [Google Benchmark flags]
 // Without --judge (or when the file is missing) a judge of random weights of the shipped shape
-// (64 hidden units) is timed: the cost does not depend on the weights.
+// (64 hidden units) is timed. Denormal floats are flushed to zero, as the node's Predictor does
+// on its thread: the shipped judge holds denormal weights (a quarter of its hidden layer), whose
+// arithmetic otherwise took over half the time measured.
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -10,9 +14,12 @@
 #include <string>
 #include <vector>
 
+#include <ATen/Context.h>
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
+#include "learn/dataset.h"
 #include "learn/fly_direction.h"
 #include "learn/fly_judge.h"
 #include "learn/heap_reuse.h"
@@ -67,6 +74,27 @@ void BM_FlyJudge(benchmark::State& state) {
 }
 BENCHMARK(BM_FlyJudge)->Unit(benchmark::kMicrosecond);
 
+// The node's path: 30 crops of 300x300 (clip_buffer's default side), each resized to the judge's
+// map side, then judged.
+void BM_FlyJudgeFromNodeCrops(benchmark::State& state) {
+  std::vector<cv::Mat> crops;
+  for (const cv::Mat& f : Clip()) {
+    cv::Mat big;
+    cv::resize(f, big, cv::Size(300, 300), 0, 0, cv::INTER_LINEAR);
+    crops.push_back(big);
+  }
+  const FlyJudge judge = Judge();
+  std::vector<cv::Mat> small(crops.size());
+  double score = 0;
+  for (auto _ : state) {
+    for (size_t t = 0; t < crops.size(); ++t)
+      clothwind::learn::ResizeCrop(crops[t], cv::Rect(0, 0, 300, 300), clothwind::learn::kMotionMapSide, small[t]);
+    benchmark::DoNotOptimize(judge.Judge(small, &score));
+  }
+  state.SetLabel(g_judge_path.empty() ? "random weights" : g_judge_path);
+}
+BENCHMARK(BM_FlyJudgeFromNodeCrops)->Unit(benchmark::kMicrosecond);
+
 void BM_MotionMapOnly(benchmark::State& state) {
   const std::vector<cv::Mat> clip = Clip();
   for (auto _ : state) benchmark::DoNotOptimize(clothwind::learn::MotionMap(clip).data);
@@ -88,6 +116,7 @@ int main(int argc, char** argv) {
   // Every benchmark from the same heap state: with glibc returning freed memory to the kernel,
   // BM_FlyJudge took 2.4 ms run alone and 0.1 ms after BM_MotionCues (the node keeps its heap too).
   clothwind::learn::KeepFreedHeapForReuse();
+  at::globalContext().setFlushDenormal(true);
   int n = static_cast<int>(rest.size());
   benchmark::Initialize(&n, rest.data());
   benchmark::RunSpecifiedBenchmarks();

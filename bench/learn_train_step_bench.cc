@@ -35,6 +35,7 @@
 #include <torch/torch.h>
 
 #include "bench_clock.h"
+#include "omp_wait_policy.h"
 #include "learn/heap_reuse.h"
 #include "learn/networks.h"
 #include "learn/spectral_layer.h"
@@ -94,6 +95,7 @@ Timing Measure(int repeats, bool cuda, F&& f) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const char* omp_wait_policy = clothwind::bench::EnsureOmpWaitPolicy(argv);
   int repeats = 10, threads = 2, batch = 16, width = 48;
   std::string device_name = "cpu";
   std::vector<Case> cases = {{64, 1}, {96, 1}, {128, 2}, {128, 1}};
@@ -124,8 +126,8 @@ int main(int argc, char** argv) {
   const at::Device device = cuda ? at::Device(at::kCUDA) : at::Device(at::kCPU);
   at::set_num_threads(threads);
   at::globalContext().setFlushDenormal(true);
-  std::printf("SDN training step on %s, batch %d x 30 frames, width %d, k 3, phase steps, %d thread(s), median of %d, %s, %s\n",
-              device_name.c_str(), batch, width, threads, repeats,
+  std::printf("SDN training step on %s, batch %d x 30 frames, width %d, k 3, phase steps, %d thread(s), median of %d, OMP_WAIT_POLICY=%s, %s, %s\n",
+              device_name.c_str(), batch, width, threads, repeats, omp_wait_policy,
               glibc_heap ? "glibc's default heap" : "freed heap kept for reuse",
               channels_last ? "channels-last kernels" : "default (NCHW) kernels");
   std::printf("%-6s %-5s | %-17s | %-17s | %-17s | %-17s | %-17s | %-17s\n", "input", "pool", "layer wall/cpu ms",

@@ -29,6 +29,7 @@
 #include <opencv2/core.hpp>
 
 #include "bench_clock.h"
+#include "omp_wait_policy.h"
 #include "learn/predictor.h"
 #include "learn/train.h"
 
@@ -48,6 +49,7 @@ struct Case {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const char* omp_wait_policy = clothwind::bench::EnsureOmpWaitPolicy(argv);
   int repeats = 20;
   bool quick = false;
   std::vector<fs::path> given;
@@ -90,6 +92,7 @@ int main(int argc, char** argv) {
     cv::merge(std::vector<cv::Mat>{cv::Mat::zeros(f.size(), CV_8UC1), 255 - f, f}, bgr);
     bgr_frames.push_back(bgr);
   }
+  std::printf("OMP_WAIT_POLICY=%s\n", omp_wait_policy);
   std::printf("%-28s %7s %5s %10s %10s %10s %14s\n", "model", "threads", "order", "mean [ms]", "p90 [ms]",
               "min [ms]", "cpu/clip [ms]");
   std::vector<fs::path> models = given;

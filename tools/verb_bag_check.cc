@@ -40,6 +40,14 @@ struct BagCheckArgs {
 // The topics replay.launch's nodes read (clip_buffer: the camera's two; the anemometer node in
 // topic mode: the raw sentences), by their names without a leading slash.
 const char* const kReplayTopics[] = {"camera/image_raw", "camera/camera_info", "anemometer/raw"};
+// The type each replayed topic's node subscribes with: another (a CompressedImage recorded as
+// camera/image_raw) passed as "ok for replay", and the node never received a message.
+const char* ReplayTopicType(const std::string& name) {
+  if (name == "camera/image_raw") return "sensor_msgs/Image";
+  if (name == "camera/camera_info") return "sensor_msgs/CameraInfo";
+  if (name == "anemometer/raw") return "clothwind/RawSentence";
+  return "";
+}
 
 std::string WithoutLeadingSlash(const std::string& topic) {
   return !topic.empty() && topic[0] == '/' ? topic.substr(1) : topic;
@@ -87,6 +95,34 @@ void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, do
   ++s.count;
 }
 
+// Counts one message into its topic's stats (ros::Exception when its bytes do not deserialise).
+void NoteMessage(const rosbag::MessageInstance& m, TopicStats& s, double t, const BagCheckArgs& a,
+                 sensors::AnemometerDecoder& decoder) {
+  if (auto img = m.instantiate<sensor_msgs::Image>()) {
+    Note(s, img->header.stamp.toSec(), t, a.gap_tolerance, a.max_future);
+    if (s.first_data.empty())
+      s.first_data = img->encoding + " " + std::to_string(img->width) + "x" + std::to_string(img->height) +
+                     " frame " + img->header.frame_id;
+  } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
+    Note(s, info->header.stamp.toSec(), t, 1e9, a.max_future);
+    if (s.first_data.empty())
+      s.first_data = std::to_string(info->width) + "x" + std::to_string(info->height) + " " + info->distortion_model;
+  } else if (auto raw = m.instantiate<clothwind::RawSentence>()) {
+    Note(s, raw->header.stamp.toSec(), t, 1e9, a.max_future);
+    if (s.first_data.empty()) s.first_data = raw->data + " (" + raw->protocol + ")";
+    // As the anemometer node in topic mode reads them (a bad checksum labels no clip).
+    const sensors::ParseResult r = decoder.Decode(std::string(raw->data.begin(), raw->data.end()));
+    if (r.status == sensors::ParseStatus::kOk) {
+      ++s.decoded;
+    } else if (r.status != sensors::ParseStatus::kNotWind) {
+      ++s.undecoded;
+      if (s.first_error.empty()) s.first_error = r.error;
+    }
+  } else {
+    Note(s, t, t, 1e9, a.max_future);  // any other message: bag time only
+  }
+}
+
 int Check(const BagCheckArgs& a);
 
 // The bag's errors name it and what to do: rosbag's own ("Error reading from file: wanted 4
@@ -105,10 +141,11 @@ int Run(const BagCheckArgs& a) {
     return Check(a);
   } catch (const rosbag::BagException& e) {
     const std::string what = e.what();
+    // A recording cut short says "unindexed", or fails reading its index ("Error reading from
+    // file"): both are what `rosbag reindex` repairs.
+    const bool cut_short = what.find("unindexed") != std::string::npos || what.find("Error reading") != std::string::npos;
     throw std::runtime_error(a.bag + ": not a readable bag (" + what + ")" +
-                             (what.find("unindexed") != std::string::npos
-                                  ? "; a recording cut short can be repaired with `rosbag reindex`"
-                                  : ""));
+                             (cut_short ? "; a recording cut short can be repaired with `rosbag reindex`" : ""));
   }
 }
 
@@ -119,31 +156,22 @@ int Check(const BagCheckArgs& a) {
   std::map<std::string, TopicStats> topics;  // by name without a leading slash
   for (const auto* c : view.getConnections()) topics[WithoutLeadingSlash(c->topic)].type = c->datatype;
   sensors::AnemometerDecoder decoder;
+  size_t index = 0;
   for (const rosbag::MessageInstance& m : view) {
     TopicStats& s = topics[WithoutLeadingSlash(m.getTopic())];
     const double t = m.getTime().toSec();
-    if (auto img = m.instantiate<sensor_msgs::Image>()) {
-      Note(s, img->header.stamp.toSec(), t, a.gap_tolerance, a.max_future);
-      if (s.first_data.empty())
-        s.first_data = img->encoding + " " + std::to_string(img->width) + "x" + std::to_string(img->height) +
-                       " frame " + img->header.frame_id;
-    } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
-      Note(s, info->header.stamp.toSec(), t, 1e9, a.max_future);
-      if (s.first_data.empty())
-        s.first_data = std::to_string(info->width) + "x" + std::to_string(info->height) + " " + info->distortion_model;
-    } else if (auto raw = m.instantiate<clothwind::RawSentence>()) {
-      Note(s, raw->header.stamp.toSec(), t, 1e9, a.max_future);
-      if (s.first_data.empty()) s.first_data = raw->data + " (" + raw->protocol + ")";
-      // As the anemometer node in topic mode reads them (a bad checksum labels no clip).
-      const sensors::ParseResult r = decoder.Decode(std::string(raw->data.begin(), raw->data.end()));
-      if (r.status == sensors::ParseStatus::kOk) {
-        ++s.decoded;
-      } else if (r.status != sensors::ParseStatus::kNotWind) {
-        ++s.undecoded;
-        if (s.first_error.empty()) s.first_error = r.error;
-      }
-    } else {
-      Note(s, t, t, 1e9, a.max_future);  // any other message: bag time only
+    ++index;
+    // A message whose bytes do not deserialise (a length field that overruns) threw a bare
+    // "Buffer Overrun" naming nothing; messages beyond 1 GiB are refused before reading.
+    if (m.size() > (1u << 30))
+      throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " on " + m.getTopic() + " is " +
+                               std::to_string(m.size()) + " bytes (a corrupt record?)");
+    try {
+      NoteMessage(m, s, t, a, decoder);
+    } catch (const ros::Exception& e) {
+      throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " on " + m.getTopic() + " (" +
+                               m.getDataType() + ", bag time " + std::to_string(t) + " s) does not deserialise: " +
+                               e.what());
     }
   }
   bag.close();
@@ -166,6 +194,9 @@ int Check(const BagCheckArgs& a) {
                   "(play it with wait:=false)");
       continue;
     }
+    if (s.type != ReplayTopicType(name))
+      fail(name + ": recorded as " + s.type + ", the replay subscribes to it as " + ReplayTopicType(name) +
+           " (it would receive nothing)");
     if (s.zero > 0) fail(name + ": " + std::to_string(s.zero) + " messages stamped 0");
     if (s.far_from_bag_time > 0)
       fail(name + ": " + std::to_string(s.far_from_bag_time) + " header stamps more than " +

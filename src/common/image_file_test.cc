@@ -43,6 +43,24 @@ TEST_F(ImageFileTest, AWholeJpegReadsAsImreadReadsIt) {
   }
 }
 
+TEST_F(ImageFileTest, AJpegDamagedInItsMiddleIsRefusedWhereImreadMakesBlocksUp) {
+  // 40 bytes overwritten in the middle of the scan: both markers stay, libjpeg decodes made-up
+  // blocks and only prints "Corrupt JPEG data" (naming no file).
+  std::vector<uint8_t> damaged = jpeg_;
+  size_t scan = 0;
+  for (size_t i = 2; i + 1 < damaged.size(); ++i)
+    if (damaged[i] == 0xFF && damaged[i + 1] == 0xDA) scan = i;
+  ASSERT_GT(scan, 0u);
+  const size_t middle = (scan + damaged.size()) / 2;
+  for (size_t i = middle; i < middle + 40; ++i) damaged[i] = static_cast<uint8_t>(0xFF - (i % 7));
+  const fs::path p = Write("damaged.jpg", damaged);
+  ASSERT_FALSE(cv::imread(p.string()).empty()) << "this libjpeg no longer decodes damaged data: the check is moot";
+  std::string why;
+  EXPECT_TRUE(ReadImageFile(p, cv::IMREAD_GRAYSCALE, &why).empty());
+  EXPECT_NE(why.find("JPEG data corrupt: Corrupt JPEG data"), std::string::npos) << why;
+  EXPECT_EQ(JpegDataProblem(jpeg_.data(), jpeg_.size()), "");  // the undamaged file
+}
+
 TEST_F(ImageFileTest, AJpegCutShortIsRefusedWhereImreadMakesRowsUp) {
   std::vector<uint8_t> cut(jpeg_.begin(), jpeg_.begin() + jpeg_.size() / 2);
   const fs::path p = Write("cut.jpg", cut);

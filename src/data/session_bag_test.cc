@@ -21,6 +21,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 
 #include <clothwind/RawSentence.h>
@@ -288,6 +289,24 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
     }
   };
   shift_anemometer(apart, -86400);
+  // The camera recorded compressed (image_transport's compressed topic renamed): clip_buffer
+  // subscribes to sensor_msgs/Image and would receive nothing.
+  {
+    rosbag::Bag src(good, rosbag::bagmode::Read), dst((dir / "compressed.bag").string(), rosbag::bagmode::Write);
+    for (const rosbag::MessageInstance& m : rosbag::View(src)) {
+      if (auto img = m.instantiate<sensor_msgs::Image>()) {
+        sensor_msgs::CompressedImage c;
+        c.header = img->header;
+        c.format = "jpeg";
+        c.data.assign(16, 0);
+        dst.write(m.getTopic(), m.getTime(), c);
+      } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
+        dst.write(m.getTopic(), m.getTime(), *info);
+      } else if (auto raw = m.instantiate<clothwind::RawSentence>()) {
+        dst.write(m.getTopic(), m.getTime(), *raw);
+      }
+    }
+  }
   shift_anemometer((dir / "after.bag").string(), 6 + 20);  // the session is 6 s long
   // Every header stamp 10 s behind its bag time (a camera's and an instrument's latency): the
   // clip buffer refuses only stamps ahead of the clock, and this bag replays into labelled clips.
@@ -301,7 +320,9 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
                         Case{"checksum.bag", "no sentence gives a wind reading"},
                         Case{"extra.bag", "wait:=false"}, Case{"slow.bag", "no stretch of frames without a hole"},
                         Case{"apart.bag", "falls in a clip's label window"},
-                        Case{"after.bag", "falls in a clip's label window"}}) {
+                        Case{"after.bag", "falls in a clip's label window"},
+                        Case{"compressed.bag", "recorded as sensor_msgs/CompressedImage, the replay subscribes to it "
+                                               "as sensor_msgs/Image"}}) {
     const auto [rc, out] = check((dir / c.name).string());
     EXPECT_EQ(rc, 1 << 8) << c.name << ": " << out;
     EXPECT_NE(out.find(c.says), std::string::npos) << c.name << ": " << out;
@@ -328,6 +349,34 @@ TEST(SessionBagTest, BagCheckNamesADamagedBag) {
     const auto [rc, out] = check((dir / name).string(), name);
     EXPECT_NE(rc, 0) << name;
     EXPECT_NE(out.find((dir / name).string() + ": not a readable bag"), std::string::npos) << out;
+  }
+  // Cut after its first chunks (no index at the end): rosbag says "Error reading from file";
+  // the repair is named too.
+  fs::copy_file(bag, dir / "cut-late.bag");
+  fs::resize_file(dir / "cut-late.bag", fs::file_size(bag) * 3 / 4);
+  {
+    const auto [rc, out] = check((dir / "cut-late.bag").string(), "cut-late");
+    EXPECT_NE(rc, 0);
+    EXPECT_NE(out.find("rosbag reindex"), std::string::npos) << out;
+  }
+  // One frame whose data length overruns the record: a bare "Buffer Overrun" named nothing.
+  {
+    const std::string plain = (dir / "uncompressed.bag").string();  // the session's chunks are LZ4
+    RewriteBag(bag, plain, [](auto&) { return true; });
+    std::ifstream in(plain, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string encoding("\x04\x00\x00\x00" "bgr8", 8);
+    const size_t at = bytes.find(encoding);
+    ASSERT_NE(at, std::string::npos);
+    const size_t length = at + encoding.size() + 1 + 4;  // is_bigendian (1 byte), step (4), then data's length
+    const uint32_t huge = 0x7FFFFFF0u;
+    bytes.replace(length, 4, reinterpret_cast<const char*>(&huge), 4);
+    std::ofstream(dir / "overrun.bag", std::ios::binary) << bytes;
+    const auto [rc, out] = check((dir / "overrun.bag").string(), "overrun");
+    EXPECT_NE(rc, 0);
+    EXPECT_NE(out.find((dir / "overrun.bag").string() + ": message 1 on /camera/image_raw (sensor_msgs/Image"),
+              std::string::npos)
+        << out;
   }
   const auto [rc, out] = check(bag + " --gap-tolerance nan", "nan");
   EXPECT_NE(rc, 0);

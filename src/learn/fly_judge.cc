@@ -1,5 +1,8 @@
 #include "learn/fly_judge.h"
 
+#include <algorithm>
+#include <cmath>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 
@@ -92,6 +95,18 @@ FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
       card["hidden"].get<int64_t>() > 4096) {
     throw std::runtime_error(card_path.string() +
                              ": field \"hidden\" must be the judge's hidden units (an integer in 1..4096)");
+  }
+  // A misspelt key ("margn": 1e9) ran the judge at margin 0 without a word: the card holds the
+  // fields Load reads and those train-fly-judge writes to say how it was made, nothing else.
+  static const char* const kCardFields[] = {"hidden", "grid", "side", "margin", "margin_note", "what", "data",
+                                            "train_windows_per_clip", "frames", "epochs", "batch",
+                                            "learning_rate", "weight_decay", "seed", "accuracy"};
+  if (card.is_object()) {
+    for (auto it = card.begin(); it != card.end(); ++it) {
+      if (std::find(std::begin(kCardFields), std::end(kCardFields), it.key()) == std::end(kCardFields))
+        throw std::runtime_error(card_path.string() + ": unknown field \"" + it.key() +
+                                 "\" (a judge's card holds hidden, grid, side, margin and how it was trained)");
+    }
   }
   const auto is_int = [&card](const char* key, int expected) {
     return card.contains(key) && card[key].is_number_integer() && card[key].get<int64_t>() == expected;

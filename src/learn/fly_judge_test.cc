@@ -220,6 +220,15 @@ TEST(FlyJudgeTest, SaveLoadRoundTripKeepsScoresAndCard) {
   }
   WriteFileAtomically(dir / "judge.json", nlohmann::json{{"hidden", 12}, {"grid", 8}, {"side", 64}}.dump());
   EXPECT_THROW(FlyJudge::Load(dir / "judge.pt"), std::runtime_error);
+  // A misspelt margin is refused (it ran at margin 0), naming the field.
+  WriteFileAtomically(dir / "judge.json",
+                      nlohmann::json{{"hidden", 12}, {"grid", 16}, {"side", 64}, {"margn", 1e9}}.dump());
+  try {
+    FlyJudge::Load(dir / "judge.pt");
+    FAIL() << "a card with \"margn\" loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("judge.json: unknown field \"margn\""), std::string::npos) << e.what();
+  }
   // A field of the wrong kind is refused as such, naming the card (not a bare JSON type error).
   WriteFileAtomically(dir / "judge.json", nlohmann::json{{"hidden", 12}, {"grid", "16"}, {"side", 64}}.dump());
   try {

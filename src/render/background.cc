@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
+#include "common/image_file.h"
 #include "render/noise.h"
 #include "common/random.h"
 
@@ -40,10 +41,13 @@ Backdrop MakeBackdrop(const RenderParams& p, const PinholeCamera& camera) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(p.background_image, ec))
       throw std::runtime_error("background_image '" + p.background_image + "': no such file");
-    cv::Mat img = cv::imread(p.background_image, cv::IMREAD_COLOR);
+    // Whole or refused (common/image_file.h): cv::imread rendered a JPEG cut short with its
+    // missing rows grey, saying only "Premature end of JPEG file" on stderr.
+    std::string why;
+    cv::Mat img = common::ReadImageFile(p.background_image, cv::IMREAD_COLOR, &why);
     if (img.empty())
-      throw std::runtime_error("background_image '" + p.background_image +
-                               "': cannot read it as an image");
+      throw std::runtime_error("background_image '" + p.background_image + "': cannot read it as an image (" +
+                               why + ")");
     b.image = Texture::FromBgr8(img);
     // Radiance that develops back to the photograph's own values.
     for (int y = 0; y < b.image.height(); ++y)

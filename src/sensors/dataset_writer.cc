@@ -94,6 +94,19 @@ DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality)
     }
     if (!index_.is_object() || !index_.contains("clips") || !index_["clips"].is_array())
       throw std::runtime_error(index_path + ": expected an object with an array \"clips\"");
+    // Every entry an object naming its clip: [1] passed, and every clip's index update then failed
+    // (operator[] on a number) while its folder was written, so none ever reached the index.
+    const nlohmann::json& clips = index_["clips"];
+    for (size_t i = 0; i < clips.size(); ++i) {
+      if (!clips[i].is_object() || !clips[i].contains("name") || !clips[i]["name"].is_string())
+        throw std::runtime_error(index_path + ": field 'clips[" + std::to_string(i) +
+                                 "]' must be an object with a string \"name\", got " + clips[i].dump());
+    }
+    // Recordings go into a recordings' index only: a make-dataset (FlagSim) index would get real
+    // clips listed under its synthetic header.
+    if (index_.value("kind", nlohmann::json("real")) != "real")
+      throw std::runtime_error(index_path + ": field 'kind' is " + index_.value("kind", nlohmann::json()).dump() +
+                               ", expected \"real\" (a folder of recorded clips; record into another folder)");
   } else {
     index_ = {{"format", "clothwind-dataset"}, {"version", kFormatVersion}, {"kind", "real"},
               {"clips", nlohmann::json::array()}};

@@ -149,6 +149,26 @@ TEST_F(DatasetWriterTest, CorruptIndexIsAClearError) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("index.json"), std::string::npos);
   }
+  // Valid JSON whose entries are not clips: each clip's index update failed after its folder was
+  // written, so no clip ever reached the index.
+  auto refusal = [&](const std::string& index) {
+    std::ofstream(root_ / "index.json") << index;
+    try {
+      DatasetWriter w(root_.string());
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  std::string m = refusal(R"({"format": "clothwind-dataset", "clips": [1]})");
+  EXPECT_NE(m.find("index.json: field 'clips[0]' must be an object with a string \"name\", got 1"), std::string::npos)
+      << m;
+  m = refusal(R"({"format": "clothwind-dataset", "clips": [{"name": "a"}, {"name": 3}]})");
+  EXPECT_NE(m.find("'clips[1]'"), std::string::npos) << m;
+  // A FlagSim dataset's index: real clips are not listed under its synthetic header.
+  m = refusal(R"({"format": "clothwind-dataset", "kind": "flag", "clips": []})");
+  EXPECT_NE(m.find("field 'kind' is \"flag\", expected \"real\""), std::string::npos) << m;
+  EXPECT_EQ(refusal(R"({"format": "clothwind-dataset", "kind": "real", "clips": [{"name": "a"}]})"), "accepted");
 }
 
 TEST_F(DatasetWriterTest, AtomicFileWriteReplacesContent) {
