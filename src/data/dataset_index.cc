@@ -71,6 +71,11 @@ void Require(const nlohmann::json& j, const char* field, bool ok, const std::str
 }
 
 nlohmann::json ReadJsonFile(const std::string& path) {
+  // A folder opened as a stream and threw "basic_filebuf::underflow ... Is a directory", naming
+  // nothing; a FIFO would wait for a writer for ever.
+  std::error_code ec;
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
+    throw std::runtime_error(path + ": not a regular file (a folder, a pipe or a device)");
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");
   try {
@@ -169,7 +174,8 @@ nlohmann::json ReadIndex(const std::string& dir) {
   const std::string path = (fs::path(dir) / "index.json").string();
   if (!fs::exists(path)) return nullptr;
   nlohmann::json j = ReadJsonFile(path);
-  if (!j.is_object() || j.value("format", "") != "clothwind-dataset")
+  // format compared as JSON: value("format", "") of a number threw a bare type error.
+  if (!j.is_object() || !j.contains("format") || j["format"] != "clothwind-dataset")
     throw std::runtime_error(path + ": field 'format' must be \"clothwind-dataset\"");
   if (!j.contains("clips") || !j["clips"].is_array())
     throw std::runtime_error(path + ": field 'clips' must be an array");

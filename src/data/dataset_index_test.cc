@@ -1,5 +1,10 @@
 #include "data/dataset_index.h"
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
 #include <gtest/gtest.h>
 
 #include "render/render_params.h"
@@ -30,6 +35,29 @@ TEST(SimExampleLabelTest, RecordsTheBackgroundPhotoByItsFileNameAlone) {
   // Procedural backdrops name none.
   zeta.background_image.clear();
   EXPECT_EQ(SimExampleLabel("flag-000001-v0", s, zeta, info)["zeta"]["background_image"], "");
+}
+
+TEST(ReadIndexTest, AFolderOrAWrongTypedFormatIsRefusedNamingTheFile) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_index_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "index.json");  // a folder where the file should be
+  auto refusal = [&]() {
+    try {
+      ReadIndex(dir.string());
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(refusal().find((dir / "index.json").string() + ": not a regular file"), std::string::npos) << refusal();
+  fs::remove(dir / "index.json");
+  std::ofstream(dir / "index.json") << R"({"format": 3, "clips": []})";
+  EXPECT_NE(refusal().find("index.json: field 'format' must be \"clothwind-dataset\""), std::string::npos)
+      << refusal();
+  std::ofstream(dir / "index.json") << R"({"format": "clothwind-dataset", "clips": []})";
+  EXPECT_EQ(refusal(), "accepted");
+  fs::remove_all(dir);
 }
 
 }  // namespace

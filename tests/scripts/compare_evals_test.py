@@ -155,6 +155,24 @@ class CommandTest(unittest.TestCase):
                     self.assertNotEqual(r.returncode, 0, r.stdout)
                     self.assertIn(f'{bad}:3: true and predicted speed must be finite, got {true} {pred}', r.stderr)
 
+    def test_speeds_beyond_any_wind_and_binary_files_are_refused_by_name(self):
+        # 1e200 squared is inf: the RMSE and its interval came out inf with exit 0; a binary file
+        # ended in a UnicodeDecodeError traceback naming no file.
+        with tempfile.TemporaryDirectory() as d:
+            good, bad = os.path.join(d, 'good.dat'), os.path.join(d, 'bad.dat')
+            write_dat(good, [('flag-000000-v0', 1.0, 1.1), ('flag-000000-v1', 1.0, 0.9)])
+            with open(bad, 'w') as f:
+                f.write('# header\n1.0 1.1 0.3 flag-000000-v0\n1.0 1e200 0.3 flag-000000-v1\n')
+            r = self.run_script(good, bad, '--resamples', '100')
+            self.assertNotEqual(r.returncode, 0, r.stdout)
+            self.assertIn(f'{bad}:3: speeds must be wind speeds', r.stderr)
+            with open(bad, 'wb') as f:
+                f.write(b'\xff\xfe\x00binary')
+            r = self.run_script(good, bad, '--resamples', '100')
+            self.assertNotEqual(r.returncode, 0, r.stdout)
+            self.assertIn(f'{bad}: not a text file', r.stderr)
+            self.assertNotIn('Traceback', r.stderr)
+
     def test_evaluations_read_two_ways_are_not_paired(self):
         # One window against three windows per clip: the protocol, not the model, would differ.
         with tempfile.TemporaryDirectory() as d:
