@@ -24,7 +24,11 @@
 namespace clothwind::learn {
 namespace fs = std::filesystem;
 nlohmann::json ReadJson(const fs::path& path) {
-  if (fs::is_directory(path)) throw std::runtime_error(path.string() + ": a folder, expected a JSON file");
+  // A folder threw basic_filebuf::underflow naming nothing; a FIFO waited for a writer for ever.
+  std::error_code ec;
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
+    throw std::runtime_error(path.string() + ": " + (fs::is_directory(path, ec) ? "a folder" : "not a regular file") +
+                             ", expected a JSON file");
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path.string() + ": cannot open");
   try {

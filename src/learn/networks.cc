@@ -317,6 +317,9 @@ void CheckConfigMatchesWeights(const ModelConfig& config, const std::filesystem:
 
 WindNet LoadWindNet(const std::filesystem::path& weights) {
   const std::filesystem::path config_path = ConfigPathFor(weights);
+  std::error_code ec;
+  if (std::filesystem::exists(config_path, ec) && !std::filesystem::is_regular_file(config_path, ec))
+    throw std::runtime_error(config_path.string() + ": not a regular file (the model's architecture)");
   std::ifstream in(config_path);
   if (!in) throw std::runtime_error(config_path.string() + ": cannot open (the model's architecture)");
   nlohmann::json j;

@@ -134,13 +134,56 @@ void SaveAtomically(T& object, const fs::path& path) {
 
 // A run's state.json, parsed. Throws std::runtime_error naming it when it cannot be read.
 nlohmann::json ReadState(const fs::path& state_path) {
+  std::error_code ec;
+  if (fs::exists(state_path, ec) && !fs::is_regular_file(state_path, ec))
+    throw std::runtime_error(state_path.string() + ": not a regular file (nothing to resume)");
   std::ifstream in(state_path);
   if (!in) throw std::runtime_error(state_path.string() + ": cannot open (nothing to resume)");
+  nlohmann::json state;
   try {
-    return nlohmann::json::parse(in);
+    state = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(state_path.string() + ": " + e.what());
   }
+  // The type of every field a resume reads, checked here: they are read in many places after,
+  // where a wrong one threw a bare "type must be string, but is number" naming neither the file
+  // nor the field.
+  if (!state.is_object()) throw std::runtime_error(state_path.string() + ": expected a JSON object");
+  using Is = bool (nlohmann::json::*)() const noexcept;
+  static const std::pair<const char*, std::pair<Is, const char*>> kFields[] = {
+      {"epoch", {&nlohmann::json::is_number_integer, "an integer"}},
+      {"seed", {&nlohmann::json::is_number_unsigned, "an unsigned integer"}},
+      {"batch", {&nlohmann::json::is_number_integer, "an integer"}},
+      {"epochs", {&nlohmann::json::is_number_integer, "an integer"}},
+      {"lr_decay_epoch", {&nlohmann::json::is_number_integer, "an integer"}},
+      {"aux_phase_bins", {&nlohmann::json::is_number_integer, "an integer"}},
+      {"average_steps", {&nlohmann::json::is_number_integer, "an integer"}},
+      {"weight_decay", {&nlohmann::json::is_number, "a number"}},
+      {"grad_clip", {&nlohmann::json::is_number, "a number"}},
+      {"lr", {&nlohmann::json::is_number, "a number"}},
+      {"aux_tracks", {&nlohmann::json::is_number, "a number"}},
+      {"weight_average", {&nlohmann::json::is_number, "a number"}},
+      {"lr_schedule", {&nlohmann::json::is_string, "a string"}},
+      {"checkpoint", {&nlohmann::json::is_string, "a string"}},
+      {"validated_on", {&nlohmann::json::is_string, "a string"}},
+      {"flip", {&nlohmann::json::is_boolean, "true or false"}},
+      {"aux_world", {&nlohmann::json::is_boolean, "true or false"}},
+      {"point_maps", {&nlohmann::json::is_boolean, "true or false"}},
+      {"crop_scales", {&nlohmann::json::is_array, "an array of numbers"}},
+      {"log", {&nlohmann::json::is_array, "an array of epochs"}},
+      {"model", {&nlohmann::json::is_object, "the model's options (an object)"}},
+  };
+  for (const auto& [key, check] : kFields) {
+    if (state.contains(key) && !(state[key].*check.first)())
+      throw std::runtime_error(state_path.string() + ": field \"" + key + "\" must be " + check.second + ", got " +
+                               state[key].dump());
+  }
+  if (state.contains("crop_scales"))
+    for (const auto& v : state["crop_scales"])
+      if (!v.is_number())
+        throw std::runtime_error(state_path.string() + ": field \"crop_scales\" must be an array of numbers, got " +
+                                 state["crop_scales"].dump());
+  return state;
 }
 
 // The checkpoint folder `state` (out/state.json, parsed) names; see CheckpointDir.

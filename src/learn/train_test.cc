@@ -1657,6 +1657,29 @@ TEST_F(TrainTest, ADatasetWithoutAValSplitSaysItValidatedOnTrain) {
   EXPECT_EQ(Train(o).validated_on, "val");
 }
 
+TEST_F(TrainTest, AStateFileOfWrongTypesOrAFolderIsRefusedNamingTheField) {
+  TrainOptions o = Options("sdn", "bad-state");
+  o.epochs = 1;
+  Train(o);
+  const fs::path state = o.out / "state.json";
+  const nlohmann::json good = ReadJson(state);
+  o.epochs = 2;
+  o.resume = true;
+  for (const auto& [field, value] : {std::pair<const char*, nlohmann::json>{"seed", "1"},
+                                     {"lr_schedule", 3}, {"flip", "yes"}, {"crop_scales", {1.0, "x"}}}) {
+    nlohmann::json bad = good;
+    bad[field] = value;
+    std::ofstream(state) << bad.dump();
+    ExpectTrainRefused(o, std::string("a state.json with ") + field + " = " + value.dump() + " resumed",
+                       {state.string() + ": field \"" + field + "\" must be"});
+  }
+  fs::remove(state);
+  fs::create_directories(state);  // a folder where the file should be
+  ExpectTrainRefused(o, "a folder as state.json resumed", {state.string() + ": not a regular file"});
+  fs::remove(state);
+  std::ofstream(state) << good.dump();
+}
+
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
   const TrainResult r = Train(InitOnly(*root_ / "init"));
   Predictor p(r.model, 1, "cpu");
