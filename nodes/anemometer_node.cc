@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
+#include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wind_conversions.h"
 #include "ros_bridge/wall_throttle.h"
@@ -58,19 +60,42 @@ class AnemometerNode {
   AnemometerNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh), backoff_(0.1, 2.0) {}
 
   bool Init() {
-    pnh_.param<std::string>("input", input_, "serial");
-    pnh_.param<std::string>("frame_id", frame_id_, "anemometer");
-    pnh_.param<std::string>("earth_frame_id", earth_frame_id_, "");
-    if (pnh_.hasParam("magnetic_declination")) {
-      double d = 0.0;
-      if (!pnh_.getParam("magnetic_declination", d) || !std::isfinite(d) || d < -180.0 || d > 180.0) {
-        ROS_FATAL("~magnetic_declination: expected degrees east of true north in -180..180 (west negative)");
-        return false;
+    // Every parameter is read whatever ~input says (config/anemometer.yaml sets the serial port's
+    // for a replay's topic input too): each is type-checked, and none is named unread for
+    // belonging to another input.
+    clothwind::ros_bridge::StrictParams params(pnh_);
+    std::string protocol_name, parity;
+    double initial = 0.1, maximum = 2.0;
+    bool stale_set = false;
+    try {
+      input_ = params.Get("input", "serial");
+      frame_id_ = params.Get("frame_id", "anemometer");
+      earth_frame_id_ = params.Get("earth_frame_id", "");
+      if (params.Has("magnetic_declination")) {
+        const double d = params.Get("magnetic_declination", 0.0);
+        if (!std::isfinite(d) || d < -180.0 || d > 180.0)
+          throw std::invalid_argument("~magnetic_declination: expected degrees east of true north in -180..180 "
+                                      "(west negative)");
+        magnetic_declination_ = d;
       }
-      magnetic_declination_ = d;
+      protocol_name = params.Get("protocol", "auto");
+      initial = params.Get("reconnect_initial_delay", initial);
+      maximum = params.Get("reconnect_max_delay", maximum);
+      serial_.port = params.Get("port", "/dev/ttyUSB0");
+      serial_.baud = params.Get("baud", 4800);
+      serial_.data_bits = params.Get("data_bits", 8);
+      parity = params.Get("parity", "none");
+      serial_.stop_bits = params.Get("stop_bits", 1);
+      usb_poll_period_ = params.Get("usb_poll_period", 10.0);
+      stale_set = params.Has("stale_timeout");
+      stale_timeout_ = params.Get("stale_timeout", 5.0);
+    } catch (const std::exception& e) {
+      ROS_FATAL("anemometer_node: %s", e.what());
+      return false;
     }
-    std::string protocol_name;
-    pnh_.param<std::string>("protocol", protocol_name, "auto");
+    params.Known("diagnostic_period");  // diagnostic_updater's
+    params.WarnUnread("anemometer_node");
+
     AnemometerProtocol protocol;
     if (!clothwind::sensors::ParseAnemometerProtocol(protocol_name, &protocol)) {
       ROS_FATAL("~protocol: '%s' unknown (expected auto, nmea, gill, csv or fine_offset)", protocol_name.c_str());
@@ -78,9 +103,6 @@ class AnemometerNode {
     }
     if (input_ == "usb" && protocol == AnemometerProtocol::kAuto) protocol = AnemometerProtocol::kFineOffset;
     decoder_ = AnemometerDecoder(protocol);
-    double initial, maximum;
-    pnh_.param("reconnect_initial_delay", initial, 0.1);
-    pnh_.param("reconnect_max_delay", maximum, 2.0);
     if (!PositiveSeconds("reconnect_initial_delay", initial) || !PositiveSeconds("reconnect_max_delay", maximum)) {
       return false;
     }
@@ -88,32 +110,23 @@ class AnemometerNode {
 
     updater_.add("anemometer", this, &AnemometerNode::Diagnose);
     if (input_ == "serial") {
-      pnh_.param<std::string>("port", serial_.port, "/dev/ttyUSB0");
-      pnh_.param("baud", serial_.baud, 4800);
-      pnh_.param("data_bits", serial_.data_bits, 8);
-      std::string parity;
-      pnh_.param<std::string>("parity", parity, "none");
       if (!clothwind::sensors::ParseParity(parity, &serial_.parity)) {
         ROS_FATAL("~parity: '%s' unknown (expected none, even or odd)", parity.c_str());
         return false;
       }
-      pnh_.param("stop_bits", serial_.stop_bits, 1);
       std::string error;
       if (!clothwind::sensors::ValidateSerialConfig(serial_, &error)) {
         ROS_FATAL("~%s", error.c_str());
         return false;
       }
-      pnh_.param("stale_timeout", stale_timeout_, 5.0);
       updater_.setHardwareID(serial_.port);
       state_ = "waiting for " + serial_.port;
     } else if (input_ == "usb") {
-      pnh_.param("usb_poll_period", usb_poll_period_, 10.0);
       // The outdoor unit transmits every 48 s; allow two missed transmissions before warning.
-      pnh_.param("stale_timeout", stale_timeout_, 3.0 * clothwind::sensors::kFineOffsetSensorPeriod);
+      if (!stale_set) stale_timeout_ = 3.0 * clothwind::sensors::kFineOffsetSensorPeriod;
       updater_.setHardwareID("usb:1941:8021");
       state_ = "waiting for USB station 1941:8021";
     } else if (input_ == "topic") {
-      pnh_.param("stale_timeout", stale_timeout_, 5.0);
       updater_.setHardwareID("topic:" + nh_.resolveName("anemometer/raw"));
       raw_sub_ = nh_.subscribe("anemometer/raw", 100, &AnemometerNode::OnRaw, this);
       state_ = "subscribed to " + raw_sub_.getTopic();

@@ -12,7 +12,11 @@
 //             ~auto_exposure (bool), ~exposure_absolute [100 us], ~gain, ~frame_id
 //             (camera_optical_frame), ~camera_name (camera), ~camera_info_url
 // Frame stamps are capture instants from the driver's buffer timestamps mapped to ROS time
-// (src/sensors/frame_timestamp.h), not the time of publishing. See docs/camera.md.
+// (src/sensors/frame_timestamp.h), not the time of publishing. A calibration file the parser
+// cannot read (a folder, a matrix of another shape) is refused before camera_info_manager reads
+// it, and camera_info goes out without calibration (ros_bridge/camera_calibration_file.h). A
+// parameter of the wrong type ends the node at start (ros_bridge/strict_param.h). See
+// docs/camera.md.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -23,10 +27,12 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/publisher.h>
 #include <image_transport/image_transport.h>
+#include <ros/package.h>
 #include <ros/ros.h>
 
-#include "ros_bridge/bool_param.h"
+#include "ros_bridge/camera_calibration_file.h"
 #include "ros_bridge/image_conversions.h"
+#include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wall_throttle.h"
 #include "sensors/frame_source.h"
@@ -49,26 +55,27 @@ class RosClock : public clothwind::sensors::SystemClock {
   bool RosTimeIsSimulated() override { return ros::Time::isSimTime(); }
 };
 
-FrameSourceOptions ReadOptions(ros::NodeHandle& pnh) {
+// Every parameter is read whatever ~source says (config/camera.yaml sets both ~device and ~path):
+// each is type-checked, and none is named unread at start for belonging to another source.
+FrameSourceOptions ReadOptions(clothwind::ros_bridge::StrictParams& params) {
   FrameSourceOptions o;
-  pnh.param<std::string>("source", o.source, "v4l2");
-  if (o.source == "v4l2") {
-    pnh.param<std::string>("device", o.path, "/dev/video0");
-  } else {
-    pnh.param<std::string>("path", o.path, "");
-  }
-  pnh.param<std::string>("pixel_format", o.pixel_format, "YUYV");
-  pnh.param("width", o.width, 640);
-  pnh.param("height", o.height, 480);
-  pnh.param("fps", o.fps, 30.0);
-  if (o.source == "folder") pnh.param("rate", o.fps, o.fps);
-  pnh.param("buffers", o.buffers, 4);
-  pnh.param("timeout", o.timeout_s, 2.0);
-  o.loop = clothwind::ros_bridge::BoolParam(pnh, "loop", false);
-  if (pnh.hasParam("auto_exposure"))  // unset: the camera's own setting (-1)
-    o.auto_exposure = clothwind::ros_bridge::BoolParam(pnh, "auto_exposure", false) ? 1 : 0;
-  pnh.param("exposure_absolute", o.exposure_absolute, -1);
-  pnh.param("gain", o.gain, -1);
+  o.source = params.Get("source", "v4l2");
+  const std::string device = params.Get("device", "/dev/video0");
+  const std::string path = params.Get("path", "");
+  o.path = o.source == "v4l2" ? device : path;
+  o.pixel_format = params.Get("pixel_format", "YUYV");
+  o.width = params.Get("width", 640);
+  o.height = params.Get("height", 480);
+  o.fps = params.Get("fps", 30.0);
+  const double rate = params.Get("rate", o.fps);
+  if (o.source == "folder") o.fps = rate;
+  o.buffers = params.Get("buffers", 4);
+  o.timeout_s = params.Get("timeout", 2.0);
+  o.loop = params.Get("loop", false);
+  if (params.Has("auto_exposure"))  // unset: the camera's own setting (-1)
+    o.auto_exposure = params.Get("auto_exposure", false) ? 1 : 0;
+  o.exposure_absolute = params.Get("exposure_absolute", -1);
+  o.gain = params.Get("gain", -1);
   return o;
 }
 
@@ -87,17 +94,20 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh;
   ros::NodeHandle pnh("~");
 
+  clothwind::ros_bridge::StrictParams params(pnh);
   FrameSourceOptions options;
+  std::string frame_id, camera_name, camera_info_url;
   try {
-    options = ReadOptions(pnh);
+    options = ReadOptions(params);
+    frame_id = params.Get("frame_id", "camera_optical_frame");
+    camera_name = params.Get("camera_name", "camera");
+    camera_info_url = params.Get("camera_info_url", "");
   } catch (const std::exception& e) {
     ROS_FATAL("camera_node: %s", e.what());
     return 1;
   }
-  std::string frame_id, camera_name, camera_info_url;
-  pnh.param<std::string>("frame_id", frame_id, "camera_optical_frame");
-  pnh.param<std::string>("camera_name", camera_name, "camera");
-  pnh.param<std::string>("camera_info_url", camera_info_url, "");
+  params.Known("diagnostic_period");  // diagnostic_updater's
+  params.WarnUnread("camera_node");
 
   RosClock clock;
   std::string error;
@@ -108,10 +118,29 @@ int main(int argc, char** argv) {
   }
 
   ros::NodeHandle camera_nh(nh, "camera");
-  camera_info_manager::CameraInfoManager info_manager(camera_nh, camera_name, camera_info_url);
-  if (!camera_info_url.empty() && !info_manager.isCalibrated()) {
-    ROS_WARN_STREAM("camera_node: no calibration loaded from '" << camera_info_url
-                    << "'; camera_info carries the image size only");
+  // Constructed without the URL, which it would read lazily: the file is checked first (see
+  // ros_bridge/camera_calibration_file.h), as a folder or a matrix of another shape aborted the
+  // node inside the parser. A refused file leaves camera_info without calibration, said in
+  // diagnostics, rather than falling back to camera_info_manager's default file, which is not
+  // the calibration asked for either.
+  camera_info_manager::CameraInfoManager info_manager(camera_nh, camera_name, "");
+  const std::string url = camera_info_url.empty() ? clothwind::ros_bridge::kDefaultCameraInfoUrl : camera_info_url;
+  const std::string calibration_refused = clothwind::ros_bridge::CheckCalibrationFile(
+      clothwind::ros_bridge::CalibrationFilePath(info_manager.resolveURL(url, camera_name), ros::package::getPath));
+  if (calibration_refused.empty()) {
+    info_manager.loadCameraInfo(camera_info_url);
+    if (!camera_info_url.empty() && !info_manager.isCalibrated()) {
+      ROS_WARN_STREAM("camera_node: no calibration loaded from '" << camera_info_url
+                      << "'; camera_info carries the image size only");
+    }
+  } else {
+    // An empty calibration, set: the manager loads nothing more (set_camera_info still stores a
+    // new one, at the default URL).
+    info_manager.setCameraInfo(sensor_msgs::CameraInfo());
+    ROS_WARN_STREAM("camera_node: calibration not loaded from '" << url << "'"
+                    << (camera_info_url.empty() ? " (~camera_info_url empty: camera_info_manager's default)" : "")
+                    << ": " << calibration_refused
+                    << "; publishing camera_info without calibration");
   }
   image_transport::ImageTransport transport(nh);
   image_transport::CameraPublisher publisher = transport.advertiseCamera("camera/image_raw", 1);
@@ -128,7 +157,10 @@ int main(int argc, char** argv) {
   uint64_t published = 0, read_errors = 0, last_drops_seen = 0, last_errors_seen = 0;
   uint64_t unsubscribed = 0;  // frames read while nobody subscribed (no message built)
   std::string last_error;
-  std::string calibration_unused;  // why the calibration is left out of camera_info ("" if it is not)
+  // Why the calibration is left out of camera_info ("" if it is not): the refused file's reason
+  // from the start (the diagnostics say it before a frame comes), then each frame's.
+  std::string calibration_unused =
+      calibration_refused.empty() ? "" : "calibration file refused: " + calibration_refused;
   bool opened = false, ended = false;
   updater.add("camera source", [&](diagnostic_updater::DiagnosticStatusWrapper& stat) {
     const auto status = source->Status();
@@ -215,6 +247,9 @@ int main(int argc, char** argv) {
           std::string unused_reason;
           sensor_msgs::CameraInfoPtr info =
               clothwind::ros_bridge::CameraInfoFor(info_manager.getCameraInfo(), *image, &unused_reason);
+          // A refused file stays the reason until set_camera_info brings a calibration.
+          if (unused_reason.empty() && !calibration_refused.empty() && !info_manager.isCalibrated())
+            unused_reason = "calibration file refused: " + calibration_refused;
           if (unused_reason != calibration_unused) {  // once per new reason (set_camera_info may change it)
             if (!unused_reason.empty())
               ROS_WARN_STREAM("camera_node: " << unused_reason << "; publishing camera_info without it");

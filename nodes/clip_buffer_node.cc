@@ -24,8 +24,8 @@
 #include <clothwind/Clip.h>
 #include <clothwind/WindMeasurement.h>
 
-#include "ros_bridge/bool_param.h"
 #include "ros_bridge/clip_conversions.h"
+#include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_throttle.h"
 #include "sensors/async_dataset_writer.h"
 #include "sensors/clip_pipeline.h"
@@ -37,35 +37,32 @@ namespace {
 
 class ClipBufferNode {
  public:
-  ClipBufferNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
+  ClipBufferNode(ros::NodeHandle& nh, ros_bridge::StrictParams& params) : nh_(nh) {
     sensors::ClipPipelineOptions o;
-    pnh.param("frame_rate", o.frame_rate, o.frame_rate);
-    pnh.param("num_frames", o.num_frames, o.num_frames);
-    pnh.param("stride", o.stride, o.stride);
-    pnh.param("size", o.size, o.size);
-    o.colour = ros_bridge::BoolParam(pnh, "colour", o.colour);
-    pnh.param("gap_tolerance", o.gap_tolerance, o.gap_tolerance);
-    pnh.param("label_window", o.label_window, o.label_window);
-    pnh.param("label_delay", o.label_delay, o.label_delay);
-    pnh.param("max_future", o.max_future, o.max_future);
-    if (pnh.hasParam("roi")) {
-      std::vector<double> roi;
-      if (!pnh.getParam("roi", roi) || (roi.size() != 3 && !roi.empty()))
-        throw std::invalid_argument("~roi: expected a list [x, y, size] in source pixels (or [] for the centred "
-                                    "square)");
-      if (roi.size() == 3)
-        o.roi = {static_cast<int>(std::lround(roi[0])), static_cast<int>(std::lround(roi[1])),
-                 static_cast<int>(std::lround(roi[2]))};
-    }
-    pnh.param("flush_after", flush_after_, 3.0);
-    pnh.param("frame_id", frame_id_, std::string());
-    std::string wind_frame_id;
-    pnh.param("wind_frame_id", wind_frame_id, wind_frame_id);
-    wind_frame_ = sensors::WindDirectionFrameGate(wind_frame_id);
-    int queue = 60;
-    pnh.param("queue_size", queue, queue);
-    pnh.param("jpeg_quality", jpeg_quality_, jpeg_quality_);
-    pnh.param("record_dir", record_dir_, std::string());
+    o.frame_rate = params.Get("frame_rate", o.frame_rate);
+    o.num_frames = params.Get("num_frames", o.num_frames);
+    o.stride = params.Get("stride", o.stride);
+    o.size = params.Get("size", o.size);
+    o.colour = params.Get("colour", o.colour);
+    o.gap_tolerance = params.Get("gap_tolerance", o.gap_tolerance);
+    o.label_window = params.Get("label_window", o.label_window);
+    o.label_delay = params.Get("label_delay", o.label_delay);
+    o.max_future = params.Get("max_future", o.max_future);
+    const std::vector<double> roi = params.Get("roi", std::vector<double>());
+    if (roi.size() != 3 && !roi.empty())
+      throw std::invalid_argument("~roi: expected a list [x, y, size] in source pixels (or [] for the centred "
+                                  "square)");
+    if (roi.size() == 3)
+      o.roi = {static_cast<int>(std::lround(roi[0])), static_cast<int>(std::lround(roi[1])),
+               static_cast<int>(std::lround(roi[2]))};
+    flush_after_ = params.Get("flush_after", 3.0);
+    frame_id_ = params.Get("frame_id", "");
+    wind_frame_ = sensors::WindDirectionFrameGate(params.Get("wind_frame_id", ""));
+    const int queue = params.Get("queue_size", 60);
+    jpeg_quality_ = params.Get("jpeg_quality", jpeg_quality_);
+    // An int is taken as its text (roslaunch makes one of record_dir:=20261206): read as a
+    // string, that left record_dir empty and recorded nothing, without a word.
+    record_dir_ = params.Get("record_dir", "");
     // Out of range is refused at start, naming the parameter: a clip buffer that runs with a
     // setting it did not mean records data that looks right and is not.
     if (!(std::isfinite(flush_after_) && flush_after_ > 0.0))
@@ -382,8 +379,11 @@ class ClipBufferNode {
 int main(int argc, char** argv) {
   ros::init(argc, argv, "clip_buffer");
   ros::NodeHandle nh, pnh("~");
+  clothwind::ros_bridge::StrictParams params(pnh);
   try {
-    clothwind::ClipBufferNode node(nh, pnh);
+    clothwind::ClipBufferNode node(nh, params);
+    params.Known("diagnostic_period");  // diagnostic_updater's
+    params.WarnUnread("clip_buffer");
     ros::spin();
     node.Finish();
   } catch (const std::exception& e) {

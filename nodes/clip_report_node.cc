@@ -24,7 +24,7 @@
 #include <clothwind/WindEstimate.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "ros_bridge/bool_param.h"
+#include "ros_bridge/strict_param.h"
 #include "sensors/dataset_writer.h"
 #include "sensors/estimate_report.h"
 
@@ -41,13 +41,13 @@ struct Row {
 
 class ClipReport {
  public:
-  explicit ClipReport(ros::NodeHandle& pnh) {
-    pnh.param("idle_timeout", idle_timeout_, 5.0);
-    pnh.param("max_wall", max_wall_, 0.0);
-    pnh.param("start_timeout", start_timeout_, 60.0);
-    pnh.param("summary", summary_path_, std::string());
-    want_estimates_ = clothwind::ros_bridge::BoolParam(pnh, "estimates", false);
-    pnh.param("estimate_plot", estimate_plot_path_, std::string());
+  explicit ClipReport(clothwind::ros_bridge::StrictParams& params) {
+    idle_timeout_ = params.Get("idle_timeout", 5.0);
+    max_wall_ = params.Get("max_wall", 0.0);
+    start_timeout_ = params.Get("start_timeout", 60.0);
+    summary_path_ = params.Get("summary", "");
+    want_estimates_ = params.Get("estimates", false);
+    estimate_plot_path_ = params.Get("estimate_plot", "");
     auto finite = [](double v) { return std::isfinite(v); };
     if (!(finite(idle_timeout_) && idle_timeout_ > 0))
       throw std::invalid_argument("~idle_timeout must be a finite time > 0 s, got " + std::to_string(idle_timeout_));
@@ -236,8 +236,10 @@ class ClipReport {
 int main(int argc, char** argv) {
   ros::init(argc, argv, "clip_report");
   ros::NodeHandle pnh("~");
+  clothwind::ros_bridge::StrictParams params(pnh);
   try {
-    ClipReport report(pnh);
+    ClipReport report(params);
+    params.WarnUnread("clip_report");
     ros::spin();
     return report.Finish() ? 0 : 1;  // Ctrl-C ends spin() before the timer printed: print now
   } catch (const std::exception& e) {

@@ -28,7 +28,8 @@
 // loads). No clip for 10 s after the first is a WARN. A model trained without flips left on
 // ~flag_flies auto with no fly judge (the motion cues misjudge ~9 % of clips) is a WARN, as is a
 // fly judge that cannot load (~fly_judge, or the one beside the model) and a parameter out of its
-// range (named, and its default used).
+// range (named, and its default used). A parameter of the wrong type (ros_bridge/strict_param.h)
+// ends the node at start with a FATAL naming it.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -49,6 +50,7 @@
 
 #include "learn/predictor.h"
 #include "ros_bridge/sdn_conversions.h"
+#include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_throttle.h"
 #include "sensors/trailing_mean.h"
 
@@ -56,21 +58,23 @@ namespace {
 
 class SdnNode {
  public:
-  SdnNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : transport_(nh), trailing_(MeanWindow(pnh)) {
-    pnh.param("model", model_path_, std::string());
-    pnh.param("threads", threads_, 2);
+  // Throws ParamError for a parameter of the wrong type (main ends on it); one out of its range is
+  // an ERROR in diagnostics and its default is used.
+  SdnNode(ros::NodeHandle& nh, clothwind::ros_bridge::StrictParams& params)
+      : transport_(nh), trailing_(MeanWindow(params)) {
+    model_path_ = params.Get("model", "");
+    threads_ = params.Get("threads", 2);
     if (threads_ < 1) threads_ = ParameterError("~threads must be >= 1, got " + std::to_string(threads_), 2);
-    pnh.param("device", device_, std::string("cpu"));
+    device_ = params.Get("device", "cpu");
     if (device_ != "cpu" && device_ != "cuda" && device_ != "auto") {
       ParameterError("~device must be cpu, cuda or auto, got \"" + device_ + "\"", 0);
       device_ = "cpu";
     }
-    int queue_size = 2;
-    pnh.param("queue_size", queue_size, 2);
+    int queue_size = params.Get("queue_size", 2);
     if (queue_size < 1) queue_size = ParameterError("~queue_size must be >= 1 clip, got " + std::to_string(queue_size), 2);
-    pnh.param("fly_judge", fly_judge_path_, std::string());
+    fly_judge_path_ = params.Get("fly_judge", "");
     if (!mean_window_error_.empty()) parameter_errors_.push_back(mean_window_error_);
-    ReadFlagFlies(pnh);
+    ReadFlagFlies(params);
     estimate_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate", 10);
     mean_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate_mean", 10);
     power_pub_ = transport_.advertise("sdn/power", 1);
@@ -102,9 +106,8 @@ class SdnNode {
   }
 
   // Before the members: the trailing mean is built with it.
-  static double MeanWindow(ros::NodeHandle& pnh) {
-    double window = 60.0;
-    pnh.param("mean_window", window, 60.0);
+  static double MeanWindow(clothwind::ros_bridge::StrictParams& params) {
+    double window = params.Get("mean_window", 60.0);
     if (!(window > 0) || !std::isfinite(window)) {
       mean_window_error_ = "~mean_window must be a finite number of seconds > 0, got " + std::to_string(window);
       ROS_ERROR("sdn_node: %s; using 60 s", mean_window_error_.c_str());
@@ -115,13 +118,11 @@ class SdnNode {
 
   // ~flag_flies and, for wind, ~camera_heading and ~end_on_angle, checked once at start: a bad
   // value is an ERROR and leaves the model's default.
-  void ReadFlagFlies(ros::NodeHandle& pnh) {
-    std::string name;
-    pnh.param("flag_flies", name, std::string());
-    pnh.param("camera_heading", camera_heading_, std::numeric_limits<double>::quiet_NaN());
-    pnh.param("camera_heading_frame", camera_heading_frame_, std::string());
-    double end_on_deg = 20.0;
-    pnh.param("end_on_angle", end_on_deg, 20.0);
+  void ReadFlagFlies(clothwind::ros_bridge::StrictParams& params) {
+    const std::string name = params.Get("flag_flies", "");
+    camera_heading_ = params.Get("camera_heading", std::numeric_limits<double>::quiet_NaN());
+    camera_heading_frame_ = params.Get("camera_heading_frame", "");
+    double end_on_deg = params.Get("end_on_angle", 20.0);
     if (!(end_on_deg >= 0 && end_on_deg <= 90)) {
       end_on_deg = ParameterError("~end_on_angle must be 0 to 90 degrees, got " + std::to_string(end_on_deg), 20);
     }
@@ -439,7 +440,16 @@ class SdnNode {
 int main(int argc, char** argv) {
   ros::init(argc, argv, "sdn_node");
   ros::NodeHandle nh, pnh("~");
-  SdnNode node(nh, pnh);
+  clothwind::ros_bridge::StrictParams params(pnh);
+  std::unique_ptr<SdnNode> node;
+  try {
+    node = std::make_unique<SdnNode>(nh, params);
+  } catch (const clothwind::ros_bridge::ParamError& e) {
+    ROS_FATAL("sdn_node: %s", e.what());
+    return 1;
+  }
+  params.Known("diagnostic_period");  // diagnostic_updater's
+  params.WarnUnread("sdn_node");
   ros::spin();
   return 0;
 }

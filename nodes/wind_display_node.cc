@@ -12,7 +12,8 @@
 // Parameters: ~mean_window [s] (60), ~plot_window [s] (180), ~plot_width/~plot_height [px]
 // (640x320), ~rate [Hz] (2), ~frame_id ("" = the anemometer's frame, else this one),
 // ~fixed_frame ("" = none): when set, a latched /tf_static places the display frame at this
-// frame with the identity transform, so rviz has a fixed frame without a robot's TF tree (the
+// frame with the identity transform, from the start (and again when the display frame changes),
+// so rviz has a fixed frame without a robot's TF tree before any data comes (the
 // monitor does not know where the anemometer is; leave it empty when a real TF tree exists).
 // ~stale_after [s] (10): an estimate older than this (by ROS time, or received longer ago than
 // this by the wall clock: a bag that ended stops /clock) is shown as "--", and the anemometer's
@@ -43,6 +44,7 @@
 
 #include "sensors/wind_direction_frame.h"
 #include "sensors/wind_plot.h"
+#include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_throttle.h"
 
 namespace {
@@ -52,18 +54,17 @@ using clothwind::sensors::WindSample;
 
 class WindDisplayNode {
  public:
-  WindDisplayNode(ros::NodeHandle nh, ros::NodeHandle pnh)
+  WindDisplayNode(ros::NodeHandle nh, clothwind::ros_bridge::StrictParams& params)
       : estimates_(1.0), anemometer_(1.0) {
-    pnh.param("mean_window", mean_window_, 60.0);
-    pnh.param("plot_window", plot_window_, 180.0);
-    pnh.param("plot_width", plot_width_, 640);
-    pnh.param("plot_height", plot_height_, 320);
-    pnh.param<std::string>("frame_id", frame_id_param_, "");
-    pnh.param<std::string>("fixed_frame", fixed_frame_, "");
-    double rate;
-    pnh.param("rate", rate, 2.0);
-    pnh.param("stale_after", stale_after_, 10.0);
-    pnh.param("max_future", max_future_, 5.0);
+    mean_window_ = params.Get("mean_window", 60.0);
+    plot_window_ = params.Get("plot_window", 180.0);
+    plot_width_ = params.Get("plot_width", 640);
+    plot_height_ = params.Get("plot_height", 320);
+    frame_id_param_ = params.Get("frame_id", "");
+    fixed_frame_ = params.Get("fixed_frame", "");
+    const double rate = params.Get("rate", 2.0);
+    stale_after_ = params.Get("stale_after", 10.0);
+    max_future_ = params.Get("max_future", 5.0);
     auto positive = [](double v) { return std::isfinite(v) && v > 0; };
     if (!positive(mean_window_) || !positive(plot_window_) || !positive(rate) || !positive(stale_after_) ||
         !positive(max_future_) ||
@@ -80,10 +81,16 @@ class WindDisplayNode {
     anemometer_ = WindHistory(span_);
     markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("monitor/wind_markers", 1, true);
     plot_pub_ = nh.advertise<sensor_msgs::Image>("monitor/wind_plot", 1, true);
-    if (!fixed_frame_.empty()) tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf_static", 1, true);
+    frame_gate_ = clothwind::sensors::WindDirectionFrameGate(frame_id_param_);
+    // The fixed frame from the start, at the frame the displays will use (~frame_id, else
+    // "anemometer" until a reading names its own; Draw moves it then): published only once data
+    // had come, rviz showed "Fixed Frame [monitor] does not exist" until then.
+    if (!fixed_frame_.empty()) {
+      tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf_static", 1, true);
+      if (FrameId() != fixed_frame_) PublishFixedFrame(FrameId());
+    }
     estimate_sub_ = nh.subscribe("wind/estimate", 10, &WindDisplayNode::OnEstimate, this);
     wind_sub_ = nh.subscribe("anemometer/wind", 50, &WindDisplayNode::OnWind, this);
-    frame_gate_ = clothwind::sensors::WindDirectionFrameGate(frame_id_param_);
     // Redraw on a timer, not per message: the plot scrolls with time even when inputs pause. A wall
     // timer: a ROS timer stops with /clock when a bag ends, and the last estimate stayed "live".
     timer_ = nh.createWallTimer(ros::WallDuration(1.0 / rate), &WindDisplayNode::Publish, this);
@@ -359,8 +366,11 @@ int main(int argc, char** argv) {
   // Held outside the try: the last NodeHandle going out of scope shuts ROS down, and the FATAL
   // naming a bad parameter was then never printed (exit 1, silent).
   ros::NodeHandle nh, pnh("~");
+  clothwind::ros_bridge::StrictParams params(pnh);
   try {
-    WindDisplayNode node(nh, pnh);
+    WindDisplayNode node(nh, params);
+    params.Known("diagnostic_period");  // diagnostic_updater's
+    params.WarnUnread("wind_display");
     ros::spin();
   } catch (const std::exception& e) {
     ROS_FATAL("wind_display: %s", e.what());

@@ -105,6 +105,7 @@ class CameraFolderTest(unittest.TestCase):
         cls.colour = Collector("/")
         cls.grey = Collector("/mono/")
         cls.calibrated = Collector("/calib/")
+        cls.refused = {"badurl": Collector("/badurl/"), "badyaml": Collector("/badyaml/")}
         # The nodes poll for folders that do not exist yet and say so; the folders are made only
         # once both have said it, so the retry is what is tested (a fixed sleep let a node that
         # started late find them at its first try).
@@ -252,6 +253,32 @@ class CameraFolderTest(unittest.TestCase):
             self.assertEqual(info.K[4], 31.0)
         status = source_status(t + 1.0)
         self.assertEqual(status.level, DiagnosticStatus.OK, status.message)
+
+    def test_a_calibration_file_the_parser_cannot_read_is_refused_and_reported(self):
+        for ns, reason in (("badurl", "camera_calibration_folder.yaml is a directory, not a calibration file"),
+                           ("badyaml", "camera_calibration_4x3.yaml: camera_matrix is 4x3, CameraInfo's is 3x3")):
+            collector = self.refused[ns]
+            self.assertTrue(collector.wait_for(3, timeout=30.0), "%s: no images (did the node end?)" % ns)
+            time.sleep(0.3)
+            with collector.lock:
+                infos = list(collector.infos)
+            self.assertTrue(infos, ns)
+            for info in infos:
+                self.assertEqual((info.width, info.height), (24, 16))
+                self.assertEqual(list(info.K), [0.0] * 9)
+            deadline = time.time() + 10.0
+            found = None
+            while time.time() < deadline and found is None:
+                for array in list(self.diagnostics):
+                    for s in array.status:
+                        if s.name == ns + "/camera_node: camera source" and s.level == DiagnosticStatus.WARN:
+                            found = s
+                time.sleep(0.2)
+            self.assertIsNotNone(found, "%s: no WARN in diagnostics" % ns)
+            self.assertIn("camera_info without calibration: calibration file refused", found.message)
+            self.assertIn(reason, found.message)
+            values = {kv.key: kv.value for kv in found.values}
+            self.assertIn(reason, values["calibration"])
 
     def test_absent_v4l2_device_is_reported(self):
         deadline = time.time() + 15.0

@@ -2,6 +2,7 @@
 """rostest for wind_display_node and clip_report_node (see monitor_nodes.test)."""
 import json
 import os
+import struct
 import sys
 import threading
 import time
@@ -11,7 +12,17 @@ import rospy
 import rostest
 from clothwind.msg import Clip, WindEstimate, WindMeasurement
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import TransformStamped
 from visualization_msgs.msg import MarkerArray
+
+SENT = []  # wall time of each message sent to the nodes under test
+
+
+def first_transform(msg):
+    """The first TransformStamped of a tf2_msgs/TFMessage taken as rospy.AnyMsg (Debian packages
+    tf2_msgs for C++ only): a uint32 count, then the transforms."""
+    (count,) = struct.unpack("<I", msg._buff[:4])
+    return TransformStamped().deserialize(msg._buff[4:]) if count else None
 
 
 class MonitorNodesTest(unittest.TestCase):
@@ -52,6 +63,24 @@ class MonitorNodesTest(unittest.TestCase):
             s = self.statuses[-1]
         return s, {kv.key: kv.value for kv in s.values}
 
+    # Sorted first (unittest runs tests by name): nothing has been sent to the display yet. rviz
+    # showed "Fixed Frame [monitor] does not exist" until data came, as the display published
+    # /tf_static only when it first drew.
+    def test_a_fixed_frame_before_any_data(self):
+        received = []
+        sub = rospy.Subscriber("/tf_static", rospy.AnyMsg, lambda m: received.append((time.time(), m)))
+        deadline = time.time() + 10.0
+        while time.time() < deadline and not received:
+            time.sleep(0.1)
+        sub.unregister()
+        self.assertTrue(received, "no /tf_static from wind_display before any input")
+        self.assertEqual(SENT, [])
+        self.assertEqual(received[0][1]._connection_header["type"], "tf2_msgs/TFMessage")
+        t = first_transform(received[0][1])
+        # The frame the display would draw in: "anemometer" until a reading names its own.
+        self.assertEqual((t.header.frame_id, t.child_frame_id), ("monitor", "anemometer"))
+        self.assertEqual(t.transform.rotation.w, 1.0)
+
     def test_display_and_report(self):
         for i in range(8):  # 4 s: estimates at 1 Hz, readings at 2 Hz
             now = rospy.Time.now()
@@ -60,6 +89,7 @@ class MonitorNodesTest(unittest.TestCase):
             wind.header.frame_id = "anemometer"
             wind.speed, wind.direction, wind.valid = 3.0, 0.0, True
             wind.velocity.x = 3.0
+            SENT.append(time.time())
             self.wind_pub.publish(wind)
             if i % 2 == 0:
                 e = WindEstimate()

@@ -1,0 +1,201 @@
+#!/usr/bin/env python3
+"""rostest: parameters reach the nodes as the types they read (see tests/node_params.test).
+
+The nodes are started from here (rosrun-style, `_name:=value` or parameters set on the master
+first), so each runs in a folder of the test's own and its exit status and console are seen.
+"""
+import glob
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import unittest
+
+import roslib.packages
+import rospy
+import rostest
+import yaml
+from clothwind.msg import WindMeasurement
+from sensor_msgs.msg import Image
+
+WIDTH, HEIGHT = 64, 48
+
+
+def node_path(name):
+    found = roslib.packages.find_node("clothwind", name)
+    if not found:
+        raise RuntimeError("clothwind %s is not built" % name)
+    return found[0]
+
+
+class Spawned:
+    """A node started from here, its console (stdout and stderr) kept as it comes."""
+
+    def __init__(self, node, args, cwd=None):
+        self.lines = []
+        self.lock = threading.Lock()
+        self.process = subprocess.Popen([node_path(node)] + args, cwd=cwd, stdout=subprocess.PIPE,
+                                        stderr=subprocess.STDOUT, text=True, errors="replace")
+        self.reader = threading.Thread(target=self.read, daemon=True)
+        self.reader.start()
+
+    def read(self):
+        for line in self.process.stdout:
+            with self.lock:
+                self.lines.append(line)
+
+    def output(self):
+        with self.lock:
+            return "".join(self.lines)
+
+    def wait_for_output(self, text, timeout):
+        deadline = time.time() + timeout
+        while time.time() < deadline and text not in self.output() and self.process.poll() is None:
+            time.sleep(0.1)
+        time.sleep(0.2)  # the line's end
+        return text in self.output()
+
+    def wait(self, timeout):
+        """Exit status, or None when still running after `timeout` s."""
+        try:
+            return self.process.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            return None
+
+    def stop(self):
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+            if self.wait(15) is None:
+                self.process.kill()
+                self.process.wait()
+        self.reader.join(5)
+
+
+def roslaunch(*args):
+    return subprocess.run(["roslaunch"] + list(args), check=True, stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True).stdout
+
+
+class NodeParamsTest(unittest.TestCase):
+    def setUp(self):
+        self.spawned = []
+        self.folder = tempfile.mkdtemp(prefix="clothwind_node_params_")
+
+    def tearDown(self):
+        for s in self.spawned:
+            s.stop()
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def spawn(self, node, args, cwd=None):
+        s = Spawned(node, args, cwd)
+        self.spawned.append(s)
+        return s
+
+    # `rosrun clothwind clip_buffer_node _record_dir:=20261206` (and roslaunch's record_dir:=20261206
+    # before its launch files said type="str") stores an int: the node read no text, left
+    # record_dir empty and recorded nothing, without a word.
+    def test_record_dir_given_as_an_int_is_recorded_into(self):
+        node = self.spawn("clip_buffer_node", [
+            "__ns:=numeric", "_record_dir:=20261206", "_num_frames:=10", "_stride:=10", "_size:=32",
+            "_label_window:=2.0", "_label_delay:=0.5", "_flush_after:=1.0"], cwd=self.folder)
+        images = rospy.Publisher("/numeric/camera/image_raw", Image, queue_size=100)
+        winds = rospy.Publisher("/numeric/anemometer/wind", WindMeasurement, queue_size=20)
+        deadline = time.time() + 20
+        while time.time() < deadline and (images.get_num_connections() == 0 or winds.get_num_connections() == 0):
+            time.sleep(0.1)
+        self.assertGreater(images.get_num_connections(), 0, node.output())
+        record = os.path.join(self.folder, "20261206")
+        deadline = time.time() + 30
+        frame = 0
+        while time.time() < deadline and not glob.glob(os.path.join(record, "*", "label.json")):
+            stamp = rospy.Time.now()
+            img = Image()
+            img.header.stamp, img.header.frame_id = stamp, "camera_optical"
+            img.height, img.width, img.encoding, img.step = HEIGHT, WIDTH, "mono8", WIDTH
+            img.data = bytes([frame % 256]) * (WIDTH * HEIGHT)
+            images.publish(img)
+            if frame % 15 == 0:
+                wind = WindMeasurement()
+                wind.header.stamp, wind.header.frame_id = stamp, "anemometer"
+                wind.speed, wind.direction, wind.valid = 4.0, 0.0, True
+                winds.publish(wind)
+            frame += 1
+            time.sleep(1.0 / 30)
+        self.assertTrue(glob.glob(os.path.join(record, "*", "label.json")),
+                        "no clip recorded into %s; node said:\n%s" % (record, node.output()))
+        self.assertIn('~record_dir is set to the int 20261206, read as the text "20261206"', node.output())
+
+    # A wrong-typed parameter ends each node with a FATAL naming it, the type found and the one
+    # expected (YAML `rate: "5"` left camera_node at 30 Hz; roscpp's param() takes its default).
+    def test_a_wrong_typed_parameter_ends_the_node_naming_it(self):
+        cases = [
+            ("camera_node", {"source": "folder", "path": self.folder, "rate": "5"},
+             '~rate is set to a string ("5"), expected a double'),
+            ("clip_buffer_node", {"queue_size": 2.5}, "~queue_size is set to a double (2.5), expected an int"),
+            ("wind_display_node", {"mean_window": "60"}, '~mean_window is set to a string ("60"), expected a double'),
+            ("clip_report_node", {"estimates": "true"}, '~estimates is set to a string ("true"), expected a bool'),
+            ("anemometer_node", {"input": "topic", "baud": 9600.0},
+             "~baud is set to a double (9600), expected an int"),
+            ("sdn_node", {"model": self.folder, "threads": "2"}, '~threads is set to a string ("2"), expected an int'),
+        ]
+        started = []
+        for node, params, _ in cases:
+            name = "/bad_" + node
+            for key, value in params.items():
+                rospy.set_param(name + "/" + key, value)
+            started.append(self.spawn(node, ["__name:=" + name.lstrip("/")], cwd=self.folder))
+        for (node, _, message), s in zip(cases, started):
+            status = s.wait(30)
+            s.reader.join(5)
+            self.assertEqual(status, 1, "%s did not end on a bad parameter; it said:\n%s" % (node, s.output()))
+            self.assertIn(message, s.output(), node)
+            self.assertIn("FATAL", s.output(), node)
+
+    # A misspelt key is named at start, not silently left to its default.
+    def test_a_parameter_the_node_does_not_read_is_named(self):
+        s = self.spawn("wind_display_node", ["__name:=spelt_display", "_rat:=5", "_plot_window:=30"])
+        self.assertTrue(s.wait_for_output("not read", 20), s.output())
+        self.assertIn("wind_display: private parameter ~rat set but not read by this node", s.output())
+        self.assertNotIn("~plot_window", s.output())
+
+    # The launch files hand text parameters over as text, whatever they look like, and pass each of
+    # sdn.launch's settings on (monitor.launch passed only model, mean_window and output).
+    def test_launch_files_pass_text_as_text_and_forward_sdn_settings(self):
+        replay = yaml.safe_load(roslaunch("--dump-params", "clothwind", "replay.launch", "bag:=/x.bag",
+                                          "record_dir:=20261206", "model:=20261207", "report:=true",
+                                          "summary:=1", "estimate_plot:=2", "device:=cuda", "mean_window:=30",
+                                          "camera_heading_frame:=enu", "end_on_angle:=15"))
+        self.assertEqual(replay["/clip_buffer/record_dir"], "20261206")
+        self.assertEqual(replay["/sdn/model"], "20261207")
+        self.assertEqual(replay["/clip_report/summary"], "1")
+        self.assertEqual(replay["/clip_report/estimate_plot"], "2")
+        self.assertEqual(replay["/sdn/device"], "cuda")
+        self.assertEqual(replay["/sdn/mean_window"], 30)
+        self.assertEqual(replay["/sdn/camera_heading_frame"], "enu")
+        self.assertEqual(replay["/sdn/end_on_angle"], 15)
+        self.assertNotIn("/sdn/camera_heading", replay)  # empty: unset, not an empty text for an angle
+        field = yaml.safe_load(roslaunch("--dump-params", "clothwind", "field.launch", "record_dir:=20261206"))
+        self.assertEqual(field["/clip_buffer/record_dir"], "20261206")
+        monitor = yaml.safe_load(roslaunch(
+            "--dump-params", "clothwind", "monitor.launch", "model:=/m.pt", "sdn_threads:=3", "device:=auto",
+            "sdn_queue_size:=4", "mean_window:=30", "flag_flies:=wind", "camera_heading:=1.5",
+            "camera_heading_frame:=enu", "end_on_angle:=15", "fly_judge:=/j.pt"))
+        for key, value in {"threads": 3, "device": "auto", "queue_size": 4, "mean_window": 30, "flag_flies": "wind",
+                           "camera_heading": 1.5, "camera_heading_frame": "enu", "end_on_angle": 15,
+                           "fly_judge": "/j.pt"}.items():
+            self.assertEqual(monitor["/sdn/" + key], value, key)
+        # rviz opens on the display's fixed frame (-f), and on the config's without one.
+        self.assertIn(" -f monitor ", roslaunch("--args", "rviz", "clothwind", "monitor.launch"))
+        self.assertIn(" -f odom ", roslaunch("--args", "rviz", "clothwind", "monitor.launch", "fixed_frame:=odom"))
+        self.assertNotIn(" -f ", roslaunch("--args", "rviz", "clothwind", "monitor.launch", "fixed_frame:=none"))
+        none = yaml.safe_load(roslaunch("--dump-params", "clothwind", "monitor.launch", "fixed_frame:=none"))
+        self.assertEqual(none["/wind_display/fixed_frame"], "")
+
+
+if __name__ == "__main__":
+    rospy.init_node("node_params_check")
+    rostest.rosrun("clothwind", "node_params", NodeParamsTest, sys.argv)
