@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -100,6 +101,9 @@ struct ClothSimulator::Impl {
   void ComputeForces(bool with_jacobian, bool with_repulsion);
   void Solve();
   void CheckState();
+  // Records `what` as the failure (naming the simulated time of step number `step` and the step's
+  // stats) and throws it: the one blow-up error of Step, wherever the step finds the blow-up.
+  [[noreturn]] void BlowUp(long step, const std::string& what);
   ClothEnergy Energy() const;
 };
 
@@ -411,9 +415,38 @@ void ClothSimulator::Impl::Solve() {
   // Preconditioned conjugate gradients, warm-started with the previous step's dv.
   for (int i = 0; i < nv; ++i)
     if (pinned[i]) dv.segment<3>(3 * i).setZero();
+  // A non-finite |b| makes every relative residual NaN, and `rel > tol` is false for NaN: the
+  // loop below would end before its first iteration and leave dv = 0, a cloth that never moves
+  // (a scene with gravity 1e200 ran to the end, exit 0, the cloth frozen). Finite forces can
+  // still overflow the norm's sum of squares, so the norm is what is checked.
+  const double b_norm = b.norm();
+  if (!std::isfinite(b_norm)) {
+    stats.cg_iterations = 0;
+    stats.cg_relative_residual = std::numeric_limits<double>::quiet_NaN();
+    char what[512];
+    int bad = -1;
+    for (int i = 0; i < nv && bad < 0; ++i)
+      if (!pinned[i] && !f.segment<3>(3 * i).allFinite()) bad = i;
+    if (bad >= 0) {
+      std::snprintf(what, sizeof(what), "vertex %d has a non-finite force (wind field or element forces)", bad);
+    } else {
+      for (int i = 0; i < nv && bad < 0; ++i)
+        if (!b.segment<3>(3 * i).allFinite()) bad = i;
+      if (bad >= 0)
+        std::snprintf(what, sizeof(what),
+                      "the linear solve's right-hand side h (f + (h + damping) K v) is not finite at vertex %d "
+                      "(stiffness, damping or velocity beyond double range)", bad);
+      else
+        std::snprintf(what, sizeof(what),
+                      "the linear solve's right-hand side h (f + (h + damping) K v) has a norm beyond double "
+                      "range (largest entry %.3g N s): gravity, density, wind or stiffness far out of range",
+                      b.cwiseAbs().maxCoeff());
+    }
+    BlowUp(steps + 1, what);
+  }
   multiply(dv, q);
   r = b - q;
-  const double bnorm = std::max(b.norm(), 1e-300);
+  const double bnorm = std::max(b_norm, 1e-300);
   auto precondition = [&]() {
     for (int i = 0; i < nv; ++i) z.segment<3>(3 * i) = precond[i] * r.segment<3>(3 * i);
   };
@@ -422,15 +455,31 @@ void ClothSimulator::Impl::Solve() {
   double rz = r.dot(z);
   int it = 0;
   double rel = r.norm() / bnorm;
+  // NaN compares false both ways: without this check a NaN residual would end the solve as if
+  // it had converged, with whatever dv it had.
+  auto check_finite = [&](double value) {
+    if (std::isfinite(value)) return;
+    stats.cg_iterations = it;
+    stats.cg_relative_residual = rel;
+    char what[256];
+    std::snprintf(what, sizeof(what),
+                  "the linear solve's residual became non-finite after %d CG iterations (the system matrix or "
+                  "the right-hand side is beyond double range)",
+                  it);
+    BlowUp(steps + 1, what);
+  };
+  check_finite(rel);
   while (rel > options.cg_tolerance && it < options.cg_max_iterations) {
     multiply(p, q);
     const double pq = p.dot(q);
-    if (!(pq > 0)) break;
+    check_finite(pq);
+    if (!(pq > 0)) break;  // not positive definite along p (compressed stretching): stop here
     const double alpha = rz / pq;
     dv += alpha * p;
     r -= alpha * q;
     ++it;
     rel = r.norm() / bnorm;
+    check_finite(rel);
     if (rel <= options.cg_tolerance) break;
     precondition();
     const double rz_new = r.dot(z);
@@ -445,8 +494,8 @@ void ClothSimulator::Impl::Solve() {
 // max_speed. One pass over x and v, negligible next to a step.
 void ClothSimulator::Impl::CheckState() {
   const double max_speed2 = options.max_speed * options.max_speed;
-  // Non-finite forces first: CG then stops at once (NaN residual) and would leave the state
-  // finite but wrong, so they must be caught here rather than in x and v.
+  // Non-finite forces first: a free vertex's already stopped Solve (its right-hand side), but a
+  // pinned vertex's never reaches the solve (its row is zeroed) and would leave x and v finite.
   const bool forces_finite = f.allFinite();
   for (int i = 0; i < nv; ++i) {
     const double speed2 = v.row(i).squaredNorm();
@@ -462,17 +511,21 @@ void ClothSimulator::Impl::CheckState() {
     else
       std::snprintf(what, sizeof(what), "vertex %d moves at %.4g m/s (more than SimOptions.max_speed = %g m/s)",
                     i, std::sqrt(speed2), options.max_speed);
-    char step[512];
-    std::snprintf(step, sizeof(step),
-                  "; that step: %d CG iterations (relative residual %.3g), %d strain-limited faces, "
-                  "%d repulsion pairs",
-                  stats.cg_iterations, stats.cg_relative_residual, stats.strain_limited_faces,
-                  stats.repulsion_pairs);
-    char head[128];
-    std::snprintf(head, sizeof(head), "ClothSimulator: the simulation blew up at t = %.4f s (step %ld): ", t, steps);
-    failure = std::string(head) + what + step;
-    throw std::runtime_error(failure);
+    BlowUp(steps, what);
   }
+}
+
+void ClothSimulator::Impl::BlowUp(long step, const std::string& what) {
+  char tail[512];
+  std::snprintf(tail, sizeof(tail),
+                "; that step: %d CG iterations (relative residual %.3g), %d strain-limited faces, "
+                "%d repulsion pairs",
+                stats.cg_iterations, stats.cg_relative_residual, stats.strain_limited_faces, stats.repulsion_pairs);
+  char head[128];
+  std::snprintf(head, sizeof(head), "ClothSimulator: the simulation blew up at t = %.4f s (step %ld): ",
+                step * options.dt, step);
+  failure = std::string(head) + what + tail;
+  throw std::runtime_error(failure);
 }
 
 ClothEnergy ClothSimulator::Impl::Energy() const {
@@ -533,6 +586,8 @@ void ClothSimulator::Step() {
     s.proximity->Update(s.x, s.options.repulsion_thickness);
   s.proximity_from_resolver = false;
   const auto t1 = Clock::now();
+  s.stats.strain_limited_faces = 0;  // (this step's, should the solve fail before the limiter)
+  s.stats.crossings_resolved = 0;
   s.ComputeForces(/*with_jacobian=*/true, repel);
   const auto t2 = Clock::now();
   s.Solve();

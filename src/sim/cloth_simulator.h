@@ -96,9 +96,11 @@ class ClothSimulator {
 
   // Advances the state by one time step options().dt.
   // Throws std::runtime_error, naming the simulated time, the vertex and what went wrong, when
-  // the step meets a non-finite force or leaves a non-finite position or velocity or a speed
-  // above options().max_speed (an exploded simulation: carrying on would only produce garbage,
-  // and slowly). The state is then left as the step made it, for diagnostics, and every further
+  // the step meets a non-finite force, a linear system beyond double range (a right-hand side
+  // whose norm overflows, a non-finite CG residual: the solve would otherwise stop at once and
+  // leave the cloth still), or leaves a non-finite position or velocity or a speed above
+  // options().max_speed (an exploded simulation: carrying on would only produce garbage, and
+  // slowly). The state is then left as the step made it, for diagnostics, and every further
   // Step throws the same error until SetState gives a valid state.
   void Step();
 

@@ -13,6 +13,7 @@
 #include <Eigen/SVD>
 #include <gtest/gtest.h>
 
+#include "common/random.h"
 #include "sim/test_expect_throw.h"
 
 namespace clothwind::sim {
@@ -52,12 +53,12 @@ Mesh HangingSheet(double w, double h, double edge) {
 
 // A material whose stiffness tables are constant (every stretching row and bending entry the
 // same): its stretching force is exactly an energy's gradient, as ArcSim freezes the table lookup.
-Material ConstantStiffnessMaterial() {
+Material ConstantStiffnessMaterial(const MaterialMultipliers& mult = {}) {
   Eigen::Matrix<double, 6, 4> s;
   for (int r = 0; r < 6; ++r) s.row(r) << 60, 10, 90, 30;
   Eigen::Matrix<double, 3, 5> b;
   b.setConstant(3e-3);
-  return MakeMaterial(0.3, s, b);
+  return MakeMaterial(0.3, s, b, mult);
 }
 
 SimOptions QuietOptions() {
@@ -100,7 +101,16 @@ double MeanSag(const ClothSimulator& sim) {
   return (sim.mesh().V.col(2) - sim.positions().col(2)).mean();
 }
 
-double HangAndMeasureSag(const MaterialMultipliers& mult, double* max_speed) {
+// How far the final state of a hanging sheet is from static equilibrium, in units of a node's
+// weight: the largest net force on a free node over its own weight m_i |g|, and the handles'
+// reaction (minus the total force on the pinned nodes) against the whole cloth's weight M g,
+// |R - (-M g)| / (M |g|).
+struct Equilibrium {
+  double worst_free_force = 0;
+  double reaction_error = 0;
+};
+
+double HangAndMeasureSag(const MaterialMultipliers& mult, double* max_speed, Equilibrium* eq = nullptr) {
   const Mesh m = HangingSheet(0.6, 0.6, 0.08);
   SimOptions o = QuietOptions();
   o.wind_density = 1.0;  // still air damps the swinging like it does in reality
@@ -111,14 +121,35 @@ double HangAndMeasureSag(const MaterialMultipliers& mult, double* max_speed) {
   ClothSimulator sim(m, TestMaterial(damped), o, nullptr);
   for (int i = 0; i < 600; ++i) sim.Step();
   *max_speed = sim.velocities().rowwise().norm().maxCoeff();
+  if (eq) {
+    // A small speed alone does not make a rest state (a solve that barely moves the cloth creeps
+    // slowly too): at rest every free node's forces cancel, and the handles carry the whole
+    // weight, the internal forces summing to zero (Newton's third law in the assembly).
+    const Eigen::MatrixX3d f = sim.Forces();
+    const Eigen::VectorXd& mass = sim.masses();
+    const double g = o.gravity.norm();
+    Eigen::Vector3d on_handles = Eigen::Vector3d::Zero();
+    for (int i = 0; i < f.rows(); ++i) {
+      const bool pinned = std::find(o.handles.begin(), o.handles.end(), i) != o.handles.end();
+      if (pinned)
+        on_handles += f.row(i).transpose();
+      else
+        eq->worst_free_force = std::max(eq->worst_free_force, f.row(i).norm() / (mass[i] * g));
+    }
+    const Eigen::Vector3d reaction = -on_handles;  // what the handles must push with
+    eq->reaction_error = (reaction + mass.sum() * o.gravity).norm() / (mass.sum() * g);
+  }
   return MeanSag(sim);
 }
 
 TEST(ClothSimulatorTest, HangingClothReachesEquilibriumWithSagOrderedByStiffnessAndWeight) {
   double speed = 0;
-  const double base = HangAndMeasureSag({}, &speed);
+  Equilibrium eq;
+  const double base = HangAndMeasureSag({}, &speed, &eq);
   EXPECT_LT(speed, 2e-3) << "not at rest";
   EXPECT_GT(base, 1e-3);
+  EXPECT_LT(eq.worst_free_force, 1e-3) << "a free node is not in equilibrium";
+  EXPECT_LT(eq.reaction_error, 1e-6) << "the handles do not carry the cloth's weight";
   MaterialMultipliers stiff;
   stiff.stretching = 4;
   const double stiffer = HangAndMeasureSag(stiff, &speed);
@@ -510,6 +541,101 @@ TEST(ClothSimulatorTest, AssembledRepulsionJacobianIsTheForcesDerivativeAlongThe
   EXPECT_LT((jdx - fd).norm(), 1e-5 * fd.norm()) << "|J dx| " << jdx.norm() << ", |FD| " << fd.norm();
   // The lower sheet is pushed too (through the blocks between a vertex and another sheet's face).
   EXPECT_GT(jdx.topRows(x.rows() / 2).norm(), 0.1 * jdx.norm());
+}
+
+TEST(ClothSimulatorTest, OneStepSolvesTheLinearSystemForceJacobianTimesDescribes) {
+  // The step is one Newton iteration of backward Euler with Rayleigh damping:
+  //   (M - h (h + gamma) K) dv = h (f0 + (h + gamma) K v0)   on the free rows,
+  // K the force Jacobian at x0. ForceJacobianTimes is checked against finite differences above;
+  // this checks that the step solves the system built from that same K, every block included:
+  // damping in the matrix and the right-hand side, the repulsion blocks outside the fixed pattern,
+  // the pinned rows left out. The energy and damping tests pass with damping doubled or the
+  // off-pattern blocks dropped; this residual is ~1e-12 and those make it 0.1-0.75.
+  const double gamma = 0.02;
+  auto sheet = [](double dx, double dy, double z) {
+    return Sheet(0.2, 0.2, 0.05, [=](double u, double v) {
+      return Eigen::Vector3d(1.02 * u + dx, v + dy, z + 0.004 * std::sin(40 * u));  // stretched, wavy
+    });
+  };
+  const Mesh lower = sheet(0, 0, 0), upper = sheet(0.031, 0.047, 5e-3);  // 5 mm apart: in contact
+  const int n = static_cast<int>(lower.V.rows());
+  Mesh m;
+  m.V.resize(2 * n, 3);
+  m.V << lower.V, upper.V;
+  m.U.resize(2 * n, 2);
+  m.U << lower.U, upper.U;
+  m.F.resize(2 * lower.F.rows(), 3);
+  m.F << lower.F, (upper.F.array() + n).matrix();
+  MaterialMultipliers mult;
+  mult.damping = gamma;
+  SimOptions o = QuietOptions();
+  o.self_collision = true;
+  o.crossing_sweeps = 0;  // the correction after the solve would move x, not v, but keep it out
+  o.bending_solve = BendingSolve::kImplicit;  // bending in K too
+  o.cg_tolerance = 1e-12;
+  o.cg_max_iterations = 5000;
+  o.handles = {0, 1, n + 2};
+  ClothSimulator sim(m, ConstantStiffnessMaterial(mult), o, nullptr);
+  Rng rng(11);
+  Eigen::MatrixX3d v0(m.V.rows(), 3);
+  for (int i = 0; i < v0.rows(); ++i)
+    for (int c = 0; c < 3; ++c) v0(i, c) = rng.Uniform(-0.5, 0.5);  // [m/s]
+  for (int h : o.handles) v0.row(h).setZero();
+  const Eigen::MatrixX3d x0 = m.V;
+  sim.SetState(x0, v0);
+  const Eigen::MatrixX3d f0 = sim.Forces(), Kv0 = sim.ForceJacobianTimes(v0);
+  sim.Step();
+  ASSERT_GT(sim.last_step_stats().repulsion_pairs, 10) << "the sheets are not in contact";
+  EXPECT_LT(sim.last_step_stats().cg_relative_residual, 1e-12);
+  const Eigen::MatrixX3d dv = sim.velocities() - v0;
+  sim.SetState(x0, v0);  // K at x0, where the step assembled it
+  const Eigen::MatrixX3d Kdv = sim.ForceJacobianTimes(dv);
+  const double h = o.dt;
+  Eigen::MatrixX3d lhs = sim.masses().asDiagonal() * dv - h * (h + gamma) * Kdv;
+  Eigen::MatrixX3d rhs = h * (f0 + (h + gamma) * Kv0);
+  for (int p : o.handles) {
+    EXPECT_EQ(sim.velocities().row(p).norm(), 0.0) << "handle " << p;  // (dv = 0 there)
+    lhs.row(p).setZero();
+    rhs.row(p).setZero();
+  }
+  // Each term matters at this size (so dropping one cannot pass): |h (h + gamma) K v0| and
+  // |h f0| are both a good part of |rhs|.
+  ASSERT_GT((h * (h + gamma) * Kv0).norm(), 0.1 * rhs.norm());
+  ASSERT_GT((h * f0).norm(), 0.1 * rhs.norm());
+  EXPECT_LT((lhs - rhs).norm(), 1e-9 * rhs.norm())
+      << "|M dv - h(h+g) K dv - h(f0 + (h+g) K v0)| / |rhs| = " << (lhs - rhs).norm() / rhs.norm();
+}
+
+TEST(ClothSimulatorTest, ALinearSystemBeyondDoubleRangeThrowsInsteadOfFreezingTheCloth) {
+  // Gravity of 1e200 m/s^2 gives finite forces (~1e197 N) whose sum of squares overflows: the
+  // relative residual was inf / inf = NaN, `NaN > tol` is false, so CG stopped before its first
+  // iteration and the step left the cloth exactly where it was (a scene ran to its end, exit 0,
+  // with a cloth that never moved). A damping of 1e307 s leaves the right-hand side of a cloth at
+  // rest finite but overflows the matrix: the residual turns NaN inside the iterations, which
+  // ended the solve as if converged.
+  const Mesh m = HangingSheet(0.3, 0.3, 0.15);
+  SimOptions o = QuietOptions();
+  o.handles = {2, 3};
+  SimOptions heavy = o;
+  heavy.gravity = Eigen::Vector3d(0, 0, -1e200);
+  MaterialMultipliers sticky;
+  sticky.damping = 1e307;
+  struct Case {
+    const char* name;
+    SimOptions options;
+    Material material;
+    const char* says;
+  };
+  const Case cases[] = {
+      {"gravity 1e200", heavy, TestMaterial(), "right-hand side h (f + (h + damping) K v) has a norm beyond double range"},
+      {"damping 1e307", o, TestMaterial(sticky), "residual became non-finite after 0 CG iterations"}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    ClothSimulator sim(m, c.material, c.options, nullptr);
+    ExpectThrowContaining([&] { sim.Step(); }, "blew up at t = 0.0050 s (step 1)");
+    ExpectThrowContaining([&] { sim.Step(); }, c.says);  // stays failed, naming the cause
+    EXPECT_TRUE(sim.positions() == m.V);  // (the solve failed before the step moved anything)
+  }
 }
 
 TEST(ClothSimulatorTest, DeterministicAcrossInstancesAndThreads) {

@@ -51,6 +51,42 @@ std::string StripJsonComments(const std::string& text) {
   return out;
 }
 
+namespace {
+
+// Throws when arrays and objects nest deeper than kMaxJsonDepth, naming the line where the limit
+// is passed. A scan of its own, before the parser: nlohmann parses deep nesting fine, but copying,
+// comparing or printing the value recurses once per level (a scene whose "motions" were nested
+// 2,000,000 deep crashed the reader with a stack overflow). The parser callback knows the depth
+// too, but not the line.
+// Inputs: text  JSON with comments already blanked (StripJsonComments), so only strings need
+// skipping.
+void CheckNesting(const std::string& text) {
+  int depth = 0, line = 1;
+  bool in_string = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') ++line;
+    if (in_string) {
+      if (c == '\\') {
+        ++i;  // the escaped character (it may be a quote)
+        if (i < text.size() && text[i] == '\n') ++line;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        throw std::runtime_error("line " + std::to_string(line) + ": arrays and objects nested more than " +
+                                 std::to_string(kMaxJsonDepth) + " deep (no scene or material needs more than a few)");
+    } else if (c == ']' || c == '}') {
+      --depth;  // (unbalanced brackets are the parser's to name)
+    }
+  }
+}
+
+}  // namespace
+
 nlohmann::json ParseJsonWithComments(const std::string& text) {
   using json = nlohmann::json;
   // One entry per open object or array, outermost first: its keys so far (objects), its element
@@ -98,7 +134,9 @@ nlohmann::json ParseJsonWithComments(const std::string& text) {
     }
     return true;
   };
-  return json::parse(StripJsonComments(text), check);
+  const std::string stripped = StripJsonComments(text);
+  CheckNesting(stripped);
+  return json::parse(stripped, check);
 }
 
 }  // namespace clothwind::sim

@@ -56,5 +56,24 @@ TEST(ParseJsonWithComments, RefusesAKeyGivenTwiceInOneObjectNamingWhere) {
   EXPECT_THROW(ParseJsonWithComments("{\"a\": }"), nlohmann::json::parse_error);
 }
 
+TEST(ParseJsonWithComments, RefusesNestingDeeperThanTheLimitNamingTheLine) {
+  // Copying or printing a parsed value recurses once per level: 2,000,000 levels overflowed the
+  // stack of the scene reader. kMaxJsonDepth levels parse; one more is refused on its line.
+  auto nested = [](int depth) { return std::string(depth, '[') + std::string(depth, ']'); };
+  EXPECT_NO_THROW(ParseJsonWithComments("{\"a\":\n" + nested(kMaxJsonDepth - 1) + "}"));
+  try {
+    ParseJsonWithComments("{\"a\":\n\n" + nested(kMaxJsonDepth) + "}");
+    ADD_FAILURE() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("line 3: arrays and objects nested more than 256 deep"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(ParseJsonWithComments(nested(2000000)), std::runtime_error);
+  // Brackets in strings and comments are not nesting.
+  const std::string quoted = "{\"s\": \"" + std::string(1000, '[') + "\\\"\", // " + std::string(1000, '{') +
+                             "\n /* " + std::string(1000, '[') + " */ \"t\": 1}";
+  EXPECT_EQ(ParseJsonWithComments(quoted)["t"], 1);
+}
+
 }  // namespace
 }  // namespace clothwind::sim

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <mutex>
@@ -45,6 +46,17 @@ Eigen::Vector4d EvaluateStretchingSample(const Eigen::Matrix2d& G,
                       d[0][angle_id + 1] * (1 - strain_weight) * angle_weight +
                       d[1][angle_id + 1] * strain_weight * angle_weight;
   return 2.0 * k.cwiseMax(0.0);
+}
+
+// Area weights above this are no cloth (1000 kg/m^2: a 13 cm steel plate; fabrics weigh 0.05-1,
+// ArcSim's heaviest material 0.324), and far above it the step's numbers overflow.
+constexpr double kMaxAreaWeight = 1e3;  // [kg/m^2]
+
+// %g: std::to_string writes 1e200 as 201 digits.
+std::string Short(double v) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", v);
+  return text;
 }
 
 void CheckPositive(double value, const char* what) {
@@ -116,6 +128,10 @@ Material MakeMaterial(double density, const Eigen::Matrix<double, 6, 4>& stretch
   if (!bending.allFinite()) throw std::invalid_argument("material: bending table has non-finite values");
   Material m;
   m.density = density * mult.density * mult.thicken;
+  if (!(m.density <= kMaxAreaWeight))
+    throw std::invalid_argument("material: area weight after multipliers (density " + Short(density) + " x density_mult " +
+                                Short(mult.density) + " x thicken " + Short(mult.thicken) + ") = " + Short(m.density) +
+                                " kg/m^2 must be at most " + Short(kMaxAreaWeight) + " kg/m^2");
   m.stretching_scale = mult.stretching * mult.thicken;
   m.damping = mult.damping;
   // ArcSim's layout: d[0][*] = row 0 for every direction, d[1][i] = row i + 1.
@@ -125,6 +141,12 @@ Material MakeMaterial(double density, const Eigen::Matrix<double, 6, 4>& stretch
   }
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 5; ++j) m.bending[i][j] = bending(i, j) * mult.bending * mult.thicken;
+  // Finite tables times finite multipliers can still overflow (1e300 x 2), which surfaced only as
+  // a non-finite force at the first step, naming no field.
+  if (!std::isfinite(2 * m.stretching_scale * stretching.cwiseAbs().maxCoeff()))  // (samples: 2 k)
+    throw std::invalid_argument("material: stretching table x stretching_mult x thicken overflows");
+  if (!std::isfinite(bending.cwiseAbs().maxCoeff() * mult.bending * mult.thicken))
+    throw std::invalid_argument("material: bending table x bending_mult x thicken overflows");
   m.stretching_samples.resize(kSamples * kSamples * kSamples);
   for (int i = 0; i < kSamples; ++i)
     for (int j = 0; j < kSamples; ++j)
@@ -226,6 +248,9 @@ Material LoadArcSimMaterial(const std::string& path, const MaterialMultipliers& 
   if (!j.contains("density")) throw std::runtime_error(path + ": missing field 'density'");
   const double density = number(j["density"], "density");
   if (!(density > 0)) throw std::runtime_error(path + ": field 'density' must be > 0 [kg/m^2]");
+  if (!(density <= kMaxAreaWeight))
+    throw std::runtime_error(path + ": field 'density' is " + Short(density) + " kg/m^2, expected at most " +
+                             Short(kMaxAreaWeight) + " kg/m^2 (fabrics: 0.05-1)");
   const Eigen::Matrix<double, 6, 4> stretching = table("stretching", 6, 4);
   // Columns 0, 2 and 3 are the warp, weft and shear stiffnesses (1, their coupling, may be 0, as
   // in paper.json): each needs a value > 0 somewhere, or the cloth has none in that direction

@@ -60,7 +60,8 @@ struct Material {
 //   stretching  6 by 4 table [N/m] (row 0: unstretched; rows 1..5: 5 directions)
 //   bending     3 by 5 table [N m]
 //   mult        multipliers (thicken multiplies density, stretching and bending)
-// Throws std::invalid_argument on non-finite or non-positive values / multipliers.
+// Throws std::invalid_argument on non-finite or non-positive values / multipliers, an area weight
+// after multipliers above 1000 kg/m^2, or tables whose product with the multipliers overflows.
 Material MakeMaterial(double density, const Eigen::Matrix<double, 6, 4>& stretching,
                       const Eigen::Matrix<double, 3, 5>& bending,
                       const MaterialMultipliers& mult = {});

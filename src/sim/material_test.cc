@@ -126,6 +126,35 @@ TEST(MaterialTest, BadFilesFailNamingFileAndField) {
   ExpectThrowContaining([&] { LoadArcSimMaterial(unclosed); }, unclosed + ": ");
 }
 
+TEST(MaterialTest, AreaWeightsFarBeyondAnyClothAreRefusedNamingFileAndField) {
+  // A density of 1e200 kg/m^2 (a typo, a hostile file) loaded, and the simulation overflowed and
+  // silently never moved the cloth. At most 1000 kg/m^2, from the file and after multipliers.
+  const std::string rows = "[[1,2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4]]";
+  const std::string bend = "[[1,2,3,4,5],[1,2,3,4,5],[1,2,3,4,5]]";
+  auto file = [&](const std::string& name, const std::string& density) {
+    return WriteText(name, "{\"density\": " + density + ", \"stretching\": " + rows + ", \"bending\": " + bend + "}");
+  };
+  const std::string huge = file("huge.json", "1e200");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(huge); },
+                        huge + ": field 'density' is 1e+200 kg/m^2, expected at most 1000");
+  EXPECT_NO_THROW(LoadArcSimMaterial(file("heaviest.json", "1000")));
+  MaterialMultipliers thick;
+  thick.thicken = 1e4;  // x 0.2 = 2000 kg/m^2
+  const std::string light = file("light.json", "0.2");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(light, thick); }, light + ": material: area weight after multipliers");
+  thick.thicken = 5e3;  // 1000 kg/m^2: the limit itself
+  EXPECT_NO_THROW(LoadArcSimMaterial(light, thick));
+  // Tables whose product with the multipliers overflows: refused, not a non-finite force later.
+  MaterialMultipliers stiff;
+  stiff.stretching = 1e307;  // x 70 N/m
+  ExpectThrowContaining([&] { MakeMaterial(0.2, Table6x4(10), Table3x5(), stiff); }, "stretching table x stretching_mult");
+  MaterialMultipliers rigid;
+  rigid.bending = 1e308;  // x thicken 1e5 x 5e-4 N m (and the weight kept: density_mult 1e-5)
+  rigid.thicken = 1e5;
+  rigid.density = 1e-5;
+  ExpectThrowContaining([&] { MakeMaterial(0.2, Table6x4(10), Table3x5(), rigid); }, "bending table x bending_mult");
+}
+
 TEST(MaterialTest, IgnoredKeysAreNamed) {
   // A misspelt key ("bendng") or one of ArcSim's that is not simulated here loads with a warning
   // naming the file and key; the three read keys warn of nothing.

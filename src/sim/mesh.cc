@@ -1,6 +1,7 @@
 #include "sim/mesh.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -37,6 +38,40 @@ int ObjIndex(const std::string& token, int count, const std::string& path, int l
     ObjError(path, line, std::string(kind) + " index " + token + " out of range (have " +
                              std::to_string(count) + ")");
   return static_cast<int>(index);
+}
+
+// OBJ keywords that carry nothing this reader uses, skipped: the standard ones (normals, groups,
+// objects, smoothing, materials, lines and points, free-form geometry) and the per-node, edge and
+// face annotations ArcSim's save_obj writes (labels, plastic rest positions, velocities, ideal
+// angles, damage, plastic strains). Anything else is refused naming its line: 'F' or 'V' (wrong
+// case) used to be skipped silently, losing that face or vertex.
+bool IsIgnoredObjKeyword(const std::string& key) {
+  static const char* const kIgnored[] = {
+      // Wavefront OBJ
+      "vn", "vp", "o", "g", "s", "mg", "usemtl", "mtllib", "l", "p", "cstype", "deg", "bmat", "step", "curv",
+      "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con", "bevel", "c_interp", "d_interp", "lod",
+      "shadow_obj", "trace_obj", "ctech", "stech", "call", "csh",
+      // ArcSim 0.2 (io.cpp)
+      "vl", "ny", "nv", "nl", "e", "ea", "ed", "el", "ep", "tm", "tp", "ts", "td", "fl"};
+  for (const char* k : kIgnored)
+    if (key == k) return true;
+  return false;
+}
+
+// Splits `text` into lines ending in "\n", "\r\n" or a lone "\r" (files saved by old Mac tools:
+// read with getline('\n') such a file was one line, and an OBJ whose first line is a comment
+// read as "no vertices"). The line terminators are dropped.
+std::vector<std::string> SplitLines(const std::string& text) {
+  std::vector<std::string> lines;
+  size_t start = 0;
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '\n' && text[i] != '\r') continue;
+    lines.push_back(text.substr(start, i - start));
+    if (text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;
+    start = i + 1;
+  }
+  if (start < text.size()) lines.push_back(text.substr(start));
+  return lines;
 }
 
 double TriangleArea3(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
@@ -97,14 +132,18 @@ class EdgeMidpoints {
 }  // namespace
 
 Mesh ReadObj(const std::string& path, bool topology) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open OBJ file");
+  std::ostringstream contents;
+  contents << in.rdbuf();
+  std::string text = contents.str();
+  // A UTF-8 byte order mark (Windows editors write one) would glue itself to the first keyword.
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
   std::vector<Eigen::Vector3d> positions;
   std::vector<Eigen::Vector2d> texcoords;
   std::vector<Eigen::Vector3i> faces;
   std::vector<Eigen::Vector3i> face_tex;  // -1 when a corner has no vt
   std::vector<int> face_lines;            // the line of each triangle's f
-  std::string line;
   int line_no = 0;
   auto read_numbers = [&](std::istringstream& s, int n, double* out, const char* what) {
     for (int i = 0; i < n; ++i) {
@@ -121,7 +160,7 @@ Mesh ReadObj(const std::string& path, bool topology) {
         ObjError(path, line_no, std::string("non-finite value '") + tok + "' in '" + what + "'");
     }
   };
-  while (std::getline(in, line)) {
+  for (const std::string& line : SplitLines(text)) {
     ++line_no;
     std::istringstream s(line);
     std::string key;
@@ -159,8 +198,13 @@ Mesh ReadObj(const std::string& path, bool topology) {
         face_tex.emplace_back(ti[0], ti[k - 1], ti[k]);
         face_lines.push_back(line_no);
       }
+    } else if (!IsIgnoredObjKeyword(key)) {
+      std::string lower = key;
+      std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+      const bool known = lower == "v" || lower == "vt" || lower == "f" || IsIgnoredObjKeyword(lower);
+      ObjError(path, line_no, "unknown keyword '" + key + "'" +
+                                  (known ? " (OBJ keywords are lower case: '" + lower + "')" : ""));
     }
-    // Other keywords (vn, g, o, s, usemtl, ArcSim's nv/ny/...) carry nothing we simulate.
   }
   if (positions.empty()) throw std::runtime_error(path + ": no vertices ('v' lines)");
   if (faces.empty()) throw std::runtime_error(path + ": no faces ('f' lines)");

@@ -21,7 +21,11 @@ struct Mesh {
 
 // Reads a Wavefront OBJ: `v x y z`, optional `vt u v`, `f a b c ...` (also a/t, a/t/n, a//n;
 // polygons are fan-triangulated; negative (relative) indices are accepted). Without `vt`, U is
-// the x,y of the positions (ArcSim's rule). The result is validated (ValidateMesh).
+// the x,y of the positions (ArcSim's rule). The result is validated (ValidateMesh). Lines may end
+// in LF, CRLF or a lone CR, and a UTF-8 byte order mark at the start is skipped. Other standard
+// OBJ keywords (vn, o, g, s, usemtl, mtllib, l, ...) and ArcSim's annotations (vl, nv, ny, e, tm,
+// ...) are skipped; any other keyword (e.g. 'F', 'V': OBJ is case-sensitive) is an error naming
+// its line, rather than a face or vertex silently lost.
 // Inputs:
 //   path  file to read
 // Returns the mesh. Throws std::runtime_error naming path:line and what was expected on bad input.

@@ -99,6 +99,61 @@ TEST(ObjTest, BadInputsFailWithFileAndLine) {
   ExpectThrowContaining([&] { ReadObj(short_face); }, short_face + ":3: a face needs at least 3");
 }
 
+TEST(ObjTest, ByteOrderMarkAndAnyLineEndingReadTheSameMesh) {
+  // A UTF-8 byte order mark glued itself to the first keyword ("\xEF\xBB\xBFv", skipped: every
+  // vertex index was then one off), and a file with old-Mac CR line endings read as one line.
+  const std::string lines[] = {"v 0 0 0", "v 1 0 0", "v 1 1 0", "v 0 1 0", "# a unit square", "vt 0 0", "vt 1 0",
+                               "vt 1 1", "vt 0 1", "f 1/1 2/2 3/3", "f 1/1 3/3 4/4"};
+  auto joined = [&](const std::string& eol) {
+    std::string text;
+    for (const std::string& l : lines) text += l + eol;
+    return text;
+  };
+  const Mesh reference = ReadObj(WriteText("lf.obj", joined("\n")));
+  ASSERT_EQ(reference.V.rows(), 4);
+  ASSERT_EQ(reference.F.rows(), 2);
+  const std::pair<const char*, std::string> variants[] = {
+      {"bom.obj", "\xEF\xBB\xBF" + joined("\n")},
+      {"crlf.obj", joined("\r\n")},
+      {"cr.obj", joined("\r")},
+      {"bom_cr_no_final_eol.obj", "\xEF\xBB\xBF" + joined("\r").substr(0, joined("\r").size() - 1)},
+  };
+  for (const auto& [name, text] : variants) {
+    SCOPED_TRACE(name);
+    const Mesh m = ReadObj(WriteText(name, text));
+    EXPECT_EQ(m.V, reference.V);
+    EXPECT_EQ(m.U, reference.U);
+    EXPECT_EQ(m.F, reference.F);
+  }
+  // Lines are still counted one per line ending (CRLF is one), so errors name the right one.
+  const std::string cr_bad = WriteText("cr_bad.obj", "v 0 0 0\rv 1 0 0\r\rv 0 1 0\rf 1 2 9\r");
+  ExpectThrowContaining([&] { ReadObj(cr_bad); }, cr_bad + ":5: vertex index 9 out of range");
+  const std::string crlf_bad = WriteText("crlf_bad.obj", "v 0 0 0\r\nv 1 0 0\r\n\r\nv 0 1 0\r\nf 1 2 9\r\n");
+  ExpectThrowContaining([&] { ReadObj(crlf_bad); }, crlf_bad + ":5: vertex index 9 out of range");
+}
+
+TEST(ObjTest, UnknownKeywordsAreErrorsNamingTheLineAndKnownOnesAreSkipped) {
+  // OBJ is case-sensitive: an 'F' line was skipped silently (the mesh lost that face), a 'V' line
+  // too (every later index then pointed one vertex off).
+  const std::string upper_f = WriteText("upper_f.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nF 1 2 3\n");
+  ExpectThrowContaining([&] { ReadObj(upper_f); },
+                        upper_f + ":4: unknown keyword 'F' (OBJ keywords are lower case: 'f')");
+  const std::string upper_v = WriteText("upper_v.obj", "v 0 0 0\nV 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  ExpectThrowContaining([&] { ReadObj(upper_v); }, upper_v + ":2: unknown keyword 'V'");
+  const std::string typo = WriteText("typo.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nface 1 2 3\n");
+  ExpectThrowContaining([&] { ReadObj(typo); }, typo + ":4: unknown keyword 'face'");
+  // What exporters and ArcSim's save_obj write beside v, vt and f is skipped.
+  const std::string rich = WriteText("rich.obj",
+                                     "# exported\nmtllib cloth.mtl\no Cloth\ng flag\ns off\nusemtl red\n"
+                                     "v 0 0 0\nnv 0 0 1\nnl 1\nv 1 0 0\nny 1 0 0\nv 0 1 0\nvl 2\nvt 0 0\nvt 1 0\n"
+                                     "vt 0 1\nvn 0 0 1\nvp 0.5\ne 1 2\nea 0.1\ned 0\nel 3\nep 1\n"
+                                     "f 1/1/1 2/2/1 3/3/1\ntm 0\ntp 1 0 0 0 1 0 0 0 1\nts 1 0 0 0 1 0 0 0 1\ntd 0\n"
+                                     "l 1 2\np 3\n");
+  const Mesh m = ReadObj(rich);
+  EXPECT_EQ(m.V.rows(), 3);
+  EXPECT_EQ(m.F.rows(), 1);
+}
+
 TEST(ValidateMeshTest, RejectsNaNRangeAndDegenerate) {
   Mesh m = Rectangle();
   m.V(1, 2) = std::numeric_limits<double>::quiet_NaN();

@@ -1,6 +1,7 @@
 #include "sim/scene.h"
 
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <algorithm>
 #include <cmath>
@@ -19,6 +20,19 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+
+// Physically sane ranges. A value far outside them is a typo or a hostile file, and the numbers
+// downstream overflow: with gravity 1e200 the solve's residual norm was inf / inf = NaN, which
+// ended the solve at once, and the scene ran to its end (exit 0) with a cloth that never moved.
+// Every scene in config/ and ArcSim's own are far inside (gravity 9.8, wind <= 10 m/s, thicken 2,
+// multipliers 1).
+constexpr double kMaxAcceleration = 1000;  // |gravity| [m/s^2]: 100 g
+constexpr double kMaxWindSpeed = 1000;     // |wind velocity|, gust amplitude [m/s]: 3x the speed of sound
+constexpr double kMaxMultiplier = 1e6;     // thicken and the density/stretching/bending multipliers
+constexpr double kMaxDamping = 1000;       // stiffness-proportional damping [s] (cloth: ~0.01 s)
+constexpr double kMaxAirDensity = 1e4;     // wind density [kg/m^3] (water: 1000)
+constexpr double kMaxAirDrag = 1e6;        // wind drag [kg/(m^2 s)]
+constexpr double kMaxTurbulence = 10;      // turbulence intensity and component ratios (~0.1-0.3 outdoors)
 
 const char* TypeName(const json& j) { return j.type_name(); }
 
@@ -101,6 +115,32 @@ class Reader {
     const auto v = Numbers(j, path, 3, 3);
     return {v[0], v[1], v[2]};
   }
+  // A 3-vector whose length is at most max_norm (`unit` names it in the message).
+  Eigen::Vector3d BoundedVector3(const json& j, const std::string& path, double max_norm, const char* unit) const {
+    const Eigen::Vector3d v = Vector3(j, path);
+    const double length = v.stableNorm();  // (norm() overflows to inf from ~1e154 on)
+    if (!(length <= max_norm))
+      Fail(path, "expected a length of at most " + Short(max_norm) + " " + unit + ", got " + Short(length));
+    return v;
+  }
+  // A number in (0, max].
+  double PositiveAtMost(const json& j, const std::string& path, double max, const char* unit = "") const {
+    const double v = Positive(j, path);
+    if (!(v <= max)) Fail(path, "expected a number in (0, " + Short(max) + "]" + unit + ", got " + Short(v));
+    return v;
+  }
+  // A number in [0, max].
+  double NonNegativeAtMost(const json& j, const std::string& path, double max, const char* unit = "") const {
+    const double v = NonNegative(j, path);
+    if (!(v <= max)) Fail(path, "expected a number in [0, " + Short(max) + "]" + unit + ", got " + Short(v));
+    return v;
+  }
+  // %g: std::to_string writes 1e200 as 201 digits.
+  static std::string Short(double v) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%g", v);
+    return text;
+  }
   // A file named in the scene, resolved (ResolveScenePath) and required to exist.
   std::string File(const json& j, const std::string& path) const {
     const std::string rel = String(j, path);
@@ -154,13 +194,17 @@ SceneMaterial ParseMaterial(const Reader& r, const json& j, const std::string& p
   SceneMaterial m;
   if (!j.contains("data")) r.Fail(path + ".data", "missing (the material JSON file)");
   m.data = r.File(j["data"], path + ".data");
-  if (j.contains("thicken")) m.thicken = r.Positive(j["thicken"], path + ".thicken");
-  if (j.contains("density_mult")) m.density_mult = r.Positive(j["density_mult"], path + ".density_mult");
-  if (j.contains("stretching_mult")) {
-    m.stretching_mult = r.Positive(j["stretching_mult"], path + ".stretching_mult");
+  if (j.contains("thicken")) m.thicken = r.PositiveAtMost(j["thicken"], path + ".thicken", kMaxMultiplier);
+  if (j.contains("density_mult")) {
+    m.density_mult = r.PositiveAtMost(j["density_mult"], path + ".density_mult", kMaxMultiplier);
   }
-  if (j.contains("bending_mult")) m.bending_mult = r.Positive(j["bending_mult"], path + ".bending_mult");
-  if (j.contains("damping")) m.damping = r.NonNegative(j["damping"], path + ".damping");
+  if (j.contains("stretching_mult")) {
+    m.stretching_mult = r.PositiveAtMost(j["stretching_mult"], path + ".stretching_mult", kMaxMultiplier);
+  }
+  if (j.contains("bending_mult")) {
+    m.bending_mult = r.PositiveAtMost(j["bending_mult"], path + ".bending_mult", kMaxMultiplier);
+  }
+  if (j.contains("damping")) m.damping = r.NonNegativeAtMost(j["damping"], path + ".damping", kMaxDamping, " s");
   if (j.contains("strain_limits")) {
     const auto v = r.Numbers(j["strain_limits"], path + ".strain_limits", 2, 2);
     if (!StrainLimitsAreValid(v[0], v[1])) {
@@ -292,12 +336,15 @@ TurbulenceParams ParseTurbulence(const Reader& r, const json& j, const std::stri
   r.ExpectObject(j, path);
   r.CheckKeys(j, path, {"intensity", "length_scale", "component_ratios", "modes", "seed"});
   TurbulenceParams t;
-  if (j.contains("intensity")) t.intensity = r.NonNegative(j["intensity"], path + ".intensity");
+  if (j.contains("intensity")) {
+    t.intensity = r.NonNegativeAtMost(j["intensity"], path + ".intensity", kMaxTurbulence, " (sigma / mean speed)");
+  }
   if (j.contains("length_scale")) t.length_scale = r.Positive(j["length_scale"], path + ".length_scale");
   if (j.contains("component_ratios")) {
     const auto v = r.Numbers(j["component_ratios"], path + ".component_ratios", 3, 3);
     for (int i = 0; i < 3; ++i) {
-      if (v[i] < 0) r.Fail(path + ".component_ratios", "ratios must be >= 0");
+      if (!(v[i] >= 0 && v[i] <= kMaxTurbulence))
+        r.Fail(path + ".component_ratios", "ratios must be in [0, " + Reader::Short(kMaxTurbulence) + "]");
       t.component_ratios[i] = v[i];
     }
   }
@@ -314,7 +361,12 @@ GustParams ParseGusts(const Reader& r, const json& j, const std::string& path) {
   r.CheckKeys(j, path, {"rate", "amplitude", "amplitude_spread", "duration", "horizon", "seed"});
   GustParams g;
   if (j.contains("rate")) g.rate = r.NonNegative(j["rate"], path + ".rate");
-  if (j.contains("amplitude")) g.amplitude = r.Number(j["amplitude"], path + ".amplitude");
+  if (j.contains("amplitude")) {
+    g.amplitude = r.Number(j["amplitude"], path + ".amplitude");
+    if (!(std::abs(g.amplitude) <= kMaxWindSpeed))
+      r.Fail(path + ".amplitude", "expected at most " + Reader::Short(kMaxWindSpeed) + " m/s in magnitude, got " +
+                                      Reader::Short(g.amplitude));
+  }
   if (j.contains("amplitude_spread")) {
     g.amplitude_spread = r.NonNegative(j["amplitude_spread"], path + ".amplitude_spread");
     if (g.amplitude_spread > 1) r.Fail(path + ".amplitude_spread", "expected a number in [0, 1]");
@@ -334,9 +386,11 @@ WindSpec ParseWind(const Reader& r, const json& j, const std::string& path) {
   r.ExpectObject(j, path);
   r.CheckKeys(j, path, {"velocity", "density", "drag", "shear", "turbulence", "gusts"});
   WindSpec w;
-  if (j.contains("velocity")) w.velocity = r.Vector3(j["velocity"], path + ".velocity");
-  if (j.contains("density")) w.density = r.NonNegative(j["density"], path + ".density");
-  if (j.contains("drag")) w.drag = r.NonNegative(j["drag"], path + ".drag");
+  if (j.contains("velocity")) w.velocity = r.BoundedVector3(j["velocity"], path + ".velocity", kMaxWindSpeed, "m/s");
+  if (j.contains("density")) {
+    w.density = r.NonNegativeAtMost(j["density"], path + ".density", kMaxAirDensity, " kg/m^3");
+  }
+  if (j.contains("drag")) w.drag = r.NonNegativeAtMost(j["drag"], path + ".drag", kMaxAirDrag, " kg/(m^2 s)");
   if (j.contains("shear")) w.shear = ParseShear(r, j["shear"], path + ".shear");
   if (j.contains("turbulence")) w.turbulence = ParseTurbulence(r, j["turbulence"], path + ".turbulence");
   if (j.contains("gusts")) w.gusts = ParseGusts(r, j["gusts"], path + ".gusts");
@@ -485,7 +539,7 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
       }
     }
   }
-  if (j.contains("gravity")) s.gravity = r.Vector3(j["gravity"], "gravity");
+  if (j.contains("gravity")) s.gravity = r.BoundedVector3(j["gravity"], "gravity", kMaxAcceleration, "m/s^2");
   if (j.contains("wind")) s.wind = ParseWind(r, j["wind"], "wind");
   // Gusts are drawn up to their horizon and none come after it: unless the scene sets one,
   // Simulate draws them over the whole run; a horizon set shorter than the scene says so.

@@ -324,6 +324,56 @@ TEST_F(SceneFiles, WrongTypesNameTheJsonPathAndFile) {
   ExpectErrorNaming([&] { LoadScene(l); }, {l, "wind.gusts.rate", "at most 1e6 gusts"});
 }
 
+TEST_F(SceneFiles, PhysicallyAbsurdMagnitudesAreRefusedNamingFileAndField) {
+  // gravity 1e200, thicken 1e300, wind 1e300: each loaded, the solve's numbers overflowed, and the
+  // scene ran to its end (exit 0) with a cloth that never moved. Each is refused by its key, and
+  // the largest sane values still load.
+  struct Case {
+    std::string name, text, key, says;
+  };
+  const std::vector<Case> cases = {
+      {"gravity", Replace(SceneText(), "[0, 0, -9.8]", "[0, 0, -1e200]"), "gravity", "at most 1000 m/s^2"},
+      {"gravity_norm", Replace(SceneText(), "[0, 0, -9.8]", "[600, 600, -600]"), "gravity", "at most 1000 m/s^2"},
+      {"thicken", Replace(SceneText(), "\"thicken\": 2", "\"thicken\": 1e300"), "cloths[0].materials[0].thicken",
+       "(0, 1e+06]"},
+      {"density_mult", Replace(SceneText(), "\"thicken\": 2", "\"density_mult\": 2e6"),
+       "cloths[0].materials[0].density_mult", "(0, 1e+06]"},
+      {"stretching_mult", Replace(SceneText(), "\"thicken\": 2", "\"stretching_mult\": 1e7"),
+       "cloths[0].materials[0].stretching_mult", "(0, 1e+06]"},
+      {"bending_mult", Replace(SceneText(), "\"thicken\": 2", "\"bending_mult\": 1e7"),
+       "cloths[0].materials[0].bending_mult", "(0, 1e+06]"},
+      {"damping", Replace(SceneText(), "\"thicken\": 2", "\"damping\": 1e300"), "cloths[0].materials[0].damping",
+       "[0, 1000] s"},
+      {"wind", SceneText(", \"wind\": {\"velocity\": [1e300, 0, 0]}"), "wind.velocity", "at most 1000 m/s"},
+      {"gusts", SceneText(", \"wind\": {\"gusts\": {\"amplitude\": -2000}}"), "wind.gusts.amplitude", "1000 m/s"},
+      {"turbulence", SceneText(", \"wind\": {\"turbulence\": {\"intensity\": 1e300}}"), "wind.turbulence.intensity",
+       "[0, 10]"},
+      {"air", SceneText(", \"wind\": {\"density\": 1e300}"), "wind.density", "kg/m^3"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path = Write("conf/" + c.name + ".json", c.text);
+    ExpectErrorNaming([&] { LoadScene(path); }, {path, c.key, c.says});
+  }
+  const std::string edge = Write("conf/edge.json", Replace(Replace(SceneText(", \"wind\": {\"velocity\": [0, 0, 1000], "
+                                                                            "\"gusts\": {\"amplitude\": 1000}}"),
+                                                                  "[0, 0, -9.8]", "[0, 0, -1000]"),
+                                                          "\"thicken\": 2", "\"thicken\": 1e6, \"density_mult\": 1e-6"));
+  const Scene s = LoadScene(edge);
+  EXPECT_EQ(s.gravity.z(), -1000);
+  EXPECT_EQ(s.cloths[0].materials[0].thicken, 1e6);
+}
+
+TEST_F(SceneFiles, JsonNestedMillionsDeepIsRefusedNamingTheLine) {
+  // A "motions" value nested 2,000,000 deep parsed, then the scene reader's copy of it recursed
+  // once per level and overflowed the stack (a crash, no message).
+  const size_t deep = 2000000;
+  const std::string nested = std::string(deep, '[') + std::string(deep, ']');
+  const std::string path = Write("conf/deep.json", Replace(SceneText(), "\"gravity\"", "\n\"motions\": [" + nested +
+                                                                                           "],\n  \"gravity\""));
+  ExpectErrorNaming([&] { LoadScene(path); }, {path + ": line 6: ", "nested more than 256 deep"});
+}
+
 TEST_F(SceneFiles, AKeyGivenTwiceIsRefusedNamingItsObject) {
   // A strict parser keeps the last of two: the scene ran with frame_steps 1000, unseen.
   const std::string a = Write("conf/a.json", SceneText(", \"frame_steps\": 1000"));
