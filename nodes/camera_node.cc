@@ -107,7 +107,6 @@ int main(int argc, char** argv) {
     return 1;
   }
   params.Known("diagnostic_period");  // diagnostic_updater's
-  params.WarnUnread("camera_node");
 
   RosClock clock;
   std::string error;
@@ -144,6 +143,9 @@ int main(int argc, char** argv) {
   }
   image_transport::ImageTransport transport(nh);
   image_transport::CameraPublisher publisher = transport.advertiseCamera("camera/image_raw", 1);
+  // After advertising: a node named "camera" publishes /camera/image_raw, where image_transport's
+  // plugins keep their parameters (~image_raw/compressed/...), which are not misspelt keys.
+  params.WarnUnread("camera_node");
 
   diagnostic_updater::Updater updater;
   clothwind::ros_bridge::WallDiagnostics wall_diagnostics(&updater);  // every wall second

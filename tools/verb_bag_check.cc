@@ -164,12 +164,12 @@ int Check(const BagCheckArgs& a) {
     // A message whose bytes do not deserialise (a length field that overruns) threw a bare
     // "Buffer Overrun" naming nothing; messages beyond 1 GiB are refused before reading.
     if (m.size() > (1u << 30))
-      throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " on " + m.getTopic() + " is " +
+      throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " of the bag (on " + m.getTopic() + ")" + " is " +
                                std::to_string(m.size()) + " bytes (a corrupt record?)");
     try {
       NoteMessage(m, s, t, a, decoder);
     } catch (const ros::Exception& e) {
-      throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " on " + m.getTopic() + " (" +
+      throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " of the bag (on " + m.getTopic() + ")" + " (" +
                                m.getDataType() + ", bag time " + std::to_string(t) + " s) does not deserialise: " +
                                e.what());
     }

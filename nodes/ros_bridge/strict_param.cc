@@ -1,5 +1,7 @@
 #include "ros_bridge/strict_param.h"
 
+#include <ros/this_node.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -42,7 +44,7 @@ std::string Shown(const XmlRpcValue& v) {
 // or a launch file's value made a string with type="str".
 std::string Hint(const XmlRpcValue& v, const std::string& expected) {
   if (v.getType() == XmlRpcValue::TypeString && expected != "string")
-    return " (a number in quotes? write it without them in YAML, and without type=\"str\" in a launch file)";
+    return " (a value in quotes? write it without them in YAML, and without type=\"str\" in a launch file)";
   if (expected == "string" && (v.getType() == XmlRpcValue::TypeDouble || v.getType() == XmlRpcValue::TypeBoolean))
     return " (roslaunch and rosparam read a value that looks like a number or a bool as one: give it as "
            "<param type=\"str\"> in a launch file, or quote it in YAML)";
@@ -171,7 +173,13 @@ bool StrictParams::Has(const std::string& name) {
 void StrictParams::WarnUnread(const std::string& who) const {
   std::vector<std::string> names;
   if (!ros::param::getParamNames(names)) return;  // no master to ask: nothing to say
-  const std::vector<std::string> unread = UnreadParams(names, pnh_.getNamespace(), asked_);
+  // A topic this node advertises under its private namespace (sdn_node's ~power) is where
+  // image_transport's plugins keep their parameters (~power/compressed/...): not a misspelling.
+  std::set<std::string> known = asked_;
+  std::vector<std::string> topics;
+  ros::this_node::getAdvertisedTopics(topics);
+  for (const std::string& t : UnreadParams(topics, pnh_.getNamespace(), {})) known.insert(t.substr(1));
+  const std::vector<std::string> unread = UnreadParams(names, pnh_.getNamespace(), known);
   if (unread.empty()) return;
   std::string list;
   for (const std::string& u : unread) list += (list.empty() ? "" : ", ") + u;

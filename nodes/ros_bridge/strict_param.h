@@ -78,7 +78,9 @@ class StrictParams {
   void Known(const std::string& name) { asked_.insert(name); }
 
   // Warns once, prefixed with `who`, naming the private parameters that are set and that neither
-  // Get, Has nor Known asked for. Call after the node has read its parameters.
+  // Get, Has nor Known asked for, nor that name a topic the node advertises (image_transport's
+  // plugins keep their parameters under it). Call after the node has read its parameters and
+  // advertised its topics.
   void WarnUnread(const std::string& who) const;
 
  private:

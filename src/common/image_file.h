@@ -4,15 +4,14 @@
 // a dataset reader or a replay that takes it trains on, or publishes, the made-up part. A JPEG
 // must therefore carry its start- and end-of-image markers, and its entropy-coded data must decode
 // without a libjpeg warning (a file damaged in its middle keeps both markers and decodes into
-// made-up blocks, with only "Corrupt JPEG data" on stderr, naming no file). Header-only
-// (OpenCV's imgcodecs and libjpeg, which the clothwind_common target links).
+// made-up blocks, with only "Corrupt JPEG data" on stderr, naming no file). The check costs about
+// half a grey decode again (libjpeg entropy-decodes every colour component). OpenCV's imgcodecs,
+// and libjpeg in image_file.cc.
 #ifndef CLOTHWIND_COMMON_IMAGE_FILE_H_
 #define CLOTHWIND_COMMON_IMAGE_FILE_H_
 
-#include <csetjmp>
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>  // jpeglib.h needs FILE
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -21,8 +20,6 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
-
-#include <jpeglib.h>
 
 namespace clothwind::common {
 
@@ -48,55 +45,15 @@ inline std::string JpegWholeness(const uint8_t* data, size_t n) {
   return "truncated: no end-of-image marker after its last scan (" + std::to_string(n) + " bytes)";
 }
 
-namespace internal {
-
-// libjpeg's error manager, with the first message kept and errors turned into a longjmp (its
-// default error_exit calls exit()). Plain data: longjmp skips no destructor.
-struct JpegErrors {
-  jpeg_error_mgr pub;  // first: libjpeg hands back &pub as the j_common_ptr's err
-  std::jmp_buf jump;
-  int warnings;
-  char first[JMSG_LENGTH_MAX];
-};
-
-inline void JpegErrorExit(j_common_ptr c) {
-  auto* e = reinterpret_cast<JpegErrors*>(c->err);
-  (*c->err->format_message)(c, e->first);
-  std::longjmp(e->jump, 1);
-}
-
-// level < 0: a warning (corrupt data); >= 0: trace messages, ignored as libjpeg's default does.
-inline void JpegEmitMessage(j_common_ptr c, int level) {
-  if (level >= 0) return;
-  auto* e = reinterpret_cast<JpegErrors*>(c->err);
-  if (e->warnings++ == 0) (*c->err->format_message)(c, e->first);
-}
-
-}  // namespace internal
-
-// Entropy-decodes a JPEG's data (its DCT coefficients; no inverse DCT, no colour conversion,
-// about a third of a full decode) and reports the first warning or error libjpeg raised.
+// Entropy-decodes a JPEG's data (its DCT coefficients; no inverse DCT, no colour conversion) and
+// reports the first warning or error libjpeg raised (common/image_file.cc). An image that claims
+// more than kMaxJpegPixels is refused from its header, before libjpeg sets aside its coefficients
+// (a 1 kB file claiming 40000x40000 took 3 GB; OpenCV refuses such a file at once).
 // Inputs: data, n  the encoded bytes (a JPEG: LooksLikeJpeg).
 // Output: "" when the data decoded cleanly, else libjpeg's message, e.g.
 //   "Corrupt JPEG data: 99 extraneous bytes before marker 0xd9".
-inline std::string JpegDataProblem(const uint8_t* data, size_t n) {
-  internal::JpegErrors errors{};
-  jpeg_decompress_struct info{};
-  info.err = jpeg_std_error(&errors.pub);
-  errors.pub.error_exit = internal::JpegErrorExit;
-  errors.pub.emit_message = internal::JpegEmitMessage;
-  if (setjmp(errors.jump)) {
-    jpeg_destroy_decompress(&info);
-    return errors.first;
-  }
-  jpeg_create_decompress(&info);
-  jpeg_mem_src(&info, data, static_cast<unsigned long>(n));
-  jpeg_read_header(&info, TRUE);
-  jpeg_read_coefficients(&info);
-  jpeg_finish_decompress(&info);
-  jpeg_destroy_decompress(&info);
-  return errors.warnings > 0 ? std::string(errors.first) : std::string();
-}
+constexpr uint64_t kMaxJpegPixels = uint64_t{1} << 30;  // OpenCV's CV_IO_MAX_IMAGE_PIXELS
+std::string JpegDataProblem(const uint8_t* data, size_t n);
 
 // Reads and decodes an image file as cv::imread(path, flags) does, refusing a JPEG that is not
 // whole (JpegWholeness) or whose data libjpeg finds corrupt (JpegDataProblem), and catching OpenCV's exceptions (a header claiming more pixels than it

@@ -61,6 +61,23 @@ TEST_F(ImageFileTest, AJpegDamagedInItsMiddleIsRefusedWhereImreadMakesBlocksUp) 
   EXPECT_EQ(JpegDataProblem(jpeg_.data(), jpeg_.size()), "");  // the undamaged file
 }
 
+TEST_F(ImageFileTest, AJpegClaimingAHugeImageIsRefusedFromItsHeader) {
+  // A 64x48 file whose frame header says 40000x40000: libjpeg set aside the coefficients of the
+  // size claimed (3 GB) before finding the data short. Refused from the header, as imread does.
+  std::vector<uint8_t> claim = jpeg_;
+  size_t sof = 0;
+  for (size_t i = 2; i + 9 < claim.size(); ++i)
+    if (claim[i] == 0xFF && (claim[i + 1] == 0xC0 || claim[i + 1] == 0xC2)) sof = i;
+  ASSERT_GT(sof, 0u);
+  for (const size_t at : {sof + 5, sof + 7}) {  // height, then width, big-endian
+    claim[at] = 40000 >> 8;
+    claim[at + 1] = 40000 & 0xFF;
+  }
+  std::string why;
+  EXPECT_TRUE(ReadImageFile(Write("claim.jpg", claim), cv::IMREAD_GRAYSCALE, &why).empty());
+  EXPECT_NE(why.find("its header claims 40000x40000 pixels"), std::string::npos) << why;
+}
+
 TEST_F(ImageFileTest, AJpegCutShortIsRefusedWhereImreadMakesRowsUp) {
   std::vector<uint8_t> cut(jpeg_.begin(), jpeg_.begin() + jpeg_.size() / 2);
   const fs::path p = Write("cut.jpg", cut);

@@ -374,7 +374,7 @@ TEST(SessionBagTest, BagCheckNamesADamagedBag) {
     std::ofstream(dir / "overrun.bag", std::ios::binary) << bytes;
     const auto [rc, out] = check((dir / "overrun.bag").string(), "overrun");
     EXPECT_NE(rc, 0);
-    EXPECT_NE(out.find((dir / "overrun.bag").string() + ": message 1 on /camera/image_raw (sensor_msgs/Image"),
+    EXPECT_NE(out.find((dir / "overrun.bag").string() + ": message 1 of the bag (on /camera/image_raw) (sensor_msgs/Image"),
               std::string::npos)
         << out;
   }

@@ -141,6 +141,24 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
       throw std::runtime_error(where + ": field \"" + key + "\" must be an integer, got " + v.dump());
     return v.get<int>();
   };
+  // The kind of every field read with get<> below, checked first: a wrong one threw nlohmann's
+  // "type must be boolean, but is string", naming the file but not the field.
+  if (j.is_object()) {
+    using Is = bool (nlohmann::json::*)() const noexcept;
+    static const std::pair<Is, const char*> kBoolean{&nlohmann::json::is_boolean, "true or false"},
+        kNumber{&nlohmann::json::is_number, "a number"}, kString{&nlohmann::json::is_string, "a string"};
+    static const std::pair<const char*, const std::pair<Is, const char*>*> kFields[] = {
+        {"format", &kString},       {"arch", &kString},          {"flow", &kBoolean},
+        {"colour", &kBoolean},      {"include_dc", &kBoolean},   {"mean_map", &kBoolean},
+        {"local_peaks", &kBoolean}, {"phase_steps", &kBoolean},  {"mode_shape", &kBoolean},
+        {"stem_pool", &kBoolean},   {"coord_maps", &kBoolean},   {"flips_in_training", &kBoolean},
+        {"dropout", &kNumber},      {"frame_rate", &kNumber},    {"label_mean", &kNumber},
+        {"label_std", &kNumber},    {"std_scale", &kNumber}};
+    for (const auto& [key, kind] : kFields) {
+      if (j.contains(key) && !(j[key].*(kind->first))())
+        throw std::runtime_error(where + ": field \"" + key + "\" must be " + kind->second + ", got " + j[key].dump());
+    }
+  }
   ModelConfig c;
   try {
     if (need("format").get<std::string>() != "clothwind-model") {

@@ -8,6 +8,7 @@
 #include <functional>
 #include <random>
 #include <sstream>
+#include <tuple>
 #include <unistd.h>
 
 #include <ATen/ATen.h>
@@ -691,6 +692,24 @@ TEST(ModelConfig, IntegerFieldsMustBeWholeNumbersWithinRange) {
       ADD_FAILURE() << key << " = " << value.dump() << " was accepted";
     } catch (const std::runtime_error& e) {
       EXPECT_NE(std::string(e.what()).find("m.json: field \"" + key + "\" must be an integer"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+TEST(ModelConfig, FieldsOfAnotherKindAreRefusedNamingTheField) {
+  // nlohmann's own "type must be boolean, but is string" named the file, not the field.
+  const nlohmann::json good = ToJson(TinySdn());
+  for (const auto& [key, value, kind] : std::vector<std::tuple<std::string, nlohmann::json, std::string>>{
+           {"format", 7, "a string"}, {"flow", "no", "true or false"}, {"label_std", "1", "a number"},
+           {"include_dc", 1, "true or false"}}) {
+    nlohmann::json j = good;
+    j[key] = value;
+    try {
+      ModelConfigFromJson(j, "m.json");
+      ADD_FAILURE() << key << " = " << value.dump() << " was accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("m.json: field \"" + key + "\" must be " + kind), std::string::npos)
           << e.what();
     }
   }

@@ -52,7 +52,9 @@ bool IsIgnoredObjKeyword(const std::string& key) {
       "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con", "bevel", "c_interp", "d_interp", "lod",
       "shadow_obj", "trace_obj", "ctech", "stech", "call", "csh",
       // ArcSim 0.2 (io.cpp)
-      "vl", "ny", "nv", "nl", "e", "ea", "ed", "el", "ep", "tm", "tp", "ts", "td", "fl"};
+      "vl", "ny", "nv", "nl", "e", "ea", "ed", "el", "ep", "tm", "tp", "ts", "td", "fl",
+      // ArcSim's face labels: save_obj writes "tl", load_obj also reads "fs" and "fd"
+      "tl", "fs", "fd"};
   for (const char* k : kIgnored)
     if (key == k) return true;
   return false;

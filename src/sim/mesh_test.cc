@@ -147,7 +147,7 @@ TEST(ObjTest, UnknownKeywordsAreErrorsNamingTheLineAndKnownOnesAreSkipped) {
                                      "# exported\nmtllib cloth.mtl\no Cloth\ng flag\ns off\nusemtl red\n"
                                      "v 0 0 0\nnv 0 0 1\nnl 1\nv 1 0 0\nny 1 0 0\nv 0 1 0\nvl 2\nvt 0 0\nvt 1 0\n"
                                      "vt 0 1\nvn 0 0 1\nvp 0.5\ne 1 2\nea 0.1\ned 0\nel 3\nep 1\n"
-                                     "f 1/1/1 2/2/1 3/3/1\ntm 0\ntp 1 0 0 0 1 0 0 0 1\nts 1 0 0 0 1 0 0 0 1\ntd 0\n"
+                                     "f 1/1/1 2/2/1 3/3/1\ntl 2\nfs 1\nfd 0\ntm 0\ntp 1 0 0 0 1 0 0 0 1\nts 1 0 0 0 1 0 0 0 1\ntd 0\n"
                                      "l 1 2\np 3\n");
   const Mesh m = ReadObj(rich);
   EXPECT_EQ(m.V.rows(), 3);

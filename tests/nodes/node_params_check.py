@@ -162,6 +162,17 @@ class NodeParamsTest(unittest.TestCase):
         self.assertIn("wind_display: private parameter ~rat set but not read by this node", s.output())
         self.assertNotIn("~plot_window", s.output())
 
+    # image_transport's plugins keep their parameters under the topics a node advertises: a camera
+    # node named "camera" publishes /camera/image_raw, so /camera/image_raw/compressed/... lie in its
+    # private namespace (left on the master by a previous run, or set by the plugin): not misspelt.
+    def test_parameters_under_an_advertised_topic_are_not_named(self):
+        rospy.set_param("/camera/image_raw/compressed/jpeg_quality", 80)
+        s = self.spawn("camera_node", ["__name:=camera", "_source:=folder", "_path:=" + self.folder,
+                                       "_ratte:=5"])
+        self.assertTrue(s.wait_for_output("not read", 20), s.output())
+        self.assertIn("~ratte", s.output())
+        self.assertNotIn("~image_raw", s.output())
+
     # The launch files hand text parameters over as text, whatever they look like, and pass each of
     # sdn.launch's settings on (monitor.launch passed only model, mean_window and output).
     def test_launch_files_pass_text_as_text_and_forward_sdn_settings(self):
