@@ -152,10 +152,13 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
   sub->add_option("--jobs", a->o.jobs, "parallel simulations (0: all cores)")->capture_default_str();
   sub->add_option("--views", a->o.views, "camera poses rendered per simulation (1..64)")->capture_default_str();
   sub->add_option("--materials", a->o.materials_dir,
-                  "ClothSim fabrics folder (default: $CLOTHWIND_SHARED_DIR/arcsim/materials, else config/materials)");
+                  "ClothSim fabrics folder (default: $CLOTHWIND_SHARED_DIR/arcsim/materials, else config/materials; "
+                  "refused with --kind flag)");
   sub->add_option("--scene", a->o.scene, "scene file (default: config/scenes/<kind>.json)");
   sub->add_option("--max-edge", a->o.max_edge, "mesh resolution [m] (0: the scene's default)")->capture_default_str();
-  sub->add_option("--warmup", a->o.warmup, "simulated time before the first kept frame [s] (0..3600)")->capture_default_str();
+  sub->add_option("--warmup", a->o.warmup,
+                  "simulated time before the first kept frame [s] (0..3600, a whole number of frames: a multiple of 1/fps)")
+      ->capture_default_str();
   sub->add_option("--frames", a->o.frames, "frames per example (>= 1)")->capture_default_str();
   sub->add_option("--samples", a->o.samples, "anti-aliasing samples per pixel (0: zeta's default, 4)")
       ->capture_default_str();
