@@ -35,4 +35,20 @@ if "$bin" render "$work/sim" --out "$work/fr" --seed 2 --count 3 --samples 1 --t
   fail "a rerun that could not write frame 1 exited 0"
 fi
 [ ! -e "$work/fr/zeta.json" ] || fail "a failed rerun left zeta.json beside a mix of two runs' frames"
+# A trajectory whose texture coordinates are all one value (no material extent) is refused
+# naming the file (the error named none).
+mkdir "$work/flat"
+/usr/bin/python3 - "$work/sim/trajectory.cwtraj" "$work/flat/trajectory.cwtraj" <<'PY'
+import struct, sys
+data = bytearray(open(sys.argv[1], 'rb').read())
+nv, nf = struct.unpack_from('<II', data, 12)
+uv = 32 + 12 * nf
+for i in range(2 * nv):
+    struct.pack_into('<f', data, uv + 4 * i, 1e30)
+open(sys.argv[2], 'wb').write(data)
+PY
+if "$bin" render "$work/flat" --out "$work/flat-out" --count 1 --samples 1 --threads 1 >"$work/out.txt" 2>&1; then
+  fail "a trajectory without texture extent rendered"
+fi
+grep -q "$work/flat/trajectory.cwtraj: texture coordinates" "$work/out.txt" || fail "the error does not name the trajectory: $(cat "$work/out.txt")"
 echo "render_cli_test: OK"

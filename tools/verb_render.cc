@@ -62,18 +62,29 @@ render::RenderParams LoadZeta(const std::string& path) {
   }
 }
 
+// The animation of a trajectory file, its errors naming the file (an animation's own checks,
+// texture coordinates without extent, named none).
+data::ClothAnimation AnimationOfTrajectory(const fs::path& file) {
+  const sim::Trajectory t = sim::ReadTrajectory(file.string());
+  try {
+    return data::AnimationFromTrajectory(t);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(file.string() + ": " + e.what());
+  }
+}
+
 data::ClothAnimation LoadInput(const RenderArgs& a, std::string* what) {
   const fs::path in(a.input);
   if (fs::is_regular_file(in)) {
     *what = "trajectory " + in.string();
-    return data::AnimationFromTrajectory(sim::ReadTrajectory(in.string()));
+    return AnimationOfTrajectory(in);
   }
   if (!fs::is_directory(in)) throw std::runtime_error(a.input + ": no such file or folder");
   const fs::path traj = in / (a.cloth == 0 ? std::string("trajectory.cwtraj")
                                             : "trajectory_" + std::to_string(a.cloth) + ".cwtraj");
   if (!a.obj && fs::exists(traj)) {
     *what = "trajectory " + traj.string();
-    return data::AnimationFromTrajectory(sim::ReadTrajectory(traj.string()));
+    return AnimationOfTrajectory(traj);
   }
   *what = "OBJ frames in " + in.string();
   return data::ReadObjSequence(in.string(), a.cloth, a.frame_time);

@@ -96,8 +96,12 @@ nlohmann::json ReadLabel(const std::string& path) {
   Require(j, "name", has("name") && j["name"].is_string(), path, "a string");
   Require(j, "kind", has("kind") && (j["kind"] == "sim" || j["kind"] == "real" || j["kind"] == "toy"), path,
           "\"sim\", \"real\" or \"toy\"");
-  Require(j, "num_frames", has("num_frames") && j["num_frames"].is_number_integer() && j["num_frames"] > 0,
-          path, "a positive integer");
+  // At most the clip message's own bound (100000): 1e12 wrapped in get<int>() to a negative
+  // frame number, and the contact sheet asked for "-363689984.jpg".
+  Require(j, "num_frames",
+          has("num_frames") && j["num_frames"].is_number_integer() && j["num_frames"] > 0 &&
+              j["num_frames"] <= 100000,
+          path, "a positive integer, at most 100000");
   Require(j, "frame_rate", has("frame_rate") && j["frame_rate"].is_number() && j["frame_rate"] > 0,
           path, "a positive number");
   Require(j, "width", has("width") && j["width"].is_number_integer(), path, "an integer");

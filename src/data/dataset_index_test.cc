@@ -37,6 +37,35 @@ TEST(SimExampleLabelTest, RecordsTheBackgroundPhotoByItsFileNameAlone) {
   EXPECT_EQ(SimExampleLabel("flag-000001-v0", s, zeta, info)["zeta"]["background_image"], "");
 }
 
+TEST(ReadLabelTest, AFrameCountBeyondAnyClipIsRefused) {
+  // 1e12 frames wrapped to a negative frame number in get<int>(): the contact sheet asked for
+  // "-363689984.jpg".
+  namespace fs = std::filesystem;
+  const fs::path file = fs::temp_directory_path() / ("clothwind_label_" + std::to_string(::getpid()) + ".json");
+  SimulationSample s;
+  s.theta.fill(0.5);
+  ClipInfo info;
+  info.dataset = "flag";
+  info.split = "train";
+  info.num_frames = 30;
+  info.frame_rate = 25;
+  info.frame_ext = "jpg";
+  nlohmann::json label = SimExampleLabel("flag-000001-v0", s, render::SampleRenderParams(render::SceneKind::kFlag, 3), info);
+  std::ofstream(file) << label.dump();
+  EXPECT_NO_THROW(ReadLabel(file.string()));
+  label["num_frames"] = 1000000000000LL;
+  std::ofstream(file) << label.dump();
+  try {
+    ReadLabel(file.string());
+    ADD_FAILURE() << "1e12 frames accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("field 'num_frames' is 1000000000000, expected a positive integer, at most"),
+              std::string::npos)
+        << e.what();
+  }
+  fs::remove(file);
+}
+
 TEST(ReadIndexTest, AFolderOrAWrongTypedFormatIsRefusedNamingTheFile) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("clothwind_index_" + std::to_string(::getpid()));
