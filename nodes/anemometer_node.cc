@@ -271,6 +271,20 @@ class AnemometerNode {
   }
 
   void OnRaw(const clothwind::RawSentence::ConstPtr& msg) {
+    // A record stamped 0, or further ahead of the clock than a replay's latency explains, would be
+    // republished as a reading with that stamp, which the clip buffer then refuses (counted
+    // there, far from its cause): dropped here and said in this node's diagnostics.
+    const ros::Time now = ros::Time::now();
+    const char* odd = msg->header.stamp.isZero() ? "stamped 0"
+                      : (!now.isZero() && (msg->header.stamp - now).toSec() > kMaxFutureStamp)
+                          ? "stamped more than 5 s ahead of the clock"
+                          : nullptr;
+    if (odd) {
+      ++odd_stamps_;
+      last_odd_stamp_ = std::string(odd) + " (" + std::to_string(msg->header.stamp.toSec()) + " s, clock " +
+                        std::to_string(now.toSec()) + " s)";
+      return;
+    }
     const std::string frame = msg->header.frame_id.empty() ? frame_id_ : msg->header.frame_id;
     HandleRecord(clothwind::ros_bridge::RawSentenceBytes(*msg), msg->header.stamp, frame, false);
   }
@@ -347,6 +361,11 @@ class AnemometerNode {
       stat.mergeSummary(DiagnosticStatus::WARN, "instrument-relative and earth-referenced directions share frame " +
                                                     frame_id_ + ": set ~earth_frame_id");
 
+    if (odd_stamps_ > last_diag_odd_stamps_)
+      stat.mergeSummaryf(DiagnosticStatus::WARN, "%llu records dropped since last report: %s",
+                         static_cast<unsigned long long>(odd_stamps_ - last_diag_odd_stamps_), last_odd_stamp_.c_str());
+    last_diag_odd_stamps_ = odd_stamps_;
+
     stat.add("input", input_);
     stat.add("connection", state_);
     const AnemometerProtocol p = decoder_.protocol();
@@ -354,6 +373,7 @@ class AnemometerNode {
                              (decoder_.auto_mode() ? (p == AnemometerProtocol::kAuto ? " (detecting)" : " (detected)")
                                                    : " (configured)"));
     stat.add("records", c.records);
+    if (input_ == "topic") stat.add("records dropped for their stamps", odd_stamps_);
     stat.add("readings", c.readings);
     stat.add("invalid readings (instrument flagged)", c.invalid_readings);
     stat.addf("reading rate [Hz]", "%.3f", rate);
@@ -402,6 +422,10 @@ class AnemometerNode {
   std::vector<uint8_t> last_usb_record_;
   uint16_t last_usb_address_ = 0;
   uint64_t connects_ = 0, disconnects_ = 0, usb_read_errors_ = 0;
+  // Topic mode: records dropped for their stamps (OnRaw), and the last one's reason.
+  static constexpr double kMaxFutureStamp = 5.0;  // [s]
+  uint64_t odd_stamps_ = 0, last_diag_odd_stamps_ = 0;
+  std::string last_odd_stamp_;
   uint64_t last_diag_readings_ = 0, last_diag_errors_ = 0;
   clothwind::sensors::WindReading last_valid_;
   bool have_valid_ = false;

@@ -105,6 +105,33 @@ class AnemometerTopicTest(unittest.TestCase):
         sub.unregister()
         return winds
 
+    def test_records_stamped_0_or_far_ahead_are_dropped_and_said(self):
+        # They were republished as readings with those stamps, which the clip buffer refuses:
+        # counted there, far from their cause.
+        body = 'Q,229,002.74,M,00,'
+        cs = functools.reduce(lambda a, c: a ^ c, body.encode('ascii'), 0)
+        gill = '\x02' + body + '\x03' + '%02X' % cs
+        winds = []
+        sub = rospy.Subscriber('/replay_odd/anemometer/wind', WindMeasurement, winds.append, queue_size=50)
+        pub = rospy.Publisher('/replay_odd/anemometer/raw', RawSentence, queue_size=50)
+        deadline = time.time() + 20.0
+        while time.time() < deadline and (pub.get_num_connections() == 0 or sub.get_num_connections() == 0):
+            time.sleep(0.1)
+        time.sleep(0.5)
+        for stamp in (rospy.Time(0, 0), rospy.Time.now() + rospy.Duration(3600), rospy.Time.now()):
+            m = RawSentence()
+            m.header.stamp = stamp
+            m.header.frame_id = 'recorded_frame'
+            m.data = gill
+            m.protocol = 'gill'
+            pub.publish(m)
+            time.sleep(0.2)
+        time.sleep(0.5)
+        sub.unregister()
+        self.assertEqual(len(winds), 1, [w.header.stamp.to_sec() for w in winds])  # the one stamped now
+        status, values = self.diagnostics('topic:/replay_odd/anemometer/raw', count=1)
+        self.assertEqual(values['records dropped for their stamps'], '2')
+
     def test_wind_kinds(self):
         # /replay's decoder already read test_replay_keeps_stamps' two Gill records (unittest runs
         # tests by name): under 3, so it has not locked onto Gill and reads the NMEA ones below.
