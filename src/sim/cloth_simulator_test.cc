@@ -306,6 +306,70 @@ TEST(ClothSimulatorTest, RayleighDampingTakesEnergyOutOfASwingingSheet) {
   EXPECT_GT(lost_more, lost_some);
 }
 
+TEST(ClothSimulatorTest, UndampedSwingLosesEnergyOnlyAtBackwardEulersFirstOrder) {
+  // Without Rayleigh damping, air, repulsion or strain limits, and with constant stiffness tables
+  // (so Energy()'s gravitational + stretching + bending terms are exactly the potential of the
+  // assembled forces: AssembledForcesAreMinusTheEnergysGradient), the only sink of energy is
+  // backward Euler's numerical dissipation. It must (a) never add energy, beyond the linear
+  // solve's round-off, and (b) shrink at first order: halving dt about halves the energy lost over
+  // a fixed time. A spurious damping that does not vanish with h (a velocity scaling, a damping
+  // floor) takes a loss that stays or grows at dt/2 and fails (b).
+  const Mesh m = HangingSheet(0.5, 0.4, 0.1);
+  const double T = 0.5;  // simulated time [s], about half a swing
+  // Start from the sheet's equilibrium (settled with heavy damping): released at its rest shape,
+  // gravity would ring its stiff stretching modes, which backward Euler damps out at any step
+  // (they are far above 1 / dt), a loss that does not shrink with h.
+  Eigen::MatrixX3d rest;
+  {
+    SimOptions o = QuietOptions();
+    o.dt = 0.02;
+    o.handles = {2, 3};
+    o.bending_solve = BendingSolve::kImplicit;
+    o.cg_tolerance = 1e-12;
+    o.cg_max_iterations = 2000;
+    MaterialMultipliers settle;
+    settle.damping = 0.1;
+    ClothSimulator sim(m, ConstantStiffnessMaterial(settle), o, nullptr);
+    for (int i = 0; i < 300; ++i) sim.Step();
+    ASSERT_LT(sim.velocities().norm(), 1e-6);
+    rest = sim.positions();
+  }
+  auto energy_lost = [&](double dt, double* worst_increase, double* scale) {
+    SimOptions o = QuietOptions();
+    o.dt = dt;
+    o.handles = {2, 3};
+    o.bending_solve = BendingSolve::kImplicit;  // all forces in the backward Euler solve
+    o.cg_tolerance = 1e-12;
+    o.cg_max_iterations = 2000;
+    ClothSimulator sim(m, ConstantStiffnessMaterial(), o, nullptr);
+    // Swinging about the line of the two handles, faster further down.
+    Eigen::MatrixX3d v = Eigen::MatrixX3d::Zero(m.V.rows(), 3);
+    for (int i = 0; i < v.rows(); ++i) v(i, 1) = 2.0 * (-rest(i, 2));
+    sim.SetState(rest, v);
+    const double start = sim.Energy().Total();
+    *scale = sim.masses().sum() * 9.8 * 0.4;  // m g L [J]
+    double previous = start;
+    *worst_increase = -std::numeric_limits<double>::infinity();
+    const int n = static_cast<int>(std::lround(T / dt));
+    for (int i = 0; i < n; ++i) {
+      sim.Step();
+      const double e = sim.Energy().Total();
+      *worst_increase = std::max(*worst_increase, e - previous);
+      previous = e;
+    }
+    return start - previous;  // [J]
+  };
+  double increase_coarse = 0, increase_fine = 0, scale = 0;
+  const double lost_coarse = energy_lost(0.004, &increase_coarse, &scale);
+  const double lost_fine = energy_lost(0.002, &increase_fine, &scale);
+  EXPECT_LT(increase_coarse, 1e-9 * scale);
+  EXPECT_LT(increase_fine, 1e-9 * scale);
+  EXPECT_GT(lost_coarse, 1e-3 * scale) << "the swing should lose a measurable energy";
+  const double ratio = lost_fine / lost_coarse;  // 1/2 at first order
+  EXPECT_GT(ratio, 0.35) << "lost " << lost_coarse << " J at dt, " << lost_fine << " J at dt/2";
+  EXPECT_LT(ratio, 0.65) << "lost " << lost_coarse << " J at dt, " << lost_fine << " J at dt/2";
+}
+
 TEST(ClothSimulatorTest, AutoBendingGoesImplicitOnlyForStiffBending) {
   const Mesh m = HangingSheet(0.6, 0.6, 0.08);
   SimOptions o;
