@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/dataset_names.h"
+#include "common/regular_file.h"
 #include "sim/trajectory_io.h"
 
 namespace clothwind::data {
@@ -71,10 +72,7 @@ void Require(const nlohmann::json& j, const char* field, bool ok, const std::str
 }
 
 nlohmann::json ReadJsonFile(const std::string& path) {
-  // A folder opened as a stream and threw "basic_filebuf::underflow ... Is a directory", naming
-  // nothing; a FIFO would wait for a writer for ever.
-  std::error_code ec;
-  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
+  if (ExistsButNotARegularFile(path))
     throw std::runtime_error(path + ": not a regular file (a folder, a pipe or a device)");
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");

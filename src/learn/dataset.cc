@@ -18,16 +18,15 @@
 #include "common/dataset_names.h"
 #include "common/image_file.h"
 #include "common/random.h"
+#include "common/regular_file.h"
 #include "learn/fly_judge.h"
 #include "learn/model_config.h"
 
 namespace clothwind::learn {
 namespace fs = std::filesystem;
 nlohmann::json ReadJson(const fs::path& path) {
-  // A folder threw basic_filebuf::underflow naming nothing; a FIFO waited for a writer for ever.
-  std::error_code ec;
-  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
-    throw std::runtime_error(path.string() + ": " + (fs::is_directory(path, ec) ? "a folder" : "not a regular file") +
+  if (ExistsButNotARegularFile(path))
+    throw std::runtime_error(path.string() + ": " + (fs::is_directory(path) ? "a folder" : "not a regular file") +
                              ", expected a JSON file");
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path.string() + ": cannot open");

@@ -10,6 +10,7 @@
 
 #include <ATen/ATen.h>
 
+#include "common/regular_file.h"
 #include "learn/track_targets.h"
 #include "learn/weight_average.h"
 
@@ -317,8 +318,7 @@ void CheckConfigMatchesWeights(const ModelConfig& config, const std::filesystem:
 
 WindNet LoadWindNet(const std::filesystem::path& weights) {
   const std::filesystem::path config_path = ConfigPathFor(weights);
-  std::error_code ec;
-  if (std::filesystem::exists(config_path, ec) && !std::filesystem::is_regular_file(config_path, ec))
+  if (ExistsButNotARegularFile(config_path))
     throw std::runtime_error(config_path.string() + ": not a regular file (the model's architecture)");
   std::ifstream in(config_path);
   if (!in) throw std::runtime_error(config_path.string() + ": cannot open (the model's architecture)");

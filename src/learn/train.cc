@@ -24,6 +24,7 @@
 #include <torch/optim/adam.h>
 #include <torch/serialize.h>
 
+#include "common/regular_file.h"
 #include "learn/aux_targets.h"
 #include "learn/dataset.h"
 #include "learn/frame_cache.h"
@@ -134,8 +135,7 @@ void SaveAtomically(T& object, const fs::path& path) {
 
 // A run's state.json, parsed. Throws std::runtime_error naming it when it cannot be read.
 nlohmann::json ReadState(const fs::path& state_path) {
-  std::error_code ec;
-  if (fs::exists(state_path, ec) && !fs::is_regular_file(state_path, ec))
+  if (ExistsButNotARegularFile(state_path))
     throw std::runtime_error(state_path.string() + ": not a regular file (nothing to resume)");
   std::ifstream in(state_path);
   if (!in) throw std::runtime_error(state_path.string() + ": cannot open (nothing to resume)");

@@ -13,6 +13,7 @@
 #include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
 
+#include "common/formatted.h"
 #include "sim/json_comments.h"
 
 namespace clothwind::sim {
@@ -51,13 +52,6 @@ Eigen::Vector4d EvaluateStretchingSample(const Eigen::Matrix2d& G,
 // Area weights above this are no cloth (1000 kg/m^2: a 13 cm steel plate; fabrics weigh 0.05-1,
 // ArcSim's heaviest material 0.324), and far above it the step's numbers overflow.
 constexpr double kMaxAreaWeight = 1e3;  // [kg/m^2]
-
-// %g: std::to_string writes 1e200 as 201 digits.
-std::string Short(double v) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", v);
-  return text;
-}
 
 void CheckPositive(double value, const char* what) {
   if (!(std::isfinite(value) && value > 0))
@@ -129,9 +123,9 @@ Material MakeMaterial(double density, const Eigen::Matrix<double, 6, 4>& stretch
   Material m;
   m.density = density * mult.density * mult.thicken;
   if (!(m.density <= kMaxAreaWeight))
-    throw std::invalid_argument("material: area weight after multipliers (density " + Short(density) + " x density_mult " +
-                                Short(mult.density) + " x thicken " + Short(mult.thicken) + ") = " + Short(m.density) +
-                                " kg/m^2 must be at most " + Short(kMaxAreaWeight) + " kg/m^2");
+    throw std::invalid_argument("material: area weight after multipliers (density " + Formatted("%g", density) + " x density_mult " +
+                                Formatted("%g", mult.density) + " x thicken " + Formatted("%g", mult.thicken) + ") = " + Formatted("%g", m.density) +
+                                " kg/m^2 must be at most " + Formatted("%g", kMaxAreaWeight) + " kg/m^2");
   m.stretching_scale = mult.stretching * mult.thicken;
   m.damping = mult.damping;
   // ArcSim's layout: d[0][*] = row 0 for every direction, d[1][i] = row i + 1.
@@ -249,8 +243,8 @@ Material LoadArcSimMaterial(const std::string& path, const MaterialMultipliers& 
   const double density = number(j["density"], "density");
   if (!(density > 0)) throw std::runtime_error(path + ": field 'density' must be > 0 [kg/m^2]");
   if (!(density <= kMaxAreaWeight))
-    throw std::runtime_error(path + ": field 'density' is " + Short(density) + " kg/m^2, expected at most " +
-                             Short(kMaxAreaWeight) + " kg/m^2 (fabrics: 0.05-1)");
+    throw std::runtime_error(path + ": field 'density' is " + Formatted("%g", density) + " kg/m^2, expected at most " +
+                             Formatted("%g", kMaxAreaWeight) + " kg/m^2 (fabrics: 0.05-1)");
   const Eigen::Matrix<double, 6, 4> stretching = table("stretching", 6, 4);
   // Columns 0, 2 and 3 are the warp, weft and shear stiffnesses (1, their coupling, may be 0, as
   // in paper.json): each needs a value > 0 somewhere, or the cloth has none in that direction

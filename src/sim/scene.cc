@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/formatted.h"
 #include "sim/json_comments.h"
 #include "sim/strain_limiter.h"
 
@@ -120,26 +121,20 @@ class Reader {
     const Eigen::Vector3d v = Vector3(j, path);
     const double length = v.stableNorm();  // (norm() overflows to inf from ~1e154 on)
     if (!(length <= max_norm))
-      Fail(path, "expected a length of at most " + Short(max_norm) + " " + unit + ", got " + Short(length));
+      Fail(path, "expected a length of at most " + Formatted("%g", max_norm) + " " + unit + ", got " + Formatted("%g", length));
     return v;
   }
   // A number in (0, max].
   double PositiveAtMost(const json& j, const std::string& path, double max, const char* unit = "") const {
     const double v = Positive(j, path);
-    if (!(v <= max)) Fail(path, "expected a number in (0, " + Short(max) + "]" + unit + ", got " + Short(v));
+    if (!(v <= max)) Fail(path, "expected a number in (0, " + Formatted("%g", max) + "]" + unit + ", got " + Formatted("%g", v));
     return v;
   }
   // A number in [0, max].
   double NonNegativeAtMost(const json& j, const std::string& path, double max, const char* unit = "") const {
     const double v = NonNegative(j, path);
-    if (!(v <= max)) Fail(path, "expected a number in [0, " + Short(max) + "]" + unit + ", got " + Short(v));
+    if (!(v <= max)) Fail(path, "expected a number in [0, " + Formatted("%g", max) + "]" + unit + ", got " + Formatted("%g", v));
     return v;
-  }
-  // %g: std::to_string writes 1e200 as 201 digits.
-  static std::string Short(double v) {
-    char text[32];
-    std::snprintf(text, sizeof(text), "%g", v);
-    return text;
   }
   // A file named in the scene, resolved (ResolveScenePath) and required to exist.
   std::string File(const json& j, const std::string& path) const {
@@ -344,7 +339,7 @@ TurbulenceParams ParseTurbulence(const Reader& r, const json& j, const std::stri
     const auto v = r.Numbers(j["component_ratios"], path + ".component_ratios", 3, 3);
     for (int i = 0; i < 3; ++i) {
       if (!(v[i] >= 0 && v[i] <= kMaxTurbulence))
-        r.Fail(path + ".component_ratios", "ratios must be in [0, " + Reader::Short(kMaxTurbulence) + "]");
+        r.Fail(path + ".component_ratios", "ratios must be in [0, " + Formatted("%g", kMaxTurbulence) + "]");
       t.component_ratios[i] = v[i];
     }
   }
@@ -364,8 +359,8 @@ GustParams ParseGusts(const Reader& r, const json& j, const std::string& path) {
   if (j.contains("amplitude")) {
     g.amplitude = r.Number(j["amplitude"], path + ".amplitude");
     if (!(std::abs(g.amplitude) <= kMaxWindSpeed))
-      r.Fail(path + ".amplitude", "expected at most " + Reader::Short(kMaxWindSpeed) + " m/s in magnitude, got " +
-                                      Reader::Short(g.amplitude));
+      r.Fail(path + ".amplitude", "expected at most " + Formatted("%g", kMaxWindSpeed) + " m/s in magnitude, got " +
+                                      Formatted("%g", g.amplitude));
   }
   if (j.contains("amplitude_spread")) {
     g.amplitude_spread = r.NonNegative(j["amplitude_spread"], path + ".amplitude_spread");
