@@ -18,6 +18,7 @@ struct TrainArgs {
   learn::TrainOptions o;
   std::string data, out;
   int frames = 30;
+  double still_floor = -1;  // -1: 1e-6 for the SDN, 0 for the baselines (which have no spectral layer)
 };
 
 VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
@@ -67,6 +68,11 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_flag("--mode-shape", o.model.mode_shape,
                 "SDN: add each pixel's amplitude at the clip's dominant frequency relative to the pixel that moves "
                 "most (real, imaginary): the whole flag's wave at once, its wavelength as stripes");
+  sub->add_option("--still-floor", args->still_floor,
+                  "SDN: a pixel's selected bins at or below this times the clip's mean periodogram read no motion "
+                  "(power and frequency 0) instead of the arbitrary frequencies of a flat spectrum; 0: off, as "
+                  "models trained before the option [default: 1e-6 for sdn]")
+      ->check(CLI::Range(0.0, 0.5));
   sub->add_option("--spectral-pool", o.model.spectral_pool,
                   "SDN: average-pool the spectral maps by this factor before the trunk (--input-size 128 "
                   "--spectral-pool 2: 128-px spectra, a 64-px trunk's cost)")
@@ -159,6 +165,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
     learn::KeepFreedHeapForReuse();
     learn::TrainOptions o = args->o;
     o.model.frames = args->frames;
+    o.model.still_floor = args->still_floor >= 0 ? args->still_floor : o.model.arch == "sdn" ? 1e-6 : 0.0;
     o.data = args->data;
     o.out = args->out;
     std::unique_ptr<ProgressBar> bar;

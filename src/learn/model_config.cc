@@ -34,6 +34,7 @@ SpectralOptions ModelConfig::Spectral() const {
   o.phase_steps = phase_steps;
   o.phase_step_far = phase_step_far;
   o.mode_shape = mode_shape;
+  o.still_floor = still_floor;
   return o;
 }
 
@@ -117,6 +118,7 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"mean_map", c.mean_map},      {"dft_size", c.dft_size},
           {"local_peaks", c.local_peaks},  {"phase_steps", c.phase_steps},
           {"phase_step_far", c.phase_step_far}, {"mode_shape", c.mode_shape},
+          {"still_floor", c.still_floor},
           {"spectral_pool", c.spectral_pool}, {"stem_pool", c.stem_pool},
           {"coord_maps", c.coord_maps}, {"frame_channels", c.frame_channels},
           {"dropout", c.dropout},        {"aux_outputs", c.aux_outputs}, {"point_maps", c.point_maps},
@@ -153,7 +155,7 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
         {"local_peaks", &kBoolean}, {"phase_steps", &kBoolean},  {"mode_shape", &kBoolean},
         {"stem_pool", &kBoolean},   {"coord_maps", &kBoolean},   {"flips_in_training", &kBoolean},
         {"dropout", &kNumber},      {"frame_rate", &kNumber},    {"label_mean", &kNumber},
-        {"label_std", &kNumber},    {"std_scale", &kNumber}};
+        {"label_std", &kNumber},    {"std_scale", &kNumber},     {"still_floor", &kNumber}};
     for (const auto& [key, kind] : kFields) {
       if (j.contains(key) && !(j[key].*(kind->first))())
         throw std::runtime_error(where + ": field \"" + key + "\" must be " + kind->second + ", got " + j[key].dump());
@@ -182,6 +184,8 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     c.phase_steps = j.contains("phase_steps") ? j.at("phase_steps").get<bool>() : false;
     c.phase_step_far = j.contains("phase_step_far") ? as_int("phase_step_far", j.at("phase_step_far")) : 0;
     c.mode_shape = j.contains("mode_shape") ? j.at("mode_shape").get<bool>() : false;
+    // Absent in models written before the option existed: still pixels' frequencies as top-k gave them.
+    c.still_floor = j.contains("still_floor") ? j.at("still_floor").get<double>() : 0.0;
     c.spectral_pool = j.contains("spectral_pool") ? as_int("spectral_pool", j.at("spectral_pool")) : 1;
     // Absent in models written before the option existed: they pooled after the stem.
     c.stem_pool = j.contains("stem_pool") ? j.at("stem_pool").get<bool>() : true;
@@ -253,6 +257,9 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
   }
   if (!(c.dropout >= 0 && c.dropout < 1)) {
     throw std::runtime_error(where + ": field \"dropout\" must be in [0, 1), got " + std::to_string(c.dropout));
+  }
+  if (!(c.still_floor >= 0 && c.still_floor < 1)) {
+    throw std::runtime_error(where + ": field \"still_floor\" must be in [0, 1), got " + std::to_string(c.still_floor));
   }
   if (!c.PhaseStepFarIsValid()) {
     throw std::runtime_error(where + ": field \"phase_step_far\" must be 0, or at least 2 with \"phase_steps\", got " +

@@ -37,6 +37,9 @@ struct ModelConfig {
   bool local_peaks = false;  // SDN: the k strongest local maxima instead of the k strongest bins
   bool phase_steps = false;  // SDN: 4C more channels, the strongest peak's phase step to the neighbours
   int phase_step_far = 0;    // SDN with phase_steps: 4C more, the step over this many pixels (0: none)
+  // SDN: selected bins at or below this times the clip's mean periodogram read power and frequency
+  // 0 (SpectralOptions::still_floor; 0: off, as every model trained before it).
+  double still_floor = 0.0;
   bool mode_shape = false;   // SDN: 2C more, each pixel's amplitude at the clip's dominant frequency
                              // relative to the pixel that moves most (SpectralOptions::mode_shape)
   // SDN: the spectral maps are computed on the input_size clip and average-pooled by this factor
@@ -105,6 +108,7 @@ struct ModelConfig {
     if (include_dc) return "include_dc";
     if (dft_size != 0) return "dft_size";
     if (local_peaks) return "local_peaks";
+    if (still_floor != 0) return "still_floor";
     return "";
   }
   // spectral_pool is >= 1, divides input_size, and is 1 unless the model is an SDN.

@@ -1,5 +1,6 @@
 #include "learn/spectral_layer.h"
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -90,6 +91,32 @@ at::Tensor ModeShape(const at::Tensor& spectrum, const at::Tensor& periodogram, 
   return at::stack({real, imag}, 2).reshape({nb, 2 * c, h, w});
 }
 
+// SpectralOptions::still_floor: the selected bins of maps.power ([N_b, kC, H, W]) at or below
+// each example's floor read power 0 and frequency 0 in maps.power and maps.frequency. The floor
+// is still_floor times the example's mean periodogram (its spectra [N_b C H W, F], complex, over
+// the candidate bins first..first+candidates-1, divided by the window's sum of w^2), or the power
+// of the detrend's rounding, (N_t · ε · max|x|)² with ε the clips' dtype's epsilon, if that is
+// larger: in a clip where nothing moves the rounding is all the mean holds, and a relative floor
+// alone kept its noise. x is the clips [N_b, C, N_t, H, W]. Nothing happens for still_floor 0.
+void ZeroStillPixels(const at::Tensor& x, const at::Tensor& spectrum, const at::Tensor& window, int64_t first,
+                     int64_t candidates, double still_floor, SpectralMaps& maps) {
+  if (still_floor == 0) return;
+  const int64_t nb = x.size(0), nt = x.size(2);
+  const at::Tensor mean = (at::real(spectrum).square() + at::imag(spectrum).square())
+                              .narrow(1, first, candidates)
+                              .reshape({nb, -1})
+                              .mean(1)
+                              .to(at::kDouble) /
+                          window.square().sum().to(at::kDouble);
+  const double epsilon = x.scalar_type() == at::kDouble ? std::numeric_limits<double>::epsilon()
+                                                         : std::numeric_limits<float>::epsilon();
+  const at::Tensor rounding = (x.detach().abs().reshape({nb, -1}).amax(1).to(at::kDouble) * (nt * epsilon)).square();
+  const at::Tensor floor = at::maximum(still_floor * mean, rounding).reshape({nb, 1, 1, 1}).to(maps.power.scalar_type());
+  const at::Tensor still = maps.power.le(floor);
+  maps.power = maps.power.masked_fill(still, 0.0);
+  maps.frequency = maps.frequency.masked_fill(still, 0.0);
+}
+
 }  // namespace
 
 SpectralMaps SpectralDecomposition(const at::Tensor& x, int k, double frame_rate, bool include_dc) {
@@ -128,6 +155,10 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
     throw std::invalid_argument("SpectralDecomposition: phase_step_far = " + std::to_string(options.phase_step_far) +
                                 " (0, or a distance of at least 2 pixels with phase_steps, expected)");
   }
+  if (!(options.still_floor >= 0) || !std::isfinite(options.still_floor)) {
+    throw std::invalid_argument("SpectralDecomposition: still_floor = " + std::to_string(options.still_floor) +
+                                " (a finite value >= 0 expected)");
+  }
   if (options.mode_shape && include_dc) {
     // Undetrended, a pixel's mean brightness leaks through the Hann window into bin 1 and the
     // still image would be the "dominant mode".
@@ -157,7 +188,9 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
     const std::vector<double> eps = options.phase_steps ? PhaseStepEps(spectrum, nb) : std::vector<double>();
     SpectralPeaks peaks = SpectralPeaksCpu(spectrum, window.square().sum(), first, candidates, k,
                                            frame_rate / static_cast<double>(length), nb, c, h, w, distances, eps);
-    return SpectralMaps{peaks.power, peaks.frequency, peaks.phase, at::Tensor()};
+    SpectralMaps maps{peaks.power, peaks.frequency, peaks.phase, at::Tensor()};
+    ZeroStillPixels(x, spectrum, window, first, candidates, options.still_floor, maps);
+    return maps;
   }
   at::Tensor periodogram = (at::real(spectrum).square() + at::imag(spectrum).square()) /
                            window.square().sum();
@@ -189,6 +222,7 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
   SpectralMaps maps{to_map(power), to_map(frequency), at::Tensor(), at::Tensor()};
   if (options.phase_steps) maps.phase = PhaseSteps(spectrum, bin.narrow(1, 0, 1) + first, nb, c, h, w, distances);
   if (options.mode_shape) maps.mode = ModeShape(spectrum, periodogram, first, nb, c, h, w);
+  ZeroStillPixels(x, spectrum, window, first, candidates, options.still_floor, maps);
   return maps;
 }
 

@@ -44,6 +44,14 @@ struct SpectralOptions {
   // less time. The tensor ops run anyway on other devices, with autograd (a clip that requires
   // grad), with local_peaks and with mode_shape; false asks for them here too (to compare).
   bool one_pass = true;
+  // Still pixels read no motion: a selected bin whose power is at most still_floor times the
+  // clip's mean periodogram (per example, over its C·H·W pixels and candidate bins), or at most
+  // the power of the detrend's rounding, (N_t · ε · max|x|)² with ε the dtype's epsilon, reads
+  // power 0 and frequency 0, as local_peaks' empty slots do. Why: a still pixel's spectrum is zeros or
+  // rounding noise, whose top k is arbitrary (8.33 Hz or 0.83 Hz on the CPU, index order on
+  // CUDA), and the frequency map reached the network ungated. 0: off, as models trained before
+  // the option (they read those frequencies); `clothwind train` uses 1e-6.
+  double still_floor = 0.0;
 };
 
 // Power and frequency maps of a batch of clips.
@@ -98,7 +106,8 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, int k, double frame_rate
 // The same with SpectralOptions: options.dft_size = L pads each windowed signal with zeros to L
 // samples, so X_j = sum_n y_n e^{-2 pi i jn/L}, j = 0..L/2, and f_j = j frame_rate / L; with
 // options.local_peaks only local maxima compete for the k slots. The defaults are Algorithm 1.
-// Inputs/outputs as above; throws std::invalid_argument also for dft_size in (0, N_t).
+// Inputs/outputs as above; throws std::invalid_argument also for dft_size in (0, N_t) and for a
+// still_floor that is negative or not finite.
 SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& options);
 
 // Algorithm 1's output as one image: [power, frequency] concatenated along channels,

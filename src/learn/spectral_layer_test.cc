@@ -244,6 +244,58 @@ TEST(SpectralLayer, LocalPeaksFindTheSecondToneThatBinsMiss) {
   EXPECT_EQ(still.frequency.abs().max().item<double>(), 0.0);
 }
 
+// A float clip [n_b, 1, 30, 2, 4]: in example b the left two columns oscillate at 2.5 Hz with
+// amplitude amplitude[b] (each pixel its own phase), the right two hold a constant grey
+// (0.3 + a pixel's own offset), as a background behind a flag does.
+at::Tensor HalfStillClip(const std::vector<double>& amplitude) {
+  const int64_t nb = static_cast<int64_t>(amplitude.size());
+  at::Tensor x = at::zeros({nb, 1, 30, 2, 4}, at::kFloat);
+  auto a = x.accessor<float, 5>();
+  for (int64_t b = 0; b < nb; ++b)
+    for (int n = 0; n < 30; ++n)
+      for (int y = 0; y < 2; ++y)
+        for (int xx = 0; xx < 4; ++xx)
+          a[b][0][n][y][xx] = xx < 2 ? static_cast<float>(amplitude[b] * std::sin(2 * M_PI * 2.5 * n / kFps + 0.7 * (y * 4 + xx)))
+                                     : 0.3f + 0.01f * static_cast<float>(y * 4 + xx);
+  return x;
+}
+
+TEST(SpectralLayer, AStillFloorLetsStillPixelsReadNoMotionInEitherSelectionPath) {
+  // Amplitudes 1e-3 and 1e3 in one batch: each clip's floor is its own.
+  const at::Tensor x = HalfStillClip({1e-3, 1e3});
+  const at::Tensor still = at::zeros({2, 1, 2, 4}, at::kBool).index_put_({"...", at::indexing::Slice(2, 4)}, true)
+                               .repeat({1, 3, 1, 1});  // [2, 3 peaks, 2, 4]
+  for (const bool one_pass : {true, false}) {
+    SpectralOptions o;
+    o.k = 3;
+    o.phase_steps = true;
+    o.one_pass = one_pass;
+    const SpectralMaps before = SpectralDecomposition(x, o);
+    // Without the floor a still pixel's flat spectrum still names frequencies (bins >= 1: > 0 Hz).
+    EXPECT_GT(before.frequency.masked_select(still).min().item<double>(), 0.0) << "one_pass " << one_pass;
+    o.still_floor = 1e-6;
+    const SpectralMaps after = SpectralDecomposition(x, o);
+    EXPECT_EQ(after.power.masked_select(still).abs().max().item<double>(), 0.0) << "one_pass " << one_pass;
+    EXPECT_EQ(after.frequency.masked_select(still).abs().max().item<double>(), 0.0) << "one_pass " << one_pass;
+    // The moving pixels, in the calm clip too, keep their maps: 2.5 Hz strongest, bit for bit.
+    const at::Tensor moving = still.logical_not();
+    EXPECT_TRUE(at::equal(after.power.masked_select(moving), before.power.masked_select(moving)));
+    EXPECT_TRUE(at::equal(after.frequency.masked_select(moving), before.frequency.masked_select(moving)));
+    EXPECT_NEAR(after.frequency.index({0, 0, 0, 0}).item<double>(), 2.5, 1e-6);
+    EXPECT_NEAR(after.frequency.index({1, 0, 1, 1}).item<double>(), 2.5, 1e-6);
+    EXPECT_TRUE(at::equal(after.phase, before.phase));
+  }
+  // A clip with nothing moving reads no motion anywhere.
+  SpectralOptions o;
+  o.still_floor = 1e-6;
+  const SpectralMaps calm = SpectralDecomposition(HalfStillClip({0.0}), o);
+  EXPECT_EQ(calm.frequency.abs().max().item<double>(), 0.0);
+  for (const double bad : {-1e-6, std::nan("")}) {
+    o.still_floor = bad;
+    EXPECT_THROW(SpectralDecomposition(x, o), std::invalid_argument) << bad;
+  }
+}
+
 // A wave cos(2π f t − κx x − κy y + φ0) over an h × w image, N_t frames.
 at::Tensor TravellingWave(int nt, int h, int w, double hz, double kx, double ky, double phi0) {
   at::Tensor x = at::zeros({1, 1, nt, h, w}, at::kDouble);

@@ -227,7 +227,7 @@ void RefuseChangedModelOnResume(const fs::path& state_path, const ModelConfig& r
       {"width", "--width"},          {"k", "--k"},                   {"include_dc", "--include-dc"},
       {"dft_size", "--dft-size"},    {"local_peaks", "--local-peaks"}, {"dropout", "--dropout"},
       {"phase_steps", "--phase-steps"}, {"phase_step_far", "--phase-step-far"}, {"mode_shape", "--mode-shape"},
-      {"spectral_pool", "--spectral-pool"}, {"stem_pool", "--no-stem-pool"}, {"coord_maps", "--coord-maps"},
+      {"still_floor", "--still-floor"}, {"spectral_pool", "--spectral-pool"}, {"stem_pool", "--no-stem-pool"}, {"coord_maps", "--coord-maps"},
       {"flow", "--flow"},            {"flow_size", "--flow-size"},   {"colour", "--colour"},
       {"head_hidden", "--head-hidden"}, {"frame_channels", "--frame-channels"}, {"mean_map", "--mean-map"}};
   for (const auto& [key, flag] : kOptions) {

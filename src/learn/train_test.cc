@@ -679,6 +679,30 @@ TEST(ModelConfig, AHiddenHeadLayerIsReluUnitsBeforeTheOutputAndOlderFilesHaveNon
   }
 }
 
+TEST(ModelConfig, AStillFloorRoundTripsReachesTheLayerAndOlderFilesHaveNone) {
+  ModelConfig c = TinySdn();
+  c.still_floor = 1e-6;
+  EXPECT_EQ(ModelConfigFromJson(ToJson(c), "m.json").still_floor, 1e-6);
+  nlohmann::json old = ToJson(c);
+  old.erase("still_floor");
+  EXPECT_EQ(ModelConfigFromJson(old, "m.json").still_floor, 0.0);
+  for (const nlohmann::json& bad : {nlohmann::json(-1e-6), nlohmann::json(1.0)}) {
+    nlohmann::json j = ToJson(c);
+    j["still_floor"] = bad;
+    ExpectFieldRefused(j, "still_floor");
+  }
+  // The trunk sees frequency 0 where the clip is still (the right half) only with the floor.
+  at::Tensor clips = at::zeros({1, 1, 30, 16, 16});
+  for (int n = 0; n < 30; ++n) clips.index_put_({0, 0, n, at::indexing::Slice(), at::indexing::Slice(0, 8)}, std::sin(n * 1.3));
+  at::NoGradGuard no_grad;
+  // Channels 2..3 are the two peaks' frequencies (k = 2, C = 1).
+  const at::Tensor with = WindNet(c)->TrunkInput(clips).narrow(1, 2, 2).narrow(3, 8, 8);
+  c.still_floor = 0;
+  const at::Tensor without = WindNet(c)->TrunkInput(clips).narrow(1, 2, 2).narrow(3, 8, 8);
+  EXPECT_EQ(with.abs().max().item<double>(), 0.0);
+  EXPECT_GT(without.abs().min().item<double>(), 0.0);
+}
+
 TEST(ModelConfig, IntegerFieldsMustBeWholeNumbersWithinRange) {
   // get<int>() read these as 30, 16 and 2, and the copy stored in the weights agreed with them.
   const nlohmann::json good = ToJson(TinySdn());
@@ -702,7 +726,7 @@ TEST(ModelConfig, FieldsOfAnotherKindAreRefusedNamingTheField) {
   const nlohmann::json good = ToJson(TinySdn());
   for (const auto& [key, value, kind] : std::vector<std::tuple<std::string, nlohmann::json, std::string>>{
            {"format", 7, "a string"}, {"flow", "no", "true or false"}, {"label_std", "1", "a number"},
-           {"include_dc", 1, "true or false"}}) {
+           {"include_dc", 1, "true or false"}, {"still_floor", "1e-6", "a number"}}) {
     nlohmann::json j = good;
     j[key] = value;
     try {
@@ -733,7 +757,7 @@ TEST(ModelConfig, CountsThatWouldAllocateTerabytesAreRefusedNamingTheFile) {
 
 TEST(ModelConfig, TheSpectralLayersOptionsAreRefusedOnABaseline) {
   // A resnet18 given --mean-map was built without it while its model.json said it had one.
-  for (const char* field : {"mean_map", "phase_steps", "include_dc", "dft_size", "local_peaks"}) {
+  for (const char* field : {"mean_map", "phase_steps", "include_dc", "dft_size", "local_peaks", "still_floor"}) {
     ModelConfig c = TinySdn();
     c.arch = "resnet18";
     c.mean_map = std::string(field) == "mean_map";
@@ -741,6 +765,7 @@ TEST(ModelConfig, TheSpectralLayersOptionsAreRefusedOnABaseline) {
     c.include_dc = std::string(field) == "include_dc";
     c.dft_size = std::string(field) == "dft_size" ? 64 : 0;
     c.local_peaks = std::string(field) == "local_peaks";
+    c.still_floor = std::string(field) == "still_floor" ? 1e-6 : 0.0;
     EXPECT_EQ(c.SpectralOptionOffSdn(), field);
     EXPECT_THROW(WindNet{c}, std::invalid_argument) << field;
     try {
