@@ -27,6 +27,9 @@ struct JudgeArgs {
   int windows = 3, frames = 30, threads = 2;
   double margin = 1.0;  // scores closer to 0 tell nothing (FlyJudge::margin)
   learn::FlyJudgeTrainOptions train;
+  // The test split is also judged slid by each of these many cells (ShiftedMotionMaps).
+  static constexpr int kShiftedRows = 3;
+  JudgeArgs() { train.shift = 3; }
 };
 
 learn::MotionMaps Collect(const learn::Dataset& dataset, const std::string& split, int frames, int windows) {
@@ -73,6 +76,11 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
   sub->add_option("--lr", a->train.learning_rate, "Adam's learning rate")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--weight-decay", a->train.weight_decay, "Adam's L2 term")->check(CLI::NonNegativeNumber)->capture_default_str();
   sub->add_option("--seed", a->train.seed, "initialisation and order")->capture_default_str();
+  sub->add_option("--shift", a->train.shift,
+                  "slide each training map by a random offset of up to this many cells of 16 each way (a camera "
+                  "that does not centre the flag, as FlagSim's all do; 0: as collected)")
+      ->check(CLI::Range(0, learn::kMotionMapGrid / 2))
+      ->capture_default_str();
   sub->add_option("--threads", a->threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--margin", a->margin,
                   "scores closer to 0 than this tell nothing (a calm or featureless clip: camera noise scores ~0.4, "
@@ -124,8 +132,16 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
       accuracy[name] = learn::ToJson(acc);
       table << Row(name, acc);
     }
+    // The test clips as a camera that does not centre the flag would show them: each map slid by
+    // d cells of 16 in the 8 directions (card: accuracy.test_shifted_<d>).
+    for (int d = 1; d <= JudgeArgs::kShiftedRows && !test.maps.empty(); ++d) {
+      const learn::FlyJudgeAccuracy acc = learn::MeasureFlyJudge(judge, learn::ShiftedMotionMaps(test, d));
+      accuracy["test_shifted_" + std::to_string(d)] = learn::ToJson(acc);
+      table << Row("test±" + std::to_string(d), acc);
+    }
     std::cout << table.str()
-              << "(each clip's mirror image is judged left exactly as often: the score is antisymmetric)\n";
+              << "(each clip's mirror image is judged left exactly as often: the score is antisymmetric; test±d: "
+                 "each test map slid by d cells of 16 in the 8 directions)\n";
     nlohmann::json card = {
         {"what", "clothwind fly-direction judge (learn/fly_judge.h): which way a flag flies, for models trained "
                  "with --no-flip"},
@@ -137,6 +153,7 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
         {"learning_rate", a->train.learning_rate},
         {"weight_decay", a->train.weight_decay},
         {"seed", a->train.seed},
+        {"shift", a->train.shift},
         {"accuracy", accuracy}};
     const std::filesystem::path parent = std::filesystem::path(a->out).parent_path();
     if (!parent.empty()) std::filesystem::create_directories(parent);

@@ -306,6 +306,85 @@ TEST(FlyJudgeTrainTest, LearnsTheHoistSideOfHeldOutFlagsAndTheirMirrors) {
   EXPECT_THROW(TrainFlyJudge({}, o), std::invalid_argument);
 }
 
+// Flags as FlagSim's cameras frame them, all at one place in the picture (hoist at column
+// 10..12 of 64, the fly end near the right edge), of random size, growth, wave and noise; with
+// `offset`, the same flags slid that many pixels right (negative: left), cut by the frame's edge,
+// as a camera that does not centre the flag shows them.
+MotionMaps FramedFlags(int count, int offset, std::mt19937_64& rng) {
+  std::uniform_int_distribution<int> x0(10, 12), length(34, 40), y0(15, 17), height(28, 32);
+  std::uniform_real_distribution<double> gain(20, 70), power(1.0, 2.0), k(-0.6, 0.6), noise(0, 4);
+  MotionMaps out;
+  for (int i = 0; i < count; ++i) {
+    FlagClip c;
+    c.x0 = x0(rng) + offset;
+    c.length = length(rng);
+    c.y0 = y0(rng);
+    c.height = height(rng);
+    c.gain = gain(rng);
+    c.power = power(rng);
+    c.k = k(rng);
+    c.noise = noise(rng);
+    out.maps.push_back(MotionMap(Clip(c, rng)));
+    out.wind_speeds.push_back(c.gain / 7);
+  }
+  return out;
+}
+
+TEST(FlyJudgeTrainTest, ShiftedTrainingJudgesFlagsACameraDoesNotCentre) {
+  std::mt19937_64 rng(4);
+  const MotionMaps train = FramedFlags(240, 0, rng);
+  FlyJudgeTrainOptions o;
+  o.hidden = 16;
+  o.epochs = 40;
+  o.batch = 32;
+  o.learning_rate = 3e-3;
+  const FlyJudge centred = TrainFlyJudge(train.maps, o);
+  o.shift = 3;
+  const FlyJudge shifted = TrainFlyJudge(train.maps, o);
+  // Framed as in training, both judges know the side.
+  const MotionMaps framed = FramedFlags(60, 0, rng);
+  EXPECT_GE(MeasureFlyJudge(centred, framed).accuracy(), 0.95);
+  EXPECT_GE(MeasureFlyJudge(shifted, framed).accuracy(), 0.95);
+  // Filmed 8 px (two cells) further left, the centred judge reads where the motion sits, which
+  // now says "left" about as often as not (measured 0.55); the shifted one still reads the flag.
+  const MotionMaps slid = FramedFlags(60, -8, rng);
+  EXPECT_LT(MeasureFlyJudge(centred, slid).accuracy(), 0.8);
+  EXPECT_GE(MeasureFlyJudge(shifted, slid).accuracy(), 0.95);
+  EXPECT_THROW(TrainFlyJudge(train.maps, [] { FlyJudgeTrainOptions bad; bad.shift = kMotionMapGrid; return bad; }()),
+               std::invalid_argument);
+}
+
+TEST(FlyJudgeTrainTest, ShiftMotionMapSlidesInStillnessAndKeepsTheMeanOne) {
+  cv::Mat map(kMotionMapGrid, kMotionMapGrid, CV_32FC1);
+  for (int y = 0; y < kMotionMapGrid; ++y)
+    for (int x = 0; x < kMotionMapGrid; ++x) map.at<float>(y, x) = static_cast<float>(1 + x + 3 * y);
+  map /= cv::mean(map)[0];
+  const cv::Mat out = ShiftMotionMap(map, 2, -1);  // two cells right, one up
+  EXPECT_NEAR(cv::mean(out)[0], 1.0, 1e-6);
+  const double scale = out.at<float>(0, 2) / map.at<float>(1, 0);
+  for (int y = 0; y < kMotionMapGrid; ++y) {
+    for (int x = 0; x < kMotionMapGrid; ++x) {
+      if (x < 2 || y == kMotionMapGrid - 1) EXPECT_EQ(out.at<float>(y, x), 0.0f) << x << ", " << y;
+      else EXPECT_NEAR(out.at<float>(y, x), scale * map.at<float>(y + 1, x - 2), 1e-5) << x << ", " << y;
+    }
+  }
+  // Eight directions per map, mirrored maps slid the mirrored way.
+  MotionMaps one;
+  one.maps = {map};
+  one.wind_speeds = {3.0};
+  const MotionMaps eight = ShiftedMotionMaps(one, 1);
+  ASSERT_EQ(eight.maps.size(), 8u);
+  EXPECT_EQ(eight.wind_speeds[7], 3.0);
+  cv::Mat mirrored, slid_mirror, mirror_slid;
+  cv::flip(map, mirrored, 1);
+  cv::flip(ShiftMotionMap(map, 3, 2), mirror_slid, 1);
+  slid_mirror = ShiftMotionMap(mirrored, -3, 2);
+  EXPECT_EQ(cv::norm(slid_mirror, mirror_slid, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::countNonZero(ShiftMotionMap(cv::Mat::zeros(kMotionMapGrid, kMotionMapGrid, CV_32FC1), 1, 1)), 0);
+  EXPECT_THROW(ShiftMotionMap(map, kMotionMapGrid, 0), std::invalid_argument);
+  EXPECT_THROW(ShiftMotionMap(cv::Mat::zeros(8, 8, CV_32FC1), 1, 0), std::invalid_argument);
+}
+
 TEST(FlyJudgeTrainTest, CollectsOneMapPerWindowOfEachClip) {
   const fs::path dir = fs::temp_directory_path() / ("fly_judge_toy_" + std::to_string(::getpid()));
   ToyDatasetOptions toy;

@@ -29,7 +29,51 @@ at::Tensor Stack(const std::vector<cv::Mat>& maps) {
   return x;
 }
 
+// Each map of the batch [B, G, G] slid by its own random offset in -shift..shift cells along
+// each axis, zeros sliding in, then scaled to average 1 (all-zero maps stay 0).
+at::Tensor RandomlyShifted(const at::Tensor& batch, int shift) {
+  const int64_t b = batch.size(0), g = kMotionMapGrid;
+  const at::Tensor padded = at::constant_pad_nd(batch, {shift, shift, shift, shift}, 0.0);
+  const at::Tensor ox = at::randint(0, 2 * shift + 1, {b, 1}, at::kLong);
+  const at::Tensor oy = at::randint(0, 2 * shift + 1, {b, 1}, at::kLong);
+  const at::Tensor steps = at::arange(g, at::kLong).unsqueeze(0);
+  const at::Tensor rows = (oy + steps).reshape({b, g, 1}), cols = (ox + steps).reshape({b, 1, g});
+  const at::Tensor shifted = padded.index({at::arange(b, at::kLong).reshape({b, 1, 1}), rows, cols});
+  const at::Tensor mean = shifted.mean({1, 2}, /*keepdim=*/true);
+  return at::where(mean > 0, shifted / mean.clamp_min(1e-30), shifted);
+}
+
 }  // namespace
+
+cv::Mat ShiftMotionMap(const cv::Mat& map, int dx, int dy) {
+  if (map.type() != CV_32FC1 || map.rows != kMotionMapGrid || map.cols != kMotionMapGrid)
+    throw std::invalid_argument("ShiftMotionMap: expected a " + std::to_string(kMotionMapGrid) + "x" +
+                                std::to_string(kMotionMapGrid) + " CV_32FC1 motion map");
+  if (std::abs(dx) >= kMotionMapGrid || std::abs(dy) >= kMotionMapGrid)
+    throw std::invalid_argument("ShiftMotionMap: shift (" + std::to_string(dx) + ", " + std::to_string(dy) +
+                                ") slides the whole map out (|dx|, |dy| < " + std::to_string(kMotionMapGrid) +
+                                " expected)");
+  cv::Mat out = cv::Mat::zeros(map.size(), CV_32FC1);
+  const int w = kMotionMapGrid - std::abs(dx), h = kMotionMapGrid - std::abs(dy);
+  map(cv::Rect(std::max(0, -dx), std::max(0, -dy), w, h)).copyTo(out(cv::Rect(std::max(0, dx), std::max(0, dy), w, h)));
+  const double mean = cv::mean(out)[0];
+  if (mean > 0) out /= mean;
+  return out;
+}
+
+MotionMaps ShiftedMotionMaps(const MotionMaps& maps, int distance) {
+  MotionMaps out;
+  for (size_t i = 0; i < maps.maps.size(); ++i) {
+    for (int dy = -distance; dy <= distance; dy += distance) {
+      for (int dx = -distance; dx <= distance; dx += distance) {
+        if (dx == 0 && dy == 0) continue;
+        out.maps.push_back(ShiftMotionMap(maps.maps[i], dx, dy));
+        out.wind_speeds.push_back(maps.wind_speeds[i]);
+      }
+    }
+  }
+  return out;
+}
 
 MotionMaps CollectMotionMaps(const std::vector<ClipInfo>& clips, int frames, int windows,
                              const std::function<void(int, int)>& progress) {
@@ -60,9 +104,11 @@ MotionMaps CollectMotionMaps(const std::vector<ClipInfo>& clips, int frames, int
 FlyJudge TrainFlyJudge(const std::vector<cv::Mat>& maps, const FlyJudgeTrainOptions& o,
                        const std::function<void(int, int, double)>& epoch_done) {
   if (maps.empty()) throw std::invalid_argument("TrainFlyJudge: no maps to train on");
-  if (o.hidden < 1 || o.epochs < 1 || o.batch < 1 || !(o.learning_rate > 0) || !(o.weight_decay >= 0)) {
-    throw std::invalid_argument("TrainFlyJudge: hidden, epochs and batch must be >= 1, the learning rate > 0 and "
-                                "the weight decay >= 0");
+  if (o.hidden < 1 || o.epochs < 1 || o.batch < 1 || !(o.learning_rate > 0) || !(o.weight_decay >= 0) ||
+      o.shift < 0 || o.shift >= kMotionMapGrid) {
+    throw std::invalid_argument("TrainFlyJudge: hidden, epochs and batch must be >= 1, the learning rate > 0, "
+                                "the weight decay >= 0 and the shift in 0.." + std::to_string(kMotionMapGrid - 1) +
+                                " cells");
   }
   at::manual_seed(o.seed);
   torch::nn::Linear hidden(kMapSize, o.hidden), output(o.hidden, 1);
@@ -74,7 +120,6 @@ FlyJudge TrainFlyJudge(const std::vector<cv::Mat>& maps, const FlyJudgeTrainOpti
   torch::optim::Adam optimizer(parameters,
                                torch::optim::AdamOptions(o.learning_rate).weight_decay(o.weight_decay));
   const at::Tensor x = Stack(maps);
-  const at::Tensor mirrored = x.flip({2});  // each map mirrored left-right (its columns reversed)
   std::vector<int64_t> order(maps.size());
   std::iota(order.begin(), order.end(), 0);
   std::mt19937_64 rng(o.seed);
@@ -84,7 +129,10 @@ FlyJudge TrainFlyJudge(const std::vector<cv::Mat>& maps, const FlyJudgeTrainOpti
     for (size_t i = 0; i < order.size(); i += o.batch) {
       const size_t end = std::min(order.size(), i + o.batch);
       const at::Tensor index = at::tensor(std::vector<int64_t>(order.begin() + i, order.begin() + end), at::kLong);
-      const at::Tensor score = logit(x.index_select(0, index)) - logit(mirrored.index_select(0, index));
+      at::Tensor batch = x.index_select(0, index);
+      if (o.shift > 0) batch = RandomlyShifted(batch, o.shift);
+      // Each map against its mirror image (columns reversed): the antisymmetric score.
+      const at::Tensor score = logit(batch) - logit(batch.flip({2}));
       const at::Tensor loss = torch::softplus(-score).mean();
       optimizer.zero_grad();
       loss.backward();

@@ -33,8 +33,25 @@ struct MotionMaps {
 MotionMaps CollectMotionMaps(const std::vector<ClipInfo>& clips, int frames, int windows,
                              const std::function<void(int, int)>& progress = {});
 
+// A motion map slid by dx cells to the right and dy cells down (negative: left, up), as the map
+// of a crop that does not centre the flag: what slides in is still (0), what slides out is lost,
+// and the result is scaled to average 1 again (MotionMap's normalisation; a map left all zeros
+// stays zeros).
+// Inputs: map  a kMotionMapGrid² CV_32FC1 motion map; |dx|, |dy| < kMotionMapGrid.
+// Throws std::invalid_argument for another map or a shift of the whole grid.
+cv::Mat ShiftMotionMap(const cv::Mat& map, int dx, int dy);
+
+// Each map of `maps` slid by `distance` cells in each of the 8 directions (dx, dy in
+// {-distance, 0, distance}, not both 0): 8 maps per map, with its wind speed.
+MotionMaps ShiftedMotionMaps(const MotionMaps& maps, int distance);
+
 struct FlyJudgeTrainOptions {
   int hidden = 64;             // hidden units
+  // Each training map slid by a random dx, dy in -shift..shift cells (ShiftMotionMap), drawn
+  // anew every time it is used (0: the maps as collected). Why: FlagSim's cameras all centre the
+  // flag, so a judge trained on its maps alone leaned on where the motion sits; a camera that
+  // does not centre the flag turned its verdict.
+  int shift = 0;
   int epochs = 100;
   int batch = 128;             // maps per Adam step
   double learning_rate = 1e-3;
