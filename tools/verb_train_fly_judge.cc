@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "learn/dataset.h"
@@ -23,7 +24,7 @@ namespace clothwind::tools {
 namespace {
 
 struct JudgeArgs {
-  std::string data, out;
+  std::string data, out, measure;
   int windows = 3, frames = 30, threads = 2;
   double margin = 1.0;  // scores closer to 0 tell nothing (FlyJudge::margin)
   learn::FlyJudgeTrainOptions train;
@@ -64,8 +65,12 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
                                  "train the judge of which way a flag flies (for models trained with --no-flip) on a "
                                  "dataset of flags that fly right, and measure it on every split");
   sub->add_option("--data", a->data, "dataset folder (its flags must all fly right, as FlagSim's do)")->required();
-  sub->add_option("--out", a->out, "weights file, e.g. models/fly_judge.pt (its card .json is written beside it)")
-      ->required();
+  auto* out = sub->add_option("--out", a->out, "weights file, e.g. models/fly_judge.pt (its card .json is written beside it)");
+  auto* measure = sub->add_option("--measure", a->measure,
+                                  "measure this judge (e.g. models/fly_judge.pt, its margin from its card) on every "
+                                  "split instead of training one; writes nothing");
+  out->excludes(measure);
+  measure->excludes(out);
   sub->add_option("--windows", a->windows, "evenly spaced training windows per clip (val and test: the centred one)")
       ->check(CLI::Range(1, 1000))  // a huge count hung (windows rebuilt per window)
       ->capture_default_str();
@@ -82,15 +87,16 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
       ->check(CLI::Range(0, learn::kMotionMapGrid / 2))
       ->capture_default_str();
   sub->add_option("--threads", a->threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
-  sub->add_option("--margin", a->margin,
+  auto* margin = sub->add_option("--margin", a->margin,
                   "scores closer to 0 than this tell nothing (a calm or featureless clip: camera noise scores ~0.4, "
-                  "a flying flag 5-12); 0..100")
+                  "a flying flag 5-12); 0..100 (with --measure: the judge's card's unless given)")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
-  return [a]() {
+  return [a, margin]() {
     // CLI11's range lets NaN through: refused here, before the training, not after it.
     if (!std::isfinite(a->margin)) throw std::invalid_argument("--margin must be a number in 0..100, got nan");
-    {
+    if (a->out.empty() && a->measure.empty()) throw std::invalid_argument("--out (to train a judge) or --measure (to measure one) is required");
+    if (a->measure.empty()) {
       // The weights and their card beside them: on neither the dataset's index nor each other,
       // checked before the training, not after it.
       const std::filesystem::path card = learn::ConfigPathFor(a->out);
@@ -103,8 +109,14 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
     }
     at::set_num_threads(a->threads);
     const learn::Dataset dataset = learn::ReadDataset(a->data);
+    // Measured: the judge first, so a wrong path fails before the frames are read.
+    std::optional<learn::FlyJudge> measured;
+    if (!a->measure.empty()) {
+      measured = learn::FlyJudge::Load(a->measure);
+      if (margin->count() > 0) measured->set_margin(a->margin);
+    }
     const learn::MotionMaps train = Collect(dataset, "train", a->frames, a->windows);
-    if (train.maps.empty()) {
+    if (train.maps.empty() && !measured) {
       std::cerr << "train-fly-judge: " << (std::filesystem::path(a->data) / "index.json").string()
                 << " lists no clips in split train\n";
       return 2;
@@ -112,16 +124,19 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
     const learn::MotionMaps val = Collect(dataset, "val", a->frames, 1);
     const learn::MotionMaps test = Collect(dataset, "test", a->frames, 1);
 
-    ProgressBar::Options b;
-    b.label = "train-fly-judge";
-    b.unit = "epochs";
-    b.rate_unit = "epochs/s";
-    ProgressBar bar(b);
-    learn::FlyJudge judge = learn::TrainFlyJudge(train.maps, a->train, [&](int epoch, int epochs, double loss) {
-      bar.Update(epoch, epochs, "loss " + std::to_string(loss));
-    });
-    bar.Finish();
-    judge.set_margin(a->margin);
+    learn::FlyJudge judge = measured ? *measured : [&] {
+      ProgressBar::Options b;
+      b.label = "train-fly-judge";
+      b.unit = "epochs";
+      b.rate_unit = "epochs/s";
+      ProgressBar bar(b);
+      learn::FlyJudge trained = learn::TrainFlyJudge(train.maps, a->train, [&](int epoch, int epochs, double loss) {
+        bar.Update(epoch, epochs, "loss " + std::to_string(loss));
+      });
+      bar.Finish();
+      trained.set_margin(a->margin);
+      return trained;
+    }();
 
     nlohmann::json accuracy;
     std::ostringstream table;
@@ -142,19 +157,9 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
     std::cout << table.str()
               << "(each clip's mirror image is judged left exactly as often: the score is antisymmetric; test±d: "
                  "each test map slid by d cells of 16 in the 8 directions)\n";
-    nlohmann::json card = {
-        {"what", "clothwind fly-direction judge (learn/fly_judge.h): which way a flag flies, for models trained "
-                 "with --no-flip"},
-        {"data", std::filesystem::absolute(a->data).lexically_normal().string()},
-        {"train_windows_per_clip", a->windows},
-        {"frames", a->frames},
-        {"epochs", a->train.epochs},
-        {"batch", a->train.batch},
-        {"learning_rate", a->train.learning_rate},
-        {"weight_decay", a->train.weight_decay},
-        {"seed", a->train.seed},
-        {"shift", a->train.shift},
-        {"accuracy", accuracy}};
+    if (measured) return 0;
+    const nlohmann::json card = learn::FlyJudgeTrainingCard(
+        std::filesystem::absolute(a->data).lexically_normal().string(), a->windows, a->frames, a->train, accuracy);
     const std::filesystem::path parent = std::filesystem::path(a->out).parent_path();
     if (!parent.empty()) std::filesystem::create_directories(parent);
     judge.Save(a->out, card);

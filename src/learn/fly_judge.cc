@@ -100,7 +100,7 @@ FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
   // fields Load reads and those train-fly-judge writes to say how it was made, nothing else.
   static const char* const kCardFields[] = {"hidden", "grid", "side", "margin", "margin_note", "what", "data",
                                             "train_windows_per_clip", "frames", "epochs", "batch",
-                                            "learning_rate", "weight_decay", "seed", "accuracy"};
+                                            "learning_rate", "weight_decay", "seed", "shift", "accuracy"};
   if (card.is_object()) {
     for (auto it = card.begin(); it != card.end(); ++it) {
       if (std::find(std::begin(kCardFields), std::end(kCardFields), it.key()) == std::end(kCardFields))

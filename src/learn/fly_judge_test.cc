@@ -201,6 +201,13 @@ TEST(FlyJudgeTest, SaveLoadRoundTripKeepsScoresAndCard) {
   const nlohmann::json card = ReadJson(dir / "judge.json");
   EXPECT_EQ(card.at("data"), "synthetic");
   EXPECT_EQ(card.at("grid"), kMotionMapGrid);
+  // The card train-fly-judge writes loads (a field Load did not know, "shift", made every newly
+  // trained judge unloadable).
+  FlyJudgeTrainOptions options;
+  options.shift = 3;
+  judge.Save(dir / "judge.pt", FlyJudgeTrainingCard("/data/flagsim-e5", 3, 30, options, {{"test", {{"count", 1}}}}));
+  EXPECT_EQ(FlyJudge::Load(dir / "judge.pt").Score(map), judge.Score(map));
+  EXPECT_EQ(ReadJson(dir / "judge.json").at("shift"), 3);
 
   // A card that disagrees with the weights' shape is refused, naming the weights file.
   WriteFileAtomically(dir / "judge.json", nlohmann::json{{"hidden", 5}, {"grid", 16}, {"side", 64}}.dump());

@@ -169,6 +169,22 @@ FlyJudgeAccuracy MeasureFlyJudge(const FlyJudge& judge, const MotionMaps& maps, 
   return a;
 }
 
+nlohmann::json FlyJudgeTrainingCard(const std::string& data, int windows, int frames,
+                                    const FlyJudgeTrainOptions& o, const nlohmann::json& accuracy) {
+  return {{"what", "clothwind fly-direction judge (learn/fly_judge.h): which way a flag flies, for models trained "
+                   "with --no-flip"},
+          {"data", data},
+          {"train_windows_per_clip", windows},
+          {"frames", frames},
+          {"epochs", o.epochs},
+          {"batch", o.batch},
+          {"learning_rate", o.learning_rate},
+          {"weight_decay", o.weight_decay},
+          {"seed", o.seed},
+          {"shift", o.shift},
+          {"accuracy", accuracy}};
+}
+
 nlohmann::json ToJson(const FlyJudgeAccuracy& a) {
   nlohmann::json bands = nlohmann::json::array();
   for (const auto& b : a.bands) {

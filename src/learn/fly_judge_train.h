@@ -86,6 +86,13 @@ struct FlyJudgeAccuracy {
 FlyJudgeAccuracy MeasureFlyJudge(const FlyJudge& judge, const MotionMaps& maps, double band_width = 2.0,
                                  int bands = 5);
 
+// How a judge was made, for its card (FlyJudge::Save adds its shape and margin): "what", "data"
+// (the dataset folder), "train_windows_per_clip", "frames", the options' "epochs", "batch",
+// "learning_rate", "weight_decay", "seed" and "shift", and "accuracy" as given (e.g. split name ->
+// ToJson(FlyJudgeAccuracy)). Every field is one FlyJudge::Load accepts.
+nlohmann::json FlyJudgeTrainingCard(const std::string& data, int windows, int frames,
+                                    const FlyJudgeTrainOptions& options, const nlohmann::json& accuracy);
+
 // {"count", "right", "undecided", "accuracy", "bands": [{"low", "high", "count", "accuracy"}]}.
 nlohmann::json ToJson(const FlyJudgeAccuracy& accuracy);
 
