@@ -316,6 +316,7 @@ class ClipBufferNode {
     stat.add("frames in", s.frames_in);
     stat.add("frames dropped", s.frames_dropped);
     stat.add("frames stamped in the future", s.frames_future);
+    stat.add("frames stamped back in time (dropped)", s.frames_stale);
     stat.add("frames out (25 fps)", s.frames_out);
     stat.add("gaps", s.gaps);
     stat.add("last gap [s]", s.last_gap);

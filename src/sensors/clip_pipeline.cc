@@ -55,6 +55,7 @@ void ClipPipeline::Reset() {
   pending_.clear();
   released_at_jump_.clear();
   held_.clear();
+  backward_.reset();
   labeller_ = WindLabeller(options_.label_window);
   data_time_ = kNegInf;
   released_end_ = kNegInf;
@@ -83,10 +84,32 @@ bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
     source_width_ = source_height_ = 0;  // re-resolve the roi on the next frame
     throw;
   }
+  // A frame back in time waits for the next: one that follows it within gap_tolerance starts a
+  // new timeline there (a bag looped or restarted, with or without --clock); any other means it
+  // was a lone stale stamp, which restarted the labeller and released the waiting clips early.
+  if (backward_) {
+    BackwardFrame held = std::move(*backward_);
+    backward_.reset();
+    if (std::isfinite(stamp) && stamp >= held.stamp && stamp - held.stamp <= options_.gap_tolerance) {
+      PushFrame(held.stamp, held.processed);
+    } else {
+      ++stats_.frames_stale;
+      ++stats_.frames_dropped;
+    }
+  }
+  if (last_frame_ > 0 && std::isfinite(stamp) && stamp < last_frame_ - options_.gap_tolerance) {
+    backward_ = BackwardFrame{stamp, processed};
+    return true;
+  }
+  PushFrame(stamp, processed);
+  return true;
+}
+
+void ClipPipeline::PushFrame(double stamp, const cv::Mat& processed) {
   const FrameResampler::Result r = resampler_.Push(stamp);
   if (r.dropped) {
     ++stats_.frames_dropped;
-    return true;
+    return;
   }
   if (r.gap) {
     ++stats_.gaps;
@@ -113,7 +136,6 @@ bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
   previous_ = processed;
   last_frame_ = stamp;
   data_time_ = std::max(data_time_, stamp);
-  return true;
 }
 
 void ClipPipeline::Emit(const FrameResampler::Tick& tick, const cv::Mat& image) {

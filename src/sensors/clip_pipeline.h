@@ -69,6 +69,9 @@ struct ClipPipelineStats {
   uint64_t readings_future = 0;   // readings refused for the same reason
   double last_future_lead = 0.0;  // how far after the clock the last refused stamp was [s]
   uint64_t time_jumps = 0;        // camera time went back (a bag restarted or looped)
+  // Frames stamped more than gap_tolerance before the frame before them that the next frame did
+  // not follow (a lone stale stamp, not a new timeline): dropped, also counted in frames_dropped.
+  uint64_t frames_stale = 0;
   uint64_t clips_at_jumps = 0;    // clips waiting at a jump, labelled with the readings held then
   uint64_t unlabelled_run = 0;    // clips released since the last one with a reading (0: it had one)
   double last_gap = 0.0;          // length of the last gap [s]
@@ -95,7 +98,10 @@ class ClipPipeline {
  public:
   explicit ClipPipeline(const ClipPipelineOptions& options);
 
-  // Pushes one camera frame.
+  // Pushes one camera frame. A frame stamped more than gap_tolerance before the last one is held
+  // until the next frame tells what it is: the start of a new timeline (a bag restarted or looped)
+  // when the next one follows it within gap_tolerance, and then both go through as a time jump;
+  // otherwise a lone stale stamp, dropped (frames_stale) without disturbing the stream.
   // Inputs:
   //   stamp     capture time [s] (header.stamp)
   //   image     rows x cols, type ClipSourceCvType(encoding); only read during the call
@@ -125,6 +131,8 @@ class ClipPipeline {
   const ClipPipelineOptions& options() const { return options_; }
 
  private:
+  // The frame, preprocessed, through the resampler, the jump and gap rules and the assembler.
+  void PushFrame(double stamp, const cv::Mat& processed);
   void Emit(const FrameResampler::Tick& tick, const cv::Mat& image);
   LabelledClip Release(AssembledClip clip);
   void TakeReading(const LabelReading& reading);  // into the labeller, counted late if it is
@@ -145,6 +153,13 @@ class ClipPipeline {
   // Readings stamped before every window this timeline can still label, held until the next
   // frame says whose they are: a looped bag's first reading arrives before its first frame.
   std::vector<LabelReading> held_;
+  // A frame stamped back in time, held until the next frame says whether a new timeline starts
+  // there (a looped bag) or it was a lone stale stamp.
+  struct BackwardFrame {
+    double stamp;
+    cv::Mat processed;
+  };
+  std::optional<BackwardFrame> backward_;
   ClipPipelineStats stats_;
 };
 

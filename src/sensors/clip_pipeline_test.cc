@@ -155,6 +155,52 @@ TEST(ClipPipelineTest, TimeJumpingBackStartsOver) {
   EXPECT_EQ(p.stats().clips_made, p.stats().clips_released);  // no clip lost
 }
 
+// One frame stamped three hours back (a camera driver's glitch) amid a steady stream: it was taken
+// as a bag restarting, so the waiting clips were released early and the labeller forgot its
+// readings; the clips after it were labelled from fewer readings or none.
+TEST(ClipPipelineTest, ALoneFrameStampedHoursBackIsDroppedAsStale) {
+  ClipPipeline p(SmallOptions());  // label window 5 s, delay 1.5 s
+  std::vector<LabelledClip> clips;
+  for (int i = 0; i <= 20 * 30; ++i) {
+    const double t = kT0 + i / 30.0;
+    if (i % 30 == 0) p.AddReading({t, 6.0, 0.0});
+    if (i == 300) p.AddFrame(t - 3 * 3600.0, Numbered(i), ClipSourceEncoding::kMono8);
+    p.AddFrame(t, Numbered(i), ClipSourceEncoding::kMono8);
+    for (auto& c : p.TakeReady()) clips.push_back(std::move(c));
+  }
+  EXPECT_EQ(p.stats().time_jumps, 0u);
+  EXPECT_EQ(p.stats().clips_at_jumps, 0u);
+  EXPECT_EQ(p.stats().frames_stale, 1u);
+  EXPECT_EQ(p.stats().gaps, 0u);
+  // Every clip of the unbroken stream, each labelled from its whole 5 s window once the stream
+  // has lasted that long (a reading a second: 5 or 6 readings).
+  EXPECT_EQ(p.stats().clips_made, 50u);  // ticks 0..500 of 20 s, clips of 10
+  ASSERT_EQ(clips.size(), 46u);          // those due by the last frame (ends <= 18.5 s)
+  for (const auto& c : clips) {
+    const double end = c.clip.frames.back().stamp - kT0;
+    if (end >= 5.0) EXPECT_GE(c.label.count, 5u) << end;
+    EXPECT_DOUBLE_EQ(c.label.mean, 6.0) << end;
+  }
+}
+
+// A frame back in time that the next frame follows is a new timeline, whatever came before.
+TEST(ClipPipelineTest, AFrameBackInTimeThatTheNextFollowsStartsANewTimeline) {
+  ClipPipeline p(SmallOptions());
+  for (int i = 0; i < 90; ++i) p.AddFrame(kT0 + 100 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  p.AddFrame(kT0, Numbered(0), ClipSourceEncoding::kMono8);
+  EXPECT_EQ(p.stats().time_jumps, 0u);  // not told yet
+  p.AddFrame(kT0 + 1 / 30.0, Numbered(1), ClipSourceEncoding::kMono8);
+  EXPECT_EQ(p.stats().time_jumps, 1u);
+  EXPECT_EQ(p.stats().frames_stale, 0u);
+  for (int i = 2; i < 30; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  const auto clips = p.Flush();
+  // The new timeline's first clip starts at its first frame: the held frame was not lost.
+  ASSERT_FALSE(clips.empty());
+  EXPECT_NEAR(clips.back().clip.frames.front().stamp, kT0 + 10 / 25.0, 1e-6);
+  EXPECT_NEAR(clips[clips.size() - 2].clip.frames.front().stamp, kT0, 1e-6);
+  EXPECT_EQ(clips[clips.size() - 2].clip.frames.front().image.at<uint8_t>(8, 8), 0);
+}
+
 // A looped bag's first reading arrives before its first frame. It labelled the old timeline's
 // last clips at the jump (a 5 m/s reading among 4 m/s ones) and was then forgotten, so the new
 // timeline's first clips had one reading fewer than the same clips the first time round.
