@@ -27,6 +27,7 @@
 #include "ros_bridge/wall_throttle.h"
 #include "sensors/anemometer_protocol.h"
 #include "sensors/anemometer_stream.h"
+#include "sensors/fine_offset_memory.h"
 #include "sensors/fine_offset_record.h"
 #include "sensors/fine_offset_usb.h"
 #include "sensors/serial_port.h"
@@ -41,6 +42,9 @@ using clothwind::sensors::ParseResult;
 using clothwind::sensors::ParseStatus;
 
 // Retry delays for opening the device: short first (a udev symlink appearing), then longer.
+// ~frame_id's default: the instrument's own frame (x towards its north mark).
+constexpr const char* kDefaultFrameId = "anemometer";
+
 class Backoff {
  public:
   Backoff(double initial, double maximum) : initial_(initial), max_(maximum), delay_(initial) {}
@@ -69,7 +73,7 @@ class AnemometerNode {
     bool stale_set = false;
     try {
       input_ = params.Get("input", "serial");
-      frame_id_ = params.Get("frame_id", "anemometer");
+      frame_id_ = params.Get("frame_id", std::string(kDefaultFrameId));
       earth_frame_id_ = params.Get("earth_frame_id", "");
       if (params.Has("magnetic_declination")) {
         const double d = params.Get("magnetic_declination", 0.0);
@@ -261,12 +265,17 @@ class AnemometerNode {
     }
     usb_health_.ReadSucceeded();
     backoff_.Reset();
-    // The station rewrites the current record when its sensor transmits (every 48 s), when its
-    // delay byte counts another minute, or when a new history slot starts: publish on change, at
-    // the device's own rate (steady weather still changes the record once a minute).
-    if (record == last_usb_record_ && address == last_usb_address_) return;
+    // The station rewrites the current record when its sensor transmits (every 48 s), but also
+    // when its delay byte counts another minute, when indoor values or pressure change and when a
+    // new history slot starts: publishing on those republished one 48 s wind value with later
+    // stamps, counting it twice in a clip's label. Published when the wind or status bytes change,
+    // or once a sensor period has passed without (steady wind is still a new measurement).
+    const bool changed = clothwind::sensors::FineOffsetWindBytesDiffer(record, last_usb_record_);
+    if (!changed && !last_usb_publish_.isZero() &&
+        (now - last_usb_publish_).toSec() < clothwind::sensors::kFineOffsetSensorPeriod)
+      return;
     last_usb_record_ = record;
-    last_usb_address_ = address;
+    last_usb_publish_ = now;
     HandleRecord(clothwind::sensors::HexEncode(record), stamp, frame_id_, true);
   }
 
@@ -357,6 +366,13 @@ class AnemometerNode {
     if (saw_magnetic_ && !std::isfinite(magnetic_declination_))
       stat.mergeSummary(DiagnosticStatus::WARN,
                         "magnetic bearings (MWD) published without direction: set ~magnetic_declination");
+    // Compass bearings (a Fine Offset vane, MWD) in the instrument's default frame name, which
+    // config/anemometer.yaml defines as x towards the instrument's north mark: a TF tree that
+    // mounts it so turns every bearing by the mark's heading.
+    if (saw_earth_ && !saw_instrument_ && earth_frame_id_.empty() && frame_id_ == kDefaultFrameId)
+      stat.mergeSummary(DiagnosticStatus::WARN, "compass bearings published in frame " + frame_id_ +
+                                                    " (the instrument's default name): set ~earth_frame_id or "
+                                                    "~frame_id to the ENU frame they are in");
     if (saw_earth_ && saw_instrument_ && earth_frame_id_.empty())
       stat.mergeSummary(DiagnosticStatus::WARN, "instrument-relative and earth-referenced directions share frame " +
                                                     frame_id_ + ": set ~earth_frame_id");
@@ -420,7 +436,7 @@ class AnemometerNode {
   double stale_timeout_ = 5.0;
   double usb_poll_period_ = 10.0;
   std::vector<uint8_t> last_usb_record_;
-  uint16_t last_usb_address_ = 0;
+  ros::WallTime last_usb_publish_;  // when the last USB record was published (zero: none yet)
   uint64_t connects_ = 0, disconnects_ = 0, usb_read_errors_ = 0;
   // Topic mode: records dropped for their stamps (OnRaw), and the last one's reason.
   static constexpr double kMaxFutureStamp = 5.0;  // [s]

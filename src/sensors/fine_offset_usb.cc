@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "sensors/fine_offset_memory.h"
 #include "sensors/fine_offset_record.h"
 
 namespace clothwind::sensors {
@@ -71,19 +72,27 @@ bool FineOffsetUsb::ReadChunk(uint16_t address, std::vector<uint8_t>* chunk, std
     if (rc == LIBUSB_ERROR_NO_DEVICE || rc == LIBUSB_ERROR_IO) Close();
     return false;
   }
+  if (rc != static_cast<int>(command.size())) {
+    *error = "fine_offset USB read command: " + std::to_string(rc) + " of 8 bytes sent";
+    return false;
+  }
   chunk->assign(kFineOffsetChunkSize, 0);
   int got = 0;
   while (got < static_cast<int>(kFineOffsetChunkSize)) {
     int transferred = 0;
     rc = libusb_interrupt_transfer(handle_, 0x81, chunk->data() + got, kFineOffsetChunkSize - got, &transferred,
                                    kTimeoutMs);
+    // A read that fails part way may leave the rest of the answer queued on the endpoint, and
+    // every later read would then start that many bytes early (two such reads agree with each
+    // other): the station is closed, and the next poll opens it afresh.
     if (rc != 0) {
-      *error = UsbError("interrupt read", rc);
-      if (rc == LIBUSB_ERROR_NO_DEVICE || rc == LIBUSB_ERROR_IO) Close();
+      *error = UsbError("interrupt read", rc) + (got > 0 ? " after " + std::to_string(got) + " of 32 bytes" : "");
+      if (rc == LIBUSB_ERROR_NO_DEVICE || rc == LIBUSB_ERROR_IO || got > 0) Close();
       return false;
     }
     if (transferred <= 0) {
       *error = "fine_offset USB interrupt read: no data";
+      if (got > 0) Close();
       return false;
     }
     got += transferred;
@@ -92,25 +101,9 @@ bool FineOffsetUsb::ReadChunk(uint16_t address, std::vector<uint8_t>* chunk, std
 }
 
 bool FineOffsetUsb::ReadCurrentRecord(std::vector<uint8_t>* record, uint16_t* address, std::string* error) {
-  std::vector<uint8_t> fixed;
-  if (!ReadChunk(0x0000, &fixed, error)) return false;
-  if (!FineOffsetCurrentAddress(fixed, address, error)) return false;
-  // Reads are 32 bytes from any address; reading at the record itself gets it whole even when
-  // it straddles a 32-byte boundary (the memory wraps at the top, so clamp to 0xFFE0).
-  const uint16_t start = *address > 0xFFE0 ? 0xFFE0 : *address;
-  const size_t offset = *address - start;
-  // The console may be writing the record while we read it: accept two identical reads.
-  std::vector<uint8_t> chunk, again;
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    if (!ReadChunk(start, &chunk, error)) return false;
-    if (!ReadChunk(start, &again, error)) return false;
-    if (std::equal(chunk.begin() + offset, chunk.begin() + offset + kFineOffsetRecordSize, again.begin() + offset)) {
-      record->assign(chunk.begin() + offset, chunk.begin() + offset + kFineOffsetRecordSize);
-      return true;
-    }
-  }
-  *error = "fine_offset USB: current record kept changing between reads";
-  return false;
+  return ReadFineOffsetCurrentRecord(
+      [this](uint16_t at, std::vector<uint8_t>* chunk, std::string* e) { return ReadChunk(at, chunk, e); }, record,
+      address, error);
 }
 
 }  // namespace clothwind::sensors

@@ -38,11 +38,11 @@ class FineOffsetUsb {
   //   address  0x0000..0xFFE0
   // Outputs:
   //   chunk  32 bytes
-  //   error  on failure (the device is closed when it vanished)
+  //   error  on failure (the device is closed when it vanished or a read stopped part way)
   // Returns true on success.
   bool ReadChunk(uint16_t address, std::vector<uint8_t>* chunk, std::string* error);
 
-  // Reads the fixed block's current-record pointer and then that record.
+  // The current record (ReadFineOffsetCurrentRecord, fine_offset_memory.h, through ReadChunk).
   // Outputs:
   //   record   16 bytes of the current record
   //   address  its address
