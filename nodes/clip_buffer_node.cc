@@ -303,6 +303,14 @@ class ClipBufferNode {
     if (s.clips_made != stall_base_.clips_made) stall_base_ = s;
     const std::string stalled = sensors::ClipStallReason(stall_base_, s, pipeline_->options());
     if (!stalled.empty()) stat.mergeSummary(DiagnosticStatus::WARN, stalled);
+    // Frames repeated by the resampler, over windows of 10 s (the last window's verdict shown).
+    const double wall = ros::WallTime::now().toSec();
+    if (wall - repeat_base_wall_ >= 10.0) {
+      repeat_reason_ = sensors::ClipRepeatReason(repeat_base_, s, pipeline_->options());
+      repeat_base_ = s;
+      repeat_base_wall_ = wall;
+    }
+    if (!repeat_reason_.empty()) stat.mergeSummary(DiagnosticStatus::WARN, repeat_reason_);
     if (s.unlabelled_run > 0)
       stat.mergeSummaryf(DiagnosticStatus::WARN, "the last %lu clip(s) have no anemometer reading in their %.0f s window",
                          static_cast<unsigned long>(s.unlabelled_run), pipeline_->options().label_window);
@@ -352,6 +360,9 @@ class ClipBufferNode {
   std::mutex mutex_;
   std::unique_ptr<sensors::ClipPipeline> pipeline_;
   sensors::ClipPipelineStats stall_base_;  // the counters when a clip was last seen made
+  sensors::ClipPipelineStats repeat_base_;  // the counters at the start of the repeat window
+  double repeat_base_wall_ = 0;             // its wall time [s]
+  std::string repeat_reason_;               // ClipRepeatReason of the last whole window
   std::unique_ptr<sensors::AsyncDatasetWriter> writer_;
   sensors::ClipSourceInfo source_;
   std::string frame_id_;

@@ -202,6 +202,9 @@ class SdnNode {
       ++dropped_;
       return;
     }
+    // Counted before the checks: a malformed clip still arrived, and is counted as malformed, not
+    // also as missing from the sequence.
+    CountSequence(clip->sequence);
     try {
       // A colour model reads Y, Cr and Cb from bgr8 clips; a grey one the grey of either kind.
       std::vector<cv::Mat> camera_frames;
@@ -211,10 +214,10 @@ class SdnNode {
       } catch (const std::invalid_argument& e) {
         throw MalformedClip(e.what());
       }
-      CountSequence(clip->sequence);
       if (follow_wind_) {  // a clip that passed the checks only
         // ~camera_heading is an angle in one frame: a direction in another says nothing of the way.
         const bool same_frame = camera_heading_frame_.empty() || clip->wind_direction_frame_id == camera_heading_frame_;
+        if (!same_frame) last_wind_frame_ = clip->wind_direction_frame_id;
         if (!same_frame)
           WALL_WARN_THROTTLE(30.0, "sdn_node: the clips' wind direction is in frame '%s', ~camera_heading in '%s': "
                             "the way the flag flies is kept as last known",
@@ -226,6 +229,10 @@ class SdnNode {
       const bool want_maps = power_pub_.getNumSubscribers() > 0 || frequency_pub_.getNumSubscribers() > 0;
       clothwind::learn::PeakMaps maps;
       const clothwind::learn::Prediction p = predictor_->PredictFrames(frames, want_maps ? &maps : nullptr);
+      // Not published: a reader would average it into everything after it.
+      if (!std::isfinite(p.speed) || !std::isfinite(p.speed_std))
+        throw std::runtime_error("the estimate is not finite (speed " + std::to_string(p.speed) + " m/s, std " +
+                                 std::to_string(p.speed_std) + " m/s)");
       const double latency = std::chrono::duration<double>(std::chrono::steady_clock::now() - received).count();
       const clothwind::WindEstimate estimate = clothwind::ros_bridge::ToWindEstimate(
           *clip, p, latency, model_name_, static_cast<uint32_t>(predictor_->config().frames));
@@ -286,6 +293,7 @@ class SdnNode {
     if (!way) {
       ++wind_unknown_;
     } else {
+      wind_told_ = true;
       predictor_->set_flag_flies(*way == clothwind::learn::FlyDirection::kRight ? clothwind::learn::FlagFlies::kRight
                                                                               : clothwind::learn::FlagFlies::kLeft);
     }
@@ -362,6 +370,17 @@ class SdnNode {
         stat.mergeSummary(warn, what);
       }
       if (!judge_error_.empty()) stat.mergeSummary(warn, "estimating; ~fly_judge did not load: " + judge_error_);
+      // ~flag_flies wind whose wind has never said the way (cups without a vane, a direction in
+      // another frame than ~camera_heading_frame, the wind end-on): every clip is read as filmed,
+      // and a flag flying left ~2.5 m/s wrong, under an OK.
+      if (follow_wind_ && !wind_told_ && wind_unknown_ > 0)
+        stat.mergeSummary(warn, "estimating; ~flag_flies wind: no clip's wind has said which way the flag flies (" +
+                                    std::to_string(wind_unknown_) + " clips: no direction, the wind end-on" +
+                                    (last_wind_frame_.empty() ? std::string()
+                                                              : ", or a direction in frame '" + last_wind_frame_ +
+                                                                    "', not ~camera_heading_frame's '" +
+                                                                    camera_heading_frame_ + "'") +
+                                    "); clips are read as filmed");
       if (!predictor_->fly_judge_error().empty()) stat.mergeSummary(warn, "estimating; " + predictor_->fly_judge_error());
       if (!parameter_errors_.empty())
         stat.mergeSummary(warn, "estimating with a default for a parameter out of range: " + parameter_errors_.front());
@@ -417,6 +436,8 @@ class SdnNode {
   std::string fly_judge_path_, judge_error_;  // ~fly_judge and why it did not load
   std::optional<clothwind::learn::FlagFlies> told_flag_flies_;  // ~flag_flies right, left or auto
   bool follow_wind_ = false;                                     // ~flag_flies wind
+  bool wind_told_ = false;          // with follow_wind_: some clip's wind has said the way
+  std::string last_wind_frame_;     // the last clip wind direction frame that was not ~camera_heading_frame's
   std::string camera_heading_frame_;  // the frame ~camera_heading is in ("": the clips' own)
   double camera_heading_ = 0, end_on_ = 0;                       // [rad], for follow_wind_
   int threads_ = 2;

@@ -105,6 +105,12 @@ TEST(CheckClipFrameRateTest, TheRateMustBeTheModelsAndTheStampsMustAgreeWithIt) 
   // One hole of a frame in otherwise good stamps.
   for (uint32_t i = 0; i < clip.num_frames; ++i) clip.frame_stamps[i] = ros::Time(100.0 + (i + (i >= 12)) / 25.0);
   EXPECT_NE(RateRefusal(clip, 25.0).find("Clip.frame_stamps[12]"), std::string::npos) << RateRefusal(clip, 25.0);
+  // Stamps 1/27 s apart: each gap within 10 % of 1/25 s, the clip 7 % short.
+  for (uint32_t i = 0; i < clip.num_frames; ++i) clip.frame_stamps[i] = ros::Time(100.0 + i / 27.0);
+  EXPECT_NE(RateRefusal(clip, 25.0).find("Clip.frame_stamps span"), std::string::npos) << RateRefusal(clip, 25.0);
+  // A camera's jitter of 2 ms about exact stamps: accepted.
+  for (uint32_t i = 0; i < clip.num_frames; ++i) clip.frame_stamps[i] = ros::Time(100.0 + i / 25.0 + (i % 2) * 0.002);
+  EXPECT_EQ(RateRefusal(clip, 25.0), "accepted");
 }
 
 TEST(ToWindEstimateTest, TheEstimateSpansTheFramesTheModelRead) {

@@ -285,6 +285,18 @@ TEST(SpectralLayer, AStillFloorLetsStillPixelsReadNoMotionInEitherSelectionPath)
     EXPECT_NEAR(after.frequency.index({1, 0, 1, 1}).item<double>(), 2.5, 1e-6);
     EXPECT_TRUE(at::equal(after.phase, before.phase));
   }
+  // The floor removes stillness, not a camera's noise: one grey level (of 255) of noise on the
+  // still half keeps its peaks, as a real camera's background does (docs/sdn.md says so).
+  {
+    at::manual_seed(11);
+    at::Tensor noisy = HalfStillClip({1.0});
+    noisy.narrow(4, 2, 2).add_(at::randn({1, 1, 30, 2, 2}) / 255.0);
+    SpectralOptions o;
+    o.still_floor = 1e-6;
+    const SpectralMaps maps = SpectralDecomposition(noisy, o);
+    EXPECT_GT(maps.frequency.narrow(3, 2, 2).abs().min().item<double>(), 0.0);
+    EXPECT_GT(maps.power.narrow(3, 2, 2).min().item<double>(), 0.0);
+  }
   // A clip with nothing moving reads no motion anywhere.
   SpectralOptions o;
   o.still_floor = 1e-6;

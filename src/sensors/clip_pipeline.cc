@@ -222,6 +222,19 @@ std::vector<LabelledClip> ClipPipeline::Flush() {
   return ready;
 }
 
+std::string ClipRepeatReason(const ClipPipelineStats& since, const ClipPipelineStats& now,
+                             const ClipPipelineOptions& options) {
+  const uint64_t in = now.frames_in - since.frames_in, out = now.frames_out - since.frames_out;
+  if (in < 20 || out * 10 <= in * 11) return "";
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "the camera gives about %.0f frames for every %.0f the clips need (%llu in, %llu out): a camera slower "
+                "than %.3g fps, whose frames repeat in the clips",
+                options.frame_rate * static_cast<double>(in) / static_cast<double>(out), options.frame_rate,
+                static_cast<unsigned long long>(in), static_cast<unsigned long long>(out), options.frame_rate);
+  return text;
+}
+
 std::string ClipStallReason(const ClipPipelineStats& since, const ClipPipelineStats& now,
                             const ClipPipelineOptions& options) {
   const uint64_t in = now.frames_in - since.frames_in;

@@ -89,6 +89,16 @@ struct ClipPipelineStats {
 std::string ClipStallReason(const ClipPipelineStats& since, const ClipPipelineStats& now,
                             const ClipPipelineOptions& options);
 
+// Why clips repeat camera frames, for diagnostics: more resampled frames out than camera frames
+// in (by over 10 %), a camera slower than the clips' rate (a UVC camera that drops to 15 fps under
+// auto-exposure) but within gap_tolerance. Nearest-frame resampling then repeats frames, the
+// clips' stamps stay exact, and the SDN reads the repeats as 25 fps motion, with nothing said.
+// Inputs: since, now  the counters at the window's start and now (a window of seconds);
+//         options     the pipeline's options (frame_rate)
+// Returns the reason, or "" while frames out do not outnumber frames in or fewer than 20 came.
+std::string ClipRepeatReason(const ClipPipelineStats& since, const ClipPipelineStats& now,
+                             const ClipPipelineOptions& options);
+
 // The ROS-free clip buffer: camera frames and anemometer readings in (each by stamp), labelled
 // clips out. Frames go through FrameResampler (nearest frame by stamp onto a 25 fps grid),
 // PreprocessClipFrame (crop, grey or colour, resize) and ClipAssembler (N_t frames every stride, broken at

@@ -126,6 +126,18 @@ TEST(ClipPipelineTest, LabelWaitsForLateReadingsByStamp) {
   EXPECT_EQ(p.stats().readings_late, 1u);
 }
 
+TEST(ClipPipelineTest, RepeatReasonNamesACameraSlowerThanTheClips) {
+  const ClipPipelineOptions o = SmallOptions();  // 25 fps clips
+  for (const auto& [fps, repeats] : std::vector<std::pair<double, bool>>{{15.0, true}, {24.9, false}, {30.0, false}}) {
+    ClipPipeline p(o);
+    const ClipPipelineStats start = p.stats();
+    for (int i = 0; i < 4 * fps; ++i) p.AddFrame(kT0 + i / fps, Numbered(i), ClipSourceEncoding::kMono8);
+    const std::string reason = ClipRepeatReason(start, p.stats(), o);
+    EXPECT_EQ(!reason.empty(), repeats) << fps << " fps: " << reason;
+    if (repeats) EXPECT_NE(reason.find("about 15 frames for every 25"), std::string::npos) << reason;
+  }
+}
+
 TEST(ClipPipelineTest, TimeJumpingBackStartsOver) {
   // A bag played twice (rosbag play -l): the second pass must not mix with the first, and the
   // first pass's waiting clips are labelled with its own readings rather than lost.
