@@ -34,6 +34,22 @@ void ImageView(const sensor_msgs::Image& msg, cv::Mat* view, sensors::ClipSource
   if (msg.data.size() < static_cast<size_t>(msg.step) * msg.height)
     throw std::invalid_argument("image data has " + std::to_string(msg.data.size()) + " bytes, expected step * height = " +
                                 std::to_string(static_cast<size_t>(msg.step) * msg.height));
+  if (msg.is_bigendian && msg.encoding == sensor_msgs::image_encodings::MONO16) {
+    // A 16-bit camera sending the most significant byte first (GigE cameras may): cv_bridge
+    // refused it on the way to bgr8, so its frames were dropped. Swapped into a mono16 copy.
+    if (msg.step < static_cast<size_t>(msg.width) * 2)
+      throw std::invalid_argument("image step " + std::to_string(msg.step) + " < width * pixel size " +
+                                  std::to_string(static_cast<size_t>(msg.width) * 2));
+    cv::Mat swapped(static_cast<int>(msg.height), static_cast<int>(msg.width), CV_16UC1);
+    for (uint32_t y = 0; y < msg.height; ++y) {
+      const uint8_t* in = msg.data.data() + static_cast<size_t>(y) * msg.step;
+      uint16_t* out = swapped.ptr<uint16_t>(static_cast<int>(y));
+      for (uint32_t x = 0; x < msg.width; ++x) out[x] = static_cast<uint16_t>(in[2 * x] << 8 | in[2 * x + 1]);
+    }
+    *view = swapped;
+    *encoding = sensors::ClipSourceEncoding::kMono16;
+    return;
+  }
   if (!ReadAsItIs(msg)) {
     // cv_bridge's conversions (debayering, YUV, depth and byte order) rather than our own.
     int bytes_per_pixel = 1;  // an encoding sensor_msgs does not know: cv_bridge refuses it below

@@ -56,6 +56,25 @@ TEST(ImageViewTest, CameraLayoutsTheCoreDoesNotReadAreConvertedToBgr) {
   EXPECT_EQ(kept.at<cv::Vec3b>(3, 3), inner);
 }
 
+TEST(ImageViewTest, BigEndianMono16IsReadMostSignificantByteFirst) {
+  // 0x1234 sent as 12 34 (cv_bridge refused it on the way to bgr8: every frame dropped).
+  sensor_msgs::Image msg = Uniform("mono16", 2, {0x12, 0x34});
+  msg.is_bigendian = 1;
+  msg.data[2 * (3 * 8 + 5)] = 0xAB;  // pixel (row 3, column 5) = 0xAB34
+  cv::Mat view;
+  sensors::ClipSourceEncoding encoding;
+  ImageView(msg, &view, &encoding);
+  EXPECT_EQ(encoding, sensors::ClipSourceEncoding::kMono16);
+  ASSERT_EQ(view.type(), CV_16UC1);
+  EXPECT_EQ(view.at<uint16_t>(0, 0), 0x1234);
+  EXPECT_EQ(view.at<uint16_t>(3, 5), 0xAB34);
+  // The same bytes little-endian read the other way round, viewed in place.
+  msg.is_bigendian = 0;
+  ImageView(msg, &view, &encoding);
+  EXPECT_EQ(view.at<uint16_t>(0, 0), 0x3412);
+  EXPECT_EQ(view.data, msg.data.data());
+}
+
 TEST(ImageViewTest, BadImagesAreNamed) {
   cv::Mat view;
   sensors::ClipSourceEncoding encoding;
