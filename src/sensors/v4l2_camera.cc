@@ -118,6 +118,7 @@ bool V4l2Camera::OpenDevice() {
   have_sequence_ = false;
   stamper_.Reset();
   last_frame_mono_ns_ = clock_->MonotonicNs();
+  corrupt_at_last_good_ = stats_.corrupt;
   state_ = "streaming";
   error_.clear();
   Log(LogLevel::kInfo, "streaming " + options_.device + " ('" + negotiated_.card + "', " +
@@ -391,7 +392,7 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
   if (r == 0) {
     if (clock_->MonotonicNs() >= loss_deadline) {
       ++stats_.timeouts;
-      Lost("no frame for " + FpsText(timeout_s) + " s");
+      Lost(NoGoodFrameText(timeout_s));
       return ReadStatus::kError;
     }
     return ReadStatus::kNoFrame;
@@ -415,7 +416,6 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
          std::to_string(buffers_.size()));
     return ReadStatus::kError;
   }
-  last_frame_mono_ns_ = clock_->MonotonicNs();
 
   // Sequence gaps are frames the driver had to drop (no free buffer, USB bandwidth, ...).
   // Unsigned arithmetic handles the 32-bit wrap; a backwards jump (driver restart) is not a drop.
@@ -457,6 +457,10 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
       frame->encoding = RosEncodingFor(negotiated_.format);
       frame->sequence = buf.sequence;
       ++stats_.frames;
+      // Only a good frame holds the loss deadline off: a camera that sends nothing but frames the
+      // driver flags or that do not convert (wedged, a wrong-size MJPEG) was never reopened.
+      last_frame_mono_ns_ = clock_->MonotonicNs();
+      corrupt_at_last_good_ = stats_.corrupt;
     }
   }
   // Hand the buffer back to the driver (the frame owns a copy of the pixels).
@@ -464,8 +468,17 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
     const int err = errno;
     Lost("VIDIOC_QBUF failed: " + ErrnoText(err));
     // The frame converted above is still good.
+  } else if (status == ReadStatus::kError && clock_->MonotonicNs() >= loss_deadline) {
+    ++stats_.timeouts;
+    Lost(NoGoodFrameText(timeout_s));
   }
   return status;
+}
+
+std::string V4l2Camera::NoGoodFrameText(double timeout_s) const {
+  if (stats_.corrupt == corrupt_at_last_good_) return "no frame for " + FpsText(timeout_s) + " s";
+  return "no good frame for " + FpsText(timeout_s) + " s, " + std::to_string(stats_.corrupt - corrupt_at_last_good_) +
+         " unreadable (the last: " + error_ + ")";
 }
 
 std::string V4l2Camera::Describe() const {

@@ -112,6 +112,9 @@ class V4l2Camera : public FrameSource {
   bool SetupBuffers();
   void ReleaseDevice();                   // STREAMOFF, munmap, close; ignores errors
   void Lost(const std::string& why);      // release and schedule a reopen
+  // Why the loss deadline passed: "no frame for T s", or "no good frame …" when frames came
+  // since the last good one but none could be read.
+  std::string NoGoodFrameText(double timeout_s) const;
   std::string ListDeviceFormats();
   bool Fail(const std::string& why);      // sets error_, returns false
   void Log(LogLevel level, const std::string& message);
@@ -133,7 +136,8 @@ class V4l2Camera : public FrameSource {
   bool ever_opened_ = false;
   bool have_sequence_ = false;
   uint32_t last_sequence_ = 0;
-  int64_t last_frame_mono_ns_ = 0;
+  int64_t last_frame_mono_ns_ = 0;  // when the last good frame was read (or the device opened)
+  uint64_t corrupt_at_last_good_ = 0;  // stats_.corrupt then: more now means frames came, none good
   int64_t next_attempt_mono_ns_ = 0;
   double backoff_s_ = 0;
 };

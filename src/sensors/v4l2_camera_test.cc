@@ -203,6 +203,27 @@ TEST(V4l2CameraTest, StalledDeviceTimesOutAndIsReopened) {
   EXPECT_EQ(rig.camera.stats().reconnects, 1u);
 }
 
+TEST(V4l2CameraTest, ACameraSendingOnlyCorruptFramesTimesOutAndIsReopened) {
+  // Every buffer from the fourth on flagged corrupt: frames keep coming, none good. The loss
+  // deadline was refreshed by every buffer, so the camera was never reopened (0 timeouts over a
+  // minute of 897 corrupt frames).
+  V4l2Options options = Ask(PixelFormat::kGrey, 320, 240, 15);
+  options.timeout_s = 1.0;
+  FakeV4l2Config config;
+  config.error_from = 3;
+  Rig rig(config, options);
+  ASSERT_TRUE(rig.camera.Open());
+  Frame f;
+  for (int i = 0; i < 3; ++i) ASSERT_EQ(rig.ReadFrame(&f), ReadStatus::kFrame);
+  const int64_t good_until = rig.clock.MonotonicNs();
+  while (rig.camera.stats().timeouts == 0 && rig.clock.MonotonicNs() - good_until < 5000 * kMs)
+    rig.camera.Read(&f, 0.2);
+  EXPECT_EQ(rig.camera.stats().timeouts, 1u);
+  EXPECT_NEAR(rig.clock.MonotonicNs() - good_until, 1000 * kMs, 150 * kMs);
+  EXPECT_NE(rig.camera.error().find("no good frame for 1 s"), std::string::npos) << rig.camera.error();
+  EXPECT_GE(rig.camera.stats().corrupt, 10u);
+}
+
 TEST(V4l2CameraTest, OpenFailureIsRetriedByRead) {
   Rig rig({}, Ask(PixelFormat::kGrey, 320, 240, 15));
   rig.device.Unplug();

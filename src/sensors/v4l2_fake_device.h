@@ -13,6 +13,7 @@
 #include <sys/mman.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <deque>
 #include <map>
@@ -48,6 +49,8 @@ struct FakeV4l2Config {
   // Capture k reports bytesused n instead of the frame's size (0: an empty frame; fewer: a frame
   // cut short), its buffer filled as usual.
   std::map<uint64_t, uint32_t> bytesused_of;
+  // Captures from this one on are flagged V4L2_BUF_FLAG_ERROR (a wedged camera); none by default.
+  uint64_t error_from = UINT64_MAX;
   std::map<uint32_t, FakeV4l2Control> controls{
       {V4L2_CID_EXPOSURE_AUTO, {0, 3, 3, V4L2_CTRL_TYPE_MENU}},
       {V4L2_CID_GAIN, {0, 100, 10, V4L2_CTRL_TYPE_INTEGER}}};
@@ -314,6 +317,7 @@ class FakeV4l2Device : public V4l2Io {
     b->length = static_cast<uint32_t>(buf.mem.size());
     b->sequence = sequence_;
     b->flags = config_.monotonic ? V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC : V4L2_BUF_FLAG_TIMESTAMP_UNKNOWN;
+    if (captures_ >= config_.error_from) b->flags |= V4L2_BUF_FLAG_ERROR;
     b->timestamp.tv_sec = next_capture_ns_ / 1000000000LL;
     b->timestamp.tv_usec = (next_capture_ns_ % 1000000000LL) / 1000;
     delivered_capture_ns_.push_back(b->timestamp.tv_sec * 1000000000LL + b->timestamp.tv_usec * 1000LL);
