@@ -41,10 +41,10 @@ using clothwind::sensors::AnemometerProtocolName;
 using clothwind::sensors::ParseResult;
 using clothwind::sensors::ParseStatus;
 
-// Retry delays for opening the device: short first (a udev symlink appearing), then longer.
 // ~frame_id's default: the instrument's own frame (x towards its north mark).
 constexpr const char* kDefaultFrameId = "anemometer";
 
+// Retry delays for opening the device: short first (a udev symlink appearing), then longer.
 class Backoff {
  public:
   Backoff(double initial, double maximum) : initial_(initial), max_(maximum), delay_(initial) {}
@@ -306,7 +306,9 @@ class AnemometerNode {
     if (earth) saw_earth_ = true;
     if (r.reference == AngleReference::kInstrument) saw_instrument_ = true;
     if (r.reference == AngleReference::kMagnetic) saw_magnetic_ = true;
-    return earth && !earth_frame_id_.empty() ? earth_frame_id_ : instrument_frame;
+    const std::string frame = earth && !earth_frame_id_.empty() ? earth_frame_id_ : instrument_frame;
+    if (earth) last_earth_frame_ = frame;
+    return frame;
   }
 
   void HandleRecord(const std::string& data, const ros::Time& stamp, const std::string& frame, bool publish_raw) {
@@ -369,8 +371,8 @@ class AnemometerNode {
     // Compass bearings (a Fine Offset vane, MWD) in the instrument's default frame name, which
     // config/anemometer.yaml defines as x towards the instrument's north mark: a TF tree that
     // mounts it so turns every bearing by the mark's heading.
-    if (saw_earth_ && !saw_instrument_ && earth_frame_id_.empty() && frame_id_ == kDefaultFrameId)
-      stat.mergeSummary(DiagnosticStatus::WARN, "compass bearings published in frame " + frame_id_ +
+    if (saw_earth_ && !saw_instrument_ && last_earth_frame_ == kDefaultFrameId)
+      stat.mergeSummary(DiagnosticStatus::WARN, "compass bearings published in frame " + last_earth_frame_ +
                                                     " (the instrument's default name): set ~earth_frame_id or "
                                                     "~frame_id to the ENU frame they are in");
     if (saw_earth_ && saw_instrument_ && earth_frame_id_.empty())
@@ -436,6 +438,7 @@ class AnemometerNode {
   double stale_timeout_ = 5.0;
   double usb_poll_period_ = 10.0;
   std::vector<uint8_t> last_usb_record_;
+  std::string last_earth_frame_;     // the frame the last compass bearing was published in
   ros::WallTime last_usb_publish_;  // when the last USB record was published (zero: none yet)
   uint64_t connects_ = 0, disconnects_ = 0, usb_read_errors_ = 0;
   // Topic mode: records dropped for their stamps (OnRaw), and the last one's reason.

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -74,7 +75,9 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
   sub->add_option("--windows", a->windows, "evenly spaced training windows per clip (val and test: the centred one)")
       ->check(CLI::Range(1, 1000))  // a huge count hung (windows rebuilt per window)
       ->capture_default_str();
-  sub->add_option("--frames", a->frames, "frames per window (the models')")->check(CLI::Range(2, 10000))->capture_default_str();
+  auto* frames = sub->add_option("--frames", a->frames, "frames per window (the models'; with --measure: the judge's card's unless given)")
+                     ->check(CLI::Range(2, 10000))
+                     ->capture_default_str();
   sub->add_option("--hidden", a->train.hidden, "hidden units (1..4096)")->check(CLI::Range(1, 4096))->capture_default_str();
   sub->add_option("--epochs", a->train.epochs, "passes over the training maps")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--batch", a->train.batch, "maps per Adam step")->check(CLI::PositiveNumber)->capture_default_str();
@@ -92,7 +95,7 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
                   "a flying flag 5-12); 0..100 (with --measure: the judge's card's unless given)")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
-  return [a, margin]() {
+  return [a, margin, frames]() {
     // CLI11's range lets NaN through: refused here, before the training, not after it.
     if (!std::isfinite(a->margin)) throw std::invalid_argument("--margin must be a number in 0..100, got nan");
     if (a->out.empty() && a->measure.empty()) throw std::invalid_argument("--out (to train a judge) or --measure (to measure one) is required");
@@ -114,6 +117,13 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
     if (!a->measure.empty()) {
       measured = learn::FlyJudge::Load(a->measure);
       if (margin->count() > 0) measured->set_margin(a->margin);
+      // Measured on windows as long as it was trained on.
+      if (frames->count() == 0) {
+        std::ifstream in(learn::ConfigPathFor(a->measure));
+        const nlohmann::json card = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+        if (card.is_object() && card.contains("frames") && card["frames"].is_number_integer())
+          a->frames = card["frames"].get<int>();
+      }
     }
     const learn::MotionMaps train = Collect(dataset, "train", a->frames, a->windows);
     if (train.maps.empty() && !measured) {

@@ -24,6 +24,15 @@ bool ReadAsItIs(const sensor_msgs::Image& msg) {
   }
 }
 
+// mono16 or its other name 16UC1 (ParseClipSourceEncoding's kMono16).
+bool IsMono16(const std::string& encoding) {
+  try {
+    return sensors::ParseClipSourceEncoding(encoding) == sensors::ClipSourceEncoding::kMono16;
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+}
+
 }  // namespace
 
 void ImageView(const sensor_msgs::Image& msg, cv::Mat* view, sensors::ClipSourceEncoding* encoding) {
@@ -34,7 +43,7 @@ void ImageView(const sensor_msgs::Image& msg, cv::Mat* view, sensors::ClipSource
   if (msg.data.size() < static_cast<size_t>(msg.step) * msg.height)
     throw std::invalid_argument("image data has " + std::to_string(msg.data.size()) + " bytes, expected step * height = " +
                                 std::to_string(static_cast<size_t>(msg.step) * msg.height));
-  if (msg.is_bigendian && msg.encoding == sensor_msgs::image_encodings::MONO16) {
+  if (msg.is_bigendian && IsMono16(msg.encoding)) {
     // A 16-bit camera sending the most significant byte first (GigE cameras may): cv_bridge
     // refused it on the way to bgr8, so its frames were dropped. Swapped into a mono16 copy.
     if (msg.step < static_cast<size_t>(msg.width) * 2)

@@ -68,6 +68,10 @@ TEST(ImageViewTest, BigEndianMono16IsReadMostSignificantByteFirst) {
   ASSERT_EQ(view.type(), CV_16UC1);
   EXPECT_EQ(view.at<uint16_t>(0, 0), 0x1234);
   EXPECT_EQ(view.at<uint16_t>(3, 5), 0xAB34);
+  msg.encoding = "16UC1";  // mono16's other name
+  ImageView(msg, &view, &encoding);
+  EXPECT_EQ(view.at<uint16_t>(3, 5), 0xAB34);
+  msg.encoding = "mono16";
   // The same bytes little-endian read the other way round, viewed in place.
   msg.is_bigendian = 0;
   ImageView(msg, &view, &encoding);

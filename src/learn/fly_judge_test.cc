@@ -382,6 +382,13 @@ TEST(FlyJudgeTrainTest, ShiftMotionMapSlidesInStillnessAndKeepsTheMeanOne) {
   const MotionMaps eight = ShiftedMotionMaps(one, 1);
   ASSERT_EQ(eight.maps.size(), 8u);
   EXPECT_EQ(eight.wind_speeds[7], 3.0);
+  int k = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      if (dx != 0 || dy != 0) EXPECT_EQ(cv::norm(eight.maps[k++], ShiftMotionMap(map, dx, dy), cv::NORM_INF), 0.0);
+  EXPECT_THROW(ShiftedMotionMaps(one, 0), std::invalid_argument);
+  one.wind_speeds.clear();
+  EXPECT_THROW(ShiftedMotionMaps(one, 1), std::invalid_argument);
   cv::Mat mirrored, slid_mirror, mirror_slid;
   cv::flip(map, mirrored, 1);
   cv::flip(ShiftMotionMap(map, 3, 2), mirror_slid, 1);

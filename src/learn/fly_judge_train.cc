@@ -62,6 +62,11 @@ cv::Mat ShiftMotionMap(const cv::Mat& map, int dx, int dy) {
 }
 
 MotionMaps ShiftedMotionMaps(const MotionMaps& maps, int distance) {
+  if (distance < 1 || distance >= kMotionMapGrid || maps.maps.size() != maps.wind_speeds.size())
+    throw std::invalid_argument("ShiftedMotionMaps: distance " + std::to_string(distance) + " (1.." +
+                                std::to_string(kMotionMapGrid - 1) + " expected) or " +
+                                std::to_string(maps.maps.size()) + " maps with " +
+                                std::to_string(maps.wind_speeds.size()) + " wind speeds");
   MotionMaps out;
   for (size_t i = 0; i < maps.maps.size(); ++i) {
     for (int dy = -distance; dy <= distance; dy += distance) {

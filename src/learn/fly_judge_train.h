@@ -42,7 +42,9 @@ MotionMaps CollectMotionMaps(const std::vector<ClipInfo>& clips, int frames, int
 cv::Mat ShiftMotionMap(const cv::Mat& map, int dx, int dy);
 
 // Each map of `maps` slid by `distance` cells in each of the 8 directions (dx, dy in
-// {-distance, 0, distance}, not both 0): 8 maps per map, with its wind speed.
+// {-distance, 0, distance}, not both 0; rows of dy, then dx, ascending): 8 maps per map, with
+// its wind speed. Throws std::invalid_argument unless 1 <= distance < kMotionMapGrid and every
+// map has its wind speed.
 MotionMaps ShiftedMotionMaps(const MotionMaps& maps, int distance);
 
 struct FlyJudgeTrainOptions {

@@ -85,6 +85,7 @@ std::string ModelConfig::Name() const {
     if (phase_steps) s << "s";
     if (phase_steps && phase_step_far > 1) s << phase_step_far;
     if (mode_shape) s << "o";
+    if (still_floor != 0) s << "z";
     if (frame_channels > 0) s << "+f" << frame_channels;
     if (spectral_pool != 1) s << "/" << spectral_pool;
   }

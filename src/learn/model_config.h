@@ -37,8 +37,9 @@ struct ModelConfig {
   bool local_peaks = false;  // SDN: the k strongest local maxima instead of the k strongest bins
   bool phase_steps = false;  // SDN: 4C more channels, the strongest peak's phase step to the neighbours
   int phase_step_far = 0;    // SDN with phase_steps: 4C more, the step over this many pixels (0: none)
-  // SDN: selected bins at or below this times the clip's mean periodogram read power and frequency
-  // 0 (SpectralOptions::still_floor; 0: off, as every model trained before it).
+  // SDN: selected bins at or below this times the clip's mean periodogram (or the detrend's
+  // rounding) read power and frequency 0 (SpectralOptions::still_floor; 0: off, as every model
+  // trained before it).
   double still_floor = 0.0;
   bool mode_shape = false;   // SDN: 2C more, each pixel's amplitude at the clip's dominant frequency
                              // relative to the pixel that moves most (SpectralOptions::mode_shape)
@@ -142,7 +143,7 @@ struct ModelConfig {
   bool FlowSizeIsValid() const { return flow_size == 0 || (flow && flow_size >= 16); }
   // A short name for logs and messages, e.g. "sdn-k3-w64-112-30f" ("…-flow-…" with flow, "sdn-k3m-…" with mean_map,
   // "sdn-k3dc-…" with include_dc, "sdn-k3d120p-…" with dft_size 120 and local_peaks, "…s-" with phase_steps,
-  // "…s4-" with phase_step_far 4, "…o-" with mode_shape, "…s/2-" with spectral_pool 2, "…-xy-" with
+  // "…s4-" with phase_step_far 4, "…o-" with mode_shape, "…z-" with a still_floor, "…s/2-" with spectral_pool 2, "…-xy-" with
   // coord_maps, "…-ycc-" with colour, "…-h256-" with head_hidden 256, "…s+f10-" with frame_channels 10).
   std::string Name() const;
   // Table 1's "input modality", e.g. "30x112x112" ("30x3x64x64" with flow's or colour's three channels).

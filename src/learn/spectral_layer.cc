@@ -95,7 +95,7 @@ at::Tensor ModeShape(const at::Tensor& spectrum, const at::Tensor& periodogram, 
 // each example's floor read power 0 and frequency 0 in maps.power and maps.frequency. The floor
 // is still_floor times the example's mean periodogram (its spectra [N_b C H W, F], complex, over
 // the candidate bins first..first+candidates-1, divided by the window's sum of w^2), or the power
-// of the detrend's rounding, (N_t · ε · max|x|)² with ε the clips' dtype's epsilon, if that is
+// of the detrend's rounding, (N_t · ε · max|x|)² / Σw² with ε the clips' dtype's epsilon, if that is
 // larger: in a clip where nothing moves the rounding is all the mean holds, and a relative floor
 // alone kept its noise. x is the clips [N_b, C, N_t, H, W]. Nothing happens for still_floor 0.
 void ZeroStillPixels(const at::Tensor& x, const at::Tensor& spectrum, const at::Tensor& window, int64_t first,
@@ -110,7 +110,9 @@ void ZeroStillPixels(const at::Tensor& x, const at::Tensor& spectrum, const at::
                           window.square().sum().to(at::kDouble);
   const double epsilon = x.scalar_type() == at::kDouble ? std::numeric_limits<double>::epsilon()
                                                          : std::numeric_limits<float>::epsilon();
-  const at::Tensor rounding = (x.detach().abs().reshape({nb, -1}).amax(1).to(at::kDouble) * (nt * epsilon)).square();
+  // In the periodogram's units (|X|² / Σw²), as the powers it is compared with.
+  const at::Tensor rounding = (x.detach().abs().reshape({nb, -1}).amax(1).to(at::kDouble) * (nt * epsilon)).square() /
+                              window.square().sum().to(at::kDouble);
   const at::Tensor floor = at::maximum(still_floor * mean, rounding).reshape({nb, 1, 1, 1}).to(maps.power.scalar_type());
   const at::Tensor still = maps.power.le(floor);
   maps.power = maps.power.masked_fill(still, 0.0);

@@ -46,7 +46,7 @@ struct SpectralOptions {
   bool one_pass = true;
   // Still pixels read no motion: a selected bin whose power is at most still_floor times the
   // clip's mean periodogram (per example, over its C·H·W pixels and candidate bins), or at most
-  // the power of the detrend's rounding, (N_t · ε · max|x|)² with ε the dtype's epsilon, reads
+  // the power of the detrend's rounding, (N_t · ε · max|x|)² / Σw² with ε the dtype's epsilon, reads
   // power 0 and frequency 0, as local_peaks' empty slots do. Why: a still pixel's spectrum is zeros or
   // rounding noise, whose top k is arbitrary (8.33 Hz or 0.83 Hz on the CPU, index order on
   // CUDA), and the frequency map reached the network ungated. 0: off, as models trained before

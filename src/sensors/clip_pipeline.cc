@@ -213,6 +213,13 @@ std::vector<LabelledClip> ClipPipeline::TakeReady() {
 }
 
 std::vector<LabelledClip> ClipPipeline::Flush() {
+  // A frame back in time with nothing after it (the stream ended or stalled) is one frame: it
+  // is dropped as stale, and the frame after the stall starts afresh.
+  if (backward_) {
+    backward_.reset();
+    ++stats_.frames_stale;
+    ++stats_.frames_dropped;
+  }
   std::vector<LabelledClip> ready = std::move(released_at_jump_);
   released_at_jump_.clear();
   while (!pending_.empty()) {

@@ -129,7 +129,8 @@ class ClipPipeline {
   // waiting when camera time went back come first, labelled with the readings held then.
   std::vector<LabelledClip> TakeReady();
 
-  // Every waiting clip, labelled with the readings held now (the stream ended or stalled).
+  // Every waiting clip, labelled with the readings held now (the stream ended or stalled); a frame
+  // held back in time with nothing after it is dropped as stale.
   std::vector<LabelledClip> Flush();
 
   // Forgets everything, waiting clips included; counters are kept. (A jump back in camera time is

@@ -211,6 +211,12 @@ TEST(ClipPipelineTest, AFrameBackInTimeThatTheNextFollowsStartsANewTimeline) {
   EXPECT_NEAR(clips.back().clip.frames.front().stamp, kT0 + 10 / 25.0, 1e-6);
   EXPECT_NEAR(clips[clips.size() - 2].clip.frames.front().stamp, kT0, 1e-6);
   EXPECT_EQ(clips[clips.size() - 2].clip.frames.front().image.at<uint8_t>(8, 8), 0);
+  // A frame back in time that the stream ends on is one stale frame at Flush, not left to be
+  // judged by whatever comes after the stall.
+  p.AddFrame(kT0 - 600, Numbered(9), ClipSourceEncoding::kMono8);
+  p.Flush();
+  EXPECT_EQ(p.stats().frames_stale, 1u);
+  EXPECT_EQ(p.stats().time_jumps, 1u);
 }
 
 // A looped bag's first reading arrives before its first frame. It labelled the old timeline's

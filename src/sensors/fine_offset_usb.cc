@@ -74,6 +74,7 @@ bool FineOffsetUsb::ReadChunk(uint16_t address, std::vector<uint8_t>* chunk, std
   }
   if (rc != static_cast<int>(command.size())) {
     *error = "fine_offset USB read command: " + std::to_string(rc) + " of 8 bytes sent";
+    Close();  // what the console makes of half a command is unknown: start afresh
     return false;
   }
   chunk->assign(kFineOffsetChunkSize, 0);
@@ -85,6 +86,8 @@ bool FineOffsetUsb::ReadChunk(uint16_t address, std::vector<uint8_t>* chunk, std
     // A read that fails part way may leave the rest of the answer queued on the endpoint, and
     // every later read would then start that many bytes early (two such reads agree with each
     // other): the station is closed, and the next poll opens it afresh.
+    // libusb reports the bytes a timed-out transfer did move: they count as part way too.
+    if (transferred > 0) got += transferred;
     if (rc != 0) {
       *error = UsbError("interrupt read", rc) + (got > 0 ? " after " + std::to_string(got) + " of 32 bytes" : "");
       if (rc == LIBUSB_ERROR_NO_DEVICE || rc == LIBUSB_ERROR_IO || got > 0) Close();
@@ -95,7 +98,6 @@ bool FineOffsetUsb::ReadChunk(uint16_t address, std::vector<uint8_t>* chunk, std
       if (got > 0) Close();
       return false;
     }
-    got += transferred;
   }
   return true;
 }
