@@ -261,14 +261,23 @@ TEST(FlyJudgeTest, RefusesWeightsOfTheWrongShape) {
                std::invalid_argument);
 }
 
-// Flags held at the left, of random place, size, shape of growth, wave and noise.
-MotionMaps RandomFlags(int count, std::mt19937_64& rng) {
-  std::uniform_int_distribution<int> x0(0, 22), length(20, 40), y0(4, 24), height(16, 36);
-  std::uniform_real_distribution<double> gain(20, 70), power(0.5, 2.0), k(-0.6, 0.6), noise(0, 4);
+// Where flags are drawn from: hoist column x0, length, top row y0 and height [px of 64], and the
+// power of their growth along the flag.
+struct FlagRanges {
+  int x0_low, x0_high, length_low, length_high, y0_low, y0_high, height_low, height_high;
+  double power_low, power_high;
+};
+
+// `count` flags held at the left, drawn from `ranges` (gain, wave and noise as every test's),
+// slid `offset` px right (negative: left), as motion maps.
+MotionMaps DrawFlags(int count, const FlagRanges& r, int offset, std::mt19937_64& rng) {
+  std::uniform_int_distribution<int> x0(r.x0_low, r.x0_high), length(r.length_low, r.length_high),
+      y0(r.y0_low, r.y0_high), height(r.height_low, r.height_high);
+  std::uniform_real_distribution<double> gain(20, 70), power(r.power_low, r.power_high), k(-0.6, 0.6), noise(0, 4);
   MotionMaps out;
   for (int i = 0; i < count; ++i) {
     FlagClip c;
-    c.x0 = x0(rng);
+    c.x0 = x0(rng) + offset;
     c.length = length(rng);
     c.y0 = y0(rng);
     c.height = height(rng);
@@ -280,6 +289,11 @@ MotionMaps RandomFlags(int count, std::mt19937_64& rng) {
     out.wind_speeds.push_back(c.gain / 7);  // any label: only the bands read it
   }
   return out;
+}
+
+// Flags held at the left, of random place, size, shape of growth, wave and noise.
+MotionMaps RandomFlags(int count, std::mt19937_64& rng) {
+  return DrawFlags(count, {0, 22, 20, 40, 4, 24, 16, 36, 0.5, 2.0}, 0, rng);
 }
 
 TEST(FlyJudgeTrainTest, LearnsTheHoistSideOfHeldOutFlagsAndTheirMirrors) {
@@ -318,23 +332,7 @@ TEST(FlyJudgeTrainTest, LearnsTheHoistSideOfHeldOutFlagsAndTheirMirrors) {
 // `offset`, the same flags slid that many pixels right (negative: left), cut by the frame's edge,
 // as a camera that does not centre the flag shows them.
 MotionMaps FramedFlags(int count, int offset, std::mt19937_64& rng) {
-  std::uniform_int_distribution<int> x0(10, 12), length(34, 40), y0(15, 17), height(28, 32);
-  std::uniform_real_distribution<double> gain(20, 70), power(1.0, 2.0), k(-0.6, 0.6), noise(0, 4);
-  MotionMaps out;
-  for (int i = 0; i < count; ++i) {
-    FlagClip c;
-    c.x0 = x0(rng) + offset;
-    c.length = length(rng);
-    c.y0 = y0(rng);
-    c.height = height(rng);
-    c.gain = gain(rng);
-    c.power = power(rng);
-    c.k = k(rng);
-    c.noise = noise(rng);
-    out.maps.push_back(MotionMap(Clip(c, rng)));
-    out.wind_speeds.push_back(c.gain / 7);
-  }
-  return out;
+  return DrawFlags(count, {10, 12, 34, 40, 15, 17, 28, 32, 1.0, 2.0}, offset, rng);
 }
 
 TEST(FlyJudgeTrainTest, ShiftedTrainingJudgesFlagsACameraDoesNotCentre) {
