@@ -270,12 +270,7 @@ class AnemometerNode {
     // new history slot starts: publishing on those republished one 48 s wind value with later
     // stamps, counting it twice in a clip's label. Published when the wind or status bytes change,
     // or once a sensor period has passed without (steady wind is still a new measurement).
-    const bool changed = clothwind::sensors::FineOffsetWindBytesDiffer(record, last_usb_record_);
-    if (!changed && !last_usb_publish_.isZero() &&
-        (now - last_usb_publish_).toSec() < clothwind::sensors::kFineOffsetSensorPeriod)
-      return;
-    last_usb_record_ = record;
-    last_usb_publish_ = now;
+    if (!usb_gate_.ShouldPublish(record, now.toSec())) return;
     HandleRecord(clothwind::sensors::HexEncode(record), stamp, frame_id_, true);
   }
 
@@ -437,9 +432,8 @@ class AnemometerNode {
   ros::WallTime next_attempt_, next_poll_, last_valid_wall_, last_diag_wall_;
   double stale_timeout_ = 5.0;
   double usb_poll_period_ = 10.0;
-  std::vector<uint8_t> last_usb_record_;
+  clothwind::sensors::FineOffsetPublishGate usb_gate_;  // which polled USB records are published
   std::string last_earth_frame_;     // the frame the last compass bearing was published in
-  ros::WallTime last_usb_publish_;  // when the last USB record was published (zero: none yet)
   uint64_t connects_ = 0, disconnects_ = 0, usb_read_errors_ = 0;
   // Topic mode: records dropped for their stamps (OnRaw), and the last one's reason.
   static constexpr double kMaxFutureStamp = 5.0;  // [s]

@@ -76,4 +76,12 @@ bool FineOffsetWindBytesDiffer(const std::vector<uint8_t>& a, const std::vector<
   return false;
 }
 
+bool FineOffsetPublishGate::ShouldPublish(const std::vector<uint8_t>& record, double now) {
+  if (any_ && !FineOffsetWindBytesDiffer(record, last_) && now - last_time_ < kFineOffsetSensorPeriod) return false;
+  last_ = record;
+  last_time_ = now;
+  any_ = true;
+  return true;
+}
+
 }  // namespace clothwind::sensors

@@ -40,6 +40,22 @@ bool ReadFineOffsetCurrentRecord(const FineOffsetBlockReader& read, std::vector<
 // Inputs: a, b  records of at least 16 bytes (shorter ones differ).
 bool FineOffsetWindBytesDiffer(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b);
 
+// Which polled current records become readings: the first, one whose wind or status bytes
+// differ from the last published (FineOffsetWindBytesDiffer), or one a sensor period
+// (kFineOffsetSensorPeriod, 48 s) after the last published, since a steady wind is still a new
+// measurement every transmission.
+class FineOffsetPublishGate {
+ public:
+  // Inputs: record  the polled current record (16 bytes); now  the poll's time [s], any clock
+  // that does not go back. Returns true when it is to be published (and remembers it).
+  bool ShouldPublish(const std::vector<uint8_t>& record, double now);
+
+ private:
+  std::vector<uint8_t> last_;
+  double last_time_ = 0;
+  bool any_ = false;
+};
+
 }  // namespace clothwind::sensors
 
 #endif  // CLOTHWIND_SENSORS_FINE_OFFSET_MEMORY_H_

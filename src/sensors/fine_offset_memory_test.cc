@@ -116,5 +116,20 @@ TEST(FineOffsetMemory, OnlyTheWindAndStatusBytesCountAsAChange) {
   EXPECT_TRUE(FineOffsetWindBytesDiffer(a, std::vector<uint8_t>(8)));
 }
 
+TEST(FineOffsetMemory, ThePublishGatePassesChangesAndOneRecordASensorPeriod) {
+  FineOffsetPublishGate gate;
+  std::vector<uint8_t> steady(16, 0x20);
+  EXPECT_TRUE(gate.ShouldPublish(steady, 100.0));  // the first
+  std::vector<uint8_t> minute = steady;
+  minute[0] = 0x21;  // the delay byte counts a minute: the same wind
+  EXPECT_FALSE(gate.ShouldPublish(minute, 110.0));
+  EXPECT_FALSE(gate.ShouldPublish(minute, 147.9));
+  EXPECT_TRUE(gate.ShouldPublish(minute, 148.0));  // a sensor period on: steady wind, a new reading
+  std::vector<uint8_t> gust = minute;
+  gust[10] = 0x30;
+  EXPECT_TRUE(gate.ShouldPublish(gust, 150.0));  // the wind changed: at once
+  EXPECT_FALSE(gate.ShouldPublish(gust, 160.0));
+}
+
 }  // namespace
 }  // namespace clothwind::sensors
