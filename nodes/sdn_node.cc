@@ -217,11 +217,12 @@ class SdnNode {
       if (follow_wind_) {  // a clip that passed the checks only
         // ~camera_heading is an angle in one frame: a direction in another says nothing of the way.
         const bool same_frame = camera_heading_frame_.empty() || clip->wind_direction_frame_id == camera_heading_frame_;
-        if (!same_frame) last_wind_frame_ = clip->wind_direction_frame_id;
-        if (!same_frame)
+        if (!same_frame) {
+          last_wind_frame_ = clip->wind_direction_frame_id;
           WALL_WARN_THROTTLE(30.0, "sdn_node: the clips' wind direction is in frame '%s', ~camera_heading in '%s': "
                             "the way the flag flies is kept as last known",
                             clip->wind_direction_frame_id.c_str(), camera_heading_frame_.c_str());
+        }
         FollowTheWind(same_frame ? clip->wind_direction_mean : std::numeric_limits<double>::quiet_NaN());
       }
       const std::vector<cv::Mat> frames =

@@ -1,7 +1,5 @@
 // clothwind train: trains the SDN or a baseline of Table 1 (ResNet-18, Yang et al.'s LSTM) on a dataset
 // (docs/dataset.md) with the seed's recipe; see docs/sdn.md.
-#include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -168,14 +166,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
     learn::TrainOptions o = args->o;
     o.model.frames = args->frames;
     o.model.still_floor = args->still_floor >= 0 ? args->still_floor : o.model.arch == "sdn" ? 1e-6 : 0.0;
-    // Resumed without --still-floor: the run's own (a run from before the option has none: 0), so
-    // an older run's command resumes as it was given.
-    if (args->still_floor < 0 && o.resume) {
-      std::ifstream in(std::filesystem::path(args->out) / "state.json");
-      const nlohmann::json state = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-      if (state.is_object() && state.contains("model") && state["model"].is_object())
-        o.model.still_floor = state["model"].value("still_floor", 0.0);
-    }
+    o.still_floor_default = args->still_floor < 0;  // resumed, the run's own
     o.data = args->data;
     o.out = args->out;
     std::unique_ptr<ProgressBar> bar;

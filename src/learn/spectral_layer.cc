@@ -91,23 +91,24 @@ at::Tensor ModeShape(const at::Tensor& spectrum, const at::Tensor& periodogram, 
   return at::stack({real, imag}, 2).reshape({nb, 2 * c, h, w});
 }
 
+// The periodogram of the candidate bins: |X_j|² / Σ w_n² for j = first..first+candidates-1 of
+// the one-sided spectra [N_b C H W, F] (complex); [N_b C H W, candidates].
+at::Tensor CandidatePeriodogram(const at::Tensor& spectrum, const at::Tensor& window, int64_t first,
+                                int64_t candidates) {
+  return ((at::real(spectrum).square() + at::imag(spectrum).square()) / window.square().sum())
+      .narrow(1, first, candidates);
+}
+
 // SpectralOptions::still_floor: the selected bins of maps.power ([N_b, kC, H, W]) at or below
 // each example's floor read power 0 and frequency 0 in maps.power and maps.frequency. The floor
-// is still_floor times the example's mean periodogram (its spectra [N_b C H W, F], complex, over
-// the candidate bins first..first+candidates-1, divided by the window's sum of w^2), or the power
-// of the detrend's rounding, (N_t · ε · max|x|)² / Σw² with ε the clips' dtype's epsilon, if that is
-// larger: in a clip where nothing moves the rounding is all the mean holds, and a relative floor
-// alone kept its noise. x is the clips [N_b, C, N_t, H, W]. Nothing happens for still_floor 0.
-void ZeroStillPixels(const at::Tensor& x, const at::Tensor& spectrum, const at::Tensor& window, int64_t first,
-                     int64_t candidates, double still_floor, SpectralMaps& maps) {
-  if (still_floor == 0) return;
+// is still_floor times the example's mean of `periodogram` (CandidatePeriodogram, [N_b C H W,
+// candidates]), or the power of the detrend's rounding, (N_t · ε · max|x|)² / Σw² with ε the
+// clips' dtype's epsilon, if that is larger: in a clip where nothing moves the rounding is all
+// the mean holds, and a relative floor alone kept its noise. x is the clips [N_b, C, N_t, H, W].
+void ZeroStillPixels(const at::Tensor& x, const at::Tensor& periodogram, const at::Tensor& window,
+                     double still_floor, SpectralMaps& maps) {
   const int64_t nb = x.size(0), nt = x.size(2);
-  const at::Tensor mean = (at::real(spectrum).square() + at::imag(spectrum).square())
-                              .narrow(1, first, candidates)
-                              .reshape({nb, -1})
-                              .mean(1)
-                              .to(at::kDouble) /
-                          window.square().sum().to(at::kDouble);
+  const at::Tensor mean = periodogram.reshape({nb, -1}).mean(1).to(at::kDouble);
   const double epsilon = x.scalar_type() == at::kDouble ? std::numeric_limits<double>::epsilon()
                                                          : std::numeric_limits<float>::epsilon();
   // In the periodogram's units (|X|² / Σw²), as the powers it is compared with.
@@ -191,12 +192,11 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
     SpectralPeaks peaks = SpectralPeaksCpu(spectrum, window.square().sum(), first, candidates, k,
                                            frame_rate / static_cast<double>(length), nb, c, h, w, distances, eps);
     SpectralMaps maps{peaks.power, peaks.frequency, peaks.phase, at::Tensor()};
-    ZeroStillPixels(x, spectrum, window, first, candidates, options.still_floor, maps);
+    if (options.still_floor != 0)
+      ZeroStillPixels(x, CandidatePeriodogram(spectrum, window, first, candidates), window, options.still_floor, maps);
     return maps;
   }
-  at::Tensor periodogram = (at::real(spectrum).square() + at::imag(spectrum).square()) /
-                           window.square().sum();
-  periodogram = periodogram.narrow(1, first, candidates);
+  const at::Tensor periodogram = CandidatePeriodogram(spectrum, window, first, candidates);
   at::Tensor ranked = periodogram;
   if (options.local_peaks) {
     // A bin is a peak when no neighbour is higher (>= on the left, > on the right, so a flat
@@ -224,7 +224,7 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
   SpectralMaps maps{to_map(power), to_map(frequency), at::Tensor(), at::Tensor()};
   if (options.phase_steps) maps.phase = PhaseSteps(spectrum, bin.narrow(1, 0, 1) + first, nb, c, h, w, distances);
   if (options.mode_shape) maps.mode = ModeShape(spectrum, periodogram, first, nb, c, h, w);
-  ZeroStillPixels(x, spectrum, window, first, candidates, options.still_floor, maps);
+  if (options.still_floor != 0) ZeroStillPixels(x, periodogram, window, options.still_floor, maps);
   return maps;
 }
 

@@ -444,7 +444,9 @@ TrainResult Train(const TrainOptions& o) {
     state = ReadState(state_path);
     try {
       config = ModelConfigFromJson(state.at("model"), state_path.string());
-      RefuseChangedModelOnResume(state_path, config, o.model);
+      ModelConfig given = o.model;
+      if (o.still_floor_default) given.still_floor = config.still_floor;
+      RefuseChangedModelOnResume(state_path, config, given);
       for (const auto& e : state.at("log")) result.log.push_back(EpochFromJson(e));
     } catch (const nlohmann::json::exception& e) {
       throw std::runtime_error(state_path.string() + ": " + e.what());

@@ -47,6 +47,9 @@ struct TrainOptions {
   int threads = 2;                   // torch intra-op threads
   std::string device = "auto";       // cpu | cuda | auto
   bool resume = false;               // continue from out/state.json and the checkpoint it names
+  // model.still_floor is the default, not asked for (train without --still-floor): a resumed run
+  // keeps its own, so a run from before the option (0) resumes with the command it was given.
+  bool still_floor_default = false;
   // Without resume, a folder that already holds a run (state.json or model.pt) is refused unless
   // this is set: rerunning a command after a crash without --resume replaced a day's run.
   bool overwrite = false;
