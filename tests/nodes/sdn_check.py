@@ -2,7 +2,11 @@
 """rostest for sdn_node: publishes synthetic clips (one malformed) and checks the estimates,
 their trailing mean, the diagnostics and the spectral images."""
 import math
+import os
+import shutil
+import subprocess
 import sys
+import tempfile
 import threading
 import unittest
 
@@ -56,6 +60,68 @@ def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encod
     clip.wind_std = 0.3
     clip.wind_count = 60 if not math.isnan(wind_mean) else 0
     clip.wind_direction_mean = wind_direction
+    return clip
+
+
+def read_pgm(path):
+    """(width, height, bytes) of a binary 8-bit PGM (P5) file."""
+    with open(path, "rb") as f:
+        data = f.read()
+    fields, pos = [], 0
+    while len(fields) < 4:
+        while data[pos:pos + 1].isspace():
+            pos += 1
+        if data[pos:pos + 1] == b"#":
+            pos = data.index(b"\n", pos) + 1
+            continue
+        end = pos
+        while not data[end:end + 1].isspace():
+            end += 1
+        fields.append(data[pos:end])
+        pos = end
+    if fields[0] != b"P5" or int(fields[3]) != 255:
+        raise ValueError("%s: expected an 8-bit binary PGM (P5, maxval 255)" % path)
+    width, height = int(fields[1]), int(fields[2])
+    pixels = data[pos + 1:pos + 1 + width * height]
+    if len(pixels) != width * height:
+        raise ValueError("%s: %d bytes of pixels, expected %d" % (path, len(pixels), width * height))
+    return width, height, pixels
+
+
+def flagsim_frames(size=64, count=30):
+    """`count` frames (size x size mono8, each bytes) of a flag rendered by FlagSim (clothwind
+    make-dataset, seed 1, 4 m/s or so: whatever the seed draws): a real flag flying right of its
+    pole, as every FlagSim camera films it. Rendered here, so the test needs no stored data."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    cli = subprocess.run(["bash", "-c", 'source "$1" && echo "$cli"', "sdn_check",
+                          os.path.join(here, "clothwind_cli.sh")],
+                         check=True, stdout=subprocess.PIPE, universal_newlines=True).stdout.strip()
+    out = tempfile.mkdtemp(prefix="sdn_check_flagsim_")
+    try:
+        subprocess.run([cli, "make-dataset", "--kind", "flag", "--count", "1", "--views", "1", "--size", str(size),
+                        "--frames", str(count), "--format", "pgm", "--seed", "1", "--jobs", "1", "--out", out],
+                       check=True, stdout=subprocess.DEVNULL)
+        example = sorted(d for d in os.listdir(out) if d.startswith("flag-"))[0]
+        frames = []
+        for t in range(count):
+            width, height, pixels = read_pgm(os.path.join(out, example, "%03d.pgm" % t))
+            if (width, height) != (size, size):
+                raise ValueError("FlagSim frame %d is %dx%d, expected %dx%d" % (t, width, height, size, size))
+            frames.append(pixels)
+        return frames
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+
+
+def frames_clip(seq, start, frames, size, mirrored=False, rate=25.0, wind_mean=4.0):
+    """A mono8 Clip of `frames` (size x size bytes each), mirrored left to right when asked."""
+    clip = make_clip(seq, start, size, 3.0, wind_mean, count=len(frames), rate=rate)
+    data = bytearray()
+    for f in frames:
+        for y in range(size):
+            row = f[y * size:(y + 1) * size]
+            data += row[::-1] if mirrored else row
+    clip.data = bytes(data)
     return clip
 
 
@@ -148,6 +214,19 @@ class SdnNodeTest(unittest.TestCase):
             return None
 
         self.wait_for(lambda: find() is not None, 10, "a diagnostic counting %d clips turned round" % count)
+        with self.lock:
+            return find()
+
+    def wait_for_estimates(self, statuses, count):
+        """The key-value pairs of the first of `statuses` that counts `count` estimates."""
+        def find():
+            for s in statuses:
+                values = {kv.key: kv.value for kv in s.values}
+                if values.get("estimates") == str(count):
+                    return values
+            return None
+
+        self.wait_for(lambda: find() is not None, 10, "a diagnostic counting %d estimates" % count)
         with self.lock:
             return find()
 
@@ -272,7 +351,12 @@ class SdnNodeTest(unittest.TestCase):
         self.wait_for(lambda: any(s.level == DiagnosticStatus.WARN and "~flag_flies" in s.message
                                   for s in self.no_flip_statuses), 60, "a WARN naming ~flag_flies")
         start = rospy.Time(1700000000, 0)
+        # The flag flying right first: read as filmed (a judge that had the sides the wrong way
+        # round would turn it, and turning either clip alone makes the two estimates equal).
         self.no_flip_pub.publish(make_clip(0, start, size, 3.0, 4.0, flag="right"))
+        self.wait_for(lambda: len(self.no_flip_estimates) >= 1, 30, "the estimate of the right-flying clip")
+        values = self.wait_for_estimates(self.no_flip_statuses, 1)
+        self.assertEqual(values["clips turned round (flag flying left)"], "0", values)
         self.no_flip_pub.publish(make_clip(1, start + rospy.Duration.from_sec(2.0), size, 3.0, 4.0, flag="left"))
         self.wait_for(lambda: len(self.no_flip_estimates) >= 2, 30, "estimates of both clips")
         values = self.wait_for_turned(self.no_flip_statuses, 1)
@@ -311,21 +395,29 @@ class SdnNodeTest(unittest.TestCase):
 
     def test_no_flip_model_with_the_fly_judge(self):
         """~fly_judge, the shipped judge: no WARN (the judge, not the motion cues, tells the way),
-        the judge named in the diagnostics, and a clip of a flag flying left turned round."""
-        size = 256
+        the judge named in the diagnostics, and a flag rendered by FlagSim read as filmed (it flies
+        right) while its mirror image (flying left) is turned round. The judge learned FlagSim's
+        flags, not the hand-drawn stripes of make_clip: it reads those the wrong way round."""
+        size = 64  # the judge's and the model's side: no resizing, so the mirror image stays exact
+        frames = flagsim_frames(size)
         self.wait_for(lambda: self.judge_pub.get_num_connections() > 0, 120, "the judged sdn_node to subscribe")
         # Loaded for over 10 s and no clip yet: a WARN that says so (it said OK "estimating").
         self.wait_for(lambda: any(s.level == DiagnosticStatus.WARN and "no clip received yet" in s.message
                                   for s in self.judge_statuses), 60, "a WARN that no clip has come yet")
         start = rospy.Time(1700000000, 0)
-        self.judge_pub.publish(make_clip(0, start, size, 3.0, 4.0, flag="right"))
-        self.judge_pub.publish(make_clip(1, start + rospy.Duration.from_sec(2.0), size, 3.0, 4.0, flag="left"))
+        self.judge_pub.publish(frames_clip(0, start, frames, size))
+        self.wait_for(lambda: len(self.judge_estimates) >= 1, 30, "the estimate of the FlagSim clip")
+        values = self.wait_for_estimates(self.judge_statuses, 1)
+        self.assertEqual(values["clips turned round (flag flying left)"], "0", values)
+        self.assertEqual(values["clips the fly judge could not tell (the last way kept)"], "0", values)
+        self.judge_pub.publish(frames_clip(1, start + rospy.Duration.from_sec(2.0), frames, size, mirrored=True))
         self.wait_for(lambda: len(self.judge_estimates) >= 2, 30, "estimates of both clips")
         with self.lock:
             del self.judge_statuses[:]
         self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.judge_statuses), 30,
                       "an OK diagnostic from the node with a fly judge once clips come")
         values = self.wait_for_turned(self.judge_statuses, 1)
+        self.assertEqual(values["clips the fly judge could not tell (the last way kept)"], "0", values)
         with self.lock:
             speeds = {e.clip_sequence: e.speed for e in self.judge_estimates}
         self.assertEqual(values["flag flies"], "auto")
