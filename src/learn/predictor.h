@@ -16,7 +16,9 @@
 namespace clothwind::learn {
 
 struct Prediction {
-  double speed = 0;      // [m/s]
+  // [m/s], never below 0: the network's output, a regression, dips below 0 for some calm clips
+  // (wind speed cannot), and 0 is nearer the truth than any negative value. NaN stays NaN.
+  double speed = 0;
   double speed_std = 0;  // [m/s] predicted standard deviation (the network's uncertainty)
   bool turned = false;   // PredictFrames mirrored the clip first: its flag flies left (flag_flies())
   bool undecided = false;  // with flag_flies auto: the judge could not tell; the last way it knew was kept

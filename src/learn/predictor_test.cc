@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 #include <opencv2/core.hpp>
+#include <torch/utils.h>
 
 #include "learn/fly_judge.h"
 #include "learn/networks.h"
@@ -58,6 +59,37 @@ std::vector<cv::Mat> LopsidedClip() {
 }
 
 double MaxAbsDiff(const cv::Mat& a, const cv::Mat& b) { return cv::norm(a, b, cv::NORM_INF); }
+
+// A network's output placed below 0 by the label scale is read as calm (0 m/s), one above it as
+// it is: the same network and clip, its labels' mean moved down by 100 m/s.
+TEST_F(PredictorTest, ASpeedBelowZeroIsReadAsCalm) {
+  ModelConfig c;
+  c.arch = "sdn";
+  c.frames = 30;
+  c.k = 3;
+  c.phase_steps = true;
+  c.width = 8;
+  c.input_size = 32;
+  c.label_std = 1.0;
+  c.label_mean = 50.0;
+  torch::manual_seed(7);  // the same initial weights in both
+  WindNet high(c);
+  fs::create_directories(dir_ / "high");
+  SaveWindNet(high, dir_ / "high" / "model.pt");
+  c.label_mean = -50.0;
+  torch::manual_seed(7);
+  WindNet low(c);
+  fs::create_directories(dir_ / "low");
+  SaveWindNet(low, dir_ / "low" / "model.pt");
+  Predictor read_high(dir_ / "high" / "model.pt", 1, "cpu");
+  Predictor read_low(dir_ / "low" / "model.pt", 1, "cpu");
+  const Prediction above = read_high.PredictFrames(LopsidedClip());
+  const Prediction below = read_low.PredictFrames(LopsidedClip());
+  ASSERT_GT(above.speed, 0.0);
+  ASSERT_LT(above.speed - 100.0, 0.0) << "the network's output must be within 50 of 0 for this test";
+  EXPECT_EQ(below.speed, 0.0);
+  EXPECT_NEAR(below.speed_std, above.speed_std, 1e-9 * above.speed_std);
+}
 
 TEST_F(PredictorTest, AFlyJudgeBesideTheModelThatCannotLoadLeavesTheModelWorking) {
   // Not a torch file, and a card without the judge's fields.
