@@ -11,10 +11,12 @@
 // Inputs: wind/estimate (clothwind/WindEstimate), anemometer/wind (clothwind/WindMeasurement).
 // Parameters: ~mean_window [s] (60), ~plot_window [s] (180), ~plot_width/~plot_height [px]
 // (640x320), ~rate [Hz] (2), ~frame_id ("" = the anemometer's frame, else this one),
-// ~fixed_frame ("" = none): when set, a latched /tf_static places the display frame at this
-// frame with the identity transform, from the start (and again when the display frame changes),
-// so rviz has a fixed frame without a robot's TF tree before any data comes (the
-// monitor does not know where the anemometer is; leave it empty when a real TF tree exists).
+// ~fixed_frame ("" = none): when set, a latched /tf_static hangs this frame, the display's own,
+// under the display frame with the identity transform, from the start (and again when the
+// display frame changes), so rviz has a fixed frame before any data comes. The display's frame
+// is the parent, never the child: a robot whose TF tree already places the anemometer's frame
+// keeps it (a frame has one parent; the old direction gave it a second). Name a frame nobody
+// else publishes (monitor.launch: "monitor").
 // ~stale_after [s] (10): an estimate older than this (by ROS time, or received longer ago than
 // this by the wall clock: a bag that ended stops /clock) is shown as "--", and the anemometer's
 // mean and arrow go when no reading is left in ~mean_window (either clock); the plot scrolls with
@@ -23,12 +25,20 @@
 // earth frame beside MWV's instrument frame) add their speeds and no arrow, so neither the arrow's
 // convention nor /tf_static flips. /diagnostics says how old each input is. Messages stamped 0
 // are dropped (counted): they would stamp the displays 0 and empty the plot; so are messages
-// stamped more than ~max_future [s] (5) ahead of a running clock. When the clock or the inputs go
-// back by more than 5 s (a replay restarted), everything shown is dropped and the display starts
-// afresh (counted in diagnostics).
+// stamped more than ~max_future [s] (5) ahead of a running clock; so are speeds or stds outside
+// 0..100 m/s, and readings marked invalid; a velocity beyond 100 m/s draws no arrow. Each such drop
+// is a WARN for ~drop_warn_for [s] (30) after the last one, the totals are kept as values. When
+// the clock goes back by more than 5 s (a replay restarted), everything shown is dropped and the
+// display starts afresh, showing "--" until the new pass's inputs come (counted in diagnostics);
+// estimates of the previous pass still arriving then (sdn_node's queue) are dropped and counted as
+// such, not as stamped in the future. One message more than 5 s behind the newest of its input
+// while the clock has not gone back (a second publisher, a relay, a bad stamp) is dropped as
+// late; a late one within 5 s joins the history but is not shown as the latest. Lazy, as
+// image_pipeline's nodes: nothing is drawn while neither display has a subscriber.
 // Drawing and averaging are the ROS-free sensors/wind_plot.
 #include <cmath>
 #include <limits>
+#include <map>
 #include <string>
 
 #include <algorithm>
@@ -65,15 +75,17 @@ class WindDisplayNode {
     const double rate = params.Get("rate", 2.0);
     stale_after_ = params.Get("stale_after", 10.0);
     max_future_ = params.Get("max_future", 5.0);
+    drop_warn_for_ = params.Get("drop_warn_for", 30.0);
     auto positive = [](double v) { return std::isfinite(v) && v > 0; };
     if (!positive(mean_window_) || !positive(plot_window_) || !positive(rate) || !positive(stale_after_) ||
-        !positive(max_future_) ||
+        !positive(max_future_) || !positive(drop_warn_for_) ||
         plot_width_ < 160 || plot_height_ < 120 || plot_width_ > 4096 || plot_height_ > 4096) {
       char what[320];
       std::snprintf(what, sizeof what,
-                    "~mean_window, ~plot_window, ~rate, ~stale_after and ~max_future must be finite and > 0, ~plot_width x "
-                    "~plot_height from 160x120 to 4096x4096 (got %g, %g, %g, %g, %g, %dx%d)",
-                    mean_window_, plot_window_, rate, stale_after_, max_future_, plot_width_, plot_height_);
+                    "~mean_window, ~plot_window, ~rate, ~stale_after, ~max_future and ~drop_warn_for must be finite and > 0, "
+                    "~plot_width x ~plot_height from 160x120 to 4096x4096 (got %g, %g, %g, %g, %g, %g, %dx%d)",
+                    mean_window_, plot_window_, rate, stale_after_, max_future_, drop_warn_for_, plot_width_,
+                    plot_height_);
       throw std::invalid_argument(what);
     }
     span_ = std::max(mean_window_, plot_window_) + 10.0;
@@ -103,29 +115,47 @@ class WindDisplayNode {
 
  private:
   void OnEstimate(const clothwind::WindEstimate::ConstPtr& msg) {
-    if (!Plausible(msg->speed)) return;
+    // speed_std NaN means none (WindEstimate.msg); 1e300 filled the text with 300 digits.
+    if (!Plausible(msg->speed) || !(std::isnan(msg->speed_std) || Plausible(msg->speed_std))) return;
     if (!AdmitStamp(msg->header.stamp, &newest_estimate_)) return;
     estimates_.Add({msg->header.stamp.toSec(), msg->speed, msg->speed_std});
-    last_estimate_ = *msg;
-    last_estimate_wall_ = ros::WallTime::now();
+    // The latest by stamp, not by arrival: a late estimate joins the history only (shown as the
+    // latest, it hid the newer one and aged the display).
+    if (!have_estimate_ || msg->header.stamp >= last_estimate_.header.stamp) {
+      last_estimate_ = *msg;
+      last_estimate_wall_ = ros::WallTime::now();
+    }
     have_estimate_ = true;
   }
 
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
-    if (!msg->valid) return;
+    if (!msg->valid) {
+      Dropped(&invalid_);  // a sensor that only reports void readings says so
+      return;
+    }
     if (!Plausible(msg->speed)) return;
     if (!AdmitStamp(msg->header.stamp, &newest_wind_)) return;
     anemometer_.Add({msg->header.stamp.toSec(), msg->speed, 0.0});
-    last_wind_ = *msg;
-    last_wind_wall_ = ros::WallTime::now();
+    const bool newest = !have_wind_ || msg->header.stamp >= last_wind_.header.stamp;
+    if (newest) {
+      last_wind_ = *msg;
+      last_wind_wall_ = ros::WallTime::now();
+    }
     if (!have_wind_) first_wind_frame_ = msg->header.frame_id;
     have_wind_ = true;
-    // The arrow only from readings in the display frame (a speed has no frame, a vector has).
-    const bool has_vector = std::isfinite(msg->velocity.x) && std::isfinite(msg->velocity.y);
+    // The arrow only from readings in the display frame (a speed has no frame, a vector has), and
+    // of a velocity an anemometer can read (1e30 drew an arrow of infinite length in rviz's floats).
+    const double vz = std::isfinite(msg->velocity.z) ? msg->velocity.z : 0.0;
+    bool has_vector = std::isfinite(msg->velocity.x) && std::isfinite(msg->velocity.y);
+    if (has_vector && std::sqrt(msg->velocity.x * msg->velocity.x + msg->velocity.y * msg->velocity.y + vz * vz) >
+                          kMaxSpeed) {
+      has_vector = false;
+      Dropped(&implausible_velocity_);
+    }
     if (frame_gate_.Admit(msg->header.frame_id, has_vector ? 0.0 : std::nan(""))) {
-      if (has_vector) {
+      if (has_vector && (!have_vector_ || msg->header.stamp >= last_vector_.header.stamp)) {
         last_vector_ = *msg;
-        last_vector_wall_ = last_wind_wall_;
+        last_vector_wall_ = ros::WallTime::now();
         have_vector_ = true;
       }
     } else {
@@ -145,34 +175,59 @@ class WindDisplayNode {
   // All in double seconds: ros::Time arithmetic throws on results beyond 32 bits.
   bool AdmitStamp(const ros::Time& stamp, ros::Time* newest_of_input) {
     if (stamp.isZero()) {
-      ++unstamped_;
+      Dropped(&unstamped_);
       return false;
     }
     const double now = ros::Time::now().toSec(), t = stamp.toSec();
     if (now > 0 && t > now + max_future_) {
-      ++future_stamped_;
+      // Stamped before the clock last went back: the previous pass's, not a clock fault.
+      if (t <= clock_before_restart_ + max_future_) {
+        ++previous_pass_;
+        return false;
+      }
+      Dropped(&future_stamped_);
       WALL_WARN_THROTTLE(10.0, "wind_display: input stamped %.1f s ahead of the clock dropped", t - now);
       return false;
     }
-    if (t + WindHistory::kRestartAfter < newest_of_input->toSec()) Restart();
+    const double newest = newest_of_input->toSec();
+    if (t + WindHistory::kRestartAfter < newest) {
+      // The replay restarted when the clock went back too (or has not started); otherwise this one
+      // message is late and wiping the display for it was wrong.
+      if (now > 0 && now + WindHistory::kRestartAfter >= newest) {
+        Dropped(&late_);
+        WALL_WARN_THROTTLE(10.0, "wind_display: input stamped %.1f s behind the newest of its kind dropped",
+                           newest - t);
+        return false;
+      }
+      Restart(std::max(newest, last_clock_));
+    }
     *newest_of_input = std::max(*newest_of_input, stamp);
     return true;
   }
 
   // A speed an anemometer can read (0..100 m/s, as the clip labels take): others are dropped and
   // counted (1e300 filled the text with 63 digits, -50 showed as a wind, with status OK).
+  static constexpr double kMaxSpeed = 100.0;  // [m/s]
   bool Plausible(double speed) {
-    if (std::isfinite(speed) && speed >= 0 && speed <= 100) return true;
-    ++implausible_;
+    if (std::isfinite(speed) && speed >= 0 && speed <= kMaxSpeed) return true;
+    Dropped(&implausible_);
     return false;
   }
 
-  // Forgets what is shown: the clock or the inputs went back (a replay restarted).
-  void Restart() {
+  // Counts a dropped message; Diagnose WARNs for ~drop_warn_for after the last one.
+  void Dropped(uint64_t* counter) {
+    ++*counter;
+    last_drop_wall_ = ros::WallTime::now();
+  }
+
+  // Forgets what is shown: the clock or the inputs went back (a replay restarted). `previous_end`
+  // [s] is the previous pass's latest time: messages stamped up to it are that pass's.
+  void Restart(double previous_end) {
     estimates_ = WindHistory(span_);
     anemometer_ = WindHistory(span_);
     have_estimate_ = have_wind_ = have_vector_ = false;
     newest_estimate_ = newest_wind_ = ros::Time();
+    clock_before_restart_ = previous_end;
     ++restarts_;
   }
 
@@ -209,16 +264,43 @@ class WindDisplayNode {
     if (!Live(have_wind_, last_wind_.header.stamp, last_wind_wall_, now, mean_window_))
       stat.mergeSummary(DiagnosticStatus::WARN,
                         have_wind_ ? "no anemometer reading in the mean window" : "no anemometer reading yet");
-    if (unstamped_ > 0) stat.mergeSummary(DiagnosticStatus::WARN, "messages stamped 0 dropped");
-    if (future_stamped_ > 0) stat.mergeSummary(DiagnosticStatus::WARN, "messages stamped in the future dropped");
-    if (implausible_ > 0) stat.mergeSummary(DiagnosticStatus::WARN, "speeds outside 0..100 m/s dropped");
+    // Drops are a WARN for drop_warn_for_ after the last one (time to be read), then OK again: a
+    // total since start kept one bad message a WARN forever and hid what came after.
+    const bool recent_drop = !last_drop_wall_.isZero() && (ros::WallTime::now() - last_drop_wall_).toSec() <
+                                                               drop_warn_for_;
+    auto warn_if_new = [&](uint64_t count, uint64_t* reported, const char* what) {
+      if (count > *reported) warned_[what] = true;  // new since the last quiet spell
+      if (recent_drop && warned_[what]) stat.mergeSummary(DiagnosticStatus::WARN, what);
+    };
+    warn_if_new(unstamped_, &reported_unstamped_, "messages stamped 0 dropped");
+    warn_if_new(future_stamped_, &reported_future_, "messages stamped in the future dropped");
+    warn_if_new(implausible_, &reported_implausible_, "speeds or stds outside 0..100 m/s dropped");
+    warn_if_new(late_, &reported_late_, "messages more than 5 s late dropped");
+    warn_if_new(invalid_, &reported_invalid_, "readings marked invalid dropped");
+    warn_if_new(implausible_velocity_, &reported_velocity_, "velocities beyond 100 m/s (no arrow)");
+    if (!recent_drop) {
+      warned_.clear();
+      reported_unstamped_ = unstamped_;
+      reported_future_ = future_stamped_;
+      reported_implausible_ = implausible_;
+      reported_late_ = late_;
+      reported_invalid_ = invalid_;
+      reported_velocity_ = implausible_velocity_;
+    }
     if (!publish_error_.empty()) stat.mergeSummary(DiagnosticStatus::ERROR, "cannot draw: " + publish_error_);
     stat.addf("estimate age [s]", "%.1f", est_age);
     stat.addf("anemometer age [s]", "%.1f", wind_age);
     stat.add("messages stamped 0 dropped", unstamped_);
     stat.add("messages stamped more than ~max_future ahead dropped", future_stamped_);
     stat.add("restarts (clock or inputs went back)", restarts_);
-    stat.add("speeds outside 0..100 m/s dropped", implausible_);
+    stat.add("speeds or stds outside 0..100 m/s dropped", implausible_);
+    stat.add("messages more than 5 s behind the newest of their input dropped (clock steady)", late_);
+    stat.add("messages of the previous pass dropped (after the clock went back)", previous_pass_);
+    stat.add("readings marked invalid dropped", invalid_);
+    stat.add("velocities beyond 100 m/s (no arrow)", implausible_velocity_);
+    stat.add("subscribers (markers, plot)", std::to_string(markers_pub_.getNumSubscribers()) + ", " +
+                                                std::to_string(plot_pub_.getNumSubscribers()));
+    stat.add("displays drawn", drawn_);
     stat.add("frame", FrameId());
     stat.add("readings in another frame (no arrow)", frame_gate_.rejected());
     stat.addf("estimate received [s ago, wall]", "%.1f",
@@ -237,8 +319,15 @@ class WindDisplayNode {
     // The clock went back (a replay restarted) before any input of the new pass came: what is
     // shown is the previous pass's.
     const double clock = ros::Time::now().toSec();
-    if (clock > 0 && last_clock_ > 0 && clock + WindHistory::kRestartAfter < last_clock_) Restart();
+    if (clock > 0 && last_clock_ > 0 && clock + WindHistory::kRestartAfter < last_clock_) {
+      Restart(std::max(last_clock_, std::max(newest_estimate_, newest_wind_).toSec()));
+    }
     if (clock > 0) last_clock_ = clock;
+    const std::string frame = FrameId();
+    if (!fixed_frame_.empty() && frame != tf_parent_ && frame != fixed_frame_) PublishFixedFrame(frame);
+    // Lazy: the plot is a 640x320 image drawn at ~rate; nobody looking, nothing drawn. A new
+    // subscriber gets the latched last one at once and a fresh one at the next tick.
+    if (markers_pub_.getNumSubscribers() == 0 && plot_pub_.getNumSubscribers() == 0) return;
     // A drawing failure is said in diagnostics and the next tick tries again; it must not end
     // the node (an exception out of a timer callback leaves ros::spin and main).
     try {
@@ -251,10 +340,13 @@ class WindDisplayNode {
   }
 
   void Draw() {
-    if (!have_estimate_ && !have_wind_) return;  // nothing to show yet
+    // Nothing to show yet. After a restart, though, the displays are drawn empty ("--", no arrow,
+    // no lines): they are latched and the previous pass's values stayed on screen until the new
+    // pass's first input (48 s for a Fine Offset station).
+    if (!have_estimate_ && !have_wind_ && drawn_ == 0) return;
     const std::string frame = FrameId();
-    if (!fixed_frame_.empty() && frame != tf_child_ && frame != fixed_frame_) PublishFixedFrame(frame);
     const ros::Time stamp = DisplayNow();
+    if (stamp.isZero()) return;  // neither a clock nor an input to stamp it with
     const double t_now = stamp.toSec();
     // A value older than it should be is not shown as if live (sdn_node died, the bag ended).
     const bool est_live = Live(have_estimate_, last_estimate_.header.stamp, last_estimate_wall_, stamp, stale_after_);
@@ -323,29 +415,40 @@ class WindDisplayNode {
     for (int y = 0; y < img.rows; ++y) std::copy(img.ptr<uint8_t>(y), img.ptr<uint8_t>(y) + msg.step,
                                                  msg.data.begin() + static_cast<size_t>(y) * msg.step);
     plot_pub_.publish(msg);
+    ++drawn_;
   }
 
-  // Latched identity transform fixed_frame_ -> frame (stamp 0: valid at all times).
+  // Latched identity transform frame -> fixed_frame_ (stamp 0: valid at all times). The display's
+  // own frame is the child, so no frame of a robot's tree gets a second parent.
   void PublishFixedFrame(const std::string& frame) {
     tf2_msgs::TFMessage tf;
     geometry_msgs::TransformStamped t;
-    t.header.frame_id = fixed_frame_;
-    t.child_frame_id = frame;
+    t.header.frame_id = frame;
+    t.child_frame_id = fixed_frame_;
     t.transform.rotation.w = 1.0;
     tf.transforms.push_back(t);
     tf_pub_.publish(tf);
-    tf_child_ = frame;
+    tf_parent_ = frame;
   }
 
   double mean_window_ = 60.0, plot_window_ = 180.0, stale_after_ = 10.0, max_future_ = 5.0, span_ = 1.0;
-  uint64_t unstamped_ = 0, future_stamped_ = 0, restarts_ = 0, implausible_ = 0;
+  double drop_warn_for_ = 30.0;
+  uint64_t unstamped_ = 0, future_stamped_ = 0, restarts_ = 0, implausible_ = 0, late_ = 0, previous_pass_ = 0,
+           invalid_ = 0, implausible_velocity_ = 0, drawn_ = 0;
+  // Each drop count as of the last quiet spell (no drop for drop_warn_for_), and which causes
+  // have dropped since: the WARN names those only.
+  uint64_t reported_unstamped_ = 0, reported_future_ = 0, reported_implausible_ = 0, reported_late_ = 0,
+           reported_invalid_ = 0, reported_velocity_ = 0;
+  std::map<std::string, bool> warned_;
+  ros::WallTime last_drop_wall_;   // when the last message was dropped (zero: never)
+  double clock_before_restart_ = -std::numeric_limits<double>::infinity();  // [s] previous pass's end
   double last_clock_ = 0;          // ROS time at the last draw [s]
   ros::Time newest_estimate_, newest_wind_;  // each input's newest stamp since the last restart
   std::string publish_error_;      // why the last draw failed ("" when it did not)
   diagnostic_updater::Updater updater_;
   ros::WallTimer diagnostics_timer_;
   int plot_width_ = 640, plot_height_ = 320;
-  std::string frame_id_param_, fixed_frame_, tf_child_;
+  std::string frame_id_param_, fixed_frame_, tf_parent_;
   WindHistory estimates_, anemometer_;
   clothwind::WindEstimate last_estimate_;
   clothwind::WindMeasurement last_wind_, last_vector_;  // the newest valid reading; the newest with a

@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -25,12 +26,23 @@ int Column(double t, double t_now, double window, int width) {
   return static_cast<int>(std::lround(x1 - (t_now - t) / window * (x1 - x0)));
 }
 
-// Draws one series as a polyline (and its std band), clipped to the shown window.
+// Draws one series as polylines (and its std band), clipped to the shown window, broken where
+// the series has a gap (WindSeriesGap): a line across an outage would show readings never made.
 void DrawSeries(cv::Mat& img, const WindHistory& h, double t_now, double window, double y_max,
                 const cv::Scalar& colour, bool band) {
+  const double gap = WindSeriesGap(h, t_now, window);
   std::vector<cv::Point> line;
+  auto flush = [&] {
+    if (line.size() == 1) cv::circle(img, line[0], 3, colour, cv::FILLED);
+    if (line.size() > 1) cv::polylines(img, line, false, colour, 2, cv::LINE_AA);
+    for (const cv::Point& p : line) cv::circle(img, p, 2, colour, cv::FILLED);
+    line.clear();
+  };
+  double previous = std::numeric_limits<double>::quiet_NaN();
   for (const WindSample& s : h.samples()) {
     if (s.t < t_now - window || s.t > t_now) continue;
+    if (s.t - previous > gap) flush();
+    previous = s.t;
     const int x = Column(s.t, t_now, window, img.cols);
     if (band && std::isfinite(s.std) && s.std > 0) {
       // Pale version of the colour: the band stays behind the lines.
@@ -40,12 +52,24 @@ void DrawSeries(cv::Mat& img, const WindHistory& h, double t_now, double window,
     }
     line.emplace_back(x, WindPlotRow(s.speed, y_max, img.rows));
   }
-  if (line.size() == 1) cv::circle(img, line[0], 3, colour, cv::FILLED);
-  if (line.size() > 1) cv::polylines(img, line, false, colour, 2, cv::LINE_AA);
-  for (const cv::Point& p : line) cv::circle(img, p, 2, colour, cv::FILLED);
+  flush();
 }
 
 }  // namespace
+
+double WindSeriesGap(const WindHistory& h, double t_now, double window) {
+  std::vector<double> steps;
+  double previous = std::numeric_limits<double>::quiet_NaN();
+  for (const WindSample& s : h.samples()) {
+    if (s.t < t_now - window || s.t > t_now) continue;
+    if (std::isfinite(previous)) steps.push_back(s.t - previous);
+    previous = s.t;
+  }
+  if (steps.size() < 2) return std::numeric_limits<double>::infinity();
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  const double median = steps[steps.size() / 2];
+  return median > 0 ? kWindSeriesGapFactor * median : std::numeric_limits<double>::infinity();
+}
 
 void WindHistory::Add(const WindSample& s) {
   if (!std::isfinite(s.speed) || !std::isfinite(s.t)) return;

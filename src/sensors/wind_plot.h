@@ -68,6 +68,7 @@ const cv::Scalar kPlotBackground(255, 255, 255);
 
 // Draws estimate vs anemometer speed over the last `window` seconds: time on x (now at the right
 // edge), speed on y from 0 to a rounded-up maximum (at least 2 m/s), grid, axis labels, legend.
+// Each series is a line broken at its gaps (WindSeriesGap), with a dot at every sample.
 // Inputs:
 //   estimate    estimator's history (std drawn as a band when finite and > 0)
 //   anemometer  anemometer's history
@@ -83,6 +84,14 @@ const cv::Scalar kPlotBackground(255, 255, 255);
 cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer, double t_now, double window,
                      int width, int height, double t_origin = std::numeric_limits<double>::quiet_NaN(),
                      const std::string& reference_name = "anemometer");
+
+// The longest step between two samples of `h` in (t_now - window, t_now] that DrawWindPlot
+// joins with a line: kWindSeriesGapFactor times the median step there (a series' own rhythm:
+// 1 s for a sonic anemometer, 48 s for a Fine Offset station, a clip's span for estimates);
+// infinity with fewer than three samples there (no rhythm to judge by). A longer step is an
+// outage (the sensor unplugged, sdn_node down) and the line breaks across it.
+double WindSeriesGap(const WindHistory& h, double t_now, double window);
+inline constexpr double kWindSeriesGapFactor = 3.0;
 
 // The pixel row of a speed in a plot DrawWindPlot drew (for tests and overlays).
 // Inputs: speed [m/s], y_max [m/s] top of the axis, height [px] image height

@@ -88,6 +88,33 @@ TEST(WindPlotTest, SeriesDrawnAtTheirSpeeds) {
   EXPECT_FALSE(HasColourInColumnRange(img, 180, 220, r_est - 1, r_est + 1, kAnemometerColour));
 }
 
+// An anemometer at 1 Hz that was unplugged for 20 s: its line breaks across the outage (a line
+// there showed readings never made), and a series at its own slower rhythm does not.
+TEST(WindPlotTest, TheLineBreaksAcrossAnOutage) {
+  WindHistory est(300), anem(300);
+  for (int i = 0; i <= 60; ++i) {
+    if (i <= 20 || i >= 40) anem.Add({1000.0 + i, 2.0, 0.0});
+    if (i % 10 == 0) est.Add({1000.0 + i, 6.0, 0.0});  // every 10 s, no outage
+  }
+  EXPECT_DOUBLE_EQ(WindSeriesGap(anem, 1060.0, 60.0), 3.0);
+  EXPECT_DOUBLE_EQ(WindSeriesGap(est, 1060.0, 60.0), 30.0);
+  WindHistory two(300);
+  two.Add({1000.0, 1.0, 0.0});
+  two.Add({1001.0, 1.0, 0.0});
+  EXPECT_TRUE(std::isinf(WindSeriesGap(two, 1060.0, 60.0)));
+  const int w = 400, h = 240;
+  const cv::Mat img = DrawWindPlot(est, anem, 1060.0, 60.0, w, h);
+  const double y_max = WindPlotAxisMax(6.0);
+  const int r_anem = WindPlotRow(2.0, y_max, h), r_est = WindPlotRow(6.0, y_max, h);
+  // Columns of t = 1030 (the outage's middle) and of t = 1010 and 1050 (readings around it).
+  auto column = [&](double t) { return static_cast<int>(std::lround(w - 10 - (1060.0 - t) / 60.0 * (w - 10 - 44))); };
+  EXPECT_FALSE(HasColourInColumnRange(img, column(1027), column(1033), r_anem - 1, r_anem + 1, kAnemometerColour));
+  EXPECT_TRUE(HasColourInColumnRange(img, column(1008), column(1012), r_anem - 1, r_anem + 1, kAnemometerColour));
+  EXPECT_TRUE(HasColourInColumnRange(img, column(1048), column(1052), r_anem - 1, r_anem + 1, kAnemometerColour));
+  // Between two estimates 10 s apart, the line is drawn.
+  EXPECT_TRUE(HasColourInColumnRange(img, column(1034), column(1036), r_est - 1, r_est + 1, kEstimateColour));
+}
+
 TEST(WindPlotTest, OnlyTheWindowIsShown) {
   WindHistory est(1000), anem(1000);
   // Estimates only long before the window: nothing of them may appear in the plot area.

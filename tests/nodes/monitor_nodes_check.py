@@ -30,6 +30,7 @@ class MonitorNodesTest(unittest.TestCase):
         self.lock = threading.RLock()
         self.markers = []
         self.statuses = []
+        self.lazy_statuses = []
         rospy.Subscriber("monitor/wind_markers", MarkerArray, self.keep(self.markers), queue_size=10)
         rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics, queue_size=50)
         self.est_pub = rospy.Publisher("wind/estimate", WindEstimate, queue_size=20)
@@ -48,7 +49,8 @@ class MonitorNodesTest(unittest.TestCase):
 
     def on_diagnostics(self, msg):
         with self.lock:
-            self.statuses += [s for s in msg.status if s.name.endswith("wind display")]
+            self.statuses += [s for s in msg.status if s.name.startswith("wind_display")]
+            self.lazy_statuses += [s for s in msg.status if s.name.startswith("lazy/")]
 
     def text(self):
         with self.lock:
@@ -78,8 +80,43 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertEqual(received[0][1]._connection_header["type"], "tf2_msgs/TFMessage")
         t = first_transform(received[0][1])
         # The frame the display would draw in: "anemometer" until a reading names its own.
-        self.assertEqual((t.header.frame_id, t.child_frame_id), ("monitor", "anemometer"))
+        # The display's own frame hangs under it (a robot's tree keeps the anemometer's parent).
+        self.assertEqual((t.header.frame_id, t.child_frame_id), ("anemometer", "monitor"))
         self.assertEqual(t.transform.rotation.w, 1.0)
+
+    def test_lazy_display(self):
+        """A display nobody subscribes to draws nothing (image_pipeline's lazy nodes), and draws
+        at once for a subscriber."""
+        pub = rospy.Publisher("lazy/anemometer/wind", WindMeasurement, queue_size=5)
+        deadline = time.time() + 20
+        while time.time() < deadline and pub.get_num_connections() < 1:
+            time.sleep(0.1)
+        for _ in range(6):
+            wind = WindMeasurement()
+            wind.header.stamp, wind.header.frame_id = rospy.Time.now(), "anemometer"
+            wind.speed, wind.valid = 2.0, True
+            pub.publish(wind)
+            time.sleep(0.25)
+
+        def lazy_values():
+            with self.lock:
+                s = self.lazy_statuses[-1] if self.lazy_statuses else None
+            return {kv.key: kv.value for kv in s.values} if s else {}
+        deadline = time.time() + 10
+        while time.time() < deadline and lazy_values().get("anemometer age [s]", "inf") == "inf":
+            time.sleep(0.2)
+        self.assertEqual(lazy_values().get("displays drawn"), "0", lazy_values())
+        got = []
+        sub = rospy.Subscriber("lazy/monitor/wind_markers", MarkerArray, got.append, queue_size=5)
+        deadline = time.time() + 10
+        while time.time() < deadline and not any("anemometer 2.0" in m.text for a in got for m in a.markers):
+            time.sleep(0.1)
+        sub.unregister()
+        self.assertTrue(any("anemometer 2.0" in m.text for a in got for m in a.markers), got)
+        deadline = time.time() + 5
+        while time.time() < deadline and lazy_values().get("displays drawn") == "0":
+            time.sleep(0.2)
+        self.assertNotEqual(lazy_values().get("displays drawn"), "0")
 
     def test_display_and_report(self):
         for i in range(8):  # 4 s: estimates at 1 Hz, readings at 2 Hz
@@ -140,6 +177,34 @@ class MonitorNodesTest(unittest.TestCase):
         time.sleep(0.3)
         text, arrow = self.text()
         self.assertIn("anemometer 3.0 m/s", text)
+        # ... nor shown as the latest: the newer estimate stays (the late one hid it, "--").
+        self.assertIn("estimate 4.0", text)
+
+        # One reading 10 s late while the clock runs on (a second publisher, a bad stamp): dropped
+        # as late, no restart (it wiped the display). Then a reading marked invalid, one whose
+        # velocity no anemometer reads and an estimate whose std is absurd: each dropped, counted.
+        late = WindMeasurement()
+        late.header.stamp, late.header.frame_id = rospy.Time.now() - rospy.Duration(10.0), "anemometer"
+        late.speed, late.valid = 7.0, True
+        self.wind_pub.publish(late)
+        invalid = WindMeasurement()
+        invalid.header.stamp, invalid.header.frame_id = rospy.Time.now(), "anemometer"
+        invalid.speed, invalid.valid = 3.0, False
+        self.wind_pub.publish(invalid)
+        wild = WindMeasurement()
+        wild.header.stamp, wild.header.frame_id = rospy.Time.now(), "anemometer"
+        wild.speed, wild.valid = 3.0, True
+        wild.velocity.x = 1e30
+        self.wind_pub.publish(wild)
+        absurd = WindEstimate()
+        absurd.header.stamp = rospy.Time.now()
+        absurd.clip_sequence, absurd.speed, absurd.speed_std = 11, 4.0, 1e300
+        absurd.reference_speed = float("nan")  # the report counts it and compares nothing
+        self.est_pub.publish(absurd)
+        time.sleep(0.3)
+        text, arrow = self.text()
+        self.assertIn("anemometer 3.0 m/s", text)
+        self.assertIn("estimate 4.0 \u00b1 0.3 m/s", text)
 
         # Past stale_after (4 s) and mean_window (3 s): polled, since markers come at 5 Hz and
         # diagnostics once a second on a machine that may be busy.
@@ -160,9 +225,27 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertEqual(values["messages stamped 0 dropped"], "2")
         self.assertEqual(values["messages stamped more than ~max_future ahead dropped"], "2")
         self.assertEqual(values["restarts (clock or inputs went back)"], "0")
+        self.assertEqual(values["messages more than 5 s behind the newest of their input dropped (clock steady)"], "1")
+        self.assertEqual(values["readings marked invalid dropped"], "1")
+        self.assertEqual(values["velocities beyond 100 m/s (no arrow)"], "1")
+        self.assertEqual(values["speeds or stds outside 0..100 m/s dropped"], "1")
         # "Says so": a WARN, naming each cause.
         self.assertEqual(status.level, DiagnosticStatus.WARN, status.message)
-        self.assertIn("messages stamped 0 dropped", status.message)
+        for cause in ("messages stamped 0 dropped", "messages more than 5 s late dropped",
+                      "readings marked invalid dropped", "speeds or stds outside 0..100 m/s dropped"):
+            self.assertIn(cause, status.message)
+        # ... for ~drop_warn_for (8 s here) after the last drop, then no more: a total since start
+        # kept one bad message a WARN for good. The counts stay.
+        deadline = time.time() + 20.0
+        while time.time() < deadline:
+            with self.lock:
+                status, values = self.latest_status()
+            if "dropped" not in status.message:
+                break
+            time.sleep(0.2)
+        self.assertNotIn("dropped", status.message)
+        self.assertIn("no anemometer reading in the mean window", status.message)  # still WARN for that
+        self.assertEqual(values["messages stamped 0 dropped"], "2")
 
         # The report ends after max_wall (30 s; wall time never idles) and writes its summary
         # although the plot's path lies under a file.
@@ -177,8 +260,9 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertEqual(j["total_clips"], 1)
         self.assertEqual(j["label_window"], 10.0)
         self.assertEqual(j["estimates"]["window"], 10.0)  # the clips' label window, not 60 s
-        # Seven estimates: the one stamped TIME_MAX has no label, so six are compared.
-        self.assertEqual(j["estimates"]["count"], 7)
+        # Eight estimates: the one stamped TIME_MAX and the one of absurd std have no label, so six
+        # are compared.
+        self.assertEqual(j["estimates"]["count"], 8)
         self.assertEqual(j["estimates"]["compared"], 6)
         self.assertAlmostEqual(j["estimates"]["rmse"], ((5 * 1.0 + 47.0 ** 2) / 6) ** 0.5, places=6)
 

@@ -2,8 +2,11 @@
 """rostest for wind_display_node when the clock goes back (see tests/wind_display_clock.test).
 
 The test plays /clock itself: 4 s of estimates at 6 m/s and readings at 6 m/s from ROS time 2000,
-then the clock jumps back 20 s and only readings at 1 m/s come. Within 3 s the display must show
-no estimate ("estimate --") and the new readings, and diagnostics must count a restart.
+then the clock jumps back 20 s. With no input yet, the display must clear itself ("--" for both:
+it is latched, and the previous pass's values stayed on screen until new input came); an estimate
+of the previous pass arriving late is counted as such, not as stamped in the future; then only
+readings at 1 m/s come: within 3 s the display must show no estimate and the new readings, and
+diagnostics must count a restart.
 """
 import sys
 import threading
@@ -21,7 +24,7 @@ from visualization_msgs.msg import MarkerArray
 class WindDisplayClockTest(unittest.TestCase):
     def setUp(self):
         self.lock = threading.Lock()
-        self.text, self.restarts = None, None
+        self.text, self.restarts, self.values = None, None, {}
         self.clock_now = 2000.0
         self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10)
         self.est_pub = rospy.Publisher("wind/estimate", WindEstimate, queue_size=20)
@@ -60,10 +63,11 @@ class WindDisplayClockTest(unittest.TestCase):
                 values = {kv.key: kv.value for kv in s.values}
                 with self.lock:
                     self.restarts = values.get("restarts (clock or inputs went back)")
+                    self.values = values
 
-    def publish(self, estimate_speed, wind_speed):
+    def publish(self, estimate_speed, wind_speed, stamp=None):
         with self.lock:
-            stamp = rospy.Time.from_sec(self.clock_now)
+            stamp = stamp or rospy.Time.from_sec(self.clock_now)
         if estimate_speed is not None:
             e = WindEstimate()
             e.header.stamp = stamp
@@ -90,7 +94,22 @@ class WindDisplayClockTest(unittest.TestCase):
             time.sleep(0.5)
         self.assertTrue(self.wait_for(lambda: self.text and "estimate 6.0" in self.text, 5), self.text)
         with self.lock:
+            old_pass = rospy.Time.from_sec(self.clock_now - 0.5)
             self.clock_now -= 20.0  # the bag plays again
+        # Nothing of the new pass yet: the display clears itself.
+        self.assertTrue(self.wait_for(lambda: self.text and "estimate --" in self.text and
+                                      "anemometer --" in self.text, 3), self.text)
+        # sdn_node's last estimate of the previous pass, published after the jump.
+        e = WindEstimate()
+        e.header.stamp = old_pass
+        e.speed, e.speed_std = 6.0, 0.3
+        self.est_pub.publish(e)
+        key = "messages of the previous pass dropped (after the clock went back)"
+        self.assertTrue(self.wait_for(lambda: self.values.get(key) == "1", 3), self.values)
+        with self.lock:
+            values = self.values
+        self.assertEqual(values["messages stamped more than ~max_future ahead dropped"], "0")
+        self.assertIn("estimate --", self.text)
         start = time.monotonic()
         while time.monotonic() - start < 3.0:
             self.publish(None, 1.0)
