@@ -341,7 +341,11 @@ void CheckCompatible(const std::string& dir, const nlohmann::json& settings, con
                                     : it.key() == "scene_files"
                                           ? " (the scene, a mesh or a material file changed since the dataset was "
                                             "made: restore them, or use another --out)"
-                                          : " (resume with the same settings, or use another --out)"));
+                                          : it.key() == "generator_version"
+                                                ? " (an older make-dataset made those frames, and this one "
+                                                  "renders them differently: make the dataset again in another "
+                                                  "--out; docs/datasets.md, generator_version)"
+                                                : " (resume with the same settings, or use another --out)"));
   }
 }
 

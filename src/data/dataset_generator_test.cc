@@ -330,6 +330,14 @@ TEST_F(DatasetGeneratorTest, AnIndexOfAnotherKindOrALargerCountIsRefused) {
   EXPECT_NE(GenerateError(fewer).find("field 'count' is 3 but this run asks for 2"), std::string::npos)
       << GenerateError(fewer);
   EXPECT_EQ(nlohmann::json::parse(Bytes(dir / "index.json")), index);
+  // A folder an older generator made (its frames render otherwise): refused, saying so.
+  nlohmann::json older = index;
+  older["dataset"]["generator_version"] = kGeneratorVersion - 1;
+  write(older);
+  const std::string error = GenerateError(Tiny(dir.string()));
+  EXPECT_NE(error.find("field 'dataset.generator_version' is " + std::to_string(kGeneratorVersion - 1)),
+            std::string::npos) << error;
+  EXPECT_NE(error.find("an older make-dataset made those frames"), std::string::npos) << error;
 }
 
 TEST_F(DatasetGeneratorTest, AnEditedSceneIsNotMixedIn) {

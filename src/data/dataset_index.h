@@ -13,7 +13,10 @@ namespace clothwind::data {
 // label.json and index.json of simulated datasets (docs/dataset.md): format "clothwind-clip" /
 // "clothwind-dataset", version 1.
 constexpr char kGeneratorName[] = "clothwind make-dataset";
-constexpr int kGeneratorVersion = 1;
+// Bumped when the frames a dataset's settings make change, so a resume does not mix two kinds
+// (the settings record it): 2 since 2026-12-06, the cloth's shadow rays leaving from the sunny side
+// of their triangle (renderer.cc, ShadeCloth; version 1 darkened single triangles at a grazing sun).
+constexpr int kGeneratorVersion = 2;
 constexpr int kFormatVersion = 1;
 
 // How an example's frames were made, for its label.

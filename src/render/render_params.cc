@@ -281,16 +281,18 @@ void ValidateRenderParams(const RenderParams& p) {
   // height rendered black frames with exit 0, and the static cache (68 B a sample) took 6 GB.
   Require(std::abs(p.background_offset) <= 1000, "background_offset", "in [-1000, 1000] m", p.background_offset);
   Require(p.background_scale <= 100, "background_scale", "<= 100", p.background_scale);
-  Require(p.sun_height <= 1e4 && p.sun_radius <= 1e4, "sun_height", "<= 1e4 m, as sun_radius",
-          std::max(p.sun_height, p.sun_radius));
+  // One Require a field: a check of two named the first with the larger value, and a user edited
+  // the wrong field of a label.json.
+  Require(p.sun_height <= 1e4, "sun_height", "<= 1e4 m", p.sun_height);
+  Require(p.sun_radius <= 1e4, "sun_radius", "<= 1e4 m", p.sun_radius);
   Require(std::isfinite(p.sun_azimuth_deg), "sun_azimuth_deg", "finite", p.sun_azimuth_deg);
   Require(p.sun_strength <= 1e4, "sun_strength", "<= 1e4", p.sun_strength);
   Require(p.sky_strength <= 1e3, "sky_strength", "<= 1e3", p.sky_strength);
-  Require(p.camera_height <= 1e4 && p.camera_radius <= 1e4, "camera_height", "<= 1e4 m, as camera_radius",
-          std::max(p.camera_height, p.camera_radius));
+  Require(p.camera_height <= 1e4, "camera_height", "<= 1e4 m", p.camera_height);
+  Require(p.camera_radius <= 1e4, "camera_radius", "<= 1e4 m", p.camera_radius);
   Require(std::isfinite(p.camera_angle_deg), "camera_angle_deg", "finite", p.camera_angle_deg);
-  Require(p.mesh_height <= 1e3 && p.mesh_width <= 1e3, "mesh_width", "<= 1000 m, as mesh_height",
-          std::max(p.mesh_width, p.mesh_height));
+  Require(p.mesh_height <= 1e3, "mesh_height", "<= 1000 m", p.mesh_height);
+  Require(p.mesh_width <= 1e3, "mesh_width", "<= 1000 m", p.mesh_width);
   Require(p.mesh_aspect_ratio >= 0.1 && p.mesh_aspect_ratio <= 10, "mesh_aspect_ratio", "in [0.1, 10]",
           p.mesh_aspect_ratio);
   if (p.has_look_at)

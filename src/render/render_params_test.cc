@@ -74,6 +74,23 @@ TEST(RenderParams, MissingOrMistypedFieldIsNamed) {
   }
 }
 
+// Each bounded field alone out of range: the error names that field (a check of two fields named
+// the first, with the larger value, whichever was wrong).
+TEST(RenderParams, EachFieldOutOfRangeIsNamedAlone) {
+  for (const char* field : {"sun_height", "sun_radius", "camera_height", "camera_radius", "mesh_height",
+                            "mesh_width"}) {
+    nlohmann::json j = ToJson(SampleRenderParams(SceneKind::kFlag, 1));
+    j[field] = 20000.0;
+    try {
+      RenderParamsFromJson(j);
+      ADD_FAILURE() << field << " 20000 was accepted";
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(std::string("field '") + field + "' is 20000"), std::string::npos) << field << ": " << what;
+    }
+  }
+}
+
 TEST(RenderParams, SamplesStayInTableTwoRanges) {
   for (uint64_t seed = 0; seed < 300; ++seed) {
     const RenderParams f = SampleRenderParams(SceneKind::kFlag, seed);

@@ -149,10 +149,15 @@ Rgb Renderer::ShadeCloth(const Hit& hit, const Eigen::Vector3f& sun) const {
   // Light through the cloth: thin fabric glows on its shaded side.
   const float tr = options_.translucency;
   Rgb irradiance = lighting_.AmbientIrradiance(n) + tr * lighting_.AmbientIrradiance(-n);
-  const float side = ndl >= 0.0f ? 1.0f : -1.0f;
   const float weight = ndl >= 0.0f ? ndl : -tr * ndl;
   if (weight > 0.0f) {
-    const Eigen::Vector3f org = hit.point + (side * kShadowEps) * hit.geom_normal;
+    // The shadow ray leaves from the side of the flat triangle that faces the sun (the sampled
+    // point of its disc), whatever the smoothed normal says. Where the two disagree (a coarse
+    // mesh curving away from a grazing sun) the ray left from the normal's side, met its own
+    // triangle, and single triangles went dark, flickering from frame to frame as the mesh moved
+    // (smooth shading's "shadow terminator", which Cycles offsets for too).
+    const float sun_side = hit.geom_normal.dot(sun) >= 0.0f ? 1.0f : -1.0f;
+    const Eigen::Vector3f org = hit.point + (sun_side * kShadowEps) * hit.geom_normal;
     if (!options_.shadows || !scene_->Occluded(org, sun, kFar))
       irradiance += weight * lighting_.sun_irradiance;
   }

@@ -122,10 +122,19 @@ TEST(Renderer, PointInThePolesShadowIsDarkerOnlyWithShadows) {
 
 TEST(Renderer, BackFaceIsLitNotBlack) {
   RenderParams p = TestParams();
-  p.sun_radius = 0.0;  // sun overhead: both faces of the vertical flag see the same light
+  // The sun on the front (-y) side, then at its mirror image on the back: the back face under the
+  // mirrored sun must look as the front did under the first (the scene is mirror-symmetric about
+  // the flag's plane). A sun overhead lit neither face (n.l = 0) and compared the sky's light only.
+  p.sun_radius = 5.0;
+  p.sun_azimuth_deg = -90.0;
+  p.sun_height = 5.0;
   const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, 0.0, 0.0);
   Renderer r(p);
   r.RenderLinear(m.V, m.F, m.UV);
+  RenderParams mirrored_p = p;
+  mirrored_p.sun_azimuth_deg = 90.0;
+  Renderer mirrored(mirrored_p);
+  mirrored.RenderLinear(m.V, m.F, m.UV);
   const Eigen::Vector3f target(1.0f, 0.0f, 5.6f);
   const Eigen::Vector3f front_org = target + Eigen::Vector3f(0, -3, 0);
   const Eigen::Vector3f back_org = target + Eigen::Vector3f(0, 3, 0);
@@ -137,9 +146,10 @@ TEST(Renderer, BackFaceIsLitNotBlack) {
   EXPECT_NE(hf.back_face, hb.back_face);
   EXPECT_GT(hb.normal.y(), 0.99f);  // shading normal turned towards the viewer
   const Rgb front = r.Trace(front_org, Eigen::Vector3f(0, 1, 0), 0.5f, 0.5f);
-  const Rgb back = r.Trace(back_org, Eigen::Vector3f(0, -1, 0), 0.5f, 0.5f);
-  EXPECT_GT(Luma(back), 0.05f);
-  EXPECT_NEAR(Luma(back), Luma(front), 1e-4f);
+  const Rgb back = mirrored.Trace(back_org, Eigen::Vector3f(0, -1, 0), 0.5f, 0.5f);
+  const Rgb front_unlit = mirrored.Trace(front_org, Eigen::Vector3f(0, 1, 0), 0.5f, 0.5f);
+  EXPECT_GT(Luma(front), 1.5f * Luma(front_unlit));  // the sun's term counts
+  EXPECT_NEAR(Luma(back), Luma(front), 1e-4f * Luma(front));
   // With the sun on the front side the back is darker, but still lit (sky, translucency).
   p.sun_radius = 5.0;
   p.sun_azimuth_deg = -90.0;  // sun on -y, the front
@@ -150,6 +160,88 @@ TEST(Renderer, BackFaceIsLitNotBlack) {
   const Rgb back2 = r2.Trace(back_org, Eigen::Vector3f(0, -1, 0), 0.5f, 0.5f);
   EXPECT_GT(Luma(front2), 1.5f * Luma(back2));
   EXPECT_GT(Luma(back2), 0.05f);
+}
+
+// A fold of two faces meeting at the hoist, the sun grazing from behind the face the camera sees
+// while that face's smoothed normal (bent by the other face) turns toward it: smooth shading
+// lights the point, and the shadow ray must leave from the triangle's sunny side. It left from
+// the normal's side, met its own triangle, and single triangles of a flag went dark.
+TEST(Renderer, ASunGrazingBehindAFacetLightsItsSmoothSide) {
+  RenderParams p = TestParams();
+  p.sun_azimuth_deg = 11.3;  // along +x, a little behind the face (+y)
+  p.sun_radius = 5.0;
+  p.sun_height = 3.0;
+  p.sun_shadow_soft_size = 0.0;
+  // Top view: face A from the edge (x = y = 0) along +x, facing -y (the camera); face B from the
+  // edge toward (-cos 60 deg, -sin 60 deg). 2 m high; two triangles each, consistently wound.
+  ClothMesh m;
+  const double bx = -0.5, by = -0.8660254;
+  m.V.resize(6, 3);
+  m.V << 0, 0, 0, 1, 0, 0, bx, by, 0, 0, 0, 2, 1, 0, 2, bx, by, 2;
+  m.F.resize(4, 3);
+  m.F << 0, 1, 4, 0, 4, 3, 2, 0, 3, 2, 3, 5;
+  m.UV.resize(6, 2);
+  m.UV << 0.5, 0, 1, 0, 0, 0, 0.5, 1, 1, 1, 0, 1;
+  RenderOptions off;
+  off.shadows = false;
+  Renderer with(p), without(p, off);
+  with.RenderLinear(m.V, m.F, m.UV);
+  without.RenderLinear(m.V, m.F, m.UV);
+  const Eigen::Vector3f org(0.05f, -3.0f, static_cast<float>(p.mesh_height) + 1.0f), dir(0, 1, 0);
+  Hit hit;
+  ASSERT_TRUE(with.scene().Intersect(org, dir, 10.0f, &hit));
+  ASSERT_EQ(hit.surface, Surface::kCloth);
+  const Eigen::Vector3f sun = with.lighting().sun_dir;
+  ASSERT_GT(hit.normal.dot(sun), 0.1f) << "the smoothed normal must face the sun";
+  ASSERT_LT(hit.geom_normal.dot(sun), -0.1f) << "the facet must face away from it";
+  const float lit = Luma(without.Trace(org, dir, 0.5f, 0.5f));
+  EXPECT_NEAR(Luma(with.Trace(org, dir, 0.5f, 0.5f)), lit, 1e-6f * lit);
+  // And the sun's term is there to lose: without the sun the point is darker.
+  RenderParams dark_p = p;
+  dark_p.sun_strength = 0.0;
+  Renderer dark(dark_p, off);
+  dark.RenderLinear(m.V, m.F, m.UV);
+  EXPECT_GT(lit, 1.2f * Luma(dark.Trace(org, dir, 0.5f, 0.5f)));
+}
+
+// The cached path with shadows: each frame's cached static sample (its shadow ray's origin, whether
+// it sees the sun) and the per-frame test of whether the cloth blocks the sun give what a
+// direct trace gives, over two frames whose flag shadows different ground. A sun disc of size 0,
+// so that a sample does not depend on its point of the disc.
+TEST(Renderer, CachedFramesWithShadowsMatchUncachedTrace) {
+  RenderParams p = TestParams();
+  p.samples = 1;
+  p.sun_shadow_soft_size = 0.0;
+  // The camera looks down at the ground where the flag's centre casts its shadow.
+  const Eigen::Vector3f sun = Renderer(p).lighting().sun_dir;
+  const Eigen::Vector3f centre(1.5f, 0.0f, 5.5f);
+  const Eigen::Vector3f g = centre - sun * (centre.z() / sun.z());
+  p.camera_height = 6.0;
+  p.has_look_at = true;
+  p.look_at[0] = g.x();
+  p.look_at[1] = g.y();
+  p.look_at[2] = g.z();
+  Renderer r(p);
+  RenderOptions off;
+  off.shadows = false;
+  Renderer unshadowed(p, off);
+  int in_shadow = 0;
+  for (double t : {0.0, 0.37}) {
+    const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, t);
+    const cv::Mat img = r.RenderLinear(m.V, m.F, m.UV);
+    unshadowed.RenderLinear(m.V, m.F, m.UV);
+    for (int y = 2; y < 120; y += 7)
+      for (int x = 1; x < 120; x += 7) {
+        const Eigen::Vector3f o = F3(r.camera().position), d = F3(r.camera().RayDirection(x + 0.5, y + 0.5));
+        const Rgb c = r.Trace(o, d, 0.3f, 0.3f);
+        const cv::Vec3f v = img.at<cv::Vec3f>(y, x);
+        EXPECT_NEAR(v[0], c[0], 1e-5f) << x << "," << y << " t=" << t;
+        EXPECT_NEAR(v[1], c[1], 1e-5f);
+        EXPECT_NEAR(v[2], c[2], 1e-5f);
+        in_shadow += Luma(c) < 0.9f * Luma(unshadowed.Trace(o, d, 0.3f, 0.3f));
+      }
+  }
+  EXPECT_GT(in_shadow, 5) << "the sampled pixels must include shadowed ones";
 }
 
 TEST(Renderer, CachedFramesMatchUncachedTraceAcrossFrames) {
