@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <sstream>
 
@@ -34,6 +35,15 @@ std::string DescribeNegotiated(const V4l2Negotiated& n) {
   s << n.width << "x" << n.height << " " << FourccToString(n.fourcc) << " @"
     << (n.fps > 0 ? FpsText(n.fps) : std::string("?")) << " fps, " << n.buffers << " buffers";
   return s.str();
+}
+
+std::string DescribeExposure(const V4l2Negotiated& n) {
+  if (n.exposure_auto < 0) return "unknown (no exposure control)";
+  if (n.exposure_auto != V4L2_EXPOSURE_MANUAL) return "auto (mode " + std::to_string(n.exposure_auto) + ")";
+  if (n.exposure_s <= 0) return "manual (time not readable)";
+  char text[48];
+  std::snprintf(text, sizeof text, "manual %.4f s", n.exposure_s);
+  return text;
 }
 
 V4l2Camera::V4l2Camera(V4l2Options options, V4l2Io* io, Clock* clock, LogFn log)
@@ -104,6 +114,7 @@ bool V4l2Camera::OpenDevice() {
   }
   NegotiateFrameRate();
   ApplyControls();
+  ReadBackExposure();
   if (!SetupBuffers()) {
     ReleaseDevice();
     return false;
@@ -280,6 +291,32 @@ void V4l2Camera::ApplyControls() {
   if (options_.gain >= 0) SetControl(V4L2_CID_GAIN, "gain", options_.gain);
 }
 
+void V4l2Camera::ReadBackExposure() {
+  negotiated_.exposure_auto = -1;
+  negotiated_.exposure_s = 0;
+  v4l2_control mode{};
+  mode.id = V4L2_CID_EXPOSURE_AUTO;
+  if (io_->Ioctl(fd_, VIDIOC_G_CTRL, &mode) < 0) return;
+  negotiated_.exposure_auto = mode.value;
+  if (mode.value != V4L2_EXPOSURE_MANUAL) return;
+  v4l2_control time{};
+  time.id = V4L2_CID_EXPOSURE_ABSOLUTE;
+  if (io_->Ioctl(fd_, VIDIOC_G_CTRL, &time) < 0 || time.value <= 0) return;
+  negotiated_.exposure_s = time.value * 1e-4;  // V4L2_CID_EXPOSURE_ABSOLUTE counts 100 us
+  const double fps = negotiated_.fps > 0 ? negotiated_.fps : options_.fps;
+  if (fps > 0 && negotiated_.exposure_s > 1.001 / fps) {
+    Log(LogLevel::kWarn, options_.device + ": exposure " + DescribeExposure(negotiated_) +
+                             " outlasts a frame period at " + FpsText(fps) + " fps: the camera delivers at most " +
+                             FpsText(1.0 / negotiated_.exposure_s) + " fps (the loss timeout waits for " +
+                             "5 exposures)");
+  }
+}
+
+double V4l2Camera::LossTimeout() const {
+  return std::max({options_.timeout_s, negotiated_.fps > 0 ? 5.0 / negotiated_.fps : 0.0,
+                   5.0 * negotiated_.exposure_s});
+}
+
 bool V4l2Camera::SetupBuffers() {
   v4l2_requestbuffers req{};
   req.count = static_cast<uint32_t>(std::max(2, options_.buffers));
@@ -378,8 +415,7 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
 
   const int64_t now = clock_->MonotonicNs();
   // A slow camera (a long exposure at night) must not be mistaken for a dead one.
-  const double timeout_s =
-      std::max(options_.timeout_s, negotiated_.fps > 0 ? 5.0 / negotiated_.fps : 0.0);
+  const double timeout_s = LossTimeout();
   const int64_t loss_deadline = last_frame_mono_ns_ + static_cast<int64_t>(timeout_s * 1e9);
   const int64_t wait_ns = std::max<int64_t>(0, std::min(max_wait_ns, loss_deadline - now));
   short revents = 0;
@@ -507,6 +543,8 @@ std::map<std::string, std::string> V4l2Camera::Status() const {
       {"last error", error_}};
   if (ever_opened_) {
     m["negotiated format"] = DescribeNegotiated(negotiated_);
+    m["exposure"] = DescribeExposure(negotiated_);
+    m["loss timeout [s]"] = std::to_string(LossTimeout());
     m["card"] = negotiated_.card + " (" + negotiated_.driver + ", " + negotiated_.bus + ")";
   }
   return m;

@@ -22,7 +22,8 @@ struct V4l2Options {
   int height = 480;       // [px]
   double fps = 30.0;      // [Hz]
   int buffers = 4;        // mmap buffers to request (the driver may grant another count, >= 2)
-  double timeout_s = 2.0; // no frame for this long (at least 5 frame periods): device lost, reopened
+  double timeout_s = 2.0; // no frame for this long (at least 5 frame periods, and 5 manual
+                          // exposures): device lost, reopened
   int auto_exposure = -1;      // -1 leave as is, 0 manual, 1 automatic
   int exposure_absolute = -1;  // V4L2_CID_EXPOSURE_ABSOLUTE [100 us]; -1 leave (>= 0 implies manual)
   int gain = -1;               // V4L2_CID_GAIN [device units]; -1 leave
@@ -42,6 +43,9 @@ struct V4l2Negotiated {
   double fps = 0;           // [Hz]; 0 if the driver does not say
   int buffers = 0;          // mmap buffers granted
   std::string driver, card, bus;  // VIDIOC_QUERYCAP strings
+  // Exposure as the driver holds it after the controls were applied (VIDIOC_G_CTRL):
+  int exposure_auto = -1;   // V4L2_CID_EXPOSURE_AUTO's value; -1 when the camera has no such control
+  double exposure_s = 0;    // manual exposure time [s]; 0 when automatic or not readable
 };
 
 // Counters for diagnostics.
@@ -108,6 +112,12 @@ class V4l2Camera : public FrameSource {
   bool NegotiateFormat();
   void NegotiateFrameRate();
   void ApplyControls();
+  // Reads back the exposure mode and, when manual, its time into negotiated_; WARNs when one
+  // exposure outlasts a frame period (the camera then delivers fewer frames than negotiated).
+  void ReadBackExposure();
+  // No frame for this long [s] means the device is lost: ~timeout, but at least 5 frame
+  // periods and 5 manual exposures (a long exposure at dusk is a slow camera, not a dead one).
+  double LossTimeout() const;
   void SetControl(uint32_t id, const char* name, int value);
   bool SetupBuffers();
   void ReleaseDevice();                   // STREAMOFF, munmap, close; ignores errors
@@ -144,6 +154,8 @@ class V4l2Camera : public FrameSource {
 
 // Formats a V4L2 negotiation for logs, e.g. "640x480 YUYV @30 fps, 4 buffers".
 std::string DescribeNegotiated(const V4l2Negotiated& n);
+// "manual 0.0150 s", "auto (mode 3)", or "unknown (no exposure control)".
+std::string DescribeExposure(const V4l2Negotiated& n);
 
 }  // namespace sensors
 }  // namespace clothwind

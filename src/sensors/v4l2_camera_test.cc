@@ -311,6 +311,36 @@ TEST(V4l2CameraTest, AppliesControlsTheDeviceHasAndSkipsOthers) {
   EXPECT_TRUE(rig2.Warned("has no exposure_absolute control; skipped"));
 }
 
+// A manual exposure of 0.4 s on a 15 fps camera: the camera stretches its frame period to 0.4 s,
+// which a loss timeout of 5 frame periods (0.33 s) took for a dead device, reopening it for ever.
+// The timeout now waits for 5 exposures, a WARN says why the rate drops, and diagnostics give
+// the exposure the driver holds.
+TEST(V4l2CameraTest, ALongManualExposureIsASlowCameraNotALostOne) {
+  FakeV4l2Config config;
+  config.controls[V4L2_CID_EXPOSURE_ABSOLUTE] = {1, 10000, 100, V4L2_CTRL_TYPE_INTEGER};
+  V4l2Options options = Ask(PixelFormat::kGrey, 320, 240, 15);
+  options.exposure_absolute = 4000;  // 0.4 s in 100 us
+  options.timeout_s = 0.3;
+  Rig rig(config, options);
+  ASSERT_TRUE(rig.camera.Open());
+  EXPECT_EQ(rig.device.controls().at(V4L2_CID_EXPOSURE_ABSOLUTE).value, 4000);
+  Frame f;
+  for (int i = 0; i < 5; ++i) ASSERT_EQ(rig.ReadFrame(&f), ReadStatus::kFrame) << "frame " << i;
+  EXPECT_EQ(rig.camera.stats().losses, 0u);
+  EXPECT_EQ(rig.camera.stats().reconnects, 0u);
+  const auto status = rig.camera.Status();
+  EXPECT_EQ(status.at("exposure"), "manual 0.4000 s");
+  EXPECT_NEAR(std::stod(status.at("loss timeout [s]")), 2.0, 1e-9);
+  EXPECT_TRUE(rig.Warned("exposure manual 0.4000 s outlasts a frame period at 15 fps"));
+  // Automatic exposure: said so, and the timeout is the usual one.
+  V4l2Options automatic = Ask(PixelFormat::kGrey, 320, 240, 15);
+  automatic.auto_exposure = 1;
+  Rig rig2(config, automatic);
+  ASSERT_TRUE(rig2.camera.Open());
+  EXPECT_EQ(rig2.camera.Status().at("exposure"), "auto (mode 3)");
+  EXPECT_NEAR(std::stod(rig2.camera.Status().at("loss timeout [s]")), 2.0, 1e-9);
+}
+
 TEST(V4l2CameraTest, CloseReleasesEverything) {
   Rig rig({}, Ask(PixelFormat::kYuyv, 320, 240, 15));
   ASSERT_TRUE(rig.camera.Open());

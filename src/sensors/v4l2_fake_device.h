@@ -167,6 +167,13 @@ class FakeV4l2Device : public V4l2Io {
         q->flags = 0;
         return 0;
       }
+      case VIDIOC_G_CTRL: {
+        auto* c = static_cast<v4l2_control*>(arg);
+        auto it = config_.controls.find(c->id);
+        if (it == config_.controls.end()) return SetErrno(EINVAL);
+        c->value = it->second.value;
+        return 0;
+      }
       case VIDIOC_S_CTRL: {
         auto* c = static_cast<v4l2_control*>(arg);
         auto it = config_.controls.find(c->id);
@@ -284,7 +291,17 @@ class FakeV4l2Device : public V4l2Io {
     return -1;
   }
   static uint32_t OffsetOf(uint32_t index) { return index * 0x100000u; }
-  int64_t Period() const { return 1000000000LL / config_.fps; }
+  // The frame period: the sensor's rate, or longer when a manual exposure outlasts it (UVC
+  // cameras' exposure_auto_priority).
+  int64_t Period() const {
+    int64_t period = 1000000000LL / config_.fps;
+    const auto mode = config_.controls.find(V4L2_CID_EXPOSURE_AUTO);
+    const auto time = config_.controls.find(V4L2_CID_EXPOSURE_ABSOLUTE);
+    if (mode != config_.controls.end() && mode->second.value == V4L2_EXPOSURE_MANUAL &&
+        time != config_.controls.end())
+      period = std::max<int64_t>(period, static_cast<int64_t>(time->second.value) * 100000);
+    return period;
+  }
   int64_t LatencyOf(uint64_t k) const {
     return config_.latency_ns + static_cast<int64_t>((k * 7919) % 5) * config_.jitter_ns;
   }
