@@ -242,7 +242,7 @@ class SdnNode {
       ages_.push_back(ros::Time::now().toSec() - estimate.clip_end.toSec());
       if (ages_.size() > 50) ages_.pop_front();
       estimate_pub_.publish(estimate);
-      PublishMean(estimate);
+      PublishMean(estimate, p.raw_speed);
       if (want_maps && !maps.power.empty()) PublishMaps(*clip, maps);
       ++estimates_;
       turned_ += p.turned;
@@ -301,19 +301,20 @@ class SdnNode {
   }
 
   // The trailing mean up to this estimate; its clip_start is the first frame of the oldest clip
-  // averaged, clip_end and the stamp those of this one.
-  void PublishMean(const clothwind::WindEstimate& estimate) {
+  // averaged, clip_end and the stamp those of this one. It averages the network's outputs before
+  // the clamp at 0 (`raw_speed`) and clamps the mean: a mean of clamped calm estimates is biased up.
+  void PublishMean(const clothwind::WindEstimate& estimate, double raw_speed) {
     const double end = estimate.clip_end.toSec();
     if (!starts_.empty() && end < starts_.back().first) {  // clip time went back: a new bag, or a loop
       starts_.clear();
       ++mean_restarts_;
     }
-    trailing_.Add(end, estimate.speed, estimate.speed_std);
+    trailing_.Add(end, raw_speed, estimate.speed_std);
     starts_.emplace_back(end, estimate.clip_start);
     while (starts_.front().first < trailing_.Oldest()) starts_.pop_front();
     clothwind::WindEstimate mean = estimate;
     mean.clip_start = starts_.front().second;
-    mean.speed = trailing_.Mean();
+    mean.speed = clothwind::learn::ClampSpeed(trailing_.Mean());
     mean.speed_std = trailing_.Std();
     char model[64];
     std::snprintf(model, sizeof model, " [trailing %.0f s mean of %zu clips]", trailing_.window(), trailing_.Count());

@@ -482,7 +482,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   ValidateOptions(o);
   const auto start = Clock::now();
   const Prepared prep = Prepare(o);
-  const nlohmann::json settings = DatasetSettingsJson(o, FabricNames(prep.fabrics), prep.scene_files);
+  nlohmann::json settings = DatasetSettingsJson(o, FabricNames(prep.fabrics), prep.scene_files);
   const nlohmann::json existing = ReadIndex(o.out);
   if (o.add_tracks && existing.is_null())
     throw std::runtime_error("--add-tracks: " + (fs::path(o.out) / "index.json").string() +
@@ -490,7 +490,12 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   if (!existing.is_null()) CheckIndexIsThisKind(o.out, existing, o);
   fs::create_directories(o.out);
   if (o.add_tracks) {
-    // The examples were made without tracks: every other setting must be theirs.
+    // The examples were made without tracks: every other setting must be theirs. Their frames
+    // stay as the generator that made them rendered them (nothing is written into them; the
+    // replay check compares the last frame within a tolerance), so the folder keeps its
+    // generator_version rather than being refused for it.
+    if (!existing.is_null() && existing.contains("dataset") && existing["dataset"].contains("generator_version"))
+      settings["generator_version"] = existing["dataset"]["generator_version"];
     CheckCompatible(o.out, settings, "tracks");
   } else {
     CheckCompatible(o.out, settings);

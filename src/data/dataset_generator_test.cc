@@ -582,6 +582,20 @@ TEST_F(DatasetGeneratorTest, AddTracksGivesADatasetTheTracksItWouldHaveBeenMadeW
     }
   }
   EXPECT_EQ(ReadIndex(added.string())["dataset"]["tracks"], nlohmann::json({4, 3}));
+  // A folder an older generator made is given its tracks too (nothing is rendered into it), and
+  // keeps its generator_version.
+  const fs::path older = root_ / "older-tracks";
+  fs::copy(Ref(), older, fs::copy_options::recursive);
+  nlohmann::json older_index = ReadIndex(older.string());
+  older_index["dataset"]["generator_version"] = kGeneratorVersion - 1;
+  std::ofstream(older / "index.json") << older_index.dump(2) << "\n";
+  DatasetOptions add_older = add;
+  add_older.out = older.string();
+  const DatasetSummary s_older = GenerateDataset(add_older);
+  ASSERT_TRUE(s_older.errors.empty()) << s_older.errors[0];
+  EXPECT_EQ(s_older.examples_written, 3);
+  EXPECT_EQ(ReadIndex(older.string())["dataset"]["generator_version"], kGeneratorVersion - 1);
+  EXPECT_EQ(ReadIndex(older.string())["dataset"]["tracks"], nlohmann::json({4, 3}));
   // --split: only that split's simulations are replayed.
   const fs::path some = root_ / "split-tracks";
   fs::copy(Ref(), some, fs::copy_options::recursive);

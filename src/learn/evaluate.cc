@@ -190,7 +190,7 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
         }
       }
       for (size_t j = 0; j < samples.size(); ++j) {
-        sum[j] += predictions[j].speed;
+        sum[j] += predictions[j].raw_speed;  // averaged as the network gave them, then clamped
         sum_var[j] += predictions[j].speed_std * predictions[j].speed_std;
       }
     }
@@ -199,7 +199,7 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
       r.dirs.push_back(clips[j].dir);
       r.truth.push_back(clips[j].wind_speed);
       r.simulations.push_back(clips[j].simulation);
-      r.predicted.push_back(sum[j - i] / passes);
+      r.predicted.push_back(ClampSpeed(sum[j - i] / passes));
       r.predicted_std.push_back(std::sqrt(sum_var[j - i] / passes));
     }
     if (progress) progress(static_cast<int>(r.truth.size()), static_cast<int>(clips.size()));

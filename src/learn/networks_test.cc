@@ -95,8 +95,8 @@ TEST(UseChannelsLastTest, NetworkAnswersAsInTheDefaultOrder) {
   Predictor nhwc(dir / "model.pt", 1, "cpu"), nchw(dir / "model.pt", 1, "cpu", /*channels_last=*/false);
   const Prediction p = nhwc.Predict({&sample})[0], q = nchw.Predict({&sample})[0];
   const ModelConfig& c = first->config();
-  EXPECT_NEAR(q.speed, c.label_mean + c.label_std * a[2][0].item<double>(), 1e-5 * c.label_std);
-  EXPECT_NEAR(p.speed, q.speed, 1e-4 * c.label_std);
+  EXPECT_NEAR(q.raw_speed, c.label_mean + c.label_std * a[2][0].item<double>(), 1e-5 * c.label_std);
+  EXPECT_NEAR(p.raw_speed, q.raw_speed, 1e-4 * c.label_std);
   EXPECT_NEAR(p.speed_std, q.speed_std, 1e-4 * q.speed_std);
   std::filesystem::remove_all(dir);
 }

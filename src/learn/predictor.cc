@@ -87,8 +87,8 @@ std::vector<Prediction> Predictor::Predict(const std::vector<const Sample*>& sam
   std::vector<Prediction> predictions(samples.size());
   const double* o = out.data_ptr<double>();
   for (size_t i = 0; i < samples.size(); ++i) {
-    const double speed = c.label_mean + c.label_std * o[2 * i];
-    predictions[i].speed = speed < 0 ? 0.0 : speed;  // not std::max: a NaN must stay NaN (callers refuse it)
+    predictions[i].raw_speed = c.label_mean + c.label_std * o[2 * i];
+    predictions[i].speed = ClampSpeed(predictions[i].raw_speed);
     predictions[i].speed_std = c.std_scale * c.label_std * std::exp(0.5 * o[2 * i + 1]);
   }
   return predictions;

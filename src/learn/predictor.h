@@ -19,6 +19,10 @@ struct Prediction {
   // [m/s], never below 0: the network's output, a regression, dips below 0 for some calm clips
   // (wind speed cannot), and 0 is nearer the truth than any negative value. NaN stays NaN.
   double speed = 0;
+  // [m/s] the network's output before that clamp. What an average of several predictions adds
+  // up (eval's windows, sdn_node's trailing mean), clamping only the average: the mean of
+  // clamped values is biased up for calm clips (E[max(X, 0)] > max(E[X], 0)).
+  double raw_speed = 0;
   double speed_std = 0;  // [m/s] predicted standard deviation (the network's uncertainty)
   bool turned = false;   // PredictFrames mirrored the clip first: its flag flies left (flag_flies())
   bool undecided = false;  // with flag_flies auto: the judge could not tell; the last way it knew was kept
@@ -29,6 +33,10 @@ struct PeakMaps {
   cv::Mat power;      // CV_32F input_size x input_size, periodogram of the strongest bin
   cv::Mat frequency;  // CV_32F input_size x input_size, its frequency [Hz]
 };
+
+// A wind speed estimate as published: `raw` [m/s] clamped at 0 from below, NaN kept (callers refuse
+// it; std::max would turn it into 0).
+inline double ClampSpeed(double raw) { return raw < 0 ? 0.0 : raw; }
 
 class Predictor {
  public:

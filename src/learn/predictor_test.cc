@@ -88,6 +88,8 @@ TEST_F(PredictorTest, ASpeedBelowZeroIsReadAsCalm) {
   ASSERT_GT(above.speed, 0.0);
   ASSERT_LT(above.speed - 100.0, 0.0) << "the network's output must be within 50 of 0 for this test";
   EXPECT_EQ(below.speed, 0.0);
+  EXPECT_NEAR(below.raw_speed, above.raw_speed - 100.0, 1e-9 * above.raw_speed);
+  EXPECT_EQ(above.raw_speed, above.speed);
   EXPECT_NEAR(below.speed_std, above.speed_std, 1e-9 * above.speed_std);
 }
 

@@ -29,6 +29,7 @@
 #include "learn/dataset.h"
 #include "learn/frame_cache.h"
 #include "learn/networks.h"
+#include "learn/predictor.h"
 #include "learn/track_targets.h"
 #include "learn/weight_average.h"
 
@@ -307,7 +308,7 @@ Validation Validate(WindNet& model, const std::vector<ClipInfo>& val, int batch,
     at::Tensor speed = (out.select(1, 0) * config.label_std + config.label_mean).to(at::kDouble).contiguous();
     at::Tensor label = speeds.to(at::kDouble).contiguous();
     for (int64_t i = 0; i < y.size(0); ++i) {
-      predicted.push_back(speed.data_ptr<double>()[i]);
+      predicted.push_back(ClampSpeed(speed.data_ptr<double>()[i]));  // as eval and the node read it
       truth.push_back(label.data_ptr<double>()[i]);
     }
     if (clips_done) clips_done(static_cast<int>(truth.size()));

@@ -237,7 +237,8 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
     ASSERT_TRUE(mirrored.flipped);
     const Prediction a = predictor.Predict({&plain}).front(), b = predictor.Predict({&mirrored}).front();
     EXPECT_NEAR(e.predicted[i], a.speed, 2e-3);
-    EXPECT_NEAR(em.predicted[i], (a.speed + b.speed) / 2, 2e-3);
+    // The two readings' outputs averaged before the clamp at 0, not the clamped ones.
+    EXPECT_NEAR(em.predicted[i], ClampSpeed((a.raw_speed + b.raw_speed) / 2), 2e-3);
     EXPECT_NEAR(em.predicted_std[i], std::sqrt((a.speed_std * a.speed_std + b.speed_std * b.speed_std) / 2), 2e-3);
     largest_difference = std::max(largest_difference, std::abs(a.speed - b.speed));
   }
@@ -364,7 +365,7 @@ TEST_F(TrainTest, CheckpointRoundTripGivesIdenticalPredictions) {
   s.pixels.assign(x[1].data_ptr<float>(), x[1].data_ptr<float>() + x[1].numel());
   const Prediction p = predictor.Predict({&s})[0];
   const ModelConfig& c = loaded->config();
-  EXPECT_NEAR(p.speed, c.label_mean + c.label_std * a[1][0].item<double>(), 1e-5);
+  EXPECT_NEAR(p.raw_speed, c.label_mean + c.label_std * a[1][0].item<double>(), 1e-5);
   EXPECT_NEAR(p.speed_std, c.label_std * std::exp(0.5 * a[1][1].item<double>()), 1e-5);
   // A calibrated copy scales the std and nothing else.
   loaded->set_std_scale(1.5);
@@ -1752,10 +1753,13 @@ TEST_F(TrainTest, AModelTrainedWithoutFlipsTurnsFlagsFlyingLeft) {
   p.set_flag_flies(FlagFlies::kRight);
   const Prediction filmed = p.PredictFrames(frames), other_way = p.PredictFrames(mirrored);
   EXPECT_FALSE(filmed.turned);
-  EXPECT_NE(filmed.speed, other_way.speed);  // the network is not mirror-symmetric
+  // The network is not mirror-symmetric (its outputs before the clamp at 0: an untrained one's
+  // may both be below 0).
+  EXPECT_NE(filmed.raw_speed, other_way.raw_speed);
   p.set_flag_flies(FlagFlies::kLeft);
   const Prediction turned = p.PredictFrames(mirrored);
   EXPECT_TRUE(turned.turned);
+  EXPECT_DOUBLE_EQ(turned.raw_speed, filmed.raw_speed);
   EXPECT_DOUBLE_EQ(turned.speed, filmed.speed);
   EXPECT_DOUBLE_EQ(turned.speed_std, filmed.speed_std);
 }
