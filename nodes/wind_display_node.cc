@@ -38,7 +38,6 @@
 // Drawing and averaging are the ROS-free sensors/wind_plot.
 #include <cmath>
 #include <limits>
-#include <map>
 #include <string>
 
 #include <algorithm>
@@ -130,7 +129,7 @@ class WindDisplayNode {
 
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
     if (!msg->valid) {
-      Dropped(&invalid_);  // a sensor that only reports void readings says so
+      Dropped(&invalid_, kInvalid);  // a sensor that only reports void readings says so
       return;
     }
     if (!Plausible(msg->speed)) return;
@@ -150,7 +149,7 @@ class WindDisplayNode {
     if (has_vector && std::sqrt(msg->velocity.x * msg->velocity.x + msg->velocity.y * msg->velocity.y + vz * vz) >
                           kMaxSpeed) {
       has_vector = false;
-      Dropped(&implausible_velocity_);
+      Dropped(&implausible_velocity_, kVelocity);
     }
     if (frame_gate_.Admit(msg->header.frame_id, has_vector ? 0.0 : std::nan(""))) {
       if (has_vector && (!have_vector_ || msg->header.stamp >= last_vector_.header.stamp)) {
@@ -169,13 +168,15 @@ class WindDisplayNode {
   // Refused (counted): stamp 0 (it would stamp the displays 0 and empty the plot), and a stamp more
   // than ~max_future ahead of a running clock (one reading stamped TIME_MAX made every later age
   // a Duration out of range, which killed the node; one 100 s ahead moved the display's now and
-  // wiped the history). A stamp more than kRestartAfter behind the newest of the same input means
-  // the replay restarted: everything shown is from the previous pass and is dropped. (Per input:
-  // estimates lag the readings by a clip's span and the model's queue, which is no restart.)
-  // All in double seconds: ros::Time arithmetic throws on results beyond 32 bits.
+  // wiped the history), unless it is of the pass before the clock went back. A stamp more than
+  // kRestartAfter behind the newest of the same input is dropped as late while the clock runs
+  // (the clock going back is CheckClock's restart); with no clock yet it restarts the display.
+  // (Per input: estimates lag the readings by a clip's span and the model's queue, which is no
+  // restart.) All in double seconds: ros::Time arithmetic throws on results beyond 32 bits.
   bool AdmitStamp(const ros::Time& stamp, ros::Time* newest_of_input) {
+    CheckClock();  // a new pass's first message may come before the next tick notices the jump
     if (stamp.isZero()) {
-      Dropped(&unstamped_);
+      Dropped(&unstamped_, kUnstamped);
       return false;
     }
     const double now = ros::Time::now().toSec(), t = stamp.toSec();
@@ -185,7 +186,7 @@ class WindDisplayNode {
         ++previous_pass_;
         return false;
       }
-      Dropped(&future_stamped_);
+      Dropped(&future_stamped_, kFuture);
       WALL_WARN_THROTTLE(10.0, "wind_display: input stamped %.1f s ahead of the clock dropped", t - now);
       return false;
     }
@@ -194,7 +195,7 @@ class WindDisplayNode {
       // The replay restarted when the clock went back too (or has not started); otherwise this one
       // message is late and wiping the display for it was wrong.
       if (now > 0 && now + WindHistory::kRestartAfter >= newest) {
-        Dropped(&late_);
+        Dropped(&late_, kLate);
         WALL_WARN_THROTTLE(10.0, "wind_display: input stamped %.1f s behind the newest of its kind dropped",
                            newest - t);
         return false;
@@ -210,14 +211,32 @@ class WindDisplayNode {
   static constexpr double kMaxSpeed = 100.0;  // [m/s]
   bool Plausible(double speed) {
     if (std::isfinite(speed) && speed >= 0 && speed <= kMaxSpeed) return true;
-    Dropped(&implausible_);
+    Dropped(&implausible_, kImplausible);
     return false;
   }
 
-  // Counts a dropped message; Diagnose WARNs for ~drop_warn_for after the last one.
-  void Dropped(uint64_t* counter) {
+  // Why messages are dropped; each cause is a WARN for ~drop_warn_for after its last drop.
+  enum DropCause { kUnstamped, kFuture, kImplausible, kLate, kInvalid, kVelocity, kDropCauses };
+  static constexpr const char* kDropWarnings[kDropCauses] = {
+      "messages stamped 0 dropped",          "messages stamped in the future dropped",
+      "speeds or stds outside 0..100 m/s dropped", "messages more than 5 s late dropped",
+      "readings marked invalid dropped",     "velocities beyond 100 m/s (no arrow)"};
+
+  // Counts a dropped message and when it was dropped (wall time: a paused bag must not hold it).
+  void Dropped(uint64_t* counter, DropCause cause) {
     ++*counter;
-    last_drop_wall_ = ros::WallTime::now();
+    last_drop_wall_[cause] = ros::WallTime::now();
+  }
+
+  // Restarts the display when ROS time went back more than kRestartAfter since it was last read
+  // (a replay played again), once: from the first message of the new pass or the next tick,
+  // whichever comes first (both restarted, and the new pass's first reading was wiped).
+  void CheckClock() {
+    const double clock = ros::Time::now().toSec();
+    if (clock > 0 && last_clock_ > 0 && clock + WindHistory::kRestartAfter < last_clock_) {
+      Restart(std::max(last_clock_, std::max(newest_estimate_, newest_wind_).toSec()));
+    }
+    if (clock > 0) last_clock_ = clock;
   }
 
   // Forgets what is shown: the clock or the inputs went back (a replay restarted). `previous_end`
@@ -264,35 +283,19 @@ class WindDisplayNode {
     if (!Live(have_wind_, last_wind_.header.stamp, last_wind_wall_, now, mean_window_))
       stat.mergeSummary(DiagnosticStatus::WARN,
                         have_wind_ ? "no anemometer reading in the mean window" : "no anemometer reading yet");
-    // Drops are a WARN for drop_warn_for_ after the last one (time to be read), then OK again: a
-    // total since start kept one bad message a WARN forever and hid what came after.
-    const bool recent_drop = !last_drop_wall_.isZero() && (ros::WallTime::now() - last_drop_wall_).toSec() <
-                                                               drop_warn_for_;
-    auto warn_if_new = [&](uint64_t count, uint64_t* reported, const char* what) {
-      if (count > *reported) warned_[what] = true;  // new since the last quiet spell
-      if (recent_drop && warned_[what]) stat.mergeSummary(DiagnosticStatus::WARN, what);
-    };
-    warn_if_new(unstamped_, &reported_unstamped_, "messages stamped 0 dropped");
-    warn_if_new(future_stamped_, &reported_future_, "messages stamped in the future dropped");
-    warn_if_new(implausible_, &reported_implausible_, "speeds or stds outside 0..100 m/s dropped");
-    warn_if_new(late_, &reported_late_, "messages more than 5 s late dropped");
-    warn_if_new(invalid_, &reported_invalid_, "readings marked invalid dropped");
-    warn_if_new(implausible_velocity_, &reported_velocity_, "velocities beyond 100 m/s (no arrow)");
-    if (!recent_drop) {
-      warned_.clear();
-      reported_unstamped_ = unstamped_;
-      reported_future_ = future_stamped_;
-      reported_implausible_ = implausible_;
-      reported_late_ = late_;
-      reported_invalid_ = invalid_;
-      reported_velocity_ = implausible_velocity_;
+    // Each cause of drops is a WARN for drop_warn_for_ after its own last drop (time to be read),
+    // then no longer: a total since start kept one bad message a WARN for good.
+    const ros::WallTime wall = ros::WallTime::now();
+    for (int c = 0; c < kDropCauses; ++c) {
+      if (!last_drop_wall_[c].isZero() && (wall - last_drop_wall_[c]).toSec() < drop_warn_for_)
+        stat.mergeSummary(DiagnosticStatus::WARN, kDropWarnings[c]);
     }
     if (!publish_error_.empty()) stat.mergeSummary(DiagnosticStatus::ERROR, "cannot draw: " + publish_error_);
     stat.addf("estimate age [s]", "%.1f", est_age);
     stat.addf("anemometer age [s]", "%.1f", wind_age);
     stat.add("messages stamped 0 dropped", unstamped_);
     stat.add("messages stamped more than ~max_future ahead dropped", future_stamped_);
-    stat.add("restarts (clock or inputs went back)", restarts_);
+    stat.add("restarts (clock or inputs went back)", restarts_);  // key kept for the tests and tools reading it
     stat.add("speeds or stds outside 0..100 m/s dropped", implausible_);
     stat.add("messages more than 5 s behind the newest of their input dropped (clock steady)", late_);
     stat.add("messages of the previous pass dropped (after the clock went back)", previous_pass_);
@@ -318,11 +321,7 @@ class WindDisplayNode {
   void Publish(const ros::WallTimerEvent& event) {
     // The clock went back (a replay restarted) before any input of the new pass came: what is
     // shown is the previous pass's.
-    const double clock = ros::Time::now().toSec();
-    if (clock > 0 && last_clock_ > 0 && clock + WindHistory::kRestartAfter < last_clock_) {
-      Restart(std::max(last_clock_, std::max(newest_estimate_, newest_wind_).toSec()));
-    }
-    if (clock > 0) last_clock_ = clock;
+    CheckClock();
     const std::string frame = FrameId();
     if (!fixed_frame_.empty() && frame != tf_parent_ && frame != fixed_frame_) PublishFixedFrame(frame);
     // Lazy: the plot is a 640x320 image drawn at ~rate; nobody looking, nothing drawn. A new
@@ -435,14 +434,9 @@ class WindDisplayNode {
   double drop_warn_for_ = 30.0;
   uint64_t unstamped_ = 0, future_stamped_ = 0, restarts_ = 0, implausible_ = 0, late_ = 0, previous_pass_ = 0,
            invalid_ = 0, implausible_velocity_ = 0, drawn_ = 0;
-  // Each drop count as of the last quiet spell (no drop for drop_warn_for_), and which causes
-  // have dropped since: the WARN names those only.
-  uint64_t reported_unstamped_ = 0, reported_future_ = 0, reported_implausible_ = 0, reported_late_ = 0,
-           reported_invalid_ = 0, reported_velocity_ = 0;
-  std::map<std::string, bool> warned_;
-  ros::WallTime last_drop_wall_;   // when the last message was dropped (zero: never)
+  ros::WallTime last_drop_wall_[kDropCauses];  // when each cause last dropped a message (zero: never)
   double clock_before_restart_ = -std::numeric_limits<double>::infinity();  // [s] previous pass's end
-  double last_clock_ = 0;          // ROS time at the last draw [s]
+  double last_clock_ = 0;          // ROS time when last read (CheckClock) [s]
   ros::Time newest_estimate_, newest_wind_;  // each input's newest stamp since the last restart
   std::string publish_error_;      // why the last draw failed ("" when it did not)
   diagnostic_updater::Updater updater_;

@@ -66,6 +66,14 @@ double WindSeriesGap(const WindHistory& h, double t_now, double window) {
     previous = s.t;
   }
   if (steps.size() < 2) return std::numeric_limits<double>::infinity();
+  // Steps far below the mean step are pairs, not the rhythm: an instrument sending its relative
+  // and its true wind (MWV R and T) milliseconds apart made the median flip between 2 ms and the
+  // period with each new sample, and the line between dots and a line.
+  double mean = 0;
+  for (double s : steps) mean += s;
+  mean /= steps.size();
+  steps.erase(std::remove_if(steps.begin(), steps.end(), [&](double s) { return s < 0.1 * mean; }), steps.end());
+  if (steps.empty()) return std::numeric_limits<double>::infinity();
   std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
   const double median = steps[steps.size() / 2];
   return median > 0 ? kWindSeriesGapFactor * median : std::numeric_limits<double>::infinity();

@@ -86,7 +86,8 @@ cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer,
                      const std::string& reference_name = "anemometer");
 
 // The longest step between two samples of `h` in (t_now - window, t_now] that DrawWindPlot
-// joins with a line: kWindSeriesGapFactor times the median step there (a series' own rhythm:
+// joins with a line: kWindSeriesGapFactor times the median step there, steps below a tenth of
+// the mean step left out (two readings of one instant, as relative and true wind; a series' own rhythm:
 // 1 s for a sonic anemometer, 48 s for a Fine Offset station, a clip's span for estimates);
 // infinity with fewer than three samples there (no rhythm to judge by). A longer step is an
 // outage (the sensor unplugged, sdn_node down) and the line breaks across it.

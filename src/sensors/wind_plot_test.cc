@@ -98,6 +98,13 @@ TEST(WindPlotTest, TheLineBreaksAcrossAnOutage) {
   }
   EXPECT_DOUBLE_EQ(WindSeriesGap(anem, 1060.0, 60.0), 3.0);
   EXPECT_DOUBLE_EQ(WindSeriesGap(est, 1060.0, 60.0), 30.0);
+  // Readings in pairs 2 ms apart (relative and true wind), one pair a second: the rhythm is the
+  // second, for an odd or an even number of steps alike (the median of all steps flipped).
+  for (int n : {60, 61}) {
+    WindHistory pairs(300);
+    for (int i = 0; i < n; ++i) pairs.Add({1000.0 + i / 2 + (i % 2) * 0.002, 2.0, 0.0});
+    EXPECT_NEAR(WindSeriesGap(pairs, 1060.0, 60.0), 2.994, 1e-9) << n;
+  }
   WindHistory two(300);
   two.Add({1000.0, 1.0, 0.0});
   two.Add({1001.0, 1.0, 0.0});

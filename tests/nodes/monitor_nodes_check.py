@@ -60,6 +60,18 @@ class MonitorNodesTest(unittest.TestCase):
                         return marker.text, [a for a in m.markers if a.ns == "anemometer_wind"][0].action
         return None, None
 
+    def wait_redraw(self):
+        """Until two marker arrays newer than this call have come (the display drew after it)."""
+        with self.lock:
+            seen = len(self.markers)
+        deadline = time.time() + 10.0
+        while time.time() < deadline:
+            with self.lock:
+                if len(self.markers) >= seen + 2:
+                    return
+            time.sleep(0.05)
+        self.fail("no redraw of the markers in 10 s")
+
     def latest_status(self):
         with self.lock:
             s = self.statuses[-1]
@@ -174,7 +186,7 @@ class MonitorNodesTest(unittest.TestCase):
         lagging.clip_sequence, lagging.speed, lagging.speed_std = 8, 4.0, 0.3
         lagging.reference_speed = 3.0
         self.est_pub.publish(lagging)
-        time.sleep(0.3)
+        self.wait_redraw()
         text, arrow = self.text()
         self.assertIn("anemometer 3.0 m/s", text)
         # ... nor shown as the latest: the newer estimate stays (the late one hid it, "--").
@@ -201,7 +213,7 @@ class MonitorNodesTest(unittest.TestCase):
         absurd.clip_sequence, absurd.speed, absurd.speed_std = 11, 4.0, 1e300
         absurd.reference_speed = float("nan")  # the report counts it and compares nothing
         self.est_pub.publish(absurd)
-        time.sleep(0.3)
+        self.wait_redraw()
         text, arrow = self.text()
         self.assertIn("anemometer 3.0 m/s", text)
         self.assertIn("estimate 4.0 \u00b1 0.3 m/s", text)

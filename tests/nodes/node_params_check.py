@@ -201,7 +201,8 @@ class NodeParamsTest(unittest.TestCase):
             self.assertEqual(monitor["/sdn/" + key], value, key)
         # rviz opens on the display's fixed frame (-f), and on the config's without one.
         self.assertIn(" -f monitor ", roslaunch("--args", "rviz", "clothwind", "monitor.launch"))
-        self.assertIn(" -f odom ", roslaunch("--args", "rviz", "clothwind", "monitor.launch", "fixed_frame:=odom"))
+        self.assertIn(" -f wind_view ", roslaunch("--args", "rviz", "clothwind", "monitor.launch",
+                                                  "fixed_frame:=wind_view"))
         self.assertNotIn(" -f ", roslaunch("--args", "rviz", "clothwind", "monitor.launch", "fixed_frame:=none"))
         none = yaml.safe_load(roslaunch("--dump-params", "clothwind", "monitor.launch", "fixed_frame:=none"))
         self.assertEqual(none["/wind_display/fixed_frame"], "")
