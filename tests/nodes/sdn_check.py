@@ -90,7 +90,7 @@ def read_pgm(path):
 
 def flagsim_frames(size=64, count=30):
     """`count` frames (size x size mono8, each bytes) of a flag rendered by FlagSim (clothwind
-    make-dataset, seed 1, 4 m/s or so: whatever the seed draws): a real flag flying right of its
+    make-dataset, seed 1: 7.2 m/s): a real flag flying right of its
     pole, as every FlagSim camera films it. Rendered here, so the test needs no stored data."""
     here = os.path.dirname(os.path.abspath(__file__))
     cli = subprocess.run(["bash", "-c", 'source "$1" && echo "$cli"', "sdn_check",
