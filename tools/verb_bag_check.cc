@@ -1,11 +1,15 @@
 // clothwind bag-check: is a recorded session bag fit for replay (launch/replay.launch)? Per topic:
 // message count, rate, span, header stamps monotonic and near their bag times; camera holes
 // longer than the clip buffer's gap tolerance; anemometer sentences decoded. Exit status 1 when
-// the replay would make no labelled clip or would not start: a required topic missing, stamps
-// going back, stamped 0 or far ahead of the bag's time (the replay's clock), no anemometer stamp
-// in any clip's label window, no sentence that decodes, no stretch of video without holes long
-// enough for a clip, or a topic no replay node reads (replay.launch waits for a subscriber on
-// every topic unless wait:=false).
+// the replay would make no labelled clip or would not start: a required topic missing, stamped 0
+// or far ahead of the bag's time (the replay's clock), no usable anemometer reading (one that
+// decodes, is not flagged void and is a speed of 0..150 m/s, as the clip buffer takes them) with a
+// stamp in any clip's label window, no stretch of video without holes long enough for a clip, or
+// a topic no replay node reads (replay.launch waits for a subscriber on every topic unless
+// wait:=false). Stamps that go back or repeat are warnings naming the first (message index and
+// bag time): the nodes drop such a frame (the resampler a repeated or slightly early one, the clip
+// buffer a lone stale one) and go on, so a driver's one duplicated frame must not refuse a field
+// bag; what they cost is counted in the holes and the longest stretch without one.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -58,6 +62,7 @@ struct TopicStats {
   size_t count = 0;
   double first = NAN, last = NAN, previous = NAN;
   size_t backwards = 0;       // header stamp before the previous one
+  std::string first_backwards, first_repeated;  // where the first of each is: "message N (bag time T s)"
   size_t repeated = 0;        // header stamp equal to the previous one (records of one serial read
                               // share it; camera frames must not: the clip buffer drops them)
   size_t bag_time_off = 0;    // |bag time - header stamp| > 1 ms
@@ -68,20 +73,26 @@ struct TopicStats {
   double longest_run = 0.0;   // longest span of stamps without a hole [s]
   double run_start = NAN;
   size_t decoded = 0, undecoded = 0;  // anemometer sentences that give a reading, and that do not
+  size_t void_readings = 0;           // decoded, but flagged void or a speed outside 0..150 m/s
+  double usable_first = NAN, usable_last = NAN;  // stamps of the readings a clip can be labelled by
   std::string first_error;
   size_t holes = 0;           // header stamp intervals > gap tolerance
   double widest = 0.0;        // largest interval [s]
   std::string first_data;     // first raw sentence / image encoding and size
 };
 
-void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, double max_future) {
+void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, double max_future, size_t index) {
   if (stamp == 0) ++s.zero;
   if (s.count == 0) s.first = s.run_start = stamp;
   if (s.count > 0) {
     const double dt = stamp - s.previous;
-    if (dt < 0) ++s.backwards;
-    if (dt == 0) ++s.repeated;
-    if (dt > gap_tolerance || dt < 0) {
+    char where[96];
+    std::snprintf(where, sizeof where, "message %zu (bag time %.3f s)", index, bag_time);
+    if (dt < 0 && s.backwards++ == 0) s.first_backwards = where;
+    if (dt == 0 && s.repeated++ == 0) s.first_repeated = where;
+    // A step back within the tolerance is a frame the resampler drops, no hole; a longer one
+    // restarts the clip buffer's clip as a hole does.
+    if (dt > gap_tolerance || dt < -gap_tolerance) {
       ++s.holes;
       s.run_start = stamp;
     }
@@ -90,36 +101,47 @@ void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, do
   s.longest_run = std::max(s.longest_run, stamp - s.run_start);
   if (std::fabs(bag_time - stamp) > 1e-3) ++s.bag_time_off;
   if (stamp - bag_time > max_future) ++s.far_from_bag_time;
-  s.previous = stamp;
+  // A message a little early is dropped by the nodes: the next is compared with the one before it.
+  if (s.count == 0 || !(stamp < s.previous && stamp >= s.previous - gap_tolerance)) s.previous = stamp;
   s.last = std::max(std::isnan(s.last) ? stamp : s.last, stamp);
   ++s.count;
 }
 
 // Counts one message into its topic's stats (ros::Exception when its bytes do not deserialise).
 void NoteMessage(const rosbag::MessageInstance& m, TopicStats& s, double t, const BagCheckArgs& a,
-                 sensors::AnemometerDecoder& decoder) {
+                 sensors::AnemometerDecoder& decoder, size_t index) {
   if (auto img = m.instantiate<sensor_msgs::Image>()) {
-    Note(s, img->header.stamp.toSec(), t, a.gap_tolerance, a.max_future);
+    Note(s, img->header.stamp.toSec(), t, a.gap_tolerance, a.max_future, index);
     if (s.first_data.empty())
       s.first_data = img->encoding + " " + std::to_string(img->width) + "x" + std::to_string(img->height) +
                      " frame " + img->header.frame_id;
   } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
-    Note(s, info->header.stamp.toSec(), t, 1e9, a.max_future);
+    Note(s, info->header.stamp.toSec(), t, 1e9, a.max_future, index);
     if (s.first_data.empty())
       s.first_data = std::to_string(info->width) + "x" + std::to_string(info->height) + " " + info->distortion_model;
   } else if (auto raw = m.instantiate<clothwind::RawSentence>()) {
-    Note(s, raw->header.stamp.toSec(), t, 1e9, a.max_future);
+    Note(s, raw->header.stamp.toSec(), t, 1e9, a.max_future, index);
     if (s.first_data.empty()) s.first_data = raw->data + " (" + raw->protocol + ")";
     // As the anemometer node in topic mode reads them (a bad checksum labels no clip).
     const sensors::ParseResult r = decoder.Decode(std::string(raw->data.begin(), raw->data.end()));
     if (r.status == sensors::ParseStatus::kOk) {
       ++s.decoded;
+      // As the clip buffer's labeller takes a reading (ToLabelReading): a void one (NMEA status V,
+      // a Gill error code) or an impossible speed labels nothing.
+      const double v = r.reading.speed;
+      if (r.reading.valid && std::isfinite(v) && v >= 0 && v <= 150) {
+        const double stamp = raw->header.stamp.toSec();
+        s.usable_first = std::isnan(s.usable_first) ? stamp : std::min(s.usable_first, stamp);
+        s.usable_last = std::isnan(s.usable_last) ? stamp : std::max(s.usable_last, stamp);
+      } else {
+        ++s.void_readings;
+      }
     } else if (r.status != sensors::ParseStatus::kNotWind) {
       ++s.undecoded;
       if (s.first_error.empty()) s.first_error = r.error;
     }
   } else {
-    Note(s, t, t, 1e9, a.max_future);  // any other message: bag time only
+    Note(s, t, t, 1e9, a.max_future, index);  // any other message: bag time only
   }
 }
 
@@ -137,6 +159,16 @@ int Run(const BagCheckArgs& a) {
     throw std::invalid_argument("--clip-duration must be in (0, 3600] s, got " + std::to_string(a.clip_duration));
   if (!in(a.label_window, 86400))
     throw std::invalid_argument("--label-window must be in (0, 86400] s, got " + std::to_string(a.label_window));
+  {
+    // A file that is no bag at all: rosbag says "Error reading version line", which the repair
+    // hint below also matched.
+    std::FILE* f = std::fopen(a.bag.c_str(), "rb");
+    char head[13] = {};
+    const size_t n = f ? std::fread(head, 1, 12, f) : 0;
+    if (f) std::fclose(f);
+    if (f && (n < 12 || std::string(head, 12) != "#ROSBAG V2.0"))
+      throw std::runtime_error(a.bag + ": not a readable bag: not a rosbag file (it does not begin with \"#ROSBAG V2.0\")");
+  }
   try {
     return Check(a);
   } catch (const rosbag::BagException& e) {
@@ -167,7 +199,7 @@ int Check(const BagCheckArgs& a) {
       throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " of the bag (on " + m.getTopic() + ")" + " is " +
                                std::to_string(m.size()) + " bytes (a corrupt record?)");
     try {
-      NoteMessage(m, s, t, a, decoder);
+      NoteMessage(m, s, t, a, decoder, index);
     } catch (const ros::Exception& e) {
       throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " of the bag (on " + m.getTopic() + ")" + " (" +
                                m.getDataType() + ", bag time " + std::to_string(t) + " s) does not deserialise: " +
@@ -178,16 +210,22 @@ int Check(const BagCheckArgs& a) {
   std::printf("%s\n", a.bag.c_str());
   std::printf("  %-22s %-28s %7s %8s %8s %6s %6s %6s %6s  %s\n", "topic", "type", "count", "rate Hz", "span s",
               "back", "same", "holes", "bagt", "first");
-  std::vector<std::string> problems;  // none: ok for replay
+  std::vector<std::string> problems, warnings;  // no problems: ok for replay
   auto fail = [&](const std::string& why) { problems.push_back(why); };
+  auto warn = [&](const std::string& why) { warnings.push_back(why); };
   for (const auto& [name, s] : topics) {
     const double span = s.count > 1 ? s.last - s.first : 0.0;
     std::printf("  %-22s %-28s %7zu %8.2f %8.2f %6zu %6zu %6zu %6zu  %s\n", name.c_str(), s.type.c_str(), s.count,
                 span > 0 ? (s.count - 1) / span : 0.0, span, s.backwards, s.repeated, s.holes, s.bag_time_off,
                 s.first_data.c_str());
     const bool camera = name.find("image") != std::string::npos;
-    if (s.backwards > 0) fail(name + ": " + std::to_string(s.backwards) + " header stamps go back");
-    if (camera && s.repeated > 0) fail(name + ": " + std::to_string(s.repeated) + " frames repeat a stamp");
+    if (s.backwards > 0)
+      warn(name + ": " + std::to_string(s.backwards) + " header stamps go back (the first at " + s.first_backwards +
+           (camera ? "; a frame a little early is dropped, one more than the gap tolerance back restarts the clip)"
+                   : ")"));
+    if (camera && s.repeated > 0)
+      warn(name + ": " + std::to_string(s.repeated) + " frames repeat a stamp (the first at " + s.first_repeated +
+           "; the clip buffer drops them)");
     const bool replayed = std::find(std::begin(kReplayTopics), std::end(kReplayTopics), name) != std::end(kReplayTopics);
     if (!replayed) {
       fail(name + ": no replay node reads it, and replay.launch waits for a subscriber on every topic "
@@ -212,12 +250,16 @@ int Check(const BagCheckArgs& a) {
   if (wind != topics.end() && wind->second.count > 0 && wind->second.decoded == 0)
     fail("anemometer/raw: no sentence gives a wind reading (" + std::to_string(wind->second.undecoded) +
          " refused, the first: " + wind->second.first_error + ")");
-  // A clip ending at e is labelled by the readings in [e - label window, e]; clips end from the
-  // first frame + a clip's duration to the last frame.
-  if (camera != topics.end() && wind != topics.end() && camera->second.count > 0 && wind->second.count > 0 &&
-      (wind->second.first > camera->second.last ||
-       wind->second.last < camera->second.first + a.clip_duration - a.label_window))
-    fail("no anemometer/raw stamp falls in a clip's label window (the " + std::to_string(a.label_window) +
+  else if (wind != topics.end() && wind->second.decoded > 0 && std::isnan(wind->second.usable_first))
+    fail("anemometer/raw: every reading is void (the instrument's status V or error code, or a speed outside "
+         "0..150 m/s: " + std::to_string(wind->second.void_readings) + "), and the clip buffer labels no clip with one");
+  // A clip ending at e is labelled by the usable readings in [e - label window, e]; clips end from
+  // the first frame + a clip's duration to the last frame.
+  if (camera != topics.end() && wind != topics.end() && camera->second.count > 0 &&
+      !std::isnan(wind->second.usable_first) &&
+      (wind->second.usable_first > camera->second.last ||
+       wind->second.usable_last < camera->second.first + a.clip_duration - a.label_window))
+    fail("no usable anemometer/raw reading's stamp falls in a clip's label window (the " + std::to_string(a.label_window) +
          " s up to its last frame, over camera/image_raw's stamps): no clip gets a label");
   std::printf("  (back: header stamps going back; same: equal to the previous (fine for anemometer records of "
               "one serial read, not for camera frames); holes: camera intervals > %.3f s, which break clips; "
@@ -226,6 +268,10 @@ int Check(const BagCheckArgs& a) {
   if (wind != topics.end() && wind->second.undecoded > 0)
     std::printf("  anemometer/raw: %zu of %zu sentences refused (the first: %s)\n", wind->second.undecoded,
                 wind->second.count, wind->second.first_error.c_str());
+  if (wind != topics.end() && wind->second.void_readings > 0)
+    std::printf("  anemometer/raw: %zu of %zu readings void or out of range (no label from them)\n",
+                wind->second.void_readings, wind->second.count);
+  for (const std::string& w : warnings) std::printf("  warning: %s\n", w.c_str());
   for (const std::string& p : problems) std::printf("  NOT ok: %s\n", p.c_str());
   std::printf("  %s\n", problems.empty() ? "ok for replay" : "NOT ok for replay");
   return problems.empty() ? 0 : 1;

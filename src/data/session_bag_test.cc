@@ -316,8 +316,58 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
     return true;
   });
   EXPECT_EQ(check(lagging).first, 0) << check(lagging).second;
+  // One camera frame repeating its predecessor's stamp, and one 20 ms early (a driver's
+  // duplicate, a reordered frame): the nodes drop them and go on, so the bag is ok, with a
+  // warning naming the first of each. (Both were refused.)
+  const std::string hiccup = (dir / "hiccup.bag").string();
+  int frame = 0;
+  double previous = 0;
+  RewriteBag(good, hiccup, [&](auto& m) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(m)>, sensor_msgs::Image>) {
+      const double t = m.header.stamp.toSec();
+      if (frame == 50) m.header.stamp = ros::Time(previous);
+      if (frame == 80) m.header.stamp = ros::Time(previous - 0.02);
+      previous = t;
+      ++frame;
+    }
+    return true;
+  });
+  {
+    const auto [rc, out] = check(hiccup);
+    EXPECT_EQ(rc, 0) << out;
+    EXPECT_NE(out.find("warning: camera/image_raw: 1 frames repeat a stamp (the first at message"), std::string::npos)
+        << out;
+    EXPECT_NE(out.find("warning: camera/image_raw: 1 header stamps go back (the first at message"), std::string::npos)
+        << out;
+  }
+  // Every anemometer sentence flagged void (NMEA status V, its checksum right): decoded, and no
+  // clip labelled by any. (It passed as "ok for replay".)
+  const std::string void_bag = (dir / "void.bag").string();
+  RewriteBag(good, void_bag, [](auto& m) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(m)>, clothwind::RawSentence>) {
+      std::string body = m.data.substr(1, m.data.find('*') - 1);
+      const size_t status = body.rfind(",A");
+      if (status != std::string::npos) body[status + 1] = 'V';
+      unsigned sum = 0;
+      for (char c : body) sum ^= static_cast<unsigned char>(c);
+      char tail[8];
+      std::snprintf(tail, sizeof tail, "*%02X", sum);
+      m.data = "$" + body + tail + (m.data.size() > 2 && m.data.substr(m.data.size() - 2) == "\r\n" ? "\r\n" : "");
+    }
+    return true;
+  });
+  // A file that is no bag at all: said so, without the repair hint for a bag cut short.
+  const std::string text_file = (dir / "notes.bag").string();
+  std::ofstream(text_file) << "hello\n";
+  {
+    const auto [rc, out] = check(text_file);
+    EXPECT_NE(rc, 0) << out;
+    EXPECT_NE(out.find("not a rosbag file"), std::string::npos) << out;
+    EXPECT_EQ(out.find("rosbag reindex"), std::string::npos) << out;
+  }
   for (const Case& c : {Case{"ahead.bag", "ahead of their bag time"}, Case{"zero.bag", "stamped 0"},
                         Case{"checksum.bag", "no sentence gives a wind reading"},
+                        Case{"void.bag", "every reading is void"},
                         Case{"extra.bag", "wait:=false"}, Case{"slow.bag", "no stretch of frames without a hole"},
                         Case{"apart.bag", "falls in a clip's label window"},
                         Case{"after.bag", "falls in a clip's label window"},
