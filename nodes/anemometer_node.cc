@@ -278,9 +278,11 @@ class AnemometerNode {
     // A record stamped 0, or further ahead of the clock than a replay's latency explains, would be
     // republished as a reading with that stamp, which the clip buffer then refuses (counted
     // there, far from its cause): dropped here and said in this node's diagnostics.
+    // In double seconds: ros::Time's difference throws beyond 32 bits (a record stamped TIME_MAX
+    // ended the node, uncaught in its callback).
     const ros::Time now = ros::Time::now();
     const char* odd = msg->header.stamp.isZero() ? "stamped 0"
-                      : (!now.isZero() && (msg->header.stamp - now).toSec() > kMaxFutureStamp)
+                      : (!now.isZero() && msg->header.stamp.toSec() - now.toSec() > kMaxFutureStamp)
                           ? "stamped more than 5 s ahead of the clock"
                           : nullptr;
     if (odd) {

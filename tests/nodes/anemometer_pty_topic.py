@@ -118,7 +118,9 @@ class AnemometerTopicTest(unittest.TestCase):
         while time.time() < deadline and (pub.get_num_connections() == 0 or sub.get_num_connections() == 0):
             time.sleep(0.1)
         time.sleep(0.5)
-        for stamp in (rospy.Time(0, 0), rospy.Time.now() + rospy.Duration(3600), rospy.Time.now()):
+        # TIME_MAX too: its difference from now as a ros::Duration threw, and the node died.
+        for stamp in (rospy.Time(0, 0), rospy.Time.now() + rospy.Duration(3600),
+                      rospy.Time(4294967295, 999999999), rospy.Time.now()):
             m = RawSentence()
             m.header.stamp = stamp
             m.header.frame_id = 'recorded_frame'
@@ -130,7 +132,7 @@ class AnemometerTopicTest(unittest.TestCase):
         sub.unregister()
         self.assertEqual(len(winds), 1, [w.header.stamp.to_sec() for w in winds])  # the one stamped now
         status, values = self.diagnostics('topic:/replay_odd/anemometer/raw', count=1)
-        self.assertEqual(values['records dropped for their stamps'], '2')
+        self.assertEqual(values['records dropped for their stamps'], '3')
 
     def test_wind_kinds(self):
         # /replay's decoder already read test_replay_keeps_stamps' two Gill records (unittest runs
