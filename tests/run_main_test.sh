@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# `make run`'s job end to end (scripts/run-main), on a small procedural session in a folder of its
+# own: the session made and checked, replayed through the nodes with the shipped model and the
+# report, the report's summary and plot written, and run-main's exit status 0. replay_sdn.test
+# checks the estimates message by message but runs no report; nothing else ran run-main.
+#   tests/run_main_test.sh <build dir>
+set -euo pipefail
+build="$1"
+root="$(cd "$(dirname "$0")/.." && pwd)"
+out="$(mktemp -d /tmp/clothwind_run_main_test.XXXXXX)"
+trap 'rm -rf "$out"' EXIT
+fail() { echo "run_main_test: $*" >&2; tail -30 "$out/run-main.txt" >&2 || true; exit 1; }
+CLOTHWIND_SESSIONS="$out" CLOTHWIND_SESSION_FRAMES=procedural CLOTHWIND_SESSION_MINUTES=0.4 \
+  CLOTHWIND_SDN_THREADS=1 "$root/scripts/run-main" "$build" >"$out/run-main.txt" 2>&1 ||
+  fail "run-main exited $?"
+grep -q "ok for replay" "$out/run-main.txt" || fail "no bag-check verdict"
+grep -q "^estimate_report:" "$out/run-main.txt" || fail "no estimate report printed"
+/usr/bin/python3 - "$out/default-replay.json" "$out/default-estimates.png" <<'PY' || fail "summary check"
+import json, math, os, sys
+s = json.load(open(sys.argv[1]))
+e = s["estimates"]
+# 0.4 min at 30 fps, clips of 30 frames resampled to 25 fps: about 20 clips, every one labelled
+# (the session's anemometer reads throughout) and estimated once.
+assert s["total_clips"] >= 15, s["total_clips"]
+assert s["labelled_clips"] == s["total_clips"], (s["labelled_clips"], s["total_clips"])
+assert e["count"] == s["total_clips"], (e["count"], s["total_clips"])
+assert e["compared"] == e["count"], e
+assert math.isfinite(e["rmse"]) and 0 <= e["rmse"] < 5, e["rmse"]
+assert os.path.getsize(sys.argv[2]) > 1000, "no estimate plot"
+print("run_main_test: %d clips, estimate RMSE %.3f m/s" % (s["total_clips"], e["rmse"]))
+PY
