@@ -6,9 +6,14 @@
 //
 // "Over": the clock (sim time from rosbag play --clock) has not moved for ~idle_timeout wall
 // seconds after it started, and no clip has arrived in that time either (the clip buffer labels
-// its last waiting clips ~flush_after wall seconds after its input stops). ~max_wall bounds it;
+// its last waiting clips ~flush_after wall seconds after its input stops: ~idle_timeout is raised
+// to the clip buffer's clip_buffer/flush_after + 2 s when it is shorter). With ~estimates, while
+// clips still lack their estimate it waits up to ~estimate_wait (60 s) more (a model slower than
+// ~idle_timeout a clip had its backlog cut off), and says when the report ends with clips
+// unestimated. ~max_wall bounds it;
 // ~start_timeout gives up when the clock never starts. Interrupted (Ctrl-C), it still prints and
 // writes what it has; a file it cannot write is an error that does not cost the others.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -43,6 +48,7 @@ class ClipReport {
  public:
   explicit ClipReport(clothwind::ros_bridge::StrictParams& params) {
     idle_timeout_ = params.Get("idle_timeout", 5.0);
+    estimate_wait_ = params.Get("estimate_wait", 60.0);
     max_wall_ = params.Get("max_wall", 0.0);
     start_timeout_ = params.Get("start_timeout", 60.0);
     summary_path_ = params.Get("summary", "");
@@ -51,6 +57,17 @@ class ClipReport {
     auto finite = [](double v) { return std::isfinite(v); };
     if (!(finite(idle_timeout_) && idle_timeout_ > 0))
       throw std::invalid_argument("~idle_timeout must be a finite time > 0 s, got " + std::to_string(idle_timeout_));
+    if (!(finite(estimate_wait_) && estimate_wait_ >= 0))
+      throw std::invalid_argument("~estimate_wait must be a finite time >= 0 s, got " + std::to_string(estimate_wait_));
+    // The clip buffer flushes its last clips ~flush_after wall seconds after its input stops; a
+    // report over before that left them out, silently.
+    double flush_after = 0;
+    if (ros::param::get("clip_buffer/flush_after", flush_after) && std::isfinite(flush_after) &&
+        idle_timeout_ < flush_after + 2.0) {
+      std::printf("clip_report: ~idle_timeout %.1f s raised to %.1f s: clip_buffer/flush_after is %.1f s\n",
+                  idle_timeout_, flush_after + 2.0, flush_after);
+      idle_timeout_ = flush_after + 2.0;
+    }
     if (!(finite(start_timeout_) && start_timeout_ > 0))
       throw std::invalid_argument("~start_timeout must be a finite time > 0 s, got " + std::to_string(start_timeout_));
     if (!(finite(max_wall_) && max_wall_ >= 0))
@@ -138,14 +155,29 @@ class ClipReport {
                    start_timeout_);
       Print(wall);
       ros::shutdown();
-    } else if ((clock_started_ && idle > idle_timeout_) || (max_wall_ > 0 && wall > max_wall_)) {
-      if (!(clock_started_ && idle > idle_timeout_))
+    } else if ((clock_started_ && idle > IdleLimit()) || (max_wall_ > 0 && wall > max_wall_)) {
+      if (!(clock_started_ && idle > IdleLimit()))
         std::printf("clip_report: stopped after ~max_wall = %.0f s, the replay still running: the report covers "
                     "only what came before\n", max_wall_);
       Print(wall);
       ros::shutdown();
     }
   }
+
+  // Clips that have come without their estimate (with ~estimates).
+  size_t Unestimated() const {
+    if (!want_estimates_) return 0;
+    std::vector<uint64_t> seen;
+    for (const auto& e : estimates_) seen.push_back(e.sequence);
+    std::sort(seen.begin(), seen.end());
+    size_t missing = 0;
+    for (const Row& r : rows_) missing += !std::binary_search(seen.begin(), seen.end(), r.sequence);
+    return missing;
+  }
+
+  // How long the replay must have been idle to be over: ~idle_timeout, and ~estimate_wait more
+  // while clips still lack their estimate (sdn_node working through its queue).
+  double IdleLimit() const { return idle_timeout_ + (Unestimated() > 0 ? estimate_wait_ : 0.0); }
 
   // Prints and writes the report once (from the timer, or after spin() when interrupted).
   // Returns false when a file could not be written.
@@ -158,6 +190,9 @@ class ClipReport {
  private:
   bool Print(double wall) {
     printed_ = true;
+    if (const size_t missing = Unestimated())
+      std::printf("clip_report: %zu of %zu clips have no estimate (sdn_node still working, or it refused them): "
+                  "the estimates' report covers the others\n", missing, rows_.size());
     std::printf("\nclip_report: %zu clip(s) from the replay\n", rows_.size());
     std::printf("%5s  %-12s  %-12s  %6s  %7s  %9s  %8s  %8s  %5s  %8s\n", "seq", "start [s]", "end [s]",
                 "frames", "span", "dt err", "wind m/s", "std", "count", "dir rad");
@@ -218,7 +253,7 @@ class ClipReport {
     return ok_;
   }
 
-  double idle_timeout_ = 5.0, max_wall_ = 0.0, start_timeout_ = 60.0;
+  double idle_timeout_ = 5.0, max_wall_ = 0.0, start_timeout_ = 60.0, estimate_wait_ = 60.0;
   std::string summary_path_, estimate_plot_path_;
   bool want_estimates_ = false;
   ros::Subscriber sub_, estimate_sub_;
