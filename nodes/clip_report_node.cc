@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -32,6 +33,7 @@
 #include "ros_bridge/strict_param.h"
 #include "sensors/dataset_writer.h"
 #include "sensors/estimate_report.h"
+#include "sensors/replay_end.h"
 
 namespace {
 
@@ -76,13 +78,19 @@ class ClipReport {
     ros::NodeHandle nh;
     sub_ = nh.subscribe("clips", 50, &ClipReport::OnClip, this);
     if (want_estimates_) estimate_sub_ = nh.subscribe("wind/estimate", 50, &ClipReport::OnEstimate, this);
-    start_wall_ = last_change_ = ros::WallTime::now();
+    start_wall_ = ros::WallTime::now();
+    clothwind::sensors::ReplayEndOptions end_options;
+    end_options.idle_timeout = idle_timeout_;
+    end_options.estimate_wait = estimate_wait_;
+    end_options.max_wall = max_wall_;
+    end_options.start_timeout = start_timeout_;
+    end_.emplace(end_options, start_wall_.toSec());
     timer_ = nh.createWallTimer(ros::WallDuration(0.5), &ClipReport::OnTimer, this);
   }
 
  private:
   void OnClip(const clothwind::Clip::ConstPtr& c) {
-    last_change_ = ros::WallTime::now();
+    end_->Activity(ros::WallTime::now().toSec());
     Row r{};
     r.sequence = c->sequence;
     r.frames = c->num_frames;
@@ -106,7 +114,7 @@ class ClipReport {
   }
 
   void OnEstimate(const clothwind::WindEstimate::ConstPtr& e) {
-    last_change_ = ros::WallTime::now();
+    end_->Activity(ros::WallTime::now().toSec());
     estimates_.push_back({e->clip_sequence, e->clip_end.toSec(), e->speed, e->speed_std, e->reference_speed,
                           e->latency});
   }
@@ -142,26 +150,25 @@ class ClipReport {
   }
 
   void OnTimer(const ros::WallTimerEvent&) {
-    const ros::Time now = ros::Time::now();
-    if (now != last_clock_) {
-      last_clock_ = now;
-      last_change_ = ros::WallTime::now();
-      clock_started_ = clock_started_ || !now.isZero();
-    }
-    const double idle = (ros::WallTime::now() - last_change_).toSec();
-    const double wall = (ros::WallTime::now() - start_wall_).toSec();
-    if (!clock_started_ && wall > start_timeout_) {
-      std::fprintf(stderr, "clip_report: the clock never started in %.0f s (is rosbag play waiting for a subscriber?)\n",
-                   start_timeout_);
-      Print(wall);
-      ros::shutdown();
-    } else if ((clock_started_ && idle > IdleLimit()) || (max_wall_ > 0 && wall > max_wall_)) {
-      if (!(clock_started_ && idle > IdleLimit()))
+    const double wall_now = ros::WallTime::now().toSec();
+    end_->Clock(ros::Time::now().toSec(), wall_now);
+    const double wall = wall_now - start_wall_.toSec();
+    switch (end_->Check(wall_now, Unestimated())) {
+      case clothwind::sensors::ReplayVerdict::kRunning:
+        return;
+      case clothwind::sensors::ReplayVerdict::kNoClock:
+        std::fprintf(stderr, "clip_report: the clock never started in %.0f s (is rosbag play waiting for a subscriber?)\n",
+                     start_timeout_);
+        break;
+      case clothwind::sensors::ReplayVerdict::kMaxWall:
         std::printf("clip_report: stopped after ~max_wall = %.0f s, the replay still running: the report covers "
                     "only what came before\n", max_wall_);
-      Print(wall);
-      ros::shutdown();
+        break;
+      case clothwind::sensors::ReplayVerdict::kOver:
+        break;
     }
+    Print(wall);
+    ros::shutdown();
   }
 
   // Clips that have come without their estimate (with ~estimates).
@@ -174,10 +181,6 @@ class ClipReport {
     for (const Row& r : rows_) missing += !std::binary_search(seen.begin(), seen.end(), r.sequence);
     return missing;
   }
-
-  // How long the replay must have been idle to be over: ~idle_timeout, and ~estimate_wait more
-  // while clips still lack their estimate (sdn_node working through its queue).
-  double IdleLimit() const { return idle_timeout_ + (Unestimated() > 0 ? estimate_wait_ : 0.0); }
 
   // Prints and writes the report once (from the timer, or after spin() when interrupted).
   // Returns false when a file could not be written.
@@ -259,9 +262,9 @@ class ClipReport {
   ros::Subscriber sub_, estimate_sub_;
   std::vector<clothwind::sensors::EstimateRow> estimates_;
   ros::WallTimer timer_;
-  ros::WallTime start_wall_, last_change_;
-  ros::Time last_clock_;
-  bool clock_started_ = false, printed_ = false, ok_ = true;
+  ros::WallTime start_wall_;
+  std::optional<clothwind::sensors::ReplayEnd> end_;  // when the replay is over (sensors/replay_end.h)
+  bool printed_ = false, ok_ = true;
   std::vector<Row> rows_;
   double rate_ = 0.0, window_ = 0.0;
 };
