@@ -3,11 +3,13 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -82,9 +84,19 @@ TEST(MaterialTest, BendingInterpolatesDirectionAndCurvature) {
   EXPECT_NEAR(m.BendingStiffness(1e3, {1, 0}), b(0, 4), 1e-15);      // clamped beyond 40 1/m
 }
 
+// The files WriteText wrote, removed when the test program ends (each run left 16 in /tmp).
+struct WrittenFiles {
+  std::vector<std::string> paths;
+  ~WrittenFiles() {
+    for (const std::string& p : paths) std::remove(p.c_str());
+  }
+};
+WrittenFiles written_files;
+
 std::string WriteText(const std::string& name, const std::string& text) {
   const std::string path = ::testing::TempDir() + "/clothwind_material_test_" + std::to_string(::getpid()) + "_" + name;
   std::ofstream(path) << text;
+  written_files.paths.push_back(path);
   return path;
 }
 
