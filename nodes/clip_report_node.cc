@@ -8,9 +8,9 @@
 // seconds after it started, and no clip has arrived in that time either (the clip buffer labels
 // its last waiting clips ~flush_after wall seconds after its input stops: ~idle_timeout is raised
 // to the clip buffer's clip_buffer/flush_after + 2 s when it is shorter). With ~estimates, while
-// clips still lack their estimate it waits up to ~estimate_wait (60 s) more (a model slower than
-// ~idle_timeout a clip had its backlog cut off), and says when the report ends with clips
-// unestimated. ~max_wall bounds it;
+// clips still lack their estimate it waits longer, by twice the model's slowest pace so far, at
+// most ~estimate_wait (60 s) more (a model slower than ~idle_timeout a clip had its backlog cut
+// off; sensors/replay_end.h), and says when the report ends with clips unestimated. ~max_wall bounds it;
 // ~start_timeout gives up when the clock never starts. Interrupted (Ctrl-C), it still prints and
 // writes what it has; a file it cannot write is an error that does not cost the others.
 #include <algorithm>
@@ -114,7 +114,7 @@ class ClipReport {
   }
 
   void OnEstimate(const clothwind::WindEstimate::ConstPtr& e) {
-    end_->Activity(ros::WallTime::now().toSec());
+    end_->Estimate(ros::WallTime::now().toSec());
     estimates_.push_back({e->clip_sequence, e->clip_end.toSec(), e->speed, e->speed_std, e->reference_speed,
                           e->latency});
   }

@@ -13,7 +13,7 @@ fail() { echo "run_main_test: $*" >&2; tail -30 "$out/run-main.txt" >&2 || true;
 CLOTHWIND_SESSIONS="$out" CLOTHWIND_SESSION_FRAMES=procedural CLOTHWIND_SESSION_MINUTES=0.4 \
   CLOTHWIND_SDN_THREADS=1 "$root/scripts/run-main" "$build" >"$out/run-main.txt" 2>&1 ||
   fail "run-main exited $?"
-grep -q "ok for replay" "$out/run-main.txt" || fail "no bag-check verdict"
+grep -qx "  ok for replay" "$out/run-main.txt" || fail "bag-check did not say ok for replay"
 grep -q "^estimate_report:" "$out/run-main.txt" || fail "no estimate report printed"
 /usr/bin/python3 - "$out/default-replay.json" "$out/default-estimates.png" <<'PY' || fail "summary check"
 import json, math, os, sys

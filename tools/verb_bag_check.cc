@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -63,6 +64,8 @@ struct TopicStats {
   double first = NAN, last = NAN, previous = NAN;
   size_t backwards = 0;       // header stamp before the previous one
   std::string first_backwards, first_repeated;  // where the first of each is: "message N (bag time T s)"
+  std::optional<double> held;  // a camera frame more than the tolerance back, waiting for the next
+  size_t stale = 0;            // such frames the next did not follow: lone stale stamps, dropped
   size_t repeated = 0;        // header stamp equal to the previous one (records of one serial read
                               // share it; camera frames must not: the clip buffer drops them)
   size_t bag_time_off = 0;    // |bag time - header stamp| > 1 ms
@@ -83,28 +86,44 @@ struct TopicStats {
 
 void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, double max_future, size_t index) {
   if (stamp == 0) ++s.zero;
-  if (s.count == 0) s.first = s.run_start = stamp;
-  if (s.count > 0) {
-    const double dt = stamp - s.previous;
-    char where[96];
-    std::snprintf(where, sizeof where, "message %zu (bag time %.3f s)", index, bag_time);
-    if (dt < 0 && s.backwards++ == 0) s.first_backwards = where;
-    if (dt == 0 && s.repeated++ == 0) s.first_repeated = where;
-    // A step back within the tolerance is a frame the resampler drops, no hole; a longer one
-    // restarts the clip buffer's clip as a hole does.
-    if (dt > gap_tolerance || dt < -gap_tolerance) {
-      ++s.holes;
-      s.run_start = stamp;
-    }
-    s.widest = std::max(s.widest, dt);
-  }
-  s.longest_run = std::max(s.longest_run, stamp - s.run_start);
   if (std::fabs(bag_time - stamp) > 1e-3) ++s.bag_time_off;
   if (stamp - bag_time > max_future) ++s.far_from_bag_time;
-  // A message a little early is dropped by the nodes: the next is compared with the one before it.
-  if (s.count == 0 || !(stamp < s.previous && stamp >= s.previous - gap_tolerance)) s.previous = stamp;
   s.last = std::max(std::isnan(s.last) ? stamp : s.last, stamp);
-  ++s.count;
+  if (s.count++ == 0) {
+    s.first = s.run_start = s.previous = stamp;
+    return;
+  }
+  // Camera frames (a finite tolerance) follow the clip pipeline's rules: a frame a little early is
+  // dropped by the resampler (no hole); one more than the tolerance back waits for the next, which
+  // either follows it (the stream went back: a new timeline from it, a hole) or does not (a lone
+  // stale frame, dropped, the run going on).
+  const bool frames = gap_tolerance < 1e9;
+  if (frames && s.held) {
+    const double held = *s.held;
+    s.held.reset();
+    if (stamp >= held && stamp - held <= gap_tolerance) {
+      ++s.holes;
+      s.run_start = s.previous = held;
+    } else {
+      ++s.stale;
+    }
+  }
+  const double dt = stamp - s.previous;
+  char where[96];
+  std::snprintf(where, sizeof where, "message %zu (bag time %.3f s)", index, bag_time);
+  if (dt < 0 && s.backwards++ == 0) s.first_backwards = where;
+  if (dt == 0 && s.repeated++ == 0) s.first_repeated = where;
+  if (frames && dt < -gap_tolerance) {
+    s.held = stamp;
+    return;
+  }
+  if (dt > gap_tolerance) {
+    ++s.holes;
+    s.run_start = stamp;
+  }
+  s.widest = std::max(s.widest, dt);
+  s.longest_run = std::max(s.longest_run, stamp - s.run_start);
+  if (!frames || dt >= 0) s.previous = stamp;
 }
 
 // Counts one message into its topic's stats (ros::Exception when its bytes do not deserialise).
@@ -166,8 +185,8 @@ int Run(const BagCheckArgs& a) {
     char head[13] = {};
     const size_t n = f ? std::fread(head, 1, 12, f) : 0;
     if (f) std::fclose(f);
-    if (f && (n < 12 || std::string(head, 12) != "#ROSBAG V2.0"))
-      throw std::runtime_error(a.bag + ": not a readable bag: not a rosbag file (it does not begin with \"#ROSBAG V2.0\")");
+    if (f && (n < 9 || std::string(head, 9) != "#ROSBAG V"))  // V2.0; rosbag still reads V1.2
+      throw std::runtime_error(a.bag + ": not a readable bag: not a rosbag file (it does not begin with \"#ROSBAG V\")");
   }
   try {
     return Check(a);
@@ -221,7 +240,8 @@ int Check(const BagCheckArgs& a) {
     const bool camera = name.find("image") != std::string::npos;
     if (s.backwards > 0)
       warn(name + ": " + std::to_string(s.backwards) + " header stamps go back (the first at " + s.first_backwards +
-           (camera ? "; a frame a little early is dropped, one more than the gap tolerance back restarts the clip)"
+           (camera ? "; a frame a little early is dropped; one more than the gap tolerance back is dropped as stale (" +
+                         std::to_string(s.stale) + " here) unless the next follows it, a new timeline)"
                    : ")"));
     if (camera && s.repeated > 0)
       warn(name + ": " + std::to_string(s.repeated) + " frames repeat a stamp (the first at " + s.first_repeated +

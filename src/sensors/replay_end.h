@@ -10,7 +10,7 @@ namespace clothwind::sensors {
 
 struct ReplayEndOptions {
   double idle_timeout = 5.0;    // [s, wall] the clock and the inputs still this long: over
-  double estimate_wait = 60.0;  // [s, wall] longer still while clips lack their estimate
+  double estimate_wait = 60.0;  // [s, wall] at most this much longer while clips lack their estimate
   double max_wall = 0.0;        // [s, wall] over after this long anyway; 0: no bound
   double start_timeout = 60.0;  // [s, wall] the clock never started this long: give up
 };
@@ -30,13 +30,17 @@ class ReplayEnd {
   // The clock read at wall time `wall` (0: not started, as ROS time before /clock). A change
   // counts as activity.
   void Clock(double clock, double wall);
-  // A clip or an estimate came at wall time `wall`.
+  // A clip came at wall time `wall`.
   void Activity(double wall) { last_change_ = wall; }
+  // An estimate came at wall time `wall`: activity, and the model's pace.
+  void Estimate(double wall);
 
   // Whether the replay is over at wall time `wall`, with `unestimated` clips still lacking their
-  // estimate (0 without a model): idle for idle_timeout, plus estimate_wait while some lack one
-  // (sdn_node working through its queue: a model slower than idle_timeout a clip had its backlog
-  // cut off).
+  // estimate (0 without a model): idle for idle_timeout, and while some lack one, longer by
+  // twice the longest wait between two estimates so far (sdn_node working through its queue: a
+  // model slower than idle_timeout a clip had its backlog cut off), estimate_wait before two
+  // estimates have come and at most. A fast model's refused clips (malformed, no model yet) so
+  // cost seconds, not a minute.
   ReplayVerdict Check(double wall, std::size_t unestimated) const;
 
   const ReplayEndOptions& options() const { return options_; }
@@ -44,6 +48,8 @@ class ReplayEnd {
  private:
   ReplayEndOptions options_;
   double start_, last_change_, last_clock_ = 0.0;
+  double last_estimate_ = 0.0, longest_estimate_gap_ = 0.0;
+  int estimates_ = 0;
   bool started_ = false;
 };
 

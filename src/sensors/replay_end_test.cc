@@ -24,18 +24,26 @@ TEST(ReplayEndTest, OverOnceTheClockAndTheInputsStandStill) {
   EXPECT_EQ(end.Check(18.1, 0), ReplayVerdict::kOver);
 }
 
-// sdn_node still working through its queue: the report waits up to estimate_wait more for the
-// estimates (a model slower than idle_timeout a clip had its backlog cut off), each estimate
-// holding it off again.
-TEST(ReplayEndTest, ClipsWithoutTheirEstimateAreWaitedFor) {
+// sdn_node still working through its queue: a model taking 8 s a clip (slower than idle_timeout,
+// whose backlog was cut off) is waited for, twice its pace after each estimate; a fast model's
+// refused clip costs two of its (short) gaps; before two estimates, estimate_wait.
+TEST(ReplayEndTest, ClipsWithoutTheirEstimateAreWaitedForAtTheModelsPace) {
   ReplayEndOptions o;
   o.estimate_wait = 30.0;
-  ReplayEnd end = Played(o);
-  EXPECT_EQ(end.Check(16.0, 3), ReplayVerdict::kRunning);
-  end.Activity(20.0);  // one more estimate
-  EXPECT_EQ(end.Check(50.0, 2), ReplayVerdict::kRunning);
-  EXPECT_EQ(end.Check(55.1, 2), ReplayVerdict::kOver);  // 20 + 5 + 30: the rest never came
-  EXPECT_EQ(end.Check(25.1, 0), ReplayVerdict::kOver);  // all in: idle_timeout alone
+  ReplayEnd slow = Played(o);
+  slow.Estimate(4.0);
+  EXPECT_EQ(slow.Check(16.0, 3), ReplayVerdict::kRunning);  // one estimate: estimate_wait
+  slow.Estimate(12.0);
+  slow.Estimate(20.0);
+  EXPECT_EQ(slow.Check(40.9, 2), ReplayVerdict::kRunning);  // 20 + 5 + 2 x 8
+  EXPECT_EQ(slow.Check(41.1, 2), ReplayVerdict::kOver);     // the rest never came
+  EXPECT_EQ(slow.Check(25.1, 0), ReplayVerdict::kOver);     // all in: idle_timeout alone
+  ReplayEnd fast = Played(o);
+  for (double wall = 2.0; wall <= 10.0; wall += 0.6) fast.Estimate(wall);
+  EXPECT_EQ(fast.Check(16.4, 1), ReplayVerdict::kOver);     // 9.8 + 5 + 1.2: one clip refused
+  ReplayEnd none = Played(o);
+  EXPECT_EQ(none.Check(44.0, 1), ReplayVerdict::kRunning);  // the model still loading
+  EXPECT_EQ(none.Check(45.1, 1), ReplayVerdict::kOver);     // 10 + 5 + 30
 }
 
 TEST(ReplayEndTest, MaxWallAndAClockThatNeverStarts) {

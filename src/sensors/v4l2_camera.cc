@@ -39,10 +39,13 @@ std::string DescribeNegotiated(const V4l2Negotiated& n) {
 
 std::string DescribeExposure(const V4l2Negotiated& n) {
   if (n.exposure_auto < 0) return "unknown (no exposure control)";
-  if (n.exposure_auto != V4L2_EXPOSURE_MANUAL) return "auto (mode " + std::to_string(n.exposure_auto) + ")";
-  if (n.exposure_s <= 0) return "manual (time not readable)";
-  char text[48];
-  std::snprintf(text, sizeof text, "manual %.4f s", n.exposure_s);
+  const bool shutter = n.exposure_auto == V4L2_EXPOSURE_SHUTTER_PRIORITY;
+  if (n.exposure_auto != V4L2_EXPOSURE_MANUAL && !shutter)
+    return "auto (mode " + std::to_string(n.exposure_auto) + ")";
+  const char* kind = shutter ? "shutter priority" : "manual";
+  if (n.exposure_s <= 0) return std::string(kind) + " (time not readable)";
+  char text[64];
+  std::snprintf(text, sizeof text, "%s %.4f s", kind, n.exposure_s);
   return text;
 }
 
@@ -298,7 +301,13 @@ void V4l2Camera::ReadBackExposure() {
   mode.id = V4L2_CID_EXPOSURE_AUTO;
   if (io_->Ioctl(fd_, VIDIOC_G_CTRL, &mode) < 0) return;
   negotiated_.exposure_auto = mode.value;
-  if (mode.value != V4L2_EXPOSURE_MANUAL) return;
+  const bool manual_asked = options_.auto_exposure == 0 || (options_.exposure_absolute >= 0 && options_.auto_exposure < 0);
+  if (manual_asked && mode.value != V4L2_EXPOSURE_MANUAL) {
+    Log(LogLevel::kWarn, options_.device + ": manual exposure was asked for, the driver holds " +
+                             DescribeExposure(negotiated_));
+  }
+  // A fixed exposure time: manual, or shutter priority (the camera varies the aperture).
+  if (mode.value != V4L2_EXPOSURE_MANUAL && mode.value != V4L2_EXPOSURE_SHUTTER_PRIORITY) return;
   v4l2_control time{};
   time.id = V4L2_CID_EXPOSURE_ABSOLUTE;
   if (io_->Ioctl(fd_, VIDIOC_G_CTRL, &time) < 0 || time.value <= 0) return;

@@ -45,7 +45,7 @@ struct V4l2Negotiated {
   std::string driver, card, bus;  // VIDIOC_QUERYCAP strings
   // Exposure as the driver holds it after the controls were applied (VIDIOC_G_CTRL):
   int exposure_auto = -1;   // V4L2_CID_EXPOSURE_AUTO's value; -1 when the camera has no such control
-  double exposure_s = 0;    // manual exposure time [s]; 0 when automatic or not readable
+  double exposure_s = 0;    // fixed exposure time [s] (manual or shutter priority); 0 when automatic or not readable
 };
 
 // Counters for diagnostics.
@@ -154,7 +154,7 @@ class V4l2Camera : public FrameSource {
 
 // Formats a V4L2 negotiation for logs, e.g. "640x480 YUYV @30 fps, 4 buffers".
 std::string DescribeNegotiated(const V4l2Negotiated& n);
-// "manual 0.0150 s", "auto (mode 3)", or "unknown (no exposure control)".
+// "manual 0.0150 s", "shutter priority 0.0100 s", "auto (mode 3)", or "unknown (no exposure control)".
 std::string DescribeExposure(const V4l2Negotiated& n);
 
 }  // namespace sensors

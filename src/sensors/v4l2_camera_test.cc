@@ -339,6 +339,13 @@ TEST(V4l2CameraTest, ALongManualExposureIsASlowCameraNotALostOne) {
   ASSERT_TRUE(rig2.camera.Open());
   EXPECT_EQ(rig2.camera.Status().at("exposure"), "auto (mode 3)");
   EXPECT_NEAR(std::stod(rig2.camera.Status().at("loss timeout [s]")), 2.0, 1e-9);
+  // Manual asked, a driver that stays in aperture priority (its menu has no manual): said so.
+  FakeV4l2Config no_manual = config;
+  no_manual.controls[V4L2_CID_EXPOSURE_AUTO] = {3, 3, 3, V4L2_CTRL_TYPE_MENU};
+  Rig rig3(no_manual, options);
+  ASSERT_TRUE(rig3.camera.Open());
+  EXPECT_TRUE(rig3.Warned("manual exposure was asked for, the driver holds auto (mode 3)"));
+  EXPECT_NEAR(std::stod(rig3.camera.Status().at("loss timeout [s]")), 5.0 / 15, 1e-6);  // no fixed exposure
 }
 
 TEST(V4l2CameraTest, CloseReleasesEverything) {
