@@ -77,6 +77,9 @@ int Run(const SimulateArgs& a) {
   if (!a.wind.empty()) {
     const auto v = ParseList(a.wind, 3, "--wind");
     setup.wind.velocity = Eigen::Vector3d(v[0], v[1], v[2]);
+    // The scene reader's bound (3x the speed of sound); stableNorm: 1e200 squared is infinite.
+    if (!(setup.wind.velocity.stableNorm() <= 1000))
+      throw std::invalid_argument("--wind: expected a speed of at most 1000 m/s, got " + a.wind);
   }
   if (!a.turbulence.empty()) {
     const auto v = ParseList(a.turbulence, 2, "--turbulence");

@@ -488,6 +488,17 @@ void ClothSimulator::Impl::Solve() {
   }
   stats.cg_iterations = it;
   stats.cg_relative_residual = rel;
+  // Worse than no step at all (dv = 0 has residual 1): the solve diverged, and the step it would
+  // take is noise (an area weight far below the forces' scale). Accepted, it surfaced only later
+  // as a vertex too fast, naming no cause.
+  if (rel > 1.0) {
+    char what[200];
+    std::snprintf(what, sizeof(what),
+                  "the linear solve diverged: relative residual %.3g after %d CG iterations (masses far below the "
+                  "forces' scale: area weight, wind or stiffness out of range for this time step)",
+                  rel, it);
+    BlowUp(steps + 1, what);
+  }
 }
 
 // Records (failure) and throws when the state has blown up: non-finite, or faster than

@@ -49,7 +49,7 @@ Theta ThetaFrom(const Material& material, const WindSpec& wind) {
   for (int d = 0; d < 3; ++d) {
     for (int c = 0; c < 5; ++c) theta[kBendingIndex + 5 * d + c] = material.bending[d][c];
   }
-  theta[kWindSpeedIndex] = wind.velocity.norm();
+  theta[kWindSpeedIndex] = wind.velocity.stableNorm();  // norm() overflowed to inf for 1e200
   return theta;
 }
 
