@@ -9,11 +9,13 @@
 #include <vector>
 #include <algorithm>
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <Eigen/SVD>
 #include <gtest/gtest.h>
 
 #include "common/random.h"
+#include "sim/cloth_forces.h"
 #include "sim/test_expect_throw.h"
 
 namespace clothwind::sim {
@@ -700,6 +702,65 @@ TEST(ClothSimulatorTest, ALinearSystemBeyondDoubleRangeThrowsInsteadOfFreezingTh
     ExpectThrowContaining([&] { sim.Step(); }, c.says);  // stays failed, naming the cause
     EXPECT_TRUE(sim.positions() == m.V);  // (the solve failed before the step moved anything)
   }
+}
+
+// The simulator's bending on one hinge against ArcSim's formula evaluated by hand: the stiffness
+// read from a table that varies along both axes, at the hinge's curvature |theta| l / (A0 + A1)
+// and its edge's direction in material space (U, here rotated 30 degrees against the world's),
+// then BendingForce with it. The assembled finite-difference tests use a constant bending, and
+// Energy() repeats the simulator's expression, so a wrong scale (l dropped, 2A, the direction
+// taken from V instead of U) passed every test.
+TEST(ClothSimulatorTest, BendingReadsTheTableAtTheHingesCurvatureAndDirection) {
+  Eigen::Matrix<double, 6, 4> stretching;
+  stretching << 30, 5, 45, 30,  //
+      80, 25, 260, 28, 70, 75, 180, 10, 110, 55, 175, 45, 145, 110, 140, 5, 145, 50, 190, 40;
+  Eigen::Matrix<double, 3, 5> table;
+  table << 1e-5, 2e-5, 4e-5, 8e-5, 16e-5,  //
+      3e-5, 5e-5, 7e-5, 9e-5, 11e-5,        //
+      20e-5, 15e-5, 10e-5, 5e-5, 2e-5;
+  const Material material = MakeMaterial(0.284, stretching, table);
+  // A 0.1 m square in material space, rotated 30 degrees, split along its diagonal 0-2 (the hinge).
+  const double side = 0.1, turn = M_PI / 6;
+  const Eigen::Matrix2d R = Eigen::Rotation2Dd(turn).toRotationMatrix();
+  Mesh m;
+  m.U.resize(4, 2);
+  const Eigen::Vector2d corners[4] = {{0, 0}, {side, 0}, {side, side}, {0, side}};
+  for (int i = 0; i < 4; ++i) m.U.row(i) = (R * corners[i]).transpose();
+  m.F.resize(2, 3);
+  m.F << 0, 1, 2, 0, 2, 3;
+  // In the world: face (0, 1, 2) flat in z = 0 as in U; face (0, 2, 3) folded about the diagonal
+  // by 1 rad (edge lengths kept: no stretching).
+  m.V.resize(4, 3);
+  for (int i = 0; i < 3; ++i) m.V.row(i) << m.U(i, 0), m.U(i, 1), 0;
+  const Eigen::Vector3d a(m.U(0, 0), m.U(0, 1), 0), c(m.U(2, 0), m.U(2, 1), 0), d(m.U(3, 0), m.U(3, 1), 0);
+  const Eigen::Vector3d axis = (c - a).normalized();
+  m.V.row(3) = (a + Eigen::AngleAxisd(1.0, axis) * (d - a)).transpose();
+  // The whole cloth turned in space (bending does not change): the edge's direction in the world
+  // is not its direction in U.
+  const Eigen::Matrix3d Q = Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.3, 0.5, 0.8).normalized()).toRotationMatrix();
+  for (int i = 0; i < 4; ++i) m.V.row(i) = (Q * m.V.row(i).transpose()).transpose();
+  SimOptions o = QuietOptions();
+  o.gravity.setZero();
+  ClothSimulator sim(m, material, o, nullptr);
+  const Eigen::MatrixX3d f = sim.Forces();
+
+  Vector12d x;
+  x << m.V.row(0).transpose(), m.V.row(2).transpose(), m.V.row(1).transpose(), m.V.row(3).transpose();
+  const double theta = DihedralAngle(x);
+  ASSERT_NEAR(std::abs(theta), 1.0, 1e-9);
+  const double l = std::sqrt(2.0) * side, areas = side * side;
+  const Eigen::Vector2d du = (m.U.row(2) - m.U.row(0)).transpose();
+  const double ke = material.BendingStiffness(std::abs(theta) * l / areas, du);
+  const Vector12d expected = BendingForce(x, ke, l, areas, 0.0).force;
+  const int order[4] = {0, 2, 1, 3};
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d want = expected.segment<3>(3 * k), got = f.row(order[k]).transpose();
+    EXPECT_LT((got - want).norm(), 1e-9 * expected.norm()) << "vertex " << order[k] << ": " << got.transpose()
+                                                             << " against " << want.transpose();
+  }
+  // The table's variation matters here: another direction or curvature reads another stiffness.
+  EXPECT_GT(std::abs(material.BendingStiffness(std::abs(theta) * l / areas, Eigen::Vector2d(1, 0)) - ke), 0.05 * ke);
+  EXPECT_GT(std::abs(material.BendingStiffness(2 * std::abs(theta) * l / areas, du) - ke), 0.05 * ke);
 }
 
 TEST(ClothSimulatorTest, DeterministicAcrossInstancesAndThreads) {
