@@ -64,16 +64,23 @@ TEST(FlagBehaviour, ArcSimFlagDroopsLessAndFlapsFasterAsWindRises) {
                 << " m, vertical RMS " << m[i].vertical_rms << " m, frequency " << m[i].dominant_hz
                 << " Hz (peak " << m[i].peak_hz << " Hz), wall " << t.wall_seconds << " s\n";
     }
-    // Droop: ~80 / ~52 / ~10 deg in ArcSim; tolerance +-15 deg at 1 and 3 m/s, +-10 at 10 m/s.
-    EXPECT_NEAR(m[0].droop_deg, 80.0, 15.0);
-    EXPECT_NEAR(m[1].droop_deg, 52.0, 15.0);
-    EXPECT_NEAR(m[2].droop_deg, 10.0, 10.0);
+    // Droop: ~80 / 52-54 / 10-12 deg in ArcSim. The windows are as wide as can still tell a wind
+    // load twice or half ArcSim's: with the scene's wind density doubled the flag droops 72.9 /
+    // 40.7 / 4.9 deg, halved 75.5 deg at 3 m/s (review, stop 72); ours 78.7 / 52.0 / 9.6 (485
+    // vertices). They were +-15 / +-15 / +-10, which passed a doubled load.
+    EXPECT_NEAR(m[0].droop_deg, 80.0, 6.0);
+    EXPECT_NEAR(m[1].droop_deg, 53.0, 7.0);
+    EXPECT_NEAR(m[2].droop_deg, 11.0, 4.5);
     EXPECT_GT(m[0].droop_deg - m[1].droop_deg, 10.0);  // falls steeply with wind
     EXPECT_GT(m[1].droop_deg - m[2].droop_deg, 20.0);
     // Flapping at 10 m/s: ~1.5 Hz in ArcSim; accept 0.8-2.5 Hz. Frequency rises with wind.
     EXPECT_GT(m[2].dominant_hz, 0.8);
     EXPECT_LT(m[2].dominant_hz, 2.5);
     EXPECT_GT(m[2].dominant_hz, m[1].dominant_hz + 0.2);
+    // ArcSim's table gives the dominant (strongest) frequency, ~1.4-1.6 Hz; dominant_hz above is a
+    // power-weighted centroid. The strongest bin: ours 1.24 Hz at 485 vertices; 1.0-1.9 Hz.
+    EXPECT_GT(m[2].peak_hz, 1.0);
+    EXPECT_LT(m[2].peak_hz, 1.9);
     // Amplitude at 10 m/s: ArcSim 0.29-0.45 m lateral, 0.18-0.21 m vertical; accept a factor ~2.
     // (At 1 m/s the flag, released horizontal, still swings after 4 s: not asserted.)
     EXPECT_GT(m[2].lateral_rms, 0.12);
