@@ -9,6 +9,7 @@
 // are recorded on a thread of their own (sensors::AsyncDatasetWriter), so a slow disk never holds
 // up the camera callback.
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -63,6 +64,14 @@ class ClipBufferNode {
     // An int is taken as its text (roslaunch makes one of record_dir:=20261206): read as a
     // string, that left record_dir empty and recorded nothing, without a word.
     record_dir_ = params.Get("record_dir", "");
+    // Relative to the node's working folder, which roslaunch makes ROS_HOME (~/.ros): days of clips
+    // went there, onto the home partition, under a name that looked like the field disk's.
+    if (!record_dir_.empty() && std::filesystem::path(record_dir_).is_relative()) {
+      const std::string absolute = std::filesystem::absolute(record_dir_).lexically_normal().string();
+      ROS_WARN("clip_buffer: ~record_dir '%s' is relative: recording into %s (the node's working folder; give an "
+               "absolute path)", record_dir_.c_str(), absolute.c_str());
+      record_dir_ = absolute;
+    }
     // Out of range is refused at start, naming the parameter: a clip buffer that runs with a
     // setting it did not mean records data that looks right and is not.
     if (!(std::isfinite(flush_after_) && flush_after_ > 0.0))

@@ -39,12 +39,18 @@ struct Dataset {
   std::filesystem::path root;
   std::string kind;  // "flag", "cloth", "real" or "toy" (make-toy-dataset); others are refused
   std::vector<ClipInfo> clips;
+  // Recorded clips (kind "real") whose anemometer gave no reading in their label window
+  // (wind_speed null: the anemometer started late, a serial dropout): kept on disk for their
+  // video, left out of `clips` (no target to train or score on) and counted here.
+  size_t unlabelled = 0;
 };
 
 // Parses a JSON file. Throws std::runtime_error naming the file when it cannot be opened or parsed.
 nlohmann::json ReadJson(const std::filesystem::path& path);
 
-// Reads DIR/index.json and every listed DIR/<name>/label.json (frames are read lazily).
+// Reads DIR/index.json and every listed DIR/<name>/label.json (frames are read lazily). A
+// recorded clip without a wind label is left out and counted (Dataset::unlabelled); in any other
+// kind of dataset a missing label is an error.
 // Throws std::runtime_error naming the file and the field that is missing or wrong.
 Dataset ReadDataset(const std::filesystem::path& dir);
 

@@ -139,9 +139,11 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   const auto start = std::chrono::steady_clock::now();
   if (windows < 1) throw std::invalid_argument("Evaluate: windows must be >= 1, got " + std::to_string(windows));
   Predictor predictor(model, threads, device);
-  const std::vector<ClipInfo> clips = SelectSplit(ReadDataset(data), split);
+  const Dataset dataset = ReadDataset(data);
+  const std::vector<ClipInfo> clips = SelectSplit(dataset, split);
   if (clips.empty()) throw std::runtime_error((data / "index.json").string() + ": no examples in split " + split);
   EvalResult r;
+  r.unlabelled = dataset.unlabelled;
   r.config = predictor.config();
   CheckClipsSuitModel(clips, r.config.frame_rate, r.config.colour, r.config.frames);
   r.split = split;
@@ -260,6 +262,7 @@ std::string EvalTable(const EvalResult& r) {
   s << std::setw(width) << name << std::setw(18) << r.config.Modality()
     << std::setw(10) << std::fixed << std::setprecision(3) << r.metrics.rmse << r.metrics.acc05 << "\n";
   s << "(" << r.metrics.count << " examples, split " << r.split;
+  if (r.unlabelled > 0) s << "; " << r.unlabelled << " recorded clips without a wind label left out";
   if (r.windows > 1) s << ", mean of " << r.windows << " frame windows per clip";
   if (r.mirror) s << ", each averaged with its mirror image";
   if (r.mirror_clips) s << ", clips mirrored (flags flying left)";

@@ -69,6 +69,7 @@ struct EvalResult {
   std::vector<std::filesystem::path> dirs;  // each example's folder (frames, label.json)
   std::vector<double> truth, predicted, predicted_std;  // [m/s]
   std::vector<int> simulations;  // each clip's simulation id (ClipInfo::simulation; -1: none)
+  size_t unlabelled = 0;  // recorded clips left out: no wind label (Dataset::unlabelled)
   int windows = 1;      // frame windows averaged per clip
   bool mirror = false;  // each window averaged with its mirror image
   bool mirror_clips = false;  // every clip mirrored first, as if its flag flew left

@@ -1,8 +1,18 @@
 #include "sensors/dataset_writer.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
+#include <set>
+#include <vector>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -82,8 +92,29 @@ DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality)
   if (jpeg_quality < 1 || jpeg_quality > 100)
     throw std::invalid_argument("jpeg_quality must be in 1..100, got " + std::to_string(jpeg_quality));
   std::error_code ec;
-  fs::create_directories(root_, ec);
+  // Only the folder itself: its parent made here (a USB disk's mount point before the disk came)
+  // was later hidden by the disk, whose own index the first clip after the mount replaced.
+  const fs::path parent = fs::absolute(fs::path(root_)).parent_path();
+  if (!fs::is_directory(parent, ec))
+    throw std::runtime_error("cannot record into " + root_ + ": its parent folder " + parent.string() +
+                             " does not exist (a disk not mounted yet?); it is not created");
+  fs::create_directory(root_, ec);
   if (ec) throw std::runtime_error("cannot create dataset folder " + root_ + ": " + ec.message());
+  // One writer a folder: each rewrites the whole index from what it holds.
+  const int fd = ::open((root_ + "/.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot open " + root_ + "/.lock: " + std::strerror(errno));
+  lock_.fd = fd;
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    throw std::runtime_error(root_ + " is being recorded into by another writer (" + root_ + "/.lock is held" +
+                             (err == EWOULDBLOCK ? "" : std::string(": ") + std::strerror(err)) +
+                             "); record into another folder");
+  }
+  struct stat st{};
+  if (::stat(root_.c_str(), &st) == 0) {
+    device_ = static_cast<unsigned long long>(st.st_dev);
+    inode_ = static_cast<unsigned long long>(st.st_ino);
+  }
   const std::string index_path = root_ + "/index.json";
   if (fs::exists(index_path)) {
     std::ifstream in(index_path);
@@ -112,10 +143,64 @@ DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality)
               {"clips", nlohmann::json::array()}};
   }
   recovered_ = RecoverLeftovers();
+  reindexed_ = ReindexUnlisted();
+  if (reindexed_ > 0) WriteIndex();
+}
+
+DatasetWriter::~DatasetWriter() = default;
+
+DatasetWriter::LockFile::~LockFile() {
+  if (fd >= 0) ::close(fd);  // releases the lock
+}
+
+void DatasetWriter::CheckSameFolder() const {
+  struct stat st{};
+  if (::stat(root_.c_str(), &st) != 0)
+    throw std::runtime_error("the dataset folder " + root_ + " is gone (" + std::strerror(errno) +
+                             "): recording stopped");
+  if (static_cast<unsigned long long>(st.st_dev) != device_ || static_cast<unsigned long long>(st.st_ino) != inode_)
+    throw std::runtime_error("the dataset folder " + root_ + " is no longer the one opened (a disk mounted over it, "
+                             "or the folder moved): recording stopped, so its index.json is not replaced by this "
+                             "one's");
+}
+
+size_t DatasetWriter::ReindexUnlisted() {
+  std::set<std::string> listed;
+  for (const auto& c : index_["clips"]) listed.insert(c["name"].get<std::string>());
+  std::vector<std::string> found;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(root_, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("clip-", 0) != 0 || listed.count(name) || !entry.is_directory(ec)) continue;
+    found.push_back(name);
+  }
+  std::sort(found.begin(), found.end());  // names sort by time
+  size_t added = 0;
+  for (const std::string& name : found) {
+    try {
+      std::ifstream in(root_ + "/" + name + "/label.json");
+      const nlohmann::json label = nlohmann::json::parse(in);
+      index_["clips"].push_back({{"name", name},
+                                 {"sequence", label.at("sequence")},
+                                 {"start", label.at("start")},
+                                 {"end", label.at("end")},
+                                 {"num_frames", label.at("num_frames")},
+                                 {"split", label.at("split")},
+                                 {"wind_speed", label.at("wind_speed")},
+                                 {"wind_std", label.at("wind").at("std")},
+                                 {"wind_count", label.at("wind").at("count")}});
+      ++added;
+    } catch (const std::exception&) {
+      // Not a clip this writer made whole (its label.json is written before the folder's
+      // rename): left out of the index, as it was.
+    }
+  }
+  return added;
 }
 
 std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo& source) {
   if (clip.clip.frames.empty()) throw std::invalid_argument("cannot record an empty clip");
+  CheckSameFolder();
   const std::string name = ClipFolderName(clip.clip.frames.front().stamp, clip.clip.sequence);
   const std::string final_dir = root_ + "/" + name;
   const std::string tmp_dir = TemporaryNameFor(root_ + "/." + name);

@@ -38,14 +38,24 @@ nlohmann::json ClipLabelJson(const LabelledClip& clip, const ClipSourceInfo& sou
 class DatasetWriter {
  public:
   // Inputs:
-  //   root          dataset folder (created if missing)
+  //   root          dataset folder (created if missing; its parent must exist: a disk not
+  //                 mounted yet is an error, not a folder made on the root filesystem that the
+  //                 disk later hides)
   //   jpeg_quality  1..100 (95)
-  // Throws std::runtime_error when the folder cannot be created or its index.json is not valid
-  // (the message names the file and what was expected); an index that cannot be read is never
-  // overwritten.
+  // Holds an exclusive lock on <root>/.lock while it lives: a second writer (another node, a
+  // replay into the folder being recorded) is refused, since each rewrites the whole index.
+  // Clip folders that a writer which died had renamed into place but not yet listed are added
+  // to the index (reindexed()).
+  // Throws std::runtime_error when the folder cannot be created or locked or its index.json is
+  // not valid (the message names the file and what was expected); an index that cannot be read
+  // is never overwritten.
   explicit DatasetWriter(const std::string& root, int jpeg_quality = 95);
+  ~DatasetWriter();
+  DatasetWriter(const DatasetWriter&) = delete;
+  DatasetWriter& operator=(const DatasetWriter&) = delete;
 
-  // Writes one clip; returns the path of its folder. A folder of the same name is replaced (the
+  // Writes one clip; returns the path of its folder. Refused when the folder is no longer the one
+  // opened (a disk mounted over it, the folder moved): its index would replace the other's. A folder of the same name is replaced (the
   // same session replayed again; if that fails the old folder stays). Throws std::runtime_error
   // naming the file that failed; nothing half-written is left behind. When only the index update
   // failed the message says so: the clip is in place and the next index written lists it.
@@ -56,15 +66,28 @@ class DatasetWriter {
   const std::string& root() const { return root_; }
   // Temporaries of a writer that died, cleared when this one opened the folder.
   size_t recovered() const { return recovered_; }
+  // Clip folders found in place but missing from the index when this one opened it (a writer
+  // that died between a clip's rename and its index update), added to the index.
+  size_t reindexed() const { return reindexed_; }
 
  private:
   void WriteIndex();
   size_t RecoverLeftovers();
+  size_t ReindexUnlisted();
+  // Throws unless root_ is still the folder opened (device and inode).
+  void CheckSameFolder() const;
 
   std::string root_;
   int jpeg_quality_;
   nlohmann::json index_;
-  size_t recovered_ = 0;
+  size_t recovered_ = 0, reindexed_ = 0;
+  // The held <root>/.lock: a member that closes it, so a constructor that throws after taking it
+  // releases it too (a destructor of the writer would not run then).
+  struct LockFile {
+    int fd = -1;
+    ~LockFile();
+  } lock_;
+  unsigned long long device_ = 0, inode_ = 0;  // of root_ when opened
 };
 
 // Writes `text` to `path` through a temporary file in the same folder, fsync and a rename (then

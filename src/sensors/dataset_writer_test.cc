@@ -44,6 +44,7 @@ class DatasetWriterTest : public ::testing::Test {
     std::set<std::string> names;
     for (const auto& e : fs::directory_iterator(root_)) {
       const std::string n = e.path().filename().string();
+      if (n == ".lock") continue;  // the writer's lock, there while one is open
       if (n[0] == '.' || n.find(".tmp-") != std::string::npos) names.insert(n);
     }
     return names;
@@ -229,6 +230,73 @@ TEST_F(DatasetWriterTest, FailedIndexUpdateIsToldAndCaughtUpNextTime) {
   fs::remove_all(root_ / "index.json");
   w.Write(MakeClip(2, 1700000002.4), {});
   EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 3u);
+}
+
+// One writer a folder (each rewrites the whole index from what it holds): a second is refused
+// while the first lives, and opens once it is gone.
+TEST_F(DatasetWriterTest, ASecondWriterOfOneFolderIsRefused) {
+  {
+    DatasetWriter first(root_.string());
+    try {
+      DatasetWriter second(root_.string());
+      FAIL() << "two writers of one folder";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("another writer"), std::string::npos) << e.what();
+    }
+    first.Write(MakeClip(0, 1700000000.0), {});
+  }
+  DatasetWriter later(root_.string());
+  EXPECT_EQ(later.size(), 1u);
+}
+
+// The parent of the folder is not made (a disk not mounted yet): made, the disk later hid it and
+// the first clip after the mount replaced the disk's own index. A folder swapped under an open
+// writer (a disk mounted over it) stops the recording instead of replacing that folder's index.
+TEST_F(DatasetWriterTest, AMissingParentOrASwappedFolderStopsTheRecording) {
+  try {
+    DatasetWriter w((root_ / "not-mounted" / "flagreal").string());
+    FAIL() << "the parent was made";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("does not exist (a disk not mounted yet?)"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(root_ / "not-mounted"));
+  fs::create_directories(root_);
+  const fs::path folder = root_ / "flagreal";
+  DatasetWriter w(folder.string());
+  w.Write(MakeClip(0, 1700000000.0), {});
+  // Another folder in its place, holding yesterday's index.
+  fs::rename(folder, root_ / "moved");
+  fs::create_directories(folder);
+  std::ofstream(folder / "index.json") << R"({"format": "clothwind-dataset", "version": 1, "kind": "real", "clips": [{"name": "clip-yesterday"}]})";
+  try {
+    w.Write(MakeClip(1, 1700000001.2), {});
+    FAIL() << "recorded into a swapped folder";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no longer the one opened"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(Read(folder / "index.json")["clips"].size(), 1u);
+  EXPECT_EQ(Read(folder / "index.json")["clips"][0]["name"], "clip-yesterday");
+}
+
+// A writer that died between a clip's rename into place and its index update: the clip is whole
+// on disk, and the next writer lists it (no reader saw it before).
+TEST_F(DatasetWriterTest, ClipsInPlaceButNotListedAreIndexedOnOpen) {
+  {
+    DatasetWriter w(root_.string());
+    w.Write(MakeClip(0, 1700000000.0), {});
+    w.Write(MakeClip(1, 1700000001.2), {});
+  }
+  nlohmann::json index = Read(root_ / "index.json");
+  index["clips"].erase(1);
+  std::ofstream(root_ / "index.json") << index.dump();
+  fs::create_directories(root_ / "clip-20231114-221320.000-000009");  // no label.json: not a whole clip
+  DatasetWriter again(root_.string());
+  EXPECT_EQ(again.reindexed(), 1u);
+  const nlohmann::json after = Read(root_ / "index.json");
+  ASSERT_EQ(after["clips"].size(), 2u);
+  EXPECT_EQ(after["clips"][1]["name"], ClipFolderName(1700000001.2, 1));
+  EXPECT_EQ(after["clips"][1]["sequence"], 1);
+  EXPECT_TRUE(after["clips"][1]["wind_speed"].is_number());
 }
 
 // What a writer that died leaves behind is cleared when the folder is opened again; a clip it was
