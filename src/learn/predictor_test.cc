@@ -19,6 +19,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The small SDN these tests save: 30 frames of 32 px, k = 3, phase steps, width 8.
+ModelConfig SmallSdn() {
+  ModelConfig c;
+  c.arch = "sdn";
+  c.frames = 30;
+  c.k = 3;
+  c.phase_steps = true;
+  c.width = 8;
+  c.input_size = 32;
+  return c;
+}
+
 // A small SDN saved as a training run saves it, in a folder of its own.
 class PredictorTest : public ::testing::Test {
  protected:
@@ -26,14 +38,7 @@ class PredictorTest : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("predictor_test_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    ModelConfig c;
-    c.arch = "sdn";
-    c.frames = 30;
-    c.k = 3;
-    c.phase_steps = true;
-    c.width = 8;
-    c.input_size = 32;
-    WindNet net(c);
+    WindNet net(SmallSdn());
     SaveWindNet(net, dir_ / "model.pt");
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -63,13 +68,7 @@ double MaxAbsDiff(const cv::Mat& a, const cv::Mat& b) { return cv::norm(a, b, cv
 // A network's output placed below 0 by the label scale is read as calm (0 m/s), one above it as
 // it is: the same network and clip, its labels' mean moved down by 100 m/s.
 TEST_F(PredictorTest, ASpeedBelowZeroIsReadAsCalm) {
-  ModelConfig c;
-  c.arch = "sdn";
-  c.frames = 30;
-  c.k = 3;
-  c.phase_steps = true;
-  c.width = 8;
-  c.input_size = 32;
+  ModelConfig c = SmallSdn();
   c.label_std = 1.0;
   c.label_mean = 50.0;
   torch::manual_seed(7);  // the same initial weights in both

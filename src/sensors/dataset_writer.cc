@@ -30,6 +30,19 @@ constexpr int kFormatVersion = 1;
 // NaN and inf become null in JSON (nlohmann does that too, but say it explicitly).
 nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
+// A clip's entry in index.json, from its label.json (throws when a field is missing).
+nlohmann::json IndexEntry(const std::string& name, const nlohmann::json& label) {
+  return {{"name", name},
+          {"sequence", label.at("sequence")},
+          {"start", label.at("start")},
+          {"end", label.at("end")},
+          {"num_frames", label.at("num_frames")},
+          {"split", label.at("split")},
+          {"wind_speed", label.at("wind_speed")},
+          {"wind_std", label.at("wind").at("std")},
+          {"wind_count", label.at("wind").at("count")}};
+}
+
 }  // namespace
 
 void WriteFileAtomically(const std::string& path, const std::string& text) {
@@ -180,15 +193,7 @@ size_t DatasetWriter::ReindexUnlisted() {
     try {
       std::ifstream in(root_ + "/" + name + "/label.json");
       const nlohmann::json label = nlohmann::json::parse(in);
-      index_["clips"].push_back({{"name", name},
-                                 {"sequence", label.at("sequence")},
-                                 {"start", label.at("start")},
-                                 {"end", label.at("end")},
-                                 {"num_frames", label.at("num_frames")},
-                                 {"split", label.at("split")},
-                                 {"wind_speed", label.at("wind_speed")},
-                                 {"wind_std", label.at("wind").at("std")},
-                                 {"wind_count", label.at("wind").at("count")}});
+      index_["clips"].push_back(IndexEntry(name, label));
       ++added;
     } catch (const std::exception&) {
       // Not a clip this writer made whole (its label.json is written before the folder's
@@ -245,15 +250,7 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
         break;
       }
     }
-    clips.push_back({{"name", name},
-                     {"sequence", clip.clip.sequence},
-                     {"start", label["start"]},
-                     {"end", label["end"]},
-                     {"num_frames", label["num_frames"]},
-                     {"split", label["split"]},
-                     {"wind_speed", label["wind_speed"]},
-                     {"wind_std", label["wind"]["std"]},
-                     {"wind_count", label["wind"]["count"]}});
+    clips.push_back(IndexEntry(name, label));
   } catch (const fs::filesystem_error& e) {
     fs::remove_all(tmp_dir, ec);
     throw std::runtime_error(std::string("recording clip ") + name + ": " + e.what());

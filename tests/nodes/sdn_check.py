@@ -204,31 +204,24 @@ class SdnNodeTest(unittest.TestCase):
             rospy.sleep(0.1)
         self.fail("timed out waiting for " + what)
 
-    def wait_for_turned(self, statuses, count):
-        """The key-value pairs of the first of `statuses` that counts `count` clips turned round."""
+    def wait_for_count(self, statuses, key, count, what):
+        """The key-value pairs of the first of `statuses` whose `key` counts `count`."""
         def find():
             for s in statuses:
                 values = {kv.key: kv.value for kv in s.values}
-                if values.get("clips turned round (flag flying left)") == str(count):
+                if values.get(key) == str(count):
                     return values
             return None
 
-        self.wait_for(lambda: find() is not None, 10, "a diagnostic counting %d clips turned round" % count)
+        self.wait_for(lambda: find() is not None, 10, "a diagnostic counting %d %s" % (count, what))
         with self.lock:
             return find()
+
+    def wait_for_turned(self, statuses, count):
+        return self.wait_for_count(statuses, "clips turned round (flag flying left)", count, "clips turned round")
 
     def wait_for_estimates(self, statuses, count):
-        """The key-value pairs of the first of `statuses` that counts `count` estimates."""
-        def find():
-            for s in statuses:
-                values = {kv.key: kv.value for kv in s.values}
-                if values.get("estimates") == str(count):
-                    return values
-            return None
-
-        self.wait_for(lambda: find() is not None, 10, "a diagnostic counting %d estimates" % count)
-        with self.lock:
-            return find()
+        return self.wait_for_count(statuses, "estimates", count, "estimates")
 
     def test_estimates(self):
         n = rospy.get_param("~clips", 6)
