@@ -5,6 +5,10 @@
 //
 //   sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10]
 //             [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N (0 = off)]
+//             [--strain-sweeps N]
+// The strain columns: the limiter's sweeps per step, the share of steps it ended outside its
+// tolerance (0.1 %), and the 99th percentile of the faces' largest principal stretch over the
+// frames of the last half (the flag's limit is 1.05).
 // Default scene: $CLOTHWIND_SHARED_DIR/arcsim/conf/flag.json (ArcSim's own, so the comparison is
 // like for like), else config/scenes/flag.json under $CLOTHWIND_SOURCE_DIR or the working dir.
 
@@ -16,6 +20,9 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
 
 #include "bench_clock.h"
 #include "sim/flag_metrics.h"
@@ -48,12 +55,35 @@ double ArcSimWallPerSimSecond(double wind) {
 
 using clothwind::bench::ThreadCpuSeconds;
 
+// The q-quantile of the faces' largest principal stretch over frames first.. of t (rest shapes
+// from mesh.U).
+double StretchPercentile(const Trajectory& t, const Mesh& mesh, int first, double q) {
+  std::vector<double> stretch;
+  for (int frame = first; frame < t.num_frames(); ++frame) {
+    const FramePositions& x = t.frames[frame];
+    for (int f = 0; f < mesh.F.rows(); ++f) {
+      Eigen::Matrix2d Dm;
+      Dm.col(0) = (mesh.U.row(mesh.F(f, 1)) - mesh.U.row(mesh.F(f, 0))).transpose();
+      Dm.col(1) = (mesh.U.row(mesh.F(f, 2)) - mesh.U.row(mesh.F(f, 0))).transpose();
+      Eigen::Matrix<double, 3, 2> Ds;
+      Ds.col(0) = (x.row(mesh.F(f, 1)) - x.row(mesh.F(f, 0))).cast<double>().transpose();
+      Ds.col(1) = (x.row(mesh.F(f, 2)) - x.row(mesh.F(f, 0))).cast<double>().transpose();
+      stretch.push_back(Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(Ds * Dm.inverse()).singularValues()[0]);
+    }
+  }
+  if (stretch.empty()) return 0.0;
+  const size_t k = std::min(stretch.size() - 1, static_cast<size_t>(q * stretch.size()));
+  std::nth_element(stretch.begin(), stretch.begin() + k, stretch.end());
+  return stretch[k];
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string scene_path = DefaultScene();
   double duration = 4.0, max_edge = 0.0, cg_tolerance = 0.0;
   int crossing_sweeps = -1;  // -1: the scene's (SimOptions default)
+  int strain_sweeps = -1;    // -1: SimOptions default
   BuildOptions build;
   std::vector<double> winds = {1, 3, 6, 10};
   for (int i = 1; i < argc; ++i) {
@@ -79,6 +109,8 @@ int main(int argc, char** argv) {
       cg_tolerance = std::stod(next());
     } else if (a == "--crossing-sweeps") {
       crossing_sweeps = std::stoi(next());
+    } else if (a == "--strain-sweeps") {
+      strain_sweeps = std::stoi(next());
     } else if (a == "--winds") {
       winds.clear();
       std::stringstream ss(next());
@@ -86,7 +118,7 @@ int main(int argc, char** argv) {
       while (std::getline(ss, item, ',')) winds.push_back(std::stod(item));
     } else {
       std::fprintf(stderr,
-                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N]\n");
+                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N] [--strain-sweeps N]\n");
       return 2;
     }
   }
@@ -98,12 +130,15 @@ int main(int argc, char** argv) {
   if (crossing_sweeps >= 0) {
     for (auto& c : setup.cloths) c.options.crossing_sweeps = crossing_sweeps;
   }
+  if (strain_sweeps >= 0) {
+    for (auto& c : setup.cloths) c.options.strain_limit_iterations = strain_sweeps;
+  }
   std::printf("scene %s, %.1f s simulated per wind, dt %.4f s, edges <= %.3f m, CG tolerance %g, one thread\n",
               scene_path.c_str(), duration, setup.cloths[0].options.dt, setup.cloths[0].max_edge,
               setup.cloths[0].options.cg_tolerance);
   std::printf("droop/RMS/frequency over the last half (cf. ArcSim: droop ~80/52/10 deg at 1/3/10 m/s, ~1.5 Hz at 10)\n\n");
-  std::printf("| wind (m/s) | vertices | faces | steps | wall s / sim s | CPU s / sim s | x real time (wall) | x real time (CPU) | x faster than ArcSim | droop (deg) | lateral RMS (m) | vertical RMS (m) | frequency (Hz) | CG iterations / step |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("| wind (m/s) | vertices | faces | steps | wall s / sim s | CPU s / sim s | x real time (wall) | x real time (CPU) | x faster than ArcSim | droop (deg) | lateral RMS (m) | vertical RMS (m) | frequency (Hz) | CG iterations / step | strain sweeps / step | steps unconverged (%%) | p99 stretch |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   bool all_fast_wall = true, all_fast_cpu = true;
   for (double wind : winds) {
     Theta theta = SceneTheta(setup);
@@ -121,11 +156,14 @@ int main(int argc, char** argv) {
     const double arcsim = ArcSimWallPerSimSecond(wind);
     char vs[32] = "n/a";
     if (arcsim > 0) std::snprintf(vs, sizeof(vs), "%.0f", arcsim / per);
-    std::printf("| %g | %d | %d | %lld | %.3f | %.3f | %.2f | %.2f | %s | %.1f | %.3f | %.3f | %.2f | %.1f |\n", wind,
+    const double steps = static_cast<double>(std::max<int64_t>(1, t.steps));
+    std::printf("| %g | %d | %d | %lld | %.3f | %.3f | %.2f | %.2f | %s | %.1f | %.3f | %.3f | %.2f | %.1f | %.1f | %.1f | %.4f |\n", wind,
                 t.num_vertices(), t.num_faces(), static_cast<long long>(t.steps), per, cpu / simulated,
                 1.0 / per, simulated / cpu, vs,
                 m.droop_deg, m.lateral_rms, m.vertical_rms, m.dominant_hz,
-                static_cast<double>(t.solver_iterations) / std::max<int64_t>(1, t.steps));
+                static_cast<double>(t.solver_iterations) / steps, t.strain_limit_sweeps / steps,
+                100.0 * t.strain_limit_unconverged / steps,
+                StretchPercentile(t, setup.cloths[0].mesh, t.num_frames() / 2, 0.99));
     std::fflush(stdout);
     all_fast_wall = all_fast_wall && per <= 0.2;
     all_fast_cpu = all_fast_cpu && cpu / simulated <= 0.2;

@@ -136,6 +136,9 @@ void ClothSimulator::Impl::Build() {
   if ((options.strain_min > 0 || std::isfinite(options.strain_max)) && options.strain_limit_iterations < 1)
     throw std::invalid_argument("SimOptions.strain_limit_iterations must be >= 1 when a strain limit is set, got " +
                                 std::to_string(options.strain_limit_iterations));
+  if (!(options.strain_limit_tolerance >= 0 && options.strain_limit_tolerance < 1))
+    throw std::invalid_argument("SimOptions.strain_limit_tolerance must be in [0, 1), got " +
+                                std::to_string(options.strain_limit_tolerance));
   if (!finite_at_least_0(options.repulsion_thickness) || !finite_at_least_0(options.collision_stiffness))
     throw std::invalid_argument("SimOptions.repulsion_thickness and collision_stiffness must be finite and >= 0");
   // The solve starts at dv = 0, whose relative residual is exactly 1: a tolerance of 1 or more
@@ -628,6 +631,8 @@ void ClothSimulator::Step() {
   s.proximity_from_resolver = false;
   const auto t1 = Clock::now();
   s.stats.strain_limited_faces = 0;  // (this step's, should the solve fail before the limiter)
+  s.stats.strain_limit_sweeps = 0;
+  s.stats.strain_limit_excess = 0;
   s.stats.crossings_resolved = 0;
   s.ComputeForces(/*with_jacobian=*/true, repel);
   const auto t2 = Clock::now();
@@ -642,9 +647,18 @@ void ClothSimulator::Step() {
   }
   const auto t3 = Clock::now();
   s.stats.strain_limited_faces = 0;
+  s.stats.strain_limit_sweeps = 0;
+  s.stats.strain_limit_excess = 0;
   if (s.options.strain_min > 0 || std::isfinite(s.options.strain_max)) {
-    s.stats.strain_limited_faces = s.limiter->Project(s.options.strain_min, s.options.strain_max,
-                                                      s.options.strain_limit_iterations, h, &s.x, &s.v);
+    StrainLimitSettings limits;
+    limits.min = s.options.strain_min;
+    limits.max = s.options.strain_max;
+    limits.tolerance = s.options.strain_limit_tolerance;
+    limits.max_sweeps = s.options.strain_limit_iterations;
+    const StrainLimitResult r = s.limiter->Project(limits, h, &s.x, &s.v);
+    s.stats.strain_limited_faces = r.initially_violated;
+    s.stats.strain_limit_sweeps = r.sweeps;
+    s.stats.strain_limit_excess = r.excess;
   }
   // Vertices that jumped through a face during the step go back to their side (see
   // crossing_resolver.h): the repulsion alone lets fast folds pass through.

@@ -55,7 +55,10 @@ Trajectory SimulateTrajectory(const SceneSetup& setup, const Theta& theta,
   auto advance_one_frame = [&] {
     for (int s = 0; s < steps_per_frame; ++s) {
       sim.Step();
-      t.solver_iterations += sim.last_step_stats().cg_iterations;
+      const StepStats& stats = sim.last_step_stats();
+      t.solver_iterations += stats.cg_iterations;
+      t.strain_limit_sweeps += stats.strain_limit_sweeps;
+      if (stats.strain_limit_excess > sim_options.strain_limit_tolerance) ++t.strain_limit_unconverged;
     }
     t.steps += steps_per_frame;
   };

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -61,6 +62,30 @@ TEST(SimulateTrajectory, FramesStepsAndShapes) {
   for (int h : setup.cloths[0].options.handles) {
     EXPECT_EQ(t.frames.back().row(h), t.frames.front().row(h));
   }
+}
+
+TEST(SimulateTrajectory, CountsTheStrainLimitersSweepsAndUnconvergedSteps) {
+  // The flag scene limits stretches to 0.95-1.05. One sweep a step: exactly one sweep counted
+  // per step, and a flag falling and blown out is not within 0.1 % of its limits after one
+  // sweep in every step. With the limits off nothing is counted.
+  SceneSetup setup = SmallFlag();
+  SimulateOptions o;
+  o.duration = 0.4;
+  o.seed = 1;
+  setup.cloths[0].options.strain_limit_iterations = 1;
+  const Trajectory one = SimulateTrajectory(setup, SceneTheta(setup), o);
+  EXPECT_EQ(one.strain_limit_sweeps, one.steps);
+  EXPECT_GT(one.strain_limit_unconverged, 0);
+  EXPECT_LE(one.strain_limit_unconverged, one.steps);
+  setup.cloths[0].options.strain_limit_iterations = 3;
+  const Trajectory three = SimulateTrajectory(setup, SceneTheta(setup), o);
+  EXPECT_GT(three.strain_limit_sweeps, three.steps);
+  EXPECT_LE(three.strain_limit_sweeps, 3 * three.steps);
+  setup.cloths[0].options.strain_max = std::numeric_limits<double>::infinity();
+  setup.cloths[0].options.strain_min = 0;
+  const Trajectory none = SimulateTrajectory(setup, SceneTheta(setup), o);
+  EXPECT_EQ(none.strain_limit_sweeps, 0);
+  EXPECT_EQ(none.strain_limit_unconverged, 0);
 }
 
 TEST(SimulateTrajectory, WarmupDropsLeadingFramesOfTheSameRun) {

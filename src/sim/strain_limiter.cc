@@ -33,29 +33,36 @@ StrainLimiter::StrainLimiter(const Mesh& mesh, const Eigen::VectorXd& mass,
   }
 }
 
-int StrainLimiter::Project(double strain_min, double strain_max, int iterations, double dt,
-                           Eigen::MatrixX3d* xp, Eigen::MatrixX3d* vp) {
+StrainLimitResult StrainLimiter::Project(const StrainLimitSettings& settings, double dt,
+                                         Eigen::MatrixX3d* xp, Eigen::MatrixX3d* vp) {
   Eigen::MatrixX3d& x = *xp;
   const int n = static_cast<int>(x.rows());
+  const double strain_min = settings.min, strain_max = settings.max;
+  const bool has_min = strain_min > 0, has_max = std::isfinite(strain_max);
   // Work on an interleaved copy (x, y, z of a vertex adjacent in memory).
   work_.resize(3 * n);
   for (int i = 0; i < n; ++i)
     for (int c = 0; c < 3; ++c) work_[3 * i + c] = x(i, c);
   double* X = work_.data();
-  // Squared limits with a small slack so converged faces are not touched again.
-  const double lo2 = strain_min > 0 ? strain_min * strain_min * (1 - 1e-6) : -1.0;
-  const double hi2 = std::isfinite(strain_max) ? strain_max * strain_max * (1 + 1e-6) : 1e300;
-  auto clampv = [&](double s) {
-    if (strain_min > 0) s = std::max(s, strain_min);
-    if (std::isfinite(strain_max)) s = std::min(s, strain_max);
+  // Squared limits with a small slack so faces just projected are not touched again...
+  const double lo2 = has_min ? strain_min * strain_min * (1 - 1e-6) : -1.0;
+  const double hi2 = has_max ? strain_max * strain_max * (1 + 1e-6) : 1e300;
+  // ...and the tolerance that ends the sweeps (a face outside by less is projected but does not
+  // keep the sweeps going).
+  const double lo2_tol = has_min ? lo2 * (1 - settings.tolerance) * (1 - settings.tolerance) : -1.0;
+  const double hi2_tol = has_max ? hi2 * (1 + settings.tolerance) * (1 + settings.tolerance) : 1e300;
+  auto clamp = [&](double s) {
+    if (has_min) s = std::max(s, strain_min);
+    if (has_max) s = std::min(s, strain_max);
     return s;
   };
-  int initially_violated = 0;
+  StrainLimitResult result;
   // After the first sweep only faces with a vertex moved by the previous sweep can be violated.
   moved_.assign(n, 1);
   moved_next_.assign(n, 0);
-  for (int sweep = 0; sweep < iterations; ++sweep) {
-    int violated = 0;
+  for (int sweep = 0; sweep < settings.max_sweeps; ++sweep) {
+    int projected = 0, violated = 0;
+    double excess = 0;
     for (const Face& face : faces_) {
       if (!moved_[face.v[0]] && !moved_[face.v[1]] && !moved_[face.v[2]]) continue;
       const double* x0 = X + 3 * face.v[0];
@@ -81,7 +88,8 @@ int StrainLimiter::Project(double strain_min, double strain_max, int iterations,
       const double l_hi = mean + rad, l_lo = mean - rad;
       if (l_hi <= hi2 && l_lo >= lo2) continue;
       if (!(l_lo > 1e-16)) continue;  // collapsed face: no meaningful direction to restore
-      ++violated;
+      ++projected;
+      if (l_hi > hi2_tol || l_lo < lo2_tol) ++violated;
       // Eigenvectors of C: e_hi, e_lo = perp(e_hi).
       double eh0, eh1;
       if (std::abs(c01) > 1e-300) {
@@ -107,7 +115,9 @@ int StrainLimiter::Project(double strain_min, double strain_max, int iterations,
       }
       const double el0 = -eh1, el1 = eh0;
       const double s_hi = std::sqrt(l_hi), s_lo = std::sqrt(l_lo);
-      const double r_hi = clampv(s_hi) / s_hi, r_lo = clampv(s_lo) / s_lo;
+      if (has_max) excess = std::max(excess, s_hi / strain_max - 1);
+      if (has_min) excess = std::max(excess, 1 - s_lo / strain_min);
+      const double r_hi = clamp(s_hi) / s_hi, r_lo = clamp(s_lo) / s_lo;
       // F' = F M, M = V diag(r) V^T (2 by 2, symmetric).
       const double m00 = r_hi * eh0 * eh0 + r_lo * el0 * el0;
       const double m01 = r_hi * eh0 * eh1 + r_lo * el0 * el1;
@@ -124,8 +134,13 @@ int StrainLimiter::Project(double strain_min, double strain_max, int iterations,
         moved_next_[face.v[c]] = 1;
       }
     }
-    if (sweep == 0) initially_violated = violated;
-    if (violated == 0) break;
+    if (sweep == 0) result.initially_violated = projected;
+    result.sweeps = sweep + 1;
+    result.excess = excess;
+    if (violated == 0) {
+      result.converged = true;
+      break;
+    }
     moved_.swap(moved_next_);
     std::fill(moved_next_.begin(), moved_next_.end(), 0);
   }
@@ -136,7 +151,7 @@ int StrainLimiter::Project(double strain_min, double strain_max, int iterations,
       (*vp)(i, c) += moved * inv_dt;
       x(i, c) = X[3 * i + c];
     }
-  return initially_violated;
+  return result;
 }
 
 }  // namespace clothwind::sim

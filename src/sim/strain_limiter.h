@@ -1,6 +1,7 @@
 #ifndef CLOTHWIND_SIM_STRAIN_LIMITER_H_
 #define CLOTHWIND_SIM_STRAIN_LIMITER_H_
 
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -20,12 +21,35 @@ inline bool StrainLimitsAreValid(double min, double max) {
 constexpr const char* kStrainLimitsRule =
     "0 <= min <= 1 <= max and min < max (min 0: no lower limit; max inf: no upper one)";
 
+// How StrainLimiter::Project sweeps (ArcSim's strain_limits, and when its sweeps stop).
+struct StrainLimitSettings {
+  double min = 0.0;  // lower limit on principal stretches (0: none)
+  double max = std::numeric_limits<double>::infinity();  // upper limit (inf: none)
+  // Sweeps stop once, over a whole sweep, no face was found outside [min (1 - tolerance),
+  // max (1 + tolerance)]; faces outside the limits by less are still projected.
+  double tolerance = 1e-3;
+  int max_sweeps = 4;
+};
+
+// What one Project call did.
+struct StrainLimitResult {
+  // Faces found outside the limits in the first sweep (each checked in its turn, after the
+  // projections of the faces before it).
+  int initially_violated = 0;
+  int sweeps = 0;              // sweeps run (<= max_sweeps)
+  // Largest relative excess found in the last sweep, before its projections: max over faces of
+  // s_max / max - 1 and 1 - s_min / min (0 when none); <= tolerance when converged.
+  double excess = 0.0;
+  bool converged = false;  // the last sweep found no face outside the limits by more than tolerance
+};
+
 // Keeps every face's principal stretches (the singular values of its deformation gradient) within
-// [strain_min, strain_max], as ArcSim's strain limiting does, but by a few Gauss-Seidel sweeps of
-// per-face projections instead of ArcSim's global constrained optimisation (43 % of its run time):
-// a face out of limits is replaced by the closest (mass-weighted, rotation kept) shape whose
-// stretches are clamped to the limits; pinned vertices do not move. The same position change,
-// divided by the time step, is added to the velocities (ArcSim updates velocities likewise).
+// [min, max], as ArcSim's strain limiting does, but by Gauss-Seidel sweeps of per-face
+// projections instead of ArcSim's global constrained optimisation (43 % of its run time): a face
+// out of limits gets the shape whose stretches are clamped to the limits, its stretch
+// directions, rotation and mass-weighted centroid kept; pinned vertices do not move. The
+// same position change, divided by the time step, is added to the velocities (ArcSim updates
+// velocities likewise).
 class StrainLimiter {
  public:
   // Inputs:
@@ -34,14 +58,23 @@ class StrainLimiter {
   //   pinned  #V flags (non-zero: vertex does not move)
   StrainLimiter(const Mesh& mesh, const Eigen::VectorXd& mass, const std::vector<char>& pinned);
 
+  // Sweeps until converged (see StrainLimitSettings) or settings.max_sweeps. The sweeps converge
+  // slowly, for two reasons measured in stop 73 (docs/simulator.md, "Strain limiting"):
+  //  - a flag in the wind is stretched along its whole length, and a projection pulls a face's
+  //    far vertex in and pushes its pole-side vertex out, so the correction creeps one face per
+  //    sweep towards the pole (over-relaxing the projections carried it faster on our flag
+  //    scene but made ArcSim's own flag scene go wild, so it is not done);
+  //  - a face's projection keeps its mass-weighted centroid but is not the closest shape in
+  //    the mass-weighted metric, so around a pinned corner the sweeps can settle into a cycle
+  //    that leaves every face of the fan ~0.3 % over the limit however many sweeps run.
   // Inputs:
-  //   strain_min, strain_max  limits on principal stretches (0 / inf: that side off)
-  //   iterations              sweeps (stops early once every face is within limits)
-  //   dt                      time step [s] (> 0) for the velocity update
-  //   x, v                    #V by 3 positions [m] and velocities [m/s], updated in place
-  // Returns the number of faces that were outside the limits before projection.
-  int Project(double strain_min, double strain_max, int iterations, double dt, Eigen::MatrixX3d* x,
-              Eigen::MatrixX3d* v);
+  //   settings  limits (validated by the caller: StrainLimitsAreValid, max_sweeps >= 1,
+  //             tolerance >= 0)
+  //   dt        time step [s] (> 0) for the velocity update
+  //   x, v      #V by 3 positions [m] and velocities [m/s], updated in place
+  // Returns what the sweeps did.
+  StrainLimitResult Project(const StrainLimitSettings& settings, double dt, Eigen::MatrixX3d* x,
+                            Eigen::MatrixX3d* v);
 
  private:
   struct Face {

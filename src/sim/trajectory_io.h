@@ -22,6 +22,8 @@ struct Trajectory {
   int64_t steps = 0;                      // time steps taken
   double wall_seconds = 0.0;              // wall time of the simulation [s]
   int64_t solver_iterations = 0;          // linear-solver (CG) iterations summed over the steps
+  int64_t strain_limit_sweeps = 0;        // the strain limiter's sweeps summed over the steps
+  int64_t strain_limit_unconverged = 0;   // steps whose limiter stopped outside its tolerance
 
   int num_vertices() const { return static_cast<int>(uv.rows()); }
   int num_faces() const { return static_cast<int>(faces.rows()); }
