@@ -5,9 +5,9 @@
 //
 //   sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10]
 //             [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N (0 = off)]
-//             [--strain-sweeps N]
+//             [--strain-sweeps N] [--strain-tolerance T]
 // The strain columns: the limiter's sweeps per step, the share of steps it ended outside its
-// tolerance (0.1 %), and the 99th percentile of the faces' largest principal stretch over the
+// tolerance (SimOptions.strain_limit_tolerance, or --strain-tolerance), and the 99th percentile of the faces' largest principal stretch over the
 // frames of the last half (the flag's limit is 1.05).
 // Default scene: $CLOTHWIND_SHARED_DIR/arcsim/conf/flag.json (ArcSim's own, so the comparison is
 // like for like), else config/scenes/flag.json under $CLOTHWIND_SOURCE_DIR or the working dir.
@@ -84,6 +84,7 @@ int main(int argc, char** argv) {
   double duration = 4.0, max_edge = 0.0, cg_tolerance = 0.0;
   int crossing_sweeps = -1;  // -1: the scene's (SimOptions default)
   int strain_sweeps = -1;    // -1: SimOptions default
+  double strain_tolerance = -1;
   BuildOptions build;
   std::vector<double> winds = {1, 3, 6, 10};
   for (int i = 1; i < argc; ++i) {
@@ -111,6 +112,8 @@ int main(int argc, char** argv) {
       crossing_sweeps = std::stoi(next());
     } else if (a == "--strain-sweeps") {
       strain_sweeps = std::stoi(next());
+    } else if (a == "--strain-tolerance") {
+      strain_tolerance = std::stod(next());
     } else if (a == "--winds") {
       winds.clear();
       std::stringstream ss(next());
@@ -118,7 +121,7 @@ int main(int argc, char** argv) {
       while (std::getline(ss, item, ',')) winds.push_back(std::stod(item));
     } else {
       std::fprintf(stderr,
-                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N] [--strain-sweeps N]\n");
+                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N] [--strain-sweeps N] [--strain-tolerance T]\n");
       return 2;
     }
   }
@@ -132,6 +135,9 @@ int main(int argc, char** argv) {
   }
   if (strain_sweeps >= 0) {
     for (auto& c : setup.cloths) c.options.strain_limit_iterations = strain_sweeps;
+  }
+  if (strain_tolerance >= 0) {
+    for (auto& c : setup.cloths) c.options.strain_limit_tolerance = strain_tolerance;
   }
   std::printf("scene %s, %.1f s simulated per wind, dt %.4f s, edges <= %.3f m, CG tolerance %g, one thread\n",
               scene_path.c_str(), duration, setup.cloths[0].options.dt, setup.cloths[0].max_edge,

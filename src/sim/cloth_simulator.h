@@ -27,10 +27,12 @@ struct SimOptions {
   double strain_min = 0.0;
   double strain_max = std::numeric_limits<double>::infinity();
   // The limiter's sweeps (strain_limiter.h): at most this many per step, ending once no face is
-  // outside the limits by more than the relative tolerance. Why 4, though they leave 1 % of the
-  // flag's faces 8-10 % over the limit: docs/simulator.md, "Strain limiting".
+  // outside the limits by more than the relative tolerance (0: by more than round-off, as before
+  // the tolerance existed, so FlagSim's frames stay those of its generator version). Why 4,
+  // though they leave 1 % of the flag's faces 8-10 % over the limit: docs/simulator.md,
+  // "Strain limiting".
   int strain_limit_iterations = 4;
-  double strain_limit_tolerance = 1e-3;
+  double strain_limit_tolerance = 0.0;
   double repulsion_thickness = 10e-3;               // ArcSim magic.repulsion_thickness [m]
   double collision_stiffness = 1e6;                 // ArcSim magic.collision_stiffness [N/m^3]
                                                     // (times min(node area, face area) per pair)

@@ -26,8 +26,9 @@ struct StrainLimitSettings {
   double min = 0.0;  // lower limit on principal stretches (0: none)
   double max = std::numeric_limits<double>::infinity();  // upper limit (inf: none)
   // Sweeps stop once, over a whole sweep, no face was found outside [min (1 - tolerance),
-  // max (1 + tolerance)]; faces outside the limits by less are still projected.
-  double tolerance = 1e-3;
+  // max (1 + tolerance)]; faces outside the limits by less are still projected. 0: until no
+  // face is out by more than round-off (1e-6).
+  double tolerance = 0.0;
   int max_sweeps = 4;
 };
 

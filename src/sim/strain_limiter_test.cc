@@ -29,6 +29,7 @@ StrainLimitSettings Limits(int sweeps) {
   l.min = 0.95;
   l.max = 1.05;
   l.max_sweeps = sweeps;
+  l.tolerance = 1e-3;
   return l;
 }
 
