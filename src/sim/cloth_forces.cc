@@ -152,7 +152,10 @@ double DihedralAngle(const Vector12d& x, Vector12d* gradient) {
     // projections onto it (weight of x0, weight of x1).
     const Eigen::Vector3d d = x1 - x0;
     const double t2 = (x2 - x0).dot(d) / d.squaredNorm(), t3 = (x3 - x0).dot(d) / d.squaredNorm();
-    const double h0 = n0l / el, h1 = n1l / el;  // = 2 area / base
+    // Heights (= 2 area / base) bounded below by 1e-3 |e|, as ArcSim's distance() does: a sliver
+    // face's exact gradient grows as 1 / height (and the Gauss-Newton Jacobian as its square),
+    // which one nearly collapsed face turns into a kick that blows the step up.
+    const double h0 = std::max(n0l / el, kMinHingeHeight * el), h1 = std::max(n1l / el, kMinHingeHeight * el);
     gradient->segment<3>(0) = -((1 - t2) * n0 / h0 + (1 - t3) * n1 / h1);
     gradient->segment<3>(3) = -(t2 * n0 / h0 + t3 * n1 / h1);
     gradient->segment<3>(6) = n0 / h0;

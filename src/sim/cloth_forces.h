@@ -60,7 +60,10 @@ double StretchingForceBlocks(const Vector9d& x, const TriangleRest& rest, const 
 // Signed dihedral angle of the hinge x0-x1 shared by triangles (x0,x1,x2) and (x1,x0,x3):
 //   theta = atan2(e . (n0 x n1), n0 . n1), e = unit(x0 - x1), n0, n1 the unit face normals
 // (ArcSim's convention: theta grows as x2 moves along n0), 0 when flat [rad]; optionally its
-// gradient (12-vector) w.r.t. (x0, x1, x2, x3) (Bridson et al. 2003).
+// gradient (12-vector) w.r.t. (x0, x1, x2, x3) (Bridson et al. 2003), exact except for a sliver
+// face: the opposite vertices' heights over the edge enter the gradient bounded below by
+// kMinHingeHeight |x0 - x1|, as in ArcSim, so it stays bounded as a face collapses.
+constexpr double kMinHingeHeight = 1e-3;
 double DihedralAngle(const Vector12d& x, Vector12d* gradient = nullptr);
 
 struct BendingTerms {

@@ -154,6 +154,36 @@ TEST(BendingForceTest, DihedralGradientMatchesFiniteDifferences) {
   }
 }
 
+TEST(BendingForceTest, ASliverFacesDihedralGradientIsBoundedAsInArcSim) {
+  // x2 at height 1e-7 |e| over the hinge edge (a face nearly collapsed onto it): the exact
+  // gradient on x2 is n0 / h, 1e7 / |e|; ArcSim bounds h below by 1e-3 |e|, so the gradient is
+  // n0 / (1e-3 |e|) and x0, x1 take their barycentric shares of it. The other face, of normal
+  // height, keeps its exact terms; so does the angle itself.
+  const double el = 0.1;
+  Vector12d x = MakeHinge(0.7, 5);
+  x.segment<3>(0) = Eigen::Vector3d(0, 0, 0);
+  x.segment<3>(3) = Eigen::Vector3d(el, 0, 0);
+  const Eigen::Vector3d off = Eigen::Vector3d(0, std::cos(0.3), std::sin(0.3));
+  x.segment<3>(6) = Eigen::Vector3d(0.25 * el, 0, 0) + 1e-7 * el * off;
+  Vector12d g;
+  const double theta = DihedralAngle(x, &g);
+  const Eigen::Vector3d n0 =
+      (x.segment<3>(3) - x.segment<3>(0)).cross(x.segment<3>(6) - x.segment<3>(0)).normalized();
+  EXPECT_LT((g.segment<3>(6) - n0 / (1e-3 * el)).norm(), 1e-9 * (1 / (1e-3 * el)));
+  // Barycentric shares along the edge: x2 projects at t = 0.25 (weight 0.75 on x0, 0.25 on x1),
+  // so the n0 parts on x0 and x1 are -0.75 and -0.25 times x2's.
+  Vector12d x_far = x;
+  x_far.segment<3>(6) = Eigen::Vector3d(0.25 * el, 0, 0) + 0.05 * off;  // same face plane, normal height
+  Vector12d g_far;
+  DihedralAngle(x_far, &g_far);
+  const Eigen::Vector3d other0 = g_far.segment<3>(0) + 0.75 * g_far.segment<3>(6);  // x3's part on x0
+  const Eigen::Vector3d other1 = g_far.segment<3>(3) + 0.25 * g_far.segment<3>(6);
+  EXPECT_LT((g.segment<3>(0) - (other0 - 0.75 * g.segment<3>(6))).norm(), 1e-9 * g.norm());
+  EXPECT_LT((g.segment<3>(3) - (other1 - 0.25 * g.segment<3>(6))).norm(), 1e-9 * g.norm());
+  EXPECT_TRUE(g.segment<3>(9) == g_far.segment<3>(9)) << "the normal face's term changed";
+  EXPECT_NEAR(theta, DihedralAngle(x_far), 1e-9) << "x2 moved within its face's plane";
+}
+
 TEST(BendingForceTest, FlatHingeHasZeroAngleAndSignFollowsArcSim) {
   Vector12d x = MakeHinge(0.0, 0);
   for (int i = 2; i < 12; i += 3) x[i] = 0;  // exactly planar
