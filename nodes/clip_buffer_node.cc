@@ -61,6 +61,7 @@ class ClipBufferNode {
     wind_frame_ = sensors::WindDirectionFrameGate(params.Get("wind_frame_id", ""));
     const int queue = params.Get("queue_size", 60);
     jpeg_quality_ = params.Get("jpeg_quality", jpeg_quality_);
+    index_interval_ = params.Get("index_interval", index_interval_);
     // An int is taken as its text (roslaunch makes one of record_dir:=20261206): read as a
     // string, that left record_dir empty and recorded nothing, without a word.
     record_dir_ = params.Get("record_dir", "");
@@ -79,6 +80,8 @@ class ClipBufferNode {
     if (queue < 1) throw std::invalid_argument("~queue_size must be >= 1, got " + std::to_string(queue));
     if (jpeg_quality_ < 1 || jpeg_quality_ > 100)
       throw std::invalid_argument("~jpeg_quality must be in 1..100, got " + std::to_string(jpeg_quality_));
+    if (!(index_interval_ >= 0 && index_interval_ <= 86400))
+      throw std::invalid_argument("~index_interval must be in 0..86400 s, got " + std::to_string(index_interval_));
     try {
       pipeline_ = std::make_unique<sensors::ClipPipeline>(o);
     } catch (const std::invalid_argument& e) {
@@ -114,7 +117,7 @@ class ClipBufferNode {
     last_open_attempt_ = ros::WallTime::now();
     try {
       writer_ = std::make_unique<sensors::AsyncDatasetWriter>(
-          std::make_unique<sensors::DatasetWriter>(record_dir_, jpeg_quality_), kRecordQueue);
+          std::make_unique<sensors::DatasetWriter>(record_dir_, jpeg_quality_, index_interval_), kRecordQueue);
       if (!recording_error_.empty()) ROS_INFO("clip_buffer: recording works again");
       recording_error_.clear();
       ROS_INFO("clip_buffer: recording clips to %s (%zu already there%s)", record_dir_.c_str(),
@@ -141,6 +144,7 @@ class ClipBufferNode {
   void OnImage(const sensor_msgs::ImageConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     last_input_ = ros::WallTime::now();
+    index_flush_asked_ = false;
     // An unstamped frame is dropped before it touches anything: taken as a bag loop, one frame
     // stamped 0 forgot the minute of readings the labels need (and lent the clips its frame_id).
     if (msg->header.stamp.isZero()) {
@@ -176,6 +180,7 @@ class ClipBufferNode {
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     last_input_ = ros::WallTime::now();
+    index_flush_asked_ = false;
     if (msg->header.stamp.isZero()) {
       NoteError("anemometer reading dropped: header.stamp is 0");
       return;
@@ -224,6 +229,12 @@ class ClipBufferNode {
     }
     if (!writer_ && !record_dir_.empty() && (ros::WallTime::now() - last_open_attempt_).toSec() >= kReopenEvery)
       OpenRecording();
+    // Input stopped (a replay ended, the camera paused): list the clips recorded since the last
+    // index rewrite now rather than after ~index_interval (after the clips just flushed).
+    if (writer_ && !index_flush_asked_ && (ros::WallTime::now() - last_input_).toSec() > flush_after_) {
+      writer_->RequestIndexFlush();
+      index_flush_asked_ = true;
+    }
     if (writer_) {  // the recording thread's failures, reported from here
       const auto r = writer_->stats();
       if (r.failed > failed_seen_) NoteError("recording failed: " + r.last_error);
@@ -232,6 +243,10 @@ class ClipBufferNode {
                   " clip(s) not recorded (queue of " + std::to_string(kRecordQueue) + " full)");
       failed_seen_ = r.failed;
       dropped_seen_ = r.dropped;
+      if (!r.index_error.empty() && r.index_error != index_error_seen_)
+        NoteError("index.json not rewritten (the clips are in place; the next rewrite or the next "
+                  "opening of the folder lists them): " + r.index_error);
+      index_error_seen_ = r.index_error;
     }
     // force_update once a wall second: Updater::update() waits for ROS time, which stands still
     // while a bag is paused and jumps back when it loops.
@@ -355,6 +370,7 @@ class ClipBufferNode {
     stat.add("clips recorded", r.written);
     stat.add("clips not recorded", not_recorded_ + r.failed + r.dropped);
     stat.add("clips waiting to be written", r.queued);
+    stat.add("clips not yet in index.json", r.unlisted);
     stat.addf("slowest clip write [s]", "%.3f", r.max_write_s);
     stat.add("errors", errors_);
     stat.add("last error", last_error_.empty() ? "(none)" : last_error_);
@@ -381,6 +397,9 @@ class ClipBufferNode {
   ros::WallTime last_input_;
   std::string record_dir_;
   int jpeg_quality_ = 95;
+  double index_interval_ = 30.0;  // [s] see sensors::DatasetWriter
+  std::string index_error_seen_;
+  bool index_flush_asked_ = false;  // since the last input
   std::string recording_error_;  // why record_dir_ is not open; empty when it is (or not set)
   ros::WallTime last_open_attempt_;
   std::string last_error_;

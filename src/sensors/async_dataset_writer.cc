@@ -41,7 +41,17 @@ bool AsyncDatasetWriter::Enqueue(LabelledClip clip, ClipSourceInfo source) {
 
 void AsyncDatasetWriter::Drain() {
   std::unique_lock<std::mutex> lock(mutex_);
-  idle_.wait(lock, [this] { return queue_.empty() && !busy_; });
+  flush_requested_ = true;
+  wake_.notify_one();
+  idle_.wait(lock, [this] { return queue_.empty() && !busy_ && !flush_requested_; });
+}
+
+void AsyncDatasetWriter::RequestIndexFlush() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    flush_requested_ = true;
+  }
+  wake_.notify_one();
 }
 
 AsyncDatasetWriter::Stats AsyncDatasetWriter::stats() const {
@@ -51,11 +61,43 @@ AsyncDatasetWriter::Stats AsyncDatasetWriter::stats() const {
   return s;
 }
 
+void AsyncDatasetWriter::FlushIndex(std::unique_lock<std::mutex>* lock) {
+  busy_ = true;
+  lock->unlock();
+  std::string error;
+  try {
+    writer_->FlushIndex();
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  const size_t unlisted = writer_->unlisted();
+  lock->lock();
+  busy_ = false;
+  stats_.unlisted = unlisted;
+  stats_.index_error = error;
+}
+
 void AsyncDatasetWriter::Run() {
   std::unique_lock<std::mutex> lock(mutex_);
+  const auto interval = std::chrono::duration<double>(writer_->index_interval());
+  auto has_work = [this] { return stop_ || flush_requested_ || !queue_.empty(); };
   for (;;) {
-    wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
-    if (queue_.empty()) break;  // stop_ and nothing left: the destructor's drain is done
+    // Clips waiting to be listed: wake after the interval even if nothing else comes.
+    if (stats_.unlisted > 0 && interval.count() > 0) {
+      if (!wake_.wait_for(lock, interval, has_work)) {
+        FlushIndex(&lock);
+        continue;
+      }
+    } else {
+      wake_.wait(lock, has_work);
+    }
+    if (queue_.empty()) {  // stop_ or a flush asked for, and nothing left to write
+      FlushIndex(&lock);
+      flush_requested_ = false;
+      idle_.notify_all();
+      if (stop_) break;
+      continue;
+    }
     auto item = std::move(queue_.front());
     queue_.pop_front();
     busy_ = true;
@@ -68,8 +110,10 @@ void AsyncDatasetWriter::Run() {
       error = e.what();
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const size_t unlisted = writer_->unlisted();
     lock.lock();
     busy_ = false;
+    stats_.unlisted = unlisted;
     stats_.last_write_s = seconds;
     stats_.max_write_s = std::max(stats_.max_write_s, seconds);
     if (error.empty()) {

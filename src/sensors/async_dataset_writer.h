@@ -28,13 +28,19 @@ class AsyncDatasetWriter {
     double last_write_s = 0.0;     // wall time the last write took [s]
     double max_write_s = 0.0;      // the longest write so far [s]
     std::string last_error;        // of the last failed write
+    // Clips in place but not yet listed in index.json (the writer's index_interval); when the
+    // last index rewrite failed, index_error says why (cleared by the next one that works).
+    size_t unlisted = 0;
+    std::string index_error;
   };
 
   // Inputs:
   //   writer     an opened DatasetWriter (owned from now on)
   //   max_queue  clips waiting at most (>= 1)
   AsyncDatasetWriter(std::unique_ptr<DatasetWriter> writer, size_t max_queue = 16);
-  // Records what is queued, then stops the thread.
+  // Records what is queued, lists it in index.json, then stops the thread. While idle the
+  // thread rewrites the index once clips have waited index_interval to be listed, so a
+  // recording that pauses (a replay that ended) does not leave its last clips unlisted.
   ~AsyncDatasetWriter();
   AsyncDatasetWriter(const AsyncDatasetWriter&) = delete;
   AsyncDatasetWriter& operator=(const AsyncDatasetWriter&) = delete;
@@ -43,8 +49,13 @@ class AsyncDatasetWriter {
   // Returns false when the queue was full (counted in dropped).
   bool Enqueue(LabelledClip clip, ClipSourceInfo source);
 
-  // Blocks until every queued clip is recorded (or failed).
+  // Blocks until every queued clip is recorded (or failed) and index.json lists them (or its
+  // rewrite failed: stats().index_error).
   void Drain();
+
+  // Asks the thread to rewrite index.json once the clips queued now are written (if any clip is
+  // unlisted then); returns at once.
+  void RequestIndexFlush();
 
   Stats stats() const;
   const std::string& root() const { return root_; }
@@ -61,7 +72,9 @@ class AsyncDatasetWriter {
   mutable std::mutex mutex_;
   std::condition_variable wake_, idle_;
   std::deque<std::pair<LabelledClip, ClipSourceInfo>> queue_;
-  bool busy_ = false, stop_ = false;
+  bool busy_ = false, stop_ = false, flush_requested_ = false;
+  // Rewrites the index now if clips are unlisted (thread only, mutex not held); updates stats_.
+  void FlushIndex(std::unique_lock<std::mutex>* lock);
   Stats stats_;
   std::thread thread_;
 };

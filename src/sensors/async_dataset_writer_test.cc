@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <chrono>
 #include <fstream>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -75,12 +77,52 @@ TEST_F(AsyncDatasetWriterTest, FailedWriteIsCountedWithItsReason) {
   EXPECT_NE(s.last_error.find("empty clip"), std::string::npos) << s.last_error;
 }
 
+TEST_F(AsyncDatasetWriterTest, AnIdleWriterListsItsUnlistedClipsOnceTheIndexIntervalPasses) {
+  // Interval 2 s: two clips queued at once, the second is written within the interval of the
+  // first's index rewrite, so it waits unlisted; with no clip after it (a replay that ended) the
+  // idle thread rewrites the index once the interval has passed, without Drain.
+  AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string(), 95, 2.0), 16);
+  ASSERT_TRUE(w.Enqueue(MakeClip(0), {}));
+  ASSERT_TRUE(w.Enqueue(MakeClip(1), {}));
+  for (int i = 0; i < 200 && w.stats().written < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_EQ(w.stats().written, 2u);
+  EXPECT_EQ(IndexSize(), 1u);
+  EXPECT_EQ(w.stats().unlisted, 1u);
+  for (int i = 0; i < 1000 && IndexSize() < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(IndexSize(), 2u);
+  EXPECT_EQ(w.stats().unlisted, 0u);
+  EXPECT_EQ(w.stats().index_error, "");
+}
+
+TEST_F(AsyncDatasetWriterTest, DrainListsEveryClipWhateverTheIndexInterval) {
+  AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string(), 95, 3600.0), 16);
+  for (uint64_t k = 0; k < 5; ++k) ASSERT_TRUE(w.Enqueue(MakeClip(k), {}));
+  w.Drain();
+  EXPECT_EQ(w.stats().written, 5u);
+  EXPECT_EQ(IndexSize(), 5u);
+  EXPECT_EQ(w.stats().unlisted, 0u);
+  ASSERT_TRUE(w.Enqueue(MakeClip(5), {}));
+  w.Drain();
+  EXPECT_EQ(IndexSize(), 6u);
+  // RequestIndexFlush: the same without waiting.
+  for (uint64_t k = 6; k < 9; ++k) ASSERT_TRUE(w.Enqueue(MakeClip(k), {}));
+  w.RequestIndexFlush();
+  for (int i = 0; i < 1000 && IndexSize() < 9; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(IndexSize(), 9u);
+  EXPECT_EQ(w.stats().written, 9u);
+}
+
 TEST_F(AsyncDatasetWriterTest, DestructorRecordsWhatIsQueued) {
   {
     AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string()), 16);
     for (uint64_t k = 0; k < 8; ++k) ASSERT_TRUE(w.Enqueue(MakeClip(k), {}));
   }
   EXPECT_EQ(IndexSize(), 8u);
+  {  // and lists them with an index interval too
+    AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string(), 95, 3600.0), 16);
+    for (uint64_t k = 8; k < 12; ++k) ASSERT_TRUE(w.Enqueue(MakeClip(k), {}));
+  }
+  EXPECT_EQ(IndexSize(), 12u);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -100,10 +101,12 @@ nlohmann::json ClipLabelJson(const LabelledClip& c, const ClipSourceInfo& source
   return j;
 }
 
-DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality)
-    : root_(root), jpeg_quality_(jpeg_quality) {
+DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality, double index_interval)
+    : root_(root), jpeg_quality_(jpeg_quality), index_interval_(index_interval) {
   if (jpeg_quality < 1 || jpeg_quality > 100)
     throw std::invalid_argument("jpeg_quality must be in 1..100, got " + std::to_string(jpeg_quality));
+  if (!(index_interval >= 0 && index_interval <= 86400))
+    throw std::invalid_argument("index_interval must be in 0..86400 s, got " + std::to_string(index_interval));
   std::error_code ec;
   // Only the folder itself: its parent made here (a USB disk's mount point before the disk came)
   // was later hidden by the disk, whose own index the first clip after the mount replaced.
@@ -160,7 +163,20 @@ DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality)
   if (reindexed_ > 0) WriteIndex();
 }
 
-DatasetWriter::~DatasetWriter() = default;
+DatasetWriter::~DatasetWriter() {
+  try {
+    FlushIndex();
+  } catch (const std::exception&) {
+    // The clips are in place; the next writer to open the folder lists them.
+  }
+}
+
+bool DatasetWriter::FlushIndex() {
+  if (unlisted_ == 0) return false;
+  CheckSameFolder();
+  WriteIndex();
+  return true;
+}
 
 DatasetWriter::LockFile::~LockFile() {
   if (fd >= 0) ::close(fd);  // releases the lock
@@ -251,6 +267,7 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
       }
     }
     clips.push_back(IndexEntry(name, label));
+    ++unlisted_;
   } catch (const fs::filesystem_error& e) {
     fs::remove_all(tmp_dir, ec);
     throw std::runtime_error(std::string("recording clip ") + name + ": " + e.what());
@@ -258,6 +275,9 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
     fs::remove_all(tmp_dir, ec);
     throw;
   }
+  if (index_interval_ > 0 &&
+      std::chrono::steady_clock::now() - last_index_write_ < std::chrono::duration<double>(index_interval_))
+    return final_dir;  // listed by a later rewrite
   try {
     WriteIndex();
   } catch (const std::exception& e) {
@@ -294,6 +314,8 @@ size_t DatasetWriter::RecoverLeftovers() {
 void DatasetWriter::WriteIndex() {
   WriteFileAtomically(root_ + "/index.json",
                       index_.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  unlisted_ = 0;
+  last_index_write_ = std::chrono::steady_clock::now();
 }
 
 }  // namespace clothwind::sensors

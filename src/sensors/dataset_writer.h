@@ -1,6 +1,7 @@
 #ifndef CLOTHWIND_SENSORS_DATASET_WRITER_H_
 #define CLOTHWIND_SENSORS_DATASET_WRITER_H_
 
+#include <chrono>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -42,6 +43,12 @@ class DatasetWriter {
   //                 mounted yet is an error, not a folder made on the root filesystem that the
   //                 disk later hides)
   //   jpeg_quality  1..100 (95)
+  //   index_interval  least seconds between rewrites of index.json (0: after every clip). Why:
+  //                 the index is rewritten whole (~270 bytes a clip), so after a day at one clip
+  //                 every 1.2 s each rewrite is ~19 MB, fsync'ed, and rewriting it for every clip
+  //                 writes more than the clips' JPEGs by far. Clips written since the last
+  //                 rewrite are in place but not listed (unlisted()): FlushIndex, the destructor
+  //                 or the next writer to open the folder (which lists clips in place) lists them.
   // Holds an exclusive lock on <root>/.lock while it lives: a second writer (another node, a
   // replay into the folder being recorded) is refused, since each rewrites the whole index.
   // Clip folders that a writer which died had renamed into place but not yet listed are added
@@ -49,7 +56,9 @@ class DatasetWriter {
   // Throws std::runtime_error when the folder cannot be created or locked or its index.json is
   // not valid (the message names the file and what was expected); an index that cannot be read
   // is never overwritten.
-  explicit DatasetWriter(const std::string& root, int jpeg_quality = 95);
+  explicit DatasetWriter(const std::string& root, int jpeg_quality = 95, double index_interval = 0.0);
+  // Lists unlisted clips (FlushIndex); a failure is swallowed: the clips are in place, and the
+  // next writer to open the folder lists them.
   ~DatasetWriter();
   DatasetWriter(const DatasetWriter&) = delete;
   DatasetWriter& operator=(const DatasetWriter&) = delete;
@@ -59,10 +68,19 @@ class DatasetWriter {
   // same session replayed again; if that fails the old folder stays). Throws std::runtime_error
   // naming the file that failed; nothing half-written is left behind. When only the index update
   // failed the message says so: the clip is in place and the next index written lists it.
+  // index.json is rewritten unless the last rewrite was less than index_interval ago.
   std::string Write(const LabelledClip& clip, const ClipSourceInfo& source);
 
-  // Clips listed in the index.
+  // Rewrites index.json if any clip is unlisted; returns whether it did. Throws
+  // std::runtime_error naming the file when the rewrite fails (the clips stay in place, and
+  // stay counted in unlisted()).
+  bool FlushIndex();
+
+  // Clips in the index held here (those on disk plus the unlisted ones).
   size_t size() const { return index_["clips"].size(); }
+  // Clips recorded (or replaced) since index.json on disk was last rewritten.
+  size_t unlisted() const { return unlisted_; }
+  double index_interval() const { return index_interval_; }
   const std::string& root() const { return root_; }
   // Temporaries of a writer that died, cleared when this one opened the folder.
   size_t recovered() const { return recovered_; }
@@ -81,6 +99,9 @@ class DatasetWriter {
   int jpeg_quality_;
   nlohmann::json index_;
   size_t recovered_ = 0, reindexed_ = 0;
+  double index_interval_ = 0.0;
+  size_t unlisted_ = 0;
+  std::chrono::steady_clock::time_point last_index_write_{};
   // The held <root>/.lock: a member that closes it, so a constructor that throws after taking it
   // releases it too (a destructor of the writer would not run then).
   struct LockFile {

@@ -141,6 +141,38 @@ TEST_F(DatasetWriterTest, ReopenAppendsAndRewriteReplaces) {
   EXPECT_EQ(folders, 3);
 }
 
+TEST_F(DatasetWriterTest, WithAnIndexIntervalClipsAreListedByTheNextRewriteFlushOrClose) {
+  // index_interval 1 h: the first clip's write rewrites the index (none written yet), the next
+  // two are in place but unlisted until FlushIndex; the destructor lists the last one. Every
+  // clip is recorded whole meanwhile, and a writer opening the folder after a crash would list
+  // what the index lacks (ClipsInPlaceButNotListedAreIndexedOnOpen).
+  {
+    DatasetWriter w(root_.string(), 95, 3600.0);
+    w.Write(MakeClip(0, 1700000000.0), {});
+    EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 1u);
+    EXPECT_EQ(w.unlisted(), 0u);
+    w.Write(MakeClip(1, 1700000001.2), {});
+    w.Write(MakeClip(2, 1700000002.4), {});
+    EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 1u) << "rewritten before the interval passed";
+    EXPECT_TRUE(fs::exists(root_ / ClipFolderName(1700000002.4, 2) / "label.json"));
+    EXPECT_EQ(w.unlisted(), 2u);
+    EXPECT_EQ(w.size(), 3u);
+    EXPECT_TRUE(w.FlushIndex());
+    EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 3u);
+    EXPECT_EQ(w.unlisted(), 0u);
+    EXPECT_FALSE(w.FlushIndex()) << "nothing unlisted: no rewrite";
+    w.Write(MakeClip(3, 1700000003.6), {});
+    EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 3u);
+  }
+  EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 4u) << "the destructor lists the last clip";
+  // Interval 0 (the default): every clip rewrites the index.
+  DatasetWriter every(root_.string());
+  every.Write(MakeClip(4, 1700000004.8), {});
+  EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 5u);
+  EXPECT_EQ(every.unlisted(), 0u);
+  EXPECT_THROW(DatasetWriter(root_.string() + "-x", 95, -1.0), std::invalid_argument);
+}
+
 TEST_F(DatasetWriterTest, CorruptIndexIsAClearError) {
   fs::create_directories(root_);
   std::ofstream(root_ / "index.json") << "{ not json";

@@ -201,8 +201,15 @@ class ReplayTest(unittest.TestCase):
     def test_recorded_dataset(self):
         if not self.record_dir:
             self.skipTest('not recording')
-        with open(os.path.join(self.record_dir, 'index.json')) as f:
-            index = json.load(f)
+        # The clip buffer rewrites the index at most every ~index_interval, and once input has
+        # stopped for ~flush_after: the last clips are listed within seconds of the last publish.
+        deadline = time.time() + 15
+        while True:
+            with open(os.path.join(self.record_dir, 'index.json')) as f:
+                index = json.load(f)
+            if len(index['clips']) >= len(self.clips) or time.time() > deadline:
+                break
+            time.sleep(0.2)
         self.assertEqual(index['format'], 'clothwind-dataset')
         self.assertEqual(len(index['clips']), len(self.clips))
         # No temporaries left (the writer's lock file, .lock, stays: it is held, not written).
