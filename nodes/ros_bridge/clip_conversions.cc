@@ -99,6 +99,9 @@ sensors::LabelReading ToLabelReading(const clothwind::WindMeasurement& msg) {
   // averaged into a minute of labels) is skipped as an invalid reading is.
   r.speed = msg.valid && msg.speed >= 0 && msg.speed <= 150 ? msg.speed : std::numeric_limits<double>::quiet_NaN();
   r.direction = msg.direction;
+  r.source = msg.source;
+  r.frame_id = msg.header.frame_id;
+  r.relative = msg.relative;
   return r;
 }
 

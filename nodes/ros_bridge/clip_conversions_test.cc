@@ -122,6 +122,14 @@ TEST(ToLabelReadingTest, SpeedsAWindMeasurementCannotHaveAreSkipped) {
   }
   m.speed = 7.5;
   EXPECT_EQ(ToLabelReading(m).speed, 7.5);
+  // The instrument travels with the reading, into the clip's label.json.
+  m.source = "gill";
+  m.header.frame_id = "mast_anemometer";
+  m.relative = true;
+  const sensors::LabelReading r = ToLabelReading(m);
+  EXPECT_EQ(r.source, "gill");
+  EXPECT_EQ(r.frame_id, "mast_anemometer");
+  EXPECT_TRUE(r.relative);
   m.valid = false;
   EXPECT_TRUE(std::isnan(ToLabelReading(m).speed));
 }

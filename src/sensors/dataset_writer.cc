@@ -98,6 +98,11 @@ nlohmann::json ClipLabelJson(const LabelledClip& c, const ClipSourceInfo& source
                {"count", l.count},            {"direction_mean", Number(l.direction_mean)},
                {"direction_frame_id", source.wind_frame_id},
                {"first_stamp", Number(l.first_stamp)}, {"last_stamp", Number(l.last_stamp)}};
+  nlohmann::json sources = nlohmann::json::array();
+  for (const WindLabelSource& w : l.sources)
+    sources.push_back({{"source", w.source}, {"frame_id", w.frame_id}, {"count", w.count}});
+  j["wind"]["sources"] = sources;
+  j["wind"]["relative_count"] = l.relative_count;
   return j;
 }
 

@@ -34,7 +34,9 @@ class DatasetWriterTest : public ::testing::Test {
     c.roi = {40, 0, 240};
     c.source_width = 320;
     c.source_height = 240;
-    c.label = ComputeWindLabel({{t0 - 1.0, 3.0, 0.5}, {t0, 5.0, 0.5}}, t0 + 0.12, 60.0);
+    c.label = ComputeWindLabel({{t0 - 1.0, 3.0, 0.5, "nmea_mwv", "anemometer", false},
+                                {t0, 5.0, 0.5, "nmea_mwv", "anemometer", false}},
+                               t0 + 0.12, 60.0);
     return c;
   }
 
@@ -78,6 +80,9 @@ TEST_F(DatasetWriterTest, WritesFramesLabelAndIndex) {
   EXPECT_DOUBLE_EQ(label["wind_speed"].get<double>(), 4.0);
   EXPECT_DOUBLE_EQ(label["wind"]["std"].get<double>(), 1.0);
   EXPECT_EQ(label["wind"]["count"], 2);
+  EXPECT_EQ(label["wind"]["sources"],
+            nlohmann::json::parse(R"([{"source": "nmea_mwv", "frame_id": "anemometer", "count": 2}])"));
+  EXPECT_EQ(label["wind"]["relative_count"], 0);
   EXPECT_EQ(label["wind"]["direction_frame_id"], "anemometer");
   EXPECT_EQ(label["roi"]["x"], 40);
   EXPECT_EQ(label["source"]["frame_id"], "camera_optical_frame");

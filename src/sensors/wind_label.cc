@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace clothwind::sensors {
 namespace {
@@ -18,9 +20,13 @@ struct Accumulator {
   double sin_sum = 0.0, cos_sum = 0.0;
   uint32_t directions = 0;
   double first = kNaN, last = kNaN;
+  std::map<std::pair<std::string, std::string>, uint32_t> sources;
+  uint32_t relative = 0;
 
   void Add(const LabelReading& r) {
     ++count;
+    ++sources[{r.source, r.frame_id}];
+    if (r.relative) ++relative;
     const double delta = r.speed - mean;
     mean += delta / count;
     m2 += delta * (r.speed - mean);
@@ -44,6 +50,8 @@ struct Accumulator {
         (directions && (sin_sum != 0.0 || cos_sum != 0.0)) ? std::atan2(sin_sum, cos_sum) : kNaN;
     label.first_stamp = first;
     label.last_stamp = last;
+    for (const auto& [key, n] : sources) label.sources.push_back({key.first, key.second, n});
+    label.relative_count = relative;
     return label;
   }
 };

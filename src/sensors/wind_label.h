@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <string>
 #include <vector>
 
 namespace clothwind::sensors {
@@ -13,6 +14,21 @@ struct LabelReading {
   double stamp = 0.0;      // when the reading was taken [s] (header.stamp)
   double speed = 0.0;      // [m/s]; NaN readings are ignored
   double direction = 0.0;  // [rad], WindMeasurement convention; NaN when the instrument gives none
+  // Which instrument measured it: the protocol (WindMeasurement.source, e.g. "nmea_mwv") and the
+  // instrument's frame (header.frame_id); and whether it is apparent (relative) wind.
+  std::string source{};
+  std::string frame_id{};
+  bool relative = false;
+};
+
+// The readings of one instrument (source and frame) among a label's.
+struct WindLabelSource {
+  std::string source;
+  std::string frame_id;
+  uint32_t count = 0;
+  bool operator==(const WindLabelSource& o) const {
+    return source == o.source && frame_id == o.frame_id && count == o.count;
+  }
 };
 
 // The anemometer label of a clip: statistics of the readings stamped in [end - window, end].
@@ -25,6 +41,11 @@ struct WindLabel {
   double direction_mean = 0.0;  // circular mean [rad] in (-pi, pi]; NaN when no reading has one
   double first_stamp = 0.0;     // stamp of the earliest / latest reading in the window [s]; NaN if none
   double last_stamp = 0.0;
+  // The instruments whose readings were counted, sorted by (source, frame_id), and how many of
+  // the counted readings were apparent (relative) wind: a label that mixes two anemometers, or
+  // relative with true wind, says so.
+  std::vector<WindLabelSource> sources;
+  uint32_t relative_count = 0;
 };
 
 // Computes the label over [end - window, end] (both ends included) from readings in any order.

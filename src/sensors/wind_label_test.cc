@@ -39,6 +39,27 @@ TEST(WindLabelTest, CircularMeanAcrossPi) {
   EXPECT_NEAR(std::fabs(l.direction_mean), M_PI, 1e-12);
 }
 
+TEST(WindLabelTest, TheLabelNamesItsInstrumentsAndCountsRelativeReadings) {
+  // Two anemometers on one topic (a masthead Gill giving apparent wind, a station's MWV giving
+  // true wind): the label counts each one's readings in the window, leaves out a reading outside
+  // it and one without a speed, and counts the relative ones; WindLabeller agrees.
+  std::vector<LabelReading> readings = {
+      {1.0, 3.0, 0.1, "gill", "mast", true},      {2.0, 3.2, 0.1, "nmea_mwv", "station", false},
+      {3.0, 3.1, 0.1, "gill", "mast", true},      {4.0, kNaN, 0.1, "nmea_xdr", "other", false},
+      {-9.0, 3.0, 0.1, "csv", "old", false},      {5.0, 3.3, 0.1, "nmea_mwv", "station", false},
+      {6.0, 3.3, 0.1, "gill", "mast", true}};
+  const WindLabel l = ComputeWindLabel(readings, 6.0, 6.0);
+  EXPECT_EQ(l.count, 5u);
+  const std::vector<WindLabelSource> want = {{"gill", "mast", 3}, {"nmea_mwv", "station", 2}};
+  EXPECT_EQ(l.sources, want);
+  EXPECT_EQ(l.relative_count, 3u);
+  WindLabeller labeller(6.0);
+  for (const auto& r : readings) labeller.Add(r);
+  EXPECT_EQ(labeller.Label(6.0).sources, want);
+  EXPECT_EQ(labeller.Label(6.0).relative_count, 3u);
+  EXPECT_TRUE(ComputeWindLabel(readings, 50.0, 1.0).sources.empty()) << "no reading, no instrument";
+}
+
 TEST(WindLabelTest, LabellerMatchesByStampNotArrival) {
   // The same readings added shuffled give the label of the sorted list, over any window.
   std::vector<LabelReading> readings;
