@@ -9,7 +9,9 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -68,20 +70,98 @@ inline void SyncDirectory(const std::string& dir) {
   if (rc != 0) throw std::runtime_error("cannot sync folder " + dir + ": " + std::strerror(err));
 }
 
-// A temporary name beside `path`, unique within this process and among processes.
+namespace atomic_file_internal {
+
+// The first 8 hex digits of this boot's id (/proc/sys/kernel/random/boot_id), "" if unreadable.
+inline std::string BootTag() {
+  std::FILE* f = std::fopen("/proc/sys/kernel/random/boot_id", "r");
+  if (!f) return "";
+  char buf[64] = {0};
+  const bool ok = std::fgets(buf, sizeof buf, f) != nullptr;
+  std::fclose(f);
+  std::string tag;
+  for (const char* c = buf; ok && *c && tag.size() < 8; ++c)
+    if (std::isxdigit(static_cast<unsigned char>(*c))) tag += *c;
+  return tag.size() == 8 ? tag : "";
+}
+
+// When process `pid` started, in clock ticks after boot (/proc/<pid>/stat field 22), "" if
+// unreadable (no such process).
+inline std::string ProcessStartTicks(long pid) {
+  std::FILE* f = std::fopen(("/proc/" + std::to_string(pid) + "/stat").c_str(), "r");
+  if (!f) return "";
+  char buf[1024] = {0};
+  const size_t n = std::fread(buf, 1, sizeof buf - 1, f);
+  std::fclose(f);
+  const std::string stat(buf, n);
+  // Fields after the command name, which is in parentheses and may hold spaces or ')'.
+  const size_t close = stat.rfind(')');
+  if (close == std::string::npos) return "";
+  size_t pos = close + 1;
+  for (int field = 3; field <= 22; ++field) {
+    while (pos < stat.size() && stat[pos] == ' ') ++pos;
+    const size_t end = stat.find(' ', pos);
+    if (field == 22) return stat.substr(pos, end == std::string::npos ? std::string::npos : end - pos);
+    if (end == std::string::npos) return "";
+    pos = end;
+  }
+  return "";
+}
+
+}  // namespace atomic_file_internal
+
+// This process as temporary names record it: "<pid>.<boot>.<start>" (boot: BootTag, start: its
+// start time in ticks after boot), or "<pid>" where /proc cannot be read. Why more than the pid:
+// after a reboot a dead writer's pid can belong to a live process, whose temporaries are not
+// cleared (and a clip the writer was replacing stays hidden); the boot and start time tell that
+// process apart from the writer.
+inline const std::string& ProcessTag() {
+  static const std::string tag = [] {
+    const std::string pid = std::to_string(::getpid());
+    const std::string boot = atomic_file_internal::BootTag();
+    const std::string start = atomic_file_internal::ProcessStartTicks(::getpid());
+    return boot.empty() || start.empty() ? pid : pid + "." + boot + "." + start;
+  }();
+  return tag;
+}
+
+// A temporary name beside `path`, unique within this process and among processes:
+// "<path>.tmp-<ProcessTag>-<n>".
 inline std::string TemporaryNameFor(const std::string& path) {
   static std::atomic<unsigned long long> counter{0};
-  return path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  return path + ".tmp-" + ProcessTag() + "-" + std::to_string(counter++);
 }
 
 // Whether `name` (a file name) is a temporary TemporaryNameFor gave a process that no longer
-// runs: what a crash or Ctrl-C left behind, safe to clear. A live writer's are not.
+// runs: what a crash or Ctrl-C left behind, safe to clear. A live writer's are not. A name
+// made in another boot, or whose pid now belongs to a process started at another time, is a
+// stopped process's; names with a pid alone (older ones) are judged by the pid.
 // Inputs: name, a file or folder name. Outputs: at, where ".tmp-" starts in it (may be null).
 inline bool IsTemporaryOfStoppedProcess(const std::string& name, size_t* at = nullptr) {
   const size_t pos = name.rfind(".tmp-");
   if (pos == std::string::npos) return false;
-  const long pid = std::strtol(name.c_str() + pos + 5, nullptr, 10);
-  if (pid <= 0 || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) return false;
+  char* end = nullptr;
+  const long pid = std::strtol(name.c_str() + pos + 5, &end, 10);
+  if (pid <= 0) return false;
+  bool stopped;
+  if (*end == '.') {  // "<pid>.<boot>.<start>-<n>"
+    const std::string rest(end + 1);
+    const size_t dot = rest.find('.'), dash = rest.find('-');
+    if (dot == std::string::npos || dash == std::string::npos || dash < dot) return false;
+    const std::string boot = rest.substr(0, dot), start = rest.substr(dot + 1, dash - dot - 1);
+    const std::string this_boot = atomic_file_internal::BootTag();
+    if (!this_boot.empty() && boot != this_boot) {
+      stopped = true;  // made before a reboot
+    } else if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
+      stopped = true;
+    } else {
+      const std::string now = atomic_file_internal::ProcessStartTicks(pid);
+      stopped = !now.empty() && now != start;  // the pid reused by a later process
+    }
+  } else {
+    stopped = ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+  }
+  if (!stopped) return false;
   if (at) *at = pos;
   return true;
 }

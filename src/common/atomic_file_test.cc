@@ -77,7 +77,33 @@ TEST_F(AtomicFileTest, AFailedWriteKeepsTheOldContentAndLeavesNoTemporary) {
 
 TEST_F(AtomicFileTest, TemporaryNamesDiffer) {
   EXPECT_NE(TemporaryNameFor("x"), TemporaryNameFor("x"));
-  EXPECT_EQ(TemporaryNameFor("x").rfind("x.tmp-" + std::to_string(::getpid()) + "-", 0), 0u);
+  EXPECT_EQ(TemporaryNameFor("x").rfind("x.tmp-" + ProcessTag() + "-", 0), 0u);
+  EXPECT_EQ(ProcessTag().rfind(std::to_string(::getpid()), 0), 0u);
+}
+
+TEST_F(AtomicFileTest, ATemporaryIsAStoppedProcessesByItsPidBootAndStartTime) {
+  // This process's own names are live; the same pid with another start time (a pid reused after
+  // the writer died) or from another boot (a reboot) is a stopped process's, as is a pid that
+  // does not run. Names with a pid alone (made before the tag) are judged by the pid.
+  const std::string live = TemporaryNameFor(".clip-x");
+  EXPECT_FALSE(IsTemporaryOfStoppedProcess(live));
+  const std::string pid = std::to_string(::getpid());
+  const std::string boot = atomic_file_internal::BootTag();
+  const std::string start = atomic_file_internal::ProcessStartTicks(::getpid());
+  if (boot.empty() || start.empty()) GTEST_SKIP() << "no /proc here: temporary names carry the pid alone";
+  EXPECT_EQ(ProcessTag(), pid + "." + boot + "." + start);
+  EXPECT_GT(std::stoll(start), 0);
+  size_t at = 0;
+  const std::string reused = ".clip-x.tmp-" + pid + "." + boot + "." + std::to_string(std::stoll(start) + 1) + "-0";
+  EXPECT_TRUE(IsTemporaryOfStoppedProcess(reused, &at));
+  EXPECT_EQ(at, 7u);  // where ".tmp-" starts
+  const std::string other_boot = boot == "00000000" ? "11111111" : "00000000";
+  EXPECT_TRUE(IsTemporaryOfStoppedProcess(".clip-x.tmp-" + pid + "." + other_boot + "." + start + "-0"));
+  EXPECT_TRUE(IsTemporaryOfStoppedProcess("index.json.tmp-999999999." + boot + ".5-0"));
+  EXPECT_FALSE(IsTemporaryOfStoppedProcess("index.json.tmp-" + pid + "-3"));
+  EXPECT_TRUE(IsTemporaryOfStoppedProcess("index.json.tmp-999999999-3"));
+  EXPECT_FALSE(IsTemporaryOfStoppedProcess("index.json"));
+  EXPECT_FALSE(IsTemporaryOfStoppedProcess("x.tmp-" + pid + ".garbled")) << "not a name it gives";
 }
 
 }  // namespace
