@@ -243,7 +243,8 @@ TEST(StrainLimiter, SweepsOnAStripStretchedAlongItsLengthConvergeSlowlyAndSaySo)
   const StrainLimitResult r = limiter.Project(Limits(5000), 0.01, &x, &v);
   EXPECT_TRUE(r.converged);
   EXPECT_LE(r.excess, 1e-3);
-  EXPECT_GT(r.sweeps, 30) << "the correction should need about a sweep per face of the strip";
+  // (2,123 sweeps when written: the correction creeps ~one face a sweep and overshoots back.)
+  EXPECT_GT(r.sweeps, 30) << "the correction should need at least a sweep per square of the strip";
   EXPECT_LT(r.sweeps, 5000);
   // (Faces are checked in turn, so a neighbour's projection can bring one within first.)
   EXPECT_GT(r.initially_violated, strip.mesh.F.rows() / 2);
