@@ -85,7 +85,7 @@ std::string TempPrefix(const std::string& name) { return "." + name + ".tmp-"; }
 
 std::string TempDirName(const std::string& name) {
   static std::atomic<uint64_t> counter{0};
-  return TempPrefix(name) + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  return TempPrefix(name) + ProcessTag() + "-" + std::to_string(counter++);
 }
 
 // The simulation index of an example or temp folder name ("flag-000012-v1",

@@ -22,7 +22,8 @@ namespace clothwind::data {
 // camera poses; each view is one example folder (ExampleName: "flag-000012-v1") of frames and a
 // label.json. Shard k of N does the simulations i ≡ k (mod N), so N machines give exactly the
 // files one machine would. A finished example is never redone (its folder exists) or seen half
-// written (each folder is written under ".<name>.tmp-<pid>-<n>" and renamed into place).
+// written (each folder is written under ".<name>.tmp-<pid>.<boot>.<start>-<n>", ProcessTag, and
+// renamed into place).
 struct DatasetOptions {
   render::SceneKind kind = render::SceneKind::kFlag;
   int64_t count = 0;           // simulations (examples = count × views)

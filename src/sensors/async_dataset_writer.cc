@@ -43,7 +43,7 @@ void AsyncDatasetWriter::Drain() {
   std::unique_lock<std::mutex> lock(mutex_);
   flush_requested_ = true;
   wake_.notify_one();
-  idle_.wait(lock, [this] { return queue_.empty() && !busy_ && !flush_requested_; });
+  idle_.wait(lock, [this] { return queue_.empty() && !busy_ && !flush_requested_ && !flushing_; });
 }
 
 void AsyncDatasetWriter::RequestIndexFlush() {
@@ -62,7 +62,7 @@ AsyncDatasetWriter::Stats AsyncDatasetWriter::stats() const {
 }
 
 void AsyncDatasetWriter::FlushIndex(std::unique_lock<std::mutex>* lock) {
-  busy_ = true;
+  flushing_ = true;  // (not busy_: no clip is being written, and stats().queued counts busy_)
   lock->unlock();
   std::string error;
   try {
@@ -72,7 +72,7 @@ void AsyncDatasetWriter::FlushIndex(std::unique_lock<std::mutex>* lock) {
   }
   const size_t unlisted = writer_->unlisted();
   lock->lock();
-  busy_ = false;
+  flushing_ = false;
   stats_.unlisted = unlisted;
   stats_.index_error = error;
 }
@@ -92,8 +92,11 @@ void AsyncDatasetWriter::Run() {
       wake_.wait(lock, has_work);
     }
     if (queue_.empty()) {  // stop_ or a flush asked for, and nothing left to write
-      FlushIndex(&lock);
+      // Cleared before the rewrite, so a request made while it runs (FlushIndex unlocks) is
+      // served by another one: cleared after, it was lost, and Drain returned with a clip
+      // written during the rewrite unlisted.
       flush_requested_ = false;
+      FlushIndex(&lock);
       idle_.notify_all();
       if (stop_) break;
       continue;

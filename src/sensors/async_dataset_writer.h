@@ -72,7 +72,7 @@ class AsyncDatasetWriter {
   mutable std::mutex mutex_;
   std::condition_variable wake_, idle_;
   std::deque<std::pair<LabelledClip, ClipSourceInfo>> queue_;
-  bool busy_ = false, stop_ = false, flush_requested_ = false;
+  bool busy_ = false, stop_ = false, flush_requested_ = false, flushing_ = false;
   // Rewrites the index now if clips are unlisted (thread only, mutex not held); updates stats_.
   void FlushIndex(std::unique_lock<std::mutex>* lock);
   Stats stats_;

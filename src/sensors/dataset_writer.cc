@@ -230,6 +230,7 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
   const std::string name = ClipFolderName(clip.clip.frames.front().stamp, clip.clip.sequence);
   const std::string final_dir = root_ + "/" + name;
   const std::string tmp_dir = TemporaryNameFor(root_ + "/." + name);
+  bool replaced = false;
   std::error_code ec;
   fs::create_directory(tmp_dir, ec);
   if (ec) throw std::runtime_error("cannot create " + tmp_dir + ": " + ec.message());
@@ -248,7 +249,8 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
     // (U+FFFD), not thrown: the throw stopped every later clip's recording.
     WriteFileAtomically(tmp_dir + "/label.json",
                         label.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
-    if (fs::exists(final_dir)) {  // replayed again: replace the old folder
+    replaced = fs::exists(final_dir);
+    if (replaced) {  // replayed again: replace the old folder
       // Two renames, not one: rename() cannot replace a non-empty folder. If the second fails the
       // old copy is put back, so the name never stays empty or hidden.
       const std::string old_dir = TemporaryNameFor(root_ + "/." + name + ".old");
@@ -280,8 +282,8 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
     fs::remove_all(tmp_dir, ec);
     throw;
   }
-  if (index_interval_ > 0 &&
-      std::chrono::steady_clock::now() - last_index_write_ < std::chrono::duration<double>(index_interval_))
+  if (index_interval_ > 0 && !replaced && last_index_write_ &&
+      std::chrono::steady_clock::now() - *last_index_write_ < std::chrono::duration<double>(index_interval_))
     return final_dir;  // listed by a later rewrite
   try {
     WriteIndex();
@@ -294,8 +296,9 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
 }
 
 size_t DatasetWriter::RecoverLeftovers() {
-  // Names this writer gives its temporaries: ".<clip>.tmp-<pid>-<n>" (a clip being written),
-  // ".<clip>.old.tmp-<pid>-<n>" (a clip being replaced) and "index.json.tmp-<pid>-<n>".
+  // Names this writer gives its temporaries: ".<clip>.tmp-<tag>-<n>" (a clip being written),
+  // ".<clip>.old.tmp-<tag>-<n>" (a clip being replaced) and "index.json.tmp-<tag>-<n>", tag the
+  // process's (ProcessTag: pid, boot, start time).
   size_t handled = 0;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(root_, ec)) {

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -68,7 +69,9 @@ class DatasetWriter {
   // same session replayed again; if that fails the old folder stays). Throws std::runtime_error
   // naming the file that failed; nothing half-written is left behind. When only the index update
   // failed the message says so: the clip is in place and the next index written lists it.
-  // index.json is rewritten unless the last rewrite was less than index_interval ago.
+  // index.json is rewritten unless the last rewrite was less than index_interval ago and the clip
+  // is new (a clip replaced is listed at once: the next writer to open the folder would list a
+  // missing clip, but not correct a stale entry).
   std::string Write(const LabelledClip& clip, const ClipSourceInfo& source);
 
   // Rewrites index.json if any clip is unlisted; returns whether it did. Throws
@@ -101,7 +104,7 @@ class DatasetWriter {
   size_t recovered_ = 0, reindexed_ = 0;
   double index_interval_ = 0.0;
   size_t unlisted_ = 0;
-  std::chrono::steady_clock::time_point last_index_write_{};
+  std::optional<std::chrono::steady_clock::time_point> last_index_write_;  // none: never written
   // The held <root>/.lock: a member that closes it, so a constructor that throws after taking it
   // releases it too (a destructor of the writer would not run then).
   struct LockFile {

@@ -147,12 +147,13 @@ TEST_F(DatasetWriterTest, ReopenAppendsAndRewriteReplaces) {
 }
 
 TEST_F(DatasetWriterTest, WithAnIndexIntervalClipsAreListedByTheNextRewriteFlushOrClose) {
-  // index_interval 1 h: the first clip's write rewrites the index (none written yet), the next
-  // two are in place but unlisted until FlushIndex; the destructor lists the last one. Every
+  // index_interval a day: the first clip's write rewrites the index (none written yet, however
+  // long the machine has been up: the steady clock starts at boot), the next two are in place
+  // but unlisted until FlushIndex; the destructor lists the last one. Every
   // clip is recorded whole meanwhile, and a writer opening the folder after a crash would list
   // what the index lacks (ClipsInPlaceButNotListedAreIndexedOnOpen).
   {
-    DatasetWriter w(root_.string(), 95, 3600.0);
+    DatasetWriter w(root_.string(), 95, 86400.0);
     w.Write(MakeClip(0, 1700000000.0), {});
     EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 1u);
     EXPECT_EQ(w.unlisted(), 0u);
@@ -176,6 +177,22 @@ TEST_F(DatasetWriterTest, WithAnIndexIntervalClipsAreListedByTheNextRewriteFlush
   EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 5u);
   EXPECT_EQ(every.unlisted(), 0u);
   EXPECT_THROW(DatasetWriter(root_.string() + "-x", 95, -1.0), std::invalid_argument);
+}
+
+TEST_F(DatasetWriterTest, AClipReplacedWithinTheIndexIntervalIsListedAtOnce) {
+  // A replay that replaces a clip changes its index entry; waiting for the interval left the old
+  // entry on disk, and a crash then kept it for good (opening a folder lists missing clips, it
+  // does not re-read those listed).
+  DatasetWriter w(root_.string(), 95, 86400.0);
+  w.Write(MakeClip(0, 1700000000.0), {});
+  w.Write(MakeClip(1, 1700000001.2), {});
+  EXPECT_EQ(w.unlisted(), 1u);
+  w.Write(MakeClip(0, 1700000000.0, 3), {});  // replaced, 3 frames now
+  EXPECT_EQ(w.unlisted(), 0u);
+  const auto index = Read(root_ / "index.json");
+  ASSERT_EQ(index["clips"].size(), 2u);
+  for (const auto& c : index["clips"])
+    if (c["name"] == ClipFolderName(1700000000.0, 0)) EXPECT_EQ(c["num_frames"], 3);
 }
 
 TEST_F(DatasetWriterTest, CorruptIndexIsAClearError) {

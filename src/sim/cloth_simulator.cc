@@ -633,6 +633,7 @@ void ClothSimulator::Step() {
   s.stats.strain_limited_faces = 0;  // (this step's, should the solve fail before the limiter)
   s.stats.strain_limit_sweeps = 0;
   s.stats.strain_limit_excess = 0;
+  s.stats.strain_limit_converged = true;
   s.stats.crossings_resolved = 0;
   s.ComputeForces(/*with_jacobian=*/true, repel);
   const auto t2 = Clock::now();
@@ -649,6 +650,7 @@ void ClothSimulator::Step() {
   s.stats.strain_limited_faces = 0;
   s.stats.strain_limit_sweeps = 0;
   s.stats.strain_limit_excess = 0;
+  s.stats.strain_limit_converged = true;
   if (s.options.strain_min > 0 || std::isfinite(s.options.strain_max)) {
     StrainLimitSettings limits;
     limits.min = s.options.strain_min;
@@ -659,6 +661,7 @@ void ClothSimulator::Step() {
     s.stats.strain_limited_faces = r.initially_violated;
     s.stats.strain_limit_sweeps = r.sweeps;
     s.stats.strain_limit_excess = r.excess;
+    s.stats.strain_limit_converged = r.converged;
   }
   // Vertices that jumped through a face during the step go back to their side (see
   // crossing_resolver.h): the repulsion alone lets fast folds pass through.

@@ -73,6 +73,7 @@ struct StepStats {
   // Largest relative excess over the limits in the limiter's last sweep (StrainLimitResult):
   // above strain_limit_tolerance when it stopped at strain_limit_iterations unconverged.
   double strain_limit_excess = 0;
+  bool strain_limit_converged = true;  // the limiter's sweeps ended within tolerance (or no limits)
   int crossings_resolved = 0;    // vertex-face crossings undone after the step
   bool implicit_bending = false;  // what kAuto (or the option) chose
   // Wall time of the phases of the step [s] (steady clock), for benches.

@@ -58,7 +58,7 @@ Trajectory SimulateTrajectory(const SceneSetup& setup, const Theta& theta,
       const StepStats& stats = sim.last_step_stats();
       t.solver_iterations += stats.cg_iterations;
       t.strain_limit_sweeps += stats.strain_limit_sweeps;
-      if (stats.strain_limit_excess > sim_options.strain_limit_tolerance) ++t.strain_limit_unconverged;
+      if (!stats.strain_limit_converged) ++t.strain_limit_unconverged;
     }
     t.steps += steps_per_frame;
   };

@@ -39,7 +39,8 @@ struct StrainLimitResult {
   int initially_violated = 0;
   int sweeps = 0;              // sweeps run (<= max_sweeps)
   // Largest relative excess found in the last sweep, before its projections: max over faces of
-  // s_max / max - 1 and 1 - s_min / min (0 when none); <= tolerance when converged.
+  // s_max / max - 1 and 1 - s_min / min (0 when none); when converged, <= tolerance (give or take
+  // the 1e-6 round-off slack on squared stretches that decides which faces are projected).
   double excess = 0.0;
   bool converged = false;  // the last sweep found no face outside the limits by more than tolerance
 };
