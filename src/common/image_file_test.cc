@@ -78,6 +78,37 @@ TEST_F(ImageFileTest, AJpegClaimingAHugeImageIsRefusedFromItsHeader) {
   EXPECT_NE(why.find("its header claims 40000x40000 pixels"), std::string::npos) << why;
 }
 
+TEST_F(ImageFileTest, DecodeJpegBgrMatchesImdecodeAndKeepsLibjpegsComplaints) {
+  // A clean JPEG: the same pixels as cv::imdecode's (both libjpeg-turbo, the same DCT). A damaged
+  // one: libjpeg's warning, where imdecode hands back made-up blocks. A header claiming 40000 x
+  // 40000: refused before any memory is set aside.
+  cv::Mat ours;
+  ASSERT_EQ(DecodeJpegBgr(jpeg_.data(), jpeg_.size(), &ours), "");
+  const cv::Mat theirs = cv::imdecode(jpeg_, cv::IMREAD_COLOR);
+  ASSERT_EQ(ours.type(), CV_8UC3);
+  ASSERT_EQ(ours.size(), theirs.size());
+  EXPECT_EQ(cv::norm(ours, theirs, cv::NORM_INF), 0.0);
+  std::vector<uint8_t> damaged = jpeg_;
+  size_t scan = 0;
+  for (size_t i = 2; i + 1 < damaged.size(); ++i)
+    if (damaged[i] == 0xFF && damaged[i + 1] == 0xDA) scan = i;
+  const size_t middle = (scan + damaged.size()) / 2;
+  for (size_t i = middle; i < middle + 40; ++i) damaged[i] = static_cast<uint8_t>(0xFF - (i % 7));
+  ASSERT_FALSE(cv::imdecode(damaged, cv::IMREAD_COLOR).empty());
+  EXPECT_NE(DecodeJpegBgr(damaged.data(), damaged.size(), &ours).find("Corrupt JPEG data"), std::string::npos);
+  std::vector<uint8_t> claim = jpeg_;
+  size_t sof = 0;
+  for (size_t i = 2; i + 9 < claim.size(); ++i)
+    if (claim[i] == 0xFF && (claim[i + 1] == 0xC0 || claim[i + 1] == 0xC2)) sof = i;
+  for (const size_t at : {sof + 5, sof + 7}) {
+    claim[at] = 40000 >> 8;
+    claim[at + 1] = 40000 & 0xFF;
+  }
+  EXPECT_NE(DecodeJpegBgr(claim.data(), claim.size(), &ours).find("40000x40000"), std::string::npos);
+  const std::vector<uint8_t> garbage = {0xFF, 0xD8, 0xFF, 0xDA, 0x12, 0x34, 0xFF, 0xD9};
+  EXPECT_NE(DecodeJpegBgr(garbage.data(), garbage.size(), &ours), "");
+}
+
 TEST_F(ImageFileTest, AJpegCutShortIsRefusedWhereImreadMakesRowsUp) {
   std::vector<uint8_t> cut(jpeg_.begin(), jpeg_.begin() + jpeg_.size() / 2);
   const fs::path p = Write("cut.jpg", cut);

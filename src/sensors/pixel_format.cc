@@ -86,17 +86,13 @@ bool ConvertToImage(PixelFormat format, const uint8_t* data, size_t bytes_used, 
     // cameras pad the buffer with zeros after the end marker).
     const std::string whole = common::JpegWholeness(data, bytes_used);
     if (!whole.empty()) return fail("MJPEG frame " + whole);
-    // imdecode only reads the buffer; the const_cast is for cv::Mat's non-const constructor.
-    const cv::Mat encoded(1, static_cast<int>(bytes_used), CV_8UC1, const_cast<uint8_t*>(data));
+    // One libjpeg pass that keeps its warnings: a frame damaged inside intact markers (a USB
+    // transfer corrupted, not lost) decodes into made-up blocks and only warns; cv::imdecode
+    // published it.
     cv::Mat decoded;
-    try {
-      decoded = cv::imdecode(encoded, cv::IMREAD_COLOR);
-    } catch (const cv::Exception& e) {
-      return fail(std::string("MJPEG decode failed: ") + e.what());
-    }
-    if (decoded.empty()) {
-      return fail("MJPEG decode failed (" + std::to_string(bytes_used) + " bytes, not a JPEG?)");
-    }
+    const std::string problem = common::DecodeJpegBgr(data, bytes_used, &decoded);
+    if (!problem.empty())
+      return fail("MJPEG decode failed (" + std::to_string(bytes_used) + " bytes): " + problem);
     if (decoded.cols != width || decoded.rows != height) {
       return fail("MJPEG frame decodes to " + std::to_string(decoded.cols) + "x" +
                   std::to_string(decoded.rows) + ", negotiated " + std::to_string(width) + "x" +

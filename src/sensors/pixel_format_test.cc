@@ -7,6 +7,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/image_file.h"
 
 namespace clothwind {
 namespace sensors {
@@ -170,6 +173,55 @@ TEST(PixelFormatTest, MjpegDecodesToBgrAndReportsGarbage) {
   std::vector<uint8_t> scanned = {0xFF, 0xD8, 0xFF, 0xDA, 0x12, 0x34, 0x56, 0xFF, 0xD9};
   EXPECT_FALSE(ConvertToImage(PixelFormat::kMjpeg, scanned.data(), scanned.size(), 64, 48, 0, &image, &error));
   EXPECT_NE(error.find("MJPEG decode failed"), std::string::npos) << error;
+}
+
+TEST(PixelFormatTest, AnMjpegFrameDamagedInsideIntactMarkersIsRefused) {
+  // A transfer corrupted, not lost: bytes inside the entropy-coded data changed, both markers
+  // intact. libjpeg decodes it into made-up blocks and only warns; cv::imdecode returned that
+  // image, and the camera published it. Every damage that libjpeg notices must be refused, the
+  // undamaged frame still decoded (grey frames come out BGR too).
+  cv::Mat original(96, 128, CV_8UC3);
+  cv::randu(original, 0, 255);
+  cv::GaussianBlur(original, original, cv::Size(5, 5), 2.0);
+  std::vector<uint8_t> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", original, jpeg, {cv::IMWRITE_JPEG_QUALITY, 90}));
+  size_t scan = 0;
+  for (size_t i = 2; i + 1 < jpeg.size(); ++i)
+    if (jpeg[i] == 0xFF && jpeg[i + 1] == 0xDA) scan = i;
+  ASSERT_GT(scan, 0u);
+  cv::Mat image;
+  std::string error;
+  int refused = 0, noticed = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    std::vector<uint8_t> damaged = jpeg;
+    // Ten bytes overwritten a third of the way into the scan data, never with a marker byte.
+    const size_t at = scan + 20 + (damaged.size() - scan - 40) / 3 + static_cast<size_t>(trial) * 7;
+    for (size_t k = 0; k < 10; ++k) damaged[at + k] = static_cast<uint8_t>((37 * (trial + k) + 11) % 255);
+    // What libjpeg says of it (the check image_file.h makes of files).
+    const bool libjpeg_warns = !common::JpegDataProblem(damaged.data(), damaged.size()).empty();
+    const bool ok = ConvertToImage(PixelFormat::kMjpeg, damaged.data(), damaged.size(), 128, 96, 0, &image, &error);
+    noticed += libjpeg_warns;
+    refused += !ok;
+    if (libjpeg_warns) {
+      EXPECT_FALSE(ok) << "trial " << trial << ": libjpeg warned, yet the frame was published";
+      if (!ok) {
+        EXPECT_NE(error.find("Corrupt JPEG data"), std::string::npos) << error;
+      }
+    }
+  }
+  EXPECT_GT(noticed, 10) << "the damage should mostly be noticeable (22 of 40 when written)";
+  EXPECT_EQ(refused, noticed);
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kMjpeg, jpeg.data(), jpeg.size(), 128, 96, 0, &image, &error)) << error;
+  cv::Mat grey;
+  cv::cvtColor(original, grey, cv::COLOR_BGR2GRAY);
+  std::vector<uint8_t> grey_jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", grey, grey_jpeg, {cv::IMWRITE_JPEG_QUALITY, 90}));
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kMjpeg, grey_jpeg.data(), grey_jpeg.size(), 128, 96, 0, &image, &error))
+      << error;
+  EXPECT_EQ(image.type(), CV_8UC3);
+  std::vector<cv::Mat> channels;
+  cv::split(image, channels);
+  EXPECT_EQ(cv::norm(channels[0], channels[2], cv::NORM_INF), 0.0);
 }
 
 }  // namespace
