@@ -112,7 +112,7 @@ std::string ModelConfig::Modality() const {
 }
 
 nlohmann::json ToJson(const ModelConfig& c) {
-  return {{"format", "clothwind-model"}, {"version", 1},   {"arch", c.arch},
+  return {{"format", "clothwind-model"}, {"version", kModelFormatVersion},   {"arch", c.arch},
           {"frames", c.frames},          {"channels", c.channels}, {"flow", c.flow}, {"flow_size", c.flow_size},
           {"colour", c.colour},
           {"k", c.k},                    {"include_dc", c.include_dc},
@@ -144,6 +144,25 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
       throw std::runtime_error(where + ": field \"" + key + "\" must be an integer, got " + v.dump());
     return v.get<int>();
   };
+  // A model from a newer clothwind: an option this build does not know was ignored, and the
+  // network computed other features from the same weights without a word (an older sdn_node
+  // loading a model trained with the still floor would have). Every field is one ToJson writes;
+  // a new option must come with a higher format version.
+  if (j.is_object()) {
+    if (j.contains("version") &&
+        (!j["version"].is_number_integer() || j["version"].get<int64_t>() < 1 ||
+         j["version"].get<int64_t>() > kModelFormatVersion))
+      throw std::runtime_error(where + ": field \"version\" is " + j["version"].dump() +
+                               ", this clothwind reads model format version " + std::to_string(kModelFormatVersion) +
+                               " (a model written by a newer clothwind?)");
+    static const nlohmann::json kKnown = ToJson(ModelConfig{});
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      if (!kKnown.contains(it.key()))
+        throw std::runtime_error(where + ": field \"" + it.key() + "\" is not one this clothwind knows (a model " +
+                                 "written by a newer clothwind? this one reads model format version " +
+                                 std::to_string(kModelFormatVersion) + ")");
+    }
+  }
   // The kind of every field read with get<> below, checked first: a wrong one threw nlohmann's
   // "type must be boolean, but is string", naming the file but not the field.
   if (j.is_object()) {

@@ -153,8 +153,12 @@ struct ModelConfig {
 // True for an architecture this version builds ("sdn", "resnet18", "lstm").
 bool IsKnownArch(const std::string& arch);
 
-// JSON round trip; FromJson throws std::runtime_error naming the missing or invalid field
-// (`where` names the file for the message).
+// The model.json format this build writes and reads: an option that changes what a network
+// computes must raise it, so an older clothwind refuses the file instead of ignoring the option.
+constexpr int kModelFormatVersion = 1;
+
+// JSON round trip; FromJson throws std::runtime_error naming the missing or invalid field, a
+// field it does not know, or a newer "version" (`where` names the file for the message).
 nlohmann::json ToJson(const ModelConfig& config);
 ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& where);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <future>
@@ -11,6 +12,7 @@
 #include <memory>
 #include <numeric>
 #include <random>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -211,11 +213,46 @@ namespace {
 void RemoveRun(const fs::path& out) {
   for (const auto& entry : fs::directory_iterator(out)) {
     const std::string name = entry.path().filename().string();
-    const bool run_file = name == "state.json" || name == "log.tsv" || name.rfind("checkpoint-e", 0) == 0 ||
-                          name.rfind("last", 0) == 0 || name.rfind("model.", 0) == 0 ||
-                          name.rfind("raw_model.", 0) == 0 || name.rfind("learning_curve.", 0) == 0;
+    // Exact names (and their temporaries): a prefix took a user's "last_eval/" or "model.onnx".
+    static const std::set<std::string> kFiles = {
+        "state.json", "log.tsv",       "last.pt",        "last_optim.pt",          "last_average.pt",
+        "model.pt",   "model.json",    "raw_model.pt",   "raw_model.json",         "learning_curve.png",
+        "learning_curve.png.dat",      "learning_curve.png.gp"};
+    const size_t tmp = name.find(".tmp-");
+    const std::string base = tmp == std::string::npos ? name : name.substr(0, tmp);
+    const bool run_file = kFiles.count(base) > 0 || name.rfind("checkpoint-e", 0) == 0 ||
+                          name.rfind(".checkpoint-e", 0) == 0;
     if (run_file) fs::remove_all(entry.path());
   }
+}
+
+// A fingerprint of the clips a run trains and validates on (names, splits, targets), so a resume
+// against another dataset is refused: the label scaling comes from the state, the clips from
+// --data, and a regenerated folder silently trained the run on other clips. Folder paths are left
+// out, so a dataset moved elsewhere still resumes.
+std::string DataFingerprint(const std::vector<ClipInfo>& train, const std::vector<ClipInfo>& val) {
+  uint64_t h = 1469598103934665603ULL;  // FNV-1a, 64 bit
+  auto add = [&h](const std::string& text) {
+    for (unsigned char c : text) {
+      h ^= c;
+      h *= 1099511628211ULL;
+    }
+    h ^= 0xff;  // separator
+    h *= 1099511628211ULL;
+  };
+  for (const auto* split : {&train, &val}) {
+    add("split");
+    for (const ClipInfo& c : *split) {
+      char target[32];
+      std::snprintf(target, sizeof target, "%.17g", c.wind_speed);
+      add(c.name);
+      add(c.split);
+      add(target);
+    }
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
 }
 
 // The model options a resumed run must be given as it started: they shape the network, and the
@@ -534,6 +571,12 @@ TrainResult Train(const TrainOptions& o) {
       }
     }
   }
+  const std::string data_fingerprint = DataFingerprint(train, val);
+  if (o.resume && state.contains("data_fingerprint") && state["data_fingerprint"] != data_fingerprint) {
+    throw std::runtime_error(state_path.string() + ": the run trained on other clips than " + o.data.string() +
+                             " holds now (their names, splits or wind speeds differ: another or a regenerated "
+                             "dataset); resume with the --data it started with, or start a new run");
+  }
   std::unique_ptr<AuxTargets> aux;
   if (o.aux_tracks > 0 && !train.empty()) {
     aux = std::make_unique<AuxTargets>(ReadAuxTargets(train, config.Sampling(), o.aux_phase_bins, o.aux_world));
@@ -579,6 +622,27 @@ TrainResult Train(const TrainOptions& o) {
     state.exp_avg_sq(state.exp_avg_sq().to(device));
     if (state.max_exp_avg_sq().defined()) state.max_exp_avg_sq(state.max_exp_avg_sq().to(device));
   }
+  const SampleOptions val_options = config.Sampling();
+  SampleOptions train_options = config.Sampling();
+  train_options.augment = true;
+  train_options.crop_scales = o.crop_scales;
+  train_options.flip = o.flip;
+  // With the frames cached, the validation split's files are read once, by the first validation,
+  // whose trunk input images serve every later one: a frame cache of it would be read only once.
+  // Checked and read before the run folder is touched: --overwrite deleted the old run and then
+  // refused --cache-frames.
+  std::unique_ptr<FrameCache> train_cache;
+  std::unique_ptr<ValidationImages> val_images;
+  if (o.cache_frames && !o.init_only) {
+    val_images = std::make_unique<ValidationImages>();
+    std::string why;
+    for (const ClipInfo& c : train) {
+      if (!FrameCache::Exact(train_options, c, &why)) {
+        throw std::runtime_error("--cache-frames would change the training samples: " + why);
+      }
+    }
+    train_cache = std::make_unique<FrameCache>(train, config.input_size, config.colour);
+  }
   // Made once the options, the data and the network are known good: a refusal used to leave an
   // empty folder.
   fs::create_directories(o.out);
@@ -596,25 +660,6 @@ TrainResult Train(const TrainOptions& o) {
   for (const EpochRecord& e : result.log) {
     result.best_val_rmse = std::min(result.best_val_rmse, e.val_rmse);
     best_raw_val_rmse = std::min(best_raw_val_rmse, e.raw_val_rmse);
-  }
-  const SampleOptions val_options = config.Sampling();
-  SampleOptions train_options = config.Sampling();
-  train_options.augment = true;
-  train_options.crop_scales = o.crop_scales;
-  train_options.flip = o.flip;
-  // With the frames cached, the validation split's files are read once, by the first validation,
-  // whose trunk input images serve every later one: a frame cache of it would be read only once.
-  std::unique_ptr<FrameCache> train_cache;
-  std::unique_ptr<ValidationImages> val_images;
-  if (o.cache_frames) {
-    val_images = std::make_unique<ValidationImages>();
-    std::string why;
-    for (const ClipInfo& c : train) {
-      if (!FrameCache::Exact(train_options, c, &why)) {
-        throw std::runtime_error("--cache-frames would change the training samples: " + why);
-      }
-    }
-    train_cache = std::make_unique<FrameCache>(train, config.input_size, config.colour);
   }
   // The seed clips gradients (max norm 10) for its recurrent models only.
   const double grad_clip = o.grad_clip >= 0 ? o.grad_clip : (config.arch == "lstm" ? 10.0 : 0.0);
@@ -667,6 +712,18 @@ TrainResult Train(const TrainOptions& o) {
         at::Tensor aux_loss = AuxLoss(outputs.aux, batch.aux.to(device));
         aux_sum += aux_loss.item<double>() * x.size(0);
         loss = loss + o.aux_tracks * aux_loss;
+      }
+      // One non-finite batch turns every weight NaN through Adam, and the run went on for hours to
+      // end "finished"; the last checkpoint is still the previous epoch's.
+      const double loss_value = loss.item<double>();
+      if (!std::isfinite(loss_value)) {
+        std::ostringstream what;
+        what << "epoch " << epoch << ", step " << step + 1 << " of " << steps << ": the training loss is "
+             << loss_value << " (a target or input not finite, or a learning rate too high); stopped before it "
+             << "reached the weights. " << (epoch > 1 ? "The checkpoint of epoch " + std::to_string(epoch - 1) +
+                                                            " is intact: --resume continues from it"
+                                                      : std::string("No epoch was saved"));
+        throw std::runtime_error(what.str());
       }
       loss.backward();
       if (grad_clip > 0) torch::nn::utils::clip_grad_norm_(net->parameters(), grad_clip);
@@ -743,7 +800,7 @@ TrainResult Train(const TrainOptions& o) {
              {"best_val_rmse", result.best_val_rmse}, {"checkpoint", checkpoint_name},
              {"batch", o.batch}, {"weight_decay", o.weight_decay}, {"grad_clip", o.grad_clip},
              {"epochs", o.epochs}, {"lr", o.lr}, {"lr_schedule", o.lr_schedule}, {"lr_decay_epoch", o.lr_decay_epoch},
-             {"validated_on", result.validated_on}};
+             {"validated_on", result.validated_on}, {"data_fingerprint", data_fingerprint}};
     WriteFileAtomically(state_path, state.dump(2));
     // Older checkpoints (and the files of the layout before checkpoint folders) once state.json
     // names the new one.

@@ -4,6 +4,7 @@
 #include "learn/train.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <random>
@@ -18,6 +19,7 @@
 #include <torch/types.h>
 #include <torch/nn/utils/clip_grad.h>
 #include <torch/optim/adam.h>
+#include <torch/serialize.h>
 
 #include "learn/aux_targets.h"
 #include "learn/dataset.h"
@@ -706,6 +708,27 @@ TEST(ModelConfig, AStillFloorRoundTripsReachesTheLayerAndOlderFilesHaveNone) {
   EXPECT_GT(without.abs().min().item<double>(), 0.0);
 }
 
+TEST(ModelConfig, AFieldThisBuildDoesNotKnowOrANewerVersionIsRefused) {
+  // A model written by a newer clothwind: an option unknown here was ignored, and the network
+  // computed other features from the same weights. The shipped models carry no unknown field.
+  nlohmann::json future = ToJson(ModelConfig{});
+  future["future_option"] = 1;
+  ExpectFieldRefused(future, "future_option", " is not one this clothwind knows");
+  nlohmann::json newer = ToJson(ModelConfig{});
+  newer["version"] = kModelFormatVersion + 1;
+  ExpectFieldRefused(newer, "version", " is 2, this clothwind reads model format version 1");
+  EXPECT_NO_THROW(ModelConfigFromJson(ToJson(ModelConfig{}), "run/model.json"));
+  nlohmann::json unversioned = ToJson(ModelConfig{});
+  unversioned.erase("version");
+  EXPECT_NO_THROW(ModelConfigFromJson(unversioned, "run/model.json"));
+  const char* source = std::getenv("CLOTHWIND_SOURCE_DIR");
+  for (const char* shipped : {"models/sdn.json"}) {
+    const fs::path p = fs::path(source ? source : ".") / shipped;
+    if (!fs::exists(p)) continue;
+    EXPECT_NO_THROW(ModelConfigFromJson(nlohmann::json::parse(std::ifstream(p)), p.string())) << p;
+  }
+}
+
 TEST(ModelConfig, IntegerFieldsMustBeWholeNumbersWithinRange) {
   // get<int>() read these as 30, 16 and 2, and the copy stored in the weights agreed with them.
   const nlohmann::json good = ToJson(TinySdn());
@@ -1098,6 +1121,9 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
     Train(old_run);
     ASSERT_TRUE(fs::exists(old_run.out / "raw_model.pt"));
     std::ofstream(old_run.out / "notes.txt") << "the user's own file";
+    // Names a run's files only start like: a prefix match took them too.
+    std::ofstream(old_run.out / "model.onnx") << "the user's export";
+    fs::create_directories(old_run.out / "last_eval");
     TrainOptions again_run = old_run;
     again_run.overwrite = true;
     again_run.weight_average = 0;
@@ -1106,6 +1132,8 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
     for (const char* gone : {"state.json", "model.pt", "raw_model.pt", "log.tsv"})
       EXPECT_FALSE(fs::exists(old_run.out / gone)) << gone;
     EXPECT_TRUE(fs::exists(old_run.out / "notes.txt"));
+    EXPECT_TRUE(fs::exists(old_run.out / "model.onnx"));
+    EXPECT_TRUE(fs::exists(old_run.out / "last_eval"));
     TrainOptions resume_it = again_run;
     resume_it.overwrite = false;
     resume_it.resume = true;
@@ -1200,6 +1228,71 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   ExpectTrainRefused(y, "a resume without the run's flips was accepted",
                      {"state.json: the run trained with --no-flip off, these options give on"});
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
+}
+
+TEST_F(TrainTest, OverwriteKeepsTheOldRunWhenTheNewOneIsRefused) {
+  // --cache-frames with crop scales it cannot cache is refused; it used to be refused only after
+  // --overwrite had deleted the old run's state, checkpoints and model.
+  TrainOptions t = Options("sdn", "overwrite_refused");
+  t.epochs = 1;
+  Train(t);
+  TrainOptions again = t;
+  again.overwrite = true;
+  again.cache_frames = true;  // the default crop scales are not 1: the cache would change the samples
+  ExpectTrainRefused(again, "--cache-frames with crop scales was accepted", {"--cache-frames would change"});
+  for (const char* kept : {"state.json", "model.pt", "log.tsv"})
+    EXPECT_TRUE(fs::exists(t.out / kept)) << kept << " deleted by a refused --overwrite";
+  EXPECT_NO_THROW(CheckpointDir(t.out));
+}
+
+TEST_F(TrainTest, AResumeOnOtherClipsIsRefusedAndAMovedDatasetResumes) {
+  // The label scaling comes from state.json, the clips from --data: resuming on a regenerated
+  // (or another) dataset trained the run on other clips without a word.
+  TrainOptions t = Options("sdn", "fingerprint");
+  t.epochs = 1;
+  Train(t);
+  ToyDatasetOptions other;
+  other.clips = 100;
+  other.frames = 60;
+  other.size = 32;
+  other.seed = 2;  // the same shape of dataset, other clips
+  WriteToyDataset(*root_ / "data_other", other);
+  TrainOptions resumed = t;
+  resumed.epochs = 2;
+  resumed.resume = true;
+  resumed.data = *root_ / "data_other";
+  ExpectTrainRefused(resumed, "a resume on other clips was accepted",
+                     {"state.json: the run trained on other clips than", "data_other"});
+  fs::copy(*root_ / "data", *root_ / "data_moved", fs::copy_options::recursive);
+  resumed.data = *root_ / "data_moved";
+  const TrainResult r = Train(resumed);
+  EXPECT_EQ(r.log.size(), 2u) << "the same clips in another folder should resume";
+}
+
+TEST_F(TrainTest, ANonFiniteTrainingLossStopsTheRunNamingTheEpochAndStep) {
+  // Weights that overflow the network's float activations (a checkpoint scaled by 1e30 stands in
+  // for a run that diverged) give an inf or NaN loss, which used to make every weight NaN
+  // through Adam while the run went on to its last epoch. Now it stops at the first such step,
+  // before the weights change, and the checkpoint of the epoch before stays as it was.
+  TrainOptions t = Options("sdn", "diverged");
+  t.epochs = 1;
+  Train(t);
+  const fs::path checkpoint = CheckpointDir(t.out) / "last.pt";
+  {
+    WindNet net(ModelConfigFromJson(ReadJson(t.out / "state.json")["model"], "state.json"));
+    torch::load(net, checkpoint.string());
+    torch::NoGradGuard no_grad;
+    for (auto& p : net->parameters()) p.mul_(1e30);
+    torch::save(net, checkpoint.string());
+  }
+  const auto saved = fs::last_write_time(t.out / "state.json");
+  TrainOptions resumed = t;
+  resumed.epochs = 2;
+  resumed.resume = true;
+  ExpectTrainRefused(resumed, "a run with an infinite loss went on",
+                     {"epoch 2, step 1 of ", "the training loss is ", "The checkpoint of epoch 1 is intact"});
+  EXPECT_EQ(fs::last_write_time(t.out / "state.json"), saved);
+  EXPECT_EQ(CheckpointDir(t.out).filename(), "checkpoint-e0001");
 }
 
 // With a weight average, validation reads the average and model.pt holds its best epoch while
