@@ -8,6 +8,7 @@
 #include <functional>
 #include <future>
 #include <iomanip>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -134,6 +135,26 @@ void SaveAtomically(T& object, const fs::path& path) {
   std::ostringstream bytes;
   torch::save(object, bytes);
   WriteFileAtomically(path, bytes.str());
+}
+
+// The best models of a run live in its checkpoint folder too (model.*, raw_model.*), so the
+// epoch state.json names and the model.pt beside it always agree: model.pt was published before
+// state.json, and a run stopped between the two kept a model.pt of an epoch its log did not show.
+constexpr const char* kBestModelFiles[] = {"model.pt", "model.json", "raw_model.pt", "raw_model.json"};
+
+// Copies `from` to `to` through a temporary and a rename (never half a file at `to`).
+void CopyFileAtomically(const fs::path& from, const fs::path& to) {
+  std::ifstream in(from, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) throw std::runtime_error("cannot read " + from.string());
+  WriteFileAtomically(to, bytes);
+}
+
+// Publishes the best models a checkpoint folder holds as the run's model.pt / raw_model.pt (and
+// their JSON); a checkpoint from before they were kept there holds none, and nothing is done.
+void PublishBestModels(const fs::path& checkpoint, const fs::path& out) {
+  for (const char* name : kBestModelFiles)
+    if (fs::exists(checkpoint / name)) CopyFileAtomically(checkpoint / name, out / name);
 }
 
 // A run's state.json, parsed. Throws std::runtime_error naming it when it cannot be read.
@@ -603,7 +624,6 @@ TrainResult Train(const TrainOptions& o) {
     LoadNamingTheFile(optimizer, resume_from / "last_optim.pt");
   }
   // The weight average starts at the initial weights and lives beside them on the device.
-  const fs::path raw_model = o.out / "raw_model.pt";
   WindNet average{nullptr};
   int64_t average_steps = 0;
   if (o.weight_average > 0) {
@@ -654,6 +674,9 @@ TrainResult Train(const TrainOptions& o) {
     SaveWindNet(net, result.model);
     return result;
   }
+  // A run stopped after publishing a model but before its state.json: the checkpoint's models are
+  // the ones its log describes.
+  if (o.resume) PublishBestModels(resume_from, o.out);
 
   result.best_val_rmse = std::numeric_limits<double>::infinity();
   double best_raw_val_rmse = std::numeric_limits<double>::infinity();
@@ -766,24 +789,43 @@ TrainResult Train(const TrainOptions& o) {
     // Checkpoint: weights on the CPU so any machine can load them.
     net->to(at::kCPU);
     if (!average.is_empty()) average->to(at::kCPU);
-    if (record.val_rmse < result.best_val_rmse) {
-      result.best_val_rmse = record.val_rmse;
-      SaveWindNet(average.is_empty() ? net : average, result.model);
-    }
-    if (!average.is_empty() && record.raw_val_rmse < best_raw_val_rmse) {
-      best_raw_val_rmse = record.raw_val_rmse;
-      SaveWindNet(net, raw_model);
-    }
     // The epoch's checkpoint goes into a folder of its own, made whole under a hidden name and
     // renamed; state.json, written after it, names it. A run stopped anywhere in between resumes
     // from the checkpoint state.json names, never from weights of one epoch with another's
-    // optimiser state and log (which the files last.pt, ... rewritten in place allowed).
+    // optimiser state and log (which the files last.pt, ... rewritten in place allowed). The best
+    // models go in it too (this epoch's if better, else the previous checkpoint's), and are
+    // published as model.pt / raw_model.pt only once state.json names it.
     char checkpoint_name[32];
     std::snprintf(checkpoint_name, sizeof checkpoint_name, "checkpoint-e%04d", epoch);
     const fs::path checkpoint = o.out / checkpoint_name;
     const fs::path checkpoint_tmp = o.out / ("." + std::string(checkpoint_name) + ".tmp");
     fs::remove_all(checkpoint_tmp);
     fs::create_directories(checkpoint_tmp);
+    const fs::path previous = state.contains("checkpoint") && state["checkpoint"].is_string()
+                                  ? o.out / state["checkpoint"].get<std::string>()
+                                  : fs::path();
+    auto carry_over = [&](const char* weights, const char* json) {
+      for (const char* name : {weights, json}) {
+        if (previous.empty() || !fs::exists(previous / name)) continue;
+        std::error_code ec;
+        fs::create_hard_link(previous / name, checkpoint_tmp / name, ec);  // unchanged: no copy
+        if (ec) fs::copy_file(previous / name, checkpoint_tmp / name);
+      }
+    };
+    const bool better = record.val_rmse < result.best_val_rmse;
+    if (better) {
+      result.best_val_rmse = record.val_rmse;
+      SaveWindNet(average.is_empty() ? net : average, checkpoint_tmp / "model.pt");
+    } else {
+      carry_over("model.pt", "model.json");
+    }
+    const bool raw_better = !average.is_empty() && record.raw_val_rmse < best_raw_val_rmse;
+    if (raw_better) {
+      best_raw_val_rmse = record.raw_val_rmse;
+      SaveWindNet(net, checkpoint_tmp / "raw_model.pt");
+    } else if (!average.is_empty()) {
+      carry_over("raw_model.pt", "raw_model.json");
+    }
     SaveAtomically(net, checkpoint_tmp / "last.pt");
     if (!average.is_empty()) SaveAtomically(average, checkpoint_tmp / "last_average.pt");
     net->to(device);
@@ -802,6 +844,7 @@ TrainResult Train(const TrainOptions& o) {
              {"epochs", o.epochs}, {"lr", o.lr}, {"lr_schedule", o.lr_schedule}, {"lr_decay_epoch", o.lr_decay_epoch},
              {"validated_on", result.validated_on}, {"data_fingerprint", data_fingerprint}};
     WriteFileAtomically(state_path, state.dump(2));
+    if (better || raw_better) PublishBestModels(checkpoint, o.out);
     // Older checkpoints (and the files of the layout before checkpoint folders) once state.json
     // names the new one.
     for (const auto& entry : fs::directory_iterator(o.out)) {

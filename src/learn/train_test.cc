@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <random>
 #include <sstream>
 #include <tuple>
@@ -1243,6 +1244,49 @@ TEST_F(TrainTest, OverwriteKeepsTheOldRunWhenTheNewOneIsRefused) {
   for (const char* kept : {"state.json", "model.pt", "log.tsv"})
     EXPECT_TRUE(fs::exists(t.out / kept)) << kept << " deleted by a refused --overwrite";
   EXPECT_NO_THROW(CheckpointDir(t.out));
+}
+
+// The bytes of a file.
+std::string Bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+TEST_F(TrainTest, TheModelBesideStateJsonIsTheBestOfTheEpochsItsLogShows) {
+  // model.pt was published before state.json: a run stopped between the two kept a model.pt of
+  // an epoch its log does not show, and a resume that did not beat it left it there. Now each
+  // checkpoint holds the best models so far, published once state.json names it, and a resume
+  // publishes them again first.
+  TrainOptions t = Options("sdn", "best_in_checkpoint");
+  t.epochs = 2;
+  t.weight_average = 0.5;
+  Train(t);
+  const fs::path checkpoint = CheckpointDir(t.out);
+  for (const char* name : {"model.pt", "model.json", "raw_model.pt", "raw_model.json"}) {
+    ASSERT_TRUE(fs::exists(checkpoint / name)) << name;
+    EXPECT_EQ(Bytes(checkpoint / name), Bytes(t.out / name)) << name;
+  }
+  // What a stop between publishing and state.json left: another epoch's model beside the state.
+  TrainOptions other = Options("sdn", "best_in_checkpoint_other");
+  other.epochs = 1;
+  other.seed = 9;
+  other.weight_average = 0.5;
+  Train(other);
+  fs::copy_file(other.out / "model.pt", t.out / "model.pt", fs::copy_options::overwrite_existing);
+  ASSERT_NE(Bytes(t.out / "model.pt"), Bytes(checkpoint / "model.pt"));
+  TrainOptions resumed = t;
+  resumed.resume = true;  // nothing left to train: the resume only restores
+  Train(resumed);
+  EXPECT_EQ(Bytes(t.out / "model.pt"), Bytes(checkpoint / "model.pt"));
+  // Epoch 3's checkpoint holds the best so far (its own, or carried over when it is no better),
+  // and that is the one published.
+  resumed.epochs = 3;
+  const TrainResult r = Train(resumed);
+  const fs::path third = CheckpointDir(t.out);
+  EXPECT_EQ(third.filename(), "checkpoint-e0003");
+  EXPECT_EQ(Bytes(third / "model.pt"), Bytes(t.out / "model.pt"));
+  EXPECT_FALSE(fs::exists(checkpoint)) << "the older checkpoint should be gone";
+  EXPECT_EQ(r.log.size(), 3u);
 }
 
 TEST_F(TrainTest, AResumeOnOtherClipsIsRefusedAndAMovedDatasetResumes) {
