@@ -5,6 +5,7 @@
 #include <string>
 
 #include <jpeglib.h>
+#include <jerror.h>  // the JWRN_ message codes
 
 namespace clothwind::common {
 namespace {
@@ -17,7 +18,25 @@ struct JpegErrors {
   std::jmp_buf jump;
   int warnings;
   char first[JMSG_LENGTH_MAX];
+  int damage_warnings;  // warnings that the entropy-coded data is damaged (IsDataDamage)
+  char first_damage[JMSG_LENGTH_MAX];
 };
+
+// More bytes than this left before a marker mean the decoder lost its place in damaged data (ten
+// bytes overwritten in a 128x96 frame left 79 before the end marker, the picture made up); a
+// camera's padding is a byte or a few (the Logitech C270 leaves some before restart markers on
+// every MJPEG frame, whose picture is whole).
+constexpr int kMaxPaddingBytes = 16;
+
+// Whether libjpeg's warning (code, its parameters) says the image data itself is damaged, so the
+// decoded picture is partly made up. Others leave the picture whole: a few padding bytes before a
+// marker, an unknown JFIF revision, a bad ICC marker.
+bool IsDataDamage(const jpeg_error_mgr& err) {
+  const int code = err.msg_code;
+  if (code == JWRN_EXTRANEOUS_DATA) return err.msg_parm.i[0] > kMaxPaddingBytes;
+  return code == JWRN_HUFF_BAD_CODE || code == JWRN_ARITH_BAD_CODE || code == JWRN_HIT_MARKER ||
+         code == JWRN_JPEG_EOF || code == JWRN_MUST_RESYNC || code == JWRN_NOT_SEQUENTIAL;
+}
 
 void JpegErrorExit(j_common_ptr c) {
   auto* e = reinterpret_cast<JpegErrors*>(c->err);
@@ -30,6 +49,7 @@ void JpegEmitMessage(j_common_ptr c, int level) {
   if (level >= 0) return;
   auto* e = reinterpret_cast<JpegErrors*>(c->err);
   if (e->warnings++ == 0) (*c->err->format_message)(c, e->first);
+  if (IsDataDamage(*c->err) && e->damage_warnings++ == 0) (*c->err->format_message)(c, e->first_damage);
 }
 
 }  // namespace
@@ -59,7 +79,8 @@ std::string JpegDataProblem(const uint8_t* data, size_t n) {
   return errors.warnings > 0 ? std::string(errors.first) : std::string();
 }
 
-std::string DecodeJpegBgr(const uint8_t* data, size_t n, cv::Mat* image) {
+std::string DecodeJpegBgr(const uint8_t* data, size_t n, cv::Mat* image, int expected_width,
+                          int expected_height) {
   JpegErrors errors{};
   jpeg_decompress_struct info{};
   info.err = jpeg_std_error(&errors.pub);
@@ -79,16 +100,30 @@ std::string DecodeJpegBgr(const uint8_t* data, size_t n, cv::Mat* image) {
     jpeg_destroy_decompress(&info);
     return claim;
   }
+  if (expected_width > 0 && (static_cast<int64_t>(info.image_width) != expected_width ||
+                             static_cast<int64_t>(info.image_height) != expected_height)) {
+    // Before any memory is set aside: a damaged header can claim gigabytes.
+    const std::string size = "decodes to " + std::to_string(info.image_width) + "x" +
+                             std::to_string(info.image_height) + ", expected " + std::to_string(expected_width) +
+                             "x" + std::to_string(expected_height);
+    jpeg_destroy_decompress(&info);
+    return size;
+  }
   info.out_color_space = JCS_EXT_BGR;  // libjpeg-turbo's extension: OpenCV's channel order
   jpeg_start_decompress(&info);
-  image->create(static_cast<int>(info.output_height), static_cast<int>(info.output_width), CV_8UC3);
+  try {
+    image->create(static_cast<int>(info.output_height), static_cast<int>(info.output_width), CV_8UC3);
+  } catch (const std::exception& e) {
+    jpeg_destroy_decompress(&info);
+    return std::string("cannot allocate the image: ") + e.what();
+  }
   while (info.output_scanline < info.output_height) {
     JSAMPROW row = image->ptr<JSAMPLE>(static_cast<int>(info.output_scanline));
     jpeg_read_scanlines(&info, &row, 1);
   }
   jpeg_finish_decompress(&info);
   jpeg_destroy_decompress(&info);
-  return errors.warnings > 0 ? std::string(errors.first) : std::string();
+  return errors.damage_warnings > 0 ? std::string(errors.first_damage) : std::string();
 }
 
 }  // namespace clothwind::common

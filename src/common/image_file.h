@@ -55,16 +55,23 @@ inline std::string JpegWholeness(const uint8_t* data, size_t n) {
 constexpr uint64_t kMaxJpegPixels = uint64_t{1} << 30;  // OpenCV's CV_IO_MAX_IMAGE_PIXELS
 std::string JpegDataProblem(const uint8_t* data, size_t n);
 
-// Decodes a JPEG into 8-bit BGR in one pass of libjpeg, keeping its first warning: a frame
-// damaged inside intact markers (a USB camera's MJPEG with a corrupted transfer) decodes into
-// made-up blocks with only a warning, which cv::imdecode drops. Same cost as cv::imdecode (both
-// are libjpeg-turbo; JpegDataProblem first would add half a decode per frame). Grey JPEGs come
-// out as BGR too. Refuses an image claiming more than kMaxJpegPixels from its header.
-// Inputs: data, n  the encoded bytes.
-// Outputs: *image (rows x cols, CV_8UC3) on success. Returns "" when it decoded cleanly, else
-//   libjpeg's error or first warning, e.g. "Corrupt JPEG data: bad Huffman code" (*image is then
-//   not to be used).
-std::string DecodeJpegBgr(const uint8_t* data, size_t n, cv::Mat* image);
+// Decodes a JPEG into 8-bit BGR in one pass of libjpeg, keeping its warnings that the image data
+// is damaged: a frame damaged inside intact markers (a USB camera's MJPEG with a corrupted
+// transfer) decodes into made-up blocks with only a warning, which cv::imdecode drops. Warnings
+// that leave the picture whole are not refused (up to 16 "extraneous bytes before marker", the
+// padding some cameras such as the Logitech C270 send on every MJPEG frame; an unknown JFIF
+// revision). libjpeg notices only part of the damage: a frame it decodes without a word can still
+// be partly made up (18 of 40 ten-byte damages in the test). Same cost as cv::imdecode
+// (both are libjpeg-turbo; JpegDataProblem first would add half a decode per frame). Grey JPEGs
+// come out as BGR too; CMYK ones are refused (no camera sends them). Refuses an image claiming
+// more than kMaxJpegPixels, or another size than expected, from its header.
+// Inputs: data, n  the encoded bytes; expected_width, expected_height  the size the image must
+//   have (0: any).
+// Outputs: *image (rows x cols, CV_8UC3) on success. Returns "" when it decoded with its data
+//   whole, else libjpeg's error or first damage warning, e.g. "Corrupt JPEG data: bad Huffman
+//   code", or the size mismatch (*image is then not to be used).
+std::string DecodeJpegBgr(const uint8_t* data, size_t n, cv::Mat* image, int expected_width = 0,
+                          int expected_height = 0);
 
 // Reads and decodes an image file as cv::imread(path, flags) does, refusing a JPEG that is not
 // whole (JpegWholeness) or whose data libjpeg finds corrupt (JpegDataProblem), and catching OpenCV's exceptions (a header claiming more pixels than it

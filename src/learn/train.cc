@@ -238,7 +238,7 @@ void RemoveRun(const fs::path& out) {
     static const std::set<std::string> kFiles = {
         "state.json", "log.tsv",       "last.pt",        "last_optim.pt",          "last_average.pt",
         "model.pt",   "model.json",    "raw_model.pt",   "raw_model.json",         "learning_curve.png",
-        "learning_curve.png.dat",      "learning_curve.png.gp"};
+        "learning_curve.png.dat",      "learning_curve.png.gp",  "learning_curve.png.gp.err"};
     const size_t tmp = name.find(".tmp-");
     const std::string base = tmp == std::string::npos ? name : name.substr(0, tmp);
     const bool run_file = kFiles.count(base) > 0 || name.rfind("checkpoint-e", 0) == 0 ||
@@ -261,15 +261,18 @@ std::string DataFingerprint(const std::vector<ClipInfo>& train, const std::vecto
     h ^= 0xff;  // separator
     h *= 1099511628211ULL;
   };
+  // In name order: a recorded dataset's index moves a replaced clip to its end, so the same
+  // clips can be listed in another order.
   for (const auto* split : {&train, &val}) {
-    add("split");
+    std::vector<std::string> entries;
     for (const ClipInfo& c : *split) {
       char target[32];
       std::snprintf(target, sizeof target, "%.17g", c.wind_speed);
-      add(c.name);
-      add(c.split);
-      add(target);
+      entries.push_back(c.name + '\n' + c.split + '\n' + target);
     }
+    std::sort(entries.begin(), entries.end());
+    add("split");
+    for (const std::string& e : entries) add(e);
   }
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
@@ -744,8 +747,9 @@ TrainResult Train(const TrainOptions& o) {
         what << "epoch " << epoch << ", step " << step + 1 << " of " << steps << ": the training loss is "
              << loss_value << " (a target or input not finite, or a learning rate too high); stopped before it "
              << "reached the weights. " << (epoch > 1 ? "The checkpoint of epoch " + std::to_string(epoch - 1) +
-                                                            " is intact: --resume continues from it"
-                                                      : std::string("No epoch was saved"));
+                                                            " is intact, but a resume repeats these batches: "
+                                                      : std::string("No epoch was saved: "))
+             << "start a new run with a lower --lr (or --grad-clip)";
         throw std::runtime_error(what.str());
       }
       loss.backward();

@@ -3,6 +3,7 @@
 // checkpoint must round-trip, resuming must continue the log, and evaluation must agree.
 #include "learn/train.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -1308,9 +1309,14 @@ TEST_F(TrainTest, AResumeOnOtherClipsIsRefusedAndAMovedDatasetResumes) {
   ExpectTrainRefused(resumed, "a resume on other clips was accepted",
                      {"state.json: the run trained on other clips than", "data_other"});
   fs::copy(*root_ / "data", *root_ / "data_moved", fs::copy_options::recursive);
+  {  // listed in another order, as a recorded dataset's index lists a replaced clip last
+    nlohmann::json index = ReadJson(*root_ / "data_moved" / "index.json");
+    std::reverse(index["clips"].begin(), index["clips"].end());
+    std::ofstream(*root_ / "data_moved" / "index.json") << index.dump(1);
+  }
   resumed.data = *root_ / "data_moved";
   const TrainResult r = Train(resumed);
-  EXPECT_EQ(r.log.size(), 2u) << "the same clips in another folder should resume";
+  EXPECT_EQ(r.log.size(), 2u) << "the same clips in another folder and order should resume";
 }
 
 TEST_F(TrainTest, ANonFiniteTrainingLossStopsTheRunNamingTheEpochAndStep) {
@@ -1334,7 +1340,8 @@ TEST_F(TrainTest, ANonFiniteTrainingLossStopsTheRunNamingTheEpochAndStep) {
   resumed.epochs = 2;
   resumed.resume = true;
   ExpectTrainRefused(resumed, "a run with an infinite loss went on",
-                     {"epoch 2, step 1 of ", "the training loss is ", "The checkpoint of epoch 1 is intact"});
+                     {"epoch 2, step 1 of ", "the training loss is ", "The checkpoint of epoch 1 is intact",
+                      "start a new run with a lower --lr"});
   EXPECT_EQ(fs::last_write_time(t.out / "state.json"), saved);
   EXPECT_EQ(CheckpointDir(t.out).filename(), "checkpoint-e0001");
 }

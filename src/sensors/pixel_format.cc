@@ -90,7 +90,7 @@ bool ConvertToImage(PixelFormat format, const uint8_t* data, size_t bytes_used, 
     // transfer corrupted, not lost) decodes into made-up blocks and only warns; cv::imdecode
     // published it.
     cv::Mat decoded;
-    const std::string problem = common::DecodeJpegBgr(data, bytes_used, &decoded);
+    const std::string problem = common::DecodeJpegBgr(data, bytes_used, &decoded, width, height);
     if (!problem.empty())
       return fail("MJPEG decode failed (" + std::to_string(bytes_used) + " bytes): " + problem);
     if (decoded.cols != width || decoded.rows != height) {
