@@ -191,8 +191,13 @@ TEST_F(DatasetWriterTest, AClipReplacedWithinTheIndexIntervalIsListedAtOnce) {
   EXPECT_EQ(w.unlisted(), 0u);
   const auto index = Read(root_ / "index.json");
   ASSERT_EQ(index["clips"].size(), 2u);
-  for (const auto& c : index["clips"])
-    if (c["name"] == ClipFolderName(1700000000.0, 0)) EXPECT_EQ(c["num_frames"], 3);
+  int found = 0;
+  for (const auto& c : index["clips"]) {
+    if (c["name"] != ClipFolderName(1700000000.0, 0)) continue;
+    EXPECT_EQ(c["num_frames"], 3);
+    ++found;
+  }
+  EXPECT_EQ(found, 1);
 }
 
 TEST_F(DatasetWriterTest, CorruptIndexIsAClearError) {
