@@ -37,7 +37,7 @@ struct Timing {
   // gave 1.0 s.)
   double first_cpu_ms, first_wall_ms;
   double later_cpu_ms = 0, later_wall_ms = 0;  // 0 with one frame
-  int frames;
+  int frames = 0;
   double ClipCpuMs() const { return first_cpu_ms + 59.0 * later_cpu_ms; }
   double ClipWallMs() const { return first_wall_ms + 59.0 * later_wall_ms; }
 };

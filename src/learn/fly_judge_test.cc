@@ -383,7 +383,9 @@ TEST(FlyJudgeTrainTest, ShiftMotionMapSlidesInStillnessAndKeepsTheMeanOne) {
   int k = 0;
   for (int dy = -1; dy <= 1; ++dy)
     for (int dx = -1; dx <= 1; ++dx)
-      if (dx != 0 || dy != 0) EXPECT_EQ(cv::norm(eight.maps[k++], ShiftMotionMap(map, dx, dy), cv::NORM_INF), 0.0);
+      if (dx != 0 || dy != 0) {
+        EXPECT_EQ(cv::norm(eight.maps[k++], ShiftMotionMap(map, dx, dy), cv::NORM_INF), 0.0);
+      }
   EXPECT_THROW(ShiftedMotionMaps(one, 0), std::invalid_argument);
   one.wind_speeds.clear();
   EXPECT_THROW(ShiftedMotionMaps(one, 1), std::invalid_argument);

@@ -134,7 +134,9 @@ TEST(ClipPipelineTest, RepeatReasonNamesACameraSlowerThanTheClips) {
     for (int i = 0; i < 4 * fps; ++i) p.AddFrame(kT0 + i / fps, Numbered(i), ClipSourceEncoding::kMono8);
     const std::string reason = ClipRepeatReason(start, p.stats(), o);
     EXPECT_EQ(!reason.empty(), repeats) << fps << " fps: " << reason;
-    if (repeats) EXPECT_NE(reason.find("about 15 frames for every 25"), std::string::npos) << reason;
+    if (repeats) {
+      EXPECT_NE(reason.find("about 15 frames for every 25"), std::string::npos) << reason;
+    }
   }
 }
 
@@ -190,7 +192,9 @@ TEST(ClipPipelineTest, ALoneFrameStampedHoursBackIsDroppedAsStale) {
   ASSERT_EQ(clips.size(), 46u);          // those due by the last frame (ends <= 18.5 s)
   for (const auto& c : clips) {
     const double end = c.clip.frames.back().stamp - kT0;
-    if (end >= 5.0) EXPECT_GE(c.label.count, 5u) << end;
+    if (end >= 5.0) {
+      EXPECT_GE(c.label.count, 5u) << end;
+    }
     EXPECT_DOUBLE_EQ(c.label.mean, 6.0) << end;
   }
 }
