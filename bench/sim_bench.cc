@@ -21,12 +21,10 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/LU>
-#include <Eigen/SVD>
-
 #include "bench_clock.h"
 #include "sim/flag_metrics.h"
 #include "sim/simulate.h"
+#include "sim/strain_limiter.h"
 
 namespace fs = std::filesystem;
 using namespace clothwind::sim;
@@ -60,16 +58,7 @@ using clothwind::bench::ThreadCpuSeconds;
 double StretchPercentile(const Trajectory& t, const Mesh& mesh, int first, double q) {
   std::vector<double> stretch;
   for (int frame = first; frame < t.num_frames(); ++frame) {
-    const FramePositions& x = t.frames[frame];
-    for (int f = 0; f < mesh.F.rows(); ++f) {
-      Eigen::Matrix2d Dm;
-      Dm.col(0) = (mesh.U.row(mesh.F(f, 1)) - mesh.U.row(mesh.F(f, 0))).transpose();
-      Dm.col(1) = (mesh.U.row(mesh.F(f, 2)) - mesh.U.row(mesh.F(f, 0))).transpose();
-      Eigen::Matrix<double, 3, 2> Ds;
-      Ds.col(0) = (x.row(mesh.F(f, 1)) - x.row(mesh.F(f, 0))).cast<double>().transpose();
-      Ds.col(1) = (x.row(mesh.F(f, 2)) - x.row(mesh.F(f, 0))).cast<double>().transpose();
-      stretch.push_back(Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(Ds * Dm.inverse()).singularValues()[0]);
-    }
+    for (int f = 0; f < mesh.F.rows(); ++f) stretch.push_back(FacePrincipalStretches(mesh, t.frames[frame], f)[0]);
   }
   if (stretch.empty()) return 0.0;
   const size_t k = std::min(stretch.size() - 1, static_cast<size_t>(q * stretch.size()));

@@ -52,14 +52,27 @@ void JpegEmitMessage(j_common_ptr c, int level) {
   if (IsDataDamage(*c->err) && e->damage_warnings++ == 0) (*c->err->format_message)(c, e->first_damage);
 }
 
+// Hands libjpeg errors to JpegErrorExit (a longjmp to errors->jump, set by the caller: the
+// frame that calls setjmp must be the one libjpeg is called from) and warnings to JpegEmitMessage.
+void UseErrors(JpegErrors* errors, jpeg_decompress_struct* info) {
+  info->err = jpeg_std_error(&errors->pub);
+  errors->pub.error_exit = JpegErrorExit;
+  errors->pub.emit_message = JpegEmitMessage;
+}
+
+// "" when the header read into `info` claims at most kMaxJpegPixels, else why it is refused.
+std::string ClaimTooLarge(const jpeg_decompress_struct& info) {
+  if (static_cast<uint64_t>(info.image_width) * info.image_height <= kMaxJpegPixels) return "";
+  return "its header claims " + std::to_string(info.image_width) + "x" + std::to_string(info.image_height) +
+         " pixels (at most 2^30)";
+}
+
 }  // namespace
 
 std::string JpegDataProblem(const uint8_t* data, size_t n) {
   JpegErrors errors{};
   jpeg_decompress_struct info{};
-  info.err = jpeg_std_error(&errors.pub);
-  errors.pub.error_exit = JpegErrorExit;
-  errors.pub.emit_message = JpegEmitMessage;
+  UseErrors(&errors, &info);
   if (setjmp(errors.jump)) {
     jpeg_destroy_decompress(&info);
     return errors.first;
@@ -67,9 +80,7 @@ std::string JpegDataProblem(const uint8_t* data, size_t n) {
   jpeg_create_decompress(&info);
   jpeg_mem_src(&info, data, static_cast<unsigned long>(n));
   jpeg_read_header(&info, TRUE);
-  if (static_cast<uint64_t>(info.image_width) * info.image_height > kMaxJpegPixels) {
-    const std::string claim = "its header claims " + std::to_string(info.image_width) + "x" +
-                              std::to_string(info.image_height) + " pixels (at most 2^30)";
+  if (const std::string claim = ClaimTooLarge(info); !claim.empty()) {
     jpeg_destroy_decompress(&info);
     return claim;
   }
@@ -83,9 +94,7 @@ std::string DecodeJpegBgr(const uint8_t* data, size_t n, cv::Mat* image, int exp
                           int expected_height) {
   JpegErrors errors{};
   jpeg_decompress_struct info{};
-  info.err = jpeg_std_error(&errors.pub);
-  errors.pub.error_exit = JpegErrorExit;
-  errors.pub.emit_message = JpegEmitMessage;
+  UseErrors(&errors, &info);
   // (image lives in the caller's frame: what it holds after a longjmp is simply not used.)
   if (setjmp(errors.jump)) {
     jpeg_destroy_decompress(&info);
@@ -94,9 +103,7 @@ std::string DecodeJpegBgr(const uint8_t* data, size_t n, cv::Mat* image, int exp
   jpeg_create_decompress(&info);
   jpeg_mem_src(&info, data, static_cast<unsigned long>(n));
   jpeg_read_header(&info, TRUE);
-  if (static_cast<uint64_t>(info.image_width) * info.image_height > kMaxJpegPixels) {
-    const std::string claim = "its header claims " + std::to_string(info.image_width) + "x" +
-                              std::to_string(info.image_height) + " pixels (at most 2^30)";
+  if (const std::string claim = ClaimTooLarge(info); !claim.empty()) {
     jpeg_destroy_decompress(&info);
     return claim;
   }

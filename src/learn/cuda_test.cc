@@ -21,6 +21,7 @@
 
 #include "learn/networks.h"
 #include "learn/spectral_layer.h"
+#include "learn/test_small_sdn.h"
 
 namespace clothwind::learn {
 namespace {
@@ -98,15 +99,9 @@ TEST(Cuda, SpectralLayerInFloatAgreesWithDoubleOnTheGpu) {
   EXPECT_TRUE(at::allclose(gpu.frequency.to(at::kCPU).to(at::kDouble), ref.frequency, 1e-6, 1e-6));
 }
 
-// A small SDN with the shipped model's phase steps, and spectral pooling.
-ModelConfig SmallSdn() {
-  ModelConfig config;
-  config.arch = "sdn";
-  config.frames = 30;
-  config.k = 3;
-  config.width = 8;
-  config.input_size = 32;
-  config.phase_steps = true;
+// test_small_sdn.h's SDN with spectral pooling too.
+ModelConfig SmallPooledSdn() {
+  ModelConfig config = SmallSdn();
   config.spectral_pool = 2;
   return config;
 }
@@ -115,7 +110,7 @@ TEST(Cuda, SdnForwardAndGradientsMatchTheCpu) {
   SKIP_WITHOUT_CUDA();
   UseFullFloat32();
   at::manual_seed(3);
-  WindNet net(SmallSdn());
+  WindNet net(SmallPooledSdn());
   net->train();  // batch statistics, as in training
   const at::Tensor clip = WaveClip(4, 30, 32, 32, at::kFloat, 4);
   const at::Tensor target = at::randn({4});
@@ -175,7 +170,7 @@ TEST(Cuda, ANetworkTrainedOnTheGpuSavesAndLoadsOnTheCpu) {
   // stay in DIR, so that another libtorch (Debian's, on the CPU machine) can be checked too.
   UseFullFloat32();
   at::manual_seed(6);
-  WindNet net(SmallSdn());
+  WindNet net(SmallPooledSdn());
   net->to(at::kCUDA);
   net->train();
   torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(1e-2));

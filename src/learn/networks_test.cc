@@ -10,21 +10,11 @@
 #include <torch/torch.h>
 
 #include "learn/predictor.h"
+#include "learn/test_small_sdn.h"
 
 namespace clothwind::learn {
 namespace {
 
-// The shipped SDN's shape at a smaller input: grey clips, k = 3 with phase steps, width 8.
-ModelConfig SmallSdn() {
-  ModelConfig config;
-  config.arch = "sdn";
-  config.frames = 30;
-  config.k = 3;
-  config.phase_steps = true;
-  config.width = 8;
-  config.input_size = 32;
-  return config;
-}
 
 // Clips whose pixels oscillate at frequencies that vary across the frame, plus noise: the
 // spectral maps then vary, so the trunk's convolutions see varied inputs.

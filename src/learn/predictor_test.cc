@@ -13,23 +13,13 @@
 
 #include "learn/fly_judge.h"
 #include "learn/networks.h"
+#include "learn/test_small_sdn.h"
 
 namespace clothwind::learn {
 namespace {
 
 namespace fs = std::filesystem;
 
-// The small SDN these tests save: 30 frames of 32 px, k = 3, phase steps, width 8.
-ModelConfig SmallSdn() {
-  ModelConfig c;
-  c.arch = "sdn";
-  c.frames = 30;
-  c.k = 3;
-  c.phase_steps = true;
-  c.width = 8;
-  c.input_size = 32;
-  return c;
-}
 
 // A small SDN saved as a training run saves it, in a folder of its own.
 class PredictorTest : public ::testing::Test {

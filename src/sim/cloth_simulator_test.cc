@@ -16,6 +16,7 @@
 
 #include "common/random.h"
 #include "sim/cloth_forces.h"
+#include "sim/strain_limiter.h"
 #include "sim/test_expect_throw.h"
 
 namespace clothwind::sim {
@@ -261,16 +262,9 @@ TEST(ClothSimulatorTest, HandlesStayPutAndStrainLimitsHold) {
   // projection: the faces at the pinned corners, where stress concentrates, converge last).
   std::vector<double> stretch, squeeze;
   for (int f = 0; f < m.F.rows(); ++f) {
-    Eigen::Matrix2d Dm;
-    Dm.col(0) = (m.U.row(m.F(f, 1)) - m.U.row(m.F(f, 0))).transpose();
-    Dm.col(1) = (m.U.row(m.F(f, 2)) - m.U.row(m.F(f, 0))).transpose();
-    Eigen::Matrix<double, 3, 2> Ds;
-    Ds.col(0) = (sim.positions().row(m.F(f, 1)) - sim.positions().row(m.F(f, 0))).transpose();
-    Ds.col(1) = (sim.positions().row(m.F(f, 2)) - sim.positions().row(m.F(f, 0))).transpose();
-    const Eigen::Matrix<double, 3, 2> F = Ds * Dm.inverse();
-    Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>> svd(F);
-    stretch.push_back(svd.singularValues()[0]);
-    squeeze.push_back(svd.singularValues()[1]);
+    const Eigen::Vector2d s = FacePrincipalStretches(m, sim.positions(), f);
+    stretch.push_back(s[0]);
+    squeeze.push_back(s[1]);
   }
   std::sort(stretch.begin(), stretch.end());
   std::sort(squeeze.begin(), squeeze.end());

@@ -5,6 +5,8 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/LU>
+#include <Eigen/SVD>
 
 #include "sim/mesh.h"
 
@@ -20,6 +22,20 @@ inline bool StrainLimitsAreValid(double min, double max) {
 }
 constexpr const char* kStrainLimitsRule =
     "0 <= min <= 1 <= max and min < max (min 0: no lower limit; max inf: no upper one)";
+
+// The principal stretches of face f of `mesh` (the singular values of its deformation gradient
+// from the rest shape mesh.U to positions x; largest first), as the limiter measures them.
+// Inputs: mesh  F and U; x  #V by 3 positions (double or float); f  a face index.
+template <typename Positions>
+Eigen::Vector2d FacePrincipalStretches(const Mesh& mesh, const Positions& x, int f) {
+  Eigen::Matrix2d Dm;
+  Dm.col(0) = (mesh.U.row(mesh.F(f, 1)) - mesh.U.row(mesh.F(f, 0))).transpose();
+  Dm.col(1) = (mesh.U.row(mesh.F(f, 2)) - mesh.U.row(mesh.F(f, 0))).transpose();
+  Eigen::Matrix<double, 3, 2> Ds;
+  Ds.col(0) = (x.row(mesh.F(f, 1)) - x.row(mesh.F(f, 0))).template cast<double>().transpose();
+  Ds.col(1) = (x.row(mesh.F(f, 2)) - x.row(mesh.F(f, 0))).template cast<double>().transpose();
+  return Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(Ds * Dm.inverse()).singularValues();
+}
 
 // How StrainLimiter::Project sweeps (ArcSim's strain_limits, and when its sweeps stop).
 struct StrainLimitSettings {

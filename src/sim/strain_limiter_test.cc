@@ -220,15 +220,7 @@ Strip StretchedStrip(int n, double stretch) {
 // The largest principal stretch over a mesh's faces at positions x.
 double LargestStretch(const Mesh& m, const Eigen::MatrixX3d& x) {
   double largest = 0;
-  for (int f = 0; f < m.F.rows(); ++f) {
-    Eigen::Matrix2d Dm;
-    Dm.col(0) = (m.U.row(m.F(f, 1)) - m.U.row(m.F(f, 0))).transpose();
-    Dm.col(1) = (m.U.row(m.F(f, 2)) - m.U.row(m.F(f, 0))).transpose();
-    Eigen::Matrix<double, 3, 2> Ds;
-    Ds.col(0) = (x.row(m.F(f, 1)) - x.row(m.F(f, 0))).transpose();
-    Ds.col(1) = (x.row(m.F(f, 2)) - x.row(m.F(f, 0))).transpose();
-    largest = std::max(largest, Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(Ds * Dm.inverse()).singularValues()[0]);
-  }
+  for (int f = 0; f < m.F.rows(); ++f) largest = std::max(largest, FacePrincipalStretches(m, x, f)[0]);
   return largest;
 }
 
