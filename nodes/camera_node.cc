@@ -22,6 +22,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <camera_info_manager/camera_info_manager.h>
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -35,6 +36,7 @@
 #include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wall_throttle.h"
+#include "sensors/frame_read_tally.h"
 #include "sensors/frame_source.h"
 #include "sensors/frame_source_factory.h"
 #include "sensors/frame_timestamp.h"
@@ -156,9 +158,11 @@ int main(int argc, char** argv) {
       "camera/image_raw", updater,
       diagnostic_updater::FrequencyStatusParam(&min_rate, &max_rate, 0.1, 10),
       diagnostic_updater::TimeStampStatusParam(-0.05, 0.5));
-  uint64_t published = 0, read_errors = 0, last_drops_seen = 0, last_errors_seen = 0;
+  uint64_t published = 0, last_drops_seen = 0;
   uint64_t unsubscribed = 0;  // frames read while nobody subscribed (no message built)
-  std::string last_error;
+  // Frames that came but could not be read, apart from failures of the source itself.
+  clothwind::sensors::FrameReadTally tally;
+  std::string last_error;  // why the source last failed to open or read
   // Why the calibration is left out of camera_info ("" if it is not): the refused file's reason
   // from the start (the diagnostics say it before a frame comes), then each frame's.
   std::string calibration_unused =
@@ -169,7 +173,8 @@ int main(int argc, char** argv) {
     for (const auto& kv : status) stat.add(kv.first, kv.second);
     stat.add("published", published);
     stat.add("read with no subscriber (not published)", unsubscribed);
-    stat.add("read errors", read_errors);
+    stat.add("unreadable frames", tally.bad_frames());
+    stat.add("source failures (device lost, reopen failed, recording unreadable)", tally.failures());
     stat.add("frame_id", frame_id);
     stat.add("calibration", !calibration_unused.empty()         ? "left out: " + calibration_unused
                             : info_manager.isCalibrated() ? std::string("published")
@@ -177,6 +182,7 @@ int main(int argc, char** argv) {
     const auto state = status.count("state") ? status.at("state") : std::string("?");
     uint64_t drops = 0;
     if (status.count("dropped frames")) drops = std::stoull(status.at("dropped frames"));
+    const std::vector<std::string> read_warnings = tally.TakeReport();
     if (!opened) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "cannot open: " + last_error);
     } else if (ended) {
@@ -195,14 +201,12 @@ int main(int argc, char** argv) {
       if (drops > last_drops_seen)
         stat.mergeSummaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu frames dropped since last report",
                            static_cast<unsigned long long>(drops - last_drops_seen));
-      // Frames the driver flagged corrupt or that would not decode: the stream runs, but not all
-      // of it reaches the clips (it used to stay OK).
-      if (read_errors > last_errors_seen)
-        stat.mergeSummaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu frames unreadable since last report: %s",
-                           static_cast<unsigned long long>(read_errors - last_errors_seen), last_error.c_str());
+      // Frames the driver flagged corrupt or that would not decode (the stream runs, but not all of
+      // it reaches the clips), and a loss healed within the report period.
+      for (const std::string& warning : read_warnings)
+        stat.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, warning);
     }
     last_drops_seen = drops;
-    last_errors_seen = read_errors;
   });
 
   double open_backoff_s = 0.25;
@@ -238,6 +242,7 @@ int main(int argc, char** argv) {
     } else {
       Frame frame;
       const ReadStatus status = source->Read(&frame, 0.1);
+      tally.Record(status, source->error());
       if (status == ReadStatus::kFrame && publisher.getNumSubscribers() == 0) {
         // The frame is read and decoded (the driver's buffers must keep moving) and counted at the
         // camera's rate, but no message is built for nobody.
@@ -263,12 +268,12 @@ int main(int argc, char** argv) {
           const double rate = source->NominalRate();  // may change after a reconnect
           if (rate > 0) min_rate = max_rate = rate;
         } catch (const std::exception& e) {
-          ++read_errors;
-          last_error = e.what();
-          WALL_ERROR_STREAM_THROTTLE(2.0, "camera_node: " << last_error);
+          tally.BadFrame(e.what());
+          WALL_ERROR_STREAM_THROTTLE(2.0, "camera_node: " << e.what());
         }
+      } else if (status == ReadStatus::kBadFrame) {
+        WALL_WARN_STREAM_THROTTLE(2.0, "camera_node: " << source->error());
       } else if (status == ReadStatus::kError) {
-        ++read_errors;
         last_error = source->error();
         WALL_WARN_STREAM_THROTTLE(2.0, "camera_node: " << last_error);
         if (!source->IsOpen()) {  // a recording that became unreadable: Open again, with backoff

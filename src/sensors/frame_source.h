@@ -33,7 +33,10 @@ enum class ReadStatus {
   kFrame,     // *frame holds a new frame
   kNoFrame,   // nothing within the wait (not an error: call again)
   kEnd,       // the source is exhausted (a file/folder without loop); no more frames will come
-  kError,     // the source failed; error() says why. V4L2 recovers by itself on later Reads.
+  kBadFrame,  // a frame came but could not be read (flagged corrupt by the driver, would not
+              // decode, another size); error() says why. The source goes on with the next.
+  kError,     // the source failed (device lost, a reopen failed, a recording no longer
+              // readable); error() says why. V4L2 recovers by itself on later Reads.
 };
 
 // A camera or a recording behind one interface, so the node and the rest of the pipeline do not

@@ -140,8 +140,9 @@ ReadStatus ImageFolderSource::Read(Frame* frame, double max_wait_s) {
         // Not one readable image in a whole round (folder deleted?): close, so Open re-lists.
         error_ = "image folder " + folder_ + ": no image readable any more (last: " + why + ")";
         Close();
+        return ReadStatus::kError;
       }
-      return ReadStatus::kError;
+      return ReadStatus::kBadFrame;
     }
     consecutive_failures_ = 0;
   }

@@ -476,7 +476,7 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
     ++stats_.corrupt;
     error_ = options_.device + ": driver flagged frame " + std::to_string(buf.sequence) +
              " as corrupt";
-    status = ReadStatus::kError;
+    status = ReadStatus::kBadFrame;
   } else {
     const Buffer& b = buffers_[buf.index];
     // bytesused 0 on a compressed format is an empty frame (the buffer still holds an older
@@ -490,7 +490,7 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
                         &frame->image, &why)) {
       ++stats_.corrupt;
       error_ = options_.device + ": frame " + std::to_string(buf.sequence) + ": " + why;
-      status = ReadStatus::kError;
+      status = ReadStatus::kBadFrame;
     } else {
       const int64_t driver_ns = static_cast<int64_t>(buf.timestamp.tv_sec) * 1000000000LL +
                                 static_cast<int64_t>(buf.timestamp.tv_usec) * 1000LL;
@@ -512,10 +512,12 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
   if (io_->Ioctl(fd_, VIDIOC_QBUF, &buf) < 0) {
     const int err = errno;
     Lost("VIDIOC_QBUF failed: " + ErrnoText(err));
-    // The frame converted above is still good.
-  } else if (status == ReadStatus::kError && clock_->MonotonicNs() >= loss_deadline) {
+    // The frame converted above is still good; after a bad one, the loss is the news.
+    if (status == ReadStatus::kBadFrame) status = ReadStatus::kError;
+  } else if (status == ReadStatus::kBadFrame && clock_->MonotonicNs() >= loss_deadline) {
     ++stats_.timeouts;
     Lost(NoGoodFrameText(timeout_s));
+    status = ReadStatus::kError;
   }
   return status;
 }

@@ -216,8 +216,19 @@ TEST(V4l2CameraTest, ACameraSendingOnlyCorruptFramesTimesOutAndIsReopened) {
   Frame f;
   for (int i = 0; i < 3; ++i) ASSERT_EQ(rig.ReadFrame(&f), ReadStatus::kFrame);
   const int64_t good_until = rig.clock.MonotonicNs();
-  while (rig.camera.stats().timeouts == 0 && rig.clock.MonotonicNs() - good_until < 5000 * kMs)
-    rig.camera.Read(&f, 0.2);
+  // Each corrupt buffer is a bad frame; the read that gives up on the device is the one failure
+  // (camera_node counts the two apart: frames unreadable, the device lost).
+  int bad_frames = 0, failures = 0;
+  while (rig.camera.stats().timeouts == 0 && rig.clock.MonotonicNs() - good_until < 5000 * kMs) {
+    const ReadStatus s = rig.camera.Read(&f, 0.2);
+    ASSERT_NE(s, ReadStatus::kFrame);
+    bad_frames += s == ReadStatus::kBadFrame;
+    failures += s == ReadStatus::kError;
+  }
+  EXPECT_EQ(failures, 1);
+  // Every corrupt buffer but (when the deadline passed on reading one) the last is a bad frame.
+  EXPECT_LE(static_cast<uint64_t>(bad_frames), rig.camera.stats().corrupt);
+  EXPECT_GE(static_cast<uint64_t>(bad_frames) + 1, rig.camera.stats().corrupt);
   EXPECT_EQ(rig.camera.stats().timeouts, 1u);
   EXPECT_NEAR(rig.clock.MonotonicNs() - good_until, 1000 * kMs, 150 * kMs);
   EXPECT_NE(rig.camera.error().find("no good frame for 1 s"), std::string::npos) << rig.camera.error();
@@ -281,7 +292,8 @@ TEST(V4l2CameraTest, EmptyAndTruncatedMjpegFramesAreErrors) {
   ReadStatus s = ReadStatus::kNoFrame;
   for (int i = 0; i < 100 && s != ReadStatus::kFrame; ++i) {
     s = rig.camera.Read(&f, 0.1);
-    if (s == ReadStatus::kError) errors.push_back(rig.camera.error());
+    ASSERT_NE(s, ReadStatus::kError) << rig.camera.error();  // bad frames; the camera is fine
+    if (s == ReadStatus::kBadFrame) errors.push_back(rig.camera.error());
   }
   ASSERT_EQ(s, ReadStatus::kFrame);
   ASSERT_EQ(errors.size(), 2u);

@@ -81,7 +81,7 @@ ReadStatus VideoFileSource::Read(Frame* frame, double max_wait_s) {
     Frame f;
     if (!NormalizeRecordedImage(raw, &f.image, &f.encoding)) {
       error_ = "video " + path_ + ": frame with " + std::to_string(raw.channels()) + " channels";
-      return ReadStatus::kError;
+      return ReadStatus::kBadFrame;
     }
     f.sequence = sequence_++;
     pending_ = std::move(f);
