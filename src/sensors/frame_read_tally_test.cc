@@ -34,7 +34,7 @@ void ReadFor(V4l2Camera* camera, FakeClock* clock, double seconds, FrameReadTall
 }
 
 // An unplugged camera is one failure per failed reopen, and not a single unreadable frame: the
-// node's one "read errors" count reported 8 s unplugged as "9 frames unreadable".
+// node's one "read errors" count reported 8 s unplugged as "10 frames unreadable" (the loss, then 9 failed reopens).
 TEST(FrameReadTallyTest, AnUnpluggedCameraFailsButReadsNoBadFrame) {
   FakeClock clock;
   FakeV4l2Device device(&clock, {});
