@@ -160,6 +160,11 @@ struct EpochRecord {
   // With a weight average (TrainOptions::weight_average), val_rmse is the average's and this the
   // trained weights' own [m/s]; 0 without one.
   double raw_val_rmse = 0;
+  // Where the epoch trained: "cpu" or "cuda", and torch's intra-op threads. A resumed run repeats
+  // the uninterrupted one exactly only on the same device with as many threads, so a resume on
+  // another machine shows in the log ("" and 0 in runs from before stop 74).
+  std::string device;
+  int threads = 0;
 };
 
 // Training and validation RMSE per epoch as a PNG via gnuplot (atomically).

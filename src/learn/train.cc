@@ -99,7 +99,7 @@ nlohmann::json EpochJson(const EpochRecord& e) {
   return {{"epoch", e.epoch},         {"lr", e.lr},           {"train_loss", e.train_loss},
           {"val_loss", e.val_loss},   {"train_rmse", e.train_rmse}, {"val_rmse", e.val_rmse},
           {"val_acc05", e.val_acc05}, {"seconds", e.seconds}, {"train_aux_loss", e.train_aux_loss},
-          {"raw_val_rmse", e.raw_val_rmse}};
+          {"raw_val_rmse", e.raw_val_rmse}, {"device", e.device}, {"threads", e.threads}};
 }
 
 EpochRecord EpochFromJson(const nlohmann::json& j) {
@@ -114,17 +114,21 @@ EpochRecord EpochFromJson(const nlohmann::json& j) {
   e.seconds = j.at("seconds").get<double>();
   e.train_aux_loss = j.value("train_aux_loss", 0.0);  // absent in runs from before auxiliary targets
   e.raw_val_rmse = j.value("raw_val_rmse", 0.0);      // absent in runs from before weight averages
+  e.device = j.value("device", std::string());         // absent in runs from before stop 74
+  e.threads = j.value("threads", 0);
   return e;
 }
 
 std::string LogTsv(const std::vector<EpochRecord>& log) {
   std::ostringstream s;
-  s << "epoch\tlr\ttrain_loss\tval_loss\ttrain_rmse\tval_rmse\tval_acc05\tseconds\ttrain_aux_loss\traw_val_rmse\n"
+  // New columns go last: plot scripts read the others by number.
+  s << "epoch\tlr\ttrain_loss\tval_loss\ttrain_rmse\tval_rmse\tval_acc05\tseconds\ttrain_aux_loss\traw_val_rmse"
+       "\tdevice\tthreads\n"
     << std::setprecision(6);
   for (const EpochRecord& e : log) {
     s << e.epoch << "\t" << e.lr << "\t" << e.train_loss << "\t" << e.val_loss << "\t" << e.train_rmse << "\t"
       << e.val_rmse << "\t" << e.val_acc05 << "\t" << e.seconds << "\t" << e.train_aux_loss << "\t"
-      << e.raw_val_rmse << "\n";
+      << e.raw_val_rmse << "\t" << (e.device.empty() ? "-" : e.device) << "\t" << e.threads << "\n";
   }
   return s.str();
 }
@@ -696,6 +700,8 @@ TrainResult Train(const TrainOptions& o) {
     EpochRecord record;
     record.epoch = epoch;
     record.lr = LearningRateAt(o, epoch);
+    record.device = result.device;
+    record.threads = at::get_num_threads();
     for (auto& group : optimizer.param_groups()) {
       static_cast<torch::optim::AdamOptions&>(group.options()).lr(record.lr);
     }

@@ -1232,6 +1232,38 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   EXPECT_EQ(fs::last_write_time(*root_ / "resume" / "state.json"), log_before);
 }
 
+// A resume repeats the uninterrupted run exactly only on the same device with as many threads:
+// each epoch's record says where it trained, so a run resumed on another machine shows it (state.json
+// and log.tsv recorded neither).
+TEST_F(TrainTest, EachEpochRecordsTheDeviceAndThreadsItTrainedWith) {
+  TrainOptions o = Options("sdn", "where_trained");
+  o.epochs = 2;
+  o.threads = 2;
+  const TrainResult r = TrainStoppedAndResumed(o, 1);  // resumed with the same options: 2 threads
+  ASSERT_EQ(r.log.size(), 2u);
+  o.epochs = 3;
+  o.threads = 1;
+  o.resume = true;
+  const TrainResult more = Train(o);
+  ASSERT_EQ(more.log.size(), 3u);
+  std::vector<std::pair<std::string, int>> where;
+  for (const EpochRecord& e : more.log) where.emplace_back(e.device, e.threads);
+  EXPECT_EQ(where, (std::vector<std::pair<std::string, int>>{{"cpu", 2}, {"cpu", 2}, {"cpu", 1}}));
+
+  std::ifstream state_file(*root_ / "where_trained" / "state.json");
+  const nlohmann::json state = nlohmann::json::parse(state_file);
+  EXPECT_EQ(state.at("log").at(0).at("threads"), 2);
+  EXPECT_EQ(state.at("log").at(2).at("threads"), 1);
+  EXPECT_EQ(state.at("log").at(2).at("device"), "cpu");
+
+  std::ifstream tsv(*root_ / "where_trained" / "log.tsv");
+  std::string header, line, last;
+  std::getline(tsv, header);
+  EXPECT_NE(header.find("\traw_val_rmse\tdevice\tthreads"), std::string::npos) << header;
+  while (std::getline(tsv, line)) last = line;
+  EXPECT_EQ(last.substr(last.size() - 6), "\tcpu\t1") << last;
+}
+
 TEST_F(TrainTest, OverwriteKeepsTheOldRunWhenTheNewOneIsRefused) {
   // --cache-frames with crop scales it cannot cache is refused; it used to be refused only after
   // --overwrite had deleted the old run's state, checkpoints and model.
