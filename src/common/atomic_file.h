@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -114,14 +115,21 @@ inline std::string ProcessStartTicks(long pid) {
 // start time in ticks after boot), or "<pid>" where /proc cannot be read. Why more than the pid:
 // after a reboot a dead writer's pid can belong to a live process, whose temporaries are not
 // cleared (and a clip the writer was replacing stays hidden); the boot and start time tell that
-// process apart from the writer.
-inline const std::string& ProcessTag() {
-  static const std::string tag = [] {
-    const std::string pid = std::to_string(::getpid());
+// process apart from the writer. Made again when the pid changes: a child forked after the first
+// call kept its parent's tag, so the two named their temporaries alike (the counter is copied too)
+// and the child's were taken for a live process's after it ended.
+inline std::string ProcessTag() {
+  static std::mutex mutex;
+  static long tagged_pid = -1;
+  static std::string tag;
+  std::lock_guard<std::mutex> lock(mutex);
+  const long pid = static_cast<long>(::getpid());
+  if (pid != tagged_pid) {
     const std::string boot = atomic_file_internal::BootTag();
-    const std::string start = atomic_file_internal::ProcessStartTicks(::getpid());
-    return boot.empty() || start.empty() ? pid : pid + "." + boot + "." + start;
-  }();
+    const std::string start = atomic_file_internal::ProcessStartTicks(pid);
+    tag = boot.empty() || start.empty() ? std::to_string(pid) : std::to_string(pid) + "." + boot + "." + start;
+    tagged_pid = pid;
+  }
   return tag;
 }
 

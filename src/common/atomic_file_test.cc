@@ -1,5 +1,8 @@
 #include "common/atomic_file.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <fstream>
 #include <sstream>
 
@@ -79,6 +82,36 @@ TEST_F(AtomicFileTest, TemporaryNamesDiffer) {
   EXPECT_NE(TemporaryNameFor("x"), TemporaryNameFor("x"));
   EXPECT_EQ(TemporaryNameFor("x").rfind("x.tmp-" + ProcessTag() + "-", 0), 0u);
   EXPECT_EQ(ProcessTag().rfind(std::to_string(::getpid()), 0), 0u);
+}
+
+// A child forked after the parent named a temporary names its own by its own pid and start time,
+// and the parent's stay the parent's: the tag was made once per process image, so a forked child
+// wrote under its parent's tag.
+TEST_F(AtomicFileTest, AForkedChildTagsItsTemporariesAsItself) {
+  const std::string parent = TemporaryNameFor("x");
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::close(fds[0]);
+    const std::string name = TemporaryNameFor("x");
+    const ssize_t n = ::write(fds[1], name.data(), name.size());
+    ::_exit(n == static_cast<ssize_t>(name.size()) ? 0 : 1);
+  }
+  ::close(fds[1]);
+  std::string from_child;
+  char buf[256];
+  for (ssize_t n; (n = ::read(fds[0], buf, sizeof buf)) > 0;) from_child.append(buf, static_cast<size_t>(n));
+  ::close(fds[0]);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  EXPECT_EQ(from_child.rfind("x.tmp-" + std::to_string(child), 0), 0u) << from_child;
+  EXPECT_EQ(parent.rfind("x.tmp-" + ProcessTag() + "-", 0), 0u) << parent;
+  // The child has ended: its names are a stopped process's, the parent's a live one's.
+  EXPECT_TRUE(IsTemporaryOfStoppedProcess(from_child)) << from_child;
+  EXPECT_FALSE(IsTemporaryOfStoppedProcess(parent)) << parent;
 }
 
 TEST_F(AtomicFileTest, ATemporaryIsAStoppedProcessesByItsPidBootAndStartTime) {
