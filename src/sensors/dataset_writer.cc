@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <utility>
 #include <set>
 #include <vector>
 #include <filesystem>
@@ -106,8 +107,11 @@ nlohmann::json ClipLabelJson(const LabelledClip& c, const ClipSourceInfo& source
   return j;
 }
 
-DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality, double index_interval)
-    : root_(root), jpeg_quality_(jpeg_quality), index_interval_(index_interval) {
+DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality, double index_interval, SteadyNow now)
+    : root_(root),
+      jpeg_quality_(jpeg_quality),
+      index_interval_(index_interval),
+      now_(now ? std::move(now) : SteadyNow([] { return std::chrono::steady_clock::now(); })) {
   if (jpeg_quality < 1 || jpeg_quality > 100)
     throw std::invalid_argument("jpeg_quality must be in 1..100, got " + std::to_string(jpeg_quality));
   if (!(index_interval >= 0 && index_interval <= 86400))
@@ -283,7 +287,7 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
     throw;
   }
   if (index_interval_ > 0 && !replaced && last_index_write_ &&
-      std::chrono::steady_clock::now() - *last_index_write_ < std::chrono::duration<double>(index_interval_))
+      now_() - *last_index_write_ < std::chrono::duration<double>(index_interval_))
     return final_dir;  // listed by a later rewrite
   try {
     WriteIndex();
@@ -323,7 +327,7 @@ void DatasetWriter::WriteIndex() {
   WriteFileAtomically(root_ + "/index.json",
                       index_.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   unlisted_ = 0;
-  last_index_write_ = std::chrono::steady_clock::now();
+  last_index_write_ = now_();
 }
 
 }  // namespace clothwind::sensors

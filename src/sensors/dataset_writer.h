@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -50,6 +51,8 @@ class DatasetWriter {
   //                 writes more than the clips' JPEGs by far. Clips written since the last
   //                 rewrite are in place but not listed (unlisted()): FlushIndex, the destructor
   //                 or the next writer to open the folder (which lists clips in place) lists them.
+  //   now           the steady clock the interval is measured on (empty: steady_clock::now; tests
+  //                 give a clock that starts near 0, as the steady clock does on a machine just booted)
   // Holds an exclusive lock on <root>/.lock while it lives: a second writer (another node, a
   // replay into the folder being recorded) is refused, since each rewrites the whole index.
   // Clip folders that a writer which died had renamed into place but not yet listed are added
@@ -57,7 +60,9 @@ class DatasetWriter {
   // Throws std::runtime_error when the folder cannot be created or locked or its index.json is
   // not valid (the message names the file and what was expected); an index that cannot be read
   // is never overwritten.
-  explicit DatasetWriter(const std::string& root, int jpeg_quality = 95, double index_interval = 0.0);
+  using SteadyNow = std::function<std::chrono::steady_clock::time_point()>;
+  explicit DatasetWriter(const std::string& root, int jpeg_quality = 95, double index_interval = 0.0,
+                         SteadyNow now = {});
   // Lists unlisted clips (FlushIndex); a failure is swallowed: the clips are in place, and the
   // next writer to open the folder lists them.
   ~DatasetWriter();
@@ -104,6 +109,7 @@ class DatasetWriter {
   size_t recovered_ = 0, reindexed_ = 0;
   double index_interval_ = 0.0;
   size_t unlisted_ = 0;
+  SteadyNow now_;
   std::optional<std::chrono::steady_clock::time_point> last_index_write_;  // none: never written
   // The held <root>/.lock: a member that closes it, so a constructor that throws after taking it
   // releases it too (a destructor of the writer would not run then).

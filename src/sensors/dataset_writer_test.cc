@@ -2,8 +2,10 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <set>
 #include <string>
 
@@ -148,12 +150,13 @@ TEST_F(DatasetWriterTest, ReopenAppendsAndRewriteReplaces) {
 
 TEST_F(DatasetWriterTest, WithAnIndexIntervalClipsAreListedByTheNextRewriteFlushOrClose) {
   // index_interval a day: the first clip's write rewrites the index (none written yet, however
-  // long the machine has been up: the steady clock starts at boot), the next two are in place
-  // but unlisted until FlushIndex; the destructor lists the last one. Every
-  // clip is recorded whole meanwhile, and a writer opening the folder after a crash would list
-  // what the index lacks (ClipsInPlaceButNotListedAreIndexedOnOpen).
+  // long the machine has been up: the steady clock starts at boot, so the clock here starts at
+  // 1 s, a machine just booted, where "never written" read as "written at 0" kept the first clip
+  // unlisted for a day), the next two are in place but unlisted until FlushIndex; the destructor
+  // lists the last one. Every clip is recorded whole meanwhile, and a writer opening the folder
+  // after a crash would list what the index lacks (ClipsInPlaceButNotListedAreIndexedOnOpen).
   {
-    DatasetWriter w(root_.string(), 95, 86400.0);
+    DatasetWriter w(root_.string(), 95, 86400.0, [] { return std::chrono::steady_clock::time_point(std::chrono::seconds(1)); });
     w.Write(MakeClip(0, 1700000000.0), {});
     EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 1u);
     EXPECT_EQ(w.unlisted(), 0u);
@@ -177,6 +180,24 @@ TEST_F(DatasetWriterTest, WithAnIndexIntervalClipsAreListedByTheNextRewriteFlush
   EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 5u);
   EXPECT_EQ(every.unlisted(), 0u);
   EXPECT_THROW(DatasetWriter(root_.string() + "-x", 95, -1.0), std::invalid_argument);
+}
+
+// Once index_interval has passed since the last rewrite, the next clip rewrites the index and
+// lists the clips held back before it.
+TEST_F(DatasetWriterTest, TheFirstClipAfterTheIntervalRewritesTheIndex) {
+  auto now = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::seconds(5));
+  DatasetWriter w(root_.string(), 95, 30.0, [now] { return *now; });
+  w.Write(MakeClip(0, 1700000000.0), {});
+  *now += std::chrono::seconds(29);
+  w.Write(MakeClip(1, 1700000001.2), {});
+  EXPECT_EQ(w.unlisted(), 1u) << "29 s after the last rewrite: held back";
+  *now += std::chrono::seconds(2);
+  w.Write(MakeClip(2, 1700000002.4), {});
+  EXPECT_EQ(w.unlisted(), 0u) << "31 s: rewritten";
+  EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 3u);
+  *now += std::chrono::seconds(1);
+  w.Write(MakeClip(3, 1700000003.6), {});
+  EXPECT_EQ(w.unlisted(), 1u) << "the interval counts from that rewrite";
 }
 
 TEST_F(DatasetWriterTest, AClipReplacedWithinTheIndexIntervalIsListedAtOnce) {
