@@ -5,7 +5,7 @@
 //
 //   sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10]
 //             [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N (0 = off)]
-//             [--strain-sweeps N] [--strain-tolerance T]
+//             [--strain-sweeps N] [--strain-tolerance T] [--strain-method sweeps|global]
 // The strain columns: the limiter's sweeps per step, the share of steps it ended outside its
 // tolerance (SimOptions.strain_limit_tolerance, or --strain-tolerance), and the 99th percentile of the faces' largest principal stretch over the
 // frames of the last half (the flag's limit is 1.05).
@@ -74,6 +74,7 @@ int main(int argc, char** argv) {
   int crossing_sweeps = -1;  // -1: the scene's (SimOptions default)
   int strain_sweeps = -1;    // -1: SimOptions default
   double strain_tolerance = -1;
+  bool strain_global = false;  // --strain-method global: local/global iterations (StrainLimitMethod)
   BuildOptions build;
   std::vector<double> winds = {1, 3, 6, 10};
   for (int i = 1; i < argc; ++i) {
@@ -103,6 +104,13 @@ int main(int argc, char** argv) {
       strain_sweeps = std::stoi(next());
     } else if (a == "--strain-tolerance") {
       strain_tolerance = std::stod(next());
+    } else if (a == "--strain-method") {
+      const std::string m = next();
+      if (m != "sweeps" && m != "global") {
+        std::fprintf(stderr, "sim_bench: --strain-method must be sweeps or global, got %s\n", m.c_str());
+        return 2;
+      }
+      strain_global = m == "global";
     } else if (a == "--winds") {
       winds.clear();
       std::stringstream ss(next());
@@ -110,7 +118,7 @@ int main(int argc, char** argv) {
       while (std::getline(ss, item, ',')) winds.push_back(std::stod(item));
     } else {
       std::fprintf(stderr,
-                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N] [--strain-sweeps N] [--strain-tolerance T]\n");
+                   "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N] [--strain-sweeps N] [--strain-tolerance T] [--strain-method sweeps|global]\n");
       return 2;
     }
   }
@@ -127,6 +135,9 @@ int main(int argc, char** argv) {
   }
   if (strain_tolerance >= 0) {
     for (auto& c : setup.cloths) c.options.strain_limit_tolerance = strain_tolerance;
+  }
+  if (strain_global) {
+    for (auto& c : setup.cloths) c.options.strain_limit_method = StrainLimitMethod::kGlobal;
   }
   std::printf("scene %s, %.1f s simulated per wind, dt %.4f s, edges <= %.3f m, CG tolerance %g, one thread\n",
               scene_path.c_str(), duration, setup.cloths[0].options.dt, setup.cloths[0].max_edge,

@@ -657,6 +657,7 @@ void ClothSimulator::Step() {
     limits.max = s.options.strain_max;
     limits.tolerance = s.options.strain_limit_tolerance;
     limits.max_sweeps = s.options.strain_limit_iterations;
+    limits.method = s.options.strain_limit_method;
     const StrainLimitResult r = s.limiter->Project(limits, h, &s.x, &s.v);
     s.stats.strain_limited_faces = r.initially_violated;
     s.stats.strain_limit_sweeps = r.sweeps;

@@ -9,6 +9,7 @@
 
 #include "sim/material.h"
 #include "sim/mesh.h"
+#include "sim/strain_limiter.h"
 #include "sim/wind_field.h"
 
 namespace clothwind::sim {
@@ -33,6 +34,9 @@ struct SimOptions {
   // "Strain limiting".
   int strain_limit_iterations = 4;
   double strain_limit_tolerance = 0.0;
+  // Sweeps (the default, FlagSim's) or local/global iterations, which strain_limit_iterations
+  // then counts (StrainLimitMethod; docs/simulator.md, "Strain limiting").
+  StrainLimitMethod strain_limit_method = StrainLimitMethod::kSweeps;
   double repulsion_thickness = 10e-3;               // ArcSim magic.repulsion_thickness [m]
   double collision_stiffness = 1e6;                 // ArcSim magic.collision_stiffness [N/m^3]
                                                     // (times min(node area, face area) per pair)

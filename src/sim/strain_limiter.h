@@ -2,6 +2,7 @@
 #define CLOTHWIND_SIM_STRAIN_LIMITER_H_
 
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -37,6 +38,13 @@ Eigen::Vector2d FacePrincipalStretches(const Mesh& mesh, const Positions& x, int
   return Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(Ds * Dm.inverse()).singularValues();
 }
 
+// How StrainLimiter::Project limits stretches:
+//   kSweeps  Gauss-Seidel sweeps of per-face projections (the default; FlagSim's datasets)
+//   kGlobal  local/global iterations: every face's projection (local), then the positions that
+//            best fit all of them at once, mass-weighted, in one sparse solve (global), so a
+//            correction reaches the whole sheet in one iteration instead of creeping a face a sweep
+enum class StrainLimitMethod { kSweeps, kGlobal };
+
 // How StrainLimiter::Project sweeps (ArcSim's strain_limits, and when its sweeps stop).
 struct StrainLimitSettings {
   double min = 0.0;  // lower limit on principal stretches (0: none)
@@ -45,7 +53,8 @@ struct StrainLimitSettings {
   // max (1 + tolerance)]; faces outside the limits by less are still projected. 0: until no
   // face is out by more than round-off (1e-6).
   double tolerance = 0.0;
-  int max_sweeps = 4;
+  int max_sweeps = 4;  // kGlobal: at most this many local/global iterations
+  StrainLimitMethod method = StrainLimitMethod::kSweeps;
 };
 
 // What one Project call did.
@@ -95,6 +104,12 @@ class StrainLimiter {
                             Eigen::MatrixX3d* v);
 
  private:
+  // The kSweeps and kGlobal methods on the interleaved positions work_ (Project's inputs).
+  StrainLimitResult Sweep(const StrainLimitSettings& settings);
+  StrainLimitResult LocalGlobal(const StrainLimitSettings& settings);
+  // Builds and factorises the global step's matrix (once, on the first kGlobal call).
+  void PrepareGlobal();
+
   struct Face {
     int v[3];
     Eigen::Matrix2d Dm_inv;
@@ -105,6 +120,13 @@ class StrainLimiter {
   std::vector<Face> faces_;
   std::vector<double> work_;  // interleaved positions during the sweeps
   std::vector<char> moved_, moved_next_;
+  // kGlobal: the global step's #V by #V matrix, factorised (empty until first used), and what
+  // builds it.
+  struct Global;
+  std::shared_ptr<Global> global_;
+  Eigen::VectorXd mass_;
+  std::vector<char> pinned_;
+  std::vector<double> face_weight_;  // kGlobal: each face's weight in the fit (its mass · area)
 };
 
 }  // namespace clothwind::sim

@@ -252,6 +252,61 @@ TEST(StrainLimiter, SweepsOnAStripStretchedAlongItsLengthConvergeSlowlyAndSaySo)
   EXPECT_GT(LargestStretch(strip.mesh, x), 1.06);
 }
 
+// The same strip under local/global iterations: the global step fits the whole strip to its
+// faces' projections at once, so the correction does not creep, and a few iterations do what took
+// the sweeps thousands.
+TEST(StrainLimiter, GlobalIterationsBringTheStretchedStripWithinLimitsAtOnce) {
+  const Strip strip = StretchedStrip(30, 1.10);
+  StrainLimiter limiter(strip.mesh, Eigen::VectorXd::Ones(strip.x.rows()), strip.pinned);
+  Eigen::MatrixX3d x = strip.x, v = Eigen::MatrixX3d::Zero(x.rows(), 3);
+  StrainLimitSettings settings = Limits(50);
+  settings.method = StrainLimitMethod::kGlobal;
+  const double dt = 0.01;
+  const StrainLimitResult r = limiter.Project(settings, dt, &x, &v);
+  EXPECT_TRUE(r.converged);
+  EXPECT_LE(r.sweeps, 50) << "iterations";  // (33 when written; the sweeps needed 2,123)
+  EXPECT_EQ(r.initially_violated, strip.mesh.F.rows()) << "every face is checked against the same positions";
+  EXPECT_LE(LargestStretch(strip.mesh, x), 1.05 * (1 + 2e-3));
+  // Not pulled in far past the limit either: the strip ends near 1.05 times its rest length
+  // (31.41 of 31.5 when written: the closest shape within the limits, mass-weighted).
+  EXPECT_GT(x(x.rows() - 1, 0), 1.04 * 30);
+  EXPECT_LE(x(x.rows() - 1, 0), 1.05 * 30 * (1 + 2e-3));
+  EXPECT_TRUE(x.topRows(2) == strip.x.topRows(2)) << "the pinned end moved";
+  EXPECT_TRUE(v.isApprox((x - strip.x) / dt, 1e-12));
+}
+
+// The global step is a mass-weighted fit whose face terms do not change under translation: with
+// nothing pinned it moves no mass centre (the correction's momentum sum_i m_i dx_i is 0), whatever
+// the masses. And a sheet within the limits is left bit-identical (no solve runs).
+TEST(StrainLimiter, GlobalIterationsKeepTheMassCentreOfAFreeSheetAndLeaveOneWithinLimits) {
+  Strip strip = StretchedStrip(8, 1.12);
+  strip.pinned.assign(strip.pinned.size(), 0);
+  Eigen::VectorXd mass(strip.x.rows());
+  Rng rng(7);
+  for (int i = 0; i < mass.size(); ++i) mass[i] = rng.Uniform(0.2, 3.0);
+  StrainLimiter limiter(strip.mesh, mass, strip.pinned);
+  StrainLimitSettings settings = Limits(30);
+  settings.method = StrainLimitMethod::kGlobal;
+  Eigen::MatrixX3d x = strip.x, v = Eigen::MatrixX3d::Zero(x.rows(), 3);
+  // Bent out of plane too, so the fit moves every coordinate.
+  for (int i = 0; i < x.rows(); ++i) x(i, 2) = 0.3 * std::sin(0.7 * x(i, 0));
+  const Eigen::MatrixX3d before = x;
+  const StrainLimitResult r = limiter.Project(settings, 0.01, &x, &v);
+  EXPECT_TRUE(r.converged);
+  EXPECT_LE(LargestStretch(strip.mesh, x), 1.05 * (1 + 2e-3));
+  const Eigen::RowVector3d momentum = mass.transpose() * (x - before);
+  EXPECT_LT(momentum.norm(), 1e-9 * mass.sum() * (x - before).norm()) << momentum;
+  EXPECT_GT((x - before).norm(), 0.1) << "the test should move the vertices";
+
+  const Eigen::MatrixX3d within = x;
+  const Eigen::MatrixX3d v_within = v;
+  settings.tolerance = 0.01;  // the converged sheet is within 1 % of the limits
+  const StrainLimitResult again = limiter.Project(settings, 0.01, &x, &v);
+  EXPECT_TRUE(again.converged);
+  EXPECT_EQ(again.sweeps, 1);
+  EXPECT_TRUE(x == within && v == v_within) << "a sheet within the tolerance was moved";
+}
+
 TEST(StrainLimiter, AFaceOutByLessThanTheToleranceIsProjectedAndEndsTheSweeps) {
   // 1.0504 is 0.04 % over 1.05: projected to the limit, and the sweeps end after the first,
   // converged (the tolerance is 0.1 %). With tolerance 0 the same face keeps the sweeps going
