@@ -20,8 +20,12 @@ bool ProgressBar::Update(int64_t done, int64_t total, const std::string& note) {
   std::lock_guard<std::mutex> lock(mutex_);
   const double now = Elapsed();
   const bool last = done >= total;
-  const double interval = tty_ ? 0.2 : o_.plain_interval;
-  if (!last && now - last_print_ < interval) return true;
+  // Every report of done >= total used to print at once: training's validation, reported as
+  // steps/steps, printed a line per batch (hundreds an epoch).
+  const bool first_last = last && !reported_last_;
+  const double interval = tty_ && !reported_last_ ? 0.2 : o_.plain_interval;
+  if (!first_last && now - last_print_ < interval) return true;
+  if (last) reported_last_ = true;
   last_print_ = now;
   Print(done, total, note, now);
   return true;

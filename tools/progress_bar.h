@@ -31,7 +31,10 @@ class ProgressBar {
   ProgressBar& operator=(const ProgressBar&) = delete;
 
   // Reports that `done` of `total` units are finished; `note` is appended (e.g. the last
-  // item's name). Returns true, so it can serve as a keep-going callback.
+  // item's name). The first report of done >= total prints at once; later ones (work after the
+  // last unit, e.g. training's validation, reported as steps/steps with a note) are throttled like
+  // the rest, at plain_interval even on a terminal, whose line the first one ended. Returns true,
+  // so it can serve as a keep-going callback.
   bool Update(int64_t done, int64_t total, const std::string& note = "");
 
   // Ends the line on a terminal (call once when done; Update(total, total) also does).
@@ -49,6 +52,7 @@ class ProgressBar {
   std::chrono::steady_clock::time_point start_;
   double last_print_ = -1e300;  // [s since start]
   bool open_line_ = false;      // a redrawn line is on screen without its newline
+  bool reported_last_ = false;  // done >= total was printed once
 };
 
 // "12 s", "3 min 05 s", "2 h 04 min": a duration [s] for people.
