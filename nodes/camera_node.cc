@@ -168,6 +168,7 @@ int main(int argc, char** argv) {
   std::string calibration_unused =
       calibration_refused.empty() ? "" : "calibration file refused: " + calibration_refused;
   bool opened = false, ended = false;
+  uint64_t opens = 0;  // successful Opens (a recording that failed is opened again)
   updater.add("camera source", [&](diagnostic_updater::DiagnosticStatusWrapper& stat) {
     const auto status = source->Status();
     for (const auto& kv : status) stat.add(kv.first, kv.second);
@@ -184,7 +185,10 @@ int main(int argc, char** argv) {
     if (status.count("dropped frames")) drops = std::stoull(status.at("dropped frames"));
     const std::vector<std::string> read_warnings = tally.TakeReport();
     if (!opened) {
-      stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "cannot open: " + last_error);
+      // A recording that opened and then failed (nothing in it readable) is not one that cannot
+      // be opened.
+      stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR,
+                   (opens > 0 ? "failed, opening again: " : "cannot open: ") + last_error);
     } else if (ended) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "recording ended");
     } else if (state != "streaming" && state != "open") {
@@ -225,10 +229,16 @@ int main(int argc, char** argv) {
         opened = true;
         const double rate = source->NominalRate();
         if (rate > 0) min_rate = max_rate = rate;
-        ROS_INFO_STREAM("camera_node: publishing " << source->Describe() << " on "
-                        << publisher.getTopic() << " in frame " << frame_id);
+        if (opens++ == 0) {
+          ROS_INFO_STREAM("camera_node: publishing " << source->Describe() << " on "
+                          << publisher.getTopic() << " in frame " << frame_id);
+        } else {
+          WALL_WARN_STREAM_THROTTLE(10.0, "camera_node: opened " << source->Describe() << " again after: "
+                                                                 << last_error);
+        }
       } else {
         last_error = source->error();
+        tally.SourceFailed(last_error);
         WALL_ERROR_STREAM_THROTTLE(5.0, "camera_node: " << last_error << " (retrying)");
         wall_diagnostics.Update();
         next_open = ros::WallTime::now() + ros::WallDuration(open_backoff_s);
@@ -242,7 +252,9 @@ int main(int argc, char** argv) {
     } else {
       Frame frame;
       const ReadStatus status = source->Read(&frame, 0.1);
-      tally.Record(status, source->error());
+      const bool failed = status == ReadStatus::kBadFrame || status == ReadStatus::kError;
+      tally.Record(status, failed ? source->error() : std::string());
+      if (status == ReadStatus::kFrame) open_backoff_s = 0.25;  // reading again: the next failure retries soon
       if (status == ReadStatus::kFrame && publisher.getNumSubscribers() == 0) {
         // The frame is read and decoded (the driver's buffers must keep moving) and counted at the
         // camera's rate, but no message is built for nobody.
@@ -276,9 +288,13 @@ int main(int argc, char** argv) {
       } else if (status == ReadStatus::kError) {
         last_error = source->error();
         WALL_WARN_STREAM_THROTTLE(2.0, "camera_node: " << last_error);
-        if (!source->IsOpen()) {  // a recording that became unreadable: Open again, with backoff
+        if (!source->IsOpen()) {
+          // A recording that became unreadable: Open again, with a backoff that grows until a
+          // frame is read (a folder whose files all fail still opens, and reopening it at once
+          // spun through it thousands of times a second).
           opened = false;
-          open_backoff_s = 0.25;
+          next_open = ros::WallTime::now() + ros::WallDuration(open_backoff_s);
+          open_backoff_s = std::min(open_backoff_s * 2.0, 5.0);
         }
       } else if (status == ReadStatus::kEnd) {
         ended = true;

@@ -15,7 +15,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -119,10 +118,10 @@ inline std::string ProcessStartTicks(long pid) {
 // call kept its parent's tag, so the two named their temporaries alike (the counter is copied too)
 // and the child's were taken for a live process's after it ended.
 inline std::string ProcessTag() {
-  static std::mutex mutex;
-  static long tagged_pid = -1;
-  static std::string tag;
-  std::lock_guard<std::mutex> lock(mutex);
+  // Per thread, without a lock: a child forked while another thread held a lock here would wait
+  // on it for ever. A thread's cached pid differs from getpid() in a forked child.
+  thread_local long tagged_pid = -1;
+  thread_local std::string tag;
   const long pid = static_cast<long>(::getpid());
   if (pid != tagged_pid) {
     const std::string boot = atomic_file_internal::BootTag();

@@ -12,8 +12,8 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
-#include <utility>
 #include <set>
+#include <utility>
 #include <vector>
 #include <filesystem>
 #include <fstream>

@@ -6,13 +6,15 @@ void FrameReadTally::Record(ReadStatus status, const std::string& error) {
   switch (status) {
     case ReadStatus::kFrame: ++frames_; break;
     case ReadStatus::kBadFrame: BadFrame(error); break;
-    case ReadStatus::kError:
-      ++failures_;
-      last_failure_ = error;
-      break;
+    case ReadStatus::kError: SourceFailed(error); break;
     case ReadStatus::kNoFrame:
     case ReadStatus::kEnd: break;
   }
+}
+
+void FrameReadTally::SourceFailed(const std::string& error) {
+  ++failures_;
+  last_failure_ = error;
 }
 
 void FrameReadTally::BadFrame(const std::string& error) {

@@ -21,16 +21,19 @@ class FrameReadTally {
   void Record(ReadStatus status, const std::string& error);
   // A frame read but not publishable (its message could not be built): a bad frame.
   void BadFrame(const std::string& error);
+  // The source failed outside a Read (FrameSource::Open refused): a failure.
+  void SourceFailed(const std::string& error);
 
-  uint64_t frames() const { return frames_; }          // frames read
+  uint64_t frames() const { return frames_; }          // frames read (kFrame)
   uint64_t bad_frames() const { return bad_frames_; }  // frames that came but could not be read
   uint64_t failures() const { return failures_; }      // device lost, reopen failed, recording unreadable
   const std::string& last_bad_frame() const { return last_bad_frame_; }
   const std::string& last_failure() const { return last_failure_; }
 
   // What changed since the previous call, as warnings for a diagnostics summary, e.g.
-  // "3 frames unreadable since last report: <last error>" and "1 source failure since last
-  // report: <last error>"; empty when nothing went wrong. Each call starts a new report.
+  // "3 frames unreadable since last report: <last error>" and "1 source failure (device lost,
+  // reopen failed or recording unreadable) since last report: <last error>"; empty when nothing
+  // went wrong. Each call starts a new report.
   std::vector<std::string> TakeReport();
 
  private:

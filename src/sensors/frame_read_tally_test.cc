@@ -12,8 +12,6 @@
 namespace clothwind::sensors {
 namespace {
 
-constexpr int64_t kMs = 1000000;
-
 V4l2Options Grey15() {
   V4l2Options o;
   o.device = "/dev/video7";
@@ -94,18 +92,19 @@ TEST(FrameReadTallyTest, ReportsCountOnlyWhatIsNew) {
   EXPECT_TRUE(tally.TakeReport().empty());
   tally.Record(ReadStatus::kBadFrame, "a");
   tally.BadFrame("b");  // a message that could not be built
-  tally.Record(ReadStatus::kError, "gone");
+  tally.Record(ReadStatus::kError, "lost");
+  tally.SourceFailed("gone");  // an Open that failed
   std::vector<std::string> report = tally.TakeReport();
   ASSERT_EQ(report.size(), 2u);
   EXPECT_EQ(report[0], "2 frames unreadable since last report: b");
-  EXPECT_EQ(report[1].rfind("1 source failure (", 0), 0u) << report[1];
+  EXPECT_EQ(report[1].rfind("2 source failures (", 0), 0u) << report[1];
   EXPECT_NE(report[1].find(": gone"), std::string::npos);
   tally.Record(ReadStatus::kBadFrame, "c");
   report = tally.TakeReport();
   ASSERT_EQ(report.size(), 1u);
   EXPECT_EQ(report[0], "1 frame unreadable since last report: c");
   EXPECT_EQ(tally.bad_frames(), 3u);
-  EXPECT_EQ(tally.failures(), 1u);
+  EXPECT_EQ(tally.failures(), 2u);
   EXPECT_EQ(tally.last_failure(), "gone");
 }
 

@@ -512,8 +512,9 @@ ReadStatus V4l2Camera::Read(Frame* frame, double max_wait_s) {
   if (io_->Ioctl(fd_, VIDIOC_QBUF, &buf) < 0) {
     const int err = errno;
     Lost("VIDIOC_QBUF failed: " + ErrnoText(err));
-    // The frame converted above is still good; after a bad one, the loss is the news.
-    if (status == ReadStatus::kBadFrame) status = ReadStatus::kError;
+    // The loss is the news, even after a good frame (which is dropped): returned as kFrame, the
+    // loss went uncounted by the node and its diagnostics named an older error.
+    status = ReadStatus::kError;
   } else if (status == ReadStatus::kBadFrame && clock_->MonotonicNs() >= loss_deadline) {
     ++stats_.timeouts;
     Lost(NoGoodFrameText(timeout_s));

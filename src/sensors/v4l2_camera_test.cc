@@ -183,6 +183,24 @@ TEST(V4l2CameraTest, ReconnectsWithBackoffAfterEnodev) {
   EXPECT_NEAR(f.stamp_ns, rig.device.delivered_capture_ns().back() + rig.clock.ros_offset_ns(), 1000);
 }
 
+// Unplugged between taking a frame and handing its buffer back: the read reports the loss (the
+// frame is dropped), so the node counts it and says why; it returned the frame and the loss went
+// unseen.
+TEST(V4l2CameraTest, ALossWhileHandingTheBufferBackIsAFailure) {
+  FakeV4l2Config config;
+  config.unplug_after = 2;
+  Rig rig(config, Ask(PixelFormat::kGrey, 320, 240, 15));
+  ASSERT_TRUE(rig.camera.Open());
+  Frame f;
+  for (int i = 0; i < 2; ++i) ASSERT_EQ(rig.ReadFrame(&f), ReadStatus::kFrame);
+  ReadStatus s = ReadStatus::kNoFrame;
+  while (s == ReadStatus::kNoFrame) s = rig.camera.Read(&f, 0.1);
+  EXPECT_EQ(s, ReadStatus::kError);
+  EXPECT_NE(rig.camera.error().find("VIDIOC_QBUF failed"), std::string::npos) << rig.camera.error();
+  EXPECT_EQ(rig.camera.stats().losses, 1u);
+  EXPECT_EQ(rig.camera.Status().at("state"), "reconnecting");
+}
+
 TEST(V4l2CameraTest, StalledDeviceTimesOutAndIsReopened) {
   V4l2Options options = Ask(PixelFormat::kGrey, 320, 240, 15);
   options.timeout_s = 1.0;

@@ -51,6 +51,8 @@ struct FakeV4l2Config {
   std::map<uint64_t, uint32_t> bytesused_of;
   // Captures from this one on are flagged V4L2_BUF_FLAG_ERROR (a wedged camera); none by default.
   uint64_t error_from = UINT64_MAX;
+  // Unplugged right after capture k is dequeued (before the reader hands its buffer back).
+  uint64_t unplug_after = UINT64_MAX;
   std::map<uint32_t, FakeV4l2Control> controls{
       {V4L2_CID_EXPOSURE_AUTO, {0, 3, 3, V4L2_CTRL_TYPE_MENU}},
       {V4L2_CID_GAIN, {0, 100, 10, V4L2_CTRL_TYPE_INTEGER}}};
@@ -338,6 +340,7 @@ class FakeV4l2Device : public V4l2Io {
     b->timestamp.tv_sec = next_capture_ns_ / 1000000000LL;
     b->timestamp.tv_usec = (next_capture_ns_ % 1000000000LL) / 1000;
     delivered_capture_ns_.push_back(b->timestamp.tv_sec * 1000000000LL + b->timestamp.tv_usec * 1000LL);
+    if (captures_ == config_.unplug_after) present_ = false;
     ++sequence_;
     ++captures_;
     skip_applied_ = false;

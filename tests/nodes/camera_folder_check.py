@@ -99,6 +99,7 @@ class CameraFolderTest(unittest.TestCase):
         cls.colour_folder = rospy.get_param("~colour_folder")
         cls.grey_folder = rospy.get_param("~grey_folder")
         cls.calibration_file = rospy.get_param("~calibration_file")
+        cls.garbage_folder = rospy.get_param("~garbage_folder")
         cls.diagnostics = []
         cls.started = time.time()
         rospy.Subscriber("/diagnostics", DiagnosticArray, lambda m: cls.diagnostics.append(m))
@@ -119,10 +120,16 @@ class CameraFolderTest(unittest.TestCase):
         assert waiting(cls.colour_folder) and waiting(cls.grey_folder), "the nodes never reported the missing folders"
         write_folder(cls.colour_folder, 40, 30, 3, colour_value)
         write_folder(cls.grey_folder, 24, 16, 1, grey_value)
+        staging = tempfile.mkdtemp(prefix=".staging_", dir=os.path.dirname(cls.garbage_folder))
+        for k in range(3):
+            with open(os.path.join(staging, "frame_%04d.png" % k), "wb") as f:
+                f.write(b"not a png")
+        os.rename(staging, cls.garbage_folder)
+        cls.garbage_written = time.time()
 
     @classmethod
     def tearDownClass(cls):
-        for folder in (cls.colour_folder, cls.grey_folder):
+        for folder in (cls.colour_folder, cls.grey_folder, cls.garbage_folder):
             shutil.rmtree(folder, ignore_errors=True)
         if os.path.exists(cls.calibration_file):
             os.remove(cls.calibration_file)
@@ -279,6 +286,25 @@ class CameraFolderTest(unittest.TestCase):
             self.assertIn(reason, found.message)
             values = {kv.key: kv.value for kv in found.values}
             self.assertIn(reason, values["calibration"])
+
+    def test_a_folder_of_unreadable_images_is_reopened_with_a_backoff(self):
+        # 10 s after its images appeared: opened, failed a round later, reopened after 0.25, 0.5,
+        # 1, 2, 4 s: about 6 failures and 12 unreadable frames (3 a round, the last a failure).
+        time.sleep(max(0.0, self.garbage_written + 10.0 - time.time()))
+        statuses = [s for array in list(self.diagnostics) for s in array.status
+                    if s.name == "garbage/camera_node: camera source" and
+                    array.header.stamp.to_sec() > self.garbage_written + 1.0]
+        self.assertTrue(statuses, "no diagnostics from the node reading unreadable images")
+        values = {kv.key: kv.value for kv in statuses[-1].values}
+        failures = int(values["source failures (device lost, reopen failed, recording unreadable)"])
+        unreadable = int(values["unreadable frames"])
+        self.assertGreaterEqual(failures, 3, values)
+        self.assertLessEqual(failures, 10, values)
+        self.assertLessEqual(unreadable, 30, values)
+        self.assertEqual(values["published"], "0")
+        self.assertTrue(any(s.level == DiagnosticStatus.ERROR and "failed, opening again: " in s.message and
+                            "no image readable any more" in s.message for s in statuses),
+                        [s.message for s in statuses])
 
     def test_absent_v4l2_device_is_reported(self):
         deadline = time.time() + 15.0
