@@ -44,6 +44,14 @@ inline void RefuseUnwritableOutput(const std::string& option, const std::filesys
     throw std::invalid_argument(option + " " + output.string() + " is a folder; expected a file name");
 }
 
+// Throws std::invalid_argument naming `option` when `output` is a folder: the verbs that make a
+// missing output folder themselves failed only when saving, after the work.
+inline void RefuseFolderAsOutput(const std::string& option, const std::filesystem::path& output) {
+  std::error_code ec;
+  if (!output.empty() && std::filesystem::is_directory(output, ec))
+    throw std::invalid_argument(option + " " + output.string() + " is a folder; expected a file name");
+}
+
 }  // namespace clothwind::tools
 
 #endif  // CLOTHWIND_TOOLS_OUTPUT_PATHS_H_

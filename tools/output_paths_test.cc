@@ -50,6 +50,10 @@ TEST(OutputPathsTest, AnOutputInAMissingFolderOrOnAFolderIsRefusedBeforeTheWork)
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", dir / "sub" / "e.json"));
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", "e.json"));  // the working folder
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", fs::path()));
+  // Verbs that make a missing folder themselves refuse only a folder.
+  EXPECT_THROW(RefuseFolderAsOutput("--out", dir / "sub"), std::invalid_argument);
+  EXPECT_NO_THROW(RefuseFolderAsOutput("--out", dir / "no_such_folder" / "m.pt"));
+  EXPECT_NO_THROW(RefuseFolderAsOutput("--out", fs::path()));
   fs::remove_all(dir);
 }
 

@@ -52,6 +52,8 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
         a->calibrate_data.empty() ? std::filesystem::path() : std::filesystem::path(a->calibrate_data) / "index.json"};
     RefuseOutputOverInput("--out", a->out, inputs);
     RefuseOutputOverInput("--out's .json", out_config, inputs);
+    RefuseFolderAsOutput("--out", a->out);
+    RefuseFolderAsOutput("--out's .json", out_config);
     if (SameFile(a->out, out_config))
       throw std::invalid_argument("--out " + a->out + ": the weights' configuration is written beside them with "
                                   "the extension .json, so --out needs another (e.g. .pt)");

@@ -47,6 +47,7 @@ struct MakeSessionArgs {
   std::string frames = "procedural";  // procedural | rendered
   data::RenderedSessionOptions rendered;
   int64_t zeta_seed = -1;  // -1: the session's seed
+  bool overwrite = false;  // replace an existing --out
 };
 
 // A pinhole camera_info for the synthetic camera: ~60 degree horizontal field of view, no distortion.
@@ -79,6 +80,15 @@ int Run(const MakeSessionArgs& a) {
   if (a.zeta_seed < -1)
     throw std::invalid_argument("--zeta-seed must be >= 0 (or -1: the session's --seed), got " +
                                 std::to_string(a.zeta_seed));
+  // --out checked before the long work: a folder failed only at the final rename (a rendered
+  // session of hours lost), and an existing bag, perhaps a recorded field session, was replaced.
+  {
+    std::error_code ec;
+    if (std::filesystem::is_directory(a.out, ec))
+      throw std::invalid_argument("--out " + a.out + " is a folder; expected a bag file name");
+    if (std::filesystem::exists(a.out, ec) && !a.overwrite)
+      throw std::invalid_argument("--out " + a.out + " exists (a recorded session?); --overwrite replaces it");
+  }
   // Checked before the long work, where a bad name used to be ignored after it (imwrite's result).
   std::string preview_extension;
   if (!a.preview.empty()) {
@@ -253,7 +263,8 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
   auto* sub = app.add_subcommand("make-session",
                                  "Write a synthetic field session (camera + NMEA anemometer) as a rosbag");
   sub->add_option("--minutes", args->minutes, "session length [min] (0.05..1440)")->capture_default_str();
-  sub->add_option("--out", args->out, "output bag")->required();
+  sub->add_option("--out", args->out, "output bag (refused if it exists, unless --overwrite)")->required();
+  sub->add_flag("--overwrite", args->overwrite, "replace an existing --out");
   sub->add_option("--seed", args->seed, "random seed")->capture_default_str();
   sub->add_option("--fps", args->fps, "camera rate [Hz] (10 to 1000: a slower camera's intervals break every clip)")->capture_default_str();
   sub->add_option("--width", args->width, "image width [px] (16..16384)")->capture_default_str();

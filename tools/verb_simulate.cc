@@ -90,12 +90,20 @@ int Run(const SimulateArgs& a) {
   sim::SimulateOptions options;
   options.duration = a.duration;
   options.warmup = a.warmup;
+  if (a.seed < -1) throw std::invalid_argument("--seed must be >= 0, got " + std::to_string(a.seed));
   if (a.seed >= 0) options.seed = static_cast<uint64_t>(a.seed);
   // -1: not given. NaN used to fall through to the scene's duration and inf to undefined behaviour.
   if (a.duration != -1 && !(std::isfinite(a.duration) && a.duration > 0 && a.duration <= 86400)) {
     throw std::invalid_argument("--duration must be a time > 0 and <= 86400 s, got " + std::to_string(a.duration));
   }
   fs::create_directories(a.out);
+  // summary.json marks a finished run (scripts/window-oracle reuses a folder that has one): the
+  // old run's goes before new frames are written, so a run stopped midway leaves none.
+  {
+    std::error_code ec;
+    fs::remove(fs::path(a.out) / "summary.json", ec);
+    if (ec) throw std::runtime_error("cannot remove the old " + (fs::path(a.out) / "summary.json").string() + ": " + ec.message());
+  }
 
   nlohmann::json summary;
   summary["scene"] = scene.path;

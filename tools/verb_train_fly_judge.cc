@@ -109,6 +109,8 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
                                     "extension .json, so --out needs another (e.g. .pt)");
       RefuseOutputOverInput("--out", a->out, {index});
       RefuseOutputOverInput("--out's card", card, {index});
+      RefuseFolderAsOutput("--out", a->out);
+      RefuseFolderAsOutput("--out's card", card);
     }
     at::set_num_threads(a->threads);
     const learn::Dataset dataset = learn::ReadDataset(a->data);

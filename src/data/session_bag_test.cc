@@ -11,6 +11,7 @@
 #include <iterator>
 #include <map>
 #include <string>
+#include <tuple>
 #include <type_traits>
 #include <vector>
 
@@ -190,6 +191,37 @@ TEST(SessionBagTest, APreviewOrZetaSeedItCannotUseIsRefusedBeforeTheWork) {
     EXPECT_NE(text.find(args.find("preview") != std::string::npos ? "--preview" : "--zeta-seed"), std::string::npos)
         << text;
   }
+  fs::remove_all(dir);
+}
+
+TEST(SessionBagTest, AnExistingOutOrAFolderIsRefusedBeforeTheWork) {
+  // An existing bag (perhaps a recorded field session) was replaced without a word, and a folder
+  // failed only at the final rename, the finished session discarded.
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_session_out_" + std::to_string(::getpid()));
+  fs::create_directories(dir / "a_folder");
+  const fs::path bag = dir / "recorded.bag";
+  std::ofstream(bag) << "a field session";
+  const std::string log = (dir / "log").string();
+  auto run = [&](const std::string& out, const std::string& extra) {
+    const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes 0.05 --out " + out + extra +
+                            " > " + log + " 2>&1";
+    const int status = std::system(cmd.c_str());
+    std::ifstream in(log);
+    return std::make_pair(status, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+  };
+  auto [status, text] = run(bag.string(), "");
+  EXPECT_NE(status, 0);
+  EXPECT_NE(text.find("--out " + bag.string() + " exists"), std::string::npos) << text;
+  EXPECT_NE(text.find("--overwrite"), std::string::npos) << text;
+  std::ifstream kept(bag);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(kept)), std::istreambuf_iterator<char>()), "a field session");
+  std::tie(status, text) = run((dir / "a_folder").string(), "");
+  EXPECT_NE(status, 0);
+  EXPECT_NE(text.find("is a folder"), std::string::npos) << text;
+  EXPECT_EQ(text.find("frames"), std::string::npos) << "refused before the work: " << text;
+  std::tie(status, text) = run(bag.string(), " --overwrite");
+  EXPECT_EQ(status, 0) << text;
+  EXPECT_GT(fs::file_size(bag), 1000u);
   fs::remove_all(dir);
 }
 

@@ -533,6 +533,17 @@ Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t s
 
 std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions& o) {
   fs::create_directories(dir);
+  // Only a toy dataset is written over: the index of a FlagSim or recorded dataset (its settings
+  // in the header) was removed and replaced by a toy one, for good.
+  if (fs::exists(dir / "index.json")) {
+    std::ifstream in(dir / "index.json");
+    const nlohmann::json index = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    const bool toy = index.is_object() && index.contains("kind") && index["kind"] == "toy";
+    if (!toy)
+      throw std::runtime_error((dir / "index.json").string() + " is not a toy dataset's index (\"kind\": " +
+                               (index.is_object() && index.contains("kind") ? index["kind"].dump() : std::string("none")) +
+                               "); write the toy dataset into another folder");
+  }
   // The old index goes first and the new one comes last: a run stopped over an earlier dataset
   // left the old index over a mix of both runs' examples, which readers took as whole. Examples
   // of a larger earlier run are removed too.

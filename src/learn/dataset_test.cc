@@ -555,6 +555,29 @@ TEST_F(DatasetTest, AToyDatasetOverAnotherReplacesItWhole) {
   EXPECT_FALSE(fs::exists(copy / "toy-00003"));
   EXPECT_FALSE(fs::exists(copy / "toy-00009"));
   for (const ClipInfo& c : d.clips) EXPECT_EQ(c.num_frames, 4);
+
+  // Over a dataset of another kind (a FlagSim one's index, its settings in the header): refused,
+  // its index kept (it was removed and replaced by a toy one).
+  nlohmann::json index;
+  {
+    std::ifstream in(copy / "index.json");
+    index = nlohmann::json::parse(in);
+  }
+  index["kind"] = "flag";
+  {
+    std::ofstream out(copy / "index.json");
+    out << index.dump();
+  }
+  try {
+    WriteToyDataset(copy, o);
+    ADD_FAILURE() << "a flag dataset was written over";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find((copy / "index.json").string() + " is not a toy dataset's index"),
+              std::string::npos)
+        << e.what();
+  }
+  std::ifstream in(copy / "index.json");
+  EXPECT_EQ(nlohmann::json::parse(in)["kind"], "flag");
 }
 
 TEST(MakeSample, FlagFliesTurnsAFlagFlyingLeftToFlyRight) {

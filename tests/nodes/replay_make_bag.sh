@@ -19,7 +19,7 @@ mkdir -p "$(dirname "$bag")"
   flock 9
   if [ ! -f "$bag" ] || [ "$cli" -nt "$bag" ] || [ "$0" -nt "$bag" ] || [ "$(cat "$bag.recipe" 2>/dev/null || true)" != "$recipe" ]; then
     rm -f "$bag.recipe"  # the recipe is written last: a run stopped midway is made again
-    "$cli" make-session --out "$bag" "${opts[@]}"
+    "$cli" make-session --out "$bag" --overwrite "${opts[@]}"
     echo "$recipe" > "$bag.recipe"
   fi
 ) 9> "$bag.lock"
