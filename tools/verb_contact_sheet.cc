@@ -29,8 +29,12 @@ int Run(const ContactSheetArgs& a) {
   RefuseOutputOverInput("--out", out, {dir / "index.json"});
   const std::filesystem::path out_folder =
       std::filesystem::path(out).has_parent_path() ? std::filesystem::path(out).parent_path() : ".";
-  for (const auto& clip : index["clips"]) {
-    const std::string name = clip.value("name", std::string());
+  // Entries of another shape are the core's to refuse naming the field (WriteContactSheet); here
+  // they are skipped: value() on a string entry, or a number for a name, threw bare type errors.
+  const nlohmann::json clips = index.contains("clips") && index["clips"].is_array() ? index["clips"] : nlohmann::json::array();
+  for (const auto& clip : clips) {
+    if (!clip.is_object() || !clip.contains("name") || !clip["name"].is_string()) continue;
+    const std::string name = clip["name"].get<std::string>();
     if (name.empty()) continue;
     const std::filesystem::path folder = dir / name;
     if (SameFile(out_folder, folder))
@@ -39,7 +43,7 @@ int Run(const ContactSheetArgs& a) {
   }
   RefuseUnwritableOutput("--out", out);
   if (!data::WriteContactSheet(a.dir, index, out, a.options)) {
-    std::printf("contact-sheet: %s has no clips\n", a.dir.c_str());
+    std::fprintf(stderr, "contact-sheet: %s has no clips\n", a.dir.c_str());
     return 1;
   }
   std::printf("contact-sheet: %s (%zu clips in the index, up to %d shown)\n", out.c_str(), index["clips"].size(),

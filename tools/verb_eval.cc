@@ -106,6 +106,17 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
                                     "); write one of them elsewhere");
     RefuseUnwritableOutput("--json", a->json);
     RefuseUnwritableOutput("--plot", a->plot);
+    if (a->track_head) {
+      // Before the evaluation, which ran whole and then lost its results to a model without a head,
+      // a window of the wrong length or a rows file over the model's configuration.
+      RefuseOutputOverInput("--track-head-rows", a->track_head_rows, inputs);
+      for (const std::string& other : {a->json, plot.string()})
+        if (!a->track_head_rows.empty() && !other.empty() && SameFile(a->track_head_rows, other))
+          throw std::invalid_argument("--track-head-rows " + a->track_head_rows + " is where another result goes (" +
+                                      other + "); write one of them elsewhere");
+      RefuseUnwritableOutput("--track-head-rows", a->track_head_rows);
+      learn::CheckTrackHead(a->model, a->track_head_window);
+    }
     ProgressBar::Options b;
     b.label = "eval";
     b.unit = "clips";
@@ -130,6 +141,8 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
         by_view_error = e.what();
       }
     }
+    // The evaluation's figures are kept whatever the track head does after them.
+    if (!a->json.empty() && a->track_head) learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
     if (a->track_head) {
       ProgressBar::Options h = b;
       h.label = "track head";

@@ -469,8 +469,10 @@ nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<st
 int64_t ReindexDataset(const std::string& dir, bool contact_sheet) {
   nlohmann::json index = ReadIndex(dir);
   if (index.is_null()) throw std::runtime_error(dir + "/index.json not found: not a dataset folder");
-  if (index.value("kind", "") != "flag" && index.value("kind", "") != "cloth")
-    throw std::runtime_error(dir + "/index.json: field 'kind' is " + index.value("kind", nlohmann::json()).dump() +
+  // Compared as JSON: value("kind", "") threw a bare type error on a kind of another type.
+  const nlohmann::json kind = index.is_object() && index.contains("kind") ? index["kind"] : nlohmann::json();
+  if (kind != nlohmann::json("flag") && kind != nlohmann::json("cloth"))
+    throw std::runtime_error(dir + "/index.json: field 'kind' is " + kind.dump() +
                              ", expected \"flag\" or \"cloth\" (only simulated datasets are re-indexed)");
   index = BuildIndex(dir, index);
   WriteIndex(dir, index);

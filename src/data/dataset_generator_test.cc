@@ -490,6 +490,14 @@ TEST_F(DatasetGeneratorTest, ReindexMergesFoldersCopiedFromOtherMachines) {
   fs::create_directories(real);
   std::ofstream(real / "index.json") << R"({"format": "clothwind-dataset", "version": 1, "kind": "real", "clips": []})";
   EXPECT_THROW(ReindexDataset(real.string()), std::runtime_error);
+  // A kind of another type is refused naming the index (it was a bare nlohmann type error).
+  std::ofstream(real / "index.json") << R"({"format": "clothwind-dataset", "version": 1, "kind": 5, "clips": []})";
+  try {
+    ReindexDataset(real.string());
+    ADD_FAILURE() << "kind 5 re-indexed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(real.string() + "/index.json: field 'kind' is 5"), std::string::npos) << e.what();
+  }
 }
 
 // A run stopped after its first simulation (killed, or timed out) has already written the

@@ -85,8 +85,11 @@ Dataset ReadDataset(const fs::path& dir) {
   // scripts/dataset-variant --split-by-clip re-splits a dataset clip by clip in its index alone
   // (the labels are hard links to the source's): there the index's split is the one, and one
   // simulation in several splits is the point (the leak that variant measures).
+  // (Compared as JSON: value() with a string default threw a bare type error, naming no file, on
+  // a "variant" of another type.)
   const bool split_by_clip = index.contains("dataset") && index["dataset"].is_object() &&
-                             index["dataset"].value("variant", std::string()) == "split_by_clip";
+                             index["dataset"].contains("variant") &&
+                             index["dataset"]["variant"] == nlohmann::json("split_by_clip");
   std::map<std::string, size_t> seen;  // name -> its first entry
   std::map<int, std::pair<std::string, std::string>> simulation_split;  // simulation -> (split, a clip's name)
   std::map<int, std::pair<double, std::string>> simulation_wind;        // simulation -> (wind, a clip's name)

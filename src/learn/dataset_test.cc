@@ -96,6 +96,14 @@ TEST_F(DatasetTest, ReadsIndexLabelsAndFrames) {
   EXPECT_THROW(LoadFrames(d.clips[0], 38, 3, true), std::runtime_error);
 }
 
+// A "dataset" header whose "variant" is of another type is no variant: value() with a string
+// default threw a bare type error naming no file, from every verb that reads a dataset.
+TEST_F(DatasetTest, AVariantOfAnotherTypeIsNoVariant) {
+  const fs::path d = Copy("variant_number");
+  EditJson(d / "index.json", [](nlohmann::json& j) { j["dataset"] = {{"variant", 1}}; });
+  EXPECT_EQ(ReadDataset(d).clips.size(), ReadDataset(*dir_).clips.size());
+}
+
 TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
   auto expect_error = [](const fs::path& dir, const std::string& file, const std::string& what) {
     try {

@@ -30,8 +30,19 @@ void ReadRunAuxOptions(const fs::path& model, int* phase_bins, bool* world) {
   const fs::path state = model.parent_path() / "state.json";
   if (!fs::exists(state)) return;
   const nlohmann::json j = ReadJson(state);
-  *phase_bins = j.value("aux_phase_bins", 0);
-  *world = j.value("aux_world", false);
+  // Checked by type, naming the file: value() threw bare type errors after a whole evaluation.
+  if (j.contains("aux_phase_bins")) {
+    if (!j["aux_phase_bins"].is_number_integer() || j["aux_phase_bins"].get<int64_t>() < 0)
+      throw std::runtime_error(state.string() + ": field \"aux_phase_bins\" is " + j["aux_phase_bins"].dump() +
+                               ", expected a whole number >= 0");
+    *phase_bins = j["aux_phase_bins"].get<int>();
+  }
+  if (j.contains("aux_world")) {
+    if (!j["aux_world"].is_boolean())
+      throw std::runtime_error(state.string() + ": field \"aux_world\" is " + j["aux_world"].dump() +
+                               ", expected true or false");
+    *world = j["aux_world"].get<bool>();
+  }
 }
 
 // Sums for an R² pooled over targets: each target's squared error and its spread around its own
@@ -55,6 +66,30 @@ struct Pooled {
 
 }  // namespace
 
+namespace {
+
+// The head's checks on a loaded network (EvaluateTrackHead, CheckTrackHead): the window in frames.
+int CheckedHeadWindow(const fs::path& model, const ModelConfig& config, int window) {
+  if (config.aux_outputs <= 0)
+    throw std::runtime_error(model.string() + ": the model has no track head (trained without --aux-tracks, or "
+                             "exported: `clothwind export-model` drops it); give a run's own model.pt");
+  const int frames = window == 0 ? config.frames : window;
+  if (frames < config.frames || frames % config.frames != 0)
+    throw std::invalid_argument("EvaluateTrackHead: window " + std::to_string(window) + " must be 0 or a multiple of " +
+                                "the model's " + std::to_string(config.frames) + " frames");
+  return frames;
+}
+
+}  // namespace
+
+void CheckTrackHead(const fs::path& model, int window) {
+  WindNet net = LoadWindNet(model);
+  CheckedHeadWindow(model, net->config(), window);
+  int phase_bins = 0;
+  bool world = false;
+  ReadRunAuxOptions(model, &phase_bins, &world);
+}
+
 TrackHeadReport EvaluateTrackHead(const fs::path& model, const fs::path& data, const std::string& split,
                                   int threads, int batch, const std::function<void(int, int)>& progress,
                                   int window) {
@@ -64,17 +99,11 @@ TrackHeadReport EvaluateTrackHead(const fs::path& model, const fs::path& data, c
   TrackHeadReport r;
   r.config = net->config();
   r.split = split;
-  if (r.config.aux_outputs <= 0)
-    throw std::runtime_error(model.string() + ": the model has no track head (trained without --aux-tracks, or "
-                             "exported: `clothwind export-model` drops it); give a run's own model.pt");
+  r.window = CheckedHeadWindow(model, r.config, window);
   int phase_bins = 0;
   bool world = false;
   ReadRunAuxOptions(model, &phase_bins, &world);
   const SampleOptions options = r.config.Sampling();
-  r.window = window == 0 ? r.config.frames : window;
-  if (r.window < r.config.frames || r.window % r.config.frames != 0)
-    throw std::invalid_argument("EvaluateTrackHead: window " + std::to_string(window) + " must be 0 or a multiple of " +
-                                "the model's " + std::to_string(r.config.frames) + " frames");
   const int parts = r.window / r.config.frames;  // consecutive model inputs per window
   const Dataset dataset = ReadDataset(data);
   // The scale training standardised the head's targets by: its train split's.

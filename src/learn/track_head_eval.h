@@ -53,6 +53,12 @@ TrackHeadReport EvaluateTrackHead(const std::filesystem::path& model, const std:
                                   const std::string& split, int threads, int batch,
                                   const std::function<void(int, int)>& progress = {}, int window = 0);
 
+// What EvaluateTrackHead refuses that can be known before any data is read: a model without a
+// head, a window that is not 0 or a multiple of its frames, a state.json whose options are of
+// another type. Throws as EvaluateTrackHead would (eval ran a whole evaluation first, then threw
+// and wrote none of its results).
+void CheckTrackHead(const std::filesystem::path& model, int window);
+
 // The report's figures as lines of text (positions in px of the input, amplitudes per bin).
 std::string TrackHeadTable(const TrackHeadReport& report);
 

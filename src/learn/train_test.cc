@@ -1825,6 +1825,23 @@ TEST_F(TrainTest, TrackHeadEvaluationReadsTheHeadBackInTheTargetsUnits) {
   // A window longer than the clips, or not made of whole model inputs, is refused.
   EXPECT_THROW(EvaluateTrackHead(one.model, data, "val", 1, 2, {}, 61), std::runtime_error);
   EXPECT_THROW(EvaluateTrackHead(r.model, data, "val", 1, 2, {}, 45), std::invalid_argument);
+  // The same refusals before any data is read (eval checks them before its evaluation, which ran
+  // whole and then lost its results to them), and a state.json option of another type named.
+  EXPECT_NO_THROW(CheckTrackHead(r.model, 0));
+  EXPECT_NO_THROW(CheckTrackHead(one.model, 30));
+  EXPECT_THROW(CheckTrackHead(r.model, 45), std::invalid_argument);
+  EXPECT_THROW(CheckTrackHead(stripped, 0), std::runtime_error);
+  const fs::path state = fs::path(one.model).parent_path() / "state.json";
+  nlohmann::json edited = ReadJson(state);
+  edited["aux_world"] = "yes";
+  std::ofstream(state) << edited.dump();
+  try {
+    CheckTrackHead(one.model, 30);
+    ADD_FAILURE() << "a state.json with aux_world \"yes\" was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(state.string() + ": field \"aux_world\" is \"yes\""), std::string::npos)
+        << e.what();
+  }
 }
 
 // A tiny initialised SDN (width 4, 32 px), written without data into `out`.
