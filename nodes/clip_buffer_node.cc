@@ -144,6 +144,7 @@ class ClipBufferNode {
   void OnImage(const sensor_msgs::ImageConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     last_input_ = ros::WallTime::now();
+    last_image_ = last_input_;
     index_flush_asked_ = false;
     // An unstamped frame is dropped before it touches anything: taken as a bag loop, one frame
     // stamped 0 forgot the minute of readings the labels need (and lent the clips its frame_id).
@@ -322,6 +323,12 @@ class ClipBufferNode {
     // hour ago is not a fault now.
     if (SecondsSince(last_error_time_) < kErrorHold) stat.mergeSummary(DiagnosticStatus::ERROR, last_error_);
     if (s.frames_in == 0) stat.mergeSummary(DiagnosticStatus::WARN, "no camera frames yet");
+    // Frames that stopped coming (a bag ended or paused, the camera node gone): it stayed OK
+    // "making clips" for ever.
+    const double idle = SecondsSince(last_image_);
+    if (s.frames_in > 0 && idle > std::max(2.0, flush_after_))
+      stat.mergeSummaryf(DiagnosticStatus::WARN,
+                         "no camera frames for %.0f s (a recording ended or paused, or the camera stopped)", idle);
     // Frames arriving and no clip made: stamps that do not increase, or a camera too slow for
     // gap_tolerance (both used to stay OK). Counted from the last report that saw a new clip.
     if (s.clips_made != stall_base_.clips_made) stall_base_ = s;
@@ -395,6 +402,7 @@ class ClipBufferNode {
   sensors::WindDirectionFrameGate wind_frame_;
   double flush_after_ = 3.0;
   ros::WallTime last_input_;
+  ros::WallTime last_image_;  // the last camera frame's arrival
   std::string record_dir_;
   int jpeg_quality_ = 95;
   double index_interval_ = 30.0;  // [s] see sensors::DatasetWriter

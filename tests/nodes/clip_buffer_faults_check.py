@@ -179,6 +179,13 @@ class ClipBufferFaultsTest(unittest.TestCase):
         for c in after:
             self.assertGreater(c.wind_count, 0, "clip %d lost its label" % c.sequence)
 
+        # 6. Frames that stop coming (a bag ended or paused) are a WARN after 2 s (flush_after is
+        # 1 s here), gone once they come again: it stayed "making clips" for ever.
+        status, values = self.wait_status(lambda s, v: "no camera frames for" in s.message, 6, "the idle warning")
+        self.assertIn("a recording ended or paused", status.message)
+        self.stream(1.0, offset=-30.0)
+        self.wait_status(lambda s, v: "no camera frames for" not in s.message, 5, "the idle warning to go")
+
 
 if __name__ == "__main__":
     rospy.init_node("clip_buffer_faults_check")
