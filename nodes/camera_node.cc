@@ -213,6 +213,16 @@ int main(int argc, char** argv) {
     last_drops_seen = drops;
   });
 
+  // The rate check measures its window in ROS time: after /clock went back (a bag looped) or
+  // first started, its windows spanned the jump (negative, or from time 0) and it said "Frequency
+  // too low" for ten reports. Cleared at each jump, as the clip buffer restarts.
+  ros::Time last_ros_now = ros::Time::now();
+  auto update_diagnostics = [&] {
+    const ros::Time now = ros::Time::now();
+    if (now < last_ros_now || (last_ros_now.isZero() && !now.isZero())) topic_diagnostic.clear_window();
+    last_ros_now = now;
+    wall_diagnostics.Update();
+  };
   double open_backoff_s = 0.25;
   ros::WallTime next_open;
   while (ros::ok()) {
@@ -221,7 +231,7 @@ int main(int argc, char** argv) {
       // keep running while the device is away (a single sleep of up to 5 s stalled them).
       if (ros::WallTime::now() < next_open) {
         ros::WallDuration(std::min(0.1, (next_open - ros::WallTime::now()).toSec())).sleep();
-        wall_diagnostics.Update();
+        update_diagnostics();
         ros::spinOnce();
         continue;
       }
@@ -240,7 +250,7 @@ int main(int argc, char** argv) {
         last_error = source->error();
         tally.SourceFailed(last_error);
         WALL_ERROR_STREAM_THROTTLE(5.0, "camera_node: " << last_error << " (retrying)");
-        wall_diagnostics.Update();
+        update_diagnostics();
         next_open = ros::WallTime::now() + ros::WallDuration(open_backoff_s);
         open_backoff_s = std::min(open_backoff_s * 2.0, 5.0);
         ros::spinOnce();
@@ -302,7 +312,7 @@ int main(int argc, char** argv) {
                         << " frames (set ~loop to repeat)");
       }
     }
-    wall_diagnostics.Update();
+    update_diagnostics();
     ros::spinOnce();
   }
   // SIGINT/shutdown: STREAMOFF, munmap, close before exiting.

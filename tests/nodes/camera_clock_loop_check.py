@@ -14,6 +14,7 @@ import unittest
 
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray
 from rosgraph_msgs.msg import Clock, Log
 from sensor_msgs.msg import Image
 
@@ -39,6 +40,17 @@ class CameraClockLoopTest(unittest.TestCase):
             with lock:
                 frames.append((time.monotonic(), msg.header.stamp.to_sec()))
 
+        windows = []  # the rate check's windows [ROS s], from its diagnostics
+
+        def on_diagnostics(msg):
+            for st in msg.status:
+                if "image_raw topic status" in st.name:
+                    values = {kv.key: kv.value for kv in st.values}
+                    if "Duration of window (s)" in values:
+                        with lock:
+                            windows.append((time.monotonic(), float(values["Duration of window (s)"])))
+
+        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics, queue_size=100)
         rospy.Subscriber("/rosout", Log, on_log, queue_size=100)
         rospy.Subscriber("camera/image_raw", Image, on_image, queue_size=100)
         clock = rospy.Publisher("/clock", Clock, queue_size=10)
@@ -89,6 +101,13 @@ class CameraClockLoopTest(unittest.TestCase):
             self.assertGreaterEqual(len(inside), 10, "loop %d: %d frames (10 Hz over %.0f s)" % (loop, len(inside), LOOP))
             self.assertTrue(all(START - 1e-6 <= s <= START + LOOP + 0.2 for s in inside),
                             "loop %d: stamps outside the loop: %s" % (loop, inside))
+        # The rate check's window is cleared when the clock goes back: it spanned the jump
+        # (negative: "Frequency too low" for ten reports after every loop) or, after the first
+        # /clock, reached back to time 0.
+        with lock:
+            played = [w for t, w in windows if t > loop_walls[0]]
+        self.assertGreaterEqual(len(played), LOOPS, "too few rate reports while the loops played: %s" % played)
+        self.assertTrue(all(0 <= w <= LOOP + 0.5 for w in played), "rate windows [ROS s]: %s" % played)
 
 
 if __name__ == "__main__":
