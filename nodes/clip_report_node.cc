@@ -25,6 +25,7 @@
 
 #include <nlohmann/json.hpp>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
 
 #include <clothwind/Clip.h>
 #include <clothwind/WindEstimate.h>
@@ -78,6 +79,8 @@ class ClipReport {
     ros::NodeHandle nh;
     sub_ = nh.subscribe("clips", 50, &ClipReport::OnClip, this);
     if (want_estimates_) estimate_sub_ = nh.subscribe("wind/estimate", 50, &ClipReport::OnEstimate, this);
+    // The player's clock messages, paused or not: a paused bag is not an ended one.
+    clock_sub_ = nh.subscribe("/clock", 10, &ClipReport::OnClockMessage, this);
     start_wall_ = ros::WallTime::now();
     clothwind::sensors::ReplayEndOptions end_options;
     end_options.idle_timeout = idle_timeout_;
@@ -89,6 +92,12 @@ class ClipReport {
   }
 
  private:
+  void OnClockMessage(const rosgraph_msgs::Clock::ConstPtr&) {
+    const double wall = ros::WallTime::now().toSec();
+    end_->Clock(ros::Time::now().toSec(), wall);  // the clock's start, if this is it
+    end_->Player(wall);
+  }
+
   void OnClip(const clothwind::Clip::ConstPtr& c) {
     end_->Activity(ros::WallTime::now().toSec());
     Row r{};
@@ -259,7 +268,7 @@ class ClipReport {
   double idle_timeout_ = 5.0, max_wall_ = 0.0, start_timeout_ = 60.0, estimate_wait_ = 60.0;
   std::string summary_path_, estimate_plot_path_;
   bool want_estimates_ = false;
-  ros::Subscriber sub_, estimate_sub_;
+  ros::Subscriber sub_, estimate_sub_, clock_sub_;
   std::vector<clothwind::sensors::EstimateRow> estimates_;
   ros::WallTimer timer_;
   ros::WallTime start_wall_;

@@ -32,6 +32,12 @@ class ReplayEnd {
   void Clock(double clock, double wall);
   // A clip came at wall time `wall`.
   void Activity(double wall) { last_change_ = wall; }
+  // A /clock message came at wall time `wall`: the player runs, perhaps paused (rosbag play keeps
+  // publishing its clock, unchanged, while paused; it stops when the player exits). Activity once
+  // the clock has started: a pause of idle_timeout ended the replay and printed its report.
+  void Player(double wall) {
+    if (started_) last_change_ = wall;
+  }
   // An estimate came at wall time `wall`: activity, and the model's pace.
   void Estimate(double wall);
 

@@ -24,6 +24,21 @@ TEST(ReplayEndTest, OverOnceTheClockAndTheInputsStandStill) {
   EXPECT_EQ(end.Check(18.1, 0), ReplayVerdict::kOver);
 }
 
+// rosbag play paused (space in its terminal): the clock stands still but its messages keep
+// coming; the replay is over only once they stop (the player exited).
+TEST(ReplayEndTest, APausedPlayerIsNotAnEndedOne) {
+  ReplayEndOptions o;
+  ReplayEnd end = Played(o);
+  for (double wall = 10.0; wall <= 30.0; wall += 0.01) end.Player(wall);
+  EXPECT_EQ(end.Check(30.0, 0), ReplayVerdict::kRunning);
+  EXPECT_EQ(end.Check(34.9, 0), ReplayVerdict::kRunning);
+  EXPECT_EQ(end.Check(35.1, 0), ReplayVerdict::kOver);
+  // Before the clock starts, its messages (a player waiting for subscribers) are not a start.
+  ReplayEnd waiting(o, 0.0);
+  for (double wall = 0.0; wall <= 70.0; wall += 0.01) waiting.Player(wall);
+  EXPECT_EQ(waiting.Check(70.0, 0), ReplayVerdict::kNoClock);
+}
+
 // sdn_node still working through its queue: a model taking 8 s a clip (slower than idle_timeout,
 // whose backlog was cut off) is waited for, twice its pace after each estimate; a fast model's
 // refused clip costs two of its (short) gaps; before two estimates, estimate_wait.
