@@ -49,7 +49,7 @@ TEST_F(AsyncDatasetWriterTest, RecordsEveryQueuedClip) {
   EXPECT_GT(s.max_write_s, 0.0);
   EXPECT_EQ(IndexSize(), 6u);
   for (uint64_t k = 0; k < 6; ++k)
-    EXPECT_TRUE(fs::exists(root_ / ClipFolderName(1700000000.0 + 1.2 * static_cast<double>(k), k) / "029.jpg"));
+    EXPECT_TRUE(fs::exists(root_ / ClipFolderName(1700000000.0 + 1.2 * static_cast<double>(k)) / "029.jpg"));
 }
 
 // A disk slower than the clips: the queue bounds the memory held, the rest is counted, and

@@ -51,16 +51,15 @@ void WriteFileAtomically(const std::string& path, const std::string& text) {
   clothwind::WriteFileAtomically(path, text);
 }
 
-std::string ClipFolderName(double first_stamp, uint64_t sequence) {
+std::string ClipFolderName(double first_stamp) {
   const double whole = std::floor(first_stamp);
   const std::time_t seconds = static_cast<std::time_t>(whole);
   const int millis = std::min(999, static_cast<int>(std::lround((first_stamp - whole) * 1000.0)));
   std::tm tm{};
   gmtime_r(&seconds, &tm);
   char buf[64];
-  std::snprintf(buf, sizeof buf, "clip-%04d%02d%02d-%02d%02d%02d.%03d-%06llu", tm.tm_year + 1900,
-                tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, millis,
-                static_cast<unsigned long long>(sequence));
+  std::snprintf(buf, sizeof buf, "clip-%04d%02d%02d-%02d%02d%02d.%03d", tm.tm_year + 1900, tm.tm_mon + 1,
+                tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, millis);
   return buf;
 }
 
@@ -231,7 +230,7 @@ size_t DatasetWriter::ReindexUnlisted() {
 std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo& source) {
   if (clip.clip.frames.empty()) throw std::invalid_argument("cannot record an empty clip");
   CheckSameFolder();
-  const std::string name = ClipFolderName(clip.clip.frames.front().stamp, clip.clip.sequence);
+  const std::string name = ClipFolderName(clip.clip.frames.front().stamp);
   const std::string final_dir = root_ + "/" + name;
   const std::string tmp_dir = TemporaryNameFor(root_ + "/." + name);
   bool replaced = false;

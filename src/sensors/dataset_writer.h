@@ -23,9 +23,14 @@ struct ClipSourceInfo {
   std::string wind_frame_id;  // frame of the label's mean direction (WindDirectionFrameGate)
 };
 
-// Folder name of a recorded clip: "clip-<UTC yyyymmdd-hhmmss.mmm of its first frame>-<seq>", so
-// names sort by time, and replaying the same session twice gives the same names.
-std::string ClipFolderName(double first_stamp, uint64_t sequence);
+// Folder name of a recorded clip: "clip-<UTC yyyymmdd-hhmmss.mmm of its first frame>", so names
+// sort by time and a clip made again from the same frames gets the same name (and replaces the
+// old one): replaying a session twice, `rosbag play -l` into a running clip buffer, or a replay
+// that lost a frame. Clips start on their own frames, 40 ms apart at 25 Hz, so no two of one
+// session share a millisecond. (Until stop 74 the clip's sequence number followed, which a loop
+// or a lost frame shifts: each pass recorded every clip again under new names, and datasets
+// counted them once a pass.)
+std::string ClipFolderName(double first_stamp);
 
 // label.json of a recorded clip (format "clothwind-clip", version 1; see docs/clips.md).
 nlohmann::json ClipLabelJson(const LabelledClip& clip, const ClipSourceInfo& source, const std::string& name);

@@ -66,7 +66,7 @@ TEST_F(DatasetWriterTest, WritesFramesLabelAndIndex) {
   DatasetWriter w(root_.string(), 95);
   const std::string dir =
       w.Write(MakeClip(3, 1700000000.5), {"camera_optical_frame", "test", nullptr, "test", "anemometer"});
-  EXPECT_EQ(fs::path(dir).filename().string(), "clip-20231114-221320.500-000003");
+  EXPECT_EQ(fs::path(dir).filename().string(), "clip-20231114-221320.500");
   for (int i = 0; i < 4; ++i) {
     char name[16];
     std::snprintf(name, sizeof name, "%03d.jpg", i);
@@ -136,13 +136,15 @@ TEST_F(DatasetWriterTest, ReopenAppendsAndRewriteReplaces) {
   }
   DatasetWriter again(root_.string());
   EXPECT_EQ(again.size(), 2u);
-  again.Write(MakeClip(1, 1700000001.2, 3), {});  // same clip replayed: replaced, not duplicated
+  // The same clip replayed: replaced, not duplicated, though its sequence number differs (a bag
+  // looped into a running clip buffer numbers each pass's clips on from the last).
+  again.Write(MakeClip(41, 1700000001.2, 3), {});
   again.Write(MakeClip(2, 1700000002.4), {});
   EXPECT_EQ(again.size(), 3u);
   EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 3u);
-  const auto replaced = Read(root_ / ClipFolderName(1700000001.2, 1) / "label.json");
+  const auto replaced = Read(root_ / ClipFolderName(1700000001.2) / "label.json");
   EXPECT_EQ(replaced["num_frames"], 3);
-  EXPECT_FALSE(fs::exists(root_ / ClipFolderName(1700000001.2, 1) / "003.jpg"));
+  EXPECT_FALSE(fs::exists(root_ / ClipFolderName(1700000001.2) / "003.jpg"));
   int folders = 0;
   for (const auto& e : fs::directory_iterator(root_)) folders += e.is_directory();
   EXPECT_EQ(folders, 3);
@@ -163,7 +165,7 @@ TEST_F(DatasetWriterTest, WithAnIndexIntervalClipsAreListedByTheNextRewriteFlush
     w.Write(MakeClip(1, 1700000001.2), {});
     w.Write(MakeClip(2, 1700000002.4), {});
     EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 1u) << "rewritten before the interval passed";
-    EXPECT_TRUE(fs::exists(root_ / ClipFolderName(1700000002.4, 2) / "label.json"));
+    EXPECT_TRUE(fs::exists(root_ / ClipFolderName(1700000002.4) / "label.json"));
     EXPECT_EQ(w.unlisted(), 2u);
     EXPECT_EQ(w.size(), 3u);
     EXPECT_TRUE(w.FlushIndex());
@@ -214,7 +216,7 @@ TEST_F(DatasetWriterTest, AClipReplacedWithinTheIndexIntervalIsListedAtOnce) {
   ASSERT_EQ(index["clips"].size(), 2u);
   int found = 0;
   for (const auto& c : index["clips"]) {
-    if (c["name"] != ClipFolderName(1700000000.0, 0)) continue;
+    if (c["name"] != ClipFolderName(1700000000.0)) continue;
     EXPECT_EQ(c["num_frames"], 3);
     ++found;
   }
@@ -272,7 +274,7 @@ TEST_F(DatasetWriterTest, FailedWriteKeepsTheOldCopyAndLeavesNoTemporary) {
   DatasetWriter w(root_.string());
   w.Write(MakeClip(0, 1700000000.0, 4), {});
   const auto index_before = Read(root_ / "index.json");
-  const fs::path clip_dir = root_ / ClipFolderName(1700000000.0, 0);
+  const fs::path clip_dir = root_ / ClipFolderName(1700000000.0);
 
   std::string message;
   {
@@ -305,7 +307,7 @@ TEST_F(DatasetWriterTest, FailedIndexUpdateIsToldAndCaughtUpNextTime) {
     message = e.what();
   }
   EXPECT_NE(message.find("index.json not updated"), std::string::npos) << message;
-  EXPECT_TRUE(fs::exists(root_ / ClipFolderName(1700000001.2, 1) / "label.json"));
+  EXPECT_TRUE(fs::exists(root_ / ClipFolderName(1700000001.2) / "label.json"));
   EXPECT_TRUE(Hidden().empty()) << *Hidden().begin();
   fs::remove_all(root_ / "index.json");
   w.Write(MakeClip(2, 1700000002.4), {});
@@ -374,7 +376,7 @@ TEST_F(DatasetWriterTest, ClipsInPlaceButNotListedAreIndexedOnOpen) {
   EXPECT_EQ(again.reindexed(), 1u);
   const nlohmann::json after = Read(root_ / "index.json");
   ASSERT_EQ(after["clips"].size(), 2u);
-  EXPECT_EQ(after["clips"][1]["name"], ClipFolderName(1700000001.2, 1));
+  EXPECT_EQ(after["clips"][1]["name"], ClipFolderName(1700000001.2));
   EXPECT_EQ(after["clips"][1]["sequence"], 1);
   EXPECT_TRUE(after["clips"][1]["wind_speed"].is_number());
 }
@@ -389,8 +391,8 @@ TEST_F(DatasetWriterTest, OpeningClearsADeadWritersLeftovers) {
     w.Write(MakeClip(1, 1700000001.2), {});
   }
   const std::string dead = ".tmp-999999999-";  // above any pid_max: no such process
-  const std::string clip1 = ClipFolderName(1700000001.2, 1);
-  fs::create_directories(root_ / ("." + ClipFolderName(1700000002.4, 2) + dead + "0"));
+  const std::string clip1 = ClipFolderName(1700000001.2);
+  fs::create_directories(root_ / ("." + ClipFolderName(1700000002.4) + dead + "0"));
   std::ofstream(root_ / ("index.json" + dead + "1")) << "{";
   fs::rename(root_ / clip1, root_ / ("." + clip1 + ".old" + dead + "2"));
   const std::string live = "index.json.tmp-" + std::to_string(::getpid()) + "-7";
