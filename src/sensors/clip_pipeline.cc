@@ -106,6 +106,10 @@ bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
 }
 
 void ClipPipeline::PushFrame(double stamp, const cv::Mat& processed) {
+  // Decided here, not only by the resampler: a new image size resets it, and the frame back in
+  // time was then its first ("restarted"), so a restart at another size kept the old timeline's
+  // labeller and data time, and every later clip went out at once, unlabelled.
+  const bool went_back = last_frame_ > 0 && stamp < last_frame_ - options_.gap_tolerance;
   const FrameResampler::Result r = resampler_.Push(stamp);
   if (r.dropped) {
     ++stats_.frames_dropped;
@@ -117,7 +121,7 @@ void ClipPipeline::PushFrame(double stamp, const cv::Mat& processed) {
     assembler_.Break();
   }
   if (r.restarted) assembler_.Break();
-  if (r.jumped_back) {
+  if (r.jumped_back || went_back) {
     // Time went back (a bag restarted or looped): the old timeline's readings must not label the
     // new one's clips. Its waiting clips are labelled now with what it has (as Flush does at the
     // end of a stream) rather than lost, and its readings forgotten.

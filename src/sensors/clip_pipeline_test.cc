@@ -169,6 +169,33 @@ TEST(ClipPipelineTest, TimeJumpingBackStartsOver) {
   EXPECT_EQ(p.stats().clips_made, p.stats().clips_released);  // no clip lost
 }
 
+// The same restart into a recording of another image size (another camera mode): the size change
+// reset the resampler, which then took the frame back in time for a first frame, not a jump, and
+// the old timeline's data time stayed: every later clip was released at once, unlabelled.
+TEST(ClipPipelineTest, TimeJumpingBackAtAnotherImageSizeStartsOverToo) {
+  ClipPipeline p(SmallOptions());
+  for (int s = 0; s <= 3; ++s) p.AddReading({kT0 + 100 + s, 9.0, 0.0});
+  for (int i = 0; i < 90; ++i) p.AddFrame(kT0 + 100 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  p.TakeReady();
+  const cv::Mat wide(60, 80, CV_8UC1, cv::Scalar(7));
+  for (int i = 0; i < 60; ++i) {
+    if (i % 15 == 0) p.AddReading({kT0 + i / 30.0, 2.0, 0.0});
+    p.AddFrame(kT0 + i / 30.0, wide, ClipSourceEncoding::kMono8);
+  }
+  EXPECT_EQ(p.stats().time_jumps, 1u);
+  std::vector<LabelledClip> clips = p.TakeReady();
+  for (LabelledClip& c : p.Flush()) clips.push_back(std::move(c));
+  int second_pass = 0;
+  for (const auto& c : clips) {
+    if (c.clip.frames.front().stamp > kT0 + 50) continue;  // the first pass's, released at the jump
+    ++second_pass;
+    EXPECT_GT(c.label.count, 0u) << "clip at " << c.clip.frames.front().stamp - kT0;
+    EXPECT_DOUBLE_EQ(c.label.mean, 2.0);
+    EXPECT_EQ(c.source_width, 80);
+  }
+  EXPECT_GE(second_pass, 3);
+}
+
 // One frame stamped three hours back (a camera driver's glitch) amid a steady stream: it was taken
 // as a bag restarting, so the waiting clips were released early and the labeller forgot its
 // readings; the clips after it were labelled from fewer readings or none.
