@@ -165,7 +165,12 @@ bool ClipPipeline::AddReading(const LabelReading& reading, double now) {
   const double open_from =
       (pending_.empty() ? last_frame_ : std::min(last_frame_, pending_.front().frames.back().stamp)) -
       options_.label_window - 1.0;
-  if (last_frame_ > 0 && reading.stamp < open_from) {
+  // Also one later than label_delay and a second behind the data: a bag shorter than the label
+  // window looped, its first reading inside every window still open, labelled the old timeline's
+  // last clips and was forgotten at the jump. Held, a late reading of this timeline only waits for
+  // the next frame (which takes it before the data moves on).
+  const double behind = data_time_ - options_.label_delay - 1.0;
+  if (last_frame_ > 0 && (reading.stamp < open_from || reading.stamp < behind)) {
     held_.push_back(reading);
     return true;
   }
@@ -224,6 +229,9 @@ std::vector<LabelledClip> ClipPipeline::Flush() {
     ++stats_.frames_stale;
     ++stats_.frames_dropped;
   }
+  // Readings held for the next frame belong to this timeline when none comes.
+  for (const LabelReading& reading : held_) TakeReading(reading);
+  held_.clear();
   std::vector<LabelledClip> ready = std::move(released_at_jump_);
   released_at_jump_.clear();
   while (!pending_.empty()) {

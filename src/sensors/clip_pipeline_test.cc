@@ -284,6 +284,48 @@ TEST(ClipPipelineTest, ANewTimelinesReadingBeforeItsFirstFrameLabelsTheNewTimeli
   EXPECT_EQ(p.stats().readings_late, 0u);
 }
 
+// The same with a bag shorter than the label window (4 s of a 5 s window, as the 24 s replay test
+// session is of the 60 s default): the loop's reading lay inside every old window still open, so
+// it was not held: it labelled the old timeline's last clips and was forgotten at the jump.
+TEST(ClipPipelineTest, AShortBagsLoopReadingLabelsTheNewTimelineToo) {
+  ClipPipeline p(SmallOptions());  // label window 5 s, delay 1.5 s
+  for (int i = 0; i <= 4 * 30; ++i) {
+    if (i % 30 == 0) p.AddReading({kT0 + i / 30, 4.0, 0.0});
+    p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  }
+  p.TakeReady();
+  ASSERT_GT(p.pending(), 0u);
+  p.AddReading({kT0 + 0.5, 5.0, 0.0});  // the loop's first reading, then its frames
+  for (int i = 0; i <= 3 * 30; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  EXPECT_EQ(p.stats().time_jumps, 1u);
+  std::vector<LabelledClip> clips = p.TakeReady();
+  for (auto& c : p.Flush()) clips.push_back(std::move(c));
+  int old_timeline = 0, new_timeline = 0;
+  for (const auto& c : clips) {
+    if (c.label.count > 0 && c.label.mean == 4.0) ++old_timeline;
+    if (c.clip.frames.back().stamp - kT0 >= 0.5 && c.label.count == 1 && c.label.mean == 5.0) ++new_timeline;
+    EXPECT_TRUE(c.label.count == 0 || c.label.mean == 4.0 || c.label.mean == 5.0)
+        << "a clip labelled by both timelines: " << c.label.mean;
+  }
+  EXPECT_GT(old_timeline, 0);
+  EXPECT_GT(new_timeline, 0);
+}
+
+// A reading arriving late (3 s behind the frames, past label_delay) is held for the next frame;
+// when the stream ends instead, Flush still gives it to the clips it falls in.
+TEST(ClipPipelineTest, ALateReadingHeldWhenTheStreamEndsStillLabels) {
+  ClipPipeline p(SmallOptions());  // label window 5 s, delay 1.5 s
+  for (int i = 0; i <= 4 * 30; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  p.AddReading({kT0 + 1.0, 6.0, 0.0});
+  const std::vector<LabelledClip> clips = p.Flush();
+  ASSERT_FALSE(clips.empty());
+  for (const auto& c : clips) {
+    if (c.clip.frames.back().stamp < kT0 + 1.0) continue;
+    EXPECT_EQ(c.label.count, 1u);
+    EXPECT_DOUBLE_EQ(c.label.mean, 6.0);
+  }
+}
+
 // One reading from a clock an hour ahead: without the check it moves the pipeline's time an hour
 // on, every later clip is released at once and the readings it needs are pruned as old.
 TEST(ClipPipelineTest, ReadingStampedInTheFutureIsRefused) {
