@@ -26,4 +26,8 @@ refused --bending-jitter --kind cloth --bending-jitter 2
 refused --materials --kind flag --materials "$work"
 refused --seed --seed -1
 refused --warmup --warmup 0.019
+# More frames than a label may hold ran for hours, then every example was refused by the index; a
+# size whose frames need terabytes of memory, likewise.
+refused --frames --frames 100001
+refused --frames --frames 100000 --size 4096
 echo "make_dataset_cli_test: OK"

@@ -58,7 +58,9 @@ void ValidateOptions(const DatasetOptions& o) {
   // Finite as well: infinity passed ">= 0", ran as a warm-up of 0 (lround(inf)) and went into the
   // header as null, which every later run was then refused against.
   Check(std::isfinite(o.warmup) && o.warmup >= 0 && o.warmup <= 3600, "--warmup must be in 0..3600 s");
-  Check(o.frames >= 1, "--frames must be >= 1");
+  // At most what a label may hold (dataset_index.cc): more ran for hours and then every example
+  // was refused when the index was built.
+  Check(o.frames >= 1 && o.frames <= 100000, "--frames must be in 1..100000 (a label's bound)");
   Check(std::isfinite(o.fps) && o.fps > 0 && o.fps <= 1000, "--fps must be in (0, 1000] Hz");
   // The first kept frame is a whole frame: a warm-up between two was rounded without a word, and
   // the header recorded the value asked for while the labels recorded the rounded one.
@@ -67,6 +69,12 @@ void ValidateOptions(const DatasetOptions& o) {
             " s), got " + std::to_string(o.warmup) + " s");
   Check(o.samples >= 0 && o.samples <= 1024, "--samples must be in 0..1024 (0: zeta's default)");
   Check(o.size >= 16 && o.size <= 4096, "--size must be in 16..4096 px");
+  // Each job renders an example's frames in memory (RenderAnimation, 3 bytes a pixel) before
+  // writing them: refused past 16 GiB an example, which no machine here holds once per job.
+  Check(static_cast<double>(o.frames) * o.size * o.size * 3 <= 16.0 * (1ull << 30),
+        "--frames x --size^2 x 3 bytes (one example's frames, held in memory while it is written) must be at "
+        "most 16 GiB, got " + std::to_string(static_cast<double>(o.frames) * o.size * o.size * 3 / (1ull << 30)) +
+            " GiB");
   Check(o.frame_ext == "jpg" || o.frame_ext == "png" || o.frame_ext == "pgm",
         "frame format must be jpg, png or pgm");
   Check(o.jpeg_quality >= 1 && o.jpeg_quality <= 100, "--jpeg-quality must be in 1..100");
