@@ -13,6 +13,8 @@
 
 #include <Eigen/Geometry>
 
+#include "common/atomic_file.h"
+
 namespace clothwind::sim {
 namespace {
 
@@ -253,32 +255,25 @@ Mesh ReadObj(const std::string& path, bool topology) {
 }
 
 void WriteObj(const std::string& path, const Mesh& mesh) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw std::runtime_error(path + ": cannot write (" + tmp + ")");
-    out.precision(17);
-    out << "# clothwind mesh: " << mesh.V.rows() << " vertices, " << mesh.F.rows() << " faces\n";
-    for (int i = 0; i < mesh.V.rows(); ++i)
-      out << "v " << mesh.V(i, 0) << ' ' << mesh.V(i, 1) << ' ' << mesh.V(i, 2) << '\n';
-    const bool tex = mesh.U.rows() == mesh.V.rows() && mesh.U.rows() > 0;
-    if (tex)
-      for (int i = 0; i < mesh.U.rows(); ++i) out << "vt " << mesh.U(i, 0) << ' ' << mesh.U(i, 1) << '\n';
-    for (int f = 0; f < mesh.F.rows(); ++f) {
-      out << 'f';
-      for (int c = 0; c < 3; ++c) {
-        out << ' ' << mesh.F(f, c) + 1;
-        if (tex) out << '/' << mesh.F(f, c) + 1;
-      }
-      out << '\n';
+  std::ostringstream out;
+  out.precision(17);
+  out << "# clothwind mesh: " << mesh.V.rows() << " vertices, " << mesh.F.rows() << " faces\n";
+  for (int i = 0; i < mesh.V.rows(); ++i)
+    out << "v " << mesh.V(i, 0) << ' ' << mesh.V(i, 1) << ' ' << mesh.V(i, 2) << '\n';
+  const bool tex = mesh.U.rows() == mesh.V.rows() && mesh.U.rows() > 0;
+  if (tex)
+    for (int i = 0; i < mesh.U.rows(); ++i) out << "vt " << mesh.U(i, 0) << ' ' << mesh.U(i, 1) << '\n';
+  for (int f = 0; f < mesh.F.rows(); ++f) {
+    out << 'f';
+    for (int c = 0; c < 3; ++c) {
+      out << ' ' << mesh.F(f, c) + 1;
+      if (tex) out << '/' << mesh.F(f, c) + 1;
     }
-    out.flush();
-    if (!out) throw std::runtime_error(path + ": write failed (" + tmp + ")");
+    out << '\n';
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot rename " + tmp + " into place");
-  }
+  // Through the one atomic writer (a temporary name of this process, fsync, rename, removed on
+  // failure): a fixed "<path>.tmp" was left behind by a failed write, and two writers shared it.
+  clothwind::WriteFileAtomically(path, out.str());
 }
 
 void ValidateMesh(const Mesh& mesh, const std::string& what, const std::vector<int>& obj_lines, bool topology) {
