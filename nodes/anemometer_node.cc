@@ -92,6 +92,7 @@ class AnemometerNode {
       serial_.stop_bits = params.Get("stop_bits", 1);
       usb_poll_period_ = params.Get("usb_poll_period", 10.0);
       stale_set = params.Has("stale_timeout");
+      stale_timeout_given_ = stale_set;
       stale_timeout_ = params.Get("stale_timeout", 5.0);
     } catch (const std::exception& e) {
       ROS_FATAL("anemometer_node: %s", e.what());
@@ -315,6 +316,11 @@ class AnemometerNode {
       const std::string protocol = used == AnemometerProtocol::kAuto ? "" : AnemometerProtocolName(used);
       raw_pub_.publish(clothwind::ros_bridge::ToRawSentence(data, protocol, stamp, frame));
     }
+    // A replayed Fine Offset station (topic mode) reports every 48 s, as the live one: 5 s of
+    // staleness read its every reading as stale. Its allowance, unless ~stale_timeout was given.
+    if (used == AnemometerProtocol::kFineOffset && !stale_timeout_given_ &&
+        stale_timeout_ < 3.0 * clothwind::sensors::kFineOffsetSensorPeriod)
+      stale_timeout_ = 3.0 * clothwind::sensors::kFineOffsetSensorPeriod;
     if (r.status == ParseStatus::kOk) {
       wind_pub_.publish(clothwind::ros_bridge::ToWindMeasurement(r.reading, stamp, FrameFor(r.reading, frame),
                                                                  magnetic_declination_));
@@ -433,6 +439,7 @@ class AnemometerNode {
   Backoff backoff_;
   ros::WallTime next_attempt_, next_poll_, last_valid_wall_, last_diag_wall_;
   double stale_timeout_ = 5.0;
+  bool stale_timeout_given_ = false;  // ~stale_timeout set: kept whatever the instrument
   double usb_poll_period_ = 10.0;
   clothwind::sensors::FineOffsetPublishGate usb_gate_;  // which polled USB records are published
   std::string last_earth_frame_;     // the frame the last compass bearing was published in

@@ -162,6 +162,14 @@ class AnemometerTopicTest(unittest.TestCase):
         self.assertEqual(status.level, DiagnosticStatus.OK, status.message)
         self.assertEqual(values['earth frame'], 'enu')
 
+    def test_a_replayed_fine_offset_station_is_not_stale_between_its_records(self):
+        winds = self.winds_on('/replay_fo/anemometer/wind', ['052DD200508A007E271C2A1006240100'])
+        self.assertEqual([w.source for w in winds], ['fine_offset'])
+        time.sleep(7.0)  # past the 5 s allowance of an instrument that reports every second
+        status, values = self.diagnostics('topic:/replay_fo/anemometer/raw')
+        self.assertNotIn('stale', status.message)
+        self.assertEqual(status.level, DiagnosticStatus.OK, status.message)
+
     def test_usb_without_station_keeps_retrying(self):
         got = []
 
