@@ -1,5 +1,7 @@
 // clothwind <verb> ...: the offline tools behind one command line.
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <map>
@@ -15,6 +17,21 @@ int main(int argc, char** argv) {
   std::sort(verbs.begin(), verbs.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   std::map<std::string, std::function<int()>> run;
   for (auto& verb : verbs) run[verb.name] = verb.setup(app);
+  // No option takes a number that is not finite, and CLI11's Range, PositiveNumber and
+  // NonNegativeNumber let "nan" through (every comparison with NaN is false): `train --still-floor
+  // nan` ran as the default taken for given, `render --fps nan` reached the renderer. Refused for
+  // every option that takes a value, naming it.
+  const CLI::Validator finite(
+      [](std::string& value) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(value.c_str(), &end);
+        if (end == value.c_str() || *end != '\0' || std::isfinite(v)) return "";  // not a number, or finite
+        return "expected a finite number, got " + value;
+      },
+      "", "finite");
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    for (CLI::Option* option : sub->get_options())
+      if (option->get_type_size() != 0) option->check(finite);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

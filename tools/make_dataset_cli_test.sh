@@ -28,6 +28,9 @@ refused --seed --seed -1
 refused --warmup --warmup 0.019
 # More frames than a label may hold ran for hours, then every example was refused by the index; a
 # size whose frames need terabytes of memory, likewise.
+# A number that is not finite, for any option (CLI11's range checks let NaN through).
+refused "--wind-min: expected a finite number" --wind-min nan
+refused "--camera-angle: expected a finite number" --camera-angle nan
 refused --frames --frames 100001
 refused --frames --frames 100000 --size 4096
 echo "make_dataset_cli_test: OK"
