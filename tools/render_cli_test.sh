@@ -15,7 +15,7 @@ fail() { echo "render_cli_test: FAIL: $*" >&2; exit 1; }
 [ -f "$work/fr/000.jpg" ] && [ -f "$work/fr/002.jpg" ] && [ -f "$work/fr/zeta.json" ] || fail "first run incomplete"
 before="$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")"
 
-for bad in "--start nan" "--start inf" "--start -1" "--fps 1e300" "--fps nan"; do
+for bad in "--start nan" "--start inf" "--start -1" "--fps 1e300" "--fps nan" "--frame-time -1" "--samples 100000000"; do
   status=0
   # shellcheck disable=SC2086
   "$bin" render "$work/sim" --out "$work/fr" $bad --samples 1 --threads 1 >"$work/out.txt" 2>&1 || status=$?

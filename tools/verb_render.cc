@@ -181,10 +181,14 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
       ->check(CLI::Range(0, 1000000))
       ->capture_default_str();
   sub->add_option("--fps", a->fps, "output frame rate [Hz]")->check(CLI::Range(1e-3, 1000.0))->capture_default_str();
-  sub->add_option("--frame-time", a->frame_time, "time between OBJ frames [s]")->capture_default_str();
+  sub->add_option("--frame-time", a->frame_time, "time between OBJ frames [s] (0.001..10)")
+      ->check(CLI::Range(1e-3, 10.0))
+      ->capture_default_str();
   sub->add_option("--cloth", a->cloth, "which cloth (the CC of NNNN_CC.obj)")->capture_default_str();
   sub->add_flag("--obj", a->obj, "read the folder's OBJ frames even if it has a trajectory");
-  sub->add_option("--samples", a->samples, "anti-aliasing samples per pixel (0: zeta's)")->capture_default_str();
+  sub->add_option("--samples", a->samples, "anti-aliasing samples per pixel (0: zeta's; at most 1024)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
   // Bounded: 99999999 threads threw bad_alloc after the old render's zeta.json was removed.
   sub->add_option("--threads", a->threads, "render threads (0: all cores; at most 1024)")
       ->check(CLI::Range(0, 1024))
