@@ -49,7 +49,10 @@ bool FramePacer::WaitNext(double max_wait_s, int64_t* stamp_ns) {
   }
   if (due > now) {
     // Simulated time may run slower than the sleep: then not due yet, and the caller asks again.
-    clock_->SleepNs(std::min(due - now, max_wait_ns));
+    // Or faster (rosbag play -r 10): a wait of ROS time slept as wall time woke 10 times too late,
+    // past kMaxLagNs at 10 fps, and every frame restarted the schedule; so it is slept in slices.
+    const int64_t wait = std::min(due - now, max_wait_ns);
+    clock_->SleepNs(simulated ? std::min(wait, kNoClockPollNs) : wait);
     now = pace_now();
     if (now < due) return false;
   }

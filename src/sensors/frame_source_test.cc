@@ -115,6 +115,24 @@ TEST(FramePacerTest, UnderSimulatedTimeFramesWaitForTheClockAndFollowItsRate) {
   }
 }
 
+// A bag played ten times faster (rosbag play -r 10): ROS time runs 10x the wall clock. The pacer
+// slept a frame's interval of ROS time as wall time, woke 0.9 s of ROS time late at 10 fps, which
+// passed the 0.5 s lag that restarts the schedule: every frame restarted it, and the stamps went
+// out of step with the rate (and the clip buffer broke every clip at the holes).
+TEST(FramePacerTest, UnderSimulatedTimeFasterThanTheWallClockTheScheduleHolds) {
+  SimulatedClock clock;
+  FramePacer pacer(&clock, 10.0);
+  const int64_t start = 1700000000LL * 1000000000LL;
+  clock.Start(start, 10.0);
+  int64_t stamp = 0;
+  for (int k = 0; k <= 50; ++k) {
+    while (!pacer.WaitNext(0.1, &stamp)) {
+    }
+    EXPECT_EQ(stamp, start + k * 100 * kMs) << "frame " << k;
+    EXPECT_LE(clock.RosNs() - stamp, 20 * kMs) << "frame " << k << " released late";
+  }
+}
+
 }  // namespace
 }  // namespace sensors
 }  // namespace clothwind
