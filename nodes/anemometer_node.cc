@@ -174,7 +174,7 @@ class AnemometerNode {
 
  private:
   void StepSerial() {
-    const ros::WallTime now = ros::WallTime::now();
+    const ros::SteadyTime now = ros::SteadyTime::now();
     if (!port_.is_open()) {
       if (now < next_attempt_) {
         ros::WallDuration(std::min(0.05, (next_attempt_ - now).toSec())).sleep();
@@ -214,7 +214,7 @@ class AnemometerNode {
   }
 
   void StepUsb() {
-    const ros::WallTime now = ros::WallTime::now();
+    const ros::SteadyTime now = ros::SteadyTime::now();
     if (!usb_.is_open()) {
       if (now < next_attempt_) {
         ros::WallDuration(std::min(0.05, (next_attempt_ - now).toSec())).sleep();
@@ -328,7 +328,7 @@ class AnemometerNode {
       last_reading_void_ = !r.reading.valid;
       if (r.reading.valid) {
         last_valid_ = r.reading;
-        last_valid_wall_ = ros::WallTime::now();
+        last_valid_wall_ = ros::SteadyTime::now();
         have_valid_ = true;
       }
     } else if (r.status != ParseStatus::kNotWind) {
@@ -339,7 +339,7 @@ class AnemometerNode {
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
     const auto& c = decoder_.counters();
-    const ros::WallTime now = ros::WallTime::now();
+    const ros::SteadyTime now = ros::SteadyTime::now();
     double rate = 0.0;
     if (!last_diag_wall_.isZero()) {
       const double dt = (now - last_diag_wall_).toSec();
@@ -437,7 +437,9 @@ class AnemometerNode {
   clothwind::sensors::RecordFramer framer_;
   AnemometerDecoder decoder_;
   Backoff backoff_;
-  ros::WallTime next_attempt_, next_poll_, last_valid_wall_, last_diag_wall_;
+  // Steady (monotonic) time: the wall clock steps back under NTP, and a next-due instant then held
+  // every poll and reconnect (and the USB gate's 48 s) until it caught up.
+  ros::SteadyTime next_attempt_, next_poll_, last_valid_wall_, last_diag_wall_;
   double stale_timeout_ = 5.0;
   bool stale_timeout_given_ = false;  // ~stale_timeout set: kept whatever the instrument
   double usb_poll_period_ = 10.0;

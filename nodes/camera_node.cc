@@ -224,13 +224,13 @@ int main(int argc, char** argv) {
     wall_diagnostics.Update();
   };
   double open_backoff_s = 0.25;
-  ros::WallTime next_open;
+  ros::SteadyTime next_open;  // steady: a wall clock stepped back by NTP held the reopen until it caught up
   while (ros::ok()) {
     if (!opened) {
       // Wait for the next attempt in short slices: diagnostics and services (set_camera_info)
       // keep running while the device is away (a single sleep of up to 5 s stalled them).
-      if (ros::WallTime::now() < next_open) {
-        ros::WallDuration(std::min(0.1, (next_open - ros::WallTime::now()).toSec())).sleep();
+      if (ros::SteadyTime::now() < next_open) {
+        ros::WallDuration(std::min(0.1, (next_open - ros::SteadyTime::now()).toSec())).sleep();
         update_diagnostics();
         ros::spinOnce();
         continue;
@@ -251,7 +251,7 @@ int main(int argc, char** argv) {
         tally.SourceFailed(last_error);
         WALL_ERROR_STREAM_THROTTLE(5.0, "camera_node: " << last_error << " (retrying)");
         update_diagnostics();
-        next_open = ros::WallTime::now() + ros::WallDuration(open_backoff_s);
+        next_open = ros::SteadyTime::now() + ros::WallDuration(open_backoff_s);
         open_backoff_s = std::min(open_backoff_s * 2.0, 5.0);
         ros::spinOnce();
         continue;
@@ -303,7 +303,7 @@ int main(int argc, char** argv) {
           // frame is read (a folder whose files all fail still opens, and reopening it at once
           // spun through it thousands of times a second).
           opened = false;
-          next_open = ros::WallTime::now() + ros::WallDuration(open_backoff_s);
+          next_open = ros::SteadyTime::now() + ros::WallDuration(open_backoff_s);
           open_backoff_s = std::min(open_backoff_s * 2.0, 5.0);
         }
       } else if (status == ReadStatus::kEnd) {

@@ -101,7 +101,7 @@ class ClipBufferNode {
 
     updater_.setHardwareID("clip_buffer");
     updater_.add("clip buffer", this, &ClipBufferNode::Diagnose);
-    flush_timer_ = nh.createWallTimer(ros::WallDuration(0.25), &ClipBufferNode::OnTimer, this);
+    flush_timer_ = nh.createSteadyTimer(ros::WallDuration(0.25), &ClipBufferNode::OnTimer, this);
     ROS_INFO("clip_buffer: %d frames at %.1f fps every %d frames, %dx%d %s, roi %s, label window %.0f s (delay %.1f s), "
              "gap tolerance %.3f s",
              o.num_frames, o.frame_rate, o.stride, o.size, o.size, sensors::ClipFrameEncoding(o.colour),
@@ -114,7 +114,7 @@ class ClipBufferNode {
   // Opens record_dir_ (when set and not open yet); on failure keeps why for the diagnostics.
   void OpenRecording() {
     if (record_dir_.empty() || writer_) return;
-    last_open_attempt_ = ros::WallTime::now();
+    last_open_attempt_ = ros::SteadyTime::now();
     try {
       writer_ = std::make_unique<sensors::AsyncDatasetWriter>(
           std::make_unique<sensors::DatasetWriter>(record_dir_, jpeg_quality_, index_interval_), kRecordQueue);
@@ -143,7 +143,7 @@ class ClipBufferNode {
  private:
   void OnImage(const sensor_msgs::ImageConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
-    last_input_ = ros::WallTime::now();
+    last_input_ = ros::SteadyTime::now();
     last_image_ = last_input_;
     index_flush_asked_ = false;
     // An unstamped frame is dropped before it touches anything: taken as a bag loop, one frame
@@ -168,7 +168,7 @@ class ClipBufferNode {
       sensors::ClipSourceEncoding encoding;
       ros_bridge::ImageView(*msg, &view, &encoding);
       if (!pipeline_->AddFrame(msg->header.stamp.toSec(), view, encoding, Now())) {
-        last_future_ = ros::WallTime::now();
+        last_future_ = ros::SteadyTime::now();
         WALL_WARN_THROTTLE(5.0, "clip_buffer: frame stamped %.1f s after the clock refused (camera clock?)",
                           pipeline_->stats().last_future_lead);
       }
@@ -180,7 +180,7 @@ class ClipBufferNode {
 
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
-    last_input_ = ros::WallTime::now();
+    last_input_ = ros::SteadyTime::now();
     index_flush_asked_ = false;
     if (msg->header.stamp.isZero()) {
       NoteError("anemometer reading dropped: header.stamp is 0");
@@ -207,7 +207,7 @@ class ClipBufferNode {
     const bool refused = future || pipeline_->stats().readings_late > before.readings_late;
     if (labelled && same_frame && !refused) wind_frame_.Admit(msg->header.frame_id, direction);
     if (future) {
-      last_future_ = ros::WallTime::now();
+      last_future_ = ros::SteadyTime::now();
       WALL_WARN_THROTTLE(5.0, "clip_buffer: anemometer reading stamped %.1f s after the clock refused",
                         pipeline_->stats().last_future_lead);
     }
@@ -221,18 +221,18 @@ class ClipBufferNode {
   }
 
   // The stream stalled or ended (end of a bag): label what waits with the readings held now.
-  void OnTimer(const ros::WallTimerEvent&) {
+  void OnTimer(const ros::SteadyTimerEvent&) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (pipeline_->pending() > 0 && (ros::WallTime::now() - last_input_).toSec() > flush_after_) {
+    if (pipeline_->pending() > 0 && (ros::SteadyTime::now() - last_input_).toSec() > flush_after_) {
       ROS_INFO("clip_buffer: no input for %.1f s, labelling %zu waiting clip(s) with the readings held",
                flush_after_, pipeline_->pending());
       Publish(pipeline_->Flush());
     }
-    if (!writer_ && !record_dir_.empty() && (ros::WallTime::now() - last_open_attempt_).toSec() >= kReopenEvery)
+    if (!writer_ && !record_dir_.empty() && (ros::SteadyTime::now() - last_open_attempt_).toSec() >= kReopenEvery)
       OpenRecording();
     // Input stopped (a replay ended, the camera paused): list the clips recorded since the last
     // index rewrite now rather than after ~index_interval (after the clips just flushed).
-    if (writer_ && !index_flush_asked_ && (ros::WallTime::now() - last_input_).toSec() > flush_after_) {
+    if (writer_ && !index_flush_asked_ && (ros::SteadyTime::now() - last_input_).toSec() > flush_after_) {
       writer_->RequestIndexFlush();
       index_flush_asked_ = true;
     }
@@ -250,12 +250,9 @@ class ClipBufferNode {
       index_error_seen_ = r.index_error;
     }
     // force_update once a wall second: Updater::update() waits for ROS time, which stands still
-    // while a bag is paused and jumps back when it loops.
-    const ros::WallTime now = ros::WallTime::now();
-    if ((now - last_diagnostics_).toSec() >= 1.0) {
-      last_diagnostics_ = now;
-      updater_.force_update();
-    }
+    // while a bag is paused and jumps back when it loops. (WallThrottle: again at once after the
+    // wall clock steps back, which held every report until it caught up.)
+    if (diagnostics_throttle_.Due(1.0)) updater_.force_update();
   }
 
   void Publish(const std::vector<sensors::LabelledClip>& clips) {
@@ -307,11 +304,11 @@ class ClipBufferNode {
   void NoteError(const std::string& what) {
     ++errors_;
     last_error_ = what;
-    last_error_time_ = ros::WallTime::now();
+    last_error_time_ = ros::SteadyTime::now();
     WALL_ERROR_THROTTLE(5.0, "clip_buffer: %s", what.c_str());
   }
 
-  double SecondsSince(const ros::WallTime& t) const { return t.isZero() ? 1e9 : (ros::WallTime::now() - t).toSec(); }
+  double SecondsSince(const ros::SteadyTime& t) const { return t.isZero() ? 1e9 : (ros::SteadyTime::now() - t).toSec(); }
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
     using diagnostic_msgs::DiagnosticStatus;
@@ -335,7 +332,7 @@ class ClipBufferNode {
     const std::string stalled = sensors::ClipStallReason(stall_base_, s, pipeline_->options());
     if (!stalled.empty()) stat.mergeSummary(DiagnosticStatus::WARN, stalled);
     // Frames repeated by the resampler, over windows of 10 s (the last window's verdict shown).
-    const double wall = ros::WallTime::now().toSec();
+    const double wall = ros::SteadyTime::now().toSec();
     if (wall - repeat_base_wall_ >= 10.0) {
       repeat_reason_ = sensors::ClipRepeatReason(repeat_base_, s, pipeline_->options());
       repeat_base_ = s;
@@ -401,24 +398,24 @@ class ClipBufferNode {
   bool frame_id_from_msg_ = false;
   sensors::WindDirectionFrameGate wind_frame_;
   double flush_after_ = 3.0;
-  ros::WallTime last_input_;
-  ros::WallTime last_image_;  // the last camera frame's arrival
+  ros::SteadyTime last_input_;
+  ros::SteadyTime last_image_;  // the last camera frame's arrival
   std::string record_dir_;
   int jpeg_quality_ = 95;
   double index_interval_ = 30.0;  // [s] see sensors::DatasetWriter
   std::string index_error_seen_;
   bool index_flush_asked_ = false;  // since the last input
   std::string recording_error_;  // why record_dir_ is not open; empty when it is (or not set)
-  ros::WallTime last_open_attempt_;
+  ros::SteadyTime last_open_attempt_;
   std::string last_error_;
-  ros::WallTime last_error_time_, last_future_;
+  ros::SteadyTime last_error_time_, last_future_;
   uint64_t errors_ = 0;
   uint64_t not_recorded_ = 0, failed_seen_ = 0, dropped_seen_ = 0;
   ros::Publisher clip_pub_, preview_pub_;
   ros::Subscriber image_sub_, info_sub_, wind_sub_;
-  ros::WallTimer flush_timer_;
+  ros::SteadyTimer flush_timer_;
   diagnostic_updater::Updater updater_;
-  ros::WallTime last_diagnostics_;
+  ros_bridge::WallThrottle diagnostics_throttle_;
 };
 
 }  // namespace

@@ -81,25 +81,25 @@ class ClipReport {
     if (want_estimates_) estimate_sub_ = nh.subscribe("wind/estimate", 50, &ClipReport::OnEstimate, this);
     // The player's clock messages, paused or not: a paused bag is not an ended one.
     clock_sub_ = nh.subscribe("/clock", 10, &ClipReport::OnClockMessage, this);
-    start_wall_ = ros::WallTime::now();
+    start_wall_ = ros::SteadyTime::now();
     clothwind::sensors::ReplayEndOptions end_options;
     end_options.idle_timeout = idle_timeout_;
     end_options.estimate_wait = estimate_wait_;
     end_options.max_wall = max_wall_;
     end_options.start_timeout = start_timeout_;
     end_.emplace(end_options, start_wall_.toSec());
-    timer_ = nh.createWallTimer(ros::WallDuration(0.5), &ClipReport::OnTimer, this);
+    timer_ = nh.createSteadyTimer(ros::WallDuration(0.5), &ClipReport::OnTimer, this);
   }
 
  private:
   void OnClockMessage(const rosgraph_msgs::Clock::ConstPtr&) {
-    const double wall = ros::WallTime::now().toSec();
+    const double wall = ros::SteadyTime::now().toSec();
     end_->Clock(ros::Time::now().toSec(), wall);  // the clock's start, if this is it
     end_->Player(wall);
   }
 
   void OnClip(const clothwind::Clip::ConstPtr& c) {
-    end_->Activity(ros::WallTime::now().toSec());
+    end_->Activity(ros::SteadyTime::now().toSec());
     Row r{};
     r.sequence = c->sequence;
     r.frames = c->num_frames;
@@ -123,7 +123,7 @@ class ClipReport {
   }
 
   void OnEstimate(const clothwind::WindEstimate::ConstPtr& e) {
-    end_->Estimate(ros::WallTime::now().toSec());
+    end_->Estimate(ros::SteadyTime::now().toSec());
     estimates_.push_back({e->clip_sequence, e->clip_end.toSec(), e->speed, e->speed_std, e->reference_speed,
                           e->latency});
   }
@@ -158,8 +158,8 @@ class ClipReport {
     }
   }
 
-  void OnTimer(const ros::WallTimerEvent&) {
-    const double wall_now = ros::WallTime::now().toSec();
+  void OnTimer(const ros::SteadyTimerEvent&) {
+    const double wall_now = ros::SteadyTime::now().toSec();
     end_->Clock(ros::Time::now().toSec(), wall_now);
     const double wall = wall_now - start_wall_.toSec();
     switch (end_->Check(wall_now, Unestimated())) {
@@ -196,7 +196,7 @@ class ClipReport {
  public:
   bool Finish() {
     if (printed_) return ok_;
-    return Print((ros::WallTime::now() - start_wall_).toSec());
+    return Print((ros::SteadyTime::now() - start_wall_).toSec());
   }
 
  private:
@@ -270,8 +270,8 @@ class ClipReport {
   bool want_estimates_ = false;
   ros::Subscriber sub_, estimate_sub_, clock_sub_;
   std::vector<clothwind::sensors::EstimateRow> estimates_;
-  ros::WallTimer timer_;
-  ros::WallTime start_wall_;
+  ros::SteadyTimer timer_;
+  ros::SteadyTime start_wall_;
   std::optional<clothwind::sensors::ReplayEnd> end_;  // when the replay is over (sensors/replay_end.h)
   bool printed_ = false, ok_ = true;
   std::vector<Row> rows_;

@@ -84,14 +84,14 @@ class SdnNode {
     // force_update: Updater::update() waits for ROS time, which stands still while a bag is
     // paused and jumps back when it restarts.
     diag_timer_ =
-        nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { updater_.force_update(); });
+        nh.createSteadyTimer(ros::WallDuration(1.0), [this](const ros::SteadyTimerEvent&) { updater_.force_update(); });
     // Subscribed before the model loads (libtorch, the weights and the warm-up take seconds):
     // clips that come meanwhile wait in the queue, as callbacks run only once spin() starts, rather
     // than going to no subscriber at all (a replay starts as soon as the bag's topics have theirs).
     clip_sub_ = nh.subscribe("clips", queue_size, &SdnNode::OnClip, this);
     TryLoad();
     if (!predictor_) {
-      load_timer_ = nh.createWallTimer(ros::WallDuration(2.0), [this](const ros::WallTimerEvent&) {
+      load_timer_ = nh.createSteadyTimer(ros::WallDuration(2.0), [this](const ros::SteadyTimerEvent&) {
         if (!predictor_) TryLoad();
       });
     }
@@ -174,7 +174,7 @@ class SdnNode {
                predictor->device().c_str(), threads_, 1e3 * warm,
                clothwind::learn::FlagFliesName(predictor->flag_flies()).c_str());
       predictor_ = std::move(predictor);
-      loaded_wall_ = ros::WallTime::now().toSec();
+      loaded_wall_ = ros::SteadyTime::now().toSec();
       load_error_.clear();
     } catch (const std::exception& e) {
       if (load_error_ != e.what()) ROS_ERROR("sdn_node: cannot load the model: %s (retrying)", e.what());
@@ -249,7 +249,7 @@ class SdnNode {
       undecided_ += p.undecided;
       latencies_.push_back(latency);
       if (latencies_.size() > 50) latencies_.pop_front();
-      last_estimate_wall_ = ros::WallTime::now().toSec();
+      last_estimate_wall_ = ros::SteadyTime::now().toSec();
       stamps_.push_back(last_estimate_wall_);
       TrimRate(last_estimate_wall_);
       clip_error_.clear();
@@ -347,7 +347,7 @@ class SdnNode {
       max = std::max(max, l);
     }
     if (!latencies_.empty()) mean /= latencies_.size();
-    const double now = ros::WallTime::now().toSec();
+    const double now = ros::SteadyTime::now().toSec();
     TrimRate(now);
     // Estimates over the last 30 s: the intervals between them, N - 1 over the time they span
     // (N over the time since the first one overstated it until the window filled).
@@ -433,7 +433,7 @@ class SdnNode {
   image_transport::Publisher power_pub_, frequency_pub_;
   ros::Subscriber clip_sub_;
   diagnostic_updater::Updater updater_;
-  ros::WallTimer diag_timer_, load_timer_;
+  ros::SteadyTimer diag_timer_, load_timer_;
   std::string model_path_, device_, model_name_, load_error_, last_error_;
   std::string fly_judge_path_, judge_error_;  // ~fly_judge and why it did not load
   std::optional<clothwind::learn::FlagFlies> told_flag_flies_;  // ~flag_flies right, left or auto

@@ -104,10 +104,10 @@ class WindDisplayNode {
     wind_sub_ = nh.subscribe("anemometer/wind", 50, &WindDisplayNode::OnWind, this);
     // Redraw on a timer, not per message: the plot scrolls with time even when inputs pause. A wall
     // timer: a ROS timer stops with /clock when a bag ends, and the last estimate stayed "live".
-    timer_ = nh.createWallTimer(ros::WallDuration(1.0 / rate), &WindDisplayNode::Publish, this);
+    timer_ = nh.createSteadyTimer(ros::WallDuration(1.0 / rate), &WindDisplayNode::Publish, this);
     updater_.setHardwareID("wind_display");
     updater_.add("wind display", this, &WindDisplayNode::Diagnose);
-    diagnostics_timer_ = nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
+    diagnostics_timer_ = nh.createSteadyTimer(ros::WallDuration(1.0), [this](const ros::SteadyTimerEvent&) {
       updater_.force_update();  // wall time: a paused bag must not stop them
     });
   }
@@ -122,7 +122,7 @@ class WindDisplayNode {
     // latest, it hid the newer one and aged the display).
     if (!have_estimate_ || msg->header.stamp >= last_estimate_.header.stamp) {
       last_estimate_ = *msg;
-      last_estimate_wall_ = ros::WallTime::now();
+      last_estimate_wall_ = ros::SteadyTime::now();
     }
     have_estimate_ = true;
   }
@@ -138,7 +138,7 @@ class WindDisplayNode {
     const bool newest = !have_wind_ || msg->header.stamp >= last_wind_.header.stamp;
     if (newest) {
       last_wind_ = *msg;
-      last_wind_wall_ = ros::WallTime::now();
+      last_wind_wall_ = ros::SteadyTime::now();
     }
     if (!have_wind_) first_wind_frame_ = msg->header.frame_id;
     have_wind_ = true;
@@ -154,7 +154,7 @@ class WindDisplayNode {
     if (frame_gate_.Admit(msg->header.frame_id, has_vector ? 0.0 : std::nan(""))) {
       if (has_vector && (!have_vector_ || msg->header.stamp >= last_vector_.header.stamp)) {
         last_vector_ = *msg;
-        last_vector_wall_ = ros::WallTime::now();
+        last_vector_wall_ = ros::SteadyTime::now();
         have_vector_ = true;
       }
     } else {
@@ -225,7 +225,7 @@ class WindDisplayNode {
   // Counts a dropped message and when it was dropped (wall time: a paused bag must not hold it).
   void Dropped(uint64_t* counter, DropCause cause) {
     ++*counter;
-    last_drop_wall_[cause] = ros::WallTime::now();
+    last_drop_wall_[cause] = ros::SteadyTime::now();
   }
 
   // Restarts the display when ROS time went back more than kRestartAfter since it was last read
@@ -265,11 +265,11 @@ class WindDisplayNode {
   }
   // Whether an input is recent enough to show: by its stamp against the display's now, and by the
   // wall clock since it arrived (the display's now stands still when a bag has ended).
-  static bool Live(bool have, const ros::Time& stamp, const ros::WallTime& arrived, const ros::Time& now,
+  static bool Live(bool have, const ros::Time& stamp, const ros::SteadyTime& arrived, const ros::Time& now,
                    double limit) {
     const double age = Age(have, stamp, now);
     // A value from the display's future (before a clock jump back was noticed) is not live either.
-    return age <= limit && age >= -WindHistory::kRestartAfter && (ros::WallTime::now() - arrived).toSec() <= limit;
+    return age <= limit && age >= -WindHistory::kRestartAfter && (ros::SteadyTime::now() - arrived).toSec() <= limit;
   }
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
@@ -285,7 +285,7 @@ class WindDisplayNode {
                         have_wind_ ? "no anemometer reading in the mean window" : "no anemometer reading yet");
     // Each cause of drops is a WARN for drop_warn_for_ after its own last drop (time to be read),
     // then no longer: a total since start kept one bad message a WARN for good.
-    const ros::WallTime wall = ros::WallTime::now();
+    const ros::SteadyTime wall = ros::SteadyTime::now();
     for (int c = 0; c < kDropCauses; ++c) {
       if (!last_drop_wall_[c].isZero() && (wall - last_drop_wall_[c]).toSec() < drop_warn_for_)
         stat.mergeSummary(DiagnosticStatus::WARN, kDropWarnings[c]);
@@ -307,7 +307,7 @@ class WindDisplayNode {
     stat.add("frame", FrameId());
     stat.add("readings in another frame (no arrow)", frame_gate_.rejected());
     stat.addf("estimate received [s ago, wall]", "%.1f",
-              have_estimate_ ? (ros::WallTime::now() - last_estimate_wall_).toSec() : -1.0);
+              have_estimate_ ? (ros::SteadyTime::now() - last_estimate_wall_).toSec() : -1.0);
   }
 
   // The display frame: ~frame_id, else the first valid reading's with a velocity (the arrow's),
@@ -318,7 +318,7 @@ class WindDisplayNode {
     return "anemometer";
   }
 
-  void Publish(const ros::WallTimerEvent& event) {
+  void Publish(const ros::SteadyTimerEvent& event) {
     // The clock went back (a replay restarted) before any input of the new pass came: what is
     // shown is the previous pass's.
     CheckClock();
@@ -434,26 +434,26 @@ class WindDisplayNode {
   double drop_warn_for_ = 30.0;
   uint64_t unstamped_ = 0, future_stamped_ = 0, restarts_ = 0, implausible_ = 0, late_ = 0, previous_pass_ = 0,
            invalid_ = 0, implausible_velocity_ = 0, drawn_ = 0;
-  ros::WallTime last_drop_wall_[kDropCauses];  // when each cause last dropped a message (zero: never)
+  ros::SteadyTime last_drop_wall_[kDropCauses];  // when each cause last dropped a message (zero: never)
   double clock_before_restart_ = -std::numeric_limits<double>::infinity();  // [s] previous pass's end
   double last_clock_ = 0;          // ROS time when last read (CheckClock) [s]
   ros::Time newest_estimate_, newest_wind_;  // each input's newest stamp since the last restart
   std::string publish_error_;      // why the last draw failed ("" when it did not)
   diagnostic_updater::Updater updater_;
-  ros::WallTimer diagnostics_timer_;
+  ros::SteadyTimer diagnostics_timer_;
   int plot_width_ = 640, plot_height_ = 320;
   std::string frame_id_param_, fixed_frame_, tf_parent_;
   WindHistory estimates_, anemometer_;
   clothwind::WindEstimate last_estimate_;
   clothwind::WindMeasurement last_wind_, last_vector_;  // the newest valid reading; the newest with a
                                                        // vector in the display frame
-  ros::WallTime last_estimate_wall_, last_wind_wall_, last_vector_wall_;  // when they arrived
+  ros::SteadyTime last_estimate_wall_, last_wind_wall_, last_vector_wall_;  // when they arrived
   std::string first_wind_frame_;  // header.frame_id of the first valid reading
   clothwind::sensors::WindDirectionFrameGate frame_gate_;
   bool have_estimate_ = false, have_wind_ = false, have_vector_ = false;
   ros::Publisher markers_pub_, plot_pub_, tf_pub_;
   ros::Subscriber estimate_sub_, wind_sub_;
-  ros::WallTimer timer_;
+  ros::SteadyTimer timer_;
 };
 
 }  // namespace

@@ -8,6 +8,8 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/time.h>
 
+#include "ros_bridge/wall_throttle.h"
+
 namespace clothwind::ros_bridge {
 
 // Call Update() as often as convenient (each loop of a node's own spin); it publishes the
@@ -18,16 +20,15 @@ class WallDiagnostics {
       : updater_(updater), period_(period) {}
 
   void Update() {
-    const ros::WallTime now = ros::WallTime::now();
-    if (now < next_) return;
-    updater_->force_update();
-    next_ = now + ros::WallDuration(period_);
+    // WallThrottle: due again at once should the wall clock step back (NTP), where a next-due
+    // instant held every report until the clock caught up (an hour's step: an hour of silence).
+    if (throttle_.Due(period_)) updater_->force_update();
   }
 
  private:
   diagnostic_updater::Updater* updater_;
   double period_;
-  ros::WallTime next_;
+  WallThrottle throttle_;
 };
 
 }  // namespace clothwind::ros_bridge

@@ -171,6 +171,11 @@ bool ClipPipeline::AddReading(const LabelReading& reading, double now) {
   // the next frame (which takes it before the data moves on).
   const double behind = data_time_ - options_.label_delay - 1.0;
   if (last_frame_ > 0 && (reading.stamp < open_from || reading.stamp < behind)) {
+    // Bounded: frames stopped while a second instrument, its clock behind, kept sending.
+    if (held_.size() >= kMaxHeldReadings) {
+      held_.pop_front();
+      ++stats_.readings_late;
+    }
     held_.push_back(reading);
     return true;
   }

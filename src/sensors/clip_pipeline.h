@@ -163,7 +163,10 @@ class ClipPipeline {
   std::vector<LabelledClip> released_at_jump_;  // labelled at a time jump, not taken yet
   // Readings stamped before every window this timeline can still label, held until the next
   // frame says whose they are: a looped bag's first reading arrives before its first frame.
-  std::vector<LabelReading> held_;
+  // Readings held for the next frame (AddReading), at most kMaxHeldReadings (the oldest dropped,
+  // counted late).
+  static constexpr size_t kMaxHeldReadings = 4096;
+  std::deque<LabelReading> held_;
   // A frame stamped back in time, held until the next frame says whether a new timeline starts
   // there (a looped bag) or it was a lone stale stamp.
   struct BackwardFrame {

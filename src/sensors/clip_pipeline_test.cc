@@ -326,6 +326,15 @@ TEST(ClipPipelineTest, ALateReadingHeldWhenTheStreamEndsStillLabels) {
   }
 }
 
+// Frames stopped while an instrument whose clock runs behind keeps sending: its readings are held
+// for a frame that does not come, at most 4096 of them (the oldest dropped and counted late).
+TEST(ClipPipelineTest, HeldReadingsAreBounded) {
+  ClipPipeline p(SmallOptions());
+  for (int i = 0; i <= 4 * 30; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  for (int k = 0; k < 5000; ++k) p.AddReading({kT0 + 1.0 + k * 1e-4, 4.0, 0.0});
+  EXPECT_EQ(p.stats().readings_late, 5000u - 4096u);
+}
+
 // One reading from a clock an hour ahead: without the check it moves the pipeline's time an hour
 // on, every later clip is released at once and the readings it needs are pruned as old.
 TEST(ClipPipelineTest, ReadingStampedInTheFutureIsRefused) {

@@ -25,9 +25,9 @@ struct ClipSourceInfo {
 
 // Folder name of a recorded clip: "clip-<UTC yyyymmdd-hhmmss.mmm of its first frame>", so names
 // sort by time and a clip made again from the same frames gets the same name (and replaces the
-// old one): replaying a session twice, `rosbag play -l` into a running clip buffer, or a replay
-// that lost a frame. Clips start on their own frames, 40 ms apart at 25 Hz, so no two of one
-// session share a millisecond. (Until stop 74 the clip's sequence number followed, which a loop
+// old one): replaying a session twice, or `rosbag play -l` into a running clip buffer. Clips start
+// on the 25 Hz grid of their frames, 40 ms apart, so no two of one session share a millisecond.
+// (A replay whose grid starts elsewhere, having lost the first frame, names its clips anew.) (Until stop 74 the clip's sequence number followed, which a loop
 // or a lost frame shifts: each pass recorded every clip again under new names, and datasets
 // counted them once a pass.)
 std::string ClipFolderName(double first_stamp);

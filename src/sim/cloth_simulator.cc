@@ -136,6 +136,11 @@ void ClothSimulator::Impl::Build() {
   if ((options.strain_min > 0 || std::isfinite(options.strain_max)) && options.strain_limit_iterations < 1)
     throw std::invalid_argument("SimOptions.strain_limit_iterations must be >= 1 when a strain limit is set, got " +
                                 std::to_string(options.strain_limit_iterations));
+  // The global method's iterates are not monotone: with 5-10 at most the flag went unstable at
+  // 10 m/s (docs/simulator.md, "Strain limiting"); the default 4 suits only the sweeps.
+  if (options.strain_limit_method == StrainLimitMethod::kGlobal && options.strain_limit_iterations < 20)
+    throw std::invalid_argument("SimOptions.strain_limit_iterations must be >= 20 with the global strain-limit "
+                                "method (30 measured), got " + std::to_string(options.strain_limit_iterations));
   if (!(options.strain_limit_tolerance >= 0 && options.strain_limit_tolerance < 1))
     throw std::invalid_argument("SimOptions.strain_limit_tolerance must be in [0, 1), got " +
                                 std::to_string(options.strain_limit_tolerance));

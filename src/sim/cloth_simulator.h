@@ -35,7 +35,8 @@ struct SimOptions {
   int strain_limit_iterations = 4;
   double strain_limit_tolerance = 0.0;
   // Sweeps (the default, FlagSim's) or local/global iterations, which strain_limit_iterations
-  // then counts (StrainLimitMethod; docs/simulator.md, "Strain limiting").
+  // then counts, at least 20 (30 and a tolerance of 1e-3 measured; StrainLimitMethod;
+  // docs/simulator.md, "Strain limiting").
   StrainLimitMethod strain_limit_method = StrainLimitMethod::kSweeps;
   double repulsion_thickness = 10e-3;               // ArcSim magic.repulsion_thickness [m]
   double collision_stiffness = 1e6;                 // ArcSim magic.collision_stiffness [N/m^3]

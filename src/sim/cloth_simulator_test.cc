@@ -813,6 +813,11 @@ TEST(ClothSimulatorTest, BadInputsFailClearly) {
   o_sweeps.strain_max = 1.1;
   o_sweeps.strain_limit_iterations = 0;  // the limit would be silently off
   ExpectThrowContaining([&] { ClothSimulator(good, TestMaterial(), o_sweeps, nullptr); }, "strain_limit_iterations must be >= 1");
+  // The global method with the sweeps' 4 iterations (it went unstable with 5-10).
+  o_sweeps.strain_limit_iterations = 4;
+  o_sweeps.strain_limit_method = StrainLimitMethod::kGlobal;
+  ExpectThrowContaining([&] { ClothSimulator(good, TestMaterial(), o_sweeps, nullptr); },
+                        "strain_limit_iterations must be >= 20 with the global strain-limit method");
   ClothSimulator sim(good, TestMaterial(), SimOptions{}, nullptr);
   ExpectThrowContaining([&] { sim.SetState(Eigen::MatrixX3d::Zero(2, 3), Eigen::MatrixX3d::Zero(2, 3)); }, "SetState");
 }

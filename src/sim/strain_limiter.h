@@ -84,6 +84,9 @@ class StrainLimiter {
   //   mass    #V node masses [kg]
   //   pinned  #V flags (non-zero: vertex does not move)
   StrainLimiter(const Mesh& mesh, const Eigen::VectorXd& mass, const std::vector<char>& pinned);
+  // Not copied: copies would share the global method's scratch space.
+  StrainLimiter(const StrainLimiter&) = delete;
+  StrainLimiter& operator=(const StrainLimiter&) = delete;
 
   // Sweeps until converged (see StrainLimitSettings) or settings.max_sweeps. The sweeps converge
   // slowly, for two reasons measured in stop 73 (docs/simulator.md, "Strain limiting"):

@@ -259,7 +259,7 @@ TEST(StrainLimiter, GlobalIterationsBringTheStretchedStripWithinLimitsAtOnce) {
   const Strip strip = StretchedStrip(30, 1.10);
   StrainLimiter limiter(strip.mesh, Eigen::VectorXd::Ones(strip.x.rows()), strip.pinned);
   Eigen::MatrixX3d x = strip.x, v = Eigen::MatrixX3d::Zero(x.rows(), 3);
-  StrainLimitSettings settings = Limits(50);
+  StrainLimitSettings settings = Limits(500);
   settings.method = StrainLimitMethod::kGlobal;
   const double dt = 0.01;
   const StrainLimitResult r = limiter.Project(settings, dt, &x, &v);

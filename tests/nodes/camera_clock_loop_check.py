@@ -107,7 +107,9 @@ class CameraClockLoopTest(unittest.TestCase):
         with lock:
             played = [w for t, w in windows if t > loop_walls[0]]
         self.assertGreaterEqual(len(played), LOOPS, "too few rate reports while the loops played: %s" % played)
-        self.assertTrue(all(0 <= w <= LOOP + 0.5 for w in played), "rate windows [ROS s]: %s" % played)
+        self.assertTrue(all(w <= LOOP + 0.5 for w in played), "rate windows [ROS s]: %s" % played)
+        # (One jump landing between the node's clock read and the rate check's may show once.)
+        self.assertLessEqual(sum(1 for w in played if w < 0), 1, "rate windows [ROS s]: %s" % played)
 
 
 if __name__ == "__main__":
