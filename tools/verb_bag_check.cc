@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
@@ -28,6 +29,7 @@
 
 #include <clothwind/RawSentence.h>
 
+#include "progress_bar.h"
 #include "sensors/anemometer_protocol.h"
 #include "verb_registry.h"
 
@@ -208,10 +210,23 @@ int Check(const BagCheckArgs& a) {
   for (const auto* c : view.getConnections()) topics[WithoutLeadingSlash(c->topic)].type = c->datatype;
   sensors::AnemometerDecoder decoder;
   size_t index = 0;
+  // A field session of hours is gigabytes, read for minutes: progress on stderr for bags of
+  // 256 MiB and more (small ones, a test's or make run's, stay quiet).
+  std::error_code size_error;
+  std::unique_ptr<ProgressBar> bar;
+  if (std::filesystem::file_size(a.bag, size_error) >= (256u << 20) && !size_error) {
+    ProgressBar::Options o;
+    o.label = "bag-check";
+    o.unit = "messages";
+    o.rate_unit = "messages/s";
+    bar = std::make_unique<ProgressBar>(o);
+  }
+  const size_t total = bar ? view.size() : 0;
   for (const rosbag::MessageInstance& m : view) {
     TopicStats& s = topics[WithoutLeadingSlash(m.getTopic())];
     const double t = m.getTime().toSec();
     ++index;
+    if (bar) bar->Update(static_cast<int64_t>(index), static_cast<int64_t>(total));
     // A message whose bytes do not deserialise (a length field that overruns) threw a bare
     // "Buffer Overrun" naming nothing; messages beyond 1 GiB are refused before reading.
     if (m.size() > (1u << 30))
@@ -226,6 +241,7 @@ int Check(const BagCheckArgs& a) {
     }
   }
   bag.close();
+  if (bar) bar->Finish();
   std::printf("%s\n", a.bag.c_str());
   std::printf("  %-22s %-28s %7s %8s %8s %6s %6s %6s %6s  %s\n", "topic", "type", "count", "rate Hz", "span s",
               "back", "same", "holes", "bagt", "first");

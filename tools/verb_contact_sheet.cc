@@ -42,6 +42,11 @@ int Run(const ContactSheetArgs& a) {
                                   "; write it elsewhere");
   }
   RefuseUnwritableOutput("--out", out);
+  // The sheet is held whole in memory (3 bytes a pixel): 10000 tiles of 1024 px were 31 GB.
+  const double sheet_bytes = static_cast<double>(a.options.max_tiles) * a.options.tile * a.options.tile * 3;
+  if (sheet_bytes > 4.0 * (1ull << 30))
+    throw std::invalid_argument("--tiles x --tile-size^2 x 3 bytes (the sheet, held in memory) must be at most 4 GiB, "
+                                "got " + std::to_string(sheet_bytes / (1ull << 30)) + " GiB");
   if (!data::WriteContactSheet(a.dir, index, out, a.options)) {
     std::fprintf(stderr, "contact-sheet: %s has no clips\n", a.dir.c_str());
     return 1;

@@ -123,8 +123,14 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
       if (frames->count() == 0) {
         std::ifstream in(learn::ConfigPathFor(a->measure));
         const nlohmann::json card = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-        if (card.is_object() && card.contains("frames") && card["frames"].is_number_integer())
-          a->frames = card["frames"].get<int>();
+        // Bounded as --frames is (the card's value was taken unchecked, past CLI11's range).
+        if (card.is_object() && card.contains("frames")) {
+          const nlohmann::json& f = card["frames"];
+          if (!f.is_number_integer() || f.get<int64_t>() < 2 || f.get<int64_t>() > 10000)
+            throw std::invalid_argument(learn::ConfigPathFor(a->measure).string() + ": field \"frames\" is " + f.dump() +
+                                        ", expected a whole number in 2..10000 (or give --frames)");
+          a->frames = f.get<int>();
+        }
       }
     }
     const learn::MotionMaps train = Collect(dataset, "train", a->frames, a->windows);
