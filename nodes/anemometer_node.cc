@@ -27,6 +27,7 @@
 #include "ros_bridge/wall_throttle.h"
 #include "sensors/anemometer_protocol.h"
 #include "sensors/anemometer_stream.h"
+#include "sensors/clock_course.h"
 #include "sensors/fine_offset_memory.h"
 #include "sensors/fine_offset_record.h"
 #include "sensors/fine_offset_usb.h"
@@ -282,10 +283,17 @@ class AnemometerNode {
     // In double seconds: ros::Time's difference throws beyond 32 bits (a record stamped TIME_MAX
     // ended the node, uncaught in its callback).
     const ros::Time now = ros::Time::now();
+    if (!now.isZero()) clock_.Note(now.toSec());
+    const bool ahead = !now.isZero() && msg->header.stamp.toSec() - now.toSec() > kMaxFutureStamp;
+    // Ahead of a clock that went back (a looped bag) but not past where it was: a record of the
+    // previous pass still in flight, dropped without calling it a clock fault.
+    if (ahead && clock_.IsPreviousPass(msg->header.stamp.toSec(), kMaxFutureStamp)) {
+      ++previous_pass_;
+      return;
+    }
     const char* odd = msg->header.stamp.isZero() ? "stamped 0"
-                      : (!now.isZero() && msg->header.stamp.toSec() - now.toSec() > kMaxFutureStamp)
-                          ? "stamped more than 5 s ahead of the clock"
-                          : nullptr;
+                      : ahead ? "stamped more than 5 s ahead of the clock"
+                              : nullptr;
     if (odd) {
       ++odd_stamps_;
       last_odd_stamp_ = std::string(odd) + " (" + std::to_string(msg->header.stamp.toSec()) + " s, clock " +
@@ -395,6 +403,7 @@ class AnemometerNode {
                                                    : " (configured)"));
     stat.add("records", c.records);
     if (input_ == "topic") stat.add("records dropped for their stamps", odd_stamps_);
+    if (input_ == "topic") stat.add("records of the previous pass dropped (after the clock went back)", previous_pass_);
     stat.add("readings", c.readings);
     stat.add("invalid readings (instrument flagged)", c.invalid_readings);
     stat.addf("reading rate [Hz]", "%.3f", rate);
@@ -449,6 +458,8 @@ class AnemometerNode {
   // Topic mode: records dropped for their stamps (OnRaw), and the last one's reason.
   static constexpr double kMaxFutureStamp = 5.0;  // [s]
   uint64_t odd_stamps_ = 0, last_diag_odd_stamps_ = 0;
+  uint64_t previous_pass_ = 0;              // topic mode: records of a looped bag's previous pass
+  clothwind::sensors::ClockCourse clock_;  // topic mode: where the clock was before it went back
   std::string last_odd_stamp_;
   uint64_t last_diag_readings_ = 0, last_diag_errors_ = 0;
   clothwind::sensors::WindReading last_valid_;

@@ -167,7 +167,9 @@ class ClipBufferNode {
       cv::Mat view;
       sensors::ClipSourceEncoding encoding;
       ros_bridge::ImageView(*msg, &view, &encoding);
-      if (!pipeline_->AddFrame(msg->header.stamp.toSec(), view, encoding, Now())) {
+      const uint64_t future_before = pipeline_->stats().frames_future;
+      if (!pipeline_->AddFrame(msg->header.stamp.toSec(), view, encoding, Now()) &&
+          pipeline_->stats().frames_future > future_before) {  // not the previous pass's
         last_future_ = ros::SteadyTime::now();
         WALL_WARN_THROTTLE(5.0, "clip_buffer: frame stamped %.1f s after the clock refused (camera clock?)",
                           pipeline_->stats().last_future_lead);
@@ -352,6 +354,8 @@ class ClipBufferNode {
     stat.add("frames in", s.frames_in);
     stat.add("frames dropped", s.frames_dropped);
     stat.add("frames stamped in the future", s.frames_future);
+    stat.add("frames of the previous pass dropped (after the clock went back)", s.frames_previous_pass);
+    stat.add("readings of the previous pass dropped (after the clock went back)", s.readings_previous_pass);
     stat.add("frames stamped back in time (dropped)", s.frames_stale);
     stat.add("frames out (25 fps)", s.frames_out);
     stat.add("gaps", s.gaps);

@@ -42,8 +42,14 @@ ClipPipeline::ClipPipeline(const ClipPipelineOptions& options)
       released_end_(kNegInf) {
 }
 
-bool ClipPipeline::StampedInFuture(double stamp, double now) {
+bool ClipPipeline::RefusedByClock(double stamp, double now, uint64_t* future, uint64_t* previous) {
+  clock_.Note(now);  // kNoClock (inf) is ignored
   if (!(stamp > now + options_.max_future)) return false;
+  if (clock_.IsPreviousPass(stamp, options_.max_future)) {
+    ++*previous;
+    return true;
+  }
+  ++*future;
   stats_.last_future_lead = stamp - now;
   return true;
 }
@@ -64,8 +70,7 @@ void ClipPipeline::Reset() {
 
 bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncoding encoding, double now) {
   ++stats_.frames_in;
-  if (StampedInFuture(stamp, now)) {
-    ++stats_.frames_future;
+  if (RefusedByClock(stamp, now, &stats_.frames_future, &stats_.frames_previous_pass)) {
     ++stats_.frames_dropped;
     return false;
   }
@@ -152,10 +157,7 @@ void ClipPipeline::Emit(const FrameResampler::Tick& tick, const cv::Mat& image) 
 }
 
 bool ClipPipeline::AddReading(const LabelReading& reading, double now) {
-  if (StampedInFuture(reading.stamp, now)) {
-    ++stats_.readings_future;
-    return false;
-  }
+  if (RefusedByClock(reading.stamp, now, &stats_.readings_future, &stats_.readings_previous_pass)) return false;
   if (!(std::isfinite(reading.stamp) && std::isfinite(reading.speed))) return false;
   ++stats_.readings_in;
   // Before every window still open (the waiting clips' and the one being assembled), with a
@@ -265,7 +267,8 @@ std::string ClipStallReason(const ClipPipelineStats& since, const ClipPipelineSt
   if (now.clips_made != since.clips_made || in < 2 * static_cast<uint64_t>(options.num_frames)) return "";
   // Frames refused as from the future have their own WARN; the rest of the drops are stamps that
   // do not increase (or bad images, which are errors of their own).
-  const uint64_t not_after = (now.frames_dropped - since.frames_dropped) - (now.frames_future - since.frames_future);
+  const uint64_t not_after = (now.frames_dropped - since.frames_dropped) - (now.frames_future - since.frames_future) -
+                             (now.frames_previous_pass - since.frames_previous_pass);
   const uint64_t gaps = now.gaps - since.gaps;
   char text[320];
   if (2 * not_after >= in) {

@@ -12,6 +12,7 @@
 
 #include "sensors/clip_assembler.h"
 #include "sensors/clip_preprocess.h"
+#include "sensors/clock_course.h"
 #include "sensors/frame_resampler.h"
 #include "sensors/wind_label.h"
 
@@ -68,6 +69,10 @@ struct ClipPipelineStats {
   uint64_t frames_future = 0;     // frames refused: stamped more than max_future after the clock
   uint64_t readings_future = 0;   // readings refused for the same reason
   double last_future_lead = 0.0;  // how far after the clock the last refused stamp was [s]
+  // Frames and readings of the previous pass still arriving after the clock went back (a looped
+  // bag's /clock): stamped ahead of the clock but not past where it was before; dropped, not
+  // counted as stamped in the future (they raised "a clock set wrong?" for 10 s after every loop).
+  uint64_t frames_previous_pass = 0, readings_previous_pass = 0;
   uint64_t time_jumps = 0;        // camera time went back (a bag restarted or looped)
   // Frames stamped more than gap_tolerance before the frame before them that the next frame did
   // not follow (a lone stale stamp, not a new timeline): dropped, also counted in frames_dropped.
@@ -147,7 +152,9 @@ class ClipPipeline {
   void Emit(const FrameResampler::Tick& tick, const cv::Mat& image);
   LabelledClip Release(AssembledClip clip);
   void TakeReading(const LabelReading& reading);  // into the labeller, counted late if it is
-  bool StampedInFuture(double stamp, double now);
+  // Whether a message stamped `stamp` that came at clock `now` is refused: past the clock by more
+  // than max_future (counted in *future) or the previous pass's (counted in *previous).
+  bool RefusedByClock(double stamp, double now, uint64_t* future, uint64_t* previous);
 
   ClipPipelineOptions options_;
   FrameResampler resampler_;
@@ -158,6 +165,7 @@ class ClipPipeline {
   int source_width_ = 0, source_height_ = 0;
   double data_time_;            // largest stamp seen on either stream [s]
   double last_frame_ = 0.0;     // stamp of the last accepted camera frame [s]
+  ClockCourse clock_;  // the clock's course (RefusedByClock): where it was before it went back
   double released_end_;         // end of the last released clip [s]
   std::deque<AssembledClip> pending_;
   std::vector<LabelledClip> released_at_jump_;  // labelled at a time jump, not taken yet

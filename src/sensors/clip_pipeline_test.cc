@@ -335,6 +335,28 @@ TEST(ClipPipelineTest, HeldReadingsAreBounded) {
   EXPECT_EQ(p.stats().readings_late, 5000u - 4096u);
 }
 
+// A looped bag's /clock goes back while frames and readings of the previous pass are still in
+// flight, stamped up to where the clock was: they are that pass's, dropped and counted as such, not
+// "stamped in the future" (which raised "a clock set wrong?" for 10 s after every loop). A stamp
+// past where the clock ever was is still refused as future.
+TEST(ClipPipelineTest, ThePreviousPassesMessagesAfterTheClockWentBackAreNotFromTheFuture) {
+  ClipPipeline p(SmallOptions());
+  for (int i = 0; i <= 20 * 30; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8, kT0 + i / 30.0);
+  const double looped = kT0 + 0.05;  // the clock back at the bag's start
+  EXPECT_FALSE(p.AddFrame(kT0 + 19.99, Numbered(1), ClipSourceEncoding::kMono8, looped));
+  EXPECT_FALSE(p.AddReading({kT0 + 19.9, 4.0, 0.0}, looped));
+  EXPECT_EQ(p.stats().frames_previous_pass, 1u);
+  EXPECT_EQ(p.stats().readings_previous_pass, 1u);
+  EXPECT_EQ(p.stats().frames_future, 0u);
+  EXPECT_EQ(p.stats().readings_future, 0u);
+  EXPECT_FALSE(p.AddFrame(kT0 + 3600, Numbered(1), ClipSourceEncoding::kMono8, looped));
+  EXPECT_EQ(p.stats().frames_future, 1u);
+  // Once the clock has passed where it was, a stamp ahead of it is the future again.
+  EXPECT_TRUE(p.AddFrame(kT0 + 21.0, Numbered(2), ClipSourceEncoding::kMono8, kT0 + 21.0));
+  EXPECT_FALSE(p.AddFrame(kT0 + 30.0, Numbered(3), ClipSourceEncoding::kMono8, kT0 + 21.0));
+  EXPECT_EQ(p.stats().frames_future, 2u);
+}
+
 // One reading from a clock an hour ahead: without the check it moves the pipeline's time an hour
 // on, every later clip is released at once and the readings it needs are pruned as old.
 TEST(ClipPipelineTest, ReadingStampedInTheFutureIsRefused) {
