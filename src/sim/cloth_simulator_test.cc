@@ -168,15 +168,20 @@ TEST(ClothSimulatorTest, HangingClothReachesEquilibriumWithSagOrderedByStiffness
 TEST(ClothSimulatorTest, EnergyDoesNotGrowWithoutInput) {
   // Released horizontally, pinned at one corner: swings down, bends, stretches, folds.
   const Mesh m = Sheet(0.5, 0.5, 0.07, [](double u, double v) { return Eigen::Vector3d(u, v, 0); });
-  for (int variant = 0; variant < 4; ++variant) {
+  for (int variant = 0; variant < 5; ++variant) {
     // 0: elasticity only; 1: + strain limits; 2: + strain limits and self-repulsion;
-    // 3: elasticity only, bending explicit.
+    // 3: elasticity only, bending explicit; 4: + strain limits by the global method.
     SCOPED_TRACE("variant " + std::to_string(variant));
     SimOptions o = QuietOptions();
     o.handles = {0};
-    if (variant >= 1) {
+    if (variant >= 1 && variant != 3) {
       o.strain_min = 0.95;
       o.strain_max = 1.05;
+    }
+    if (variant == 4) {
+      o.strain_limit_method = StrainLimitMethod::kGlobal;
+      o.strain_limit_iterations = 30;
+      o.strain_limit_tolerance = 1e-3;
     }
     o.self_collision = variant == 2;
     o.bending_solve = variant == 3 ? BendingSolve::kExplicit : BendingSolve::kImplicit;
@@ -202,10 +207,14 @@ TEST(ClothSimulatorTest, EnergyDoesNotGrowWithoutInput) {
     if (variant == 0) {
       EXPECT_EQ(increases, 0);
     }
-    if (variant == 1 || variant == 3) {
+    if (variant == 1 || variant == 3 || variant == 4) {
       EXPECT_LT(worst_increase, 1e-3 * scale);
     }
-    EXPECT_LT(highest, e0 + 1e-4 * scale);
+    // The global method's positions are a penalty fit stopped at a tolerance, not the exact
+    // mass-weighted projection, and its move / dt adds energy the sweeps do not: 6.8e-4 m g L in
+    // its worst step and 0.47 % of m g L above the start at most (stop 74; the sweeps: 7e-7, and
+    // never above the start). One reason it is not FlagSim's limiter (docs/simulator.md).
+    EXPECT_LT(highest, e0 + (variant == 4 ? 1e-2 : 1e-4) * scale);
     EXPECT_LT(previous, e0 - 0.05 * scale);
   }
 }
