@@ -213,7 +213,7 @@ TEST(ClothSimulatorTest, EnergyDoesNotGrowWithoutInput) {
     // The global method's positions are a penalty fit stopped at a tolerance, not the exact
     // mass-weighted projection, and its move / dt adds energy the sweeps do not: 6.8e-4 m g L in
     // its worst step and 0.47 % of m g L above the start at most (stop 74; the sweeps: 7e-7, and
-    // never above the start). One reason it is not FlagSim's limiter (docs/simulator.md).
+    // never above the start). Converged to 1e-7 it gains nothing (docs/simulator.md).
     EXPECT_LT(highest, e0 + (variant == 4 ? 1e-2 : 1e-4) * scale);
     EXPECT_LT(previous, e0 - 0.05 * scale);
   }
