@@ -239,7 +239,10 @@ class SdnNode {
           *clip, p, latency, model_name_, static_cast<uint32_t>(predictor_->config().frames));
       // In ROS time, so a replay's is the bag's: the delay a reader of the estimate sees, queue included.
       // In double seconds: ros::Time arithmetic throws beyond 32 bits (a clip stamped TIME_MAX).
-      ages_.push_back(ros::Time::now().toSec() - estimate.clip_end.toSec());
+      // Not a negative age: a clip of a looped bag's previous pass, estimated after the clock went
+      // back, is the bag's length "in the future", and it skewed the mean over 50 clips.
+      const double age = ros::Time::now().toSec() - estimate.clip_end.toSec();
+      if (age >= 0) ages_.push_back(age);
       if (ages_.size() > 50) ages_.pop_front();
       estimate_pub_.publish(estimate);
       PublishMean(estimate, p.raw_speed);

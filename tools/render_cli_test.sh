@@ -10,6 +10,12 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 fail() { echo "render_cli_test: FAIL: $*" >&2; exit 1; }
 
+# (simulate, which makes the input: a day at 0.04 s a frame is 2.16 million frames held in memory,
+# refused naming --duration before its --out is made.)
+status=0
+"$bin" simulate "$src/config/scenes/flag.json" --out "$work/day" --duration 86000 --no-obj >"$work/out.txt" 2>&1 || status=$?
+[ "$status" -eq 1 ] && grep -q -- "--duration 86000" "$work/out.txt" && [ ! -e "$work/day" ] ||
+  fail "simulate --duration 86000 was not refused before the work: $(cat "$work/out.txt")"
 "$bin" simulate "$src/config/scenes/flag.json" --out "$work/sim" --duration 0.2 --max-edge 1 --no-obj >/dev/null
 "$bin" render "$work/sim" --out "$work/fr" --count 3 --samples 1 --threads 1 >/dev/null 2>&1
 [ -f "$work/fr/000.jpg" ] && [ -f "$work/fr/002.jpg" ] && [ -f "$work/fr/zeta.json" ] || fail "first run incomplete"

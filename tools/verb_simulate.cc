@@ -96,6 +96,13 @@ int Run(const SimulateArgs& a) {
   if (a.duration != -1 && !(std::isfinite(a.duration) && a.duration > 0 && a.duration <= 86400)) {
     throw std::invalid_argument("--duration must be a time > 0 and <= 86400 s, got " + std::to_string(a.duration));
   }
+  // The scene's own bound on its frames (held in memory, then copied to write the trajectory):
+  // a day at the flag's 0.04 s was 2.16 million frames.
+  if (a.duration != -1 && !(a.duration / scene.frame_time <= 1e6)) {
+    throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s is " +
+                                std::to_string(a.duration / scene.frame_time) + " frames of " + a.scene +
+                                "'s frame_time " + std::to_string(scene.frame_time) + " s; at most 1e6");
+  }
   fs::create_directories(a.out);
   // summary.json marks a finished run (scripts/window-oracle reuses a folder that has one): the
   // old run's goes before new frames are written, so a run stopped midway leaves none.
