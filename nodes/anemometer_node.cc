@@ -71,7 +71,6 @@ class AnemometerNode {
     clothwind::ros_bridge::StrictParams params(pnh_);
     std::string protocol_name, parity;
     double initial = 0.1, maximum = 2.0;
-    bool stale_set = false;
     try {
       input_ = params.Get("input", "serial");
       frame_id_ = params.Get("frame_id", std::string(kDefaultFrameId));
@@ -92,8 +91,7 @@ class AnemometerNode {
       parity = params.Get("parity", "none");
       serial_.stop_bits = params.Get("stop_bits", 1);
       usb_poll_period_ = params.Get("usb_poll_period", 10.0);
-      stale_set = params.Has("stale_timeout");
-      stale_timeout_given_ = stale_set;
+      stale_timeout_given_ = params.Has("stale_timeout");
       stale_timeout_ = params.Get("stale_timeout", 5.0);
     } catch (const std::exception& e) {
       ROS_FATAL("anemometer_node: %s", e.what());
@@ -129,7 +127,7 @@ class AnemometerNode {
       state_ = "waiting for " + serial_.port;
     } else if (input_ == "usb") {
       // The outdoor unit transmits every 48 s; allow two missed transmissions before warning.
-      if (!stale_set) stale_timeout_ = 3.0 * clothwind::sensors::kFineOffsetSensorPeriod;
+      if (!stale_timeout_given_) stale_timeout_ = 3.0 * clothwind::sensors::kFineOffsetSensorPeriod;
       updater_.setHardwareID("usb:1941:8021");
       state_ = "waiting for USB station 1941:8021";
     } else if (input_ == "topic") {

@@ -31,6 +31,14 @@ inline void RefuseOutputOverInput(const std::string& option, const std::filesyst
                                   "); write it elsewhere");
 }
 
+// Throws std::invalid_argument naming `option` when `output` is a folder: the verbs that make a
+// missing output folder themselves failed only when saving, after the work.
+inline void RefuseFolderAsOutput(const std::string& option, const std::filesystem::path& output) {
+  std::error_code ec;
+  if (!output.empty() && std::filesystem::is_directory(output, ec))
+    throw std::invalid_argument(option + " " + output.string() + " is a folder; expected a file name");
+}
+
 // Throws std::invalid_argument naming `option` unless `output` (empty: none) could be written: its
 // folder exists and it is not a folder itself. Checked before the work, which used to run to its
 // end (a whole evaluation) and then fail to write or, for a plot, exit 0.
@@ -40,16 +48,7 @@ inline void RefuseUnwritableOutput(const std::string& option, const std::filesys
   const std::filesystem::path folder = output.has_parent_path() ? output.parent_path() : ".";
   if (!std::filesystem::is_directory(folder, ec))
     throw std::invalid_argument(option + " " + output.string() + ": folder " + folder.string() + " does not exist");
-  if (std::filesystem::is_directory(output, ec))
-    throw std::invalid_argument(option + " " + output.string() + " is a folder; expected a file name");
-}
-
-// Throws std::invalid_argument naming `option` when `output` is a folder: the verbs that make a
-// missing output folder themselves failed only when saving, after the work.
-inline void RefuseFolderAsOutput(const std::string& option, const std::filesystem::path& output) {
-  std::error_code ec;
-  if (!output.empty() && std::filesystem::is_directory(output, ec))
-    throw std::invalid_argument(option + " " + output.string() + " is a folder; expected a file name");
+  RefuseFolderAsOutput(option, output);
 }
 
 }  // namespace clothwind::tools

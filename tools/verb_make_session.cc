@@ -23,6 +23,7 @@
 
 #include "common/atomic_file.h"
 #include "data/rendered_flag_generator.h"
+#include "output_paths.h"
 #include "progress_bar.h"
 #include "sensors/synthetic_session.h"
 #include "verb_registry.h"
@@ -82,10 +83,9 @@ int Run(const MakeSessionArgs& a) {
                                 std::to_string(a.zeta_seed));
   // --out checked before the long work: a folder failed only at the final rename (a rendered
   // session of hours lost), and an existing bag, perhaps a recorded field session, was replaced.
+  RefuseFolderAsOutput("--out", a.out);
   {
     std::error_code ec;
-    if (std::filesystem::is_directory(a.out, ec))
-      throw std::invalid_argument("--out " + a.out + " is a folder; expected a bag file name");
     if (std::filesystem::exists(a.out, ec) && !a.overwrite)
       throw std::invalid_argument("--out " + a.out + " exists (a recorded session?); --overwrite replaces it");
   }

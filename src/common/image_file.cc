@@ -67,6 +67,15 @@ std::string ClaimTooLarge(const jpeg_decompress_struct& info) {
          " pixels (at most 2^30)";
 }
 
+// Creates the decompressor on `data` and reads its header; "" or why the header is refused
+// (ClaimTooLarge). libjpeg's errors longjmp to the caller's setjmp, so it is called only after it.
+std::string StartDecompress(jpeg_decompress_struct* info, const uint8_t* data, size_t n) {
+  jpeg_create_decompress(info);
+  jpeg_mem_src(info, data, static_cast<unsigned long>(n));
+  jpeg_read_header(info, TRUE);
+  return ClaimTooLarge(*info);
+}
+
 }  // namespace
 
 std::string JpegDataProblem(const uint8_t* data, size_t n) {
@@ -77,10 +86,7 @@ std::string JpegDataProblem(const uint8_t* data, size_t n) {
     jpeg_destroy_decompress(&info);
     return errors.first;
   }
-  jpeg_create_decompress(&info);
-  jpeg_mem_src(&info, data, static_cast<unsigned long>(n));
-  jpeg_read_header(&info, TRUE);
-  if (const std::string claim = ClaimTooLarge(info); !claim.empty()) {
+  if (const std::string claim = StartDecompress(&info, data, n); !claim.empty()) {
     jpeg_destroy_decompress(&info);
     return claim;
   }
@@ -100,10 +106,7 @@ std::string DecodeJpegBgr(const uint8_t* data, size_t n, cv::Mat* image, int exp
     jpeg_destroy_decompress(&info);
     return errors.first;
   }
-  jpeg_create_decompress(&info);
-  jpeg_mem_src(&info, data, static_cast<unsigned long>(n));
-  jpeg_read_header(&info, TRUE);
-  if (const std::string claim = ClaimTooLarge(info); !claim.empty()) {
+  if (const std::string claim = StartDecompress(&info, data, n); !claim.empty()) {
     jpeg_destroy_decompress(&info);
     return claim;
   }

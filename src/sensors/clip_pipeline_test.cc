@@ -253,20 +253,27 @@ TEST(ClipPipelineTest, AFrameBackInTimeThatTheNextFollowsStartsANewTimeline) {
 // A looped bag's first reading arrives before its first frame. It labelled the old timeline's
 // last clips at the jump (a 5 m/s reading among 4 m/s ones) and was then forgotten, so the new
 // timeline's first clips had one reading fewer than the same clips the first time round.
-TEST(ClipPipelineTest, ANewTimelinesReadingBeforeItsFirstFrameLabelsTheNewTimeline) {
-  const ClipPipelineOptions o = SmallOptions();  // label window 5 s
-  ClipPipeline p(o);
-  for (int i = 0; i <= 12 * 30; ++i) {
-    if (i % 30 == 0) p.AddReading({kT0 + i / 30, 4.0, 0.0});
-    p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+// A pass of `seconds` of frames with a 4 m/s reading each second, then the bag looped: its first
+// reading (5 m/s, at 0.5 s) comes before its first frame, then 3 s of its frames. Every clip made,
+// those released at the jump, after it and at the end, into *clips.
+void PlayAndLoopWithAnEarlyReading(ClipPipeline* p, int seconds, std::vector<LabelledClip>* clips) {
+  for (int i = 0; i <= seconds * 30; ++i) {
+    if (i % 30 == 0) p->AddReading({kT0 + i / 30, 4.0, 0.0});
+    p->AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
   }
-  p.TakeReady();
-  ASSERT_GT(p.pending(), 0u);
-  p.AddReading({kT0 + 0.5, 5.0, 0.0});  // the loop's first reading, then its frames
-  for (int i = 0; i <= 3 * 30; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
-  EXPECT_EQ(p.stats().time_jumps, 1u);
-  std::vector<LabelledClip> clips = p.TakeReady();
-  for (auto& c : p.Flush()) clips.push_back(std::move(c));
+  p->TakeReady();
+  ASSERT_GT(p->pending(), 0u);
+  p->AddReading({kT0 + 0.5, 5.0, 0.0});  // the loop's first reading, then its frames
+  for (int i = 0; i <= 3 * 30; ++i) p->AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  EXPECT_EQ(p->stats().time_jumps, 1u);
+  *clips = p->TakeReady();
+  for (auto& c : p->Flush()) clips->push_back(std::move(c));
+}
+
+TEST(ClipPipelineTest, ANewTimelinesReadingBeforeItsFirstFrameLabelsTheNewTimeline) {
+  ClipPipeline p(SmallOptions());  // label window 5 s
+  std::vector<LabelledClip> clips;
+  ASSERT_NO_FATAL_FAILURE(PlayAndLoopWithAnEarlyReading(&p, 12, &clips));
   int old_timeline = 0, new_timeline = 0;
   for (const auto& c : clips) {
     const double end = c.clip.frames.back().stamp - kT0;
@@ -289,17 +296,8 @@ TEST(ClipPipelineTest, ANewTimelinesReadingBeforeItsFirstFrameLabelsTheNewTimeli
 // it was not held: it labelled the old timeline's last clips and was forgotten at the jump.
 TEST(ClipPipelineTest, AShortBagsLoopReadingLabelsTheNewTimelineToo) {
   ClipPipeline p(SmallOptions());  // label window 5 s, delay 1.5 s
-  for (int i = 0; i <= 4 * 30; ++i) {
-    if (i % 30 == 0) p.AddReading({kT0 + i / 30, 4.0, 0.0});
-    p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
-  }
-  p.TakeReady();
-  ASSERT_GT(p.pending(), 0u);
-  p.AddReading({kT0 + 0.5, 5.0, 0.0});  // the loop's first reading, then its frames
-  for (int i = 0; i <= 3 * 30; ++i) p.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
-  EXPECT_EQ(p.stats().time_jumps, 1u);
-  std::vector<LabelledClip> clips = p.TakeReady();
-  for (auto& c : p.Flush()) clips.push_back(std::move(c));
+  std::vector<LabelledClip> clips;
+  ASSERT_NO_FATAL_FAILURE(PlayAndLoopWithAnEarlyReading(&p, 4, &clips));
   int old_timeline = 0, new_timeline = 0;
   for (const auto& c : clips) {
     if (c.label.count > 0 && c.label.mean == 4.0) ++old_timeline;

@@ -130,6 +130,8 @@ constexpr double kGlobalStiffness = 1e2;
 
 struct StrainLimiter::Global {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
+  std::vector<Eigen::Matrix<double, 2, 3>> B;  // per face: F_f(X)^T = B_f X_f
+  double pin_weight = 0;                        // a pinned vertex's weight in the fit
   Eigen::MatrixX3d rhs, solved, anchor;  // #V by 3
   std::vector<Eigen::Matrix<double, 3, 2>> duals;  // per face: u_f (ADMM's scaled dual)
   std::vector<Eigen::Matrix<double, 3, 2>> projections;  // per face: z_f of the last iteration
@@ -175,15 +177,18 @@ void StrainLimiter::PrepareGlobal() {
   //   sum_i w_i |X_i - anchor_i|^2 + sum_f c_f |F_f(X) - F*_f|^2,  F_f(X)^T = B_f X_f,
   // B_f = Dm_inv^T [-1 1 0; -1 0 1] (2 by 3), w_i the mass (huge when pinned): the normal
   // equations' matrix W + sum_f c_f B_f^T B_f is the same every step, factorised here once.
-  const double pin_weight = 1e9 * std::max(mass_.maxCoeff(), 1e-12);
+  Global& g = *global_;
+  g.pin_weight = 1e9 * std::max(mass_.maxCoeff(), 1e-12);
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(n + 9 * faces_.size());
-  for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, pinned_[i] ? pin_weight : mass_[i]);
+  for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, pinned_[i] ? g.pin_weight : mass_[i]);
+  Eigen::Matrix<double, 2, 3> E;
+  E << -1, 1, 0, -1, 0, 1;
+  g.B.resize(faces_.size());
   for (size_t f = 0; f < faces_.size(); ++f) {
     const Face& face = faces_[f];
-    Eigen::Matrix<double, 2, 3> E;
-    E << -1, 1, 0, -1, 0, 1;
-    const Eigen::Matrix<double, 2, 3> B = face.Dm_inv.transpose() * E;
+    g.B[f] = face.Dm_inv.transpose() * E;
+    const Eigen::Matrix<double, 2, 3>& B = g.B[f];
     const Eigen::Matrix3d BtB = face_weight_[f] * B.transpose() * B;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) triplets.emplace_back(face.v[a], face.v[b], BtB(a, b));
@@ -265,33 +270,40 @@ StrainLimitResult StrainLimiter::LocalGlobal(const StrainLimitSettings& settings
     for (int c = 0; c < 3; ++c) g.anchor(i, c) = X[3 * i + c];
   g.duals.assign(faces_.size(), Eigen::Matrix<double, 3, 2>::Zero());
   g.projections.resize(faces_.size());
-  // The first iteration's z_f are compared with the shapes they start from.
-  for (size_t f = 0; f < faces_.size(); ++f) {
-    FaceProjection p;
-    ProjectFace(faces_[f], X, limits, &p);
-    for (int r = 0; r < 3; ++r) {
-      g.projections[f](r, 0) = p.Fu[r];
-      g.projections[f](r, 1) = p.Fv[r];
+  std::vector<FaceProjection>& shapes = g.shapes;
+  shapes.resize(faces_.size());
+  // Where the positions X stand: each face's shape (into `shapes`), and how many are projected
+  // and violated, and by how much at most.
+  struct Standing {
+    int projected = 0, violated = 0;
+    double excess = 0;
+  };
+  const auto measure = [&] {
+    Standing s;
+    for (size_t f = 0; f < faces_.size(); ++f) {
+      if (!ProjectFace(faces_[f], X, limits, &shapes[f])) continue;
+      ++s.projected;
+      if (shapes[f].violated) ++s.violated;
+      s.excess = std::max(s.excess, shapes[f].excess);
     }
-  }
-  const double pin_weight = 1e9 * std::max(mass_.maxCoeff(), 1e-12);
+    return s;
+  };
   StrainLimitResult result;
-  Eigen::Matrix<double, 2, 3> E;
-  E << -1, 1, 0, -1, 0, 1;
   double z_change = 0;  // largest change of a face's projection z_f in the last iteration
   for (int iteration = 0; iteration < settings.max_sweeps; ++iteration) {
     // Where the positions stand: what the result reports, and whether to go on.
-    int projected = 0, violated = 0;
-    double excess = 0;
-    std::vector<FaceProjection>& shapes = g.shapes;
-    shapes.resize(faces_.size());
-    for (size_t f = 0; f < faces_.size(); ++f) {
-      if (!ProjectFace(faces_[f], X, limits, &shapes[f])) continue;
-      ++projected;
-      if (shapes[f].violated) ++violated;
-      excess = std::max(excess, shapes[f].excess);
+    const Standing standing = measure();
+    const int violated = standing.violated;
+    const double excess = standing.excess;
+    if (iteration == 0) {
+      result.initially_violated = standing.projected;
+      // The first iteration's z_f are compared with the shapes they start from.
+      for (size_t f = 0; f < faces_.size(); ++f)
+        for (int r = 0; r < 3; ++r) {
+          g.projections[f](r, 0) = shapes[f].Fu[r];
+          g.projections[f](r, 1) = shapes[f].Fv[r];
+        }
     }
-    if (iteration == 0) result.initially_violated = projected;
     result.sweeps = iteration + 1;
     // Done when the positions are within the limits and the projections have settled (ADMM's
     // dual residual): feasibility alone stopped at the first shape within the limits however far
@@ -311,7 +323,7 @@ StrainLimitResult StrainLimiter::LocalGlobal(const StrainLimitSettings& settings
       g.best.assign(X, X + 3 * n);
     }
     g.rhs.resize(n, 3);
-    for (int i = 0; i < n; ++i) g.rhs.row(i) = (pinned_[i] ? pin_weight : mass_[i]) * g.anchor.row(i);
+    for (int i = 0; i < n; ++i) g.rhs.row(i) = (pinned_[i] ? g.pin_weight : mass_[i]) * g.anchor.row(i);
     for (size_t f = 0; f < faces_.size(); ++f) {
       const Face& face = faces_[f];
       Eigen::Matrix<double, 3, 2>& u = g.duals[f];
@@ -338,9 +350,8 @@ StrainLimitResult StrainLimiter::LocalGlobal(const StrainLimitSettings& settings
         u(r, 0) += shapes[f].Fu[r] - z(r, 0);
         u(r, 1) += shapes[f].Fv[r] - z(r, 1);
       }
-      // Normal equations' right side: c_f B_f^T (z - u)^T, B_f = Dm_inv^T E.
-      const Eigen::Matrix3d contribution =
-          face_weight_[f] * (face.Dm_inv.transpose() * E).transpose() * (z - u).transpose();
+      // Normal equations' right side: c_f B_f^T (z - u)^T.
+      const Eigen::Matrix3d contribution = face_weight_[f] * g.B[f].transpose() * (z - u).transpose();
       for (int a = 0; a < 3; ++a) g.rhs.row(face.v[a]) += contribution.row(a);
     }
     g.solved = g.solver.solve(g.rhs);
@@ -349,19 +360,12 @@ StrainLimitResult StrainLimiter::LocalGlobal(const StrainLimitSettings& settings
   }
   if (!result.converged) {
     // The last solve's positions were not checked: better only if within tolerance after all.
-    int violated = 0;
-    double excess = 0;
-    for (const Face& face : faces_) {
-      FaceProjection p;
-      if (!ProjectFace(face, X, limits, &p)) continue;
-      violated += p.violated;
-      excess = std::max(excess, p.excess);
-    }
-    if (violated == 0) {
+    const Standing last = measure();
+    if (last.violated == 0) {
       result.converged = true;
-      result.excess = excess;
-    } else if (excess < result.excess) {
-      result.excess = excess;
+      result.excess = last.excess;
+    } else if (last.excess < result.excess) {
+      result.excess = last.excess;
     } else {
       std::copy(g.best.begin(), g.best.end(), X);
     }
