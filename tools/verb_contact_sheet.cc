@@ -8,6 +8,7 @@
 #include "data/contact_sheet.h"
 #include "data/dataset_index.h"
 #include "output_paths.h"
+#include "progress_bar.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -47,7 +48,15 @@ int Run(const ContactSheetArgs& a) {
   if (sheet_bytes > 4.0 * (1ull << 30))
     throw std::invalid_argument("--tiles x --tile-size^2 x 3 bytes (the sheet, held in memory) must be at most 4 GiB, "
                                 "got " + std::to_string(sheet_bytes / (1ull << 30)) + " GiB");
-  if (!data::WriteContactSheet(a.dir, index, out, a.options)) {
+  ProgressBar::Options b;
+  b.label = "contact-sheet";
+  b.unit = "tiles";
+  b.rate_unit = "tiles/s";
+  ProgressBar bar(b);
+  const bool written =
+      data::WriteContactSheet(a.dir, index, out, a.options, [&](int done, int total) { bar.Update(done, total); });
+  bar.Finish();
+  if (!written) {
     std::fprintf(stderr, "contact-sheet: %s has no clips\n", a.dir.c_str());
     return 1;
   }

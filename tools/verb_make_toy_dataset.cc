@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "learn/dataset.h"
+#include "progress_bar.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -25,7 +26,13 @@ VerbRegistrar registrar("make-toy-dataset", [](CLI::App& app) -> std::function<i
   sub->add_option("--size", a->o.size, "frame side [px]")->check(CLI::Range(16, 2048))->capture_default_str();
   sub->add_option("--seed", a->o.seed, "seed")->capture_default_str();
   return [a]() {
-    learn::WriteToyDataset(a->out, a->o);
+    ProgressBar::Options b;
+    b.label = "make-toy-dataset";
+    b.unit = "examples";
+    b.rate_unit = "examples/s";
+    ProgressBar bar(b);
+    learn::WriteToyDataset(a->out, a->o, [&](int done, int total) { bar.Update(done, total); });
+    bar.Finish();
     std::cout << "wrote " << a->o.clips << " examples to " << a->out << "\n";
     return 0;
   };

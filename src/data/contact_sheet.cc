@@ -40,7 +40,7 @@ void Label(cv::Mat& tile, const std::string& text, int y, double scale) {
 }  // namespace
 
 cv::Mat MakeContactSheet(const std::string& dir, const nlohmann::json& index,
-                         const ContactSheetOptions& o) {
+                         const ContactSheetOptions& o, const std::function<void(int, int)>& progress) {
   if (o.max_tiles < 1 || o.tile < 32) throw std::invalid_argument("contact sheet: max_tiles >= 1, tile >= 32");
   struct Item {
     std::string name;
@@ -96,13 +96,14 @@ cv::Mat MakeContactSheet(const std::string& dir, const nlohmann::json& index,
     Label(tile, wind, 16, 0.5);
     Label(tile, shown[k].name, o.tile - 4, 0.35);
     tile.copyTo(sheet(cv::Rect((k % cols) * o.tile, (k / cols) * o.tile, o.tile, o.tile)));
+    if (progress) progress(k + 1, n);
   }
   return sheet;
 }
 
 bool WriteContactSheet(const std::string& dir, const nlohmann::json& index, const std::string& path,
-                       const ContactSheetOptions& options) {
-  const cv::Mat sheet = MakeContactSheet(dir, index, options);
+                       const ContactSheetOptions& options, const std::function<void(int, int)>& progress) {
+  const cv::Mat sheet = MakeContactSheet(dir, index, options, progress);
   if (sheet.empty()) return false;
   render::WriteFrameAtomic(path, sheet);
   return true;

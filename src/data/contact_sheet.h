@@ -1,6 +1,7 @@
 #ifndef CLOTHWIND_DATA_CONTACT_SHEET_H_
 #define CLOTHWIND_DATA_CONTACT_SHEET_H_
 
+#include <functional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -19,15 +20,19 @@ struct ContactSheetOptions {
 // Inputs:
 //   dir    dataset folder
 //   index  its index.json (BuildIndex/ReadIndex)
+//   progress  called with (tiles read, tiles shown) after each tile (10,000 frames of a slow
+//             disk take minutes)
 // Returns CV_8UC3 BGR; empty when the index has no clips. Throws std::runtime_error naming a
 // frame that cannot be read.
 cv::Mat MakeContactSheet(const std::string& dir, const nlohmann::json& index,
-                         const ContactSheetOptions& options = {});
+                         const ContactSheetOptions& options = {},
+                         const std::function<void(int, int)>& progress = {});
 
 // MakeContactSheet written atomically as a PNG to `path`. Returns false (writing nothing) when
 // the index has no clips.
 bool WriteContactSheet(const std::string& dir, const nlohmann::json& index, const std::string& path,
-                       const ContactSheetOptions& options = {});
+                       const ContactSheetOptions& options = {},
+                       const std::function<void(int, int)>& progress = {});
 
 }  // namespace clothwind::data
 

@@ -474,7 +474,7 @@ nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<st
   return settings;
 }
 
-int64_t ReindexDataset(const std::string& dir, bool contact_sheet) {
+int64_t ReindexDataset(const std::string& dir, bool contact_sheet, const std::function<void(int, int)>& progress) {
   nlohmann::json index = ReadIndex(dir);
   if (index.is_null()) throw std::runtime_error(dir + "/index.json not found: not a dataset folder");
   // Compared as JSON: value("kind", "") threw a bare type error on a kind of another type.
@@ -482,13 +482,14 @@ int64_t ReindexDataset(const std::string& dir, bool contact_sheet) {
   if (kind != nlohmann::json("flag") && kind != nlohmann::json("cloth"))
     throw std::runtime_error(dir + "/index.json: field 'kind' is " + kind.dump() +
                              ", expected \"flag\" or \"cloth\" (only simulated datasets are re-indexed)");
-  index = BuildIndex(dir, index);
+  index = BuildIndex(dir, index, progress);
   WriteIndex(dir, index);
   if (contact_sheet) WriteContactSheet(dir, index, (fs::path(dir) / "contact_sheet.png").string());
   return static_cast<int64_t>(index["clips"].size());
 }
 
-DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCallback& progress) {
+DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCallback& progress,
+                               const std::function<void(int, int)>& index_progress) {
   ValidateOptions(o);
   const auto start = Clock::now();
   const Prepared prep = Prepare(o);
@@ -655,7 +656,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   std::sort(summary.errors.begin(), summary.errors.end());
 
   // Every run rebuilds the index from the folders present: shards and resumed runs converge.
-  nlohmann::json index = BuildIndex(o.out, IndexHeader(o, settings));
+  nlohmann::json index = BuildIndex(o.out, IndexHeader(o, settings), index_progress);
   if (o.add_tracks) {
     // The header's "tracks" says every example has its tracks.json: not while a replay failed or
     // another split still waits for its tracks (a later --add-tracks run completes it; a run with

@@ -479,11 +479,16 @@ TEST_F(DatasetGeneratorTest, ReindexMergesFoldersCopiedFromOtherMachines) {
   DatasetOptions o = Tiny(dir.string());
   o.shards = 2;
   o.shard = 1;
-  GenerateDataset(o);
+  std::vector<std::pair<int, int>> index_reports;
+  GenerateDataset(o, {}, [&](int done, int total) { index_reports.emplace_back(done, total); });
+  EXPECT_EQ(index_reports, (std::vector<std::pair<int, int>>{{1, 1}}));
   EXPECT_EQ(ReadIndex(dir.string())["clips"].size(), 1u);
   for (const char* name : {"flag-000000-v0", "flag-000002-v0"})
     fs::copy(Ref() / name, dir / name, fs::copy_options::recursive);
-  EXPECT_EQ(ReindexDataset(dir.string()), 3);
+  // Progress counts every label found, once each, ending at the total.
+  std::vector<std::pair<int, int>> reports;
+  EXPECT_EQ(ReindexDataset(dir.string(), true, [&](int done, int total) { reports.emplace_back(done, total); }), 3);
+  EXPECT_EQ(reports, (std::vector<std::pair<int, int>>{{1, 3}, {2, 3}, {3, 3}}));
   EXPECT_EQ(Files(dir), Files(Ref()));
   // A recorded dataset's index is the clip writer's: not rebuilt from labels.
   const fs::path real = root_ / "real";
@@ -769,8 +774,11 @@ TEST_F(DatasetGeneratorTest, ContactSheetStaysInsideTheDataset) {
   nlohmann::json index = ReadIndex(Ref().string());
   ContactSheetOptions o;
   o.tile = 32;
-  const cv::Mat sheet = MakeContactSheet(Ref().string(), index, o);
+  std::vector<std::pair<int, int>> reports;
+  const cv::Mat sheet =
+      MakeContactSheet(Ref().string(), index, o, [&](int done, int total) { reports.emplace_back(done, total); });
   EXPECT_FALSE(sheet.empty());
+  EXPECT_EQ(reports, (std::vector<std::pair<int, int>>{{1, 3}, {2, 3}, {3, 3}}));
   // A clip without a wind (a recording's unlabelled one) is shown, last: the third of the 2x2
   // sheet's tiles is the one a sheet of that clip alone shows.
   index["clips"][0].erase("wind_speed");

@@ -147,7 +147,8 @@ nlohmann::json IndexEntry(const nlohmann::json& label) {
   return e;
 }
 
-nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header) {
+nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
+                          const std::function<void(int, int)>& progress) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
@@ -163,6 +164,7 @@ nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header) {
       throw std::runtime_error(path + ": field 'name' is " + label["name"].dump() +
                                ", expected the folder's name \"" + name + "\"");
     clips.push_back(IndexEntry(label));
+    if (progress) progress(static_cast<int>(clips.size()), static_cast<int>(names.size()));
   }
   header["clips"] = clips;
   return header;

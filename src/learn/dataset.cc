@@ -534,7 +534,8 @@ Sample LoadSample(const ClipInfo& clip, const SampleOptions& options, uint64_t s
                     [&clip, &options](int first, int count) { return LoadFrames(clip, first, count, options.colour); });
 }
 
-std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions& o) {
+std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions& o,
+                                    const std::function<void(int, int)>& progress) {
   fs::create_directories(dir);
   // Only a toy dataset is written over: the index of a FlagSim or recorded dataset (its settings
   // in the header) was removed and replaced by a toy one, for good.
@@ -607,6 +608,7 @@ std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions
     fs::remove_all(dir / name);
     fs::rename(tmp, dir / name);
     clips.push_back({{"name", name}, {"wind_speed", speed}, {"split", split}});
+    if (progress) progress(i + 1, o.clips);
   }
   nlohmann::json index = {{"format", "clothwind-dataset"}, {"version", 1}, {"kind", "toy"}, {"clips", clips}};
   WriteFileAtomically(dir / "index.json", index.dump(2));

@@ -557,7 +557,9 @@ TEST_F(DatasetTest, AToyDatasetOverAnotherReplacesItWhole) {
   o.frames = 4;
   o.size = 16;
   o.seed = 9;
-  WriteToyDataset(copy, o);
+  std::vector<std::pair<int, int>> reports;
+  WriteToyDataset(copy, o, [&](int done, int total) { reports.emplace_back(done, total); });
+  EXPECT_EQ(reports, (std::vector<std::pair<int, int>>{{1, 3}, {2, 3}, {3, 3}}));
   const Dataset d = ReadDataset(copy);
   EXPECT_EQ(d.clips.size(), 3u);
   EXPECT_FALSE(fs::exists(copy / "toy-00003"));
