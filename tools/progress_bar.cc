@@ -19,6 +19,11 @@ double ProgressBar::Elapsed() const {
 bool ProgressBar::Update(int64_t done, int64_t total, const std::string& note) {
   std::lock_guard<std::mutex> lock(mutex_);
   const double now = Elapsed();
+  if (!have_first_) {
+    have_first_ = true;
+    first_done_ = done;
+    first_time_ = now;
+  }
   const bool last = done >= total;
   // Every report of done >= total used to print at once: training's validation, reported as
   // steps/steps, printed a line per batch (hundreds an epoch).
@@ -32,16 +37,23 @@ bool ProgressBar::Update(int64_t done, int64_t total, const std::string& note) {
 }
 
 void ProgressBar::Print(int64_t done, int64_t total, const std::string& note, double now) {
-  const double rate = now > 0 ? done * o_.rate_scale / now : 0.0;  // in rate_unit
-  const double per_unit = done > 0 ? now / done : 0.0;             // [s per unit done]
-  const double eta = done > 0 ? (total - done) * per_unit : 0.0;
+  // Paced since the first report while under way; the end reports the whole run's average.
+  const bool paced = done > first_done_ && now > first_time_;
+  const bool end = done >= total;
+  const double units_per_s = end ? (now > 0 ? done / now : 0.0)
+                                 : (paced ? (done - first_done_) / (now - first_time_) : 0.0);
+  const double eta = units_per_s > 0 ? (total - done) / units_per_s : 0.0;
+  char rate[48];
+  if (end || paced)
+    std::snprintf(rate, sizeof(rate), "%.3g", units_per_s * o_.rate_scale);  // in rate_unit
+  else
+    std::snprintf(rate, sizeof(rate), "?");
   const int percent = total > 0 ? static_cast<int>(100 * std::min(done, total) / total) : 100;
   char text[256];
-  std::snprintf(text, sizeof(text), "%3d%%  %lld/%lld %s  %.3g %s  %s %s", percent,
+  std::snprintf(text, sizeof(text), "%3d%%  %lld/%lld %s  %s %s  %s %s", percent,
                 static_cast<long long>(done), static_cast<long long>(total), o_.unit.c_str(),
-                rate, o_.rate_unit.c_str(), done >= total ? "took" : "ETA",
-                done >= total ? FormatDuration(now).c_str()
-                              : (done > 0 ? FormatDuration(eta).c_str() : "?"));
+                rate, o_.rate_unit.c_str(), end ? "took" : "ETA",
+                end ? FormatDuration(now).c_str() : (units_per_s > 0 ? FormatDuration(eta).c_str() : "?"));
   const std::string label = o_.label.empty() ? "" : o_.label + " ";
   if (tty_) {
     constexpr int kWidth = 30;

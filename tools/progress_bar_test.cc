@@ -1,7 +1,9 @@
 #include "progress_bar.h"
 
+#include <chrono>
 #include <cstdio>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -48,6 +50,31 @@ TEST(ProgressBar, ReportsAfterTheEndAreThrottledLikeTheRest) {
     EXPECT_EQ(text.find("validating"), std::string::npos) << text;
     EXPECT_NE(text.find("took"), std::string::npos) << text;
   }
+}
+
+// The pace is measured from the first report: the setup before it (300 ms here) read as the
+// first unit's time, and a first line of "ETA 4 min 59 s" for work of a fraction of a second.
+TEST(ProgressBar, PaceIsMeasuredFromTheFirstReport) {
+  std::FILE* f = std::tmpfile();
+  ASSERT_NE(f, nullptr);
+  ProgressBar::Options o;
+  o.stream = f;
+  o.tty = 0;
+  o.plain_interval = 0;
+  ProgressBar bar(o);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  bar.Update(1, 1000);
+  const std::string first = Written(f);
+  EXPECT_NE(first.find("? items/s  ETA ?"), std::string::npos) << first;
+  std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  bar.Update(2, 1000);
+  const std::string second = Written(f).substr(first.size());
+  std::fclose(f);
+  // 998 units at the pace of the last one (a few ms, however loaded the machine): seconds, not
+  // the 998 x 0.3 s the setup implied.
+  EXPECT_EQ(second.find("ETA ?"), std::string::npos) << second;
+  EXPECT_EQ(second.find(" min"), std::string::npos) << second;
+  EXPECT_EQ(second.find(" h "), std::string::npos) << second;
 }
 
 TEST(ProgressBar, FormatsDurationsForPeople) {
