@@ -93,7 +93,10 @@ std::string JpegDataProblem(const uint8_t* data, size_t n) {
   jpeg_read_coefficients(&info);
   jpeg_finish_decompress(&info);
   jpeg_destroy_decompress(&info);
-  return errors.warnings > 0 ? std::string(errors.first) : std::string();
+  // Only warnings of damage, as DecodeJpegBgr: a Logitech C270's MJPEG frame saved to a folder
+  // (its few padding bytes before restart markers) was refused frame by frame on replay, while the
+  // live camera published the same frames.
+  return errors.damage_warnings > 0 ? std::string(errors.first_damage) : std::string();
 }
 
 std::string DecodeJpegBgr(const uint8_t* data, size_t n, cv::Mat* image, int expected_width,

@@ -28,25 +28,55 @@ inline bool LooksLikeJpeg(const uint8_t* data, size_t n) {
   return n >= 2 && data[0] == 0xFF && data[1] == 0xD8;
 }
 
-// Checks that a JPEG's bytes are whole: the start-of-image marker first, and the end-of-image
-// marker (FF D9) after the start of its last scan (FF DA). Inside a scan's entropy-coded data an
-// FF byte is always followed by 00 or a restart marker, so neither marker appears there; an
-// embedded thumbnail's scan and end come before the main image's scan. Anything may follow the
-// end (cameras pad their buffers with zeros; phones append trailers).
+// Checks that a JPEG's bytes are whole: the start-of-image marker first, then its segments in
+// turn, each skipped by its length (an embedded thumbnail lies inside its APP1 segment), every
+// scan's entropy-coded data up to the next marker (inside it an FF byte is followed by 00, a
+// restart marker or more FF fill), until the end-of-image marker (FF D9) after at least one scan.
+// Anything may follow the end (cameras pad their buffers with zeros; phones append trailers,
+// a Motion Photo a whole MP4, whose bytes may hold FF DA: searching the file for the last FF DA
+// took such a trailer for the last scan and refused the photo as truncated). Bytes that are not
+// a marker where one is due are skipped to the next FF, as libjpeg does (it warns of
+// "extraneous bytes", which JpegDataProblem judges), and so is a segment whose length runs past
+// the end (damage; a cut shows as no end after the last scan).
 // Inputs: data, n  the encoded bytes. Output: "" when whole, else why not (for an error message).
 inline std::string JpegWholeness(const uint8_t* data, size_t n) {
   if (n < 4 || !LooksLikeJpeg(data, n)) return "no start-of-image marker (" + std::to_string(n) + " bytes)";
-  size_t last_scan = 0;
-  for (size_t i = 2; i + 1 < n; ++i)
-    if (data[i] == 0xFF && data[i + 1] == 0xDA) last_scan = i;
-  if (last_scan == 0) return "no image data: no start-of-scan marker (" + std::to_string(n) + " bytes)";
-  for (size_t i = last_scan + 2; i + 1 < n; ++i)
-    if (data[i] == 0xFF && data[i + 1] == 0xD9) return "";
-  return "truncated: no end-of-image marker after its last scan (" + std::to_string(n) + " bytes)";
+  const auto standalone = [](uint8_t m) { return m == 0x01 || m == 0xD8 || (m >= 0xD0 && m <= 0xD7); };
+  bool scanned = false;
+  size_t i = 2;
+  while (true) {
+    while (i < n && data[i] != 0xFF) ++i;                // extraneous bytes
+    while (i + 1 < n && data[i + 1] == 0xFF) ++i;        // fill bytes before the marker
+    if (i + 1 >= n) break;
+    const uint8_t marker = data[i + 1];
+    i += 2;
+    if (marker == 0xD9) {
+      if (scanned) return "";
+      continue;  // an end before any scan is no image's end: what follows decides
+    }
+    if (marker == 0x00 || standalone(marker)) continue;
+    // A length past the end or below its own two bytes is damage (an FF byte overwritten in the
+    // data reads as a marker), not a cut: the search goes on from the marker, as before segments
+    // were walked, and JpegDataProblem says what libjpeg makes of it.
+    const size_t length = i + 2 <= n ? (static_cast<size_t>(data[i]) << 8) | data[i + 1] : 0;
+    scanned = scanned || marker == 0xDA;
+    if (length < 2 || length > n - i) continue;
+    i += length;
+    if (marker != 0xDA) continue;
+    // Entropy-coded data: up to an FF that starts a marker other than a restart.
+    while (i + 1 < n && !(data[i] == 0xFF && data[i + 1] != 0x00 && data[i + 1] != 0xFF &&
+                          !(data[i + 1] >= 0xD0 && data[i + 1] <= 0xD7)))
+      ++i;
+  }
+  const std::string size = " (" + std::to_string(n) + " bytes)";
+  if (!scanned) return "no image data: no start-of-scan marker" + size;
+  return "truncated: no end-of-image marker after its last scan" + size;
 }
 
 // Entropy-decodes a JPEG's data (its DCT coefficients; no inverse DCT, no colour conversion) and
-// reports the first warning or error libjpeg raised (common/image_file.cc). An image that claims
+// reports libjpeg's error, or its first warning that the image data is damaged
+// (common/image_file.cc; the warnings DecodeJpegBgr refuses: up to 16 extraneous bytes before a
+// marker, a camera's padding, and an unknown JFIF revision leave the picture whole). An image that claims
 // more than kMaxJpegPixels is refused from its header, before libjpeg sets aside its coefficients
 // (a 1 kB file claiming 40000x40000 took 3 GB; OpenCV refuses such a file at once).
 // Inputs: data, n  the encoded bytes (a JPEG: LooksLikeJpeg).

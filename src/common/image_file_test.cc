@@ -61,6 +61,26 @@ TEST_F(ImageFileTest, AJpegDamagedInItsMiddleIsRefusedWhereImreadMakesBlocksUp) 
   EXPECT_EQ(JpegDataProblem(jpeg_.data(), jpeg_.size()), "");  // the undamaged file
 }
 
+// What a Logitech C270 sends on every MJPEG frame, saved to a file: a few bytes before a restart
+// marker. libjpeg warns of "3 extraneous bytes" and decodes the picture whole; the live decoder
+// publishes it, and a folder of such frames was refused frame by frame on replay.
+TEST_F(ImageFileTest, ACamerasPaddingBeforeARestartMarkerReadsWhole) {
+  cv::Mat picture(96, 128, CV_8UC3);
+  cv::randu(picture, 0, 255);
+  std::vector<uint8_t> restarts;
+  ASSERT_TRUE(cv::imencode(".jpg", picture, restarts, {cv::IMWRITE_JPEG_QUALITY, 90, cv::IMWRITE_JPEG_RST_INTERVAL, 4}));
+  const cv::Mat clean = cv::imdecode(restarts, cv::IMREAD_COLOR);
+  size_t rst = 0;
+  for (size_t i = 2; i + 1 < restarts.size() && rst == 0; ++i)
+    if (restarts[i] == 0xFF && restarts[i + 1] >= 0xD0 && restarts[i + 1] <= 0xD7) rst = i;
+  ASSERT_GT(rst, 0u);
+  restarts.insert(restarts.begin() + static_cast<std::ptrdiff_t>(rst), {0x00, 0x17, 0x2a});
+  std::string why;
+  const cv::Mat read = ReadImageFile(Write("c270.jpg", restarts), cv::IMREAD_COLOR, &why);
+  ASSERT_FALSE(read.empty()) << why;
+  EXPECT_EQ(cv::norm(read, clean, cv::NORM_INF), 0.0);
+}
+
 TEST_F(ImageFileTest, AJpegClaimingAHugeImageIsRefusedFromItsHeader) {
   // A 64x48 file whose frame header says 40000x40000: libjpeg set aside the coefficients of the
   // size claimed (3 GB) before finding the data short. Refused from the header, as imread does.
@@ -126,6 +146,17 @@ TEST_F(ImageFileTest, AJpegCutShortIsRefusedWhereImreadMakesRowsUp) {
   trailed.insert(trailed.end(), trailer.begin(), trailer.end());
   ASSERT_FALSE(cv::imread(Write("trailed.jpg", trailed).string()).empty());
   EXPECT_FALSE(ReadImageFile(dir_ / "trailed.jpg", cv::IMREAD_COLOR, &why).empty()) << why;
+  // A trailer holding FF DA and no FF D9 after it (a Motion Photo's MP4): it was taken for the
+  // last scan, and the photo refused as truncated.
+  std::vector<uint8_t> motion = jpeg_;
+  const uint8_t mp4_bytes[] = {0x00, 0x00, 0x00, 0x18, 'f', 't', 'y', 'p', 0xFF, 0xDA, 0x00, 0x08, 0x12};
+  motion.insert(motion.end(), mp4_bytes, mp4_bytes + sizeof(mp4_bytes));
+  EXPECT_EQ(JpegWholeness(motion.data(), motion.size()), "");
+  EXPECT_FALSE(ReadImageFile(Write("motion.jpg", motion), cv::IMREAD_COLOR, &why).empty()) << why;
+  // A cut inside the header segments, before any scan.
+  const std::vector<uint8_t> header_cut(jpeg_.begin(), jpeg_.begin() + 30);
+  EXPECT_NE(JpegWholeness(header_cut.data(), header_cut.size()).find("no start-of-scan"), std::string::npos)
+      << JpegWholeness(header_cut.data(), header_cut.size());
   // A cut that keeps a thumbnail's end marker ahead of the main scan is still cut: the marker
   // must follow the last scan.
   std::vector<uint8_t> early_end(jpeg_.begin(), jpeg_.begin() + 2);
