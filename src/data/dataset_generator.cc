@@ -1,7 +1,12 @@
 #include "data/dataset_generator.h"
 
-#include <cstdio>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 
 #include <algorithm>
 #include <cctype>
@@ -106,6 +111,9 @@ int64_t IndexOfName(const std::string& name, render::SceneKind kind) {
   size_t end = start;
   while (end < name.size() && std::isdigit(static_cast<unsigned char>(name[end]))) ++end;
   if (end == start || end + 2 > name.size() || name.compare(end, 2, "-v") != 0) return -1;
+  // More digits than an int64 holds is no name of ours (std::stoll threw a bare "stoll" at the
+  // start of a run over a folder holding, say, ".flag-99999999999999999999-v0.tmp-x").
+  if (end - start > 18) return -1;
   return std::stoll(name.substr(start, end - start));
 }
 
@@ -203,6 +211,81 @@ sim::SceneSetup SetupFor(const Prepared& p, const SimulationSample& s, render::S
   return setup;
 }
 
+// An exclusive flock(2) on DIR/.index.lock while alive: the index is rebuilt from the folders
+// present and written whole, and two shards (or --split runs) into one folder did that at once.
+// One that listed the folder before the other's last rename and wrote after it left an index
+// without that example. Under the lock, the last to write listed the folder after every rename
+// that finished before it. (Linux's NFS client maps flock to the server's POSIX locks.)
+class IndexLock {
+ public:
+  explicit IndexLock(const std::string& dir) {
+    const std::string path = (fs::path(dir) / ".index.lock").string();
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw std::runtime_error("cannot open " + path + ": " + std::strerror(errno));
+    while (::flock(fd_, LOCK_EX) != 0) {
+      if (errno == EINTR) continue;
+      const std::string why = std::strerror(errno);
+      ::close(fd_);
+      throw std::runtime_error("cannot lock " + path + ": " + why);
+    }
+  }
+  ~IndexLock() { ::close(fd_); }  // closing releases the lock
+  IndexLock(const IndexLock&) = delete;
+  IndexLock& operator=(const IndexLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+// Simulation i's sample, as this run draws it.
+SimulationSample SampleOf(const DatasetOptions& o, const Prepared& p, int64_t i) {
+  return o.kind == render::SceneKind::kFlag ? SampleFlagSimulation(p.base_theta, o.seed, i, p.ranges)
+                                            : SampleClothSimulation(p.fabrics, o.seed, i, p.ranges);
+}
+
+// View v's rendering parameters of sample s, as this run renders them.
+render::RenderParams ViewOf(const DatasetOptions& o, const Prepared& p, const SimulationSample& s, int v) {
+  render::RenderParams zeta = SampleView(o.kind, s.seed, v, o.views, o.background_images, p.ranges.camera);
+  if (o.samples > 0) zeta.samples = o.samples;
+  zeta.width = zeta.height = o.size;
+  zeta.fps = o.fps;
+  return zeta;
+}
+
+// Whether every one of an example's `frames` frame files (000.<ext> ...) is in `folder`: an
+// interrupted copy (cp goes in the folder's hashed order, so label.json can come before 047.jpg)
+// left a label beside missing frames, counted complete at a resume and indexed.
+bool FramesPresent(const fs::path& folder, int frames, const std::string& ext) {
+  for (int k = 0; k < frames; ++k) {
+    char file[32];
+    std::snprintf(file, sizeof(file), "%03d.%s", k, ext.c_str());
+    if (!fs::exists(folder / file)) return false;
+  }
+  return true;
+}
+
+// Whether two label values agree: numbers within a relative 1e-9 (a label's doubles come back
+// from their JSON text), objects and arrays element by element, the rest exactly.
+bool JsonNear(const nlohmann::json& a, const nlohmann::json& b) {
+  if (a.is_number() && b.is_number()) {
+    const double x = a.get<double>(), y = b.get<double>();
+    return std::abs(x - y) <= 1e-9 * std::max(1.0, std::abs(y));
+  }
+  if (a.is_object() && b.is_object()) {
+    if (a.size() != b.size()) return false;
+    for (auto it = a.begin(); it != a.end(); ++it)
+      if (!b.contains(it.key()) || !JsonNear(it.value(), b[it.key()])) return false;
+    return true;
+  }
+  if (a.is_array() && b.is_array()) {
+    if (a.size() != b.size()) return false;
+    for (size_t k = 0; k < a.size(); ++k)
+      if (!JsonNear(a[k], b[k])) return false;
+    return true;
+  }
+  return a == b;
+}
+
 // Whether an example's tracks.json holds the points' positions ("world"; data/clip_tracks.h).
 // Files written before them, and unreadable ones, do not: --add-tracks makes them again.
 // And whether they are of `grid`: --add-tracks with another grid made a dataset of two grids.
@@ -243,12 +326,17 @@ void WriteExample(const std::string& out, const std::string& name, const std::ve
     }
     if (!tracks.is_null()) sim::WriteFileAtomically((tmp / "tracks.json").string(), tracks.dump() + "\n");
     sim::WriteFileAtomically((tmp / "label.json").string(), label.dump(2) + "\n");
-    // A folder of this name without label.json (written last) is an unfinished copy, e.g. an
-    // interrupted cp or rsync of a dataset: the rename failed on it ("Directory not empty") at
-    // every resume. It is incomplete by this writer's own rule, so it is replaced.
+    // A folder of this name without label.json (written last) or without one of its frames is
+    // an unfinished copy, e.g. an interrupted cp or rsync of a dataset: the rename failed on it
+    // ("Directory not empty") at every resume. It is incomplete by this writer's own rule, so it
+    // is replaced.
     const fs::path target = fs::path(out) / name;
-    if (fs::exists(target) && !fs::exists(target / "label.json")) {
-      std::fprintf(stderr, "make-dataset: %s has no label.json (unfinished): made again\n", target.c_str());
+    if (fs::exists(target)) {
+      const bool labelled = fs::exists(target / "label.json");
+      if (labelled && FramesPresent(target, static_cast<int>(images.size()), o.frame_ext))
+        throw std::runtime_error(target.string() + " is already complete: not replaced");
+      std::fprintf(stderr, "make-dataset: %s has %s (unfinished): made again\n", target.c_str(),
+                   labelled ? "frames missing" : "no label.json");
       fs::remove_all(target);
     }
     fs::rename(tmp, target);
@@ -377,12 +465,19 @@ void CheckIndexIsThisKind(const std::string& dir, const nlohmann::json& existing
                              " or more: a smaller count would leave the header below the simulations listed)");
 }
 
-// Throws unless the example folder `name`'s label.json says it was made as this run would make
-// it: FlagSim or ClothSim, global and simulation seed, frames, size, format, rate, warm-up, scene
-// and mesh. Why: without an index (the e5 recipe copies another dataset's examples and drops its
-// index) nothing else compared them, and examples of other settings were counted complete.
-void CheckExampleLabel(const std::string& dir, const std::string& name, uint64_t simulation_seed,
-                       const DatasetOptions& o, const Prepared& p) {
+// Throws unless the example folder of simulation i, view v has a label.json that says it was
+// made as this run would make it: FlagSim or ClothSim, global and simulation seed, frames, size,
+// format, rate, warm-up, scene and mesh; the views, the split, the fabric, θ and ζ drawn for it;
+// the generator's version (not for --add-tracks, which keeps the frames that are there); and a
+// tracks.json when this run makes tracks. Why: without an index (the e5 recipe copies another
+// dataset's examples and drops its index) nothing else compared them, and examples of other
+// settings were counted complete: another binary's frames, --views 2 over a copy of one view,
+// --wind-max 5 over 0-10 m/s, --tracks over examples made without (whose header then claimed
+// tracks), or other --val/--test fractions (one simulation in two splits).
+void CheckExampleLabel(const std::string& dir, int64_t i, int v, const DatasetOptions& o, const Prepared& p) {
+  const std::string name = ExampleName(o.kind, i, v);
+  const SimulationSample s = SampleOf(o, p, i);
+  const uint64_t simulation_seed = s.seed;
   const fs::path file = fs::path(dir) / name / "label.json";
   std::ifstream in(file);
   const nlohmann::json label = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
@@ -399,6 +494,14 @@ void CheckExampleLabel(const std::string& dir, const std::string& name, uint64_t
       {"frame_pattern", {label.value("frame_pattern", nlohmann::json()), "%03d." + o.frame_ext}},
       {"simulation_settings.scene", {sim.value("scene", nlohmann::json()), p.scene_name}},
       {"simulation_settings.vertices", {sim.value("vertices", nlohmann::json()), p.setup.cloths[0].mesh.V.rows()}},
+      {"views", {label.value("views", nlohmann::json()), o.views}},
+      {"split", {label.value("split", nlohmann::json()), SplitOf(simulation_seed, o.val_fraction, o.test_fraction)}},
+      {"fabric", {label.value("fabric", nlohmann::json()), s.fabric}},
+      {"generator.version",
+       {o.add_tracks || !label.contains("generator") || !label["generator"].is_object()
+            ? nlohmann::json()
+            : label["generator"].value("version", nlohmann::json()),
+        kGeneratorVersion}},
   };
   for (const auto& [field, values] : fields) {
     // A field the label lacks (a label of an older generator) is not compared.
@@ -407,6 +510,23 @@ void CheckExampleLabel(const std::string& dir, const std::string& name, uint64_t
                                values.second.dump() + " (the example was made with other settings: resume with "
                                "theirs, or use another --out)");
   }
+  // θ and ζ as drawn for this simulation and view (the ranges, cameras and backgrounds), compared
+  // by value: a label holds them as JSON text.
+  nlohmann::json theta = nlohmann::json::array();
+  for (int k = 0; k < sim::kNumParameters; ++k) theta.push_back(s.theta[k]);
+  const std::vector<std::pair<std::string, nlohmann::json>> drawn = {
+      {"theta", theta}, {"zeta", ZetaLabelJson(ViewOf(o, p, s, v))}};
+  for (const auto& [field, expected] : drawn) {
+    if (label.contains(field) && !JsonNear(label[field], expected))
+      throw std::runtime_error(file.string() + ": field '" + field + "' is " + label[field].dump() +
+                               ", this run draws " + expected.dump() +
+                               " (the example was made with other ranges, cameras or backgrounds: resume with "
+                               "theirs, or use another --out)");
+  }
+  if (o.tracks && !o.add_tracks && !fs::exists(fs::path(dir) / name / "tracks.json"))
+    throw std::runtime_error((fs::path(dir) / name).string() +
+                             " has no tracks.json, and this run makes tracks (give the examples theirs with "
+                             "--add-tracks, then resume with --tracks)");
   const auto near = [](const nlohmann::json& v, double expected) {
     return v.is_number() && std::abs(v.get<double>() - expected) <= 1e-9 * std::max(1.0, std::abs(expected));
   };
@@ -482,7 +602,25 @@ int64_t ReindexDataset(const std::string& dir, bool contact_sheet, const std::fu
   if (kind != nlohmann::json("flag") && kind != nlohmann::json("cloth"))
     throw std::runtime_error(dir + "/index.json: field 'kind' is " + kind.dump() +
                              ", expected \"flag\" or \"cloth\" (only simulated datasets are re-indexed)");
+  const IndexLock lock(dir);
   index = BuildIndex(dir, index, progress);
+  // The header's "tracks" says every example has its tracks.json: not when a merged shard was made
+  // without them (the claim was kept, and training with --aux-tracks failed on the first such).
+  if (index.contains("dataset") && index["dataset"].is_object() && index["dataset"].contains("tracks")) {
+    const nlohmann::json grid = index["dataset"]["tracks"];
+    const TrackGrid tracks{grid.is_array() && grid.size() == 2 && grid[0].is_number_integer() ? grid[0].get<int>() : 0,
+                           grid.is_array() && grid.size() == 2 && grid[1].is_number_integer() ? grid[1].get<int>() : 0};
+    int64_t without = 0;
+    for (const auto& clip : index["clips"])
+      if (!TracksHaveWorld(fs::path(dir) / clip["name"].get<std::string>() / "tracks.json", tracks)) ++without;
+    if (without > 0) {
+      index["dataset"].erase("tracks");
+      std::fprintf(stderr,
+                   "make-dataset --reindex: %lld examples have no tracks.json of the header's grid %s: the header no "
+                   "longer claims tracks (give them theirs with --add-tracks --tracks %dx%d)\n",
+                   static_cast<long long>(without), grid.dump().c_str(), tracks.cols, tracks.rows);
+    }
+  }
   WriteIndex(dir, index);
   if (contact_sheet) WriteContactSheet(dir, index, (fs::path(dir) / "contact_sheet.png").string());
   return static_cast<int64_t>(index["clips"].size());
@@ -531,7 +669,9 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
     return fs::exists(fs::path(o.out) / ExampleName(o.kind, i, v) / file);
   };
   auto view_done = [&](int64_t i, int v) {
-    if (!o.add_tracks) return has(i, v, "label.json");
+    if (!o.add_tracks)
+      return has(i, v, "label.json") &&
+             FramesPresent(fs::path(o.out) / ExampleName(o.kind, i, v), o.frames, o.frame_ext);
     return !has(i, v, "label.json") ||
            TracksHaveWorld(fs::path(o.out) / ExampleName(o.kind, i, v) / "tracks.json", *o.tracks);
   };
@@ -543,7 +683,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
     bool complete = true;
     for (int v = 0; v < o.views && complete; ++v) complete = view_done(i, v);
     for (int v = 0; v < o.views; ++v)  // every finished view is this run's, complete simulation or not
-      if (has(i, v, "label.json")) CheckExampleLabel(o.out, ExampleName(o.kind, i, v), SimulationSeed(o.seed, i), o, prep);
+      if (has(i, v, "label.json")) CheckExampleLabel(o.out, i, v, o, prep);
     if (complete) ++summary.skipped;
     else todo.push_back(i);
   }
@@ -566,17 +706,19 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
     int written = 0;
     std::string last, error;
     try {
-      const SimulationSample s = o.kind == render::SceneKind::kFlag
-                                     ? SampleFlagSimulation(prep.base_theta, o.seed, i, prep.ranges)
-                                     : SampleClothSimulation(prep.fabrics, o.seed, i, prep.ranges);
+      const SimulationSample s = SampleOf(o, prep, i);
       auto t0 = Clock::now();
       const sim::SceneSetup setup = SetupFor(prep, s, o.kind);
+      // The warm-up is the simulator's own (the same steps, wind and gust horizon as simulating
+      // it as frames, so the same frames): kept as frames, --warmup 3600 --fps 1000 held 3.6
+      // million of them, some 18 GB a job, only to drop them.
       sim::SimulateOptions so;
-      so.duration = (first_frame + o.frames - 1) * frame_time;
+      so.warmup = first_frame * frame_time;
+      so.duration = (o.frames - 1) * frame_time;
       so.seed = s.seed;
       const sim::Trajectory traj = sim::SimulateTrajectory(setup, s.theta, so);
       CheckFinite(traj);
-      const ClothAnimation anim = AnimationFromTrajectory(traj, first_frame, o.frames);
+      const ClothAnimation anim = AnimationFromTrajectory(traj, 0, o.frames);
       sim_s += Seconds(t0);
       ClipInfo info;
       info.dataset = render::SceneKindName(o.kind);
@@ -596,10 +738,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
         const std::string name = ExampleName(o.kind, i, v);
         if (view_done(i, v)) continue;
         t0 = Clock::now();
-        render::RenderParams zeta = SampleView(o.kind, s.seed, v, o.views, o.background_images, prep.ranges.camera);
-        if (o.samples > 0) zeta.samples = o.samples;
-        zeta.width = zeta.height = o.size;
-        zeta.fps = o.fps;
+        const render::RenderParams zeta = ViewOf(o, prep, s, v);
         render::RenderOptions ro;
         ro.threads = 1;  // parallel over simulations instead
         render::Renderer renderer(zeta, ro);
@@ -656,6 +795,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   std::sort(summary.errors.begin(), summary.errors.end());
 
   // Every run rebuilds the index from the folders present: shards and resumed runs converge.
+  const IndexLock lock(o.out);
   nlohmann::json index = BuildIndex(o.out, IndexHeader(o, settings), index_progress);
   if (o.add_tracks) {
     // The header's "tracks" says every example has its tracks.json: not while a replay failed or

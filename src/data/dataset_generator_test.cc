@@ -1,9 +1,13 @@
 #include "data/dataset_generator.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <map>
 #include <sstream>
 
@@ -122,8 +126,12 @@ TEST_F(DatasetGeneratorTest, IndexAndLabelsRoundTrip) {
     EXPECT_FALSE(fs::exists(Ref() / name / "006.jpg"));
   }
   EXPECT_TRUE(fs::exists(Ref() / "contact_sheet.png"));
-  // No temporary folder is left behind.
-  for (const auto& e : fs::directory_iterator(Ref())) EXPECT_NE(e.path().filename().string()[0], '.');
+  // No temporary folder is left behind (the index's lock file stays: removing it would race a
+  // shard about to lock it).
+  for (const auto& e : fs::directory_iterator(Ref())) {
+    if (e.path().filename() == ".index.lock") continue;
+    EXPECT_NE(e.path().filename().string()[0], '.') << e.path();
+  }
 }
 
 TEST_F(DatasetGeneratorTest, DeterministicBySeed) {
@@ -144,7 +152,8 @@ TEST_F(DatasetGeneratorTest, ResumesAfterAKillWithoutRedoingFinishedExamples) {
   // The state a kill leaves: example 1 was being written (a temporary folder with a partial
   // frame, no folder under its name); 0 and 2 were finished long ago.
   fs::remove_all(dir / "flag-000001-v0");
-  const fs::path stale = dir / ".flag-000001-v0.tmp-999999-7";
+  // A pid above any pid_max (at most 2^22): 999999 can be a live process on a host of 4 million.
+  const fs::path stale = dir / ".flag-000001-v0.tmp-999999999-7";
   fs::create_directories(stale);
   std::ofstream(stale / "000.jpg") << "partial";
   const auto old_time = fs::file_time_type::clock::now() - std::chrono::hours(1);
@@ -302,6 +311,45 @@ TEST_F(DatasetGeneratorTest, AResumeWithoutAnIndexChecksTheExamplesItFinds) {
   o.max_edge = 0.5;  // another mesh
   error = GenerateError(o);
   EXPECT_NE(error.find("field 'simulation_settings.vertices'"), std::string::npos) << error;
+  // What was drawn for each example, and how many views and which split, were not compared: the
+  // copies were counted complete under a header that claimed this run's settings.
+  o = Tiny(dir.string());
+  o.views = 2;  // over a copy of one view
+  error = GenerateError(o);
+  EXPECT_NE(error.find("field 'views' is 1, this run makes 2"), std::string::npos) << error;
+  o = Tiny(dir.string());
+  SamplingRanges narrow = DefaultRanges(render::SceneKind::kFlag);
+  narrow.wind_max = 5;  // over 0-10 m/s
+  o.ranges = narrow;
+  error = GenerateError(o);
+  EXPECT_NE(error.find("field 'theta' is"), std::string::npos) << error;
+  o = Tiny(dir.string());
+  SamplingRanges high = DefaultRanges(render::SceneKind::kFlag);
+  high.camera.height_min = 5.1, high.camera.height_max = 6.1;  // other cameras
+  o.ranges = high;
+  error = GenerateError(o);
+  EXPECT_NE(error.find("field 'zeta' is"), std::string::npos) << error;
+  o = Tiny(dir.string());
+  o.val_fraction = 0, o.test_fraction = 1;  // every simulation in test: one of them was not
+  error = GenerateError(o);
+  EXPECT_NE(error.find("field 'split' is \"train\", this run makes \"test\""), std::string::npos) << error;
+  o = Tiny(dir.string());
+  o.tracks = TrackGrid{4, 3};
+  error = GenerateError(o);
+  EXPECT_NE(error.find("flag-000000-v0 has no tracks.json, and this run makes tracks"), std::string::npos) << error;
+  {  // another generator's frames
+    const fs::path file = dir / "flag-000001-v0" / "label.json";
+    const std::string bytes = Bytes(file);
+    nlohmann::json label = nlohmann::json::parse(bytes);
+    label["generator"]["version"] = kGeneratorVersion - 1;
+    std::ofstream(file) << label.dump(2) << "\n";
+    error = GenerateError(Tiny(dir.string()));
+    EXPECT_NE(error.find("field 'generator.version' is " + std::to_string(kGeneratorVersion - 1) +
+                         ", this run makes " + std::to_string(kGeneratorVersion)),
+              std::string::npos)
+        << error;
+    std::ofstream(file, std::ios::binary) << bytes;
+  }
   EXPECT_FALSE(fs::exists(dir / "index.json"));  // the refused runs wrote no header of theirs
   // The same settings resume it, with nothing to do, and the index is the reference's again.
   const DatasetSummary s = GenerateDataset(Tiny(dir.string()));
@@ -378,7 +426,7 @@ TEST_F(DatasetGeneratorTest, ALiveRunsTemporaryFolderIsLeftAlone) {
   const fs::path dir = root_ / "live-temporary";
   fs::copy(Ref(), dir, fs::copy_options::recursive);
   const fs::path live = dir / (".flag-000001-v0.tmp-" + std::to_string(::getpid()) + "-3");
-  const fs::path stopped = dir / ".flag-000001-v0.tmp-999999-3";
+  const fs::path stopped = dir / ".flag-000001-v0.tmp-999999999-3";
   for (const auto& t : {live, stopped}) {
     fs::create_directories(t);
     std::ofstream(t / "000.jpg") << "partial";
@@ -396,9 +444,12 @@ TEST_F(DatasetGeneratorTest, AnExampleFolderWithoutItsLabelIsMadeAgain) {
   fs::copy(Ref(), dir, fs::copy_options::recursive);
   fs::remove(dir / "flag-000001-v0" / "label.json");
   fs::remove(dir / "flag-000001-v0" / "005.jpg");
+  // A copy that went in the folder's hashed order: the label came, a frame did not. It was counted
+  // complete and indexed.
+  fs::remove(dir / "flag-000002-v0" / "003.jpg");
   const DatasetSummary s = GenerateDataset(Tiny(dir.string()));
   ASSERT_TRUE(s.errors.empty()) << s.errors[0];
-  EXPECT_EQ(s.examples_written, 1);
+  EXPECT_EQ(s.examples_written, 2);
   EXPECT_EQ(Files(dir), Files(Ref()));
 }
 
@@ -529,6 +580,56 @@ TEST_F(DatasetGeneratorTest, AStoppedRunLeavesAnIndexThatReindexCompletes) {
   EXPECT_EQ(Files(dir), Files(Ref()));
 }
 
+// A merge indexes other machines' shards under this folder's header: one made with other settings
+// is refused naming its label and the field, and a header claiming tracks the examples lack stops
+// claiming them (training with --aux-tracks failed on the first without).
+TEST_F(DatasetGeneratorTest, ReindexRefusesAShardOfOtherSettingsAndClaimsOnlyTracksThatAreThere) {
+  const fs::path dir = root_ / "merge-other";
+  fs::copy(Ref(), dir, fs::copy_options::recursive);
+  const fs::path file = dir / "flag-000002-v0" / "label.json";
+  const std::string bytes = Bytes(file);
+  for (const auto& [field, value] : std::vector<std::pair<std::string, nlohmann::json>>{
+           {"dataset_seed", 2}, {"width", 32}, {"num_frames", 5}, {"split", "elsewhere"}}) {
+    nlohmann::json label = nlohmann::json::parse(bytes);
+    label[field] = value;
+    std::ofstream(file) << label.dump(2) << "\n";
+    try {
+      ReindexDataset(dir.string(), false);
+      ADD_FAILURE() << field << " " << value << " was indexed";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(file.string() + ": field '" + field + "' is " + value.dump()),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  std::ofstream(file, std::ios::binary) << bytes;
+  nlohmann::json index = ReadIndex(dir.string());
+  index["dataset"]["tracks"] = {4, 3};
+  std::ofstream(dir / "index.json") << index.dump(2) << "\n";
+  EXPECT_EQ(ReindexDataset(dir.string(), false), 3);
+  EXPECT_FALSE(ReadIndex(dir.string())["dataset"].contains("tracks"));
+}
+
+// Two shards into one folder rebuilt its index at once: the index is rebuilt and written under an
+// exclusive lock, and a run waits for another's to finish. A hidden folder whose number has more
+// digits than an int64 (no name of ours) stopped the run with a bare "stoll".
+TEST_F(DatasetGeneratorTest, TheIndexIsRebuiltUnderALock) {
+  const fs::path dir = root_ / "locked";
+  fs::copy(Ref(), dir, fs::copy_options::recursive);
+  fs::create_directories(dir / ".flag-99999999999999999999-v0.tmp-x");
+  const int fd = ::open((dir / ".index.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+  auto reindex = std::async(std::launch::async, [&] { return ReindexDataset(dir.string(), false); });
+  auto generate = std::async(std::launch::async, [&] { return GenerateDataset(Tiny(dir.string())); });
+  EXPECT_EQ(reindex.wait_for(std::chrono::milliseconds(500)), std::future_status::timeout);
+  EXPECT_EQ(generate.wait_for(std::chrono::milliseconds(10)), std::future_status::timeout);
+  ::close(fd);
+  EXPECT_EQ(reindex.get(), 3);
+  EXPECT_EQ(generate.get().examples_in_index, 3);
+  EXPECT_TRUE(fs::exists(dir / ".flag-99999999999999999999-v0.tmp-x"));
+}
+
 // PGM frames are the grey of the colour frames, exactly: one channel, the weights of
 // cv::IMREAD_GRAYSCALE, nothing lost (PNG as the lossless colour reference).
 TEST_F(DatasetGeneratorTest, PgmFramesHoldTheGreyOfTheColourFrames) {
@@ -602,6 +703,12 @@ TEST_F(DatasetGeneratorTest, AddTracksGivesADatasetTheTracksItWouldHaveBeenMadeW
   nlohmann::json older_index = ReadIndex(older.string());
   older_index["dataset"]["generator_version"] = kGeneratorVersion - 1;
   std::ofstream(older / "index.json") << older_index.dump(2) << "\n";
+  for (const auto& clip : older_index["clips"]) {  // its labels say so too
+    const fs::path file = older / clip["name"].get<std::string>() / "label.json";
+    nlohmann::json label = ReadLabel(file.string());
+    label["generator"]["version"] = kGeneratorVersion - 1;
+    std::ofstream(file) << label.dump(2) << "\n";
+  }
   DatasetOptions add_older = add;
   add_older.out = older.string();
   const DatasetSummary s_older = GenerateDataset(add_older);

@@ -1,9 +1,11 @@
 #include "data/dataset_index.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <tuple>
 #include <vector>
 
 #include "common/dataset_names.h"
@@ -13,6 +15,15 @@
 namespace clothwind::data {
 
 namespace fs = std::filesystem;
+
+nlohmann::json ZetaLabelJson(const render::RenderParams& zeta) {
+  // The background photo by its file name (as the settings list them): the folder it was read
+  // from differs between machines, and labels are byte-identical on every one.
+  render::RenderParams recorded = zeta;
+  if (!recorded.background_image.empty())
+    recorded.background_image = fs::path(recorded.background_image).filename().string();
+  return render::ToJson(recorded);
+}
 
 nlohmann::json SimExampleLabel(const std::string& name, const SimulationSample& s,
                                const render::RenderParams& zeta, const ClipInfo& info) {
@@ -40,12 +51,7 @@ nlohmann::json SimExampleLabel(const std::string& name, const SimulationSample& 
   j["theta_names"] = names;
   j["theta_units"] = units;
   j["wind_velocity"] = {s.wind_velocity.x(), s.wind_velocity.y(), s.wind_velocity.z()};
-  // The background photo by its file name (as the settings list them): the folder it was read
-  // from differs between machines, and labels are byte-identical on every one.
-  render::RenderParams recorded = zeta;
-  if (!recorded.background_image.empty())
-    recorded.background_image = fs::path(recorded.background_image).filename().string();
-  j["zeta"] = render::ToJson(recorded);
+  j["zeta"] = ZetaLabelJson(zeta);
   j["seed"] = s.seed;
   j["dataset_seed"] = info.dataset_seed;
   j["simulation"] = s.index;
@@ -147,6 +153,50 @@ nlohmann::json IndexEntry(const nlohmann::json& label) {
   return e;
 }
 
+namespace {
+
+// Throws unless `label` (read from `path`) agrees with a make-dataset header's settings block
+// `settings` on what both record: kind, seed, views, frames, size, format, rate, generator
+// version, and the split its seed falls in. A field either lacks (an older generator's) is not
+// compared. Why: a merge copies other machines' shards into the folder, and a shard run with
+// another --seed, --size or binary was indexed under this header without a word.
+void CheckLabelAgainstSettings(const std::string& path, const nlohmann::json& label, const nlohmann::json& settings) {
+  const auto field = [](const nlohmann::json& j, const char* key) {
+    return j.is_object() && j.contains(key) ? j[key] : nlohmann::json();
+  };
+  const auto refuse = [&](const std::string& name, const nlohmann::json& got, const nlohmann::json& header) {
+    throw std::runtime_error(path + ": field '" + name + "' is " + got.dump() + ", the dataset's header says " +
+                             header.dump() + " (an example made with other settings: remove it, or index it in "
+                             "a folder of its own)");
+  };
+  const nlohmann::json format = field(settings, "frame_format");
+  const std::vector<std::tuple<std::string, nlohmann::json, nlohmann::json>> pairs = {
+      {"dataset", field(label, "dataset"), field(settings, "kind")},
+      {"dataset_seed", field(label, "dataset_seed"), field(settings, "seed")},
+      {"views", field(label, "views"), field(settings, "views")},
+      {"num_frames", field(label, "num_frames"), field(settings, "frames")},
+      {"width", field(label, "width"), field(settings, "size")},
+      {"height", field(label, "height"), field(settings, "size")},
+      {"frame_pattern", field(label, "frame_pattern"),
+       format.is_string() ? nlohmann::json("%03d." + format.get<std::string>()) : nlohmann::json()},
+      {"generator.version", field(field(label, "generator"), "version"), field(settings, "generator_version")},
+  };
+  for (const auto& [name, got, header] : pairs)
+    if (!got.is_null() && !header.is_null() && got != header) refuse(name, got, header);
+  const nlohmann::json rate = field(label, "frame_rate"), fps = field(settings, "fps");
+  if (rate.is_number() && fps.is_number() &&
+      std::abs(rate.get<double>() - fps.get<double>()) > 1e-9 * std::max(1.0, std::abs(fps.get<double>())))
+    refuse("frame_rate", rate, fps);
+  const nlohmann::json seed = field(label, "seed"), split = field(label, "split");
+  const nlohmann::json val = field(settings, "val_fraction"), test = field(settings, "test_fraction");
+  if (seed.is_number_unsigned() && split.is_string() && val.is_number() && test.is_number()) {
+    const std::string expected = SplitOf(seed.get<uint64_t>(), val.get<double>(), test.get<double>());
+    if (split != expected) refuse("split", split, expected + " (its seed's, at val " + val.dump() + ", test " + test.dump() + ")");
+  }
+}
+
+}  // namespace
+
 nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
                           const std::function<void(int, int)>& progress) {
   std::vector<std::string> names;
@@ -160,6 +210,7 @@ nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
   for (const auto& name : names) {
     const std::string path = (fs::path(dir) / name / "label.json").string();
     const nlohmann::json label = ReadLabel(path);
+    if (header.is_object() && header.contains("dataset")) CheckLabelAgainstSettings(path, label, header["dataset"]);
     if (label["name"] != name)
       throw std::runtime_error(path + ": field 'name' is " + label["name"].dump() +
                                ", expected the folder's name \"" + name + "\"");

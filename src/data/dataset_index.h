@@ -36,6 +36,10 @@ struct ClipInfo {
   double warmup = 0.0;         // simulated before frame 0 [s]
 };
 
+// The label's "zeta": render::ToJson of `zeta` with its background photo named by file name
+// alone (the folder differs between machines; labels are byte-identical on every one).
+nlohmann::json ZetaLabelJson(const render::RenderParams& zeta);
+
 // label.json of a simulated example (every field docs/dataset.md lists: name, kind "sim",
 // num_frames, frame_rate, width, height, encoding "rgb8", frame_pattern, wind_speed = θ_e,
 // theta + theta_names + theta_units, wind_velocity, zeta, seed, generator, split; plus dataset,
@@ -60,7 +64,9 @@ nlohmann::json IndexEntry(const nlohmann::json& label);
 // Rebuilds index.json of `dir` from the example folders present (every non-hidden subfolder
 // with a label.json), sorted by name, so that any set of runs (shards, resumed runs) that left
 // the same folders gives the same index. `header` supplies the top-level fields (format,
-// version, kind, generator, dataset settings); "clips" is filled in.
+// version, kind, generator, dataset settings); "clips" is filled in. A label that contradicts the
+// header's settings (kind, seed, views, frames, size, format, rate, generator version, the split
+// of its seed) is refused naming it and the field: a shard made elsewhere with other settings.
 // `progress`, when set, is called with (labels read, labels found) after each label (a dataset of
 // 20,000 examples takes tens of seconds).
 // Throws std::runtime_error naming a label.json that cannot be read.
