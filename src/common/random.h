@@ -43,8 +43,10 @@ class Rng {
   uint64_t state_;
 };
 
-// Mixes up to four integers into one seed: pixel samples are drawn from Rng(HashSeed(seed, x, y,
-// frame)) so an image does not depend on how rows are shared among threads.
+// Mixes up to four integers into one seed: the renderer draws a pixel's samples from
+// Rng(HashSeed(seed, x, y)) (render/renderer.cc, PixelSampleAt: the same pattern every frame, so
+// a still cloth renders the same) so an image does not depend on how rows are shared among
+// threads.
 inline uint64_t HashSeed(uint64_t a, uint64_t b = 0, uint64_t c = 0, uint64_t d = 0) {
   uint64_t h = a * 0x9e3779b97f4a7c15ULL;
   for (uint64_t x : {b, c, d}) {
