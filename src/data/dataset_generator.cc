@@ -656,8 +656,17 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   // Left-overs of a killed run of this shard: its temporary folders whose process has stopped
   // (other shards' may be in use on other machines, and a run of another split into this folder
   // may be writing this shard's: its folders were removed under it and its rename failed).
+  // And the index's and contact sheet's temporaries of any run that stopped while writing them
+  // (they were never cleared: each killed run left one more).
   for (const auto& e : fs::directory_iterator(o.out)) {
     const std::string name = e.path().filename().string();
+    size_t at = 0;
+    if (IsTemporaryOfStoppedProcess(name, &at) &&
+        (name.substr(0, at) == "index.json" || name.substr(0, at) == "contact_sheet.png")) {
+      std::error_code ec;
+      fs::remove(e.path(), ec);
+      continue;
+    }
     if (name.empty() || name[0] != '.' || name.find(".tmp-") == std::string::npos) continue;
     const int64_t i = IndexOfName(name, o.kind);
     if (i >= 0 && i % o.shards == o.shard && IsTemporaryOfStoppedProcess(name)) fs::remove_all(e.path());

@@ -156,6 +156,9 @@ TEST_F(DatasetGeneratorTest, ResumesAfterAKillWithoutRedoingFinishedExamples) {
   const fs::path stale = dir / ".flag-000001-v0.tmp-999999999-7";
   fs::create_directories(stale);
   std::ofstream(stale / "000.jpg") << "partial";
+  // And what a kill while the index or the contact sheet was written leaves (never cleared).
+  std::ofstream(dir / "index.json.tmp-999999999-4") << "{";
+  std::ofstream(dir / "contact_sheet.png.tmp-999999999-5") << "PNG";
   const auto old_time = fs::file_time_type::clock::now() - std::chrono::hours(1);
   for (const char* name : {"flag-000000-v0", "flag-000002-v0"}) {
     fs::last_write_time(dir / name / "label.json", old_time);
