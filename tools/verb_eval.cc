@@ -40,7 +40,8 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--threads", a->threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--batch", a->batch, "clips per forward pass")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--windows", a->windows,
-                  "average this many evenly spaced frame windows per clip (1: the centred one, Table 1)")
+                  "average this many evenly spaced frame windows per clip (1: the centred one, Table 1; a clip "
+                  "with fewer distinct ones is read at each once, and the table and JSON say so)")
       ->check(CLI::Range(1, 1000))  // a huge count hung (windows rebuilt per window)
       ->capture_default_str();
   sub->add_flag("--mirror", a->mirror,
@@ -72,7 +73,8 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
                   "--frames 1 network: the window-mean positions a per-frame tracker gives a 30-frame window)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  sub->add_option("--device", a->device, "cpu, cuda or auto")
+  sub->add_option("--device", a->device,
+                  "cpu, cuda or auto (CUDA when there is one; there in full float32, TF32 off, as on the CPU)")
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
       ->capture_default_str();
   return [a]() {

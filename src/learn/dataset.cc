@@ -65,6 +65,28 @@ std::string FrameName(const ClipInfo& clip, int index) {
   return buffer;
 }
 
+// The split of index.json's clips[i] (`entry`), whose label.json (`label`, at label_path) may
+// repeat it: the index's (fixed by seed at generation), else the label's, else "train". Unless
+// split_by_clip (a variant re-split in its index alone), the two must agree.
+// Throws std::runtime_error naming the file and field for a split other than train, val, test.
+std::string ReadClipSplit(const nlohmann::json& entry, const nlohmann::json& label, size_t i,
+                          const fs::path& index_path, const fs::path& label_path, bool split_by_clip) {
+  const std::string split =
+      entry.contains("split")   ? Field<std::string>(entry, "split", index_path, "\"train\", \"val\" or \"test\"")
+      : label.contains("split") ? Field<std::string>(label, "split", label_path, "\"train\", \"val\" or \"test\"")
+                                : std::string("train");
+  if (split != "train" && split != "val" && split != "test") {
+    throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
+                             "].split must be \"train\", \"val\" or \"test\", got \"" + split + "\"");
+  }
+  if (!split_by_clip && entry.contains("split") && label.contains("split") && label["split"] != entry["split"]) {
+    throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) + "].split is " +
+                             entry["split"].dump() + " but " + label_path.string() + " says " +
+                             label["split"].dump());
+  }
+  return split;
+}
+
 }  // namespace
 
 Dataset ReadDataset(const fs::path& dir) {
@@ -116,11 +138,15 @@ Dataset ReadDataset(const fs::path& dir) {
     }
     const fs::path label_path = clip.dir / "label.json";
     const nlohmann::json label = ReadJson(label_path);
+    // Read before an unlabelled clip is left out, so that it is counted in its own split: counted
+    // in none, eval --split test reported the train split's unlabelled clips as left out of it.
+    clip.split = ReadClipSplit(entry, label, i, index_path, label_path, split_by_clip);
     // A recorded clip the anemometer did not label (no reading in its window): one such clip made
     // train and eval refuse a whole field dataset. Left out and counted; in a simulated or toy
     // dataset every clip has its wind, and a null is an error below.
     if (dataset.kind == "real" && label.contains("wind_speed") && label["wind_speed"].is_null()) {
       ++dataset.unlabelled;
+      ++dataset.unlabelled_by_split[clip.split];
       continue;
     }
     clip.wind_speed = Field<double>(label, "wind_speed", label_path, "a number [m/s]");
@@ -165,19 +191,6 @@ Dataset ReadDataset(const fs::path& dir) {
     if (!ValidFramePattern(clip.frame_pattern)) {
       throw std::runtime_error(label_path.string() + ": field \"frame_pattern\" must hold one integer "
                                "conversion like \"%03d.jpg\", got \"" + clip.frame_pattern + "\"");
-    }
-    // The split is the index's (fixed by seed at generation); label.json may repeat it.
-    clip.split = entry.contains("split") ? Field<std::string>(entry, "split", index_path, "\"train\", \"val\" or \"test\"")
-                 : label.contains("split") ? Field<std::string>(label, "split", label_path, "\"train\", \"val\" or \"test\"")
-                                           : std::string("train");
-    if (clip.split != "train" && clip.split != "val" && clip.split != "test") {
-      throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
-                               "].split must be \"train\", \"val\" or \"test\", got \"" + clip.split + "\"");
-    }
-    if (!split_by_clip && entry.contains("split") && label.contains("split") && label["split"] != entry["split"]) {
-      throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) + "].split is " +
-                               entry["split"].dump() + " but " + label_path.string() + " says " +
-                               label["split"].dump());
     }
     // The views of one simulation share its flag's motion: in two splits, a test clip's motion is
     // trained on (the leak docs/sdn.md measures). The generator splits by simulation; a merged or
@@ -224,6 +237,12 @@ void CheckClipsSuitModel(const std::vector<ClipInfo>& clips, double model_rate, 
                                std::to_string(c.frame_rate) + " Hz, the model reads clips at " +
                                std::to_string(model_rate) + " Hz");
   }
+}
+
+size_t UnlabelledIn(const Dataset& dataset, const std::string& split) {
+  if (split == "all") return dataset.unlabelled;
+  const auto it = dataset.unlabelled_by_split.find(split);
+  return it == dataset.unlabelled_by_split.end() ? 0 : it->second;
 }
 
 std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& split) {
@@ -310,9 +329,14 @@ std::vector<int> EvenWindowStarts(int num_frames, int frames, int windows) {
   }
   const int slack = num_frames - frames;
   if (windows == 1) return {slack / 2};
+  // No more windows than there are starts: spaced under a frame apart, rounding repeated starts
+  // ({0, 1, 1} for 3 windows of 30 in 31 frames) and eval weighted the repeated window double.
+  // Spaced a frame or more apart, the rounded starts are distinct and as before.
+  const int count = std::min(windows, slack + 1);
+  if (count == 1) return {0};
   std::vector<int> starts;
-  for (int j = 0; j < windows; ++j) {
-    starts.push_back(static_cast<int>(std::lround(static_cast<double>(j) * slack / (windows - 1))));
+  for (int j = 0; j < count; ++j) {
+    starts.push_back(static_cast<int>(std::lround(static_cast<double>(j) * slack / (count - 1))));
   }
   return starts;
 }

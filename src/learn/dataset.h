@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <random>
 #include <string>
@@ -41,8 +42,10 @@ struct Dataset {
   std::vector<ClipInfo> clips;
   // Recorded clips (kind "real") whose anemometer gave no reading in their label window
   // (wind_speed null: the anemometer started late, a serial dropout): kept on disk for their
-  // video, left out of `clips` (no target to train or score on) and counted here.
+  // video, left out of `clips` (no target to train or score on) and counted here, in all and
+  // by the split index.json (or label.json) gives them ("train", "val", "test").
   size_t unlabelled = 0;
+  std::map<std::string, size_t> unlabelled_by_split;
 };
 
 // Parses a JSON file. Throws std::runtime_error naming the file when it cannot be opened or parsed.
@@ -56,6 +59,10 @@ Dataset ReadDataset(const std::filesystem::path& dir);
 
 // The examples of one split ("train", "val", "test"), or all of them for "all".
 std::vector<ClipInfo> SelectSplit(const Dataset& dataset, const std::string& split);
+
+// The recorded clips without a wind label that SelectSplit(dataset, split) leaves out: those of
+// `split`, or all of them for "all" (0 for a split with none).
+size_t UnlabelledIn(const Dataset& dataset, const std::string& split);
 
 // Throws std::runtime_error naming the first clip's label.json whose frame_rate differs from
 // `model_rate` [Hz] by more than 1 %: the SDN reads frequencies in Hz at its own rate, so a clip
@@ -133,10 +140,13 @@ struct SampleOptions {
 
 // A network input with the augmentation that produced it (for tests and logs).
 struct Sample {
-  // C x frames x input_size x input_size. Channel 0: grey, per-clip zero mean and unit std.
-  // Channels 1, 2 (options.colour): Cr and Cb, each less its per-clip mean, divided by the one
-  // std of all three channels' deviations together (so a flag whose colours share one grey keeps
-  // its colour edges at their strength, and a black-and-white one gets no amplified JPEG noise).
+  // C x frames x input_size x input_size. Channel 0: grey (or Y), less its per-clip mean; a
+  // grey sample is divided by its per-clip std (unit std; at least 1e-3 is divided by).
+  // Colour samples: Y, Cr and Cb (channels 1, 2) each less its own per-clip mean, all three
+  // divided by one std, the root mean of their three variances (at least 1e-3): the three have
+  // unit mean variance, not Y alone (a colourless clip's Y has std √3). So a flag whose colours
+  // share one grey keeps its colour edges at their strength, and a black-and-white one gets no
+  // amplified JPEG noise.
   // Channels 1, 2 (options.flow): flow x (right) and y (down) [input pixels per frame], unnormalised:
   // how far the cloth moves is the measurement, so it keeps its scale.
   std::vector<float> pixels;
@@ -191,7 +201,8 @@ std::vector<cv::Mat> WindowFlows(const std::vector<cv::Mat>& frames);
 // multi-scale position and size when augmenting, the centred square of the shorter side
 // otherwise), resize to input_size (area interpolation), flip horizontally with probability
 // 1/2 when augmenting (not augmenting: once for each of options.mirror_clip, a turn by
-// options.flag_flies and options.mirror), and normalise the whole clip to zero mean and unit standard deviation.
+// options.flag_flies and options.mirror), and normalise the whole clip (Sample::pixels: zero mean, unit
+// std for grey; one joint std for Y Cr Cb).
 // With options.flow, the flow of the resized frames (WindowFlows) follows as channels 1 and 2,
 // flipped with the frames (mirrored, x negated). `flows`, when given, are those T - 1 flows
 // already computed (a cache's): only for frames that are already input_size squares, whose crop
@@ -201,7 +212,9 @@ Sample MakeSample(const std::vector<cv::Mat>& frames, const SampleOptions& optio
 
 // The starts of `windows` evenly spaced frame windows of `frames` frames in a clip of `num_frames`:
 // the first at 0 and the last at num_frames - frames (one window: the centred one, as evaluation
-// takes). Throws std::invalid_argument for windows < 1 or a clip shorter than one window.
+// takes). Distinct and increasing: a clip with fewer than `windows` starts (num_frames - frames + 1)
+// gets each of them once, so its size is min(windows, num_frames - frames + 1) (windows > 1).
+// Throws std::invalid_argument for windows < 1 or a clip shorter than one window.
 std::vector<int> EvenWindowStarts(int num_frames, int frames, int windows);
 
 // Frames first..first+count-1 of a clip, from wherever they are held (LoadFrames: the files).

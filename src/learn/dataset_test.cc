@@ -320,6 +320,21 @@ TEST_F(DatasetTest, ARecordedClipWithoutAWindLabelIsLeftOutAndCounted) {
   EXPECT_EQ(d.unlabelled, 1u);
   EXPECT_EQ(d.clips.size(), index["clips"].size() - 1);
   for (const ClipInfo& c : d.clips) EXPECT_NE(c.name, name);
+  // Counted in its own split, and in that one only (eval --split test said the train split's
+  // unlabelled clips were left out of the test split).
+  const std::string split = index["clips"][3]["split"];
+  for (const char* other : {"train", "val", "test"}) {
+    EXPECT_EQ(UnlabelledIn(d, other), other == split ? 1u : 0u) << other;
+  }
+  EXPECT_EQ(UnlabelledIn(d, "all"), 1u);
+  // An unlabelled clip's split is checked as any other's.
+  EditJson(real / "index.json", [](nlohmann::json& j) { j["clips"][3]["split"] = "holdout"; });
+  try {
+    ReadDataset(real);
+    ADD_FAILURE() << "an unlabelled clip of split \"holdout\" was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("clips[3].split must be"), std::string::npos) << e.what();
+  }
   const fs::path toy = Copy("toy-null");
   EditJson(toy / name / "label.json", [](nlohmann::json& j) { j["wind_speed"] = nullptr; });
   try {
@@ -475,7 +490,13 @@ TEST_F(DatasetTest, ExplicitWindowStartsAreEvenlySpacedAndRespected) {
   EXPECT_EQ(EvenWindowStarts(60, 30, 2), (std::vector<int>{0, 30}));
   EXPECT_EQ(EvenWindowStarts(60, 30, 3), (std::vector<int>{0, 15, 30}));
   EXPECT_EQ(EvenWindowStarts(40, 30, 4), (std::vector<int>{0, 3, 7, 10}));
-  EXPECT_EQ(EvenWindowStarts(30, 30, 3), (std::vector<int>{0, 0, 0}));
+  // Fewer starts than windows: each start once ({0, 0, 0} and {0, 1, 1} weighted one window
+  // more than the others in eval's mean).
+  EXPECT_EQ(EvenWindowStarts(30, 30, 3), (std::vector<int>{0}));
+  EXPECT_EQ(EvenWindowStarts(31, 30, 3), (std::vector<int>{0, 1}));
+  EXPECT_EQ(EvenWindowStarts(32, 30, 3), (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(EvenWindowStarts(33, 30, 10), (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(EvenWindowStarts(31, 30, 2), (std::vector<int>{0, 1}));
   EXPECT_THROW(EvenWindowStarts(60, 30, 0), std::invalid_argument);
   EXPECT_THROW(EvenWindowStarts(20, 30, 1), std::invalid_argument);
   // The dataset's clips have 40 frames: a window set at the centred start is the centred window;

@@ -38,8 +38,11 @@ double CalibrationScale(const EvalResult& result) {
 }
 
 double StdCoverage(const EvalResult& result, double multiple) {
-  const size_t n = std::min(result.truth.size(), result.predicted_std.size());
-  if (n == 0) return std::numeric_limits<double>::quiet_NaN();
+  // All three lengths, since all three are read: sized by truth and std alone, a shorter
+  // `predicted` was read past its end.
+  const size_t n = result.truth.size();
+  if (n == 0 || result.predicted.size() != n || result.predicted_std.size() != n)
+    return std::numeric_limits<double>::quiet_NaN();
   size_t within = 0;
   for (size_t i = 0; i < n; ++i) {
     within += std::abs(result.predicted[i] - result.truth[i]) <= multiple * result.predicted_std[i];
@@ -132,6 +135,21 @@ SimulationMetrics ComputeSimulationMetrics(const std::vector<double>& truth, con
   return m;
 }
 
+namespace {
+
+// The distinct starts of `windows` evenly spaced windows of `frames` frames in `clip`
+// (EvenWindowStarts; one: the centred window, as ChooseFirstFrame takes it).
+// Throws std::runtime_error naming the clip when it is shorter than one window.
+std::vector<int> ClipWindowStarts(const ClipInfo& clip, int frames, int windows) {
+  try {
+    return EvenWindowStarts(clip.num_frames, frames, windows);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(clip.name + ": " + e.what());
+  }
+}
+
+}  // namespace
+
 EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::string& split, int threads,
                     const std::string& device, int batch, int windows, bool mirror, bool mirror_clips,
                     FlagFlies flag_flies, const std::function<void(int, int)>& progress,
@@ -143,15 +161,16 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
   const std::vector<ClipInfo> clips = SelectSplit(dataset, split);
   if (clips.empty()) throw std::runtime_error((data / "index.json").string() + ": no examples in split " + split);
   EvalResult r;
-  r.unlabelled = dataset.unlabelled;
+  r.unlabelled = UnlabelledIn(dataset, split);
   r.config = predictor.config();
+  r.device = predictor.device();
   CheckClipsSuitModel(clips, r.config.frame_rate, r.config.colour, r.config.frames);
   r.split = split;
   r.windows = windows;
   r.mirror = mirror;
   r.mirror_clips = mirror_clips;
   r.flag_flies = flag_flies;
-  const int passes = windows * (mirror ? 2 : 1);
+  const int views = mirror ? 2 : 1;  // images read per window: it, and its mirror image
   SampleOptions options = r.config.Sampling();
   options.mirror_clip = mirror_clips;
   options.flag_flies = flag_flies;
@@ -164,39 +183,51 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
       r.fly_judge += " (the judge beside the model was not used: " + predictor.fly_judge_error() + ")";
   }
   batch = std::max(1, batch);
+  r.windows_min = std::numeric_limits<int>::max();
+  r.windows_max = 0;
   for (size_t i = 0; i < clips.size(); i += batch) {
     const size_t end = std::min(clips.size(), i + batch);
+    // Each clip's own starts: a clip with little slack holds fewer distinct windows than asked.
+    std::vector<std::vector<int>> starts;
+    size_t most = 0;
+    for (size_t j = i; j < end; ++j) {
+      starts.push_back(ClipWindowStarts(clips[j], options.frames, windows));
+      most = std::max(most, starts.back().size());
+    }
     std::vector<double> sum(end - i, 0.0), sum_var(end - i, 0.0);
-    for (int pass = 0; pass < passes; ++pass) {
-      const int w = mirror ? pass / 2 : pass;
-      std::vector<Sample> samples;
-      for (size_t j = i; j < end; ++j) {
-        SampleOptions o = options;
-        o.mirror = mirror && pass % 2 == 1;
-        if (windows > 1) {
-          try {
-            o.first_frame = EvenWindowStarts(clips[j].num_frames, options.frames, windows)[w];
-          } catch (const std::invalid_argument& e) {
-            throw std::runtime_error(clips[j].name + ": " + e.what());
+    for (size_t w = 0; w < most; ++w) {
+      for (int view = 0; view < views; ++view) {
+        std::vector<Sample> samples;
+        std::vector<size_t> of;  // the batch's clip each sample shows
+        for (size_t j = i; j < end; ++j) {
+          if (w >= starts[j - i].size()) continue;
+          SampleOptions o = options;
+          o.mirror = view == 1;
+          o.first_frame = starts[j - i][w];
+          samples.push_back(LoadSample(clips[j], o, 0));
+          of.push_back(j - i);
+        }
+        std::vector<const Sample*> pointers;
+        for (const Sample& s : samples) pointers.push_back(&s);
+        const std::vector<Prediction> predictions = predictor.Predict(pointers);
+        if (view == 0) {
+          for (const Sample& sample : samples) {
+            r.turned += sample.turned;
+            r.undecided += sample.undecided;
           }
         }
-        samples.push_back(LoadSample(clips[j], o, 0));
-      }
-      std::vector<const Sample*> pointers;
-      for (const Sample& s : samples) pointers.push_back(&s);
-      const std::vector<Prediction> predictions = predictor.Predict(pointers);
-      if (pass % (mirror ? 2 : 1) == 0) {
-        for (const Sample& sample : samples) {
-          r.turned += sample.turned;
-          r.undecided += sample.undecided;
+        for (size_t k = 0; k < samples.size(); ++k) {
+          sum[of[k]] += predictions[k].raw_speed;  // averaged as the network gave them, then clamped
+          sum_var[of[k]] += predictions[k].speed_std * predictions[k].speed_std;
         }
-      }
-      for (size_t j = 0; j < samples.size(); ++j) {
-        sum[j] += predictions[j].raw_speed;  // averaged as the network gave them, then clamped
-        sum_var[j] += predictions[j].speed_std * predictions[j].speed_std;
       }
     }
     for (size_t j = i; j < end; ++j) {
+      const int used = static_cast<int>(starts[j - i].size());
+      const int passes = used * views;
+      r.windows_min = std::min(r.windows_min, used);
+      r.windows_max = std::max(r.windows_max, used);
+      r.windows_read += used;
       r.names.push_back(clips[j].name);
       r.dirs.push_back(clips[j].dir);
       r.truth.push_back(clips[j].wind_speed);
@@ -235,7 +266,10 @@ nlohmann::json EvalJson(const EvalResult& r) {
   }
   return {{"rmse", r.metrics.rmse},   {"acc05", r.metrics.acc05}, {"count", r.metrics.count},
           {"model", r.config.Name()}, {"arch", r.config.arch},    {"modality", r.config.Modality()},
-          {"split", r.split},         {"windows", r.windows},     {"mirror", r.mirror},
+          {"split", r.split},         {"windows", r.windows},
+          {"windows_used", {{"min", r.windows_min}, {"max", r.windows_max}, {"total", r.windows_read}}},
+          {"device", r.device.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.device)},
+          {"mirror", r.mirror},
           {"mirror_clips", r.mirror_clips}, {"flag_flies", FlagFliesName(r.flag_flies)}, {"turned", r.turned},
           {"undecided", r.undecided},
           {"fly_judge", r.fly_judge.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.fly_judge)},
@@ -250,6 +284,25 @@ nlohmann::json EvalJson(const EvalResult& r) {
                                                   {"clips", r.per_simulation.clips}}}};
 }
 
+namespace {
+
+// EvalTable's words for the windows a result with windows > 1 averaged, e.g. ", mean of 3 frame
+// windows per clip"; the count of each clip's distinct windows when it is not what was asked.
+std::string WindowsUsed(const EvalResult& r) {
+  std::ostringstream s;
+  if (r.windows_min == r.windows && r.windows_max == r.windows) {
+    s << ", mean of " << r.windows << " frame windows per clip";
+  } else {
+    s << ", mean of " << r.windows_min;
+    if (r.windows_max != r.windows_min) s << " to " << r.windows_max;
+    s << " distinct frame window" << (r.windows_max == 1 ? "" : "s") << " per clip, not the " << r.windows
+      << " asked for: " << (r.windows_max == r.windows_min ? "the clips hold no more" : "shorter clips hold fewer");
+  }
+  return s.str();
+}
+
+}  // namespace
+
 std::string EvalTable(const EvalResult& r) {
   std::ostringstream s;
   const std::string model = r.config.arch == "sdn"    ? "SDN"
@@ -262,15 +315,18 @@ std::string EvalTable(const EvalResult& r) {
   s << std::setw(width) << name << std::setw(18) << r.config.Modality()
     << std::setw(10) << std::fixed << std::setprecision(3) << r.metrics.rmse << r.metrics.acc05 << "\n";
   s << "(" << r.metrics.count << " examples, split " << r.split;
+  // Said only off the CPU, where the figures can differ (cuDNN's algorithms): the CPU's table stays
+  // as it was.
+  if (!r.device.empty() && r.device != "cpu") s << ", on " << r.device;
   if (r.unlabelled > 0) s << "; " << r.unlabelled << " recorded clips without a wind label left out";
-  if (r.windows > 1) s << ", mean of " << r.windows << " frame windows per clip";
+  if (r.windows > 1) s << WindowsUsed(r);
   if (r.mirror) s << ", each averaged with its mirror image";
   if (r.mirror_clips) s << ", clips mirrored (flags flying left)";
   if (r.flag_flies == FlagFlies::kLeft) s << ", every clip turned round (--flag-flies left)";
   if (r.flag_flies == FlagFlies::kAuto) {
     s << ", turned round by " << (r.fly_judge.rfind("motion cues", 0) == 0 ? "their motion" + r.fly_judge.substr(11)
                                                                 : "the judge " + r.fly_judge) << ": "
-      << r.turned << " of " << r.metrics.count * r.windows << " windows";
+      << r.turned << " of " << r.windows_read << " windows";
     if (r.undecided > 0) s << ", " << r.undecided << " it could not tell read as filmed";
   }
   s << ")\n";

@@ -69,8 +69,13 @@ struct EvalResult {
   std::vector<std::filesystem::path> dirs;  // each example's folder (frames, label.json)
   std::vector<double> truth, predicted, predicted_std;  // [m/s]
   std::vector<int> simulations;  // each clip's simulation id (ClipInfo::simulation; -1: none)
-  size_t unlabelled = 0;  // recorded clips left out: no wind label (Dataset::unlabelled)
-  int windows = 1;      // frame windows averaged per clip
+  // Recorded clips of this split left out: no wind label (UnlabelledIn; other splits' not counted).
+  size_t unlabelled = 0;
+  std::string device;   // where the network ran: "cpu" or "cuda" (Predictor::device; "" unset)
+  int windows = 1;      // frame windows asked for per clip (eval --windows; the protocol's)
+  // The distinct windows each clip was read at, fewest and most over the clips, and their sum:
+  // fewer than `windows` for a clip with less than windows - 1 frames of slack (EvenWindowStarts).
+  int windows_min = 1, windows_max = 1, windows_read = 0;
   bool mirror = false;  // each window averaged with its mirror image
   bool mirror_clips = false;  // every clip mirrored first, as if its flag flew left
   FlagFlies flag_flies = FlagFlies::kRight;  // how each clip was turned before the model read it
@@ -88,9 +93,10 @@ struct EvalResult {
 // preprocessing (centred frame window, centred square crop, no flip).
 // Inputs: threads  torch threads; device  cpu|cuda|auto; batch  clips per forward pass;
 //         windows  frame windows per clip (EvenWindowStarts; 1: the centred one, Table 1's
-//                  protocol): the clip's prediction is their mean speed and its std the root mean
-//                  of their variances (not divided by the count: the windows show one flag, so
-//                  their errors are not independent);
+//                  protocol; a clip with too little slack for that many distinct ones is read at
+//                  those it has, each once: EvalResult::windows_min): the clip's prediction is
+//                  their mean speed and its std the root mean of their variances (not divided by
+//                  the count: the windows show one flag, so their errors are not independent);
 //         mirror   also predict each window's mirror image (horizontal flip, as training's
 //                  augmentation: a flag seen from the other side) and average the two the same way;
 //         mirror_clips  mirror every clip before anything else (SampleOptions::mirror_clip): FlagSim's
@@ -109,13 +115,16 @@ EvalResult Evaluate(const std::filesystem::path& model, const std::filesystem::p
 // {"rmse", "acc05", "bias", "count"} of one group of examples; NaN figures (an empty group) as null.
 nlohmann::json MetricsJson(const Metrics& metrics);
 
-// {"rmse": …, "acc05": …, "count": …} plus the model, split, windows, mirror, mirror_clips,
+// {"rmse": …, "acc05": …, "count": …} plus the model, split, windows (asked for), "windows_used"
+// ({"min", "max", "total"}: the distinct windows read per clip, and over all clips), "device"
+// ("cpu" or "cuda"; null unset), mirror, mirror_clips,
 // flag_flies, turned, fly_judge (null unless flag_flies is auto), "bands" (a list of
 // {"lo", "hi", "rmse", "acc05", "bias", "count"}; NaNs of empty bands as null) and
 // "per_simulation" ({"rmse", "scatter", "simulations", "clips"}; null without simulation ids).
 nlohmann::json EvalJson(const EvalResult& result);
 
-// Table 1's layout: header and one row ("Model  Input Modality  RMSE  Acc@0.5"), then one line
+// Table 1's layout: header and one row ("Model  Input Modality  RMSE  Acc@0.5"), a line of how
+// the clips were read (count, split, the device when not the CPU, windows, ...), then one line
 // per non-empty speed band (RMSE, Acc@0.5, bias, count) and one for the per-simulation split.
 std::string EvalTable(const EvalResult& result);
 
@@ -145,7 +154,8 @@ bool PlotPredictions(const EvalResult& result, const std::filesystem::path& png,
 double CalibrationScale(const EvalResult& result);
 
 // Fraction of the examples whose error is at most `multiple` predicted stds (a calibrated
-// Gaussian std gives 0.683 at 1 and 0.954 at 2). Inputs as CalibrationScale; NaN when empty.
+// Gaussian std gives 0.683 at 1 and 0.954 at 2). Inputs as CalibrationScale; NaN when empty or
+// when truth, predicted and predicted_std differ in length (a result without stds).
 double StdCoverage(const EvalResult& result, double multiple);
 
 // One line of the training log per epoch.

@@ -1,16 +1,27 @@
 // Table 1's metrics and their split by true wind speed and by simulation, checked against figures
-// worked out by hand and against the whole-split metrics they must recombine into.
+// worked out by hand and against the whole-split metrics they must recombine into; Evaluate end
+// to end with an untrained network (windows, unlabelled clips, device).
 #include "learn/evaluate.h"
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <unistd.h>
 
+#include <ATen/ATen.h>
 #include <gtest/gtest.h>
+
+#include "learn/dataset.h"
+#include "learn/networks.h"
+#include "learn/predictor.h"
 
 namespace clothwind::learn {
 namespace {
+namespace fs = std::filesystem;
 
 TEST(EvaluateTest, MetricsOfAHandWorkedExample) {
   // Errors +0.2, -0.5, +0.6, -0.9, 0: |e| <= 0.5 for three of five (the bound is inclusive).
@@ -41,6 +52,22 @@ TEST(EvaluateTest, CalibrationScaleMakesErrorsUnitInTheirStd) {
   r.predicted_std[1] = 0;
   EXPECT_THROW(CalibrationScale(r), std::invalid_argument);
   EXPECT_THROW(CalibrationScale(EvalResult{}), std::invalid_argument);
+}
+
+TEST(EvaluateTest, StdCoverageOfListsOfDifferentLengthsIsNaN) {
+  // Sized by truth and std alone, a shorter `predicted` was read past its end (here within its
+  // capacity, so the old code counted garbage rather than crash).
+  EvalResult r;
+  r.truth = {1.0, 5.0, 3.0};
+  r.predicted_std = {1.0, 1.0, 2.0};
+  r.predicted.reserve(3);
+  r.predicted = {1.0};
+  EXPECT_TRUE(std::isnan(StdCoverage(r, 1))) << StdCoverage(r, 1);
+  r.predicted = {1.0, 5.0, 3.0};
+  EXPECT_DOUBLE_EQ(StdCoverage(r, 1), 1.0);
+  r.predicted_std.pop_back();  // a result without (all) stds
+  EXPECT_TRUE(std::isnan(StdCoverage(r, 1)));
+  EXPECT_TRUE(EvalJson(r)["std_within_1"].is_null());
 }
 
 TEST(EvaluateTest, BandsSplitByTrueSpeedAndKeepEmptyBands) {
@@ -200,6 +227,127 @@ TEST(EvaluateTest, JsonAndTableCarryThePerSimulationSplit) {
   r.per_simulation = ComputeSimulationMetrics(r.truth, r.predicted, r.simulations);
   EXPECT_TRUE(EvalJson(r)["per_simulation"].is_null());
   EXPECT_EQ(EvalTable(r).find("per simulation"), std::string::npos);
+}
+
+// A toy dataset of `clips` clips of `frames` frames (kind "real" when `real`) and an untrained
+// TinySdn-like model beside it, in a fresh folder: Evaluate end to end, without training.
+class EvaluateRunTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() / ("clothwind_evaluate_test_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    ToyDatasetOptions o;
+    o.clips = 10;
+    o.frames = 32;
+    o.size = 16;
+    WriteToyDataset(root_ / "data", o);
+    ModelConfig c;
+    c.frames = 30;
+    c.k = 2;
+    c.width = 4;
+    c.input_size = 16;
+    c.label_mean = 5;  // raw speeds well above the clamp at 0, so that averaging them shows
+    c.label_std = 3;
+    at::manual_seed(3);
+    WindNet net(c);
+    net->eval();
+    SaveWindNet(net, root_ / "model.pt");
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  // Edits `file` (JSON) in place.
+  static void EditJson(const fs::path& file, const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json j = nlohmann::json::parse(std::ifstream(file));
+    edit(j);
+    std::ofstream(file) << j.dump(2);
+  }
+  // Sets clip `name`'s label num_frames (its frames beyond stay on disk, unread).
+  void SetFrames(const std::string& name, int frames) {
+    EditJson(root_ / "data" / name / "label.json", [&](nlohmann::json& j) { j["num_frames"] = frames; });
+  }
+  fs::path root_;
+};
+
+TEST_F(EvaluateRunTest, AClipWithFewerDistinctWindowsThanAskedReadsEachOnce) {
+  // 31 frames, 30-frame windows, --windows 3: the starts were {0, 1, 1}, window 1 weighted double
+  // while the table said "mean of 3 frame windows".
+  const std::vector<ClipInfo> test = SelectSplit(ReadDataset(root_ / "data"), "test");
+  ASSERT_GE(test.size(), 2u);
+  SetFrames(test[0].name, 31);
+  const EvalResult r = Evaluate(root_ / "model.pt", root_ / "data", "test", 1, "cpu", 1, 3);
+  ASSERT_EQ(r.names[0], test[0].name);
+  Predictor predictor(root_ / "model.pt", 1, "cpu");
+  SampleOptions o = predictor.config().Sampling();
+  double raw[2], var[2];
+  for (int start : {0, 1}) {
+    o.first_frame = start;
+    const Sample sample = LoadSample(test[0], o, 0);
+    const Prediction p = predictor.Predict({&sample})[0];
+    raw[start] = p.raw_speed;
+    var[start] = p.speed_std * p.speed_std;
+  }
+  // The two windows differ enough that weighting one double shows.
+  ASSERT_GT(std::abs(raw[1] - raw[0]), 1e-4) << raw[0] << " " << raw[1];
+  EXPECT_NEAR(r.predicted[0], ClampSpeed((raw[0] + raw[1]) / 2), 1e-6);
+  EXPECT_NEAR(r.predicted_std[0], std::sqrt((var[0] + var[1]) / 2), 1e-6);
+  // Reported: the other clips (32 frames) hold 3 windows.
+  EXPECT_EQ(r.windows, 3);
+  EXPECT_EQ(r.windows_min, 2);
+  EXPECT_EQ(r.windows_max, 3);
+  EXPECT_EQ(r.windows_read, 2 + 3 * static_cast<int>(test.size() - 1));
+  const nlohmann::json j = EvalJson(r);
+  EXPECT_EQ(j["windows"].get<int>(), 3);
+  EXPECT_EQ(j["windows_used"]["min"].get<int>(), 2);
+  EXPECT_EQ(j["windows_used"]["max"].get<int>(), 3);
+  const std::string table = EvalTable(r);
+  EXPECT_NE(table.find("mean of 2 to 3 distinct frame windows per clip, not the 3 asked for: shorter clips hold fewer"),
+            std::string::npos) << table;
+  // Every clip short: one count, said as such.
+  for (const ClipInfo& c : test) SetFrames(c.name, 31);
+  const EvalResult all = Evaluate(root_ / "model.pt", root_ / "data", "test", 1, "cpu", 4, 3);
+  EXPECT_EQ(all.windows_min, 2);
+  EXPECT_EQ(all.windows_max, 2);
+  EXPECT_NEAR(all.predicted[0], r.predicted[0], 1e-5);
+  EXPECT_NE(EvalTable(all).find("mean of 2 distinct frame windows per clip, not the 3 asked for: the clips hold no more"),
+            std::string::npos) << EvalTable(all);
+  // Clips with room for them all: as before.
+  for (const ClipInfo& c : test) SetFrames(c.name, 32);
+  const EvalResult room = Evaluate(root_ / "model.pt", root_ / "data", "test", 1, "cpu", 4, 3);
+  EXPECT_EQ(room.windows_min, 3);
+  EXPECT_NE(EvalTable(room).find(", mean of 3 frame windows per clip)"), std::string::npos) << EvalTable(room);
+}
+
+TEST_F(EvaluateRunTest, UnlabelledClipsAreReportedForTheirOwnSplitOnly) {
+  // A recorded dataset with unlabelled clips in the train split only: eval --split test said
+  // "2 recorded clips without a wind label left out" of the test split.
+  const Dataset before = ReadDataset(root_ / "data");
+  const std::vector<ClipInfo> train = SelectSplit(before, "train");
+  ASSERT_GE(train.size(), 2u);
+  EditJson(root_ / "data" / "index.json", [](nlohmann::json& j) { j["kind"] = "real"; });
+  for (size_t i = 0; i < 2; ++i)
+    EditJson(root_ / "data" / train[i].name / "label.json", [](nlohmann::json& j) { j["wind_speed"] = nullptr; });
+  const EvalResult test = Evaluate(root_ / "model.pt", root_ / "data", "test", 1, "cpu", 4);
+  EXPECT_EQ(test.unlabelled, 0u);
+  EXPECT_EQ(EvalTable(test).find("without a wind label"), std::string::npos) << EvalTable(test);
+  const EvalResult on_train = Evaluate(root_ / "model.pt", root_ / "data", "train", 1, "cpu", 4);
+  EXPECT_EQ(on_train.unlabelled, 2u);
+  EXPECT_EQ(on_train.metrics.count, static_cast<int>(train.size()) - 2);
+  EXPECT_NE(EvalTable(on_train).find("; 2 recorded clips without a wind label left out"), std::string::npos)
+      << EvalTable(on_train);
+}
+
+TEST_F(EvaluateRunTest, TheDeviceIsRecordedAndTheCpuTableIsAsBefore) {
+  const EvalResult r = Evaluate(root_ / "model.pt", root_ / "data", "test", 1, "cpu", 4);
+  EXPECT_EQ(r.device, "cpu");
+  EXPECT_EQ(EvalJson(r)["device"].get<std::string>(), "cpu");
+  // Only a GPU's figures are said to be one's: the CPU's line reads as it did.
+  const std::string table = EvalTable(r);
+  EXPECT_NE(table.find("(" + std::to_string(r.metrics.count) + " examples, split test)\n"), std::string::npos)
+      << table;
+  EvalResult gpu = r;
+  gpu.device = "cuda";
+  EXPECT_NE(EvalTable(gpu).find("examples, split test, on cuda)"), std::string::npos) << EvalTable(gpu);
+  EXPECT_TRUE(EvalJson(EvalResult{})["device"].is_null());
 }
 
 }  // namespace

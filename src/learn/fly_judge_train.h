@@ -28,7 +28,8 @@ struct MotionMaps {
 //   frames    window length (a model's frames, 30)
 //   windows   evenly spaced windows per clip (EvenWindowStarts; 1: the centred one, as eval reads)
 //   progress  called after each clip with (done, total) (may be empty)
-// Returns clips.size() * windows maps, clip by clip: each window's centred square, as a model
+// Returns clips.size() * windows maps (fewer where a clip holds fewer distinct windows:
+// EvenWindowStarts), clip by clip: each window's centred square, as a model
 // reads it, through MotionMap. Throws as LoadFrames when a frame is missing or unreadable.
 MotionMaps CollectMotionMaps(const std::vector<ClipInfo>& clips, int frames, int windows,
                              const std::function<void(int, int)>& progress = {});

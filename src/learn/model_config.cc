@@ -129,6 +129,32 @@ nlohmann::json ToJson(const ModelConfig& c) {
           {"label_std", c.label_std},    {"std_scale", c.std_scale}};
 }
 
+namespace {
+
+// The WindNet constructor's checks of how many frames, peaks and frame channels an SDN can have,
+// made here where the file is known: a 30-frame model.json with "k": 20 or "frame_channels": 40
+// used to pass and then fail in eval, export-model or sdn_node with the constructor's
+// std::invalid_argument, naming no file (and train's early check of its options missed them).
+// Throws std::runtime_error prefixed with `where`, naming the field and what it may be.
+void CheckSpectralShape(const ModelConfig& c, const std::string& where) {
+  if (c.arch == "sdn" && c.frames < 2) {
+    throw std::runtime_error(where + ": field \"frames\" must be at least 2 on an \"sdn\" (a spectrum needs two "
+                             "frames), got " + std::to_string(c.frames));
+  }
+  if (c.arch == "sdn" && c.k > c.SpectralCandidates()) {
+    throw std::runtime_error(where + ": field \"k\" must be at most the " + std::to_string(c.SpectralCandidates()) +
+                             " frequency bins a DFT of " + std::to_string(c.DftLength()) + " frames offers" +
+                             (c.include_dc ? " with its DC bin" : "") + ", got " + std::to_string(c.k));
+  }
+  if (!c.FrameChannelsAreValid()) {
+    throw std::runtime_error(where + ": field \"frame_channels\" must be 0, or 1 to \"frames\" (" +
+                             std::to_string(c.frames) + ") on an \"sdn\", got " + std::to_string(c.frame_channels) +
+                             " on \"" + c.arch + "\"");
+  }
+}
+
+}  // namespace
+
 ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& where) {
   auto need = [&](const char* key) -> const nlohmann::json& {
     if (!j.is_object() || !j.contains(key)) {
@@ -303,6 +329,7 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     throw std::runtime_error(where + ": field \"dft_size\" must be 0 or at least \"frames\" (" +
                              std::to_string(c.frames) + "), got " + std::to_string(c.dft_size));
   }
+  CheckSpectralShape(c, where);
   return c;
 }
 

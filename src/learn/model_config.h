@@ -158,7 +158,9 @@ bool IsKnownArch(const std::string& arch);
 constexpr int kModelFormatVersion = 1;
 
 // JSON round trip; FromJson throws std::runtime_error naming the missing or invalid field, a
-// field it does not know, or a newer "version" (`where` names the file for the message).
+// field it does not know, or a newer "version" (`where` names the file for the message). Every
+// configuration it returns passes the WindNet constructor's checks (k within the DFT's bins, at
+// least 2 frames on an SDN, FrameChannelsAreValid(), ...).
 nlohmann::json ToJson(const ModelConfig& config);
 ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& where);
 

@@ -314,6 +314,17 @@ void CheckConfigMatchesWeights(const ModelConfig& config, const std::filesystem:
   }
 }
 
+// WindNet(config), its std::invalid_argument rethrown as std::runtime_error naming config_path:
+// ModelConfigFromJson makes the constructor's checks itself, so this only catches one added to
+// the constructor and not there, which would otherwise stop eval or sdn_node naming no file.
+WindNet BuildWindNet(const ModelConfig& config, const std::filesystem::path& config_path) {
+  try {
+    return WindNet(config);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(config_path.string() + ": " + e.what());
+  }
+}
+
 }  // namespace
 
 WindNet LoadWindNet(const std::filesystem::path& weights) {
@@ -328,7 +339,7 @@ WindNet LoadWindNet(const std::filesystem::path& weights) {
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(config_path.string() + ": not valid JSON: " + e.what());
   }
-  WindNet net(ModelConfigFromJson(j, config_path.string()));
+  WindNet net = BuildWindNet(ModelConfigFromJson(j, config_path.string()), config_path);
   std::string stored;
   try {
     LoadModuleWeights(*net, weights, &stored);

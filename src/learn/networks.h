@@ -150,7 +150,8 @@ WindNet WithoutAuxHead(WindNet& net);
 
 // Loads a network saved by SaveWindNet in either precision (config from the JSON beside the
 // weights) as float32, in eval mode on the CPU. Throws std::runtime_error naming the file
-// that is missing or does not match, and the tensor; and naming the JSON and each field in
+// that is missing or does not match, and the tensor; naming the JSON and its field for a
+// network that cannot be built (ModelConfigFromJson; e.g. "k" beyond the DFT's bins); and naming the JSON and each field in
 // which it differs from the configuration saved inside the weights (a model.json edited or
 // swapped: input_size, frames, frame_rate, label scale, ... shape no tensor). Weights saved
 // before the configuration was stored inside them load under their JSON as it is.

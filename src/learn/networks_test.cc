@@ -1,10 +1,14 @@
 // UseChannelsLast: the convolutions' kernels change memory order and nothing else, so a network
 // answers as in torch's default order to float rounding, and so does the Predictor built on it.
+// LoadWindNet: a model.json no network can be built from is refused naming the file and field.
 #include "learn/networks.h"
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <unistd.h>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>
@@ -88,6 +92,29 @@ TEST(UseChannelsLastTest, NetworkAnswersAsInTheDefaultOrder) {
   EXPECT_NEAR(q.raw_speed, c.label_mean + c.label_std * a[2][0].item<double>(), 1e-5 * c.label_std);
   EXPECT_NEAR(p.raw_speed, q.raw_speed, 1e-4 * c.label_std);
   EXPECT_NEAR(p.speed_std, q.speed_std, 1e-4 * q.speed_std);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(LoadWindNetTest, AModelJsonTheNetworkCannotBeBuiltFromIsNamed) {
+  // "k": 20 on 30 frames passed the file's checks and stopped eval, export-model and sdn_node
+  // with the constructor's std::invalid_argument, which named no file.
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("clothwind_networks_load_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const auto& [field, value] : std::vector<std::pair<std::string, int>>{{"k", 20}, {"frame_channels", 40}}) {
+    nlohmann::json j = ToJson(SmallSdn());
+    j[field] = value;
+    std::ofstream(dir / "model.json") << j.dump();
+    try {
+      LoadWindNet(dir / "model.pt");
+      ADD_FAILURE() << field << " " << value << " was loaded";
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find((dir / "model.json").string() + ": field \"" + field + "\""), std::string::npos) << what;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << field << ": not a std::runtime_error naming model.json: " << e.what();
+    }
+  }
   std::filesystem::remove_all(dir);
 }
 

@@ -16,6 +16,20 @@
 
 namespace clothwind::learn {
 
+namespace {
+
+// Turns off TF32 for this process's CUDA convolutions and matrix products. libtorch allows it in
+// cuDNN's convolutions by default, rounding their inputs to 10 mantissa bits (~1e-3 relative), so
+// eval --device auto on a GPU scored another network than the float32 one the CPU runs and the
+// figures were measured with. Estimates cost a little more GPU time; they are worth the same.
+// Process-wide (libtorch has no per-module switch): set only once a Predictor runs on CUDA.
+void UseFullFloat32OnCuda() {
+  at::globalContext().setAllowTF32CuDNN(false);
+  at::globalContext().setAllowTF32CuBLAS(false);
+}
+
+}  // namespace
+
 struct Predictor::Impl {
   WindNet net{nullptr};
   at::Device device = at::kCPU;
@@ -36,6 +50,7 @@ Predictor::Predictor(const std::filesystem::path& weights, int threads, const st
     throw std::runtime_error("device must be cpu, cuda or auto, got \"" + device + "\"");
   }
   impl_->device = (device != "cpu" && torch::cuda::is_available()) ? at::Device(at::kCUDA) : at::Device(at::kCPU);
+  if (impl_->device.is_cuda()) UseFullFloat32OnCuda();
   impl_->net = LoadWindNet(weights);
   impl_->net->to(impl_->device);
   impl_->net->eval();

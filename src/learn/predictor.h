@@ -43,7 +43,8 @@ class Predictor {
   // Inputs:
   //   weights  a model saved by training (model.pt with model.json beside it)
   //   threads  torch intra-op threads (process-wide setting)
-  //   device   "cpu", "cuda" (error when absent) or "auto" (CUDA when libtorch finds one)
+  //   device   "cpu", "cuda" (error when absent) or "auto" (CUDA when libtorch finds one); on
+  //            CUDA, TF32 is turned off process-wide (full float32, as on the CPU)
   //   channels_last  on the CPU, run the convolutions in channels-last order (UseChannelsLast:
   //            ~10 % faster, the same predictions to float rounding); false keeps torch's
   //            default order (bench/sdn_bench --both-orders measures the difference)
@@ -75,8 +76,9 @@ class Predictor {
   // fly_judge_error(). Throws as FlyJudge::Load, leaving the judge before it.
   void LoadFlyJudge(const std::filesystem::path& path);
 
-  // Predictions for prepared samples (each config().frames x input_size² floats, as MakeSample
-  // makes them), in one batch.
+  // Predictions for prepared samples (each config().channels x config().frames x input_size²
+  // floats, as MakeSample makes them), in one batch. Throws std::invalid_argument naming the
+  // sample of another size.
   std::vector<Prediction> Predict(const std::vector<const Sample*>& samples);
 
   // A raw greyscale clip as a node receives it: the last config().frames frames, centred square

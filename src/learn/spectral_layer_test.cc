@@ -523,9 +523,11 @@ TEST(SpectralLayer, CommutesWithCropAndHorizontalFlip) {
   at::Tensor maps = layer(x);
   EXPECT_TRUE(at::equal(layer(x.flip({4})), maps.flip({3})));
   EXPECT_TRUE(at::equal(layer(x.narrow(3, 2, 5).narrow(4, 1, 6)), maps.narrow(2, 2, 5).narrow(3, 1, 6)));
-  // A temporal shift is not a spatial augmentation: it changes the result (sanity check that
-  // the comparisons above can fail).
-  EXPECT_FALSE(at::equal(layer(x.roll({3}, {2})), maps.flip({3})));
+  // Sanity checks that the comparisons above can fail: the flipped clip's maps are not the
+  // unflipped maps, and a temporal shift, not a spatial augmentation, changes them. (Compared
+  // with maps.flip({3}), the shift's check held whatever the layer did with time.)
+  EXPECT_FALSE(at::equal(layer(x.flip({4})), maps));
+  EXPECT_FALSE(at::equal(layer(x.roll({3}, {2})), maps));
 }
 
 TEST(SpectralLayer, RejectsBadShapesAndK) {

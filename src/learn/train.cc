@@ -41,7 +41,7 @@ namespace fs = std::filesystem;
 namespace {
 
 struct Batch {
-  at::Tensor clips;   // [B, 1, N_t, S, S]
+  at::Tensor clips;   // [B, C, N_t, S, S] (C = SampleOptions::channels(): 1 grey, 3 with flow or colour)
   at::Tensor speeds;  // [B] [m/s]
   at::Tensor aux;     // [B, A] standardised track targets (undefined without them)
 };

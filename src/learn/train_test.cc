@@ -771,6 +771,34 @@ TEST(ModelConfig, CountsThatWouldAllocateTerabytesAreRefusedNamingTheFile) {
   }
 }
 
+TEST(ModelConfig, WhatTheNetworkCannotBeBuiltWithIsRefusedNamingTheField) {
+  // Only the WindNet constructor checked these, with a std::invalid_argument naming no file: a
+  // 30-frame model.json with "k": 20 failed in eval, export-model and sdn_node that way.
+  struct Case {
+    std::function<void(ModelConfig&)> edit;
+    std::string field, saying;
+  };
+  const std::vector<Case> cases = {
+      {[](ModelConfig& c) { c.k = 20; }, "k", " must be at most the 15 frequency bins a DFT of 30 frames offers"},
+      {[](ModelConfig& c) { c.k = 17, c.include_dc = true; }, "k", " must be at most the 16 frequency bins"},
+      {[](ModelConfig& c) { c.k = 40, c.dft_size = 64; }, "k", " must be at most the 32 frequency bins a DFT of 64"},
+      {[](ModelConfig& c) { c.frames = 1, c.k = 1; }, "frames", " must be at least 2 on an \"sdn\""},
+      {[](ModelConfig& c) { c.frame_channels = 40; }, "frame_channels", " must be 0, or 1 to \"frames\" (30)"},
+      {[](ModelConfig& c) { c.arch = "resnet18", c.frame_channels = 2; }, "frame_channels", ""}};
+  for (const Case& t : cases) {
+    ModelConfig c = TinySdn();
+    t.edit(c);
+    EXPECT_THROW(WindNet{c}, std::invalid_argument) << t.field;  // what the file check stands in for
+    ExpectFieldRefused(ToJson(c), t.field, t.saying);
+  }
+  // The largest k each DFT allows still reads.
+  ModelConfig widest = TinySdn();
+  widest.k = 15;
+  EXPECT_NO_THROW(ModelConfigFromJson(ToJson(widest), "run/model.json"));
+  widest.frame_channels = 30;
+  EXPECT_NO_THROW(ModelConfigFromJson(ToJson(widest), "run/model.json"));
+}
+
 TEST(ModelConfig, TheSpectralLayersOptionsAreRefusedOnABaseline) {
   // A resnet18 given --mean-map was built without it while its model.json said it had one.
   for (const char* field : {"mean_map", "phase_steps", "include_dc", "dft_size", "local_peaks", "still_floor"}) {
