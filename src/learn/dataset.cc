@@ -604,33 +604,42 @@ std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions
     const fs::path tmp = dir / (std::string(".") + name + ".tmp");
     fs::remove_all(tmp);
     fs::create_directories(tmp);
-    for (int t = 0; t < o.frames; ++t) {
-      cv::Mat frame(o.size, o.size, CV_8UC1);
-      for (int y = 0; y < o.size; ++y) {
-        for (int x = 0; x < o.size; ++x) {
-          double v = 80 + 10 * std::sin(0.3 * x + 0.2 * y);
-          if (x >= x0 && x < x0 + patch && y >= y0 && y < y0 + patch) {
-            v = 140 + 60 * std::sin(2 * M_PI * (f * t / o.frame_rate - (x - x0) / wavelength) + phase);
+    // A failure part way (a full disk) removes its temporary folder (it was left behind). The
+    // frames are not fsync'ed, unlike make-dataset's: a toy dataset is smoke-test data, made again
+    // in seconds, and thousands of fsyncs would slow every test that makes one.
+    try {
+      for (int t = 0; t < o.frames; ++t) {
+        cv::Mat frame(o.size, o.size, CV_8UC1);
+        for (int y = 0; y < o.size; ++y) {
+          for (int x = 0; x < o.size; ++x) {
+            double v = 80 + 10 * std::sin(0.3 * x + 0.2 * y);
+            if (x >= x0 && x < x0 + patch && y >= y0 && y < y0 + patch) {
+              v = 140 + 60 * std::sin(2 * M_PI * (f * t / o.frame_rate - (x - x0) / wavelength) + phase);
+            }
+            frame.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(v + 3.0 * clip_rng.Normal());
           }
-          frame.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(v + 3.0 * clip_rng.Normal());
+        }
+        char file[32];
+        std::snprintf(file, sizeof(file), "%03d.jpg", t);
+        if (!cv::imwrite((tmp / file).string(), frame, {cv::IMWRITE_JPEG_QUALITY, 95})) {
+          throw std::runtime_error((tmp / file).string() + ": cannot write");
         }
       }
-      char file[32];
-      std::snprintf(file, sizeof(file), "%03d.jpg", t);
-      if (!cv::imwrite((tmp / file).string(), frame, {cv::IMWRITE_JPEG_QUALITY, 95})) {
-        throw std::runtime_error((tmp / file).string() + ": cannot write");
-      }
+      nlohmann::json label = {{"format", "clothwind-clip"}, {"version", 1},       {"name", name},
+                              {"kind", "toy"},              {"num_frames", o.frames},
+                              {"frame_rate", o.frame_rate}, {"width", o.size},   {"height", o.size},
+                              {"encoding", "mono8"},        {"frame_pattern", "%03d.jpg"},
+                              {"wind_speed", speed},        {"seed", seed},      {"split", split},
+                              {"generator", {{"name", "learn::WriteToyDataset"}, {"version", 1}}},
+                              {"toy_frequency", f}};
+      WriteFileAtomically(tmp / "label.json", label.dump(2));
+      fs::remove_all(dir / name);
+      fs::rename(tmp, dir / name);
+    } catch (...) {
+      std::error_code ec;
+      fs::remove_all(tmp, ec);
+      throw;
     }
-    nlohmann::json label = {{"format", "clothwind-clip"}, {"version", 1},       {"name", name},
-                            {"kind", "toy"},              {"num_frames", o.frames},
-                            {"frame_rate", o.frame_rate}, {"width", o.size},   {"height", o.size},
-                            {"encoding", "mono8"},        {"frame_pattern", "%03d.jpg"},
-                            {"wind_speed", speed},        {"seed", seed},      {"split", split},
-                            {"generator", {{"name", "learn::WriteToyDataset"}, {"version", 1}}},
-                            {"toy_frequency", f}};
-    WriteFileAtomically(tmp / "label.json", label.dump(2));
-    fs::remove_all(dir / name);
-    fs::rename(tmp, dir / name);
     clips.push_back({{"name", name}, {"wind_speed", speed}, {"split", split}});
     if (progress) progress(i + 1, o.clips);
   }

@@ -13,6 +13,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/scoped_file_size_limit.h"
+
 namespace clothwind::learn {
 namespace {
 namespace fs = std::filesystem;
@@ -567,6 +569,22 @@ std::vector<cv::Mat> FlagFlyingRight(int frames) {
     out.push_back(f);
   }
   return out;
+}
+
+// A toy dataset that cannot be written (a full disk part way) leaves no temporary folder behind
+// (each failed run left one).
+TEST_F(DatasetTest, AToyDatasetThatCannotBeWrittenLeavesNoTemporaryFolder) {
+  const fs::path dir = Copy("toy_full_disk");
+  ToyDatasetOptions o;
+  o.clips = 2;
+  o.frames = 3;
+  o.size = 64;
+  {
+    const ScopedFileSizeLimit full(200);  // a 64-px frame takes some kilobytes
+    EXPECT_ANY_THROW(WriteToyDataset(dir, o));
+  }
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }
 
 // A smaller toy dataset over a larger one: the old index and the examples beyond the new count
