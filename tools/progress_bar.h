@@ -31,7 +31,9 @@ class ProgressBar {
   ProgressBar& operator=(const ProgressBar&) = delete;
 
   // Reports that `done` of `total` units are finished; `note` is appended (e.g. the last
-  // item's name). The first report of done >= total prints at once; later ones (work after the
+  // item's name). Rate and time left are measured from the first report: report (0, total) when
+  // the work starts if setup comes before it or units finish in batches (--jobs 16 finishing 16
+  // simulations at once). The first report of done >= total prints at once; later ones (work after the
   // last unit, e.g. training's validation, reported as steps/steps with a note) are throttled like
   // the rest, at plain_interval even on a terminal, whose line the first one ended. Returns true,
   // so it can serve as a keep-going callback.

@@ -78,6 +78,7 @@ cv::Mat MakeContactSheet(const std::string& dir, const nlohmann::json& index,
   const int cols = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
   const int rows = (n + cols - 1) / cols;
   cv::Mat sheet(rows * o.tile, cols * o.tile, CV_8UC3, cv::Scalar(40, 40, 40));
+  if (progress) progress(0, n);
   for (int k = 0; k < n; ++k) {
     const fs::path folder = fs::path(dir) / shown[k].name;
     const nlohmann::json label = ReadLabel((folder / "label.json").string());

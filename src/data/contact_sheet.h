@@ -20,8 +20,8 @@ struct ContactSheetOptions {
 // Inputs:
 //   dir    dataset folder
 //   index  its index.json (BuildIndex/ReadIndex)
-//   progress  called with (tiles read, tiles shown) after each tile (10,000 frames of a slow
-//             disk take minutes)
+//   progress  called with (0, tiles shown) before the first tile and (tiles read, tiles shown)
+//             after each (10,000 frames of a slow disk take minutes)
 // Returns CV_8UC3 BGR; empty when the index has no clips. Throws std::runtime_error naming a
 // frame that cannot be read.
 cv::Mat MakeContactSheet(const std::string& dir, const nlohmann::json& index,

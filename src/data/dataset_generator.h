@@ -76,7 +76,8 @@ struct DatasetOptions {
 // at quality 95, where the clip's frame before (the cloth 40 ms earlier) already differs by 3.
 constexpr double kMaxReplayGreyDifference = 1.5;
 
-// Progress after each simulation (called from worker threads, serialised by the generator).
+// Progress once before the first simulation (done 0: the work starts) and after each (called
+// from worker threads, serialised by the generator).
 struct DatasetProgress {
   int64_t done = 0;       // simulations finished (or failed) in this run
   int64_t total = 0;      // simulations this run has to do (not already complete)

@@ -206,6 +206,8 @@ nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
     if (fs::exists(entry.path() / "label.json")) names.push_back(name);
   }
   std::sort(names.begin(), names.end());
+  // (0, n) first, once the folder is listed: a progress bar paces the labels from there.
+  if (progress && !names.empty()) progress(0, static_cast<int>(names.size()));
   nlohmann::json clips = nlohmann::json::array();
   for (const auto& name : names) {
     const std::string path = (fs::path(dir) / name / "label.json").string();

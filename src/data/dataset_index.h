@@ -67,8 +67,9 @@ nlohmann::json IndexEntry(const nlohmann::json& label);
 // version, kind, generator, dataset settings); "clips" is filled in. A label that contradicts the
 // header's settings (kind, seed, views, frames, size, format, rate, generator version, the split
 // of its seed) is refused naming it and the field: a shard made elsewhere with other settings.
-// `progress`, when set, is called with (labels read, labels found) after each label (a dataset of
-// 20,000 examples takes tens of seconds).
+// `progress`, when set, is called with (0, labels found) once the folder is listed and with
+// (labels read, labels found) after each label (a dataset of 20,000 examples takes tens of
+// seconds).
 // Throws std::runtime_error naming a label.json that cannot be read.
 nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
                           const std::function<void(int, int)>& progress = {});

@@ -584,6 +584,7 @@ std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions
   }
   nlohmann::json clips = nlohmann::json::array();
   std::vector<double> frequencies;
+  if (progress) progress(0, o.clips);
   for (int i = 0; i < o.clips; ++i) {
     const uint64_t seed = o.seed * 1000003ULL + static_cast<uint64_t>(i);
     // common::Rng, not <random>'s distributions (implementation-defined): the toy dataset, and the

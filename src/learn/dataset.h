@@ -248,8 +248,8 @@ struct ToyDatasetOptions {
 // Writes the dataset into `dir` (created; examples are replaced; an earlier index.json and
 // examples beyond `clips` are removed first, so a stopped run leaves no index over a mix of
 // runs, and the new index is written last). Splits: 60% train, 20% val,
-// 20% test, by the example's seed. `progress`, when set, is called with (examples written,
-// examples) after each. Returns the frequency of each example [Hz], in index order.
+// 20% test, by the example's seed. `progress`, when set, is called with (0, examples) first and
+// (examples written, examples) after each. Returns the frequency of each example [Hz], in index order.
 std::vector<double> WriteToyDataset(const std::filesystem::path& dir, const ToyDatasetOptions& options,
                                     const std::function<void(int, int)>& progress = {});
 

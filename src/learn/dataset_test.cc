@@ -598,7 +598,7 @@ TEST_F(DatasetTest, AToyDatasetOverAnotherReplacesItWhole) {
   o.seed = 9;
   std::vector<std::pair<int, int>> reports;
   WriteToyDataset(copy, o, [&](int done, int total) { reports.emplace_back(done, total); });
-  EXPECT_EQ(reports, (std::vector<std::pair<int, int>>{{1, 3}, {2, 3}, {3, 3}}));
+  EXPECT_EQ(reports, (std::vector<std::pair<int, int>>{{0, 3}, {1, 3}, {2, 3}, {3, 3}}));
   const Dataset d = ReadDataset(copy);
   EXPECT_EQ(d.clips.size(), 3u);
   EXPECT_FALSE(fs::exists(copy / "toy-00003"));
