@@ -20,6 +20,7 @@ status=0
 "$bin" render "$work/sim" --out "$work/fr" --count 3 --samples 1 --threads 1 >/dev/null 2>&1
 [ -f "$work/fr/000.jpg" ] && [ -f "$work/fr/002.jpg" ] && [ -f "$work/fr/zeta.json" ] || fail "first run incomplete"
 before="$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")"
+cp "$work/fr/zeta.json" "$work/zeta-3m.json"  # a zeta made for the scene's 3 m x 2 m flag
 
 for bad in "--start nan" "--start inf" "--start -1" "--fps 1e300" "--fps nan" "--frame-time -1" "--samples 100000000"; do
   status=0
@@ -57,4 +58,33 @@ if "$bin" render "$work/flat" --out "$work/flat-out" --count 1 --samples 1 --thr
   fail "a trajectory without texture extent rendered"
 fi
 grep -q "$work/flat/trajectory.cwtraj: texture coordinates" "$work/out.txt" || fail "the error does not name the trajectory: $(cat "$work/out.txt")"
+# A cloth of another size than zeta's (a custom scene: here the flag scaled to 6 m x 4 m) flew
+# beside its 3 m pole with the camera aimed past it, silently. With --seed zeta takes the cloth's
+# size; a --zeta made for a 3 m flag is refused naming mesh_width, before --out is made.
+mkdir "$work/big"
+/usr/bin/python3 - "$work/sim/trajectory.cwtraj" "$work/big/trajectory.cwtraj" <<'PY'
+import struct, sys
+data = bytearray(open(sys.argv[1], 'rb').read())
+nv, nf, frames = struct.unpack_from('<III', data, 12)
+start = 32 + 12 * nf  # uv (material metres), then every frame's positions: all floats, all x2
+for i in range(2 * nv + 3 * nv * frames):
+    (x,) = struct.unpack_from('<f', data, start + 4 * i)
+    struct.pack_into('<f', data, start + 4 * i, 2 * x)
+open(sys.argv[2], 'wb').write(data)
+PY
+"$bin" render "$work/big" --out "$work/big-seed" --count 1 --samples 1 --threads 1 >"$work/out.txt" 2>&1 ||
+  fail "a 6 m flag with --seed did not render: $(cat "$work/out.txt")"
+grep -q "mesh_width" "$work/out.txt" || fail "render did not say it fitted zeta to the cloth: $(cat "$work/out.txt")"
+/usr/bin/python3 - "$work/big-seed/zeta.json" <<'PY' || fail "zeta.json of the 6 m flag: $(cat "$work/big-seed/zeta.json")"
+import json, sys
+z = json.load(open(sys.argv[1]))
+assert abs(z["mesh_width"] - 6) < 0.1 and abs(z["mesh_width"] / z["mesh_aspect_ratio"] - 4) < 0.1, z
+PY
+grep -q '"mesh_width": 3.0' "$work/zeta-3m.json" || fail "the 3 m flag's zeta changed: $(cat "$work/zeta-3m.json")"
+status=0
+"$bin" render "$work/big" --out "$work/big-zeta" --zeta "$work/zeta-3m.json" --count 1 --samples 1 --threads 1 \
+  >"$work/out.txt" 2>&1 || status=$?
+[ "$status" -ne 0 ] && [ "$status" -lt 128 ] || fail "a 3 m zeta rendered a 6 m flag (status $status): $(cat "$work/out.txt")"
+grep -q "mesh_width" "$work/out.txt" || fail "the refusal does not name mesh_width: $(cat "$work/out.txt")"
+[ ! -e "$work/big-zeta" ] || fail "the refused render made its --out"
 echo "render_cli_test: OK"

@@ -90,6 +90,24 @@ data::ClothAnimation LoadInput(const RenderArgs& a, std::string* what) {
   return data::ReadObjSequence(in.string(), a.cloth, a.frame_time);
 }
 
+// The pole, rod and camera aim follow ζ's mesh_width and mesh_aspect_ratio, so a cloth of
+// another size (a custom scene or OBJ) flew beside its pole, the camera aimed past it, silently.
+// A sampled ζ (--seed) takes the size the cloth measures; a given one (--zeta) must fit it.
+// A size within 5 % keeps ζ as it is: frames of the usual meshes stay what they were.
+void FitMeshSize(const data::ClothAnimation& anim, const RenderArgs& a, render::RenderParams* zeta) {
+  const data::ClothFrame first = data::FrameAt(anim, 0.0);
+  const Eigen::Vector2d size = render::MeasureClothSize(first.V, first.F, first.UV);
+  const std::string why = render::MeshSizeMismatch(*zeta, size);
+  if (why.empty()) return;
+  if (!a.zeta.empty())
+    throw std::invalid_argument("--zeta " + a.zeta + ": " + why + " (render it with --seed to fit zeta to it)");
+  zeta->mesh_width = size.x();
+  zeta->mesh_aspect_ratio = size.x() / size.y();
+  std::fprintf(stderr, "render: the cloth measures %.4g x %.4g m; zeta's mesh_width and mesh_aspect_ratio follow it\n",
+               size.x(), size.y());
+  render::ValidateRenderParams(*zeta);
+}
+
 int Run(const RenderArgs& a) {
   render::RenderParams zeta = a.zeta.empty()
                                   ? render::SampleRenderParams(render::SceneKindFromName(a.kind), a.seed)
@@ -105,6 +123,7 @@ int Run(const RenderArgs& a) {
   if (a.format != "jpg" && a.format != "png") throw std::invalid_argument("--format: jpg or png");
   std::string what;
   const data::ClothAnimation anim = LoadInput(a, &what);
+  FitMeshSize(anim, a, &zeta);
   // NaN passed a range check written as (start < 0 || start > duration), and a frame count
   // computed from it or from a huge rate overflowed int: nothing rendered, the earlier run's
   // frames deleted, exit 0.

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <string>
 
 namespace clothwind::render {
 namespace {
@@ -146,6 +148,40 @@ TEST(FrameClip, HangingFlagStaysInTheFrame) {
   FrameClip({V, V * 0.9}, &wide);
   EXPECT_TRUE(all_in_view(wide));
   EXPECT_GT(wide.camera_fov_deg, framed.camera_fov_deg);
+}
+
+// "Never narrows": a field of view past the widening's 120 deg cap stays (it was cut to 120).
+TEST(FrameClip, AWideFieldOfViewStays) {
+  Eigen::MatrixXd flying(4, 3);
+  flying << 0, 0, 0, 0, 0, 2, 3, 0.3, 0.2, 3, -0.3, 1.9;
+  RenderParams p;
+  p.camera_fov_deg = 150.0;
+  FrameClip({flying}, &p);
+  EXPECT_EQ(p.camera_fov_deg, 150.0);
+  // And the widening still stops at 120: a camera 0.2 m from a 3 m flag, level with it, would
+  // need more.
+  RenderParams near;
+  near.camera_radius = 0.2;
+  near.camera_height = near.mesh_height + 1.0;
+  FrameClip({flying}, &near);
+  EXPECT_EQ(near.camera_fov_deg, kFrameClipMaxFovDeg);
+}
+
+TEST(FrameClip, NonFiniteVerticesAreNamed) {
+  Eigen::MatrixXd V(3, 3);
+  V << 0, 0, 0, 0, 0, 2, 3, 0, 1;
+  Eigen::MatrixXd bad = V;
+  bad(2, 1) = std::numeric_limits<double>::quiet_NaN();
+  RenderParams p;
+  try {
+    FrameClip({V, bad}, &p);
+    FAIL() << "a NaN vertex was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("frame 1, vertex 2 has coordinate y = nan"), std::string::npos)
+        << e.what();
+  }
+  bad(2, 1) = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(FrameClip({bad}, &p), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "render/render_params.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -51,8 +52,8 @@ void ValidateCameraRanges(const CameraRanges& r) {
   // Bounded too: a radius of 1e308 m failed every simulation as "viewing direction is vertical".
   check(r.height_min > 0 && r.height_max >= r.height_min && r.height_max <= 100, "camera height", r.height_min,
         r.height_max, "0 < min <= max <= 100 [m]");
-  check(r.radius_min > 0 && r.radius_max >= r.radius_min && r.radius_max <= 1000, "camera radius", r.radius_min,
-        r.radius_max, "0 < min <= max <= 1000 [m]");
+  check(r.radius_min >= kMinCameraRadius && r.radius_max >= r.radius_min && r.radius_max <= 1000, "camera radius",
+        r.radius_min, r.radius_max, "0.1 <= min <= max <= 1000 [m]");
   check(r.angle_max_deg >= 0 && r.angle_max_deg < 90, "camera angle", -r.angle_max_deg, r.angle_max_deg,
         "a half-range in [0, 90) deg");
 }
@@ -140,11 +141,29 @@ nlohmann::json ToJson(const RenderParams& p) {
   return j;
 }
 
+namespace {
+// Refuses a vertex that is not finite: its box made a look-at point of NaN, refused as "viewing
+// direction is vertical", which named neither the frame nor the vertex.
+void CheckFiniteFrame(const Eigen::MatrixXd& V, size_t frame) {
+  if (V.allFinite()) return;
+  for (Eigen::Index i = 0; i < V.rows(); ++i)
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(V(i, k))) {
+        std::ostringstream m;
+        m << "FrameClip: frame " << frame << ", vertex " << i << " has coordinate " << "xyz"[k]
+          << " = " << V(i, k) << ", expected a finite value";
+        throw std::invalid_argument(m.str());
+      }
+}
+}  // namespace
+
 void FrameClip(const std::vector<Eigen::MatrixXd>& frames, RenderParams* p) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-  for (const Eigen::MatrixXd& V : frames) {
+  for (size_t f = 0; f < frames.size(); ++f) {
+    const Eigen::MatrixXd& V = frames[f];
     if (V.cols() != 3 || V.rows() == 0)
       throw std::invalid_argument("FrameClip: every frame must be #V by 3 with #V > 0");
+    CheckFiniteFrame(V, f);
     lo = lo.cwiseMin(V.colwise().minCoeff().transpose());
     hi = hi.cwiseMax(V.colwise().maxCoeff().transpose());
   }
@@ -169,7 +188,54 @@ void FrameClip(const std::vector<Eigen::MatrixXd>& frames, RenderParams* p) {
                      std::abs(d.dot(cam.down)) / z * p->width / static_cast<double>(p->height)});
   }
   const double fov = 2.0 * std::atan(need / 0.95) * 180.0 / M_PI;
-  p->camera_fov_deg = std::min(std::max(p->camera_fov_deg, fov), 120.0);
+  // The widening stops at 120 deg; a field of view already wider stays (the cap applied to it
+  // too narrowed a valid 150 deg to 120).
+  p->camera_fov_deg = std::max(p->camera_fov_deg, std::min(fov, kFrameClipMaxFovDeg));
+}
+
+Eigen::Vector2d MeasureClothSize(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                 const Eigen::MatrixXd& UV) {
+  if (V.cols() != 3 || UV.cols() != 2 || UV.rows() != V.rows() || F.cols() != 3)
+    throw std::invalid_argument("MeasureClothSize: expected V #V by 3, F #F by 3, UV #V by 2");
+  double width = 0.0, height = 0.0, weight = 0.0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
+    if (std::min({a, b, c}) < 0 || std::max({a, b, c}) >= V.rows())
+      throw std::invalid_argument("MeasureClothSize: F(" + std::to_string(f) +
+                                  ", :) is not a face of the " + std::to_string(V.rows()) +
+                                  " vertices");
+    // The affine map of the face from texture to world: [e1 e2] = J [t1 t2], J = [dX/du dX/dv].
+    Eigen::Matrix2d T;
+    T.col(0) = (UV.row(b) - UV.row(a)).transpose();
+    T.col(1) = (UV.row(c) - UV.row(a)).transpose();
+    const double area = 0.5 * std::abs(T.determinant());  // in texture space
+    if (!(area > 0.0)) continue;  // degenerate in texture space: says nothing about the size
+    Eigen::Matrix<double, 3, 2> E;
+    E.col(0) = (V.row(b) - V.row(a)).transpose();
+    E.col(1) = (V.row(c) - V.row(a)).transpose();
+    const Eigen::Matrix<double, 3, 2> J = E * T.inverse();
+    width += area * J.col(0).norm();
+    height += area * J.col(1).norm();
+    weight += area;
+  }
+  if (!(weight > 0.0) || !std::isfinite(width) || !std::isfinite(height))
+    throw std::invalid_argument(
+        "MeasureClothSize: the texture coordinates span no area, so the cloth has no measurable size");
+  return Eigen::Vector2d(width / weight, height / weight);
+}
+
+std::string MeshSizeMismatch(const RenderParams& p, const Eigen::Vector2d& size, double tolerance) {
+  const double w = size.x(), h = size.y();
+  std::ostringstream m;
+  if (!(std::abs(w / p.mesh_width - 1.0) <= tolerance)) {
+    m << "field 'mesh_width' is " << p.mesh_width << " m but the cloth being rendered is " << w
+      << " m long (u, hoist to fly); expected within " << 100 * tolerance << " %";
+  } else if (!(std::abs(h / p.MeshRestHeight() - 1.0) <= tolerance)) {
+    m << "field 'mesh_aspect_ratio' is " << p.mesh_aspect_ratio << " (" << p.MeshRestHeight()
+      << " m tall) but the cloth being rendered is " << w << " m by " << h << " m (aspect "
+      << w / h << "); expected its height within " << 100 * tolerance << " %";
+  }
+  return m.str();
 }
 
 namespace {
@@ -258,7 +324,9 @@ RenderParams RenderParamsFromJson(const nlohmann::json& j) {
 }
 
 void ValidateRenderParams(const RenderParams& p) {
-  Require(p.background_scale > 0, "background_scale", "> 0", p.background_scale);
+  // At least a 0.45 m tall backdrop: a tiny scale became 0 as a float, and its texture
+  // coordinates NaN.
+  Require(p.background_scale >= 0.01, "background_scale", ">= 0.01", p.background_scale);
   Require(p.sun_height > 0, "sun_height", "> 0 (the sun must be above the ground)", p.sun_height);
   Require(p.sun_radius >= 0, "sun_radius", ">= 0", p.sun_radius);
   Require(p.sun_strength >= 0, "sun_strength", ">= 0", p.sun_strength);
@@ -267,7 +335,9 @@ void ValidateRenderParams(const RenderParams& p) {
   Require(p.sky_strength >= 0, "sky_strength", ">= 0", p.sky_strength);
   Require(p.samples >= 1 && p.samples <= 1024, "samples", "in [1, 1024]", p.samples);
   Require(p.camera_height > 0, "camera_height", "> 0", p.camera_height);
-  Require(p.camera_radius > 0, "camera_radius", "> 0", p.camera_radius);
+  // A camera (nearly) above its target looks straight down, and the camera's frame had no
+  // "right": 1e-10 m failed inside the camera without naming the field.
+  Require(p.camera_radius >= kMinCameraRadius, "camera_radius", ">= 0.1 m", p.camera_radius);
   Require(p.camera_fov_deg > 1 && p.camera_fov_deg < 170, "camera_fov_deg", "in (1, 170)",
           p.camera_fov_deg);
   Require(p.mesh_height >= 0, "mesh_height", ">= 0", p.mesh_height);
@@ -288,7 +358,9 @@ void ValidateRenderParams(const RenderParams& p) {
   Require(std::isfinite(p.sun_azimuth_deg), "sun_azimuth_deg", "finite", p.sun_azimuth_deg);
   Require(p.sun_strength <= 1e4, "sun_strength", "<= 1e4", p.sun_strength);
   Require(p.sky_strength <= 1e3, "sky_strength", "<= 1e3", p.sky_strength);
-  Require(p.camera_height <= 1e4, "camera_height", "<= 1e4 m", p.camera_height);
+  // The ground reaches 1e6 m (the renderer's far limit): from higher than 1e3 m a band of sky
+  // showed below the horizon.
+  Require(p.camera_height <= 1e3, "camera_height", "<= 1000 m", p.camera_height);
   Require(p.camera_radius <= 1e4, "camera_radius", "<= 1e4 m", p.camera_radius);
   Require(std::isfinite(p.camera_angle_deg), "camera_angle_deg", "finite", p.camera_angle_deg);
   Require(p.mesh_height <= 1e3, "mesh_height", "<= 1000 m", p.mesh_height);
@@ -297,9 +369,23 @@ void ValidateRenderParams(const RenderParams& p) {
           p.mesh_aspect_ratio);
   if (p.has_look_at)
     for (double c : p.look_at) Require(std::abs(c) <= 1e4, "look_at", "coordinates in [-1e4, 1e4] m", c);
-  const double pixel_samples = static_cast<double>(p.width) * p.height * p.samples;
-  Require(pixel_samples <= (1 << 24), "samples", "at most 2^24 = 16.8M for width x height x samples (the cache "
-          "holds 68 B each)", p.samples);
+  // The static cache holds 68 B per pixel sample: at most 2^24 of them. Named after what is too
+  // big: an 8192x8192 frame is refused under width/height whatever its samples.
+  constexpr double kMaxPixelSamples = 1 << 24;
+  const double pixels = static_cast<double>(p.width) * p.height;
+  if (pixels > kMaxPixelSamples) {
+    std::ostringstream m;
+    m << "render params: fields 'width' x 'height' are " << p.width << " x " << p.height
+      << " = " << pixels << " pixels, expected at most 2^24 = 16.8M (the static cache holds 68 B "
+      << "per pixel sample)";
+    throw std::invalid_argument(m.str());
+  }
+  const double max_samples = std::floor(kMaxPixelSamples / pixels);
+  Require(p.samples <= max_samples, "samples",
+          "at most " + std::to_string(static_cast<int64_t>(max_samples)) + " for a " +
+              std::to_string(p.width) + "x" + std::to_string(p.height) +
+              " frame (width x height x samples at most 2^24 = 16.8M; the cache holds 68 B each)",
+          p.samples);
   if (p.texture_kind == "flag")
     FlagDesignFromName(p.texture_name);
   else if (p.texture_kind == "fabric")

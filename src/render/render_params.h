@@ -90,8 +90,13 @@ struct CameraRanges {
 // Table 2's camera ranges: flag height 0.2-3, radius 4-6, angle ±15; cloth 0.5-2, 1-2.5, ±5.
 CameraRanges TableTwoCameraRanges(SceneKind kind);
 
+// The nearest a camera may stand to its target horizontally [m] (ζ.camera_radius and
+// CameraRanges::radius_min): nearer, it looks (almost) straight up or down.
+constexpr double kMinCameraRadius = 0.1;
+
 // Throws std::invalid_argument naming the field ("camera height", ...) unless
-// 0 < min <= max for height and radius and 0 <= angle_max_deg < 90.
+// 0 < min <= max <= 100 m for height, 0.1 <= min <= max <= 1000 m for radius and
+// 0 <= angle_max_deg < 90.
 void ValidateCameraRanges(const CameraRanges& r);
 
 // Draws ζ from the ranges of seed Table 2 for the given scene kind, the camera from `camera`
@@ -111,14 +116,37 @@ nlohmann::json ToJson(const RenderParams& p);
 RenderParams RenderParamsFromJson(const nlohmann::json& j);
 
 // Aims the camera of a clip at the centre of the cloth's bounding box over all its frames
-// (sets p->look_at), instead of the flag's flying rest centre, and widens camera_fov_deg (never
-// narrows it; at most 120 deg) so that box fits in the frame with a 5 % margin.
+// (sets p->look_at), instead of the flag's flying rest centre, and widens camera_fov_deg so that
+// box fits in the frame with a 5 % margin: to at most kFrameClipMaxFovDeg, and never narrows it
+// (a field of view already wider stays).
 // Inputs: frames  each #V by 3 vertex positions [m] in the simulator's frame (as given to the
-//   renderer; p->mesh_height lifts them). Throws std::invalid_argument if there are none.
+//   renderer; p->mesh_height lifts them). Throws std::invalid_argument if there are none or a
+//   coordinate is not finite (naming the frame and vertex).
+constexpr double kFrameClipMaxFovDeg = 120.0;
 void FrameClip(const std::vector<Eigen::MatrixXd>& frames, RenderParams* p);
 
-// Checks the values are usable (positive sizes, samples >= 1, known texture, ...); throws
-// std::invalid_argument naming the field and the expected range.
+// The size at rest of the cloth a renderer is given, measured from one of its frames: the
+// area-weighted mean over the faces of how many metres one unit of u (and of v) spans. The
+// texture map follows the material, so a folded or flying cloth measures its rest size to within
+// its stretch (a few percent), and no rest state is needed.
+// Inputs: V  #V by 3 positions [m]; F  #F by 3 faces; UV  #V by 2 texture coordinates spanning
+//   [0,1] (u hoist to fly, v bottom to top), as the renderer takes them.
+// Returns (width along u, height along v) [m]. Throws std::invalid_argument on mismatched
+// sizes, bad indices, or texture coordinates that span no area.
+Eigen::Vector2d MeasureClothSize(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                 const Eigen::MatrixXd& UV);
+
+// Why ζ does not fit a cloth of the measured size: the pole, rod and camera aim follow
+// ζ.mesh_width and ζ.mesh_aspect_ratio, so a cloth of another size flew off its pole unseen.
+// Inputs: p; size  (width, height) [m], from MeasureClothSize; tolerance  relative, e.g. 0.05.
+// Returns "" if the width and the rest height (width / aspect) are both within tolerance of
+// ζ's, else a message naming 'mesh_width' or 'mesh_aspect_ratio' with both sizes.
+std::string MeshSizeMismatch(const RenderParams& p, const Eigen::Vector2d& size,
+                             double tolerance = 0.05);
+
+// Checks the values are usable (positive sizes, samples >= 1, known texture, a camera at least
+// kMinCameraRadius from its target and at most 1000 m up, ...); throws std::invalid_argument
+// naming the field and the expected range.
 void ValidateRenderParams(const RenderParams& p);
 
 }  // namespace clothwind::render

@@ -1,10 +1,13 @@
 #include "render/render_params.h"
 
 #include <limits>
+#include <string>
 
 #include <gtest/gtest.h>
 
 #include <set>
+
+#include "render/test_meshes.h"
 
 namespace clothwind::render {
 namespace {
@@ -89,6 +92,99 @@ TEST(RenderParams, EachFieldOutOfRangeIsNamedAlone) {
       EXPECT_NE(what.find(std::string("field '") + field + "' is 20000"), std::string::npos) << field << ": " << what;
     }
   }
+}
+
+std::string FromJsonError(const nlohmann::json& j) {
+  try {
+    RenderParamsFromJson(j);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// Lower bounds that name their field: a background_scale of 1e-50 became 0 as a float (NaN
+// texture coordinates), a camera_radius of 1e-10 failed inside the camera as "viewing direction
+// is vertical", and a camera 2 km up saw sky below the horizon.
+TEST(RenderParams, TinyScaleAndRadiusAndHighCameraAreNamed) {
+  nlohmann::json j = ToJson(SampleRenderParams(SceneKind::kFlag, 1));
+  j["background_scale"] = 1e-50;
+  EXPECT_NE(FromJsonError(j).find("field 'background_scale' is"), std::string::npos) << FromJsonError(j);
+  EXPECT_NE(FromJsonError(j).find(">= 0.01"), std::string::npos) << FromJsonError(j);
+  j = ToJson(SampleRenderParams(SceneKind::kFlag, 1));
+  j["camera_radius"] = 1e-10;
+  EXPECT_NE(FromJsonError(j).find("field 'camera_radius' is"), std::string::npos) << FromJsonError(j);
+  EXPECT_NE(FromJsonError(j).find(">= 0.1 m"), std::string::npos) << FromJsonError(j);
+  j = ToJson(SampleRenderParams(SceneKind::kFlag, 1));
+  j["camera_height"] = 2000.0;
+  EXPECT_NE(FromJsonError(j).find("field 'camera_height' is 2000"), std::string::npos) << FromJsonError(j);
+  // The bounds themselves are usable.
+  j = ToJson(SampleRenderParams(SceneKind::kFlag, 1));
+  j["background_scale"] = 0.01;
+  j["camera_radius"] = kMinCameraRadius;
+  j["camera_height"] = 1000.0;
+  EXPECT_EQ(FromJsonError(j), "no error");
+  CameraRanges r;
+  r.radius_min = 1e-10;
+  EXPECT_THROW(ValidateCameraRanges(r), std::invalid_argument);
+}
+
+// The cache limit is on width x height x samples; a frame too big by itself is named by its size
+// (an 8192x8192 frame with 1 sample was refused as 'samples').
+TEST(RenderParams, TooManyPixelSamplesNameTheRightField) {
+  RenderParams p = SampleRenderParams(SceneKind::kFlag, 1);
+  p.width = p.height = 8192;
+  p.samples = 1;
+  try {
+    ValidateRenderParams(p);
+    FAIL() << "8192x8192 was accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("fields 'width' x 'height' are 8192 x 8192"), std::string::npos) << what;
+    EXPECT_EQ(what.find("'samples'"), std::string::npos) << what;
+  }
+  p.width = p.height = 300;
+  p.samples = 1024;
+  try {
+    ValidateRenderParams(p);
+    FAIL() << "300x300 x 1024 samples was accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("field 'samples' is 1024"), std::string::npos) << what;
+    EXPECT_NE(what.find("expected at most 186 for a 300x300 frame"), std::string::npos) << what;
+  }
+  p.samples = 186;
+  EXPECT_NO_THROW(ValidateRenderParams(p));
+}
+
+// The cloth's rest size from any frame of it, and the ζ fields that disagree with it named.
+TEST(MeshSize, MeasuredFromTheTextureMapAndMismatchesNamed) {
+  const ClothMesh flat = FlatCloth(7, 5, 3.0, 2.0);
+  const Eigen::Vector2d s = MeasureClothSize(flat.V, flat.F, flat.UV);
+  EXPECT_NEAR(s.x(), 3.0, 1e-12);
+  EXPECT_NEAR(s.y(), 2.0, 1e-12);
+  // Flying and folded, the material keeps its size (the test flag's waves stretch it ~3 %).
+  const ClothMesh waving = WavingFlag(39, 26, 3.0, 2.0, 0.3);
+  const Eigen::Vector2d w = MeasureClothSize(waving.V, waving.F, waving.UV);
+  EXPECT_NEAR(w.x(), 3.0, 0.1);
+  EXPECT_NEAR(w.y(), 2.0, 0.06);
+  const RenderParams flag = SampleRenderParams(SceneKind::kFlag, 1);
+  EXPECT_EQ(MeshSizeMismatch(flag, w), "");
+  const ClothMesh cloth = HangingCloth(32, 32, 1.0, 1.0, 0.2);
+  EXPECT_EQ(MeshSizeMismatch(SampleRenderParams(SceneKind::kCloth, 1),
+                             MeasureClothSize(cloth.V, cloth.F, cloth.UV)),
+            "");
+  // A 6x4 m flag under a 3x2 m ζ: the pole and aim would be wrong.
+  const std::string big = MeshSizeMismatch(flag, Eigen::Vector2d(6.0, 4.0));
+  EXPECT_NE(big.find("field 'mesh_width' is 3 m but the cloth being rendered is 6 m"), std::string::npos) << big;
+  const std::string square = MeshSizeMismatch(flag, Eigen::Vector2d(3.0, 3.0));
+  EXPECT_NE(square.find("field 'mesh_aspect_ratio' is 1.5"), std::string::npos) << square;
+  EXPECT_NE(square.find("3 m by 3 m"), std::string::npos) << square;
+  EXPECT_EQ(MeshSizeMismatch(flag, Eigen::Vector2d(3.1, 1.94)), "");  // within 5 %
+  // Texture coordinates without area cannot say.
+  ClothMesh none = flat;
+  none.UV.col(1).setZero();
+  EXPECT_THROW(MeasureClothSize(none.V, none.F, none.UV), std::invalid_argument);
 }
 
 TEST(RenderParams, SamplesStayInTableTwoRanges) {

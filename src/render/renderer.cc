@@ -16,7 +16,10 @@ namespace clothwind::render {
 namespace {
 constexpr float kInvPi = static_cast<float>(1.0 / M_PI);
 constexpr float kShadowEps = 2e-3f;    // [m] shadow-ray offset along the geometric normal
-constexpr float kFar = 1e4f;           // [m]
+// [m] how far rays look. Past what ValidateRenderParams lets a camera reach (1e4 m away, 1e3 m
+// up): at 1e4 m a camera far away saw sky between the ground and the backdrop's foot. Nothing
+// static stands beyond 500 m but the ground, so nearer cameras' pixels do not depend on it.
+constexpr float kFar = 1e6f;
 constexpr float kGrassTile = 6.0f;     // [m] period of the grass texture
 const Rgb kPoleAlbedo(0.62f, 0.62f, 0.60f);
 const Rgb kFinialAlbedo(0.55f, 0.42f, 0.12f);
@@ -191,10 +194,9 @@ namespace {
 // evenly spread sub-pixel and sun-disc samples for any count. Sample 0 is the pixel centre.
 constexpr float kA1 = 0.7548776662f, kA2 = 0.5698402910f;
 
-struct PixelSample {
-  float jx, jy, su, sv;
-};
-inline PixelSample SampleOf(uint64_t seed, int x, int y, int s) {
+}  // namespace
+
+PixelSample PixelSampleAt(uint64_t seed, int x, int y, int s) {
   Rng rng(HashSeed(seed, static_cast<uint64_t>(x), static_cast<uint64_t>(y)));
   const float ox = rng.UniformF(), oy = rng.UniformF();
   const float sx = rng.UniformF(), sy = rng.UniformF();
@@ -205,6 +207,8 @@ inline PixelSample SampleOf(uint64_t seed, int x, int y, int s) {
   p.sv = Fract(sy + s * kA2);
   return p;
 }
+
+namespace {
 
 template <typename Fn>
 void ForRows(int threads, int h, const Fn& fn) {
@@ -229,7 +233,7 @@ void Renderer::BuildCache() {
   ForRows(options_.threads, h, [&](int y) {
     for (int x = 0; x < w; ++x)
       for (int s = 0; s < spp; ++s) {
-        const PixelSample ps = SampleOf(params_.seed, x, y, s);
+        const PixelSample ps = PixelSampleAt(params_.seed, x, y, s);
         const Eigen::Vector3f dir = camera_.RayDirection(x + ps.jx, y + ps.jy).cast<float>();
         cache_[(static_cast<size_t>(y) * w + x) * spp + s] =
             ComputeStatic(org, dir, lighting_.SampleSunDirection(ps.su, ps.sv));

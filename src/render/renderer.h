@@ -102,6 +102,17 @@ class Renderer {
   std::vector<StaticSample> cache_;  // width * height * samples, pixel-major
 };
 
+// Where sample s of pixel (x, y) looks and which point of the sun disc its shadow ray aims at:
+// an R2 low-discrepancy sequence shifted per pixel by Rng(HashSeed(seed, x, y)), so images do
+// not depend on the thread count. Sample 0 is the pixel centre.
+// Inputs: seed  ζ.seed; x, y  pixel; s  sample index in [0, ζ.samples).
+// Outputs (returned): jx, jy  offset in the pixel, in [0,1) (the ray goes through (x + jx,
+//   y + jy)); su, sv  in [0,1), the sun-disc point (Lighting::SampleSunDirection).
+struct PixelSample {
+  float jx, jy, su, sv;
+};
+PixelSample PixelSampleAt(uint64_t seed, int x, int y, int s);
+
 // Film response and sRGB encoding of a radiance image (CV_32FC3 RGB) into an 8-bit frame
 // (CV_8UC3 BGR), per channel: ToSrgb8(Tone(L)).
 cv::Mat Develop(const cv::Mat& linear_rgb);

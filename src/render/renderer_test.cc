@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -41,15 +42,21 @@ float Luma(const Rgb& c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[
 TEST(Renderer, SameParamsAndSeedGiveIdenticalBytesOnAnyThreadCount) {
   const RenderParams p = TestParams();
   const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, 0.3);
-  RenderOptions one;
+  // Explicit counts: 0 (all cores) is 1 or 2 on a small test machine and proved nothing.
+  RenderOptions one, three, seven;
   one.threads = 1;
-  Renderer a(p, one), b(p);
+  three.threads = 3;
+  seven.threads = 7;
+  Renderer a(p, one), b(p, three), c(p, seven);
   const cv::Mat fa = a.RenderFrame(m.V, m.F, m.UV);
   const cv::Mat fb = b.RenderFrame(m.V, m.F, m.UV);
   ASSERT_EQ(fa.type(), CV_8UC3);
   ASSERT_EQ(fa.rows, 120);
   ASSERT_EQ(fa.cols, 120);
   EXPECT_EQ(cv::norm(fa, fb, cv::NORM_INF), 0.0);
+  // Radiance too, bit for bit (8-bit frames hide differences below a level).
+  const cv::Mat la = a.RenderLinear(m.V, m.F, m.UV), lc = c.RenderLinear(m.V, m.F, m.UV);
+  EXPECT_EQ(cv::norm(la, lc, cv::NORM_INF), 0.0);
   // Another pixel-sampling seed moves anti-aliasing and penumbra samples only a little.
   RenderParams q = p;
   q.seed = 43;
@@ -262,6 +269,177 @@ TEST(Renderer, CachedFramesMatchUncachedTraceAcrossFrames) {
         EXPECT_NEAR(v[1], c[1], 1e-5f);
         EXPECT_NEAR(v[2], c[2], 1e-5f);
       }
+  }
+}
+
+// Several samples a pixel, with shadows and a sun disc: each pixel is its centre sample (one
+// sample is the answer away from edges) or the mean of its jittered ones, each traced along
+// PixelSampleAt's ray to its point of the sun. The tests above take one sample, so a cache
+// indexed wrongly across samples, or samples given each other's sun points, passed them.
+TEST(Renderer, CachedFramesWithManySamplesMatchUncachedTrace) {
+  RenderParams p = TestParams();
+  p.samples = 4;
+  p.sun_shadow_soft_size = 8.0;  // penumbrae: the sun point of each sample counts
+  const Eigen::Vector3f sun = Renderer(p).lighting().sun_dir;
+  const Eigen::Vector3f centre(1.5f, 0.0f, 5.5f);
+  const Eigen::Vector3f g = centre - sun * (centre.z() / sun.z());
+  p.camera_height = 6.0;  // looking down at the flag's shadow, the flag in view too
+  p.has_look_at = true;
+  p.look_at[0] = 0.5 * (g.x() + centre.x());
+  p.look_at[1] = 0.5 * (g.y() + centre.y());
+  p.look_at[2] = 0.5 * (g.z() + centre.z());
+  p.width = p.height = 60;
+  Renderer r(p);
+  int edges = 0;
+  for (double t : {0.0, 0.37}) {
+    const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, t);
+    const cv::Mat img = r.RenderLinear(m.V, m.F, m.UV);
+    const Eigen::Vector3f o = F3(r.camera().position);
+    for (int y = 0; y < p.height; ++y)
+      for (int x = 0; x < p.width; ++x) {
+        Rgb samples[4];
+        for (int s = 0; s < 4; ++s) {
+          const PixelSample ps = PixelSampleAt(p.seed, x, y, s);
+          samples[s] = r.Trace(o, F3(r.camera().RayDirection(x + ps.jx, y + ps.jy)), ps.su, ps.sv);
+        }
+        const Rgb jittered = (samples[1] + samples[2] + samples[3]) / 3.0f;
+        const cv::Vec3f v = img.at<cv::Vec3f>(y, x);
+        const Rgb got(v[0], v[1], v[2]);
+        const bool is_centre = (got - samples[0]).cwiseAbs().maxCoeff() < 1e-5f;
+        const bool is_mean = (got - jittered).cwiseAbs().maxCoeff() < 1e-5f;
+        EXPECT_TRUE(is_centre || is_mean) << x << "," << y << " t=" << t;
+        edges += !is_centre && is_mean;
+      }
+  }
+  EXPECT_GT(edges, 50) << "the frames must have edge pixels, where the jittered samples count";
+}
+
+// The ground is a plane to the horizon: from a camera 700 m from the flag (ζ allows 1e4 m) the
+// rays below the horizon met nothing past the ground's 500 m triangles, and half the frame was sky.
+TEST(EmbreeScene, GroundReachesPastItsTriangles) {
+  const EmbreeScene scene(TestParams());
+  const Eigen::Vector3f org(0.0f, -700.0f, 3.0f), dir = Eigen::Vector3f(0, 1, -0.02f).normalized();
+  Hit hit;
+  ASSERT_TRUE(scene.IntersectStatic(org, dir, 1e4f, &hit));
+  EXPECT_EQ(hit.surface, Surface::kGround);
+  EXPECT_NEAR(hit.point.y(), -700.0f + 150.0f, 0.01f);
+  EXPECT_EQ(hit.point.z(), 0.0f);
+  EXPECT_EQ(hit.normal, Eigen::Vector3f::UnitZ());
+  EXPECT_NEAR(hit.t, 150.0f * std::sqrt(1.0004f), 0.01f);  // 3 m down at 0.02 m a metre
+  ASSERT_TRUE(scene.Intersect(org, dir, 1e4f, &hit));
+  EXPECT_EQ(hit.surface, Surface::kGround);
+  EXPECT_TRUE(scene.Occluded(org, dir, 1e4f));
+  EXPECT_TRUE(scene.OccludedStatic(org, dir, 1e4f));
+  // Not before t_max, not upwards, not from below.
+  EXPECT_FALSE(scene.IntersectStatic(org, dir, 100.0f, &hit));
+  EXPECT_FALSE(scene.OccludedStatic(org, dir, 100.0f));
+  EXPECT_FALSE(scene.IntersectStatic(org, Eigen::Vector3f(0, 1, 0.02f).normalized(), 1e4f, &hit));
+  EXPECT_FALSE(scene.IntersectStatic(Eigen::Vector3f(0, -700, -1), dir, 1e4f, &hit));
+}
+
+TEST(Renderer, AFarCameraSeesGroundBelowTheHorizon) {
+  RenderParams p = TestParams();
+  p.samples = 1;
+  p.width = p.height = 40;
+  p.camera_radius = 700.0;
+  p.camera_height = 3.0;
+  Renderer r(p);
+  const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, 0.0);
+  const cv::Mat img = r.RenderLinear(m.V, m.F, m.UV);
+  int below = 0;
+  for (int y = 0; y < p.height; ++y)
+    for (int x = 0; x < p.width; ++x) {
+      const Eigen::Vector3f d = F3(r.camera().RayDirection(x + 0.5, y + 0.5));
+      if (d.z() > -0.002f) continue;  // the horizon and above
+      ++below;
+      const cv::Vec3f v = img.at<cv::Vec3f>(y, x);
+      const Rgb sky = r.lighting().SkyRadiance(d);
+      EXPECT_GT((Rgb(v[0], v[1], v[2]) - sky).cwiseAbs().maxCoeff(), 1e-3f)
+          << "sky below the horizon at " << x << "," << y;
+    }
+  EXPECT_GT(below, 300);
+}
+
+// A SetCloth refused half way (a bad index in its last face) leaves the previous cloth: it
+// rewrote the faces up to the bad one while Embree kept the old geometry, so hits read the new
+// faces' vertices (here: the old ones in another order, other texture coordinates).
+TEST(EmbreeScene, RefusedClothLeavesThePreviousOne) {
+  Renderer r(TestParams());
+  const ClothMesh a = WavingFlag(25, 17, 3.0, 2.0, 0.1);
+  r.RenderLinear(a.V, a.F, a.UV);
+  const Eigen::Vector3f org(1.2f, -3.0f, 5.3f), dir(0, 1, 0);
+  Hit before, after;
+  ASSERT_TRUE(r.scene().Intersect(org, dir, 10.0f, &before));
+  ASSERT_EQ(before.surface, Surface::kCloth);
+  const Rgb traced = r.Trace(org, dir, 0.5f, 0.5f);
+  const Eigen::AlignedBox3f bounds = r.scene().cloth_bounds();
+
+  ClothMesh b = a;
+  for (int f = 0; f < b.F.rows(); ++f) b.F.row(f) << a.F(f, 1), a.F(f, 2), a.F(f, 0);
+  b.F(b.F.rows() - 1, 2) = static_cast<int>(b.V.rows()) + 5;
+  b.V.array() += 0.5;
+  EXPECT_THROW(r.RenderLinear(b.V, b.F, b.UV), std::invalid_argument);
+
+  ASSERT_TRUE(r.scene().Intersect(org, dir, 10.0f, &after));
+  EXPECT_EQ(after.surface, Surface::kCloth);
+  EXPECT_EQ(after.t, before.t);
+  EXPECT_EQ(after.uv, before.uv);
+  EXPECT_EQ(after.normal, before.normal);
+  EXPECT_TRUE(r.scene().cloth_bounds().isApprox(bounds));
+  const Rgb again = r.Trace(org, dir, 0.5f, 0.5f);
+  EXPECT_EQ(again, traced);
+}
+
+std::string SetClothError(EmbreeScene* scene, const ClothMesh& m) {
+  try {
+    scene->SetCloth(m.V, m.F, m.UV);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// Non-finite coordinates are refused naming the vertex and the coordinate: 1e39 is finite as a
+// double and became inf as a float, and NaN texture coordinates reached float-to-int conversions.
+TEST(EmbreeScene, NonFiniteVerticesAndTextureCoordinatesAreRefused) {
+  EmbreeScene scene(TestParams());
+  const ClothMesh good = WavingFlag(5, 4);
+  scene.SetCloth(good.V, good.F, good.UV);
+  const Eigen::AlignedBox3f bounds = scene.cloth_bounds();
+  ClothMesh m = good;
+  m.V(7, 1) = 1e39;
+  std::string e = SetClothError(&scene, m);
+  EXPECT_NE(e.find("vertex 7 has V coordinate y = 1e+39"), std::string::npos) << e;
+  m = good;
+  m.V(2, 2) = std::numeric_limits<double>::quiet_NaN();
+  e = SetClothError(&scene, m);
+  EXPECT_NE(e.find("vertex 2 has V coordinate z = nan"), std::string::npos) << e;
+  m = good;
+  m.V(4, 0) = 2e6;  // finite, but the normals' cross products overflow soon after
+  e = SetClothError(&scene, m);
+  EXPECT_NE(e.find("vertex 4 has V coordinate x = 2e+06"), std::string::npos) << e;
+  EXPECT_NE(e.find("within +-1e+06 m"), std::string::npos) << e;
+  m = good;
+  m.UV(3, 0) = std::numeric_limits<double>::quiet_NaN();
+  e = SetClothError(&scene, m);
+  EXPECT_NE(e.find("vertex 3 has UV coordinate u = nan"), std::string::npos) << e;
+  m = good;
+  m.UV(5, 1) = -std::numeric_limits<double>::infinity();
+  e = SetClothError(&scene, m);
+  EXPECT_NE(e.find("vertex 5 has UV coordinate v = -inf"), std::string::npos) << e;
+  EXPECT_TRUE(scene.cloth_bounds().isApprox(bounds));  // still the good cloth
+}
+
+// A device that cannot be made says why (the reason was dropped), and nothing leaks on the way
+// out (the handles release what was made before the throw).
+TEST(EmbreeScene, DeviceErrorsAreNamed) {
+  try {
+    EmbreeScene scene(TestParams(), "threads=not-a-number");
+    FAIL() << "a bad device configuration was accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("threads=not-a-number"), std::string::npos) << what;
+    EXPECT_NE(what.find("RTC_ERROR_"), std::string::npos) << what;
   }
 }
 

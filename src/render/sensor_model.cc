@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
@@ -58,16 +59,36 @@ SensorModelParams SensorModelParamsFromJson(const nlohmann::json& j) {
   s.full_well = number("full_well");
   s.read_noise = number("read_noise");
   s.jpeg_quality = integer("jpeg_quality");
-  if (s.subframes < 1) throw std::invalid_argument("sensor model: field 'subframes' must be >= 1");
-  if (!(s.full_well > 0)) throw std::invalid_argument("sensor model: field 'full_well' must be > 0");
-  if (s.read_noise < 0) throw std::invalid_argument("sensor model: field 'read_noise' must be >= 0");
-  if (s.jpeg_quality < 0 || s.jpeg_quality > 100)
-    throw std::invalid_argument("sensor model: field 'jpeg_quality' must be in [0, 100]");
+  ValidateSensorModelParams(s);
   return s;
+}
+
+namespace {
+void Require(bool ok, const char* field, const std::string& expected, double value) {
+  if (!ok) {
+    std::ostringstream m;
+    m << "sensor model: field '" << field << "' is " << value << ", expected " << expected;
+    throw std::invalid_argument(m.str());
+  }
+}
+}  // namespace
+
+void ValidateSensorModelParams(const SensorModelParams& s) {
+  // Bounded above: the caller renders `subframes` meshes per frame (2^31 of them, silently), and
+  // a huge or non-finite noise made every pixel 0 or 255, or NaN before the 8-bit conversion.
+  Require(s.subframes >= 1 && s.subframes <= SensorModelParams::kMaxSubframes, "subframes",
+          "in [1, " + std::to_string(SensorModelParams::kMaxSubframes) + "]", s.subframes);
+  Require(s.full_well >= 1 && s.full_well <= 1e12, "full_well", "in [1, 1e12] electrons",
+          s.full_well);
+  Require(s.read_noise >= 0 && s.read_noise <= 1, "read_noise",
+          "in [0, 1] (of the display range)", s.read_noise);
+  Require(s.jpeg_quality >= 0 && s.jpeg_quality <= 100, "jpeg_quality", "in [0, 100]",
+          s.jpeg_quality);
 }
 
 cv::Mat ApplySensorModel(const std::vector<cv::Mat>& linear_subframes,
                          const SensorModelParams& s, uint64_t seed) {
+  ValidateSensorModelParams(s);
   if (linear_subframes.empty())
     throw std::invalid_argument("ApplySensorModel: no sub-frames given");
   for (const cv::Mat& m : linear_subframes)
@@ -80,6 +101,7 @@ cv::Mat ApplySensorModel(const std::vector<cv::Mat>& linear_subframes,
     for (const cv::Mat& m : linear_subframes) radiance += m;
     radiance /= static_cast<double>(linear_subframes.size());
   } else {
+    // The middle one; of an even count the later of the two (kept: frames were made so).
     radiance = linear_subframes[linear_subframes.size() / 2];
   }
   cv::Mat out(radiance.rows, radiance.cols, CV_8UC3);

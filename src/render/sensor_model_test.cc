@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -74,6 +76,81 @@ TEST(SensorModel, NoiseIsZeroMeanOfTheExpectedSizeAndSeeded) {
   EXPECT_NEAR(stddev[0], 0.02 * slope * 255, 0.3);
   EXPECT_EQ(cv::norm(noisy, ApplySensorModel({flat}, s, 3), cv::NORM_INF), 0.0);
   EXPECT_GT(cv::norm(noisy, ApplySensorModel({flat}, s, 4), cv::NORM_L1), 0.0);
+}
+
+// Shot noise: variance y / full_well grows with the signal (the test above sets full_well to 1e9,
+// where it is nil, so dropping or mis-scaling the shot term passed it).
+TEST(SensorModel, ShotNoiseGrowsWithTheSignal) {
+  SensorModelParams s;
+  s.noise = true;
+  s.full_well = 300;  // sigma 0.035 at 0.37 of white, 0.058 at white
+  s.read_noise = 0.0;
+  double sigma[2], display[2];  // measured, display-linear
+  const int levels[2] = {102, 170};
+  for (int i = 0; i < 2; ++i) {
+    display[i] = SrgbToLinear(levels[i] / 255.0f);
+    const float radiance = InverseTone(static_cast<float>(display[i]));
+    const cv::Mat flat(100, 100, CV_32FC3, cv::Scalar(radiance, radiance, radiance));
+    const cv::Mat clean = Develop(flat);
+    ASSERT_EQ(clean.at<cv::Vec3b>(0, 0)[0], levels[i]);
+    cv::Mat noisy, cl;
+    ApplySensorModel({flat}, s, 5).convertTo(noisy, CV_32F);
+    clean.convertTo(cl, CV_32F);
+    const cv::Mat diff = noisy - cl;
+    cv::Scalar mean, stddev;
+    cv::meanStdDev(diff.reshape(1), mean, stddev);
+    // 8-bit levels back to display-linear units through the encoding's slope there.
+    const double h = 1e-3;
+    const double slope = (LinearToSrgb(display[i] + h) - LinearToSrgb(display[i] - h)) / (2 * h);
+    sigma[i] = stddev[0] / (slope * 255);
+    EXPECT_NEAR(sigma[i], std::sqrt(display[i] / s.full_well), 0.06 * sigma[i]) << levels[i];
+  }
+  // sqrt(y): the brighter grey is the noisier in display-linear units.
+  EXPECT_NEAR(sigma[1] / sigma[0], std::sqrt(display[1] / display[0]), 0.1);
+}
+
+// Bounds that name their field: a huge subframes made the caller render that many meshes a
+// frame, and a huge or non-finite read_noise made every pixel 0 or 255 (NaN before conversion).
+TEST(SensorModel, OutOfRangeFieldsAreNamed) {
+  const auto error = [](const nlohmann::json& j) {
+    try {
+      SensorModelParamsFromJson(j);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const nlohmann::json good = ToJson(SensorModelParams());
+  nlohmann::json j = good;
+  j["subframes"] = 100000;
+  EXPECT_NE(error(j).find("field 'subframes' is 100000, expected in [1, 64]"), std::string::npos) << error(j);
+  j["subframes"] = SensorModelParams::kMaxSubframes;
+  EXPECT_EQ(error(j), "no error");
+  j = good;
+  j["read_noise"] = 1e300;
+  EXPECT_NE(error(j).find("field 'read_noise' is 1e+300"), std::string::npos) << error(j);
+  j = good;
+  j["full_well"] = 1e-300;
+  EXPECT_NE(error(j).find("field 'full_well'"), std::string::npos) << error(j);
+  // Given in code, past the JSON reader, they are refused too.
+  SensorModelParams s;
+  s.noise = true;
+  s.read_noise = std::numeric_limits<double>::quiet_NaN();
+  try {
+    ApplySensorModel({TestRadiance()}, s, 1);
+    FAIL() << "a NaN read_noise was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("read_noise"), std::string::npos) << e.what();
+  }
+}
+
+// Without blur an even count of sub-frames gives the later of the two middle ones (documented,
+// kept: frames were made so).
+TEST(SensorModel, EvenSubframeCountTakesTheLaterMiddleOne) {
+  const SensorModelParams off;
+  const cv::Mat a = TestRadiance(-6), b = TestRadiance(-2), c = TestRadiance(2), d = TestRadiance(6);
+  EXPECT_EQ(cv::norm(ApplySensorModel({a, b, c, d}, off, 1), Develop(c), cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(ApplySensorModel({a, b}, off, 1), Develop(b), cv::NORM_INF), 0.0);
 }
 
 TEST(SensorModel, JpegChangesBytesButKeepsTheImage) {

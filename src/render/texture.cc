@@ -32,15 +32,24 @@ inline int WrapIndex(int i, int n, Wrap wrap) {
   }
   return 0;
 }
+
+// A texel coordinate int can hold: float to int of NaN or of anything past int's range is
+// undefined (x86 gives INT_MIN, so u = 1e30 clamped to the left edge instead of the right).
+// Beyond 2^24 texels float has no fractional part left, so clamping there changes no lookup
+// that meant anything.
+inline float SafeTexelCoordinate(float x) {
+  constexpr float kLimit = 16777216.0f;  // 2^24
+  return x < -kLimit ? -kLimit : (x > kLimit ? kLimit : x);
+}
 }  // namespace
 
 Rgb Texture::Sample(float u, float v, Wrap wrap, float* alpha_out) const {
-  if (empty()) {
+  if (empty() || std::isnan(u) || std::isnan(v)) {
     if (alpha_out) *alpha_out = 0.0f;
     return Rgb::Zero();
   }
-  const float x = u * width_ - 0.5f;
-  const float y = (1.0f - v) * height_ - 0.5f;
+  const float x = SafeTexelCoordinate(u * width_ - 0.5f);
+  const float y = SafeTexelCoordinate((1.0f - v) * height_ - 0.5f);
   const float fx = std::floor(x), fy = std::floor(y);
   const float tx = x - fx, ty = y - fy;
   const int x0 = WrapIndex(static_cast<int>(fx), width_, wrap);

@@ -34,9 +34,10 @@ class Texture {
   float alpha(int x, int y) const { return alpha_[static_cast<size_t>(y) * width_ + x]; }
 
   // Bilinear lookup.
-  // Inputs: u, v  texture coordinates; wrap  behaviour outside [0,1].
+  // Inputs: u, v  texture coordinates, any float (infinite ones clamp to +-2^24 texels);
+  //   wrap  behaviour outside [0,1].
   // Outputs: alpha_out  (optional) interpolated alpha.
-  // Returns the interpolated linear colour.
+  // Returns the interpolated linear colour; zero (and alpha 0) if u or v is NaN.
   Rgb Sample(float u, float v, Wrap wrap = Wrap::kClamp, float* alpha_out = nullptr) const;
 
   // From an 8-bit BGR or BGRA OpenCV image (sRGB encoded, as cv::imread gives it).

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "render/fabric_patterns.h"
 #include "render/flag_designs.h"
 #include "render/texture.h"
@@ -79,6 +81,31 @@ TEST(Texture, WrapModes) {
   EXPECT_LT((t.Sample(-3.0f, 0.5f, Wrap::kClamp) - Rgb(1, 0, 0)).norm(), 1e-6f);
   EXPECT_LT((t.Sample(1.25f, 0.5f, Wrap::kRepeat) - Rgb(1, 0, 0)).norm(), 1e-6f);
   EXPECT_LT((t.Sample(1.25f, 0.5f, Wrap::kMirror) - Rgb(0, 0, 1)).norm(), 1e-6f);
+}
+
+// Coordinates past int's range: the float-to-int conversion was undefined (x86: INT_MIN), so
+// u = 1e30 read the left edge under kClamp, and NaN gave NaN colours.
+TEST(Texture, HugeInfiniteAndNanCoordinates) {
+  Texture t(2, 1);
+  t.at(0, 0) = Rgb(1, 0, 0);
+  t.at(1, 0) = Rgb(0, 0, 1);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (float u : {1e30f, 3e9f, inf})
+    EXPECT_LT((t.Sample(u, 0.5f, Wrap::kClamp) - Rgb(0, 0, 1)).norm(), 1e-6f) << u;
+  for (float u : {-1e30f, -3e9f, -inf})
+    EXPECT_LT((t.Sample(u, 0.5f, Wrap::kClamp) - Rgb(1, 0, 0)).norm(), 1e-6f) << u;
+  for (Wrap w : {Wrap::kRepeat, Wrap::kMirror})
+    for (float u : {1e30f, -1e30f, inf, -inf}) {
+      float alpha = -1;
+      const Rgb c = t.Sample(u, 1e30f, w, &alpha);
+      EXPECT_TRUE(c.allFinite()) << u;
+      EXPECT_EQ(alpha, 1.0f) << u;
+    }
+  float alpha = -1;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(t.Sample(nan, 0.5f, Wrap::kRepeat, &alpha), Rgb::Zero());
+  EXPECT_EQ(alpha, 0.0f);
+  EXPECT_EQ(t.Sample(0.5f, nan), Rgb::Zero());
 }
 
 }  // namespace
