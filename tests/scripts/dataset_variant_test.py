@@ -134,6 +134,67 @@ class DatasetVariantTest(unittest.TestCase):
         self.assertNotEqual(r.returncode, 0)
         self.assertFalse(os.path.exists(os.path.join(self.tmp.name, 'out')))
 
+    def edit_index(self, change):
+        path = os.path.join(self.src, 'index.json')
+        with open(path) as f:
+            index = json.load(f)
+        change(index)
+        with open(path, 'w') as f:
+            json.dump(index, f)
+
+    def test_a_clip_without_a_split_takes_its_labels(self):
+        # A hand-made index: the split read as train reads it (the index's, else label.json's), and
+        # every check made before DST.tmp exists (a KeyError came after DST was renamed into place).
+        self.edit_index(lambda index: [c.pop('split') for c in index['clips'] if c['name'] in
+                                       ('flag-000000-v1', 'flag-000008-v0')])
+        dst = os.path.join(self.tmp.name, 'dst')
+        r = run(self.src, dst, '--train-views', '1')
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn(f"{os.path.join(self.src, 'flag-000000-v1', 'label.json')}: cannot read the label, "
+                      f"where clips[1] of {os.path.join(self.src, 'index.json')} has no split", r.stderr)
+        self.assertNotIn('Traceback', r.stderr)
+        self.assertFalse(os.path.exists(dst) or os.path.exists(dst + '.tmp'))
+        for name, split in (('flag-000000-v1', 'holdout'), ('flag-000008-v0', 'val')):
+            with open(os.path.join(self.src, name, 'label.json'), 'w') as f:
+                json.dump({'split': split}, f)
+        r = run(self.src, dst, '--train-views', '1')
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn(f"flag-000000-v1/label.json: field 'split' (clips[1] of {self.src}/index.json has none) "
+                      'must be "train", "val" or "test", got "holdout"', r.stderr)
+        self.assertFalse(os.path.exists(dst) or os.path.exists(dst + '.tmp'))
+        with open(os.path.join(self.src, 'flag-000000-v1', 'label.json'), 'w') as f:
+            json.dump({'split': 'train'}, f)
+        dst, index = self.resplit(change=('--train-views', '1'))
+        names = [c['name'] for c in index['clips']]
+        self.assertNotIn('flag-000000-v1', names)  # a training view, dropped as its index said "train"
+        self.assertIn('flag-000008-v0', names)  # a val clip, kept with its siblings
+        self.assertNotIn('split', index['clips'][names.index('flag-000008-v0')])  # the index as it was
+        expected = run(self.src, os.path.join(self.tmp.name, 'again'), '--train-views', '1').stdout
+        self.assertIn(f'{sum((s // 4) % 4 < 2 for s in range(250))} train clips', expected)
+        self.assertIn(f'{sum((s // 4) % 4 == 2 for s in range(250)) * 4} val', expected)
+
+    def test_a_malformed_index_is_refused_before_anything_is_written(self):
+        dst = os.path.join(self.tmp.name, 'dst')
+        index_path = os.path.join(self.src, 'index.json')
+        for change, expected in [
+                (lambda index: index['clips'].__setitem__(3, 5), 'clips[3] must be an object, got 5'),
+                (lambda index: index['clips'][3].__setitem__('split', ['x']),
+                 'clips[3].split must be "train", "val" or "test", got ["x"]'),
+                (lambda index: index.__setitem__('dataset', [1]), "field 'dataset' must be an object"),
+                (lambda index: index['dataset'].__setitem__('views', 'four'),
+                 'fields dataset.views, dataset.val_fraction and dataset.test_fraction must be numbers, got "four"')]:
+            with self.subTest(expected=expected):
+                with open(index_path) as f:
+                    good = f.read()
+                self.edit_index(change)
+                r = run(self.src, dst, '--train-views', '1')
+                with open(index_path, 'w') as f:
+                    f.write(good)
+                self.assertNotEqual(r.returncode, 0)
+                self.assertIn(f'{index_path}: {expected}', r.stderr)
+                self.assertNotIn('Traceback', r.stderr)
+                self.assertFalse(os.path.exists(dst) or os.path.exists(dst + '.tmp'))
+
     def test_a_variant_is_not_a_source(self):
         # Its header would name one change where the copy differs from the original by two.
         dst, _ = self.resplit()

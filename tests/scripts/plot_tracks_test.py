@@ -75,6 +75,50 @@ class PlotTracksTest(unittest.TestCase):
         self.assertIn(os.path.join(self.example, 'tracks.json'), r.stderr)
         self.assertFalse(os.path.exists(out))
 
+    def test_a_missing_or_malformed_field_is_named(self):
+        # Each ended in a traceback (KeyError, IndexError) instead of naming the field.
+        out = os.path.join(self.tmp.name, 'e.png')
+        path = os.path.join(self.example, 'tracks.json')
+        good = json.loads(json.dumps(self.tracks))
+        for field, change, expected in [
+                ('xy', lambda t: t.pop('xy'), "field 'xy' must be a list of frames"),
+                ('width', lambda t: t.pop('width'), "field 'width' must be a positive number of pixels; it is missing"),
+                ('grid', lambda t: t.pop('grid'), "field 'grid' must be [cols, rows]"),
+                ('grid', lambda t: t.update(grid=[2]), "field 'grid' must be [cols, rows], positive integers; got [2]"),
+                ('xy', lambda t: t['xy'][2].pop(), "field 'xy' frame 2 must be 4 numbers"),
+                ('xy', lambda t: t['xy'][1].__setitem__(3, 'a'), 'got entry 3 "a"')]:
+            with self.subTest(field=field, expected=expected):
+                self.tracks = json.loads(json.dumps(good))
+                change(self.tracks)
+                self.write_tracks()
+                r = self.run_script(out)
+                self.assertNotEqual(r.returncode, 0)
+                self.assertIn(f'{path}: ', r.stderr)
+                self.assertIn(expected, r.stderr)
+                self.assertNotIn('Traceback', r.stderr)
+                self.assertFalse(os.path.exists(out))
+
+    def test_a_malformed_frame_list_is_named(self):
+        out = os.path.join(self.tmp.name, 'f.png')
+        r = self.run_script(out, '--frames', '1,,2')  # a ValueError traceback
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("--frames '1,,2': expected frame numbers separated by commas", r.stderr)
+        self.assertNotIn('Traceback', r.stderr)
+        self.assertFalse(os.path.exists(out))
+
+    def test_paths_with_quotes_and_newlines_reach_gnuplot(self):
+        # '{path}' in the gnuplot script: a quote in the example's or OUT's name ended the string.
+        example = os.path.join(self.tmp.name, "it's a \"flag\"\nexample")
+        os.rename(self.example, example)
+        self.example = example
+        folder = os.path.join(self.tmp.name, "o'ut")
+        os.makedirs(folder)
+        out = os.path.join(folder, "a'b.png")
+        r = self.run_script(out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(png_size(out), (900, 330))
+        self.assertEqual(os.listdir(folder), ["a'b.png"])  # no temporary left
+
     def test_a_missing_folder_is_named(self):
         # gnuplot could not open OUT there and wrote the PNG's bytes to stdout (a decoding traceback).
         folder = os.path.join(self.tmp.name, 'no-such-folder')

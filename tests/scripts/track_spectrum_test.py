@@ -117,6 +117,59 @@ class TrackSpectrumTest(unittest.TestCase):
         self.assertIn(os.path.join(folder, 'label.json'), r.stderr)
         self.assertFalse(os.path.exists(self.out))
 
+    def test_a_missing_or_malformed_field_is_named(self):
+        # Each ended in a traceback (KeyError, IndexError, ValueError) instead of naming the field.
+        folder = self.add('flag-000000-v0', 2.0, 'test', self.sine(40, 2 / 30, 3.0))
+        tracks_path = os.path.join(folder, 'tracks.json')
+        with open(tracks_path) as f:
+            good = f.read()
+        for change, expected in [
+                (lambda t: t.pop('xy'), "tracks.json: field 'xy' must be a list of frames"),
+                (lambda t: t['xy'][7].pop(), "tracks.json: field 'xy' frame 7 must be 4 numbers, as frame 0; got 3"),
+                (lambda t: t['xy'][3].__setitem__(1, None), "tracks.json: field 'xy' frame 3 must be 4 numbers, "
+                                                            'as frame 0; got entry 1 null')]:
+            with self.subTest(expected=expected):
+                t = json.loads(good)
+                change(t)
+                with open(tracks_path, 'w') as f:
+                    json.dump(t, f)
+                r = self.run_script()
+                self.assertNotEqual(r.returncode, 0)
+                self.assertIn(expected, r.stderr)
+                self.assertIn(folder, r.stderr)
+                self.assertNotIn('Traceback', r.stderr)
+                self.assertFalse(os.path.exists(self.out))
+        with open(tracks_path, 'w') as f:
+            f.write(good)
+        with open(os.path.join(folder, 'label.json'), 'w') as f:
+            json.dump({'wind_speed': 'fast', 'split': 'test'}, f)
+        r = self.run_script()
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn(f"{folder}/label.json: field 'wind_speed' must be a number", r.stderr)
+        for args, expected in [(('--offset', 'x'), "--offset 'x': expected a frame number or 'centred'"),
+                               (('--fps', '0'), '--fps 0.0: expected > 0'),
+                               (('--max', '-1'), '--max -1: expected >= 0')]:
+            r = self.run_script(*args)
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn(expected, r.stderr)
+            self.assertNotIn('Traceback', r.stderr)
+        r = subprocess.run([SCRIPT, os.path.join(self.tmp.name, 'no-data'), self.out], capture_output=True, text=True)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn(f"{os.path.join(self.tmp.name, 'no-data')}: cannot read the dataset folder", r.stderr)
+        self.assertFalse(os.path.exists(self.out))
+
+    def test_paths_with_quotes_and_newlines_reach_gnuplot(self):
+        # '{path}' in the gnuplot script: a quote in the dataset's, the split's or OUT's name ended the string.
+        self.data = os.path.join(self.tmp.name, "it's a \"dataset\"\nhere")
+        self.add('flag-000000-v0', 3.2, "te'st", self.sine(60, 2 / 30, 4.0))
+        folder = os.path.join(self.tmp.name, "o'ut")
+        os.makedirs(folder)
+        self.out = os.path.join(folder, "a'b.png")
+        r = self.run_script('--split', "te'st")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(png_size(self.out), (1000, 420))
+        self.assertEqual(os.listdir(folder), ["a'b.png"])  # no temporary left
+
     def test_the_window_is_the_sdns_periodic_hann(self):
         # learn/spectral_layer.cc: at::hann_window(n, periodic=true). Through it a sine on bin 2
         # leaks a quarter of its amplitude into bins 1 and 3 and nothing elsewhere: powers 1:4:1,
