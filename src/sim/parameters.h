@@ -42,7 +42,9 @@ int ParameterIndex(const std::string& name);
 Theta ThetaFrom(const Material& material, const WindSpec& wind);
 
 // Writes theta into a material and a wind. The wind keeps its direction (+x if it was zero) and
-// gets speed theta[16]; turbulence and gusts keep their parameters (they scale with the speed).
+// gets speed theta[16]; turbulence and gusts keep their parameters: turbulence scales with the
+// speed (its intensity is relative), gusts do not (their amplitude is in m/s), and a calm wind
+// (speed 0) has neither (MakeWindField).
 // Inputs:
 //   theta  17 values (area weight > 0, bending > 0, wind speed >= 0, all finite)
 // Outputs:

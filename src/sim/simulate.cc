@@ -31,6 +31,11 @@ Trajectory SimulateTrajectory(const SceneSetup& setup, const Theta& theta,
 
   const double duration = options.duration >= 0 ? options.duration : setup.scene.duration;
   const double frame_time = setup.scene.frame_time;
+  // The scene reader's limits: inf went to lround (undefined), 1e9 s overflowed the frame count.
+  if (std::isnan(options.duration) || !(std::isfinite(duration) && duration <= 86400 && duration / frame_time <= 1e6)) {
+    throw std::invalid_argument("duration must be at most 86400 s and 1e6 frames of " + std::to_string(frame_time) +
+                                " s, got " + std::to_string(duration) + " s");
+  }
   const int steps_per_frame = setup.scene.frame_steps;
   const int frames = static_cast<int>(std::lround(duration / frame_time));
   // At most an hour (as make-dataset's): 1e8 s overflowed the frame count and ran no warm-up.

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -111,6 +113,22 @@ TEST(SimulateTrajectory, WarmupDropsLeadingFramesOfTheSameRun) {
   for (double bad : {-1.0, std::nan(""), 1e8}) {
     o.warmup = bad;
     EXPECT_THROW(SimulateTrajectory(setup, SceneTheta(setup), o), std::invalid_argument) << bad;
+  }
+}
+
+// The scene reader's limits hold for a duration given in code: inf went to lround (undefined),
+// 1e9 s overflowed the frame count, NaN ran the scene's duration.
+TEST(SimulateTrajectory, ADurationPastTheScenesLimitsIsRefused) {
+  const SceneSetup setup = SmallFlag();
+  for (double bad : {std::numeric_limits<double>::infinity(), 1e9, 86401.0, std::numeric_limits<double>::quiet_NaN()}) {
+    SimulateOptions o;
+    o.duration = bad;
+    try {
+      SimulateTrajectory(setup, SceneTheta(setup), o);
+      ADD_FAILURE() << bad << " s ran";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("duration must be at most 86400 s"), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -66,7 +66,8 @@ TurbulentWind::TurbulentWind(const TurbulenceParams& p, const Eigen::Vector3d& m
     const double x = k / ke;
     const double energy = std::pow(x, 4) / std::pow(1.0 + x * x, 17.0 / 6.0);
     const Eigen::Vector3d dir = RandomUnit(g);
-    // Polarisation: a random unit vector perpendicular to the wavevector (divergence-free).
+    // Polarisation: a random unit vector perpendicular to the wavevector (divergence-free until
+    // the anisotropic rescaling below, which breaks that a little: docs/scenes.md).
     Eigen::Vector3d helper = RandomUnit(g);
     Eigen::Vector3d pol = helper - helper.dot(dir) * dir;
     if (pol.norm() < 1e-6) pol = dir.unitOrthogonal();

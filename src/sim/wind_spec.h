@@ -27,8 +27,11 @@ struct WindSpec {
 };
 
 // Builds the field shear × mean + turbulence + gusts that `spec` describes (a SteadyWind when
-// it has neither shear, turbulence nor gusts). The returned field is immutable and
-// thread-safe. Throws std::invalid_argument for bad parameters.
+// it has neither shear, turbulence nor gusts; a calm wind, velocity 0, has neither turbulence
+// nor gusts: both are relative to the wind's direction). The returned field is immutable and
+// thread-safe. Throws std::invalid_argument for bad parameters (a non-finite velocity, a
+// negative or non-finite turbulence intensity or gust rate, a non-finite gust amplitude, and
+// what the parts' constructors refuse).
 std::shared_ptr<const WindField> MakeWindField(const WindSpec& spec);
 
 }  // namespace clothwind::sim

@@ -1,6 +1,8 @@
 #include "sim/wind_spec.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -32,6 +34,48 @@ TEST(MakeWindField, SteadyWhenNothingElseIsAsked) {
   const auto w = MakeWindField(spec);
   EXPECT_NE(dynamic_cast<const SteadyWind*>(w.get()), nullptr);
   EXPECT_EQ(w->Velocity(Eigen::Vector3d(1, 2, 3), 7.0), spec.velocity);
+}
+
+// A calm sample (wind speed 0) is calm: gusts blow along the wind, and without one they blew at
+// full amplitude along +x.
+TEST(MakeWindField, ACalmWindHasNoGustsOrTurbulence) {
+  WindSpec spec;
+  spec.turbulence.intensity = 0.2;
+  spec.gusts.rate = 2.0;
+  spec.gusts.amplitude = 3.0;
+  spec.gusts.duration = 1.0;
+  spec.SetSeed(5);
+  const auto w = MakeWindField(spec);
+  for (int i = 0; i < 200; ++i) EXPECT_EQ(w->Velocity(Eigen::Vector3d(0.1 * i, 0, 2), 0.05 * i).norm(), 0.0) << i;
+}
+
+// Checked where the field is made: an edited SceneSetup's NaN or negative intensity or rate read
+// as "none" (a steady wind, without a word).
+TEST(MakeWindField, BadParametersAreRefusedNamingTheField) {
+  const auto error = [](WindSpec spec) {
+    try {
+      MakeWindField(spec);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  WindSpec spec;
+  spec.velocity = Eigen::Vector3d(5, 0, 0);
+  WindSpec bad = spec;
+  bad.turbulence.intensity = NAN;
+  EXPECT_NE(error(bad).find("wind.turbulence.intensity must be finite and >= 0"), std::string::npos) << error(bad);
+  bad = spec;
+  bad.turbulence.intensity = -0.1;
+  EXPECT_NE(error(bad).find("wind.turbulence.intensity"), std::string::npos);
+  bad = spec;
+  bad.gusts.rate = -1;
+  bad.gusts.amplitude = 2;
+  EXPECT_NE(error(bad).find("wind.gusts.rate"), std::string::npos);
+  bad = spec;
+  bad.velocity.x() = INFINITY;
+  EXPECT_NE(error(bad).find("wind.velocity must be finite"), std::string::npos);
+  EXPECT_EQ(error(spec), "");
 }
 
 TEST(MakeWindField, ComposesShearTurbulenceAndGusts) {
