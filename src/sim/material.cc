@@ -49,10 +49,6 @@ Eigen::Vector4d EvaluateStretchingSample(const Eigen::Matrix2d& G,
   return 2.0 * k.cwiseMax(0.0);
 }
 
-// Area weights above this are no cloth (1000 kg/m^2: a 13 cm steel plate; fabrics weigh 0.05-1,
-// ArcSim's heaviest material 0.324), and far above it the step's numbers overflow.
-constexpr double kMaxAreaWeight = 1e3;  // [kg/m^2]
-
 void CheckPositive(double value, const char* what) {
   if (!(std::isfinite(value) && value > 0))
     throw std::invalid_argument(std::string("material: ") + what + " must be finite and > 0, got " +

@@ -11,6 +11,10 @@ namespace clothwind::sim {
 
 // Scales applied to a material as ArcSim's scene files do (`density_mult`, `stretching_mult`,
 // `bending_mult`, `thicken`; thicken multiplies all three) plus ArcSim's `damping`.
+// Area weights above this are no cloth (1000 kg/m^2: a 13 cm steel plate; fabrics weigh 0.05-1,
+// ArcSim's heaviest material 0.324), and far above it the step's numbers overflow.
+constexpr double kMaxAreaWeight = 1e3;  // [kg/m^2]
+
 struct MaterialMultipliers {
   double density = 1.0;
   double stretching = 1.0;

@@ -57,11 +57,14 @@ void ValidateTheta(const Theta& theta) {
   const auto& names = ParameterNames();
   for (int i = 0; i < kNumParameters; ++i) {
     const double v = theta[i];
-    const bool ok = std::isfinite(v) && (i == kWindSpeedIndex ? v >= 0.0 : v > 0.0);
+    const bool ok = std::isfinite(v) && (i == kWindSpeedIndex ? v >= 0.0 : v > 0.0) &&
+                    (i != kAreaWeightIndex || v <= kMaxAreaWeight);
     if (!ok) {
+      // The area weight's cap is the material's (MakeMaterial): ApplyTheta wrote past it.
       std::ostringstream msg;
       msg << "parameter " << i << " (" << names[i] << ") = " << v << " [" << ParameterUnits()[i]
-          << "]: expected a finite number " << (i == kWindSpeedIndex ? ">= 0" : "> 0");
+          << "]: expected a finite number " << (i == kWindSpeedIndex ? ">= 0" : "> 0")
+          << (i == kAreaWeightIndex ? " and at most 1000" : "");
       throw std::invalid_argument(msg.str());
     }
   }

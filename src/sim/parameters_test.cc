@@ -72,6 +72,14 @@ TEST(Parameters, ZeroWindTakesXAndBadValuesNameTheEntry) {
   theta[5] = 1e-6;
   theta[0] = std::nan("");
   EXPECT_THROW(ValidateTheta(theta), std::invalid_argument);
+  // Past the material's cap (MakeMaterial refuses it; ApplyTheta wrote it).
+  theta[0] = 2e3;
+  try {
+    ApplyTheta(theta, &m, &still);
+    FAIL() << "an area weight of 2000 kg/m^2 was applied";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("at most 1000"), std::string::npos) << e.what();
+  }
   theta[0] = 0.1;
   theta[16] = -1;
   EXPECT_THROW(ValidateTheta(theta), std::invalid_argument);
