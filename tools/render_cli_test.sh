@@ -87,4 +87,27 @@ status=0
 [ "$status" -ne 0 ] && [ "$status" -lt 128 ] || fail "a 3 m zeta rendered a 6 m flag (status $status): $(cat "$work/out.txt")"
 grep -q "mesh_width" "$work/out.txt" || fail "the refusal does not name mesh_width: $(cat "$work/out.txt")"
 [ ! -e "$work/big-zeta" ] || fail "the refused render made its --out"
+# --keep-zeta renders a label's zeta as given (a dataset made with another scene), and says so.
+"$bin" render "$work/big" --out "$work/big-keep" --zeta "$work/zeta-3m.json" --keep-zeta --count 1 --samples 1 \
+  --threads 1 >"$work/out.txt" 2>&1 || fail "--keep-zeta did not render: $(cat "$work/out.txt")"
+grep -q "keep-zeta: field 'mesh_width'" "$work/out.txt" || fail "--keep-zeta did not say what differs: $(cat "$work/out.txt")"
+grep -q '"mesh_width": 3.0' "$work/big-keep/zeta.json" || fail "--keep-zeta changed zeta: $(cat "$work/big-keep/zeta.json")"
+# The size is the cloth's rest size (its material space), not its first frame's: a flag flying
+# stretched after a warm-up (here its 3 m flag's positions stretched by 10 %, its material space
+# left) measured 3.3 m, and --seed rewrote zeta's size.
+mkdir "$work/stretched"
+/usr/bin/python3 - "$work/sim/trajectory.cwtraj" "$work/stretched/trajectory.cwtraj" <<'PY'
+import struct, sys
+data = bytearray(open(sys.argv[1], 'rb').read())
+nv, nf, frames = struct.unpack_from('<III', data, 12)
+start = 32 + 12 * nf + 8 * nv  # past the uv: every frame's positions
+for i in range(3 * nv * frames):
+    (x,) = struct.unpack_from('<f', data, start + 4 * i)
+    struct.pack_into('<f', data, start + 4 * i, 1.1 * x)
+open(sys.argv[2], 'wb').write(data)
+PY
+"$bin" render "$work/stretched" --out "$work/stretched-seed" --count 1 --samples 1 --threads 1 >"$work/out.txt" 2>&1 ||
+  fail "the stretched flag did not render: $(cat "$work/out.txt")"
+! grep -q "mesh_width" "$work/out.txt" || fail "a stretched 3 m flag changed zeta's size: $(cat "$work/out.txt")"
+grep -q '"mesh_width": 3.0' "$work/stretched-seed/zeta.json" || fail "zeta of the stretched flag: $(cat "$work/stretched-seed/zeta.json")"
 echo "render_cli_test: OK"

@@ -32,6 +32,7 @@ struct RenderArgs {
   std::string kind = "flag";
   uint64_t seed = 1;
   std::string zeta;        // JSON file (a ζ object, or a label.json with "zeta")
+  bool keep_zeta = false;  // render --zeta as given even when its mesh size is not the cloth's
   std::string backgrounds; // folder a relative background_image of --zeta is found in
   std::string format = "jpg";
   int jpeg_quality = 95;
@@ -92,15 +93,27 @@ data::ClothAnimation LoadInput(const RenderArgs& a, std::string* what) {
 
 // The pole, rod and camera aim follow ζ's mesh_width and mesh_aspect_ratio, so a cloth of
 // another size (a custom scene or OBJ) flew beside its pole, the camera aimed past it, silently.
-// A sampled ζ (--seed) takes the size the cloth measures; a given one (--zeta) must fit it.
+// A sampled ζ (--seed) takes the cloth's rest size; a given one (--zeta) must fit it, unless
+// --keep-zeta (a label's ζ of a dataset made with another scene: its frames as they were made).
 // A size within 5 % keeps ζ as it is: frames of the usual meshes stay what they were.
+// The rest size is the material space's extent (exact); measured from the first frame only
+// when unknown: a flag flying at 30 m/s after a warm-up measured 3.18 m for its 3 m, and --seed
+// rewrote its ζ.
 void FitMeshSize(const data::ClothAnimation& anim, const RenderArgs& a, render::RenderParams* zeta) {
-  const data::ClothFrame first = data::FrameAt(anim, 0.0);
-  const Eigen::Vector2d size = render::MeasureClothSize(first.V, first.F, first.UV);
+  Eigen::Vector2d size = anim.rest_size;
+  if (!(size.minCoeff() > 0)) {
+    const data::ClothFrame first = data::FrameAt(anim, 0.0);
+    size = render::MeasureClothSize(first.V, first.F, first.UV);
+  }
   const std::string why = render::MeshSizeMismatch(*zeta, size);
   if (why.empty()) return;
+  if (!a.zeta.empty() && a.keep_zeta) {
+    std::fprintf(stderr, "render: --keep-zeta: %s; rendered with zeta as given\n", why.c_str());
+    return;
+  }
   if (!a.zeta.empty())
-    throw std::invalid_argument("--zeta " + a.zeta + ": " + why + " (render it with --seed to fit zeta to it)");
+    throw std::invalid_argument("--zeta " + a.zeta + ": " + why +
+                                " (render it with --seed to fit zeta to it, or --keep-zeta to render it as given)");
   zeta->mesh_width = size.x();
   zeta->mesh_aspect_ratio = size.x() / size.y();
   std::fprintf(stderr, "render: the cloth measures %.4g x %.4g m; zeta's mesh_width and mesh_aspect_ratio follow it\n",
@@ -191,6 +204,9 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
       ->check(CLI::IsMember({"flag", "cloth"}))->capture_default_str();
   sub->add_option("--seed", a->seed, "seed of the render parameters zeta")->capture_default_str();
   sub->add_option("--zeta", a->zeta, "zeta JSON file (or an example's label.json) instead of --seed");
+  sub->add_flag("--keep-zeta", a->keep_zeta,
+                "render --zeta as given even when its mesh_width/mesh_aspect_ratio are not the cloth's size "
+                "(a label of a dataset made with another scene); refused otherwise");
   sub->add_option("--backgrounds", a->backgrounds,
                   "folder of the background photo a --zeta names by file name (make-dataset --backgrounds)");
   sub->add_option("--format", a->format, "jpg or png")->capture_default_str();

@@ -42,6 +42,7 @@ ClothAnimation AnimationFromTrajectory(const sim::Trajectory& t, int first, int 
   Eigen::Vector2d lo, hi;
   Bounds(U, &lo, &hi);
   a.UV = NormalizeTextureCoordinates(U, lo, hi);
+  a.rest_size = hi - lo;
   a.frames.resize(count);
   for (int i = 0; i < count; ++i) a.frames[i].V = t.frames[first + i].cast<double>();
   return a;
@@ -59,7 +60,10 @@ ClothAnimation ReadObjSequence(const std::string& folder, int cloth, double fram
     if (!fs::exists(path)) break;
     const sim::Mesh m = sim::ReadObj(path.string(), /*topology=*/false);  // drawn, not simulated
     const Eigen::MatrixXd U = m.U;
-    if (f == 0) Bounds(U, &lo, &hi);
+    if (f == 0) {
+      Bounds(U, &lo, &hi);
+      a.rest_size = hi - lo;
+    }
     ClothFrame frame;
     frame.V = m.V;
     frame.F = m.F;

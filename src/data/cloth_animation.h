@@ -27,6 +27,9 @@ struct ClothAnimation {
   Eigen::MatrixXi F;              // shared faces (frames with empty F use these)
   Eigen::MatrixXd UV;             // shared texture coordinates in [0,1]
   std::vector<ClothFrame> frames;
+  // The cloth's size at rest [m]: the extent of its material space (u, v), the bounds the
+  // texture coordinates were normalised with. Zero when unknown (an animation built by hand).
+  Eigen::Vector2d rest_size = Eigen::Vector2d::Zero();
 
   int num_frames() const { return static_cast<int>(frames.size()); }
   double duration() const { return frames.empty() ? 0.0 : (frames.size() - 1) * frame_time; }

@@ -197,6 +197,11 @@ Eigen::Vector2d MeasureClothSize(const Eigen::MatrixXd& V, const Eigen::MatrixXi
                                  const Eigen::MatrixXd& UV) {
   if (V.cols() != 3 || UV.cols() != 2 || UV.rows() != V.rows() || F.cols() != 3)
     throw std::invalid_argument("MeasureClothSize: expected V #V by 3, F #F by 3, UV #V by 2");
+  // A diverged frame is named as such (it read as "texture coordinates span no area").
+  for (Eigen::Index i = 0; i < V.rows(); ++i)
+    if (!V.row(i).allFinite() || !UV.row(i).allFinite())
+      throw std::invalid_argument("MeasureClothSize: vertex " + std::to_string(i) +
+                                  " has a coordinate that is not finite (a diverged frame?)");
   double width = 0.0, height = 0.0, weight = 0.0;
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
@@ -359,7 +364,8 @@ void ValidateRenderParams(const RenderParams& p) {
   Require(p.sun_strength <= 1e4, "sun_strength", "<= 1e4", p.sun_strength);
   Require(p.sky_strength <= 1e3, "sky_strength", "<= 1e3", p.sky_strength);
   // The ground reaches 1e6 m (the renderer's far limit): from higher than 1e3 m a band of sky
-  // showed below the horizon.
+  // showed below the horizon. (At 1e3 m, rays within 0.057 deg below the horizon still pass the
+  // far limit and show sky.)
   Require(p.camera_height <= 1e3, "camera_height", "<= 1000 m", p.camera_height);
   Require(p.camera_radius <= 1e4, "camera_radius", "<= 1e4 m", p.camera_radius);
   Require(std::isfinite(p.camera_angle_deg), "camera_angle_deg", "finite", p.camera_angle_deg);

@@ -33,7 +33,8 @@ class GustWind final : public WindField {
  public:
   // Inputs:
   //   params         rate, amplitude, duration, seed
-  //   mean_velocity  U [m/s]: gust direction e = U/|U| (x if U = 0) and front speed |U|
+  //   mean_velocity  U [m/s]: gust direction e = U/|U| (x if U = 0; MakeWindField makes no gusts
+  //                  for a calm wind) and front speed |U|
   GustWind(const GustParams& params, const Eigen::Vector3d& mean_velocity);
 
   Eigen::Vector3d Velocity(const Eigen::Vector3d& x, double t) const override;
