@@ -32,6 +32,7 @@
 #include "data/contact_sheet.h"
 #include "data/dataset_index.h"
 #include "data/paths.h"
+#include "render/render_params.h"
 #include "render/renderer.h"
 #include "sim/scene.h"
 #include "sim/scene_builder.h"
@@ -125,6 +126,7 @@ struct Prepared {
   SamplingRanges ranges;
   std::string scene_name;
   std::string scene_files;  // SceneFilesFingerprint: the contents the examples were simulated from
+  Eigen::Vector2d rest_size = Eigen::Vector2d::Zero();  // [m] the cloth's material-space extent
 };
 
 // FNV-1a (64 bit) of the bytes of every file a simulation reads: the scene, its cloths' meshes and
@@ -187,6 +189,8 @@ Prepared Prepare(const DatasetOptions& o) {
   sim::BuildOptions build;
   build.max_edge = o.max_edge;
   p.setup = sim::BuildScene(scene, build);
+  const Eigen::MatrixXd& U = p.setup.cloths[0].mesh.U;
+  if (U.rows() > 0 && U.cols() == 2) p.rest_size = (U.colwise().maxCoeff() - U.colwise().minCoeff()).transpose();
   p.base_theta = sim::SceneTheta(p.setup);
   p.scene_name = fs::path(scene_path).filename().string();
   p.ranges = o.ranges ? *o.ranges : DefaultRanges(o.kind);
@@ -279,6 +283,14 @@ SimulationSample SampleOf(const DatasetOptions& o, const Prepared& p, int64_t i)
 // View v's rendering parameters of sample s, as this run renders them.
 render::RenderParams ViewOf(const DatasetOptions& o, const Prepared& p, const SimulationSample& s, int v) {
   render::RenderParams zeta = SampleView(o.kind, s.seed, v, o.views, o.background_images, p.ranges.camera);
+  // ζ's pole, rod and camera aim assume the scene's usual cloth (3 x 2 m flag, 1 x 1 m cloth): a
+  // --scene of another size flew beside its pole, framed wrongly, without a word. Its rest size
+  // is taken instead when more than 5 % off (the usual meshes keep ζ, and their frames, as they
+  // were), as `clothwind render --seed` does.
+  if (p.rest_size.minCoeff() > 0 && !render::MeshSizeMismatch(zeta, p.rest_size).empty()) {
+    zeta.mesh_width = p.rest_size.x();
+    zeta.mesh_aspect_ratio = p.rest_size.x() / p.rest_size.y();
+  }
   if (o.samples > 0) zeta.samples = o.samples;
   zeta.width = zeta.height = o.size;
   zeta.fps = o.fps;

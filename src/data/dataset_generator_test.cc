@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -389,6 +390,40 @@ TEST_F(DatasetGeneratorTest, AnIndexOfAnotherKindOrALargerCountIsRefused) {
   EXPECT_NE(error.find("field 'dataset.generator_version' is " + std::to_string(kGeneratorVersion - 1)),
             std::string::npos) << error;
   EXPECT_NE(error.find("an older make-dataset made those frames"), std::string::npos) << error;
+}
+
+// A scene whose flag is another size (here 6 m x 4 m): ζ's pole and camera aim follow it (they
+// assumed the usual 3 m x 2 m flag, which then flew beside its pole), and the usual flag's ζ is
+// what it was (the reference's labels are made by the same code: 3 m, aspect 1.5).
+TEST_F(DatasetGeneratorTest, AFlagOfAnotherSizeGetsZetaOfItsSize) {
+  const fs::path config = fs::path(DefaultScenePath(render::SceneKind::kFlag)).parent_path().parent_path();
+  const fs::path copy = root_ / "big-scene";
+  for (const char* f : {"scenes/flag.json", "meshes/flag.obj", "materials/camel-ponte-roma.json"}) {
+    fs::create_directories((copy / f).parent_path());
+    fs::copy_file(config / f, copy / f);
+  }
+  {  // every vertex twice as far from the origin
+    std::ifstream in(config / "meshes/flag.obj");
+    std::ofstream out(copy / "meshes/flag.obj");
+    for (std::string line; std::getline(in, line);) {
+      double x, y, z;
+      if (line.rfind("v ", 0) == 0 && std::sscanf(line.c_str(), "v %lf %lf %lf", &x, &y, &z) == 3)
+        out << "v " << 2 * x << " " << 2 * y << " " << 2 * z << "\n";
+      else
+        out << line << "\n";
+    }
+  }
+  DatasetOptions o = Tiny((root_ / "big-flag").string());
+  o.count = 1;
+  o.max_edge = 2.0;
+  o.scene = (copy / "scenes/flag.json").string();
+  ASSERT_EQ(GenerateError(o), "");
+  const nlohmann::json zeta = ReadLabel((root_ / "big-flag" / "flag-000000-v0" / "label.json").string())["zeta"];
+  EXPECT_NEAR(zeta["mesh_width"].get<double>(), 6.0, 1e-6) << zeta;
+  EXPECT_NEAR(zeta["mesh_aspect_ratio"].get<double>(), 1.5, 1e-6) << zeta;
+  const nlohmann::json usual = ReadLabel((Ref() / "flag-000000-v0" / "label.json").string())["zeta"];
+  EXPECT_EQ(usual["mesh_width"], 3.0);
+  EXPECT_EQ(usual["mesh_aspect_ratio"], 1.5);
 }
 
 TEST_F(DatasetGeneratorTest, AnEditedSceneIsNotMixedIn) {
