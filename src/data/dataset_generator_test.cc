@@ -812,6 +812,27 @@ TEST_F(DatasetGeneratorTest, AddTracksGivesADatasetTheTracksItWouldHaveBeenMadeW
   ASSERT_TRUE(upgraded.errors.empty()) << upgraded.errors[0];
   EXPECT_EQ(upgraded.examples_written, 1);
   EXPECT_EQ(Bytes(added / name0 / "tracks.json"), Bytes(root_ / "with-tracks" / name0 / "tracks.json"));
+  // The check reads the file's head only (up to "world"): a copy cut short after it is still
+  // made again, and so is one of another grid, or one whose keys come in another order but hold
+  // everything (kept).
+  const std::string whole = Bytes(added / name0 / "tracks.json");
+  std::ofstream(added / name0 / "tracks.json") << whole.substr(0, whole.find("\"world\"") + 40);
+  EXPECT_EQ(GenerateDataset(add).examples_written, 1);
+  EXPECT_EQ(Bytes(added / name0 / "tracks.json"), whole);
+  nlohmann::json other = nlohmann::json::parse(whole);
+  other["grid"] = {5, 3};
+  std::ofstream(added / name0 / "tracks.json") << other.dump() << "\n";
+  EXPECT_EQ(GenerateDataset(add).examples_written, 1);
+  EXPECT_EQ(Bytes(added / name0 / "tracks.json"), whole);
+  {
+    std::string reordered = "{\"world\":" + nlohmann::json::parse(whole)["world"].dump();
+    nlohmann::json rest = nlohmann::json::parse(whole);
+    rest.erase("world");
+    for (auto it = rest.begin(); it != rest.end(); ++it) reordered += ",\"" + it.key() + "\":" + it.value().dump();
+    std::ofstream(added / name0 / "tracks.json") << reordered << "}\n";
+    EXPECT_EQ(GenerateDataset(add).examples_written, 0);
+    std::ofstream(added / name0 / "tracks.json") << whole;
+  }
   // Resuming a dataset made without tracks with --tracks alone would leave its examples without:
   // refused, pointing at --add-tracks.
   const fs::path plain = root_ / "plain-resumed-with-tracks";
