@@ -74,7 +74,9 @@ void CheckClipFrameRate(const clothwind::Clip& msg, double model_rate) {
   // frequencies. Allowed: 10 % per gap (nanosecond rounding and a camera's jitter are far below).
   const double period = 1.0 / msg.frame_rate;
   for (size_t i = 1; i < msg.frame_stamps.size(); ++i) {
-    const double gap = (msg.frame_stamps[i] - msg.frame_stamps[i - 1]).toSec();
+    // As doubles: ros::Time - ros::Time throws std::runtime_error past 2^31 s ([1 s, 3e9 s]
+    // passes the increasing-stamps check), reported as the model failing, not a malformed clip.
+    const double gap = msg.frame_stamps[i].toSec() - msg.frame_stamps[i - 1].toSec();
     if (std::abs(gap - period) > 0.1 * period) {
       throw std::invalid_argument("Clip.frame_stamps[" + std::to_string(i) + "] is " + std::to_string(gap) +
                                   " s after frame " + std::to_string(i - 1) + ", Clip.frame_rate " +
@@ -86,7 +88,7 @@ void CheckClipFrameRate(const clothwind::Clip& msg, double model_rate) {
   // gap's 10 % under a 25 Hz rate, and every frequency would read 7 % low.
   if (msg.frame_stamps.size() > 1) {
     const size_t n = msg.frame_stamps.size() - 1;
-    const double span = (msg.frame_stamps.back() - msg.frame_stamps.front()).toSec();
+    const double span = msg.frame_stamps.back().toSec() - msg.frame_stamps.front().toSec();
     if (std::abs(span - n * period) > 0.01 * n * period) {
       throw std::invalid_argument("Clip.frame_stamps span " + std::to_string(span) + " s over " + std::to_string(n) +
                                   " intervals, Clip.frame_rate " + std::to_string(msg.frame_rate) + " Hz says " +

@@ -111,6 +111,10 @@ TEST(CheckClipFrameRateTest, TheRateMustBeTheModelsAndTheStampsMustAgreeWithIt) 
   // A camera's jitter of 2 ms about exact stamps: accepted.
   for (uint32_t i = 0; i < clip.num_frames; ++i) clip.frame_stamps[i] = ros::Time(100.0 + i / 25.0 + (i % 2) * 0.002);
   EXPECT_EQ(RateRefusal(clip, 25.0), "accepted");
+  // Stamps more than 2^31 s apart (increasing, so not refused before): ros::Time's difference threw
+  // a runtime_error, which sdn_node reported as the model failing on the clip.
+  for (uint32_t i = 0; i < clip.num_frames; ++i) clip.frame_stamps[i] = ros::Time(i == 0 ? 1.0 : 3e9 + i);
+  EXPECT_NE(RateRefusal(clip, 25.0).find("Clip.frame_stamps[1]"), std::string::npos) << RateRefusal(clip, 25.0);
 }
 
 TEST(ToWindEstimateTest, TheEstimateSpansTheFramesTheModelRead) {

@@ -15,7 +15,8 @@ std::unique_ptr<FrameSource> MakeFrameSource(const FrameSourceOptions& o, Clock*
     if (error) *error = why;
     return nullptr;
   };
-  if (!(o.fps > 0)) return fail("fps/rate must be > 0 Hz, got " + std::to_string(o.fps));
+  // At most 1000 Hz: inf went to lround (undefined) in the pacer and the camera's frame interval.
+  if (!(o.fps > 0 && o.fps <= 1000)) return fail("fps/rate must be > 0 and <= 1000 Hz, got " + std::to_string(o.fps));
   if (o.source == "v4l2") {
     V4l2Options v;
     v.device = o.path.empty() ? "/dev/video0" : o.path;
@@ -25,7 +26,10 @@ std::unique_ptr<FrameSource> MakeFrameSource(const FrameSourceOptions& o, Clock*
                   std::to_string(o.height));
     }
     if (o.buffers < 2) return fail("buffers must be >= 2, got " + std::to_string(o.buffers));
-    if (!(o.timeout_s > 0)) return fail("timeout must be > 0 s");
+    // Finite and at most a day: inf or 1e10 overflowed its nanoseconds (INT64_MIN on x86), so the
+    // loss deadline was always past and the camera was reopened every 0.25 s.
+    if (!(o.timeout_s > 0 && o.timeout_s <= 86400))
+      return fail("timeout must be > 0 and <= 86400 s, got " + std::to_string(o.timeout_s));
     v.width = o.width;
     v.height = o.height;
     v.fps = o.fps;

@@ -1,5 +1,7 @@
 #include "sensors/frame_source.h"
 
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include "sensors/frame_timestamp_fake_clock.h"
@@ -158,6 +160,18 @@ TEST(MakeFrameSourceTest, BuildsEachKindAndNamesBadOptions) {
   o.width = 0;
   EXPECT_EQ(MakeFrameSource(o, &clock, {}, &error), nullptr);
   EXPECT_NE(error.find("width and height"), std::string::npos) << error;
+  // An unbounded timeout overflowed its nanoseconds: the camera was lost on every read.
+  o.width = 640;
+  for (double bad : {std::numeric_limits<double>::infinity(), 1e10}) {
+    o.timeout_s = bad;
+    EXPECT_EQ(MakeFrameSource(o, &clock, {}, &error), nullptr) << bad;
+    EXPECT_NE(error.find("timeout must be > 0 and <= 86400 s"), std::string::npos) << error;
+  }
+  o.timeout_s = 2.0;
+  o.fps = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(MakeFrameSource(o, &clock, {}, &error), nullptr);
+  EXPECT_NE(error.find("<= 1000 Hz"), std::string::npos) << error;
+  o.fps = 30;
 
   FrameSourceOptions f;
   f.source = "folder";
@@ -175,7 +189,7 @@ TEST(MakeFrameSourceTest, BuildsEachKindAndNamesBadOptions) {
   f.source = "folder";
   f.fps = 0;
   EXPECT_EQ(MakeFrameSource(f, &clock, {}, &error), nullptr);
-  EXPECT_NE(error.find("must be > 0 Hz"), std::string::npos);
+  EXPECT_NE(error.find("must be > 0 and <= 1000 Hz"), std::string::npos);
 }
 
 }  // namespace
