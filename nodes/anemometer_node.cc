@@ -303,10 +303,15 @@ class AnemometerNode {
   }
 
   // The frame a reading's direction is in: earth-referenced bearings (NMEA MWD, a north-aligned
-  // station) in ~earth_frame_id when set, instrument-relative angles in the instrument's.
+  // station) in ~earth_frame_id when set, instrument-relative angles in the instrument's. A
+  // reading of such a record type without a direction (calm, or bearings left empty) goes with
+  // its type's others: in ~frame_id, a station's calm first reading made wind_display adopt the
+  // instrument's frame and leave every later bearing out of the arrow for the whole session.
   std::string FrameFor(const clothwind::sensors::WindReading& r, const std::string& instrument_frame) {
     using clothwind::sensors::AngleReference;
-    const bool earth = r.reference == AngleReference::kEarth || r.reference == AngleReference::kMagnetic;
+    const bool earth_type = r.source == "nmea_mwd" || r.source == "fine_offset";
+    const bool earth = r.reference == AngleReference::kEarth || r.reference == AngleReference::kMagnetic ||
+                       (r.reference == AngleReference::kNone && earth_type);
     if (earth) saw_earth_ = true;
     if (r.reference == AngleReference::kInstrument) saw_instrument_ = true;
     if (r.reference == AngleReference::kMagnetic) saw_magnetic_ = true;

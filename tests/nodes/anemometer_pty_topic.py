@@ -153,8 +153,12 @@ class AnemometerTopicTest(unittest.TestCase):
         self.assertIn('~earth_frame_id', status.message)
         self.assertIn('speed 500', values['last error'])
 
-        winds = self.winds_on('/replay_earth/anemometer/wind', [mwv, mwd_magnetic])
-        self.assertEqual([w.header.frame_id for w in winds], ['recorded_frame', 'enu'])
+        # An MWD without bearings (a calm one) goes with the MWDs: in the instrument's frame, a
+        # station's calm first reading made wind_display adopt that frame and refuse the bearings.
+        mwd_calm = nmea('WIMWD,,T,,M,0.0,N,0.0,M')
+        winds = self.winds_on('/replay_earth/anemometer/wind', [mwv, mwd_magnetic, mwd_calm])
+        self.assertEqual([w.header.frame_id for w in winds], ['recorded_frame', 'enu', 'enu'])
+        self.assertTrue(math.isnan(winds[2].direction))
         # Magnetic 90 + 10 east = 100 deg true, from the east-south-east: blows to 280 deg, i.e.
         # 170 deg counter-clockwise from east.
         self.assertAlmostEqual(winds[1].direction, math.radians(170.0), places=9)
