@@ -10,7 +10,9 @@ namespace clothwind::tools {
 ProgressBar::ProgressBar(Options options)
     : o_(std::move(options)),
       tty_(o_.tty >= 0 ? o_.tty == 1 : ::isatty(::fileno(o_.stream)) == 1),
-      start_(std::chrono::steady_clock::now()) {}
+      start_(std::chrono::steady_clock::now()) {
+  if (o_.rate_unit.empty()) o_.rate_unit = o_.unit + "/s";
+}
 
 double ProgressBar::Elapsed() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();

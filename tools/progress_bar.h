@@ -20,7 +20,7 @@ class ProgressBar {
     std::string label;              // printed first, e.g. "make-dataset"
     std::string unit = "items";     // what `done` counts
     double rate_scale = 1.0;        // the rate shown is done * rate_scale per second ...
-    std::string rate_unit = "items/s";  // ... in this unit (e.g. frame_time and "sim s/s")
+    std::string rate_unit;          // ... in this unit (e.g. frame_time and "sim s/s"); "": unit + "/s"
     double plain_interval = 10.0;   // [s] between plain lines when not on a terminal
     std::FILE* stream = stderr;
     int tty = -1;                   // -1: detect (isatty); 0: plain lines; 1: redraw

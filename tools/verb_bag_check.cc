@@ -218,7 +218,6 @@ int Check(const BagCheckArgs& a) {
     ProgressBar::Options o;
     o.label = "bag-check";
     o.unit = "messages";
-    o.rate_unit = "messages/s";
     bar = std::make_unique<ProgressBar>(o);
   }
   const size_t total = bar ? view.size() : 0;

@@ -51,7 +51,6 @@ int Run(const ContactSheetArgs& a) {
   ProgressBar::Options b;
   b.label = "contact-sheet";
   b.unit = "tiles";
-  b.rate_unit = "tiles/s";
   ProgressBar bar(b);
   const bool written =
       data::WriteContactSheet(a.dir, index, out, a.options, [&](int done, int total) { bar.Update(done, total); });

@@ -122,7 +122,6 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     ProgressBar::Options b;
     b.label = "eval";
     b.unit = "clips";
-    b.rate_unit = "clips/s";
     ProgressBar bar(b);
     const learn::EvalResult r = learn::Evaluate(a->model, a->data, a->split, a->threads, a->device, a->batch,
                                                 a->windows, a->mirror, a->mirror_clips,

@@ -72,7 +72,6 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
       ProgressBar::Options b;
       b.label = "calibrate";
       b.unit = "clips";
-      b.rate_unit = "clips/s";
       ProgressBar bar(b);
       const learn::EvalResult r =
           learn::Evaluate(a->model, a->calibrate_data, "val", a->threads, "cpu", 16, 1, false, false,

@@ -57,7 +57,6 @@ int Run(MakeDatasetArgs& a) {
     ProgressBar::Options b;
     b.label = "make-dataset --reindex";
     b.unit = "labels";
-    b.rate_unit = "labels/s";
     ProgressBar bar(b);
     const int64_t n = data::ReindexDataset(o.out, !a.no_contact_sheet,
                                            [&](int done, int total) { bar.Update(done, total); });
@@ -123,7 +122,6 @@ int Run(MakeDatasetArgs& a) {
           ProgressBar::Options b;
           b.label = "make-dataset index";
           b.unit = "labels";
-          b.rate_unit = "labels/s";
           index_bar = std::make_unique<ProgressBar>(b);
         }
         index_bar->Update(done, total);

@@ -148,7 +148,6 @@ int Run(const MakeSessionArgs& a) {
   ProgressBar::Options bo;
   bo.label = "make-session";
   bo.unit = "frames";
-  bo.rate_unit = "frames/s";
   auto bar = std::make_unique<ProgressBar>(bo);
   if (rendered) {
     std::fprintf(stderr, "make-session: rendering %zu frames of a simulated flag (%d vertices), %dx%d\n",

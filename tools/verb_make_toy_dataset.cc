@@ -29,7 +29,6 @@ VerbRegistrar registrar("make-toy-dataset", [](CLI::App& app) -> std::function<i
     ProgressBar::Options b;
     b.label = "make-toy-dataset";
     b.unit = "examples";
-    b.rate_unit = "examples/s";
     ProgressBar bar(b);
     learn::WriteToyDataset(a->out, a->o, [&](int done, int total) { bar.Update(done, total); });
     bar.Finish();

@@ -114,8 +114,7 @@ void FitMeshSize(const data::ClothAnimation& anim, const RenderArgs& a, render::
   if (!a.zeta.empty())
     throw std::invalid_argument("--zeta " + a.zeta + ": " + why +
                                 " (render it with --seed to fit zeta to it, or --keep-zeta to render it as given)");
-  zeta->mesh_width = size.x();
-  zeta->mesh_aspect_ratio = size.x() / size.y();
+  render::SetMeshSize(size, zeta);
   std::fprintf(stderr, "render: the cloth measures %.4g x %.4g m; zeta's mesh_width and mesh_aspect_ratio follow it\n",
                size.x(), size.y());
   render::ValidateRenderParams(*zeta);
@@ -174,7 +173,6 @@ int Run(const RenderArgs& a) {
   ProgressBar::Options bo;
   bo.label = "render";
   bo.unit = "frames";
-  bo.rate_unit = "frames/s";
   ProgressBar bar(bo);
   std::fprintf(stderr, "render: %s, %d frames at %.4g fps from %.3f s, %dx%d, %s %s\n", what.c_str(), count,
                a.fps, a.start, zeta.width, zeta.height, zeta.texture_kind.c_str(), zeta.texture_name.c_str());

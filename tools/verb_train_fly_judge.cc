@@ -39,7 +39,6 @@ learn::MotionMaps Collect(const learn::Dataset& dataset, const std::string& spli
   ProgressBar::Options b;
   b.label = "motion maps (" + split + ")";
   b.unit = "clips";
-  b.rate_unit = "clips/s";
   ProgressBar bar(b);
   learn::MotionMaps maps = learn::CollectMotionMaps(clips, frames, windows, [&](int d, int t) { bar.Update(d, t); });
   bar.Finish();
@@ -146,7 +145,6 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
       ProgressBar::Options b;
       b.label = "train-fly-judge";
       b.unit = "epochs";
-      b.rate_unit = "epochs/s";
       ProgressBar bar(b);
       learn::FlyJudge trained = learn::TrainFlyJudge(train.maps, a->train, [&](int epoch, int epochs, double loss) {
         bar.Update(epoch, epochs, "loss " + std::to_string(loss));

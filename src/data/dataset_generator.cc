@@ -289,25 +289,27 @@ render::RenderParams ViewOf(const DatasetOptions& o, const Prepared& p, const Si
   // --scene of another size flew beside its pole, framed wrongly, without a word. Its rest size
   // is taken instead when more than 5 % off (the usual meshes keep ζ, and their frames, as they
   // were), as `clothwind render --seed` does.
-  if (p.rest_size.minCoeff() > 0 && !render::MeshSizeMismatch(zeta, p.rest_size).empty()) {
-    zeta.mesh_width = p.rest_size.x();
-    zeta.mesh_aspect_ratio = p.rest_size.x() / p.rest_size.y();
-  }
+  if (p.rest_size.minCoeff() > 0 && !render::MeshSizeMismatch(zeta, p.rest_size).empty())
+    render::SetMeshSize(p.rest_size, &zeta);
   if (o.samples > 0) zeta.samples = o.samples;
   zeta.width = zeta.height = o.size;
   zeta.fps = o.fps;
   return zeta;
 }
 
+// Frame k's file name in an example folder: "%03d.<ext>", the labels' frame_pattern.
+std::string ExampleFrameFile(size_t k, const std::string& ext) {
+  char file[32];
+  std::snprintf(file, sizeof(file), "%03zu.", k);
+  return file + ext;
+}
+
 // Whether every one of an example's `frames` frame files (000.<ext> ...) is in `folder`: an
 // interrupted copy (cp goes in the folder's hashed order, so label.json can come before 047.jpg)
 // left a label beside missing frames, counted complete at a resume and indexed.
 bool FramesPresent(const fs::path& folder, int frames, const std::string& ext) {
-  for (int k = 0; k < frames; ++k) {
-    char file[32];
-    std::snprintf(file, sizeof(file), "%03d.%s", k, ext.c_str());
-    if (!fs::exists(folder / file)) return false;
-  }
+  for (int k = 0; k < frames; ++k)
+    if (!fs::exists(folder / ExampleFrameFile(k, ext))) return false;
   return true;
 }
 
@@ -442,8 +444,7 @@ void WriteExample(const std::string& out, const std::string& name, const std::ve
     cv::Mat grey;
     std::vector<uchar> encoded;
     for (size_t k = 0; k < images.size(); ++k) {
-      char file[32];
-      std::snprintf(file, sizeof(file), "%03zu.%s", k, o.frame_ext.c_str());
+      const std::string file = ExampleFrameFile(k, o.frame_ext);
       // PGM holds one channel: the grey the SDN reads (cv::imread's IMREAD_GRAYSCALE weights).
       if (o.frame_ext == "pgm") cv::cvtColor(images[k], grey, cv::COLOR_BGR2GRAY);
       if (!cv::imencode("." + o.frame_ext, o.frame_ext == "pgm" ? grey : images[k], encoded, params))
@@ -479,9 +480,7 @@ void WriteExample(const std::string& out, const std::string& name, const std::ve
 // --add-tracks: throws unless `rendered` (the example's last frame rendered again from its replayed
 // simulation) matches the stored one within kMaxReplayGreyDifference.
 void CheckReplay(const fs::path& example, int last_frame, const std::string& ext, const cv::Mat& rendered) {
-  char file[32];
-  std::snprintf(file, sizeof(file), "%03d.%s", last_frame, ext.c_str());
-  const fs::path path = example / file;
+  const fs::path path = example / ExampleFrameFile(last_frame, ext);
   std::string why;
   const cv::Mat stored = common::ReadImageFile(path, cv::IMREAD_GRAYSCALE, &why);
   if (stored.empty()) throw std::runtime_error("cannot read " + path.string() + " (" + why + ")");
@@ -657,14 +656,11 @@ void CheckExampleLabel(const std::string& dir, int64_t i, int v, const DatasetOp
     throw std::runtime_error((fs::path(dir) / name).string() +
                              " has no tracks.json, and this run makes tracks (give the examples theirs with "
                              "--add-tracks, then resume with --tracks)");
-  const auto near = [](const nlohmann::json& v, double expected) {
-    return v.is_number() && std::abs(v.get<double>() - expected) <= 1e-9 * std::max(1.0, std::abs(expected));
-  };
-  if (label.contains("frame_rate") && !near(label["frame_rate"], o.fps))
+  if (label.contains("frame_rate") && !JsonNear(label["frame_rate"], o.fps))
     throw std::runtime_error(file.string() + ": field 'frame_rate' is " + label.value("frame_rate", nlohmann::json()).dump() +
                              ", this run makes " + std::to_string(o.fps) + " Hz (resume with its settings, or use another --out)");
   const double warmup = std::lround(o.warmup / frame_time) * frame_time;
-  if (sim.contains("warmup") && !near(sim["warmup"], warmup))
+  if (sim.contains("warmup") && !JsonNear(sim["warmup"], warmup))
     throw std::runtime_error(file.string() + ": field 'simulation_settings.warmup' is " +
                              sim.value("warmup", nlohmann::json()).dump() + ", this run makes " + std::to_string(warmup) +
                              " s (resume with its settings, or use another --out)");

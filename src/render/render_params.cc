@@ -229,6 +229,11 @@ Eigen::Vector2d MeasureClothSize(const Eigen::MatrixXd& V, const Eigen::MatrixXi
   return Eigen::Vector2d(width / weight, height / weight);
 }
 
+void SetMeshSize(const Eigen::Vector2d& size, RenderParams* p) {
+  p->mesh_width = size.x();
+  p->mesh_aspect_ratio = size.x() / size.y();
+}
+
 std::string MeshSizeMismatch(const RenderParams& p, const Eigen::Vector2d& size, double tolerance) {
   const double w = size.x(), h = size.y();
   std::ostringstream m;

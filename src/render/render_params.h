@@ -144,6 +144,9 @@ Eigen::Vector2d MeasureClothSize(const Eigen::MatrixXd& V, const Eigen::MatrixXi
 std::string MeshSizeMismatch(const RenderParams& p, const Eigen::Vector2d& size,
                              double tolerance = 0.05);
 
+// Sets ζ's mesh_width and mesh_aspect_ratio to a cloth of `size` (width, height) [m].
+void SetMeshSize(const Eigen::Vector2d& size, RenderParams* p);
+
 // Checks the values are usable (positive sizes, samples >= 1, known texture, a camera at least
 // kMinCameraRadius from its target and at most 1000 m up, ...); throws std::invalid_argument
 // naming the field and the expected range.
