@@ -48,6 +48,9 @@ class ImageFolderSource : public FrameSource {
   uint64_t sequence_ = 0;
   bool open_ = false;
   bool pending_valid_ = false;
+  // An unreadable image waiting for its slot: it is reported (kBadFrame) when its frame was due,
+  // so the next image keeps its own slot's stamp rather than taking this one's.
+  bool bad_pending_ = false;
   Frame pending_;
   int first_cols_ = 0, first_rows_ = 0;
   std::string first_encoding_;

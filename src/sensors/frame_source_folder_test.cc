@@ -138,6 +138,38 @@ TEST(ImageFolderSourceTest, ClearErrorsForMissingEmptyAndInconsistentFolders) {
   EXPECT_NE(shortened.error().find("frame_0001.jpg (JPEG truncated"), std::string::npos) << shortened.error();
 }
 
+TEST(ImageFolderSourceTest, AnUnreadableImageKeepsItsSlotInTime) {
+  // frame_0002 cannot be used (another size): the frames after it keep their own slots and
+  // sequence numbers, as a camera's lost frame leaves a gap. Before, frame_0003 took frame_0002's
+  // stamp: a clip across the bad frame held 31 intervals in 30 slots, every frequency 3 % high.
+  TempDir dir;
+  WriteFrames(dir.path(), 5, 1);
+  ASSERT_TRUE(cv::imwrite(dir.path() + "/frame_0002.png", cv::Mat(10, 10, CV_8UC1, cv::Scalar(0))));
+  FakeClock clock;
+  ImageFolderSource source(dir.path(), 10.0, false, &clock);
+  ASSERT_TRUE(source.Open()) << source.error();
+  std::vector<ReadStatus> statuses;
+  std::vector<int64_t> stamps, sequences, returned_at;
+  for (int k = 0; k < 5; ++k) {
+    Frame f;
+    statuses.push_back(source.Read(&f, 1.0));
+    returned_at.push_back(clock.MonotonicNs());
+    if (statuses.back() != ReadStatus::kFrame) continue;
+    if (stamps.empty()) stamps.push_back(f.stamp_ns);
+    stamps.push_back(f.stamp_ns - stamps.front());
+    sequences.push_back(static_cast<int64_t>(f.sequence));
+  }
+  stamps.erase(stamps.begin());
+  EXPECT_EQ(statuses, (std::vector<ReadStatus>{ReadStatus::kFrame, ReadStatus::kFrame, ReadStatus::kBadFrame,
+                                               ReadStatus::kFrame, ReadStatus::kFrame}));
+  EXPECT_EQ(stamps, (std::vector<int64_t>{0, 100 * kMs, 300 * kMs, 400 * kMs}));
+  EXPECT_EQ(sequences, (std::vector<int64_t>{0, 1, 3, 4}));
+  // The bad frame is reported when its frame was due, not at once.
+  EXPECT_EQ(returned_at[2] - returned_at[0], 200 * kMs);
+  Frame f;
+  EXPECT_EQ(source.Read(&f, 1.0), ReadStatus::kEnd);
+}
+
 TEST(ImageFolderSourceTest, ClosesItselfWhenNothingIsReadableAnyMore) {
   FakeClock clock;
   {

@@ -59,7 +59,7 @@ ReadStatus VideoFileSource::Read(Frame* frame, double max_wait_s) {
     error_ = "video " + path_ + " is not open";
     return ReadStatus::kError;
   }
-  if (!pending_valid_) {
+  if (!pending_valid_ && !bad_pending_) {
     cv::Mat raw;
     if (!capture_.read(raw) || raw.empty()) {
       // A file that opens but yields no frame at all (a broken stream, a codec OpenCV lacks) is
@@ -80,15 +80,23 @@ ReadStatus VideoFileSource::Read(Frame* frame, double max_wait_s) {
     }
     Frame f;
     if (!NormalizeRecordedImage(raw, &f.image, &f.encoding)) {
-      error_ = "video " + path_ + ": frame with " + std::to_string(raw.channels()) + " channels";
-      return ReadStatus::kBadFrame;
+      error_ = "video " + path_ + ": frame " + std::to_string(sequence_) + " has " + std::to_string(raw.channels()) +
+               " channels, expected 1, 3 or 4";
+      // Its slot and sequence number are kept (the frames after it were stamped a period early).
+      ++sequence_;
+      bad_pending_ = true;
+    } else {
+      f.sequence = sequence_++;
+      pending_ = std::move(f);
+      pending_valid_ = true;
     }
-    f.sequence = sequence_++;
-    pending_ = std::move(f);
-    pending_valid_ = true;
   }
   int64_t stamp = 0;
   if (!pacer_->WaitNext(max_wait_s, &stamp)) return ReadStatus::kNoFrame;
+  if (bad_pending_) {
+    bad_pending_ = false;
+    return ReadStatus::kBadFrame;
+  }
   *frame = std::move(pending_);
   frame->stamp_ns = stamp;
   pending_valid_ = false;
@@ -99,6 +107,7 @@ void VideoFileSource::Close() {
   capture_.release();
   open_ = false;
   pending_valid_ = false;
+  bad_pending_ = false;
 }
 
 std::string VideoFileSource::Describe() const {

@@ -44,6 +44,7 @@ class VideoFileSource : public FrameSource {
   cv::VideoCapture capture_;
   bool open_ = false;
   bool pending_valid_ = false;
+  bool bad_pending_ = false;  // an undecodable frame waiting for its slot (see frame_source_folder.h)
   Frame pending_;
   uint64_t sequence_ = 0;
   int loops_ = 0;
