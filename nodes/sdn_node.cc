@@ -25,7 +25,8 @@
 // the sequence. A malformed clip (wrong encoding, size, stamps, or a frame rate other than the
 // model's) is an ERROR, not a crash, until a good clip is estimated; a failure of the model itself
 // is an ERROR of its own. A model that cannot be loaded is retried every 2 s (ERROR until it
-// loads). No clip for 10 s after the first is a WARN. A model trained without flips left on
+// loads). No clip for 10 s after the first is a WARN, and so are clips missing from the sequence
+// in the last 30 s (the queue dropping clips the model is too slow for, or losses upstream). A model trained without flips left on
 // ~flag_flies auto with no fly judge (the motion cues misjudge ~9 % of clips) is a WARN, as is a
 // fly judge that cannot load (~fly_judge, or the one beside the model) and a parameter out of its
 // range (named, and its default used). A parameter of the wrong type (ros_bridge/strict_param.h)
@@ -37,6 +38,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 
@@ -88,6 +90,7 @@ class SdnNode {
     // Subscribed before the model loads (libtorch, the weights and the warm-up take seconds):
     // clips that come meanwhile wait in the queue, as callbacks run only once spin() starts, rather
     // than going to no subscriber at all (a replay starts as soon as the bag's topics have theirs).
+    queue_size_ = queue_size;
     clip_sub_ = nh.subscribe("clips", queue_size, &SdnNode::OnClip, this);
     TryLoad();
     if (!predictor_) {
@@ -140,7 +143,14 @@ class SdnNode {
                        "frame [rad]); the model's way is used",
                        0);
       }
-    } else if (!name.empty()) {
+    } else if (std::isfinite(camera_heading_)) {
+      // Read but unused: a ~camera_heading given without ~flag_flies wind read every clip as
+      // filmed without a word (a flag flying left then reads ~2.5 m/s off).
+      ParameterError("~camera_heading is set but ~flag_flies is '" + name +
+                         "', not wind: the anemometer's direction is not used to tell the way the flag flies",
+                     0);
+    }
+    if (name != "wind" && !name.empty()) {
       try {
         told_flag_flies_ = clothwind::learn::FlagFliesFromName(name, "~flag_flies");
       } catch (const std::invalid_argument& e) {
@@ -202,9 +212,6 @@ class SdnNode {
       ++dropped_;
       return;
     }
-    // Counted before the checks: a malformed clip still arrived, and is counted as malformed, not
-    // also as missing from the sequence.
-    CountSequence(clip->sequence);
     try {
       // A colour model reads Y, Cr and Cb from bgr8 clips; a grey one the grey of either kind.
       std::vector<cv::Mat> camera_frames;
@@ -212,8 +219,10 @@ class SdnNode {
         camera_frames = clothwind::ros_bridge::ClipFrames(*clip);
         clothwind::ros_bridge::CheckClipFrameRate(*clip, predictor_->config().frame_rate);
       } catch (const std::invalid_argument& e) {
+        CountMalformedSequence(clip->sequence);
         throw MalformedClip(e.what());
       }
+      CountSequence(clip->sequence);
       if (follow_wind_) {  // a clip that passed the checks only
         // ~camera_heading is an angle in one frame: a direction in another says nothing of the way.
         const bool same_frame = camera_heading_frame_.empty() || clip->wind_direction_frame_id == camera_heading_frame_;
@@ -277,17 +286,33 @@ class SdnNode {
   // upstream); a sequence that starts again (a restarted buffer or bag) counts nothing.
   // A jump of more than a day's clips (at 25 fps with a stride of 1) is a new numbering, not
   // losses: sequence 2^63 then 0, 1, 2 read as 9.2e18 clips missing.
+  // Counted for clips that pass the checks: a malformed clip's own number, however stray, does
+  // not move the sequence (one numbered 1000 between clips 1 and 2 read as 998 missing), and the
+  // malformed clips between two good ones arrived, so they are not missing either.
   void CountSequence(uint64_t sequence) {
     constexpr uint64_t kMaxGap = 25ull * 86400;
-    if (have_sequence_ && sequence > last_sequence_ + 1 && sequence - last_sequence_ - 1 <= kMaxGap)
-      missing_ += sequence - last_sequence_ - 1;
+    if (have_sequence_ && sequence > last_sequence_ + 1 && sequence - last_sequence_ - 1 <= kMaxGap) {
+      uint64_t gap = sequence - last_sequence_ - 1;
+      for (uint64_t m : malformed_since_good_) gap -= m > last_sequence_ && m < sequence;
+      if (gap > 0) {
+        missing_ += gap;
+        recent_missing_.emplace_back(ros::SteadyTime::now().toSec(), gap);
+      }
+    }
+    malformed_since_good_.clear();
     last_sequence_ = sequence;
     have_sequence_ = true;
+  }
+
+  // Bounded: a stream of malformed clips only (a colour model fed grey clips) would grow it for ever.
+  void CountMalformedSequence(uint64_t sequence) {
+    if (malformed_since_good_.size() < 4096) malformed_since_good_.insert(sequence);
   }
 
   // The estimates' wall times over the last 30 s, for the rate.
   void TrimRate(double now) {
     while (!stamps_.empty() && now - stamps_.front() > 30.0) stamps_.pop_front();
+    while (!recent_missing_.empty() && now - recent_missing_.front().first > 30.0) recent_missing_.pop_front();
   }
 
   // ~flag_flies wind: the way the anemometer's wind makes the flag fly; a wind end-on to the
@@ -374,6 +399,18 @@ class SdnNode {
                       estimates_ > 0 ? "no clip" : "no clip received yet", idle);
         stat.mergeSummary(warn, what);
       }
+      // Clips lost while estimating: the counter alone left an OK over a model slower than the
+      // clips come, its queue dropping most of them.
+      uint64_t missing = 0;
+      for (const auto& m : recent_missing_) missing += m.second;
+      if (missing > 0) {
+        char what[224];
+        std::snprintf(what, sizeof what,
+                      "estimating; %llu clip%s missing from the sequence in the last 30 s (this node's ~queue_size "
+                      "of %d overflowing while an estimate takes %.3g s, or lost upstream)",
+                      static_cast<unsigned long long>(missing), missing == 1 ? "" : "s", queue_size_, mean);
+        stat.mergeSummary(warn, what);
+      }
       if (!judge_error_.empty()) stat.mergeSummary(warn, "estimating; ~fly_judge did not load: " + judge_error_);
       // ~flag_flies wind whose wind has never said the way (cups without a vane, a direction in
       // another frame than ~camera_heading_frame, the wind end-on): every clip is read as filmed,
@@ -447,6 +484,9 @@ class SdnNode {
   double camera_heading_ = 0, end_on_ = 0;                       // [rad], for follow_wind_
   int threads_ = 2;
   std::unique_ptr<clothwind::learn::Predictor> predictor_;
+  int queue_size_ = 2;
+  std::set<uint64_t> malformed_since_good_;  // sequence numbers of malformed clips since the last good one
+  std::deque<std::pair<double, uint64_t>> recent_missing_;  // (wall time [s], clips missing) of each gap
   std::deque<double> latencies_, stamps_, ages_;  // ages_: [s] ROS time from clip end to its estimate
   clothwind::sensors::TrailingMean trailing_;
   std::deque<std::pair<double, ros::Time>> starts_;  // (clip end [s], clip start) of the averaged clips

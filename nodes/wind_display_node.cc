@@ -21,7 +21,7 @@
 // this by the wall clock: a bag that ended stops /clock) is shown as "--", and the anemometer's
 // mean and arrow go when no reading is left in ~mean_window (either clock); the plot scrolls with
 // the clock while inputs pause. The display frame is ~frame_id, else the frame of the first
-// valid reading with a velocity (else of the first valid one): readings in another frame (MWD's
+// valid reading with a velocity other than calm (0, 0, 0) (else of the first valid one): readings in another frame (MWD's
 // earth frame beside MWV's instrument frame) add their speeds and no arrow, so neither the arrow's
 // convention nor /tf_static flips. /diagnostics says how old each input is. Messages stamped 0
 // are dropped (counted): they would stamp the displays 0 and empty the plot; so are messages
@@ -151,7 +151,11 @@ class WindDisplayNode {
       has_vector = false;
       Dropped(&implausible_velocity_, kVelocity);
     }
-    if (frame_gate_.Admit(msg->header.frame_id, has_vector ? 0.0 : std::nan(""))) {
+    // A calm velocity (0, 0, 0) has no bearing, so it names no frame: a station whose first
+    // reading was calm made its frame the display's and left every later bearing, in another
+    // frame, out of the arrow. Its zero arrow is drawn in whichever frame the display has.
+    const bool bearing = has_vector && (msg->velocity.x != 0.0 || msg->velocity.y != 0.0 || vz != 0.0);
+    if (frame_gate_.Admit(msg->header.frame_id, bearing ? 0.0 : std::nan(""))) {
       if (has_vector && (!have_vector_ || msg->header.stamp >= last_vector_.header.stamp)) {
         last_vector_ = *msg;
         last_vector_wall_ = ros::SteadyTime::now();
@@ -310,7 +314,7 @@ class WindDisplayNode {
               have_estimate_ ? (ros::SteadyTime::now() - last_estimate_wall_).toSec() : -1.0);
   }
 
-  // The display frame: ~frame_id, else the first valid reading's with a velocity (the arrow's),
+  // The display frame: ~frame_id, else the first valid reading's with a bearing (the arrow's),
   // else the first valid reading's (a speed-only instrument's text), else "anemometer".
   std::string FrameId() const {
     if (!frame_gate_.frame_id().empty()) return frame_gate_.frame_id();

@@ -129,6 +129,19 @@ class MonitorNodesTest(unittest.TestCase):
         while time.time() < deadline and lazy_values().get("displays drawn") == "0":
             time.sleep(0.2)
         self.assertNotEqual(lazy_values().get("displays drawn"), "0")
+        # The readings above were calm (velocity 0, 0, 0: no bearing) in "anemometer": they name no
+        # frame, so a bearing in the earth frame after them fixes the display's. The calm ones
+        # fixed it before, and every later bearing was left out of the arrow.
+        wind = WindMeasurement()
+        wind.header.stamp, wind.header.frame_id = rospy.Time.now(), "earth"
+        wind.speed, wind.valid = 2.0, True
+        wind.velocity.x = 2.0
+        pub.publish(wind)
+        deadline = time.time() + 10
+        while time.time() < deadline and lazy_values().get("frame") != "earth":
+            time.sleep(0.2)
+        self.assertEqual(lazy_values().get("frame"), "earth", lazy_values())
+        self.assertEqual(lazy_values().get("readings in another frame (no arrow)"), "0", lazy_values())
 
     def test_display_and_report(self):
         for i in range(8):  # 4 s: estimates at 1 Hz, readings at 2 Hz

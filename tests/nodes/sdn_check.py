@@ -288,6 +288,11 @@ class SdnNodeTest(unittest.TestCase):
         # The malformed clip raised an ERROR naming the field, and the node carried on.
         self.wait_for(lambda: any(s.level == DiagnosticStatus.ERROR and "data" in s.message for s in self.statuses),
                       10, "an ERROR diagnostic for the malformed clip")
+        # ...and its stray number (1000, between clips 1 and 2) made no clip missing: counted before
+        # the checks, it read as 998 clips missing.
+        values = self.wait_for_estimates(self.statuses, n)
+        self.assertEqual(values["clips missing from the sequence (queue or upstream)"], "0", values)
+        self.assertEqual(values["malformed clips"], "1", values)
         # Spectral images: colour-mapped at the model's input size, stamped like the estimates.
         self.wait_for(lambda: len(self.power) > 0 and len(self.frequency) > 0, 10, "sdn/power and sdn/frequency")
         with self.lock:
@@ -437,6 +442,8 @@ class SdnNodeTest(unittest.TestCase):
         status, values = latest()
         self.assertIn("~queue_size must be >= 1", values["parameter errors"])
         self.assertIn("~end_on_angle must be 0 to 90", values["parameter errors"])
+        # ~camera_heading without ~flag_flies wind is read but would go unused: said, not silent.
+        self.assertIn("~camera_heading is set but ~flag_flies is '', not wind", values["parameter errors"])
         # A clip resampled at another rate than the model's is refused, and the ERROR stays on the
         # periodic diagnostics (not only the one published at once) until a good clip comes.
         self.bad_judge_pub.publish(make_clip(1, start + rospy.Duration.from_sec(2.0), size, 3.0, 4.0, rate=30.0))
@@ -466,6 +473,9 @@ class SdnNodeTest(unittest.TestCase):
         rospy.sleep(1.5)
         status, values = latest()
         self.assertNotEqual(status.level, DiagnosticStatus.ERROR, status.message)
+        # ...and the clip missing in the last 30 s is a WARN of its own (an OK hid a queue dropping clips).
+        self.assertEqual(status.level, DiagnosticStatus.WARN, status.message)
+        self.assertIn("1 clip missing from the sequence in the last 30 s", status.message)
         # Clip 3 was never sent; clips 1 and 2 came and are counted as malformed, not missing.
         self.assertEqual(values["clips missing from the sequence (queue or upstream)"], "1")
         self.assertEqual(values["malformed clips"], "2")
