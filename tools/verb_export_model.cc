@@ -73,10 +73,17 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
       b.label = "calibrate";
       b.unit = "clips";
       ProgressBar bar(b);
+      // The clips read as the node reads them: the model's default way round (auto, for a model
+      // trained without flips) with the judge beside the model, as Predictor finds it (Evaluate's
+      // empty fly_judge). Read as filmed, a --no-flip model's std was scaled on errors of flags
+      // flying left that the node turns round.
+      const learn::FlagFlies flag_flies = net->config().DefaultFlagFlies();
       const learn::EvalResult r =
-          learn::Evaluate(a->model, a->calibrate_data, "val", a->threads, "cpu", 16, 1, false, false,
-                          learn::FlagFlies::kRight, [&](int done, int total) { bar.Update(done, total); });
+          learn::Evaluate(a->model, a->calibrate_data, "val", a->threads, "cpu", 16, 1, false, false, flag_flies,
+                          [&](int done, int total) { bar.Update(done, total); });
       bar.Finish();
+      if (flag_flies == learn::FlagFlies::kAuto)
+        std::cout << "calibrated as the node reads clips: flag flies auto (judge: " << r.fly_judge << ")\n";
       const double k = learn::CalibrationScale(r);
       // Within m stds scaled by k is within m·k of the raw stds.
       const double one = learn::StdCoverage(r, 1), two = learn::StdCoverage(r, 2);

@@ -106,7 +106,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--device", o.device, "cpu, cuda or auto (CUDA when libtorch finds one)")
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
       ->capture_default_str();
-  sub->add_flag("--resume", o.resume, "continue the run in --out from its last epoch");
+  CLI::Option* resume = sub->add_flag("--resume", o.resume, "continue the run in --out from its last epoch");
   sub->add_flag("--overwrite", o.overwrite,
                 "start again in an --out that holds a run (without it, or --resume, such an --out is refused)");
   sub->add_flag("--cache-frames", o.cache_frames,
@@ -136,7 +136,10 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                   "raw_model.pt the trained weights' best")
       ->check(CLI::Range(0.0, 0.9999999))
       ->capture_default_str();
-  sub->add_flag("--init-only", o.init_only, "write an initialised (untrained) model and stop (tests, smoke runs)");
+  // Refused together at parsing (Train refuses them too): --init-only wrote the resumed run's last
+  // weights over its best model.pt and called them untrained.
+  sub->add_flag("--init-only", o.init_only, "write an initialised (untrained) model and stop (tests, smoke runs)")
+      ->excludes(resume);
   sub->add_option("--lr", o.lr, "initial learning rate (Adam)")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--lr-schedule", o.lr_schedule,
                   "step (the seed's: divide by 10 once) or cosine (from --lr down to 0 over the epochs)")

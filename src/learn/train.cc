@@ -102,19 +102,45 @@ nlohmann::json EpochJson(const EpochRecord& e) {
           {"raw_val_rmse", e.raw_val_rmse}, {"device", e.device}, {"threads", e.threads}};
 }
 
-EpochRecord EpochFromJson(const nlohmann::json& j) {
+// One epoch of state.json's log read back; `where` names it ("RUN/state.json: log[3]") in every
+// refusal, which used to be nlohmann's bare "type must be number, but is null".
+EpochRecord EpochFromJson(const nlohmann::json& j, const std::string& where) {
+  if (!j.is_object()) throw std::runtime_error(where + ": expected an object (one epoch's record), got " + j.dump());
+  auto field = [&](const char* name) -> const nlohmann::json* { return j.contains(name) ? &j[name] : nullptr; };
+  auto refuse = [&](const char* name, const char* expected) {
+    const nlohmann::json* v = field(name);
+    throw std::runtime_error(where + "." + name + ": expected " + expected + ", got " + (v ? v->dump() : "nothing"));
+  };
+  // nlohmann writes a NaN or infinite double as null (JSON has no such numbers): an epoch whose
+  // validation diverged is read back as NaN, or its run could never be resumed. `absent`: the
+  // value of a field older runs did not write (NaN: the field is required).
+  auto number = [&](const char* name, double absent) {
+    const nlohmann::json* v = field(name);
+    if (!v) {
+      if (std::isnan(absent)) refuse(name, "a number (null for NaN)");
+      return absent;
+    }
+    if (v->is_null()) return std::numeric_limits<double>::quiet_NaN();
+    if (!v->is_number()) refuse(name, "a number (null for NaN)");
+    return v->get<double>();
+  };
+  constexpr double kRequired = std::numeric_limits<double>::quiet_NaN();
   EpochRecord e;
-  e.epoch = j.at("epoch").get<int>();
-  e.lr = j.at("lr").get<double>();
-  e.train_loss = j.at("train_loss").get<double>();
-  e.val_loss = j.at("val_loss").get<double>();
-  e.train_rmse = j.at("train_rmse").get<double>();
-  e.val_rmse = j.at("val_rmse").get<double>();
-  e.val_acc05 = j.at("val_acc05").get<double>();
-  e.seconds = j.at("seconds").get<double>();
-  e.train_aux_loss = j.value("train_aux_loss", 0.0);  // absent in runs from before auxiliary targets
-  e.raw_val_rmse = j.value("raw_val_rmse", 0.0);      // absent in runs from before weight averages
-  e.device = j.value("device", std::string());         // absent in runs from before stop 74
+  if (!field("epoch") || !j["epoch"].is_number_integer()) refuse("epoch", "an integer");
+  e.epoch = j["epoch"].get<int>();
+  e.lr = number("lr", kRequired);
+  e.train_loss = number("train_loss", kRequired);
+  e.val_loss = number("val_loss", kRequired);
+  e.train_rmse = number("train_rmse", kRequired);
+  e.val_rmse = number("val_rmse", kRequired);
+  e.val_acc05 = number("val_acc05", kRequired);
+  e.seconds = number("seconds", kRequired);
+  e.train_aux_loss = number("train_aux_loss", 0.0);  // absent in runs from before auxiliary targets
+  e.raw_val_rmse = number("raw_val_rmse", 0.0);      // absent in runs from before weight averages
+  // Absent in runs from before stop 74.
+  if (field("device") && !j["device"].is_string()) refuse("device", "a string");
+  e.device = j.value("device", std::string());
+  if (field("threads") && !j["threads"].is_number_integer()) refuse("threads", "an integer");
   e.threads = j.value("threads", 0);
   return e;
 }
@@ -466,6 +492,11 @@ TrainResult Train(const TrainOptions& o) {
     }
   }
   if (o.data.empty() && !o.init_only) throw std::runtime_error("training needs --data");
+  // --init-only writes an untrained model.pt and stops; with --resume it wrote the last epoch's
+  // raw weights over the run's best model and called them untrained.
+  if (o.init_only && o.resume)
+    throw std::runtime_error("--init-only and --resume cannot be combined: --init-only writes an untrained model, "
+                             "--resume continues a run's training");
   TrainResult result;
   result.device = device.is_cuda() ? "cuda" : "cpu";
   result.model = o.out / "model.pt";
@@ -475,8 +506,23 @@ TrainResult Train(const TrainOptions& o) {
     const Dataset dataset = ReadDataset(o.data);
     train = SelectSplit(dataset, "train");
     val = SelectSplit(dataset, "val");
+    // In name order, whatever order the index lists them in: the epoch's shuffle and each clip's
+    // augmentation seed are positions in the split, so a dataset whose index lists the same clips
+    // in another order (a recorded one moves a replaced clip to its end) trained another run, and
+    // a resume on it (which DataFingerprint accepts) did not repeat the uninterrupted run.
+    // make-dataset's and the toy dataset's indexes are already in this order (BuildIndex sorts the
+    // names the same way), so their runs are unchanged.
+    for (std::vector<ClipInfo>* split : {&train, &val})
+      std::sort(split->begin(), split->end(), [](const ClipInfo& a, const ClipInfo& b) { return a.name < b.name; });
     if (!o.init_only && train.empty()) {
       throw std::runtime_error((o.data / "index.json").string() + ": no examples in split train");
+    }
+    // Batch normalisation needs two clips in a batch (the check of --batch above); a split of one
+    // trains batches of one, and libtorch failed mid-epoch naming no option.
+    if (!o.init_only && train.size() < 2) {
+      throw std::runtime_error((o.data / "index.json").string() + ": split train has " +
+                               std::to_string(train.size()) +
+                               " clip; training needs at least 2 (batch normalisation normalises over a batch)");
     }
     // A dataset without a validation split validates, and chooses model.pt, on the train split:
     // said in the result (the CLI prints it) and in state.json, so its "validation RMSE" is not
@@ -513,7 +559,9 @@ TrainResult Train(const TrainOptions& o) {
       ModelConfig given = o.model;
       if (o.still_floor_default) given.still_floor = config.still_floor;
       RefuseChangedModelOnResume(state_path, config, given);
-      for (const auto& e : state.at("log")) result.log.push_back(EpochFromJson(e));
+      const nlohmann::json& log = state.at("log");
+      for (size_t i = 0; i < log.size(); ++i)
+        result.log.push_back(EpochFromJson(log[i], state_path.string() + ": log[" + std::to_string(i) + "]"));
     } catch (const nlohmann::json::exception& e) {
       throw std::runtime_error(state_path.string() + ": " + e.what());
     }
@@ -819,7 +867,9 @@ TrainResult Train(const TrainOptions& o) {
         if (previous.empty() || !fs::exists(previous / name)) continue;
         std::error_code ec;
         fs::create_hard_link(previous / name, checkpoint_tmp / name, ec);  // unchanged: no copy
-        if (ec) fs::copy_file(previous / name, checkpoint_tmp / name);
+        // A copy (no hard links there) is synced like every file of the checkpoint: the rename
+        // below publishes the folder, and a crash must not leave it with a model cut short.
+        if (ec) CopyFileAtomically(previous / name, checkpoint_tmp / name);
       }
     };
     const bool better = record.val_rmse < result.best_val_rmse;

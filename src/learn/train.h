@@ -53,7 +53,7 @@ struct TrainOptions {
   // Without resume, a folder that already holds a run (state.json or model.pt) is refused unless
   // this is set: rerunning a command after a crash without --resume replaced a day's run.
   bool overwrite = false;
-  bool init_only = false;            // write an initialised (untrained) model and stop
+  bool init_only = false;            // write an initialised (untrained) model and stop (not with resume)
   // Keep every frame decoded and resized in memory after its first read (learn/frame_cache.h):
   // the same samples, without rereading a dataset larger than the page cache each epoch.
   // Needs crop_scales = {1} and square frames; costs clips x frames x input_size^2 bytes.

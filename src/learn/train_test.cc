@@ -1377,6 +1377,14 @@ TEST_F(TrainTest, AResumeOnOtherClipsIsRefusedAndAMovedDatasetResumes) {
   resumed.data = *root_ / "data_moved";
   const TrainResult r = Train(resumed);
   EXPECT_EQ(r.log.size(), 2u) << "the same clips in another folder and order should resume";
+  // And it trains epoch 2 as the uninterrupted run does: the shuffle and augmentation seeds are
+  // positions in the split, which used to follow the index's order.
+  TrainOptions straight = Options("sdn", "fingerprint_straight");
+  straight.epochs = 2;
+  const TrainResult s = Train(straight);
+  ASSERT_EQ(s.log.size(), 2u);
+  EXPECT_NEAR(r.log[1].train_loss, s.log[1].train_loss, 1e-6)
+      << "a resume on the same clips listed in another order trained another epoch";
 }
 
 TEST_F(TrainTest, ANonFiniteTrainingLossStopsTheRunNamingTheEpochAndStep) {
@@ -1934,6 +1942,72 @@ TEST_F(TrainTest, AStateFileOfWrongTypesOrAFolderIsRefusedNamingTheField) {
   ExpectTrainRefused(o, "a folder as state.json resumed", {state.string() + ": not a regular file"});
   fs::remove(state);
   std::ofstream(state) << good.dump();
+}
+
+TEST_F(TrainTest, AnEpochWhoseValidationIsNotFiniteResumesAndABadEpochFieldIsNamed) {
+  // nlohmann writes NaN and inf as null: an epoch whose validation diverged made state.json
+  // unreadable on --resume ("type must be number, but is null", naming no field).
+  TrainOptions o = Options("sdn", "nan-epoch");
+  o.epochs = 1;
+  Train(o);
+  const fs::path state = o.out / "state.json";
+  const nlohmann::json good = ReadJson(state);
+  nlohmann::json nan_epoch = good;
+  nan_epoch["log"][0]["val_rmse"] = nullptr;
+  std::ofstream(state) << nan_epoch.dump(2);
+  TrainOptions resumed = o;
+  resumed.epochs = 2;
+  resumed.resume = true;
+  const TrainResult r = Train(resumed);
+  ASSERT_EQ(r.log.size(), 2u);
+  EXPECT_TRUE(std::isnan(r.log[0].val_rmse)) << r.log[0].val_rmse;
+  EXPECT_TRUE(std::isfinite(r.log[1].val_rmse));
+  EXPECT_DOUBLE_EQ(r.best_val_rmse, r.log[1].val_rmse);
+  // A field of another type is refused naming the epoch and the field.
+  for (const auto& [field, value] : {std::pair<const char*, nlohmann::json>{"train_loss", "x"}, {"epoch", 1.5}}) {
+    nlohmann::json bad = ReadJson(state);
+    bad["log"][0][field] = value;
+    std::ofstream(state) << bad.dump(2);
+    ExpectTrainRefused(resumed, std::string("log[0].") + field + " = " + value.dump() + " resumed",
+                       {state.string() + ": log[0]." + field + ": expected "});
+  }
+}
+
+TEST_F(TrainTest, InitOnlyWithResumeIsRefusedAndTheModelKept) {
+  // --init-only with --resume wrote the last epoch's raw weights over the run's best model.pt.
+  TrainOptions o = Options("sdn", "init-resume");
+  o.epochs = 1;
+  Train(o);
+  const std::string model = Bytes(o.out / "model.pt");
+  o.resume = true;
+  o.init_only = true;
+  ExpectTrainRefused(o, "--init-only with --resume was accepted", {"--init-only", "--resume"});
+  EXPECT_EQ(Bytes(o.out / "model.pt"), model);
+}
+
+TEST_F(TrainTest, ATrainSplitOfOneClipIsRefusedNamingTheIndex) {
+  // One training clip trains batches of one, which batch normalisation cannot normalise (libtorch
+  // threw mid-epoch, naming no option).
+  const fs::path data = *root_ / "one-train-clip";
+  ToyDatasetOptions d;
+  d.clips = 6;
+  d.frames = 40;
+  d.size = 32;
+  WriteToyDataset(data, d);
+  nlohmann::json index = ReadJson(data / "index.json");
+  nlohmann::json kept = nlohmann::json::array();
+  int train = 0;
+  for (const auto& clip : index["clips"])
+    if (clip["split"] != "train" || train++ == 0) kept.push_back(clip);
+  ASSERT_GE(train, 2) << "the toy dataset should have two train clips to drop one";
+  index["clips"] = kept;
+  std::ofstream(data / "index.json") << index.dump(2);
+  TrainOptions o = Options("sdn", "one-train-clip-run");
+  o.data = data;
+  o.epochs = 1;
+  ExpectTrainRefused(o, "a train split of one clip was trained",
+                     {(data / "index.json").string() + ": split train has 1 clip; training needs at least 2"});
+  EXPECT_FALSE(fs::exists(o.out)) << "refused before the run folder is made";
 }
 
 TEST_F(TrainTest, InitOnlyWritesALoadableModelWithoutData) {
