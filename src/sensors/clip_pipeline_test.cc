@@ -78,6 +78,22 @@ TEST(ClipPipelineTest, StallReasonNamesStampsThatDoNotIncreaseAndASlowCamera) {
   }
 }
 
+TEST(ClipPipelineTest, StallReasonNamesHolesThatBreakEveryClip) {
+  // 30 fps losing 4 frames of every 12: each hole (0.167 s) is over the 0.1 s tolerance, and the
+  // 8 frames between holes (0.23 s) are short of a 10-frame clip's 0.36 s. One interval in 8 is a
+  // hole, too few for the slow-camera reason: this stall said nothing.
+  const ClipPipelineOptions o = SmallOptions();
+  ClipPipeline bursts(o);
+  for (int i = 0; i < 240; ++i)
+    if (i % 12 < 8) bursts.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  EXPECT_EQ(bursts.stats().clips_made, 0u);
+  const std::string why = ClipStallReason(ClipPipelineStats(), bursts.stats(), o);
+  EXPECT_NE(why.find("no clip from the last 160 camera frames: 19 holes longer than gap_tolerance 0.1 s"),
+            std::string::npos)
+      << why;
+  EXPECT_NE(why.find("broke every clip before its 10 frames"), std::string::npos) << why;
+}
+
 TEST(ClipPipelineTest, GapBreaksTheClip) {
   ClipPipeline p(SmallOptions());
   int i = 0;
