@@ -97,7 +97,7 @@ class AnemometerNode {
       ROS_FATAL("anemometer_node: %s", e.what());
       return false;
     }
-    params.Known("diagnostic_period");  // diagnostic_updater's
+    params.Known("diagnostic_period");  // read by diagnostic_updater: the wall timer's period (ros_bridge/wall_diagnostics.h)
     params.WarnUnread("anemometer_node");
 
     AnemometerProtocol protocol;

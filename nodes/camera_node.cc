@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
     ROS_FATAL("camera_node: %s", e.what());
     return 1;
   }
-  params.Known("diagnostic_period");  // diagnostic_updater's
+  params.Known("diagnostic_period");  // read by diagnostic_updater: the wall timer's period (ros_bridge/wall_diagnostics.h)
 
   RosClock clock;
   std::string error;

@@ -27,6 +27,7 @@
 
 #include "ros_bridge/clip_conversions.h"
 #include "ros_bridge/strict_param.h"
+#include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wall_throttle.h"
 #include "sensors/async_dataset_writer.h"
 #include "sensors/clip_pipeline.h"
@@ -254,7 +255,7 @@ class ClipBufferNode {
     // force_update once a wall second: Updater::update() waits for ROS time, which stands still
     // while a bag is paused and jumps back when it loops. (WallThrottle: again at once after the
     // wall clock steps back, which held every report until it caught up.)
-    if (diagnostics_throttle_.Due(1.0)) updater_.force_update();
+    if (diagnostics_throttle_.Due(diagnostic_period_)) updater_.force_update();
   }
 
   void Publish(const std::vector<sensors::LabelledClip>& clips) {
@@ -420,6 +421,7 @@ class ClipBufferNode {
   ros::SteadyTimer flush_timer_;
   diagnostic_updater::Updater updater_;
   ros_bridge::WallThrottle diagnostics_throttle_;
+  double diagnostic_period_ = ros_bridge::DiagnosticPeriod(updater_);  // after updater_, which reads it
 };
 
 }  // namespace
@@ -431,7 +433,7 @@ int main(int argc, char** argv) {
   clothwind::ros_bridge::StrictParams params(pnh);
   try {
     clothwind::ClipBufferNode node(nh, params);
-    params.Known("diagnostic_period");  // diagnostic_updater's
+    params.Known("diagnostic_period");  // read by diagnostic_updater: the wall timer's period (ros_bridge/wall_diagnostics.h)
     params.WarnUnread("clip_buffer");
     ros::spin();
     node.Finish();

@@ -53,6 +53,7 @@
 #include "learn/predictor.h"
 #include "ros_bridge/sdn_conversions.h"
 #include "ros_bridge/strict_param.h"
+#include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wall_throttle.h"
 #include "sensors/trailing_mean.h"
 
@@ -86,7 +87,8 @@ class SdnNode {
     // force_update: Updater::update() waits for ROS time, which stands still while a bag is
     // paused and jumps back when it restarts.
     diag_timer_ =
-        nh.createSteadyTimer(ros::WallDuration(1.0), [this](const ros::SteadyTimerEvent&) { updater_.force_update(); });
+        nh.createSteadyTimer(ros::WallDuration(clothwind::ros_bridge::DiagnosticPeriod(updater_)),
+                             [this](const ros::SteadyTimerEvent&) { updater_.force_update(); });
     // Subscribed before the model loads (libtorch, the weights and the warm-up take seconds):
     // clips that come meanwhile wait in the queue, as callbacks run only once spin() starts, rather
     // than going to no subscriber at all (a replay starts as soon as the bag's topics have theirs).
@@ -514,7 +516,7 @@ int main(int argc, char** argv) {
     ROS_FATAL("sdn_node: %s", e.what());
     return 1;
   }
-  params.Known("diagnostic_period");  // diagnostic_updater's
+  params.Known("diagnostic_period");  // read by diagnostic_updater: the wall timer's period (ros_bridge/wall_diagnostics.h)
   params.WarnUnread("sdn_node");
   ros::spin();
   return 0;

@@ -54,6 +54,7 @@
 #include "sensors/wind_direction_frame.h"
 #include "sensors/wind_plot.h"
 #include "ros_bridge/strict_param.h"
+#include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wall_throttle.h"
 
 namespace {
@@ -107,7 +108,8 @@ class WindDisplayNode {
     timer_ = nh.createSteadyTimer(ros::WallDuration(1.0 / rate), &WindDisplayNode::Publish, this);
     updater_.setHardwareID("wind_display");
     updater_.add("wind display", this, &WindDisplayNode::Diagnose);
-    diagnostics_timer_ = nh.createSteadyTimer(ros::WallDuration(1.0), [this](const ros::SteadyTimerEvent&) {
+    diagnostics_timer_ = nh.createSteadyTimer(
+        ros::WallDuration(clothwind::ros_bridge::DiagnosticPeriod(updater_)), [this](const ros::SteadyTimerEvent&) {
       updater_.force_update();  // wall time: a paused bag must not stop them
     });
   }
@@ -470,7 +472,7 @@ int main(int argc, char** argv) {
   clothwind::ros_bridge::StrictParams params(pnh);
   try {
     WindDisplayNode node(nh, params);
-    params.Known("diagnostic_period");  // diagnostic_updater's
+    params.Known("diagnostic_period");  // read by diagnostic_updater: the wall timer's period (ros_bridge/wall_diagnostics.h)
     params.WarnUnread("wind_display");
     ros::spin();
   } catch (const std::exception& e) {

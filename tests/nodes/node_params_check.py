@@ -162,6 +162,26 @@ class NodeParamsTest(unittest.TestCase):
         self.assertIn("wind_display: private parameter ~rat set but not read by this node", s.output())
         self.assertNotIn("~plot_window", s.output())
 
+    # ~diagnostic_period sets how often a node publishes its diagnostics. The nodes publish on wall
+    # timers of their own (a paused bag stops ROS time), which ran every second whatever it said.
+    def test_the_diagnostic_period_is_kept(self):
+        from diagnostic_msgs.msg import DiagnosticArray
+        stamps = []
+        sub = rospy.Subscriber("/diagnostics", DiagnosticArray,
+                               lambda m: stamps.extend(time.time() for s in m.status if "slow_diagnostics" in s.name))
+        s = self.spawn("wind_display_node", ["__name:=slow_diagnostics", "_diagnostic_period:=3.0"])
+        deadline = time.time() + 30
+        while time.time() < deadline and not stamps:
+            time.sleep(0.1)
+        self.assertTrue(stamps, s.output())
+        first = stamps[0]
+        time.sleep(9.5)
+        sub.unregister()
+        within = [t for t in stamps if t <= first + 9.0]
+        # At 3 s: 0, 3, 6 and 9 s (4, one spare for a late timer); at 1 s there were 10.
+        self.assertLessEqual(len(within), 5, (len(within), s.output()))
+        self.assertGreaterEqual(len(within), 3, (len(within), s.output()))
+
     # image_transport's plugins keep their parameters under the topics a node advertises: a camera
     # node named "camera" publishes /camera/image_raw, so /camera/image_raw/compressed/... lie in its
     # private namespace (left on the master by a previous run, or set by the plugin): not misspelt.
