@@ -11,6 +11,9 @@ namespace {
 // schedule instead of bursting frames out to catch up.
 constexpr int64_t kMaxLagNs = 500000000LL;
 constexpr int64_t kNoClockPollNs = 10000000LL;  // how often to look for /clock [ns]
+// Wall time stepped this far from the schedule (NTP's first sync on a field computer, a clock set
+// by hand) moves the stamps with it.
+constexpr int64_t kMaxClockStepNs = 500000000LL;
 
 }  // namespace
 
@@ -55,6 +58,13 @@ bool FramePacer::WaitNext(double max_wait_s, int64_t* stamp_ns) {
     clock_->SleepNs(simulated ? std::min(wait, kNoClockPollNs) : wait);
     now = pace_now();
     if (now < due) return false;
+  }
+  // Outside simulated time the stamps are wall time read once and carried on by the monotonic
+  // clock: a source started before NTP stepped the wall clock back 2 min stamped every frame
+  // 120 s ahead, and clip_buffer refused them all (~max_future) for as long as it ran.
+  if (!simulated) {
+    const int64_t step = clock_->RosNs() - (start_ros_ns_ + (now - start_pace_ns_));
+    if (std::abs(step) > kMaxClockStepNs) start_ros_ns_ += step;
   }
   *stamp_ns = start_ros_ns_ + (due - start_pace_ns_);
   ++index_;

@@ -27,6 +27,29 @@ TEST(FramePacerTest, StampsAreTheDueInstantsAtTheRate) {
   }
 }
 
+TEST(FramePacerTest, AWallClockStepMovesTheStamps) {
+  FakeClock clock;
+  FramePacer pacer(&clock, 10.0);
+  int64_t stamp = 0;
+  for (int k = 0; k < 10; ++k) ASSERT_TRUE(pacer.WaitNext(1.0, &stamp));
+  EXPECT_EQ(stamp, clock.RosNs());
+  // NTP steps the wall clock back 100 s: the next stamps follow it, 100 ms apart as before
+  // (they stayed 100 s ahead).
+  clock.StepRos(-100000 * kMs);
+  const int64_t before = stamp;
+  ASSERT_TRUE(pacer.WaitNext(1.0, &stamp));
+  EXPECT_EQ(stamp, clock.RosNs());
+  EXPECT_EQ(stamp - before, -100000 * kMs + 100 * kMs);
+  const int64_t after_step = stamp;
+  ASSERT_TRUE(pacer.WaitNext(1.0, &stamp));
+  EXPECT_EQ(stamp - after_step, 100 * kMs);
+  // A wall clock that drifts by less than the 0.5 s threshold keeps the schedule's stamps.
+  clock.StepRos(200 * kMs);
+  const int64_t drifted = stamp;
+  ASSERT_TRUE(pacer.WaitNext(1.0, &stamp));
+  EXPECT_EQ(stamp - drifted, 100 * kMs);
+}
+
 TEST(FramePacerTest, ShortWaitReturnsFalseWithoutSkipping) {
   FakeClock clock;
   FramePacer pacer(&clock, 10.0);

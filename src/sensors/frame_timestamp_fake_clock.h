@@ -29,6 +29,7 @@ class FakeClock : public Clock {
   }
 
   void Advance(int64_t ns) { mono_ns_ += ns; }
+  void StepRos(int64_t ns) { ros_offset_ns_ += ns; }  // the wall clock set (NTP), monotonic time unmoved
   void DelayNextRosRead(int64_t ns) { next_ros_read_delay_ns_ = ns; }
   int64_t ros_offset_ns() const { return ros_offset_ns_; }
   int64_t slept_ns() const { return slept_ns_; }
