@@ -3,12 +3,15 @@
 // judge as sdn_node runs it: from the clip's 300 px crops, each resized to the judge's own side
 // first (learn/dataset.cc TurnsToFlyRight), which costs more than judging.
 //   build/bin/learn_fly_judge_bench [--judge models/fly_judge.pt] [Google Benchmark flags]
-// Without --judge (or when the file is missing) a judge of random weights of the shipped shape
-// (64 hidden units) is timed. Denormal floats are flushed to zero, as the node's Predictor does
+// Without --judge a judge of random weights of the shipped shape (64 hidden units) is timed; a
+// --judge file that is missing is an error (its rows were labelled with the path while random
+// weights were timed). Denormal floats are flushed to zero, as the node's Predictor does
 // on its thread: the shipped judge holds denormal weights (a quarter of its hidden layer), whose
 // arithmetic otherwise took over half the time measured.
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -49,7 +52,7 @@ std::vector<cv::Mat> Clip() {
 }
 
 FlyJudge Judge() {
-  if (!g_judge_path.empty() && std::filesystem::exists(g_judge_path)) return FlyJudge::Load(g_judge_path);
+  if (!g_judge_path.empty()) return FlyJudge::Load(g_judge_path);  // main checked it exists
   std::mt19937_64 rng(2);
   std::normal_distribution<float> n(0.0f, 0.1f);
   Eigen::MatrixXf w1(64, clothwind::learn::kMotionMapGrid * clothwind::learn::kMotionMapGrid);
@@ -107,10 +110,32 @@ int main(int argc, char** argv) {
   // --judge FILE is ours; everything else is Google Benchmark's.
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--judge") == 0 && i + 1 < argc) {
+    if (std::strcmp(argv[i], "--judge") == 0) {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "learn_fly_judge_bench: --judge: expected a judge file (e.g. models/fly_judge.pt)\n");
+        return 2;
+      }
       g_judge_path = argv[++i];
+    } else if (std::strncmp(argv[i], "--judge=", 8) == 0) {
+      g_judge_path = argv[i] + 8;
     } else {
       rest.push_back(argv[i]);
+    }
+  }
+  // Checked before any timing: a missing judge used to time random weights under its path.
+  std::error_code ec;
+  if (!g_judge_path.empty() && !std::filesystem::is_regular_file(g_judge_path, ec)) {
+    std::fprintf(stderr, "learn_fly_judge_bench: --judge %s: no such file (expected a judge, e.g. models/fly_judge.pt)\n",
+                 g_judge_path.c_str());
+    return 2;
+  }
+  // A judge that does not load is named too, not timed as random weights.
+  if (!g_judge_path.empty()) {
+    try {
+      (void)FlyJudge::Load(g_judge_path);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "learn_fly_judge_bench: --judge %s: %s\n", g_judge_path.c_str(), e.what());
+      return 2;
     }
   }
   // Every benchmark from the same heap state: with glibc returning freed memory to the kernel,

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # CLI test of `clothwind contact-sheet` on what it refuses before reading a frame: a sheet too large
-# to hold in memory (10000 tiles of 1024 px were 31 GB) and index entries of another shape (bare
-# nlohmann type errors, naming no file). Usage: contact_sheet_cli_test.sh CLOTHWIND_BINARY
+# to hold in memory (10000 tiles of 1024 px were 31 GB), index entries of another shape (bare
+# nlohmann type errors, naming no file) and an --out of another format. Usage:
+# contact_sheet_cli_test.sh CLOTHWIND_BINARY
 set -euo pipefail
 bin="$1"
 work="$(mktemp -d)"
@@ -25,4 +26,21 @@ echo '{"format":"clothwind-dataset","version":1,"kind":"toy","clips":[{"name":5}
 refused "$work/ds/index.json: clips[0].name must be a string"
 echo '{"format":"clothwind-dataset","version":1,"kind":"toy","clips":["a"]}' > "$work/ds/index.json"
 refused "$work/ds/index.json"
+# An --out the sheet cannot be written as (PNG or JPEG by its extension, any case) is refused
+# naming --out before a tile is read (it failed after reading every tile, naming
+# WriteFrameAtomic); a dataset folder named nan is a name, not a number that is not finite.
+"$bin" make-toy-dataset --out "$work/nan" --clips 2 --frames 2 --size 16 >/dev/null 2>&1 ||
+  fail "make-toy-dataset failed"
+for out in sheet.tiff sheet inf; do
+  status=0
+  (cd "$work" && "$bin" contact-sheet nan --out "$out" >"$work/msg.txt" 2>&1) || status=$?
+  [ "$status" -eq 1 ] || fail "contact-sheet --out $out exited $status: $(cat "$work/msg.txt")"
+  grep -qF -- "--out $out: expected a file name ending in .png, .jpg or .jpeg" "$work/msg.txt" ||
+    fail "contact-sheet --out $out: the message does not name --out: $(cat "$work/msg.txt")"
+  ! grep -q "contact-sheet.*tiles" "$work/msg.txt" || fail "contact-sheet --out $out read tiles: $(cat "$work/msg.txt")"
+  [ ! -e "$work/$out" ] || fail "contact-sheet --out $out wrote it"
+done
+(cd "$work" && "$bin" contact-sheet nan --out sheet.JPEG >"$work/msg.txt" 2>&1) ||
+  fail "contact-sheet nan --out sheet.JPEG was refused: $(cat "$work/msg.txt")"
+[ -s "$work/sheet.JPEG" ] || fail "contact-sheet --out sheet.JPEG wrote no sheet"
 echo "contact_sheet_cli_test: OK"

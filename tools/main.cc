@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
   // No option takes a number that is not finite, and CLI11's Range, PositiveNumber and
   // NonNegativeNumber let "nan" through (every comparison with NaN is false): `train --still-floor
   // nan` ran as the default taken for given, `render --fps nan` reached the renderer. Refused for
-  // every option that takes a value, naming it.
+  // every floating-point option (CLI11's type name FLOAT, its validators' descriptions after a
+  // ':'), naming it; not for text, where `--out inf` or a folder named nan is a name.
   const CLI::Validator finite(
       [](std::string& value) -> std::string {
         char* end = nullptr;
@@ -31,7 +32,7 @@ int main(int argc, char** argv) {
       "", "finite");
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
     for (CLI::Option* option : sub->get_options())
-      if (option->get_type_size() != 0) option->check(finite);
+      if (option->get_type_size() != 0 && option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

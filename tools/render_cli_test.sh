@@ -2,7 +2,9 @@
 # CLI test of `clothwind render` on a rerun into a used --out: a bad --start or --fps is refused
 # before anything is touched (NaN passed the range check, the frame count overflowed, and the
 # earlier run's frames were deleted with exit 0), and zeta.json, the mark of a whole run, is
-# written last. Usage: render_cli_test.sh CLOTHWIND_BINARY SOURCE_DIR
+# written last; options it would ignore are refused; and of `clothwind simulate`, which makes
+# its input (a rerun removes the earlier run's frames and trajectories). Usage:
+# render_cli_test.sh CLOTHWIND_BINARY SOURCE_DIR
 set -euo pipefail
 bin="$1"
 src="$2"
@@ -16,7 +18,36 @@ status=0
 "$bin" simulate "$src/config/scenes/flag.json" --out "$work/day" --duration 86000 --no-obj >"$work/out.txt" 2>&1 || status=$?
 [ "$status" -eq 1 ] && grep -q -- "--duration 86000" "$work/out.txt" && [ ! -e "$work/day" ] ||
   fail "simulate --duration 86000 was not refused before the work: $(cat "$work/out.txt")"
+# --duration and --seed given as -1 (once the "not given" sentinels) are refused like any other
+# negative, naming the option, before --out is made.
+for bad in "--duration -1" "--seed -1 --duration 0.04"; do
+  status=0
+  # (--max-edge 1: the old code simulated the scene's whole duration, coarse.)
+  # shellcheck disable=SC2086
+  "$bin" simulate "$src/config/scenes/flag.json" --out "$work/neg" --max-edge 1 $bad --no-obj >"$work/out.txt" 2>&1 || status=$?
+  [ "$status" -eq 1 ] && grep -q -- "${bad%% *} must be" "$work/out.txt" && [ ! -e "$work/neg" ] ||
+    fail "simulate $bad was not refused before the work (status $status): $(cat "$work/out.txt")"
+done
 "$bin" simulate "$src/config/scenes/flag.json" --out "$work/sim" --duration 0.2 --max-edge 1 --no-obj >/dev/null
+# A rerun into the folder of an earlier run: its frame OBJs (here cloth 0's, and cloth 1's of a
+# run of two cloths) and its trajectory of cloth 1 go, whether this run writes OBJs or not (with
+# --no-obj they stayed beside the new summary, and `render DIR --obj` rendered the old cloth).
+"$bin" simulate "$src/config/scenes/flag.json" --out "$work/rerun" --duration 0.08 --max-edge 1 >/dev/null
+[ -f "$work/rerun/0002_00.obj" ] || fail "simulate wrote no frame OBJs: $(ls "$work/rerun")"
+cp "$work/rerun/0000_00.obj" "$work/rerun/0000_01.obj"
+cp "$work/rerun/trajectory.cwtraj" "$work/rerun/trajectory_1.cwtraj"
+"$bin" simulate "$src/config/scenes/flag.json" --out "$work/rerun" --duration 0.04 --max-edge 1 >/dev/null 2>"$work/out.txt"
+left="$(cd "$work/rerun" && LC_ALL=C ls)"
+[ "$left" = "$(printf '0000_00.obj\n0001_00.obj\nsummary.json\ntrajectory.cwtraj')" ] ||
+  fail "a shorter rerun left files of the earlier run: $left"
+cp "$work/rerun/0000_00.obj" "$work/rerun/0000_01.obj"
+cp "$work/rerun/trajectory.cwtraj" "$work/rerun/trajectory_1.cwtraj"
+"$bin" simulate "$src/config/scenes/flag.json" --out "$work/rerun" --duration 0.04 --max-edge 1 --no-obj >/dev/null 2>"$work/out.txt"
+left="$(cd "$work/rerun" && LC_ALL=C ls)"
+[ "$left" = "$(printf 'summary.json\ntrajectory.cwtraj')" ] || fail "a --no-obj rerun left files of the earlier run: $left"
+if "$bin" render "$work/rerun" --obj --out "$work/rerun-fr" --count 1 --samples 1 --threads 1 >"$work/out.txt" 2>&1; then
+  fail "render --obj of a --no-obj run rendered an earlier run's frames"
+fi
 "$bin" render "$work/sim" --out "$work/fr" --count 3 --samples 1 --threads 1 >/dev/null 2>&1
 [ -f "$work/fr/000.jpg" ] && [ -f "$work/fr/002.jpg" ] && [ -f "$work/fr/zeta.json" ] || fail "first run incomplete"
 before="$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")"
@@ -24,15 +55,45 @@ cp "$work/fr/zeta.json" "$work/zeta-3m.json"  # a zeta made for the scene's 3 m 
 
 for bad in "--start nan" "--start inf" "--start -1" "--fps 1e300" "--fps nan" "--frame-time -1" "--samples 100000000"; do
   status=0
+  # --samples 1 (a fast render, were it not refused) only beside another option: given twice,
+  # CLI11 refused the repetition whatever --samples's range said, and that case could not fail.
+  samples="--samples 1"
+  case "$bad" in --samples*) samples="" ;; esac
   # shellcheck disable=SC2086
-  "$bin" render "$work/sim" --out "$work/fr" $bad --samples 1 --threads 1 >"$work/out.txt" 2>&1 || status=$?
+  "$bin" render "$work/sim" --out "$work/fr" $bad $samples --threads 1 >"$work/out.txt" 2>&1 || status=$?
   # Refused, not crashed (a signal is 128 + its number), with a message naming the option.
   [ "$status" -ne 0 ] || fail "render $bad exited 0: $(cat "$work/out.txt")"
   [ "$status" -lt 128 ] || fail "render $bad died with status $status: $(cat "$work/out.txt")"
+  # Named as given, dashes and all: --samples beyond its range is also refused by the renderer's
+  # own check of zeta ("field 'samples'"), which names no option.
   option="${bad%% *}"
-  grep -q -- "${option#--}" "$work/out.txt" || fail "render $bad: the message does not name ${option#--}: $(cat "$work/out.txt")"
+  grep -qF -- "$option" "$work/out.txt" || fail "render $bad: the message does not name $option: $(cat "$work/out.txt")"
   [ "$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")" = "$before" ] || fail "render $bad changed the earlier run's files"
 done
+
+# Options given and then ignored are refused naming them, before --out is touched: --backgrounds
+# (only a --zeta names a photo) and --keep-zeta without --zeta, and --seed or --kind beside a
+# --zeta (rendered as given). Each ran as if not given.
+for bad in "--backgrounds $work" "--keep-zeta" "--zeta $work/zeta-3m.json --seed 2" "--zeta $work/zeta-3m.json --kind cloth"; do
+  status=0
+  # shellcheck disable=SC2086
+  "$bin" render "$work/sim" --out "$work/fr" $bad --count 1 --samples 1 --threads 1 >"$work/out.txt" 2>&1 || status=$?
+  [ "$status" -ne 0 ] && [ "$status" -lt 128 ] || fail "render $bad exited $status: $(cat "$work/out.txt")"
+  option="${bad##* --}"
+  option="${option%% *}"
+  case "$bad" in --backgrounds*) option="backgrounds" ;; --keep-zeta) option="keep-zeta" ;; esac
+  grep -q -- "--$option" "$work/out.txt" || fail "render $bad: the message does not name --$option: $(cat "$work/out.txt")"
+  [ "$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")" = "$before" ] || fail "render $bad changed the earlier run's files"
+done
+# A floating-point option given nan is refused as not finite; a name that reads as a number is
+# a name (the finite-number check held every option: `--out inf` was "expected a finite number").
+status=0
+"$bin" render "$work/sim" --out "$work/fr" --fps nan >"$work/out.txt" 2>&1 || status=$?
+[ "$status" -ne 0 ] && grep -q -- "--fps: expected a finite number" "$work/out.txt" ||
+  fail "render --fps nan was not refused as not finite: $(cat "$work/out.txt")"
+(cd "$work" && "$bin" render sim --out inf --count 1 --samples 1 --threads 1 >out.txt 2>&1) ||
+  fail "render --out inf was refused: $(cat "$work/out.txt")"
+[ -f "$work/inf/000.jpg" ] || fail "render --out inf wrote no frame"
 
 # A rerun that fails after it starts writing (frame 1 cannot take its place: a folder holds its
 # name) leaves no zeta.json beside its new frame 0 and the earlier run's frame 2.

@@ -9,6 +9,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace clothwind::tools {
 
@@ -46,6 +47,33 @@ inline std::optional<int> FrameNumber(const std::string& name, int digits, const
   std::snprintf(printed, sizeof printed, "%0*d", digits, n);
   if (number != printed) return std::nullopt;  // "0012.jpg" is no frame of "%03d"
   return n;
+}
+
+// The frame and cloth of a name ArcSim's "%04d_%02d.obj" gives ("0012_01.obj": 12 and 1; frames of
+// 10000 and more, cloths of 100 and more, as printf names them); nullopt for any other name.
+inline std::optional<std::pair<int, int>> ObjFrameAndCloth(const std::string& name) {
+  const std::string suffix = ".obj";
+  if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+    return std::nullopt;
+  const std::string stem = name.substr(0, name.size() - suffix.size());
+  const size_t underscore = stem.rfind('_');
+  if (underscore == std::string::npos) return std::nullopt;
+  const auto frame = FrameNumber(stem.substr(0, underscore), 4, "");
+  const auto cloth = FrameNumber(stem.substr(underscore + 1), 2, "");
+  if (!frame || !cloth) return std::nullopt;
+  return std::make_pair(*frame, *cloth);
+}
+
+// Whether `name` is a trajectory `clothwind simulate` writes: trajectory.cwtraj (cloth 0) or
+// trajectory_<c>.cwtraj (cloth c >= 1, no leading zeros).
+inline bool IsSimulateTrajectory(const std::string& name) {
+  if (name == "trajectory.cwtraj") return true;
+  const std::string prefix = "trajectory_", suffix = ".cwtraj";
+  if (name.size() <= prefix.size() + suffix.size() || name.compare(0, prefix.size(), prefix) != 0 ||
+      name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+    return false;
+  const auto cloth = FrameNumber(name.substr(prefix.size(), name.size() - prefix.size() - suffix.size()), 1, "");
+  return cloth && *cloth >= 1;
 }
 
 }  // namespace clothwind::tools

@@ -24,6 +24,26 @@ TEST(StaleFramesTest, FrameNumberReadsOnlyItsOwnPattern) {
   EXPECT_EQ(FrameNumber(".jpg", 3, ".jpg"), std::nullopt);
 }
 
+TEST(StaleFramesTest, ObjFrameAndClothReadArcSimNames) {
+  EXPECT_EQ(ObjFrameAndCloth("0012_01.obj"), std::make_pair(12, 1));
+  EXPECT_EQ(ObjFrameAndCloth("0000_00.obj"), std::make_pair(0, 0));
+  EXPECT_EQ(ObjFrameAndCloth("12345_100.obj"), std::make_pair(12345, 100));
+  EXPECT_EQ(ObjFrameAndCloth("012_00.obj"), std::nullopt);
+  EXPECT_EQ(ObjFrameAndCloth("0012_1.obj"), std::nullopt);
+  EXPECT_EQ(ObjFrameAndCloth("0012_01.obj.bak"), std::nullopt);
+  EXPECT_EQ(ObjFrameAndCloth("flag.obj"), std::nullopt);
+  EXPECT_EQ(ObjFrameAndCloth("a_0012_01.obj"), std::nullopt);
+  EXPECT_EQ(ObjFrameAndCloth(".obj"), std::nullopt);
+}
+
+TEST(StaleFramesTest, IsSimulateTrajectoryReadsItsNames) {
+  for (const char* yes : {"trajectory.cwtraj", "trajectory_1.cwtraj", "trajectory_12.cwtraj"})
+    EXPECT_TRUE(IsSimulateTrajectory(yes)) << yes;
+  for (const char* no : {"trajectory_0.cwtraj", "trajectory_01.cwtraj", "trajectory_.cwtraj", "trajectory_a.cwtraj",
+                         "other.cwtraj", "trajectory.cwtraj.tmp", "summary.json"})
+    EXPECT_FALSE(IsSimulateTrajectory(no)) << no;
+}
+
 // A shorter rerun: frames past its count go, its own frames and other files stay.
 TEST(StaleFramesTest, RemovesOnlyTheFramesBeyondTheNewRun) {
   const fs::path dir = fs::temp_directory_path() / ("clothwind_stale_frames_" + std::to_string(::getpid()));

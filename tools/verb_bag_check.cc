@@ -79,7 +79,7 @@ struct TopicStats {
   double run_start = NAN;
   size_t decoded = 0, undecoded = 0;  // anemometer sentences that give a reading, and that do not
   size_t void_readings = 0;           // decoded, but flagged void or a speed outside 0..150 m/s
-  double usable_first = NAN, usable_last = NAN;  // stamps of the readings a clip can be labelled by
+  std::vector<double> usable;  // stamps of the readings a clip can be labelled by (sorted after the read)
   std::string first_error;
   size_t holes = 0;           // header stamp intervals > gap tolerance
   double widest = 0.0;        // largest interval [s]
@@ -151,9 +151,7 @@ void NoteMessage(const rosbag::MessageInstance& m, TopicStats& s, double t, cons
       // a Gill error code) or an impossible speed labels nothing.
       const double v = r.reading.speed;
       if (r.reading.valid && std::isfinite(v) && v >= 0 && v <= 150) {
-        const double stamp = raw->header.stamp.toSec();
-        s.usable_first = std::isnan(s.usable_first) ? stamp : std::min(s.usable_first, stamp);
-        s.usable_last = std::isnan(s.usable_last) ? stamp : std::max(s.usable_last, stamp);
+        s.usable.push_back(raw->header.stamp.toSec());
       } else {
         ++s.void_readings;
       }
@@ -241,6 +239,7 @@ int Check(const BagCheckArgs& a) {
   }
   bag.close();
   if (bar) bar->Finish();
+  for (auto& [name, s] : topics) std::sort(s.usable.begin(), s.usable.end());
   std::printf("%s\n", a.bag.c_str());
   std::printf("  %-22s %-28s %7s %8s %8s %6s %6s %6s %6s  %s\n", "topic", "type", "count", "rate Hz", "span s",
               "back", "same", "holes", "bagt", "first");
@@ -285,15 +284,20 @@ int Check(const BagCheckArgs& a) {
   if (wind != topics.end() && wind->second.count > 0 && wind->second.decoded == 0)
     fail("anemometer/raw: no sentence gives a wind reading (" + std::to_string(wind->second.undecoded) +
          " refused, the first: " + wind->second.first_error + ")");
-  else if (wind != topics.end() && wind->second.decoded > 0 && std::isnan(wind->second.usable_first))
+  else if (wind != topics.end() && wind->second.decoded > 0 && wind->second.usable.empty())
     fail("anemometer/raw: every reading is void (the instrument's status V or error code, or a speed outside "
          "0..150 m/s: " + std::to_string(wind->second.void_readings) + "), and the clip buffer labels no clip with one");
   // A clip ending at e is labelled by the usable readings in [e - label window, e]; clips end from
-  // the first frame + a clip's duration to the last frame.
-  if (camera != topics.end() && wind != topics.end() && camera->second.count > 0 &&
-      !std::isnan(wind->second.usable_first) &&
-      (wind->second.usable_first > camera->second.last ||
-       wind->second.usable_last < camera->second.first + a.clip_duration - a.label_window))
+  // the first frame + a clip's duration to the last frame, so some usable reading must lie in
+  // [first + duration - window, last]. (Comparing only the earliest and latest usable stamps passed
+  // a bag with usable readings before and after the video and only void ones during it.)
+  const auto labels_a_clip = [&](const std::vector<double>& usable) {
+    const auto it = std::lower_bound(usable.begin(), usable.end(),
+                                     camera->second.first + a.clip_duration - a.label_window);
+    return it != usable.end() && *it <= camera->second.last;
+  };
+  if (camera != topics.end() && wind != topics.end() && camera->second.count > 0 && !wind->second.usable.empty() &&
+      !labels_a_clip(wind->second.usable))
     fail("no usable anemometer/raw reading's stamp falls in a clip's label window (the " + std::to_string(a.label_window) +
          " s up to its last frame, over camera/image_raw's stamps): no clip gets a label");
   std::printf("  (back: header stamps going back; same: equal to the previous (fine for anemometer records of "

@@ -1,8 +1,11 @@
 // clothwind contact-sheet DIR: a grid of a dataset's middle frames labelled with their wind speed
 // (any dataset in the docs/dataset.md format: simulated or recorded), to check it at a glance.
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "data/contact_sheet.h"
@@ -21,6 +24,14 @@ struct ContactSheetArgs {
 };
 
 int Run(const ContactSheetArgs& a) {
+  // The sheet is written as PNG or JPEG by its name's extension (any case): another failed only
+  // after every tile was read, naming WriteFrameAtomic rather than --out.
+  if (!a.out.empty()) {
+    std::string ext = std::filesystem::path(a.out).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (ext != ".png" && ext != ".jpg" && ext != ".jpeg")
+      throw std::invalid_argument("--out " + a.out + ": expected a file name ending in .png, .jpg or .jpeg");
+  }
   const nlohmann::json index = data::ReadIndex(a.dir);
   if (index.is_null()) throw std::runtime_error(a.dir + "/index.json not found: not a dataset folder");
   const std::string out =
@@ -68,7 +79,7 @@ const VerbRegistrar kRegistrar{"contact-sheet", [](CLI::App& app) -> std::functi
   auto a = std::make_shared<ContactSheetArgs>();
   auto* sub = app.add_subcommand("contact-sheet", "grid of a dataset's middle frames with their wind speeds (PNG)");
   sub->add_option("dir", a->dir, "dataset folder (with index.json)")->required();
-  sub->add_option("--out", a->out, "PNG to write (default: DIR/contact_sheet.png)");
+  sub->add_option("--out", a->out, "sheet to write, .png, .jpg or .jpeg (default: DIR/contact_sheet.png)");
   sub->add_option("--tiles", a->options.max_tiles, "examples shown at most")
       ->check(CLI::Range(1, 10000))
       ->capture_default_str();

@@ -66,7 +66,13 @@ sensor_msgs::CameraInfo MakeCameraInfo(int width, int height) {
   return info;
 }
 
-int Run(const MakeSessionArgs& a) {
+// Inputs: a; rendered_only: the options of --frames rendered that were given (their names).
+int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only) {
+  // Settings of the rendered flag do nothing to a procedural session: accepted and ignored, a
+  // procedural bag came out of a command that asked for a rendered one's settings.
+  if (a.frames != "rendered" && !rendered_only.empty())
+    throw std::invalid_argument(rendered_only.front() + " is a setting of --frames rendered; this session's frames are " +
+                                a.frames);
   // Bounded and long enough for a clip and a reading: infinity (cast to a frame count, undefined)
   // and a few milliseconds both wrote an empty bag and exited 0.
   if (!(a.minutes >= 0.05 && a.minutes <= 1440.0))
@@ -282,17 +288,23 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
   sub->add_option("--frames", args->frames,
                   "procedural (fast drawing) or rendered (simulated flag + anemometer sensor model)")
       ->check(CLI::IsMember({"procedural", "rendered"}))->capture_default_str();
-  sub->add_option("--render-samples", args->rendered.samples, "rendered: anti-aliasing samples per pixel")
-      ->capture_default_str();
-  sub->add_option("--max-edge", args->rendered.max_edge, "rendered: flag mesh resolution [m] (0: the scene's)")
-      ->capture_default_str();
-  sub->add_option("--warmup", args->rendered.warmup, "rendered: flag simulated before the session starts [s]")
-      ->capture_default_str();
-  sub->add_option("--zeta-seed", args->zeta_seed,
-                  "rendered: seed of sun, sky, backdrop and flag design (default: --seed)");
-  sub->add_option("--camera-distance", args->rendered.camera_radius, "rendered: camera's distance to the flag [m]")
-      ->capture_default_str();
-  return [args] { return Run(*args); };
+  const std::vector<CLI::Option*> rendered_only = {
+      sub->add_option("--render-samples", args->rendered.samples, "rendered: anti-aliasing samples per pixel")
+          ->capture_default_str(),
+      sub->add_option("--max-edge", args->rendered.max_edge, "rendered: flag mesh resolution [m] (0: the scene's)")
+          ->capture_default_str(),
+      sub->add_option("--warmup", args->rendered.warmup, "rendered: flag simulated before the session starts [s]")
+          ->capture_default_str(),
+      sub->add_option("--zeta-seed", args->zeta_seed,
+                      "rendered: seed of sun, sky, backdrop and flag design (default: --seed)"),
+      sub->add_option("--camera-distance", args->rendered.camera_radius, "rendered: camera's distance to the flag [m]")
+          ->capture_default_str()};
+  return [args, rendered_only] {
+    std::vector<std::string> given;
+    for (const CLI::Option* option : rendered_only)
+      if (option->count() > 0) given.push_back(option->get_name());
+    return Run(*args, given);
+  };
 }};
 
 }  // namespace

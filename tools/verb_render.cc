@@ -198,15 +198,24 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
   sub->add_option("input", a->input, ".cwtraj file, or a folder with trajectory.cwtraj or NNNN_CC.obj frames")
       ->required();
   sub->add_option("--out", a->out, "output folder (000.jpg ..., zeta.json)")->required();
-  sub->add_option("--kind", a->kind, "scene sampling when no --zeta: flag or cloth")
-      ->check(CLI::IsMember({"flag", "cloth"}))->capture_default_str();
-  sub->add_option("--seed", a->seed, "seed of the render parameters zeta")->capture_default_str();
-  sub->add_option("--zeta", a->zeta, "zeta JSON file (or an example's label.json) instead of --seed");
+  auto* kind = sub->add_option("--kind", a->kind, "scene sampling when no --zeta: flag or cloth")
+                   ->check(CLI::IsMember({"flag", "cloth"}))
+                   ->capture_default_str();
+  auto* seed = sub->add_option("--seed", a->seed, "seed of the render parameters zeta (not with --zeta)")
+                   ->capture_default_str();
+  auto* zeta = sub->add_option("--zeta", a->zeta, "zeta JSON file (or an example's label.json) instead of --seed");
+  // A --zeta is rendered as given: a --seed or --kind beside it was accepted and ignored.
+  zeta->excludes(seed);
+  zeta->excludes(kind);
+  // Both are about a given ζ: without --zeta they were accepted and ignored (a ζ drawn from --seed
+  // takes the cloth's size and has a procedural backdrop, no photo).
   sub->add_flag("--keep-zeta", a->keep_zeta,
                 "render --zeta as given even when its mesh_width/mesh_aspect_ratio are not the cloth's size "
-                "(a label of a dataset made with another scene); refused otherwise");
+                "(a label of a dataset made with another scene); refused otherwise")
+      ->needs(zeta);
   sub->add_option("--backgrounds", a->backgrounds,
-                  "folder of the background photo a --zeta names by file name (make-dataset --backgrounds)");
+                  "folder of the background photo a --zeta names by file name (make-dataset --backgrounds)")
+      ->needs(zeta);
   sub->add_option("--format", a->format, "jpg or png")->capture_default_str();
   sub->add_option("--jpeg-quality", a->jpeg_quality, "JPEG quality")->check(CLI::Range(1, 100))->capture_default_str();
   sub->add_option("--start", a->start, "first frame's time in the animation [s]")->capture_default_str();

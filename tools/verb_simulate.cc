@@ -30,10 +30,12 @@ namespace fs = std::filesystem;
 struct SimulateArgs {
   std::string scene;
   std::string out;
-  double duration = -1;
+  double duration = 0;     // [s]; read only when given (duration_given)
+  bool duration_given = false;
   std::string wind;        // "VX,VY,VZ"
   std::string turbulence;  // "I,L"
-  int64_t seed = -1;
+  int64_t seed = 0;        // read only when given (seed_given)
+  bool seed_given = false;
   double max_edge = 0;
   int frame_steps = 0;
   double warmup = 0;
@@ -88,17 +90,19 @@ int Run(const SimulateArgs& a) {
     setup.wind.turbulence.length_scale = v[1];
   }
   sim::SimulateOptions options;
-  options.duration = a.duration;
   options.warmup = a.warmup;
-  if (a.seed < -1) throw std::invalid_argument("--seed must be >= 0, got " + std::to_string(a.seed));
-  if (a.seed >= 0) options.seed = static_cast<uint64_t>(a.seed);
-  // -1: not given. NaN used to fall through to the scene's duration and inf to undefined behaviour.
-  if (a.duration != -1 && !(std::isfinite(a.duration) && a.duration > 0 && a.duration <= 86400)) {
+  // "Not given" is told by the option's count, not a value: --seed -1 and --duration -1 (the old
+  // sentinels) ran as if not given, where any other negative was refused.
+  if (a.seed_given && a.seed < 0) throw std::invalid_argument("--seed must be >= 0, got " + std::to_string(a.seed));
+  if (a.seed_given) options.seed = static_cast<uint64_t>(a.seed);
+  // NaN used to fall through to the scene's duration and inf to undefined behaviour.
+  if (a.duration_given && !(std::isfinite(a.duration) && a.duration > 0 && a.duration <= 86400)) {
     throw std::invalid_argument("--duration must be a time > 0 and <= 86400 s, got " + std::to_string(a.duration));
   }
+  if (a.duration_given) options.duration = a.duration;  // else SimulateOptions' default: the scene's
   // The scene's own bound on its frames (held in memory, then copied to write the trajectory):
   // a day at the flag's 0.04 s was 2.16 million frames.
-  if (a.duration != -1 && !(a.duration / scene.frame_time <= 1e6)) {
+  if (a.duration_given && !(a.duration / scene.frame_time <= 1e6)) {
     throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s is " +
                                 std::to_string(a.duration / scene.frame_time) + " frames of " + a.scene +
                                 "'s frame_time " + std::to_string(scene.frame_time) + " s; at most 1e6");
@@ -110,6 +114,14 @@ int Run(const SimulateArgs& a) {
     std::error_code ec;
     fs::remove(fs::path(a.out) / "summary.json", ec);
     if (ec) throw std::runtime_error("cannot remove the old " + (fs::path(a.out) / "summary.json").string() + ": " + ec.message());
+  }
+  // Every frame OBJ and trajectory of an earlier run goes too (this run writes all of its own):
+  // kept, a --no-obj run or one with fewer cloths left the old run's frames and trajectory_<c>
+  // beside the new summary, and `render DIR --obj` (or --cloth c) rendered the old cloth.
+  {
+    const int stale = RemoveStaleFrames(
+        a.out, [](const std::string& name) { return ObjFrameAndCloth(name) || IsSimulateTrajectory(name); });
+    if (stale > 0) std::fprintf(stderr, "simulate: removed %d frame OBJs and trajectories left by an earlier run\n", stale);
   }
 
   nlohmann::json summary;
@@ -147,15 +159,6 @@ int Run(const SimulateArgs& a) {
         mesh.V = t.frames[f].cast<double>();
         sim::WriteObj((fs::path(a.out) / FrameName(f, c)).string(), mesh);
       }
-      // A longer earlier run's frames of this cloth would read as this run's continuation.
-      char suffix[16];
-      std::snprintf(suffix, sizeof suffix, "_%02d.obj", c);
-      const int frames = t.num_frames();
-      const int stale = RemoveStaleFrames(a.out, [&](const std::string& name) {
-        const auto n = FrameNumber(name, 4, suffix);
-        return n && *n >= frames;
-      });
-      if (stale > 0) std::fprintf(stderr, "simulate: removed %d frames of cloth %d left by a longer run\n", stale, c);
     }
     // Everything simulated, warm-up included (what the wall time paid for).
     const double simulated = t.steps * setup.cloths[c].options.dt;
@@ -199,10 +202,10 @@ const VerbRegistrar kRegistrar{"simulate", [](CLI::App& app) -> std::function<in
                                  "simulate an ArcSim scene: frame OBJs, binary trajectory, summary.json");
   sub->add_option("scene", args->scene, "ArcSim scene JSON (comments allowed)")->required()->check(CLI::ExistingFile);
   sub->add_option("--out", args->out, "output folder")->required();
-  sub->add_option("--duration", args->duration, "simulated seconds (default: the scene's)");
+  auto* duration = sub->add_option("--duration", args->duration, "simulated seconds, > 0 (default: the scene's)");
   sub->add_option("--wind", args->wind, "mean wind VX,VY,VZ [m/s] (replaces the scene's)");
   sub->add_option("--turbulence", args->turbulence, "turbulence intensity and length scale I,L [-, m]");
-  sub->add_option("--seed", args->seed, "seed of the wind's turbulence and gusts");
+  auto* seed = sub->add_option("--seed", args->seed, "seed of the wind's turbulence and gusts, >= 0");
   sub->add_option("--max-edge", args->max_edge,
                   "refine uniformly to this edge length [m] (default: the scene's: uniformly to the upper end of its "
                   "remeshing size range, then edges over 0.4 of it split)");
@@ -214,7 +217,11 @@ const VerbRegistrar kRegistrar{"simulate", [](CLI::App& app) -> std::function<in
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--param", args->params, "set a theta entry, NAME=VALUE (repeatable; e.g. area_weight=0.3)");
   sub->add_flag("--no-obj", args->no_obj, "skip the per-frame OBJ files");
-  return [args] { return Run(*args); };
+  return [args, duration, seed] {
+    args->duration_given = duration->count() > 0;
+    args->seed_given = seed->count() > 0;
+    return Run(*args);
+  };
 }};
 
 }  // namespace

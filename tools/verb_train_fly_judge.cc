@@ -17,6 +17,7 @@
 #include "learn/dataset.h"
 #include "learn/fly_judge_train.h"
 #include "learn/model_config.h"
+#include "fly_judge_table.h"
 #include "progress_bar.h"
 #include "output_paths.h"
 #include "verb_registry.h"
@@ -45,20 +46,6 @@ learn::MotionMaps Collect(const learn::Dataset& dataset, const std::string& spli
   return maps;
 }
 
-// One line of the table: split, windows, right, accuracy and the accuracy per band.
-std::string Row(const std::string& split, const learn::FlyJudgeAccuracy& a) {
-  char line[256];
-  std::snprintf(line, sizeof line, "%-6s %7d %7d %9.2f %%", split.c_str(), a.count, a.right, 100 * a.accuracy());
-  std::string row = line;
-  for (const auto& b : a.bands) {
-    // An empty band has no accuracy: "-" (as eval's JSON has null), not 0 %, which reads as a failure.
-    if (b.count > 0) std::snprintf(line, sizeof line, " %8.2f", 100.0 * b.right / b.count);
-    else std::snprintf(line, sizeof line, " %8s", "-");
-    row += line;
-  }
-  return row + "\n";
-}
-
 VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<int()> {
   auto a = std::make_shared<JudgeArgs>();
   auto* sub = app.add_subcommand("train-fly-judge",
@@ -77,17 +64,21 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
   auto* frames = sub->add_option("--frames", a->frames, "frames per window (the models'; with --measure: the judge's card's unless given)")
                      ->check(CLI::Range(2, 10000))
                      ->capture_default_str();
-  sub->add_option("--hidden", a->train.hidden, "hidden units (1..4096)")->check(CLI::Range(1, 4096))->capture_default_str();
-  sub->add_option("--epochs", a->train.epochs, "passes over the training maps")->check(CLI::PositiveNumber)->capture_default_str();
-  sub->add_option("--batch", a->train.batch, "maps per Adam step")->check(CLI::PositiveNumber)->capture_default_str();
-  sub->add_option("--lr", a->train.learning_rate, "Adam's learning rate")->check(CLI::PositiveNumber)->capture_default_str();
-  sub->add_option("--weight-decay", a->train.weight_decay, "Adam's L2 term")->check(CLI::NonNegativeNumber)->capture_default_str();
-  sub->add_option("--seed", a->train.seed, "initialisation and order")->capture_default_str();
-  sub->add_option("--shift", a->train.shift,
-                  "slide each training map by a random offset of up to this many cells of 16 each way (a camera "
-                  "that does not centre the flag, as FlagSim's all do; 0: as collected)")
-      ->check(CLI::Range(0, learn::kMotionMapGrid / 2))
-      ->capture_default_str();
+  // Options of the training alone: with --measure (which trains nothing) they were accepted and
+  // ignored, refused now naming both.
+  const std::vector<CLI::Option*> training = {
+      sub->add_option("--hidden", a->train.hidden, "hidden units (1..4096)")->check(CLI::Range(1, 4096))->capture_default_str(),
+      sub->add_option("--epochs", a->train.epochs, "passes over the training maps")->check(CLI::PositiveNumber)->capture_default_str(),
+      sub->add_option("--batch", a->train.batch, "maps per Adam step")->check(CLI::PositiveNumber)->capture_default_str(),
+      sub->add_option("--lr", a->train.learning_rate, "Adam's learning rate")->check(CLI::PositiveNumber)->capture_default_str(),
+      sub->add_option("--weight-decay", a->train.weight_decay, "Adam's L2 term")->check(CLI::NonNegativeNumber)->capture_default_str(),
+      sub->add_option("--seed", a->train.seed, "initialisation and order")->capture_default_str(),
+      sub->add_option("--shift", a->train.shift,
+                      "slide each training map by a random offset of up to this many cells of 16 each way (a camera "
+                      "that does not centre the flag, as FlagSim's all do; 0: as collected)")
+          ->check(CLI::Range(0, learn::kMotionMapGrid / 2))
+          ->capture_default_str()};
+  for (CLI::Option* option : training) measure->excludes(option);
   sub->add_option("--threads", a->threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   auto* margin = sub->add_option("--margin", a->margin,
                   "scores closer to 0 than this tell nothing (a calm or featureless clip: camera noise scores ~0.4, "
@@ -156,23 +147,28 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
 
     nlohmann::json accuracy;
     std::ostringstream table;
-    table << "split   windows   right  accuracy    by wind speed [m/s]: 0-2      2-4      4-6      6-8      8-\n";
+    // The header from the first row's bands (every row has the same), over its columns.
+    auto add_row = [&](const std::string& split, const learn::FlyJudgeAccuracy& acc) {
+      if (table.tellp() == 0) table << FlyJudgeHeader(acc.bands);
+      table << FlyJudgeRow(split, acc);
+    };
     for (const auto& [name, maps] : {std::pair{"train", &train}, std::pair{"val", &val}, std::pair{"test", &test}}) {
       if (maps->maps.empty()) continue;
       const learn::FlyJudgeAccuracy acc = learn::MeasureFlyJudge(judge, *maps);
       accuracy[name] = learn::ToJson(acc);
-      table << Row(name, acc);
+      add_row(name, acc);
     }
     // The test clips as a camera that does not centre the flag would show them: each map slid by
     // d cells of 16 in the 8 directions (card: accuracy.test_shifted_<d>).
     for (int d = 1; d <= JudgeArgs::kShiftedRows && !test.maps.empty(); ++d) {
       const learn::FlyJudgeAccuracy acc = learn::MeasureFlyJudge(judge, learn::ShiftedMotionMaps(test, d));
       accuracy["test_shifted_" + std::to_string(d)] = learn::ToJson(acc);
-      table << Row("test±" + std::to_string(d), acc);
+      add_row("test±" + std::to_string(d), acc);
     }
     std::cout << table.str()
-              << "(each clip's mirror image is judged left exactly as often: the score is antisymmetric; test±d: "
-                 "each test map slid by d cells of 16 in the 8 directions)\n";
+              << "(accuracy [%] overall and by the clips' wind speed; each clip's mirror image is judged left "
+                 "exactly as often: the score is antisymmetric; test±d: each test map slid by d cells of 16 in the 8 "
+                 "directions)\n";
     if (measured) return 0;
     const nlohmann::json card = learn::FlyJudgeTrainingCard(
         std::filesystem::absolute(a->data).lexically_normal().string(), a->windows, a->frames, a->train, accuracy);

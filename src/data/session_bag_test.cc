@@ -194,6 +194,27 @@ TEST(SessionBagTest, APreviewOrZetaSeedItCannotUseIsRefusedBeforeTheWork) {
   fs::remove_all(dir);
 }
 
+TEST(SessionBagTest, SettingsOfARenderedSessionAreRefusedForAProceduralOne) {
+  // Accepted and ignored: a procedural bag came out of a command given a rendered one's settings.
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_session_procedural_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string bag = (dir / "bad.bag").string(), log = (dir / "log").string();
+  for (const std::string option : {"--zeta-seed 3", "--render-samples 2", "--max-edge 0.5", "--warmup 1",
+                                   "--camera-distance 5"}) {
+    for (const std::string frames : {"", " --frames procedural"}) {
+      const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes 0.05 --out " + bag + frames + " " +
+                              option + " > " + log + " 2>&1";
+      EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
+      EXPECT_FALSE(fs::exists(bag)) << cmd;
+      std::ifstream in(log);
+      const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      EXPECT_NE(text.find(option.substr(0, option.find(' ')) + " is a setting of --frames rendered"), std::string::npos)
+          << cmd << ": " << text;
+    }
+  }
+  fs::remove_all(dir);
+}
+
 TEST(SessionBagTest, AnExistingOutOrAFolderIsRefusedBeforeTheWork) {
   // An existing bag (perhaps a recorded field session) was replaced without a word, and a folder
   // failed only at the final rename, the finished session discarded.
@@ -260,6 +281,19 @@ void RewriteBag(const std::string& in, const std::string& out, Edit edit, bool e
       if (extra) dst.write("/diagnostics", m.getTime(), *raw);
     }
   }
+}
+
+// An NMEA MWV sentence flagged void (status V), its checksum made right again.
+std::string VoidSentence(const std::string& sentence) {
+  std::string body = sentence.substr(1, sentence.find('*') - 1);
+  const size_t status = body.rfind(",A");
+  if (status != std::string::npos) body[status + 1] = 'V';
+  unsigned sum = 0;
+  for (char c : body) sum ^= static_cast<unsigned char>(c);
+  char tail[8];
+  std::snprintf(tail, sizeof tail, "*%02X", sum);
+  return "$" + body + tail +
+         (sentence.size() > 2 && sentence.substr(sentence.size() - 2) == "\r\n" ? "\r\n" : "");
 }
 
 TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
@@ -340,6 +374,28 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
     }
   }
   shift_anemometer((dir / "after.bag").string(), 6 + 20);  // the session is 6 s long
+  // Usable readings only before and after the video, void ones during it: the first sentence
+  // 100 s earlier (past the 60 s label window of the first clip), the last 30 s after the last
+  // frame, the three between flagged void. Comparing only the earliest and latest usable stamps
+  // with the clips' windows passed it, and no clip got a label.
+  {
+    rosbag::Bag src(good, rosbag::bagmode::Read), dst((dir / "around.bag").string(), rosbag::bagmode::Write);
+    int sentence = 0;
+    for (const rosbag::MessageInstance& m : rosbag::View(src)) {
+      if (auto raw = m.instantiate<clothwind::RawSentence>()) {
+        const int k = sentence++;
+        if (k == 0) raw->header.stamp -= ros::Duration(100);
+        else if (k == 4) raw->header.stamp += ros::Duration(30);
+        else raw->data = VoidSentence(raw->data);
+        dst.write(m.getTopic(), raw->header.stamp, *raw);
+      } else if (auto img = m.instantiate<sensor_msgs::Image>()) {
+        dst.write(m.getTopic(), m.getTime(), *img);
+      } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
+        dst.write(m.getTopic(), m.getTime(), *info);
+      }
+    }
+    ASSERT_EQ(sentence, 5);
+  }
   // Every header stamp 10 s behind its bag time (a camera's and an instrument's latency): the
   // clip buffer refuses only stamps ahead of the clock, and this bag replays into labelled clips.
   const std::string lagging = (dir / "lagging.bag").string();
@@ -379,16 +435,7 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
   // clip labelled by any. (It passed as "ok for replay".)
   const std::string void_bag = (dir / "void.bag").string();
   RewriteBag(good, void_bag, [](auto& m) {
-    if constexpr (std::is_same_v<std::decay_t<decltype(m)>, clothwind::RawSentence>) {
-      std::string body = m.data.substr(1, m.data.find('*') - 1);
-      const size_t status = body.rfind(",A");
-      if (status != std::string::npos) body[status + 1] = 'V';
-      unsigned sum = 0;
-      for (char c : body) sum ^= static_cast<unsigned char>(c);
-      char tail[8];
-      std::snprintf(tail, sizeof tail, "*%02X", sum);
-      m.data = "$" + body + tail + (m.data.size() > 2 && m.data.substr(m.data.size() - 2) == "\r\n" ? "\r\n" : "");
-    }
+    if constexpr (std::is_same_v<std::decay_t<decltype(m)>, clothwind::RawSentence>) m.data = VoidSentence(m.data);
     return true;
   });
   // A file that is no bag at all: said so, without the repair hint for a bag cut short.
@@ -406,6 +453,7 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
                         Case{"extra.bag", "wait:=false"}, Case{"slow.bag", "no stretch of frames without a hole"},
                         Case{"apart.bag", "falls in a clip's label window"},
                         Case{"after.bag", "falls in a clip's label window"},
+                        Case{"around.bag", "falls in a clip's label window"},
                         Case{"compressed.bag", "recorded as sensor_msgs/CompressedImage, the replay subscribes to it "
                                                "as sensor_msgs/Image"}}) {
     const auto [rc, out] = check((dir / c.name).string());
