@@ -146,9 +146,17 @@ TEST(ToClipMsgTest, FramesStampsAndLabelAreCarriedWithTheDirectionsFrame) {
       for (int col = 0; col < 5; ++col) f.image.at<uint8_t>(r, col) = static_cast<uint8_t>(100 * i + 10 * r + col);
     c.clip.frames.push_back(f);
   }
+  // Every number distinct, so a field filled from its neighbour (x for y, mean for std, width
+  // for height) is caught.
   c.clip.sequence = 7;
   c.roi = {10, 20, 300};
+  c.source_width = 640;
+  c.source_height = 480;
+  c.frame_rate = 12.5;
+  c.label.window = 45.0;  // not the default 60 s, which a constant would also give
+  c.label.end = 100.08;
   c.label.mean = 4.5;
+  c.label.std = 0.75;
   c.label.count = 12;
   c.label.direction_mean = -1.25;
   const clothwind::Clip msg = ToClipMsg(c, "camera_optical", "anemometer");
@@ -161,8 +169,19 @@ TEST(ToClipMsgTest, FramesStampsAndLabelAreCarriedWithTheDirectionsFrame) {
   EXPECT_EQ(msg.encoding, "mono8");
   ASSERT_EQ(msg.data.size(), 3u * 4 * 5);
   EXPECT_EQ(msg.data[2 * 20 + 3 * 5 + 4], 200 + 30 + 4);  // frame 2, row 3, column 4
+  EXPECT_EQ(msg.sequence, 7u);
+  EXPECT_EQ(msg.num_frames, 3u);
+  EXPECT_FLOAT_EQ(msg.frame_rate, 12.5f);
   EXPECT_EQ(msg.roi.x_offset, 10u);
+  EXPECT_EQ(msg.roi.y_offset, 20u);
   EXPECT_EQ(msg.roi.width, 300u);
+  EXPECT_EQ(msg.roi.height, 300u);
+  EXPECT_FALSE(msg.roi.do_rectify);
+  EXPECT_EQ(msg.source_width, 640u);
+  EXPECT_EQ(msg.source_height, 480u);
+  EXPECT_DOUBLE_EQ(msg.label_window, 45.0);
+  EXPECT_DOUBLE_EQ(msg.wind_mean, 4.5);
+  EXPECT_DOUBLE_EQ(msg.wind_std, 0.75);
   EXPECT_EQ(msg.wind_count, 12u);
   EXPECT_DOUBLE_EQ(msg.wind_direction_mean, -1.25);
   EXPECT_EQ(msg.wind_direction_frame_id, "anemometer");

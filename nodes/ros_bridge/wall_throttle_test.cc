@@ -1,5 +1,8 @@
 #include "ros_bridge/wall_throttle.h"
 
+#include <chrono>
+#include <thread>
+
 #include <gtest/gtest.h>
 
 namespace clothwind::ros_bridge {
@@ -23,6 +26,13 @@ TEST(WallThrottle, TheFirstMessageComesAtRosTimeZero) {
   WallThrottle t;
   EXPECT_TRUE(t.Due(5.0));
   EXPECT_FALSE(t.Due(5.0));
+  // And the period is counted in wall time while ROS time stands still at 0: a throttle that
+  // read ROS time (stuck at 0, never a period past its first message) would stay silent after it.
+  WallThrottle fast;
+  EXPECT_TRUE(fast.Due(0.05));
+  std::this_thread::sleep_for(std::chrono::milliseconds(60));
+  EXPECT_EQ(ros::Time::now(), ros::Time(0, 0));
+  EXPECT_TRUE(fast.Due(0.05));  // 60 ms of wall time > the 50 ms period
 }
 
 }  // namespace

@@ -1,7 +1,10 @@
 #include "data/example_sampling.h"
 
 #include <cmath>
+#include <cstdint>
 #include <set>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -16,6 +19,36 @@ sim::Theta BaseTheta() {
   return t;
 }
 
+// The documented derivations, written out here independently of common/random.h so that a
+// change to the code under test (its stream constant, the mixing, the split's stream or draw)
+// fails instead of being compared with itself: a dataset made from a seed today must get the
+// seeds and splits it got a year ago.
+//   SimulationSeed(g, i) = HashSeed(g, i, 0x5eedda7a)
+//   SplitOf(s, val, test): u = the first Uniform() of Rng(HashSeed(s, 4)); test if u < test,
+//                          val if u < test + val, else train
+uint64_t ReferenceHashSeed(uint64_t a, uint64_t b, uint64_t c, uint64_t d) {
+  uint64_t h = a * 0x9e3779b97f4a7c15ULL;
+  for (uint64_t x : {b, c, d}) {
+    h ^= x + 0x632be59bd9b4e019ULL + (h << 6) + (h >> 2);
+    h *= 0xbf58476d1ce4e5b9ULL;
+    h ^= h >> 31;
+  }
+  return h;
+}
+
+uint64_t ReferenceSimulationSeed(uint64_t global_seed, uint64_t index) {
+  return ReferenceHashSeed(global_seed, index, 0x5eedda7aULL, 0);
+}
+
+std::string ReferenceSplit(uint64_t simulation_seed, double val_fraction, double test_fraction) {
+  uint64_t z = ReferenceHashSeed(simulation_seed, 4, 0, 0) + 0x9e3779b97f4a7c15ULL;  // SplitMix64's first output
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  const double u = static_cast<double>(z >> 11) * 0x1.0p-53;
+  return u < test_fraction ? "test" : u < test_fraction + val_fraction ? "val" : "train";
+}
+
 TEST(ExampleSamplingTest, SimulationSeedDependsOnGlobalSeedAndIndexOnly) {
   std::set<uint64_t> seen;
   for (uint64_t g = 0; g < 5; ++g)
@@ -23,6 +56,16 @@ TEST(ExampleSamplingTest, SimulationSeedDependsOnGlobalSeedAndIndexOnly) {
   EXPECT_EQ(seen.size(), 1000u);  // no collisions across seeds and indices
   EXPECT_EQ(SimulationSeed(7, 12), SimulationSeed(7, 12));
   EXPECT_THROW(SimulationSeed(7, -1), std::invalid_argument);
+  // Values of an independent big-integer implementation (Python, reduced mod 2^64) of the
+  // formula above: every simulation's parameters, turbulence, split and views follow from these.
+  EXPECT_EQ(SimulationSeed(0, 0), 17073249975117185832ULL);
+  EXPECT_EQ(SimulationSeed(7, 12), 18113783181998945970ULL);
+  EXPECT_EQ(SimulationSeed(5, 1234), 7222369404594022915ULL);
+  EXPECT_EQ(SimulationSeed(UINT64_MAX, 999999), 7201227481990545264ULL);
+  EXPECT_EQ(ReferenceSimulationSeed(7, 12), 18113783181998945970ULL);  // the reference agrees too
+  for (uint64_t g : {0ULL, 1ULL, 42ULL, 0xffffffffffffULL})
+    for (int64_t i = 0; i < 50; ++i)
+      ASSERT_EQ(SimulationSeed(g, i), ReferenceSimulationSeed(g, static_cast<uint64_t>(i))) << g << " " << i;
 }
 
 TEST(ExampleSamplingTest, FlagDrawsStayInTheirRangesAndCoverThem) {
@@ -190,6 +233,19 @@ TEST(ExampleSamplingTest, SplitsFollowTheFractions) {
   EXPECT_NEAR(counts[1] / double(n), 0.1, 0.01);
   EXPECT_NEAR(counts[2] / double(n), 0.2, 0.012);
   EXPECT_THROW(SplitOf(1, 0.6, 0.6), std::invalid_argument);
+  // The splits of dataset seed 5's first simulations, from the independent Python implementation
+  // (index 8 draws u = 0.2001, just past the test fraction): a dataset regenerated or resumed
+  // must put each simulation in the split it was in.
+  const std::vector<std::string> expected = {"train", "train", "train", "train", "train", "train",
+                                             "test",  "test",  "val",   "test",  "test",  "train",
+                                             "train", "train", "train", "train", "train", "train",
+                                             "test",  "train", "train", "test",  "train", "test"};
+  for (size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(SplitOf(SimulationSeed(5, i), 0.1, 0.2), expected[i]) << i;
+  for (int i = 0; i < 500; ++i) {
+    const uint64_t seed = ReferenceSimulationSeed(5, i);
+    ASSERT_EQ(SplitOf(seed, 0.1, 0.2), ReferenceSplit(seed, 0.1, 0.2)) << i;
+    ASSERT_EQ(SplitOf(seed, 0.3, 0.05), ReferenceSplit(seed, 0.3, 0.05)) << i;
+  }
 }
 
 TEST(ExampleSamplingTest, ExampleNames) {

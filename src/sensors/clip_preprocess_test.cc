@@ -83,6 +83,17 @@ TEST(ClipPreprocessTest, AreaResizeAveragesFineTexture) {
   cv::minMaxLoc(out, &lo, &hi);
   EXPECT_GE(lo, 99);
   EXPECT_LE(hi, 101);
+  // A 1-px checkerboard averages to ~100 under bilinear or bicubic shrinking too (any 2x2 block
+  // does). One bright column in four does not: INTER_AREA averages the 4 source columns under an
+  // output pixel (200 / 4 = 50 everywhere), while a point-sampling interpolation lands on or
+  // between the stripes and gives 0, 200 or a stripe pattern (aliasing).
+  cv::Mat stripes(400, 400, CV_8UC1, cv::Scalar(0));
+  for (int c = 0; c < 400; c += 4) stripes.col(c).setTo(200);
+  const cv::Mat shrunk = PreprocessClipFrame(stripes, ClipSourceEncoding::kMono8, {}, 100);
+  ASSERT_EQ(shrunk.size(), cv::Size(100, 100));
+  cv::minMaxLoc(shrunk, &lo, &hi);
+  EXPECT_GE(lo, 49);
+  EXPECT_LE(hi, 51);
 }
 
 TEST(ClipPreprocessTest, Mono16ScaledToEightBitsAndOutputIsACopy) {

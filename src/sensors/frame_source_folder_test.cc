@@ -196,6 +196,23 @@ TEST(ImageFolderSourceTest, NormalizesSixteenBitAndAlpha) {
   ASSERT_TRUE(NormalizeRecordedImage(cv::Mat(2, 2, CV_16UC1, cv::Scalar(65535)), &image, &encoding));
   EXPECT_EQ(encoding, "mono8");
   EXPECT_EQ(image.at<uint8_t>(0, 0), 255);
+  // Scaled by 255/65535 (= 1/257), not saturated: a full-scale 65535 is 255 either way, but a
+  // 16-bit PNG's mid grey 0x8080 must read 128 and a dark 1000 must read 4 (unscaled they
+  // saturate to 255, a white frame), and bright channels stay apart from dark ones in colour.
+  cv::Mat sixteen(1, 3, CV_16UC1);
+  sixteen.at<uint16_t>(0, 0) = 0x8080;
+  sixteen.at<uint16_t>(0, 1) = 1000;
+  sixteen.at<uint16_t>(0, 2) = 0;
+  ASSERT_TRUE(NormalizeRecordedImage(sixteen, &image, &encoding));
+  EXPECT_EQ(encoding, "mono8");
+  ASSERT_EQ(image.type(), CV_8UC1);
+  EXPECT_EQ(image.at<uint8_t>(0, 0), 128);
+  EXPECT_EQ(image.at<uint8_t>(0, 1), 4);
+  EXPECT_EQ(image.at<uint8_t>(0, 2), 0);
+  ASSERT_TRUE(NormalizeRecordedImage(cv::Mat(2, 2, CV_16UC3, cv::Scalar(257 * 10, 0x8080, 65535)), &image,
+                                     &encoding));
+  EXPECT_EQ(encoding, "bgr8");
+  EXPECT_EQ(image.at<cv::Vec3b>(1, 0), cv::Vec3b(10, 128, 255));
   ASSERT_TRUE(NormalizeRecordedImage(cv::Mat(2, 2, CV_8UC4, cv::Scalar(1, 2, 3, 4)), &image, &encoding));
   EXPECT_EQ(encoding, "bgr8");
   EXPECT_EQ(image.at<cv::Vec3b>(1, 1), cv::Vec3b(1, 2, 3));

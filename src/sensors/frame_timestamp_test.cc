@@ -99,10 +99,22 @@ TEST(FrameTimestamperTest, ZeroStampFallsBackToNowAndClockChangeResets) {
   FakeClock clock;
   FrameTimestamper stamper(&clock);
   EXPECT_EQ(stamper.Map(0, DriverClock::kMonotonic), clock.RosNs());
-  // An unknown-clock offset must not leak into monotonic mapping.
-  stamper.Map(123, DriverClock::kUnknown);
+  // An unknown-clock offset must not leak into monotonic mapping. The unknown clock runs 1 s
+  // ahead of the monotonic one, so its offset (ROS - driver) is 1 s smaller than the monotonic
+  // offset: were the estimator not reset on the change of clock, that leaked sample would be
+  // the window's minimum and shift the monotonic stamps 1 s early.
+  stamper.Map(clock.MonotonicNs() + 1000 * kMs, DriverClock::kUnknown);
+  EXPECT_EQ(stamper.OffsetNs(), clock.ros_offset_ns() - 1000 * kMs);
+  clock.Advance(5 * kMs);
   const int64_t capture = clock.MonotonicNs() - 10 * kMs;
   EXPECT_EQ(stamper.Map(capture, DriverClock::kMonotonic), capture + clock.ros_offset_ns());
+  EXPECT_EQ(stamper.OffsetNs(), clock.ros_offset_ns());
+  // And back to an unknown clock, now 1 s behind: its offset is 1 s larger than the monotonic
+  // one, which would win the minimum were the monotonic samples kept; alone, the frame maps to
+  // the time it was dequeued.
+  clock.Advance(5 * kMs);
+  const int64_t behind = clock.MonotonicNs() - 1000 * kMs;
+  EXPECT_EQ(stamper.Map(behind, DriverClock::kUnknown), clock.RosNs());
 }
 
 }  // namespace

@@ -21,6 +21,21 @@ bool HasColourInColumnRange(const cv::Mat& img, int x0, int x1, int y0, int y1, 
   return false;
 }
 
+// Vertical grid lines in a plot DrawWindPlot drew: columns strictly inside the plot frame whose
+// pixels are mostly the grid's grey (a horizontal grid line greys one pixel of a column; series
+// may cross a grid column but cover little of it).
+int GridColumns(const cv::Mat& img) {
+  const int left = 44, right = img.cols - 10, top = 22, bottom = img.rows - 24;  // wind_plot.cc's margins
+  const cv::Vec3b grey(225, 225, 225);
+  int lines = 0;
+  for (int x = left + 1; x < right; ++x) {
+    int n = 0;
+    for (int y = top + 1; y < bottom; ++y) n += img.at<cv::Vec3b>(y, x) == grey;
+    lines += 2 * n > bottom - top - 1;
+  }
+  return lines;
+}
+
 TEST(WindHistoryTest, MeanOverWindowAndForgetting) {
   WindHistory h(100.0);
   for (int i = 0; i <= 200; ++i) h.Add({static_cast<double>(i), static_cast<double>(i % 2), 0.0});
@@ -51,9 +66,22 @@ TEST(WindPlotTest, AbsurdValuesAndSpansDrawPromptly) {
   anem.Add({1.7e9, 4.0, 0.0});
   EXPECT_EQ(WindPlotAxisMax(1e20), kWindPlotAxisCap);
   EXPECT_EQ(WindPlotRow(1e20, kWindPlotAxisCap, 240), WindPlotRow(kWindPlotAxisCap, kWindPlotAxisCap, 240));
-  // Hung before: a regression shows as this test timing out (CTest's 900 s), not as a failed check.
-  const cv::Mat img = DrawWindPlot(est, anem, 1.7e9, 1.7e9, 320, 200, 0.0);
-  EXPECT_EQ(img.rows, 200);
+  // The vertical grid step widens with the window so that at most ~12 lines are drawn. Checked on
+  // a window (1e5 s, ~1700 lines at the 60 s step) that draws quickly even without the widening,
+  // so a regression fails here instead of hanging on the 1.7e9 s span below.
+  const int w = 320, h = 200;
+  WindHistory day(1e6), none(1e6);
+  day.Add({1e5, 3.0, 0.0});
+  const int day_lines = GridColumns(DrawWindPlot(day, none, 1e5, 1e5, w, h));
+  ASSERT_GE(day_lines, 2);  // the grid is there, and is counted
+  ASSERT_LE(day_lines, 13);
+  // Hung before (the step stayed 60 s: 2.8e7 lines): a regression of the widening is caught just
+  // above; one elsewhere would show as this test timing out (CTest's 900 s).
+  const cv::Mat img = DrawWindPlot(est, anem, 1.7e9, 1.7e9, w, h, 0.0);
+  EXPECT_EQ(img.rows, h);
+  const int span_lines = GridColumns(img);
+  EXPECT_GE(span_lines, 2);
+  EXPECT_LE(span_lines, 13);
   EXPECT_THROW(DrawWindPlot(est, anem, 1.7e9, std::numeric_limits<double>::infinity(), 320, 200),
                std::invalid_argument);
 }
@@ -131,6 +159,15 @@ TEST(WindPlotTest, OnlyTheWindowIsShown) {
   // Legend swatches are in the top margin (rows < 22); the plot area must have no estimate colour.
   EXPECT_FALSE(HasColourInColumnRange(img, 0, img.cols - 1, 22, img.rows - 1, kEstimateColour));
   EXPECT_TRUE(HasColourInColumnRange(img, 0, img.cols - 1, 22, img.rows - 1, kAnemometerColour));
+  // Samples long before the window land far off the image, where OpenCV clips them whether the
+  // series is cut to the window or not. Samples every second just before it would land in the
+  // left margin (the y labels' room, x < 44) and draw over the labels: none may show there. The
+  // first sample inside the window (t = 440, at x = 44) has a dot of radius 2, reaching x = 42.
+  WindHistory near(1000), none(1000);
+  for (int t = 430; t <= 500; ++t) near.Add({static_cast<double>(t), 3.0, 0.0});
+  const cv::Mat edge = DrawWindPlot(near, none, 500.0, 60.0, 320, 200);
+  EXPECT_FALSE(HasColourInColumnRange(edge, 0, 41, 22, edge.rows - 1, kEstimateColour));
+  EXPECT_TRUE(HasColourInColumnRange(edge, 42, edge.cols - 1, 22, edge.rows - 1, kEstimateColour));
 }
 
 TEST(WindPlotTest, BadArguments) {
