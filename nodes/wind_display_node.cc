@@ -155,9 +155,11 @@ class WindDisplayNode {
     }
     // A calm velocity (0, 0, 0) has no bearing, so it names no frame: a station whose first
     // reading was calm made its frame the display's and left every later bearing, in another
-    // frame, out of the arrow. Its zero arrow is drawn in whichever frame the display has.
+    // frame, out of the arrow. Before the display has a frame its zero arrow is drawn; after, a
+    // calm reading in another frame is left out like any other (it zeroed the arrow).
     const bool bearing = has_vector && (msg->velocity.x != 0.0 || msg->velocity.y != 0.0 || vz != 0.0);
-    if (frame_gate_.Admit(msg->header.frame_id, bearing ? 0.0 : std::nan(""))) {
+    const bool names_frame = bearing || (has_vector && !frame_gate_.frame_id().empty());
+    if (frame_gate_.Admit(msg->header.frame_id, names_frame ? 0.0 : std::nan(""))) {
       if (has_vector && (!have_vector_ || msg->header.stamp >= last_vector_.header.stamp)) {
         last_vector_ = *msg;
         last_vector_wall_ = ros::SteadyTime::now();

@@ -73,17 +73,15 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
       b.label = "calibrate";
       b.unit = "clips";
       ProgressBar bar(b);
-      // The clips read as the node reads them: the model's default way round (auto, for a model
-      // trained without flips) with the judge beside the model, as Predictor finds it (Evaluate's
-      // empty fly_judge). Read as filmed, a --no-flip model's std was scaled on errors of flags
-      // flying left that the node turns round.
-      const learn::FlagFlies flag_flies = net->config().DefaultFlagFlies();
+      // Read as filmed (right), as FlagSim's flags fly: the scale is the model's own spread on clips
+      // whose way is known. A fly judge's misreadings (auto) are not the model's error, and the
+      // judge beside a training run's model.pt is not the one the node will use (models/ ships
+      // fly_judge.pt beside the exported file): read with auto, the card's recipe calibrated on the
+      // motion cues' 7-9 % misjudged clips, each ~8 stds off.
       const learn::EvalResult r =
-          learn::Evaluate(a->model, a->calibrate_data, "val", a->threads, "cpu", 16, 1, false, false, flag_flies,
-                          [&](int done, int total) { bar.Update(done, total); });
+          learn::Evaluate(a->model, a->calibrate_data, "val", a->threads, "cpu", 16, 1, false, false,
+                          learn::FlagFlies::kRight, [&](int done, int total) { bar.Update(done, total); });
       bar.Finish();
-      if (flag_flies == learn::FlagFlies::kAuto)
-        std::cout << "calibrated as the node reads clips: flag flies auto (judge: " << r.fly_judge << ")\n";
       const double k = learn::CalibrationScale(r);
       // Within m stds scaled by k is within m·k of the raw stds.
       const double one = learn::StdCoverage(r, 1), two = learn::StdCoverage(r, 2);

@@ -289,7 +289,11 @@ std::string ClipStallReason(const ClipPipelineStats& since, const ClipPipelineSt
   // Holes too rare for the test above but too frequent for a clip: a 30 fps stream losing 3
   // frames about once a second (a bag recorded with drops, a USB camera losing bursts) never
   // has the 29 periods unbroken that a clip needs, and the node said OK "making clips".
-  if (gaps > 0) {
+  // Only past a clip's frames plus its stride of output frames: with ~stride over num_frames (a
+  // clip every 6 s) no clip for 2 clips' worth of frames is the stride, not the holes.
+  const uint64_t out = now.frames_out - since.frames_out;
+  const uint64_t clip_period = static_cast<uint64_t>(options.num_frames + std::max(options.stride, options.num_frames));
+  if (gaps > 0 && out >= clip_period) {
     std::snprintf(text, sizeof text,
                   "no clip from the last %llu camera frames: %llu holes longer than gap_tolerance %.3g s (last %.3g s) "
                   "broke every clip before its %d frames (frames lost in bursts: a USB camera, or a bag recorded "

@@ -92,6 +92,21 @@ TEST(ClipPipelineTest, StallReasonNamesHolesThatBreakEveryClip) {
             std::string::npos)
       << why;
   EXPECT_NE(why.find("broke every clip before its 10 frames"), std::string::npos) << why;
+  // With a clip every 40 frames (~stride 40), frames without a clip across one hole are the
+  // stride's wait (the clip after the hole comes 10 frames on), not a stall: nothing is said
+  // before a clip's frames and its stride have passed.
+  ClipPipelineOptions sparse = SmallOptions();
+  sparse.stride = 40;
+  ClipPipeline waiting(sparse);
+  int i = 0;
+  for (; waiting.stats().clips_made == 0; ++i) waiting.AddFrame(kT0 + i / 25.0, Numbered(i), ClipSourceEncoding::kMono8);
+  const ClipPipelineStats after_first = waiting.stats();
+  for (; i < 35; ++i)
+    if (i < 25 || i > 27) waiting.AddFrame(kT0 + i / 25.0, Numbered(i), ClipSourceEncoding::kMono8);
+  ASSERT_EQ(waiting.stats().clips_made, after_first.clips_made);
+  ASSERT_GE(waiting.stats().frames_in - after_first.frames_in, 2u * sparse.num_frames);
+  ASSERT_EQ(waiting.stats().gaps - after_first.gaps, 1u);
+  EXPECT_EQ(ClipStallReason(after_first, waiting.stats(), sparse), "");
 }
 
 TEST(ClipPipelineTest, GapBreaksTheClip) {

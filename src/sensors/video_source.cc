@@ -48,6 +48,7 @@ bool VideoFileSource::Open() {
   }
   pacer_ = std::make_unique<FramePacer>(clock_, rate_hz_);
   sequence_ = 0;
+  usable_frames_ = 0;
   loops_ = 0;
   open_ = true;
   error_.clear();
@@ -64,7 +65,7 @@ ReadStatus VideoFileSource::Read(Frame* frame, double max_wait_s) {
     if (!capture_.read(raw) || raw.empty()) {
       // A file that opens but yields no frame at all (a broken stream, a codec OpenCV lacks) is
       // an error, not an empty recording that ended.
-      if (sequence_ == 0) {
+      if (usable_frames_ == 0) {  // not sequence_: bad frames take numbers too
         error_ = "video " + path_ + ": no frame could be decoded (broken file or unsupported codec?)";
         Close();
         return ReadStatus::kError;
@@ -87,6 +88,7 @@ ReadStatus VideoFileSource::Read(Frame* frame, double max_wait_s) {
       bad_pending_ = true;
     } else {
       f.sequence = sequence_++;
+      ++usable_frames_;
       pending_ = std::move(f);
       pending_valid_ = true;
     }

@@ -47,6 +47,7 @@ class VideoFileSource : public FrameSource {
   bool bad_pending_ = false;  // an undecodable frame waiting for its slot (see frame_source_folder.h)
   Frame pending_;
   uint64_t sequence_ = 0;
+  uint64_t usable_frames_ = 0;  // frames decoded and usable since Open (a file with none is an error)
   int loops_ = 0;
   std::string error_;
 };

@@ -142,6 +142,17 @@ class MonitorNodesTest(unittest.TestCase):
             time.sleep(0.2)
         self.assertEqual(lazy_values().get("frame"), "earth", lazy_values())
         self.assertEqual(lazy_values().get("readings in another frame (no arrow)"), "0", lazy_values())
+        # Once the display has its frame, a calm reading in another frame is left out like any
+        # other reading there, not drawn as a zero arrow.
+        wind = WindMeasurement()
+        wind.header.stamp, wind.header.frame_id = rospy.Time.now(), "anemometer"
+        wind.speed, wind.valid = 0.0, True
+        pub.publish(wind)
+        deadline = time.time() + 10
+        while time.time() < deadline and lazy_values().get("readings in another frame (no arrow)") != "1":
+            time.sleep(0.2)
+        self.assertEqual(lazy_values().get("readings in another frame (no arrow)"), "1", lazy_values())
+        self.assertEqual(lazy_values().get("frame"), "earth", lazy_values())
 
     def test_display_and_report(self):
         for i in range(8):  # 4 s: estimates at 1 Hz, readings at 2 Hz
