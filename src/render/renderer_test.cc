@@ -57,13 +57,51 @@ TEST(Renderer, SameParamsAndSeedGiveIdenticalBytesOnAnyThreadCount) {
   // Radiance too, bit for bit (8-bit frames hide differences below a level).
   const cv::Mat la = a.RenderLinear(m.V, m.F, m.UV), lc = c.RenderLinear(m.V, m.F, m.UV);
   EXPECT_EQ(cv::norm(la, lc, cv::NORM_INF), 0.0);
-  // Another pixel-sampling seed moves anti-aliasing and penumbra samples only a little.
-  RenderParams q = p;
-  q.seed = 43;
-  const cv::Mat fc = Renderer(q).RenderFrame(m.V, m.F, m.UV);
-  EXPECT_GT(cv::norm(fa, fc, cv::NORM_L1), 0.0);
+  // Another pixel-sampling seed moves anti-aliasing and penumbra samples only a little: a few
+  // edge pixels change, the rest of the frame (backdrop, ground, the flag's interior) not at all.
+  // Another background seed redraws the backdrop and the grass. Two views: the usual one (the
+  // flag against the backdrop, little ground) and one looking down at the grass, so that a
+  // backdrop or a grass texture seeded from the pixel seed shows in one of them. Only "differs"
+  // was asserted before, which a pixel seed that redrew the whole background passed.
+  RenderParams ground_p = p;
+  ground_p.width = ground_p.height = 80;
+  ground_p.samples = 1;  // no jitter: the grass is all texture edges, where 2 samples differ
+  ground_p.camera_height = 6.0;
+  ground_p.has_look_at = true;
+  ground_p.look_at[0] = 1.0;
+  ground_p.look_at[1] = -4.0;
+  ground_p.look_at[2] = 0.0;
+  for (const RenderParams& view : {p, ground_p}) {
+    SCOPED_TRACE(view.has_look_at ? "looking down at the grass" : "the usual view");
+    const cv::Mat base = view.has_look_at ? Renderer(view).RenderFrame(m.V, m.F, m.UV) : fa;
+    // Mean absolute difference per channel [8-bit levels] and fraction of pixels that differ.
+    auto compare = [&](const RenderParams& other, double* mean, double* changed) {
+      const cv::Mat f = Renderer(other).RenderFrame(m.V, m.F, m.UV);
+      cv::Mat diff;
+      cv::absdiff(base, f, diff);
+      const double pixels = static_cast<double>(diff.total());
+      *mean = cv::norm(diff, cv::NORM_L1) / (3.0 * pixels);
+      cv::Mat any;
+      cv::transform(diff, any, cv::Matx13f(1, 1, 1));
+      *changed = cv::countNonZero(any) / pixels;
+    };
+    double mean, changed;
+    RenderParams q = view;
+    q.seed = view.seed + 1;
+    compare(q, &mean, &changed);
+    if (!view.has_look_at) {
+      EXPECT_GT(changed, 0.0);  // the seed is used
+    }
+    EXPECT_LT(changed, 0.10);    // edge pixels only (~3.6 % in the usual view, ~0.03 % on the grass)
+    EXPECT_LT(mean, 2.0);        // ~1 level in the usual view, ~0.02 on the grass
+    q = view;
+    q.background_seed = view.background_seed + 1;
+    compare(q, &mean, &changed);
+    EXPECT_GT(changed, 0.25);    // the backdrop or the grass everywhere (~37 %, and ~100 % on the grass)
+    EXPECT_GT(mean, 5.0);        // ~13 levels in the usual view, ~7 on the grass
+  }
   // Another texture seed recolours the flag.
-  q = p;
+  RenderParams q = p;
   q.texture_seed = 4;
   const cv::Mat fd = Renderer(q).RenderFrame(m.V, m.F, m.UV);
   EXPECT_GT(cv::norm(fa, fd, cv::NORM_L1) / (120.0 * 120.0), 1.0);
@@ -167,6 +205,64 @@ TEST(Renderer, BackFaceIsLitNotBlack) {
   const Rgb back2 = r2.Trace(back_org, Eigen::Vector3f(0, -1, 0), 0.5f, 0.5f);
   EXPECT_GT(Luma(front2), 1.5f * Luma(back2));
   EXPECT_GT(Luma(back2), 0.05f);
+}
+
+// The sun's term is irradiance x n.l: on a level surface (n = z) its radiance is albedo / pi x
+// sun_irradiance x sin(elevation). With no sky (sky_strength 0) and n = z the ambient term is 0
+// (an upward face sees no ground bounce), shadows off, no translucency: the sun's term is all the
+// light, and Trace's radiance (linear, before the film's response) is checked against it, on the
+// cloth (ShadeCloth) and on the ground (ComputeStatic), at two elevations. The other tests compare
+// brighter and darker only: a weight of 1 for any sun above the surface's horizon passed them.
+TEST(Renderer, SunLightFollowsTheCosineOfItsIncidence) {
+  RenderParams p = TestParams();
+  p.sky_strength = 0.0;
+  p.sun_shadow_soft_size = 0.0;
+  p.sun_radius = 5.0;
+  // A level 2 m x 2 m cloth 1 m above the mesh's base, away from the pole.
+  ClothMesh m;
+  m.V.resize(4, 3);
+  m.V << 0.5, -1, 1, 2.5, -1, 1, 2.5, 1, 1, 0.5, 1, 1;
+  m.F.resize(2, 3);
+  m.F << 0, 1, 2, 0, 2, 3;
+  m.UV.resize(4, 2);
+  m.UV << 0, 0, 1, 0, 1, 1, 0, 1;
+  RenderOptions o;
+  o.shadows = false;
+  o.translucency = 0.0f;
+  const Eigen::Vector3f down(0, 0, -1);
+  const Eigen::Vector3f above_cloth(1.3f, 0.1f, static_cast<float>(p.mesh_height) + 3.0f);
+  const Eigen::Vector3f above_ground(-6.0f, -3.0f, 0.5f);
+  float cloth[2], ground[2], sin_elevation[2];
+  int k = 0;
+  for (const double sun_height : {5.0, 1.5}) {  // 45 deg and 16.7 deg up
+    SCOPED_TRACE("sun height " + std::to_string(sun_height));
+    p.sun_height = sun_height;
+    Renderer r(p, o);
+    r.RenderLinear(m.V, m.F, m.UV);
+    const Lighting& l = r.lighting();
+    sin_elevation[k] = static_cast<float>(sun_height / std::hypot(5.0, sun_height));
+    ASSERT_NEAR(l.sun_dir.z(), sin_elevation[k], 1e-6f);
+    Hit hit;
+    ASSERT_TRUE(r.scene().Intersect(above_cloth, down, 10.0f, &hit));
+    ASSERT_EQ(hit.surface, Surface::kCloth);
+    ASSERT_NEAR(hit.normal.z(), 1.0f, 1e-6f);
+    const Rgb c = r.Trace(above_cloth, down, 0.5f, 0.5f);
+    const Rgb albedo = r.cloth_texture().Sample(hit.uv.x(), hit.uv.y(), Wrap::kClamp);
+    const Rgb expected = (static_cast<float>(1.0 / M_PI) * sin_elevation[k]) * albedo.cwiseProduct(l.sun_irradiance);
+    ASSERT_GT(Luma(expected), 0.05f);
+    EXPECT_LT((c - expected).cwiseAbs().maxCoeff(), 1e-5f * expected.maxCoeff()) << c.transpose() << " vs "
+                                                                                  << expected.transpose();
+    cloth[k] = Luma(c);
+    ASSERT_TRUE(r.scene().Intersect(above_ground, down, 10.0f, &hit));
+    ASSERT_EQ(hit.surface, Surface::kGround);
+    ground[k] = Luma(r.Trace(above_ground, down, 0.5f, 0.5f));
+    ASSERT_GT(ground[k], 0.0f);
+    ++k;
+  }
+  // The same point under both suns: the albedo cancels, the cosine ratio remains (~2.44 here).
+  const float cos_ratio = sin_elevation[0] / sin_elevation[1];
+  EXPECT_NEAR(cloth[0] / cloth[1], cos_ratio, 1e-5f * cos_ratio);
+  EXPECT_NEAR(ground[0] / ground[1], cos_ratio, 1e-5f * cos_ratio);
 }
 
 // A fold of two faces meeting at the hoist, the sun grazing from behind the face the camera sees

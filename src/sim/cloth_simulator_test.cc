@@ -456,6 +456,70 @@ TEST(ClothSimulatorTest, ForcesIncludeGravityAndArcSimWind) {
   EXPECT_NEAR(sim.masses().sum(), 0.284 * area, 1e-12);
 }
 
+// A wind that varies over space (and in time): its value at a face's centroid differs from its
+// value at any vertex, at the origin, and from the mean of the vertices' values (it is not linear).
+class CurvedWind final : public WindField {
+ public:
+  Eigen::Vector3d Velocity(const Eigen::Vector3d& x, double t) const override {
+    return Eigen::Vector3d(4 + 3 * x.y() * x.y() + x.z() + t, 1 + 2 * x.z() - x.y() * x.z(), 0.5 * x.y());
+  }
+};
+
+TEST(ClothSimulatorTest, WindIsSampledAtTheCentroidAndActsOnTheRestArea) {
+  // docs/simulator.md: per face, the wind is queried at the face centroid and A is the rest area.
+  // The test above has a steady wind and an undeformed face, so the wind at a vertex or at the
+  // origin, or the current area, gave the same forces. Here the face is stretched 1.2x from rest
+  // (current area 1.44 x rest), moving, away from the origin, in a wind that varies over space.
+  Mesh m;
+  m.V.resize(3, 3);
+  m.V << 0, 0, 0, 0, 1, 0, 0, 0, 1;  // rest: in the y-z plane, area 0.5
+  m.U = m.V.rightCols(2);
+  m.F.resize(1, 3);
+  m.F << 0, 1, 2;
+  Eigen::MatrixX3d x(3, 3), v(3, 3);
+  for (int i = 0; i < 3; ++i) x.row(i) << 0.3, 0.5 + 1.2 * m.V(i, 1), 0.2 + 1.2 * m.V(i, 2);
+  v << 0.1, 0.0, 0.2, -0.3, 0.1, 0.0, 0.2, 0.0, -0.1;
+  SimOptions o;
+  o.wind_density = 1.2;
+  o.wind_drag = 0.1;
+  const auto wind = std::make_shared<CurvedWind>();
+  ClothSimulator sim(m, TestMaterial(), o, wind);
+  // The same cloth without any air: gravity and stretching only, so the difference is the wind's.
+  SimOptions still = o;
+  still.wind_density = 0;
+  still.wind_drag = 0;
+  ClothSimulator no_air(m, TestMaterial(), still, nullptr);
+  sim.SetState(x, v);
+  no_air.SetState(x, v);
+  const Eigen::MatrixX3d f_wind = sim.Forces() - no_air.Forces();
+  Vector9d xf, vf;
+  for (int c = 0; c < 3; ++c) {
+    xf.segment<3>(3 * c) = x.row(c).transpose();
+    vf.segment<3>(3 * c) = v.row(c).transpose();
+  }
+  const Eigen::Vector3d centroid = (x.row(0) + x.row(1) + x.row(2)).transpose() / 3.0;
+  const double rest_area = 0.5, current_area = 1.44 * rest_area;
+  const double t = sim.time();
+  auto as_rows = [](const Vector9d& f) {
+    Eigen::MatrixX3d r(3, 3);
+    for (int c = 0; c < 3; ++c) r.row(c) = f.segment<3>(3 * c).transpose();
+    return r;
+  };
+  const Eigen::MatrixX3d expected =
+      as_rows(WindForce(xf, vf, wind->Velocity(centroid, t), rest_area, o.wind_density, o.wind_drag));
+  EXPECT_LT((f_wind - expected).norm(), 1e-12 * expected.norm()) << f_wind << "\nexpected\n" << expected;
+  // The variants the test must tell apart differ from it by far more than its tolerance.
+  const Eigen::Vector3d mean_of_vertices =
+      (wind->Velocity(x.row(0).transpose(), t) + wind->Velocity(x.row(1).transpose(), t) +
+       wind->Velocity(x.row(2).transpose(), t)) / 3.0;
+  for (const Eigen::MatrixX3d& wrong :
+       {as_rows(WindForce(xf, vf, wind->Velocity(x.row(0).transpose(), t), rest_area, 1.2, 0.1)),
+        as_rows(WindForce(xf, vf, wind->Velocity(Eigen::Vector3d::Zero(), t), rest_area, 1.2, 0.1)),
+        as_rows(WindForce(xf, vf, mean_of_vertices, rest_area, 1.2, 0.1)),
+        as_rows(WindForce(xf, vf, wind->Velocity(centroid, t), current_area, 1.2, 0.1))})
+    EXPECT_GT((wrong - expected).norm(), 1e-3 * expected.norm());
+}
+
 // The central difference of the simulator's forces along dx at x (at rest), step h: what the
 // force Jacobian times dx must be where its form is exact.
 Eigen::MatrixX3d ForcesCentralDifference(ClothSimulator& sim, const Eigen::MatrixX3d& x, const Eigen::MatrixX3d& dx,

@@ -22,6 +22,11 @@ TEST(GustWind, OneMinusCosineShapePeaksMidwayWithItsAmplitude) {
     if (w.gusts()[i + 1].start - g.start < p.duration) continue;
     EXPECT_NEAR(w.Speed(g.start + 0.5 * p.duration), g.amplitude, 1e-12);
     EXPECT_NEAR(w.Speed(g.start + 0.25 * p.duration), 0.5 * g.amplitude, 1e-12);
+    // 0, 1/4 and 1/2 of the duration fit a triangle A (1 - |2 tau - 1|) too; at 1/8 and 7/8 the
+    // 1 - cos shape gives A (1 - cos(pi/4)) / 2 ~ 0.146 A, the triangle 0.25 A.
+    const double eighth = 0.5 * g.amplitude * (1 - std::cos(M_PI / 4));
+    EXPECT_NEAR(w.Speed(g.start + 0.125 * p.duration), eighth, 1e-12);
+    EXPECT_NEAR(w.Speed(g.start + 0.875 * p.duration), eighth, 1e-12);
     EXPECT_NEAR(w.Speed(g.start), 0.0, 1e-12);
     EXPECT_NEAR(w.Speed(g.start - 1e-3), 0.0, 1e-12);
     EXPECT_NEAR(w.Speed(g.start + p.duration + 1e-3), 0.0, 1e-12);

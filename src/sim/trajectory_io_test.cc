@@ -1,7 +1,10 @@
 #include "sim/trajectory_io.h"
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -44,6 +47,47 @@ TEST(TrajectoryIo, RoundTripIsExactAndSizeMatchesTheDocumentedLayout) {
   EXPECT_EQ(header[12], 4);  // #V
   EXPECT_EQ(header[16], 2);  // #F
   EXPECT_EQ(header[20], 3);  // #frames
+  in.close();
+  // The body at the documented offsets (docs/scenes.md, trajectory_io.h): a round trip alone
+  // passes any layout the writer and reader agree on (1-based faces, uv after the frames, ...).
+  std::string bytes;
+  {
+    std::ifstream whole(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(whole), std::istreambuf_iterator<char>());
+  }
+  ASSERT_EQ(bytes.size(), 32u + 12 * 2 + 8 * 4 + 12 * 4 * 3);
+  auto at = [&bytes](auto value, size_t offset) {  // the little-endian value at offset
+    static_assert(sizeof(value) == 4 || sizeof(value) == 8);
+    unsigned char b[8];
+    for (size_t i = 0; i < sizeof(value); ++i) b[i] = static_cast<unsigned char>(bytes[offset + i]);
+    uint64_t u = 0;
+    for (size_t i = sizeof(value); i-- > 0;) u = (u << 8) | b[i];
+    if constexpr (sizeof(value) == 4) {
+      const uint32_t u32 = static_cast<uint32_t>(u);
+      std::memcpy(&value, &u32, 4);
+    } else {
+      std::memcpy(&value, &u, 8);
+    }
+    return value;
+  };
+  EXPECT_EQ(bytes.substr(0, 8), std::string("CWTRAJ\0\0", 8));
+  EXPECT_EQ(at(uint32_t{}, 8), 1u);
+  EXPECT_EQ(at(uint32_t{}, 12), 4u);
+  EXPECT_EQ(at(uint32_t{}, 16), 2u);
+  EXPECT_EQ(at(uint32_t{}, 20), 3u);
+  EXPECT_EQ(at(double{}, 24), 0.04);
+  const size_t faces_at = 32, uv_at = faces_at + 12 * 2, frames_at = uv_at + 8 * 4;
+  for (int f = 0; f < 2; ++f)
+    for (int c = 0; c < 3; ++c)
+      EXPECT_EQ(at(int32_t{}, faces_at + 12 * f + 4 * c), t.faces(f, c)) << "face " << f << " corner " << c;
+  for (int v = 0; v < 4; ++v)
+    for (int c = 0; c < 2; ++c) EXPECT_EQ(at(float{}, uv_at + 8 * v + 4 * c), t.uv(v, c)) << "uv " << v;
+  for (int k = 0; k < 3; ++k)
+    for (int v = 0; v < 4; ++v)
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(at(float{}, frames_at + 48 * k + 12 * v + 4 * c), t.frames[k](v, c))
+            << "frame " << k << " vertex " << v << " coordinate " << c;
+  EXPECT_EQ(at(float{}, frames_at + 48 * 1), 0.1f);  // frame 1, vertex 0, x (spelled out)
   const Trajectory r = ReadTrajectory(path);
   EXPECT_EQ(r.faces, t.faces);
   EXPECT_EQ(r.uv, t.uv);

@@ -44,6 +44,44 @@ TEST(VertexFaceProximity, FindsVertexWithinThicknessAboveFace) {
   EXPECT_TRUE(prox.pairs().empty());
 }
 
+// A vertex within the thickness of a face's plane and inside its box grown by the thickness, but
+// whose projection falls outside the triangle, is no pair (the other tests' vertices all project
+// inside, so dropping the barycentric test passed them). One vertex beyond each edge: the
+// hypotenuse (wb + wc > 1), the edge on the x axis (wc < 0) and the one on the y axis (wb < 0);
+// the same vertex just inside the hypotenuse is found. Update and UpdateFromCandidates alike.
+TEST(VertexFaceProximity, VertexBesideTheTriangleIsNoPair) {
+  struct Case {
+    double x, y;
+    bool inside;
+  };
+  const Case cases[] = {{0.07, 0.07, false},   // beyond the hypotenuse (wb + wc = 1.4)
+                        {0.052, 0.052, false}, // just beyond it (1.04)
+                        {0.05, -0.005, false}, // below the edge along x
+                        {-0.005, 0.05, false}, // left of the edge along y
+                        {0.045, 0.045, true}}; // just inside the hypotenuse (0.9)
+  for (const Case& c : cases) {
+    SCOPED_TRACE("vertex at (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ", 0.004)");
+    Fixture s;
+    s.X.row(6) << c.x, c.y, 0.004;  // 4 mm from the plane of face 0, within its grown box
+    VertexFaceProximity prox(s.F, 7, 0.05), from_candidates(s.F, 7, 0.05);
+    prox.Update(s.X, 0.01);
+    std::vector<std::pair<int, int>> all;
+    for (int v = 0; v < 7; ++v)
+      for (int f = 0; f < 2; ++f) all.emplace_back(v, f);
+    from_candidates.UpdateFromCandidates(s.X, 0.01, all);
+    for (const VertexFaceProximity* p : {&prox, &from_candidates}) {
+      if (c.inside) {
+        ASSERT_EQ(p->pairs().size(), 1u);
+        EXPECT_EQ(p->pairs()[0].vertex, 6);
+        EXPECT_EQ(p->pairs()[0].face, 0);
+      } else {
+        EXPECT_TRUE(p->pairs().empty()) << p->pairs().size() << " pairs, the first (" << p->pairs()[0].vertex
+                                        << ", " << p->pairs()[0].face << ")";
+      }
+    }
+  }
+}
+
 TEST(VertexFaceProximity, HugeAndNonFiniteFacesReturnPromptlyAndSparedFacesStillWork) {
   const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
   for (double bad : {1e4, 1e9, 1e300, inf, -inf, nan}) {
