@@ -68,12 +68,7 @@ class ClipBufferNode {
     record_dir_ = params.Get("record_dir", "");
     // Relative to the node's working folder, which roslaunch makes ROS_HOME (~/.ros): days of clips
     // went there, onto the home partition, under a name that looked like the field disk's.
-    if (!record_dir_.empty() && std::filesystem::path(record_dir_).is_relative()) {
-      const std::string absolute = std::filesystem::absolute(record_dir_).lexically_normal().string();
-      ROS_WARN("clip_buffer: ~record_dir '%s' is relative: recording into %s (the node's working folder; give an "
-               "absolute path)", record_dir_.c_str(), absolute.c_str());
-      record_dir_ = absolute;
-    }
+    record_dir_ = ros_bridge::AbsolutePathParam("clip_buffer: ~record_dir", record_dir_);
     // Out of range is refused at start, naming the parameter: a clip buffer that runs with a
     // setting it did not mean records data that looks right and is not.
     if (!(std::isfinite(flush_after_) && flush_after_ > 0.0))

@@ -54,9 +54,9 @@ class ClipReport {
     estimate_wait_ = params.Get("estimate_wait", 60.0);
     max_wall_ = params.Get("max_wall", 0.0);
     start_timeout_ = params.Get("start_timeout", 60.0);
-    summary_path_ = params.Get("summary", "");
+    summary_path_ = clothwind::ros_bridge::AbsolutePathParam("clip_report: ~summary", params.Get("summary", ""));
     want_estimates_ = params.Get("estimates", false);
-    estimate_plot_path_ = params.Get("estimate_plot", "");
+    estimate_plot_path_ = clothwind::ros_bridge::AbsolutePathParam("clip_report: ~estimate_plot", params.Get("estimate_plot", ""));
     auto finite = [](double v) { return std::isfinite(v); };
     if (!(finite(idle_timeout_) && idle_timeout_ > 0))
       throw std::invalid_argument("~idle_timeout must be a finite time > 0 s, got " + std::to_string(idle_timeout_));

@@ -65,7 +65,7 @@ class SdnNode {
   // an ERROR in diagnostics and its default is used.
   SdnNode(ros::NodeHandle& nh, clothwind::ros_bridge::StrictParams& params)
       : transport_(nh), trailing_(MeanWindow(params)) {
-    model_path_ = params.Get("model", "");
+    model_path_ = clothwind::ros_bridge::AbsolutePathParam("sdn_node: ~model", params.Get("model", ""));
     threads_ = params.Get("threads", 2);
     if (threads_ < 1) threads_ = ParameterError("~threads must be >= 1, got " + std::to_string(threads_), 2);
     device_ = params.Get("device", "cpu");
@@ -75,7 +75,7 @@ class SdnNode {
     }
     int queue_size = params.Get("queue_size", 2);
     if (queue_size < 1) queue_size = ParameterError("~queue_size must be >= 1 clip, got " + std::to_string(queue_size), 2);
-    fly_judge_path_ = params.Get("fly_judge", "");
+    fly_judge_path_ = clothwind::ros_bridge::AbsolutePathParam("sdn_node: ~fly_judge", params.Get("fly_judge", ""));
     if (!mean_window_error_.empty()) parameter_errors_.push_back(mean_window_error_);
     ReadFlagFlies(params);
     estimate_pub_ = nh.advertise<clothwind::WindEstimate>("wind/estimate", 10);

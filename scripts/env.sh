@@ -1,11 +1,13 @@
 # Sourced by the project's scripts: a ROS environment that does not depend on the host.
 # - /usr/bin first: a pyenv/conda python3 earlier on PATH breaks catkin and rospy.
-# - ROS_HOME inside the build folder (logs, test results), ROS_HOSTNAME=localhost so nothing
+# - ROS_HOME inside the build folder (logs, test results, nodes' relative outputs), even when set
+#   before: the tests' cached bags and results live there. ROS_HOSTNAME=localhost so nothing
 #   depends on the host name resolving.
 # - OMP_WAIT_POLICY=PASSIVE: libtorch's spinning OpenMP threads slow other nodes down 5-15x.
 CLOTHWIND_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 CLOTHWIND_BUILD="${CLOTHWIND_BUILD:-$CLOTHWIND_ROOT/build}"
-export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
+# The build's bin first: `clothwind` and the benches by name, as every doc types them.
+export PATH="$CLOTHWIND_BUILD/bin:/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 export ROS_HOME="$CLOTHWIND_BUILD/ros_home"
 export ROS_HOSTNAME=localhost
 export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"

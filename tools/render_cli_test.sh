@@ -85,6 +85,16 @@ for bad in "--backgrounds $work" "--keep-zeta" "--zeta $work/zeta-3m.json --seed
   grep -q -- "--$option" "$work/out.txt" || fail "render $bad: the message does not name --$option: $(cat "$work/out.txt")"
   [ "$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")" = "$before" ] || fail "render $bad changed the earlier run's files"
 done
+# A --zeta naming its background photo by file name needs --backgrounds: it was looked up in the
+# current folder ("no such file" naming no option, or another photo of that name rendered).
+sed 's/"background_image": *"[^"]*"/"background_image": "sky.png"/' "$work/zeta-3m.json" >"$work/zeta-photo.json"
+grep -q '"background_image": "sky.png"' "$work/zeta-photo.json" || fail "no background_image to set in $work/zeta-photo.json"
+cp "$work/fr/000.jpg" "$work/sky.png"  # a photo of that name in the current folder is not taken
+status=0
+(cd "$work" && "$bin" render sim --out "$work/photo" --zeta zeta-photo.json --count 1 --samples 1 --threads 1 \
+  >out.txt 2>&1) || status=$?
+[ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "pass --backgrounds DIR" "$work/out.txt" ||
+  fail "a --zeta naming its photo by file name without --backgrounds was not refused naming it: $(cat "$work/out.txt")"
 # A floating-point option given nan is refused as not finite; a name that reads as a number is
 # a name (the finite-number check held every option: `--out inf` was "expected a finite number").
 status=0

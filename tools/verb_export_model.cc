@@ -10,6 +10,7 @@
 #include <iostream>
 #include <memory>
 
+#include "learn/dataset.h"
 #include "learn/evaluate.h"
 #include "learn/networks.h"
 #include "learn/weights_io.h"
@@ -69,6 +70,12 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
     }
     std::cout << std::fixed << std::setprecision(3);
     if (!a->calibrate_data.empty()) {
+      // Checked before the work, with the way out: Evaluate's "no examples in split val" left the
+      // user to guess that the option needs one.
+      if (learn::SelectSplit(learn::ReadDataset(a->calibrate_data), "val").empty())
+        throw std::invalid_argument("--calibrate-std " + a->calibrate_data +
+                                    ": the dataset has no val split, which calibration reads; give one that has, or "
+                                    "leave --calibrate-std out (the std is then the network's own)");
       ProgressBar::Options b;
       b.label = "calibrate";
       b.unit = "clips";

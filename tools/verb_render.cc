@@ -126,9 +126,14 @@ int Run(const RenderArgs& a) {
                                   : LoadZeta(a.zeta);
   // A dataset example's label names its background photo by file name alone (labels are the same
   // on every machine); the folder it is in comes from here.
-  if (!a.backgrounds.empty() && !zeta.background_image.empty() &&
-      std::filesystem::path(zeta.background_image).is_relative())
+  // Without --backgrounds it was looked up in the current folder: "no such file" naming no option,
+  // or, where a photo of that name happened to be, another photo rendered without a word.
+  if (!zeta.background_image.empty() && std::filesystem::path(zeta.background_image).is_relative()) {
+    if (a.backgrounds.empty())
+      throw std::invalid_argument("--zeta " + a.zeta + " names its background photo '" + zeta.background_image +
+                                  "' by file name: pass --backgrounds DIR, the folder make-dataset was given");
     zeta.background_image = (std::filesystem::path(a.backgrounds) / zeta.background_image).string();
+  }
   if (a.samples > 0) zeta.samples = a.samples;
   zeta.fps = a.fps;
   render::ValidateRenderParams(zeta);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 
 namespace clothwind::ros_bridge {
 namespace {
@@ -185,6 +186,14 @@ void StrictParams::WarnUnread(const std::string& who) const {
   for (const std::string& u : unread) list += (list.empty() ? "" : ", ") + u;
   ROS_WARN("%s: private parameter%s %s set but not read by this node (misspelt?)", who.c_str(),
            unread.size() > 1 ? "s" : "", list.c_str());
+}
+
+std::string AbsolutePathParam(const std::string& what, const std::string& value) {
+  if (value.empty() || std::filesystem::path(value).is_absolute()) return value;
+  const std::string absolute = std::filesystem::absolute(value).lexically_normal().string();
+  ROS_WARN("%s '%s' is relative: %s (the node's working folder, ROS_HOME under roslaunch; give an absolute path)",
+           what.c_str(), value.c_str(), absolute.c_str());
+  return absolute;
 }
 
 }  // namespace clothwind::ros_bridge

@@ -53,6 +53,13 @@ std::string XmlRpcTypeName(const XmlRpc::XmlRpcValue& v);
 template <typename T>
 T ParamValue(const XmlRpc::XmlRpcValue& v, const std::string& name, std::string* note = nullptr);
 
+// A path parameter as the node will use it. Inputs: `what` names it in the log ("sdn_node:
+// ~model"), `value` is the parameter's text. Output: `value` when empty or absolute; else the
+// absolute path it names from the node's working folder, said in a WARN. roslaunch runs nodes in
+// ROS_HOME, not the folder it was typed in: `model:=runs/x/model.pt` was retried for ever as
+// "cannot open runs/x/model.json", and a relative summary went to ROS_HOME while its name was printed.
+std::string AbsolutePathParam(const std::string& what, const std::string& value);
+
 // The private parameters among `names` (full names, as ros::param::getParamNames gives them)
 // that lie under `private_ns` ("/clip_buffer") and whose first key below it is not in `asked`.
 // Returns each such key once, sorted, as "~key" ("/clip_buffer/rate/x" gives "~rate").

@@ -2,6 +2,8 @@
 // reading of a wrong-typed parameter end to end is tests/node_params.test.
 #include "ros_bridge/strict_param.h"
 
+#include <filesystem>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -107,4 +109,11 @@ TEST(StrictParamTest, UnreadParamsAreTheNodesOwnKeysNotAskedFor) {
 }
 
 }  // namespace
+TEST(AbsolutePathParamTest, ARelativePathIsMadeAbsoluteFromTheWorkingFolder) {
+  const std::string cwd = std::filesystem::current_path().string();
+  EXPECT_EQ(AbsolutePathParam("node: ~model", "runs/x/../y/model.pt"), cwd + "/runs/y/model.pt");
+  EXPECT_EQ(AbsolutePathParam("node: ~model", "/data/model.pt"), "/data/model.pt");
+  EXPECT_EQ(AbsolutePathParam("node: ~model", ""), "");
+}
+
 }  // namespace clothwind::ros_bridge

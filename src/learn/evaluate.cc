@@ -451,7 +451,8 @@ bool PlotPredictions(const EvalResult& r, const fs::path& png, std::string* erro
   });
 }
 
-bool PlotLearningCurve(const std::vector<EpochRecord>& log, const fs::path& png, std::string* error) {
+bool PlotLearningCurve(const std::vector<EpochRecord>& log, const fs::path& png, std::string* error,
+                       const std::string& validated_on) {
   return Plotting(error, [&] {
   const fs::path data = png.string() + ".dat";
   std::ostringstream d;
@@ -463,11 +464,13 @@ bool PlotLearningCurve(const std::vector<EpochRecord>& log, const fs::path& png,
     averaged = averaged || e.raw_val_rmse > 0;
   }
   WriteFileAtomically(data, d.str());
+  // A run without a val split validates on train: its curve said "validation RMSE" all the same.
+  const std::string val = validated_on == "val" ? "validation RMSE" : "RMSE on " + validated_on;
   std::ostringstream s;
   s << "set title 'learning curve'\nset xlabel 'epoch'\nset ylabel 'RMSE [m/s]'\nset grid\nset key top right\n"
     << "plot " << GnuplotQuoted(data.string()) << " using 1:2 with linespoints title 'train RMSE', '' using 1:3 with "
-    << "linespoints title '" << (averaged ? "validation RMSE (weight average)" : "validation RMSE") << "'";
-  if (averaged) s << ", '' using 1:6 with linespoints title 'validation RMSE (trained weights)'";
+    << "linespoints title '" << (averaged ? val + " (weight average)" : val) << "'";
+  if (averaged) s << ", '' using 1:6 with linespoints title '" << val << " (trained weights)'";
   s << "\n";
   return RunGnuplot(s.str(), png, error);
   });

@@ -178,7 +178,8 @@ struct EpochRecord {
 };
 
 // Training and validation RMSE per epoch as a PNG via gnuplot (atomically).
-bool PlotLearningCurve(const std::vector<EpochRecord>& log, const std::filesystem::path& png, std::string* error);
+bool PlotLearningCurve(const std::vector<EpochRecord>& log, const std::filesystem::path& png, std::string* error,
+                       const std::string& validated_on = "val");
 
 // Runs a gnuplot script that writes `png`; the script and data are written next to it.
 bool RunGnuplot(const std::string& script, const std::filesystem::path& png, std::string* error);

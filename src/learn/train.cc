@@ -914,7 +914,7 @@ TrainResult Train(const TrainOptions& o) {
         fs::remove_all(entry.path());
     }
     WriteFileAtomically(o.out / "log.tsv", LogTsv(result.log));
-    if (!PlotLearningCurve(result.log, o.out / "learning_curve.png", &result.plot_error)) {
+    if (!PlotLearningCurve(result.log, o.out / "learning_curve.png", &result.plot_error, result.validated_on)) {
       // The plot is a convenience; training goes on without it.
     }
     if (o.epoch_done) o.epoch_done(record);

@@ -1915,6 +1915,13 @@ TEST_F(TrainTest, ADatasetWithoutAValSplitSaysItValidatedOnTrain) {
   const TrainResult r = Train(o);
   EXPECT_EQ(r.validated_on, "train (the dataset has no val split)");
   EXPECT_EQ(ReadJson(o.out / "state.json").value("validated_on", ""), r.validated_on);
+  // Its learning curve says what it validated on (its legend said "validation RMSE").
+  {
+    std::ifstream script(o.out / "learning_curve.png.gp");  // written before gnuplot runs
+    const std::string gp((std::istreambuf_iterator<char>(script)), std::istreambuf_iterator<char>());
+    EXPECT_NE(gp.find("title 'RMSE on train (the dataset has no val split)'"), std::string::npos) << gp;
+    EXPECT_EQ(gp.find("validation RMSE"), std::string::npos) << gp;
+  }
   // With a val split, validation is on it.
   o = Options("sdn", "val-run");
   o.epochs = 1;
