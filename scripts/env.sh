@@ -6,6 +6,8 @@
 # - OMP_WAIT_POLICY=PASSIVE: libtorch's spinning OpenMP threads slow other nodes down 5-15x.
 CLOTHWIND_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 CLOTHWIND_BUILD="${CLOTHWIND_BUILD:-$CLOTHWIND_ROOT/build}"
+# Absolute: a relative one put a relative folder on PATH and ROS_HOME, wrong after the next cd.
+CLOTHWIND_BUILD="$(realpath -ms -- "$CLOTHWIND_BUILD")"  # as scripts/build
 # The build's bin first: `clothwind` and the benches by name, as every doc types them.
 export PATH="$CLOTHWIND_BUILD/bin:/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 export ROS_HOME="$CLOTHWIND_BUILD/ros_home"

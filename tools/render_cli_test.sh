@@ -95,6 +95,15 @@ status=0
   >out.txt 2>&1) || status=$?
 [ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "pass --backgrounds DIR" "$work/out.txt" ||
   fail "a --zeta naming its photo by file name without --backgrounds was not refused naming it: $(cat "$work/out.txt")"
+# With --backgrounds (relative) it renders, and the zeta.json it writes renders the same photo again
+# from another folder without it (a relative photo path in it was refused, or looked up twice).
+(cd "$work" && "$bin" render sim --out photo --zeta zeta-photo.json --backgrounds . --count 1 --samples 1 \
+  --threads 1 >out.txt 2>&1) || fail "render --zeta with --backgrounds .: $(cat "$work/out.txt")"
+grep -q "\"background_image\": \"$work/sky.png\"" "$work/photo/zeta.json" ||
+  fail "the written zeta.json does not name the photo by its absolute path: $(grep background_image "$work/photo/zeta.json")"
+(cd / && "$bin" render "$work/sim" --out "$work/photo2" --zeta "$work/photo/zeta.json" --count 1 --samples 1 \
+  --threads 1 >"$work/out.txt" 2>&1) || fail "render of render's own zeta.json: $(cat "$work/out.txt")"
+cmp -s "$work/photo/000.jpg" "$work/photo2/000.jpg" || fail "render's own zeta.json rendered another image"
 # A floating-point option given nan is refused as not finite; a name that reads as a number is
 # a name (the finite-number check held every option: `--out inf` was "expected a finite number").
 status=0

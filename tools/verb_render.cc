@@ -128,11 +128,18 @@ int Run(const RenderArgs& a) {
   // on every machine); the folder it is in comes from here.
   // Without --backgrounds it was looked up in the current folder: "no such file" naming no option,
   // or, where a photo of that name happened to be, another photo rendered without a word.
-  if (!zeta.background_image.empty() && std::filesystem::path(zeta.background_image).is_relative()) {
-    if (a.backgrounds.empty())
+  // Made absolute, so the zeta.json written below renders the same photo from any folder.
+  const std::filesystem::path photo = zeta.background_image;
+  if (!photo.empty() && photo.is_relative()) {
+    if (!a.backgrounds.empty()) {
+      zeta.background_image =
+          std::filesystem::absolute(std::filesystem::path(a.backgrounds) / photo).lexically_normal().string();
+    } else if (!photo.has_parent_path()) {
       throw std::invalid_argument("--zeta " + a.zeta + " names its background photo '" + zeta.background_image +
                                   "' by file name: pass --backgrounds DIR, the folder make-dataset was given");
-    zeta.background_image = (std::filesystem::path(a.backgrounds) / zeta.background_image).string();
+    } else {
+      zeta.background_image = std::filesystem::absolute(photo).lexically_normal().string();  // as an older render wrote it
+    }
   }
   if (a.samples > 0) zeta.samples = a.samples;
   zeta.fps = a.fps;

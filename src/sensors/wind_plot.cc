@@ -15,8 +15,7 @@
 namespace clothwind::sensors {
 namespace {
 
-// Plot area margins [px]: room for the y labels on the left, the legend on top, x labels below.
-constexpr int kLeft = 44, kRight = 10, kTop = 22, kBottom = 24;
+constexpr int kLeft = kPlotLeft, kRight = kPlotRight, kTop = kPlotTop, kBottom = kPlotBottom;  // wind_plot.h
 
 int PlotTop() { return kTop; }
 int PlotBottom(int height) { return height - kBottom; }
@@ -153,7 +152,7 @@ cv::Mat DrawWindPlot(const WindHistory& estimate, const WindHistory& anemometer,
   const double y_max = WindPlotAxisMax(top);
 
   cv::Mat img(height, width, CV_8UC3, kPlotBackground);
-  const cv::Scalar grid(225, 225, 225), ink(60, 60, 60);
+  const cv::Scalar grid = kPlotGrid, ink(60, 60, 60);
   const double font = 0.4;
   // Horizontal grid at a round step, labelled in m/s.
   const double step = y_max <= 4 ? 0.5 : y_max <= 10 ? 1.0 : y_max <= 20 ? 2.0 : y_max <= 50 ? 5.0 : 10.0;

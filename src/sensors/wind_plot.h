@@ -65,6 +65,10 @@ std::string WindSummaryText(double estimate, double estimate_std, double anemome
 const cv::Scalar kEstimateColour(0, 140, 255);   // orange line, with a pale ±std band
 const cv::Scalar kAnemometerColour(200, 110, 0); // blue line
 const cv::Scalar kPlotBackground(255, 255, 255);
+const cv::Scalar kPlotGrid(225, 225, 225);
+// The plot area's margins [px]: room for the y labels on the left, the legend on top, the x labels
+// below (public so a test finds the plot frame in an image rather than copying the numbers).
+constexpr int kPlotLeft = 44, kPlotRight = 10, kPlotTop = 22, kPlotBottom = 24;
 
 // Draws estimate vs anemometer speed over the last `window` seconds: time on x (now at the right
 // edge), speed on y from 0 to a rounded-up maximum (at least 2 m/s), grid, axis labels, legend.

@@ -25,8 +25,8 @@ bool HasColourInColumnRange(const cv::Mat& img, int x0, int x1, int y0, int y1, 
 // pixels are mostly the grid's grey (a horizontal grid line greys one pixel of a column; series
 // may cross a grid column but cover little of it).
 int GridColumns(const cv::Mat& img) {
-  const int left = 44, right = img.cols - 10, top = 22, bottom = img.rows - 24;  // wind_plot.cc's margins
-  const cv::Vec3b grey(225, 225, 225);
+  const int left = kPlotLeft, right = img.cols - kPlotRight, top = kPlotTop, bottom = img.rows - kPlotBottom;
+  const cv::Vec3b grey(kPlotGrid[0], kPlotGrid[1], kPlotGrid[2]);
   int lines = 0;
   for (int x = left + 1; x < right; ++x) {
     int n = 0;
@@ -142,7 +142,9 @@ TEST(WindPlotTest, TheLineBreaksAcrossAnOutage) {
   const double y_max = WindPlotAxisMax(6.0);
   const int r_anem = WindPlotRow(2.0, y_max, h), r_est = WindPlotRow(6.0, y_max, h);
   // Columns of t = 1030 (the outage's middle) and of t = 1010 and 1050 (readings around it).
-  auto column = [&](double t) { return static_cast<int>(std::lround(w - 10 - (1060.0 - t) / 60.0 * (w - 10 - 44))); };
+  auto column = [&](double t) {
+    return static_cast<int>(std::lround(w - kPlotRight - (1060.0 - t) / 60.0 * (w - kPlotRight - kPlotLeft)));
+  };
   EXPECT_FALSE(HasColourInColumnRange(img, column(1027), column(1033), r_anem - 1, r_anem + 1, kAnemometerColour));
   EXPECT_TRUE(HasColourInColumnRange(img, column(1008), column(1012), r_anem - 1, r_anem + 1, kAnemometerColour));
   EXPECT_TRUE(HasColourInColumnRange(img, column(1048), column(1052), r_anem - 1, r_anem + 1, kAnemometerColour));
@@ -166,8 +168,8 @@ TEST(WindPlotTest, OnlyTheWindowIsShown) {
   WindHistory near(1000), none(1000);
   for (int t = 430; t <= 500; ++t) near.Add({static_cast<double>(t), 3.0, 0.0});
   const cv::Mat edge = DrawWindPlot(near, none, 500.0, 60.0, 320, 200);
-  EXPECT_FALSE(HasColourInColumnRange(edge, 0, 41, 22, edge.rows - 1, kEstimateColour));
-  EXPECT_TRUE(HasColourInColumnRange(edge, 42, edge.cols - 1, 22, edge.rows - 1, kEstimateColour));
+  EXPECT_FALSE(HasColourInColumnRange(edge, 0, kPlotLeft - 3, kPlotTop, edge.rows - 1, kEstimateColour));
+  EXPECT_TRUE(HasColourInColumnRange(edge, kPlotLeft - 2, edge.cols - 1, kPlotTop, edge.rows - 1, kEstimateColour));
 }
 
 TEST(WindPlotTest, BadArguments) {
