@@ -129,29 +129,28 @@ class MonitorNodesTest(unittest.TestCase):
         while time.time() < deadline and lazy_values().get("displays drawn") == "0":
             time.sleep(0.2)
         self.assertNotEqual(lazy_values().get("displays drawn"), "0")
+        def reading(frame, speed, vx):
+            wind = WindMeasurement()
+            wind.header.stamp, wind.header.frame_id = rospy.Time.now(), frame
+            wind.speed, wind.valid, wind.velocity.x = speed, True, vx
+            pub.publish(wind)
+
+        def wait_lazy(key, value):
+            deadline = time.time() + 10
+            while time.time() < deadline and lazy_values().get(key) != value:
+                time.sleep(0.2)
+            self.assertEqual(lazy_values().get(key), value, lazy_values())
+
         # The readings above were calm (velocity 0, 0, 0: no bearing) in "anemometer": they name no
         # frame, so a bearing in the earth frame after them fixes the display's. The calm ones
         # fixed it before, and every later bearing was left out of the arrow.
-        wind = WindMeasurement()
-        wind.header.stamp, wind.header.frame_id = rospy.Time.now(), "earth"
-        wind.speed, wind.valid = 2.0, True
-        wind.velocity.x = 2.0
-        pub.publish(wind)
-        deadline = time.time() + 10
-        while time.time() < deadline and lazy_values().get("frame") != "earth":
-            time.sleep(0.2)
-        self.assertEqual(lazy_values().get("frame"), "earth", lazy_values())
+        reading("earth", 2.0, 2.0)
+        wait_lazy("frame", "earth")
         self.assertEqual(lazy_values().get("readings in another frame (no arrow)"), "0", lazy_values())
         # Once the display has its frame, a calm reading in another frame is left out like any
         # other reading there, not drawn as a zero arrow.
-        wind = WindMeasurement()
-        wind.header.stamp, wind.header.frame_id = rospy.Time.now(), "anemometer"
-        wind.speed, wind.valid = 0.0, True
-        pub.publish(wind)
-        deadline = time.time() + 10
-        while time.time() < deadline and lazy_values().get("readings in another frame (no arrow)") != "1":
-            time.sleep(0.2)
-        self.assertEqual(lazy_values().get("readings in another frame (no arrow)"), "1", lazy_values())
+        reading("anemometer", 0.0, 0.0)
+        wait_lazy("readings in another frame (no arrow)", "1")
         self.assertEqual(lazy_values().get("frame"), "earth", lazy_values())
 
     def test_display_and_report(self):
