@@ -62,6 +62,7 @@ void ClipPipeline::Reset() {
   released_at_jump_.clear();
   held_.clear();
   backward_.reset();
+  forward_.reset();
   labeller_ = WindLabeller(options_.label_window);
   data_time_ = kNegInf;
   released_end_ = kNegInf;
@@ -92,10 +93,23 @@ bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
   // A frame back in time waits for the next: one that follows it within gap_tolerance starts a
   // new timeline there (a bag looped or restarted, with or without --clock); any other means it
   // was a lone stale stamp, which restarted the labeller and released the waiting clips early.
+  // Strictly after: the same stale frame delivered twice confirmed itself as a new timeline.
   if (backward_) {
     BackwardFrame held = std::move(*backward_);
     backward_.reset();
-    if (std::isfinite(stamp) && stamp >= held.stamp && stamp - held.stamp <= options_.gap_tolerance) {
+    if (std::isfinite(stamp) && stamp > held.stamp && stamp - held.stamp <= options_.gap_tolerance) {
+      PushFrame(held.stamp, held.processed);
+    } else {
+      ++stats_.frames_stale;
+      ++stats_.frames_dropped;
+    }
+  }
+  // A frame after a hole waits for the next likewise: time going on from it confirms it; time
+  // coming back before it (one frame stamped 0.15 s ahead at 30 fps) drops it as stale.
+  if (forward_) {
+    BackwardFrame held = std::move(*forward_);
+    forward_.reset();
+    if (std::isfinite(stamp) && stamp > held.stamp) {
       PushFrame(held.stamp, held.processed);
     } else {
       ++stats_.frames_stale;
@@ -104,6 +118,10 @@ bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
   }
   if (last_frame_ > 0 && std::isfinite(stamp) && stamp < last_frame_ - options_.gap_tolerance) {
     backward_ = BackwardFrame{stamp, processed};
+    return true;
+  }
+  if (last_frame_ > 0 && std::isfinite(stamp) && stamp - last_frame_ > options_.gap_tolerance) {
+    forward_ = BackwardFrame{stamp, processed};
     return true;
   }
   PushFrame(stamp, processed);
@@ -235,6 +253,11 @@ std::vector<LabelledClip> ClipPipeline::Flush() {
     backward_.reset();
     ++stats_.frames_stale;
     ++stats_.frames_dropped;
+  }
+  // A frame after a hole with nothing after it: time did go on to it, so it is taken.
+  if (forward_) {
+    PushFrame(forward_->stamp, forward_->processed);
+    forward_.reset();
   }
   // Readings held for the next frame belong to this timeline when none comes.
   for (const LabelReading& reading : held_) TakeReading(reading);

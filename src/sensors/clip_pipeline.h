@@ -182,6 +182,10 @@ class ClipPipeline {
     cv::Mat processed;
   };
   std::optional<BackwardFrame> backward_;
+  // A frame stamped more than gap_tolerance after the last, held until the next frame says whether
+  // time goes on from it (a real hole, or a slow camera) or comes back (a lone frame stamped
+  // ahead: taken, it made the next frames a jump back and reset the labeller's readings).
+  std::optional<BackwardFrame> forward_;
   ClipPipelineStats stats_;
 };
 

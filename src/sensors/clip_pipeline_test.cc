@@ -257,6 +257,39 @@ TEST(ClipPipelineTest, ALoneFrameStampedHoursBackIsDroppedAsStale) {
   }
 }
 
+// The mirror case: one frame stamped ahead of the stream (0.15 s at 30 fps) made the frames after
+// it a jump back, which reset the labeller: a minute of clips labelled over part of their window.
+// And the same stale frame delivered twice confirmed itself as a new timeline.
+TEST(ClipPipelineTest, ALoneFrameStampedAheadOrAStaleFrameTwiceKeepsTheReadings) {
+  for (const bool twice : {false, true}) {
+    ClipPipeline p(SmallOptions());  // label window 5 s, delay 1.5 s
+    std::vector<LabelledClip> clips;
+    for (int i = 0; i <= 20 * 30; ++i) {
+      const double t = kT0 + i / 30.0;
+      if (i % 30 == 0) p.AddReading({t, 6.0, 0.0});
+      if (i == 300 && !twice) {
+        p.AddFrame(t + 0.15, Numbered(i), ClipSourceEncoding::kMono8);  // in place of frame 300
+        continue;
+      }
+      if (i == 300 && twice) {
+        p.AddFrame(t - 3 * 3600.0, Numbered(i), ClipSourceEncoding::kMono8);
+        p.AddFrame(t - 3 * 3600.0, Numbered(i), ClipSourceEncoding::kMono8);
+      }
+      p.AddFrame(t, Numbered(i), ClipSourceEncoding::kMono8);
+      for (auto& c : p.TakeReady()) clips.push_back(std::move(c));
+    }
+    EXPECT_EQ(p.stats().time_jumps, 0u) << twice;
+    EXPECT_EQ(p.stats().frames_stale, twice ? 2u : 1u) << twice;
+    ASSERT_GT(clips.size(), 40u) << twice;
+    for (const auto& c : clips) {
+      const double end = c.clip.frames.back().stamp - kT0;
+      if (end >= 5.0) {
+        EXPECT_GE(c.label.count, 5u) << end << (twice ? " twice" : " ahead");
+      }
+    }
+  }
+}
+
 // A frame back in time that the next frame follows is a new timeline, whatever came before.
 TEST(ClipPipelineTest, AFrameBackInTimeThatTheNextFollowsStartsANewTimeline) {
   ClipPipeline p(SmallOptions());

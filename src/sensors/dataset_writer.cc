@@ -118,7 +118,11 @@ DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality, double i
   std::error_code ec;
   // Only the folder itself: its parent made here (a USB disk's mount point before the disk came)
   // was later hidden by the disk, whose own index the first clip after the mount replaced.
-  const fs::path parent = fs::absolute(fs::path(root_)).parent_path();
+  // Without its trailing separators: "/data/flagreal/" had "/data/flagreal" itself as its parent,
+  // refused for ever as "does not exist (a disk not mounted yet?)".
+  fs::path folder = fs::absolute(fs::path(root_)).lexically_normal();
+  if (!folder.has_filename() && folder.has_relative_path()) folder = folder.parent_path();
+  const fs::path parent = folder.parent_path();
   if (!fs::is_directory(parent, ec))
     throw std::runtime_error("cannot record into " + root_ + ": its parent folder " + parent.string() +
                              " does not exist (a disk not mounted yet?); it is not created");

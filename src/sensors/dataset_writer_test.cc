@@ -343,6 +343,12 @@ TEST_F(DatasetWriterTest, AMissingParentOrASwappedFolderStopsTheRecording) {
   }
   EXPECT_FALSE(fs::exists(root_ / "not-mounted"));
   fs::create_directories(root_);
+  // A trailing slash names the same folder: its "parent" was the folder itself, missing for ever.
+  {
+    DatasetWriter slash((root_ / "slashed").string() + "//");
+    slash.Write(MakeClip(0, 1700000000.0), {});
+  }
+  EXPECT_EQ(Read(root_ / "slashed" / "index.json")["clips"].size(), 1u);
   const fs::path folder = root_ / "flagreal";
   DatasetWriter w(folder.string());
   w.Write(MakeClip(0, 1700000000.0), {});
