@@ -9,6 +9,7 @@
 // are recorded on a thread of their own (sensors::AsyncDatasetWriter), so a slow disk never holds
 // up the camera callback.
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -130,10 +131,24 @@ class ClipBufferNode {
   }
 
   // Labels and records whatever is still waiting (called on shutdown; nothing is published then).
+  // The last clips wait for room in the writer's queue (a full queue of a slow disk dropped them
+  // with no report after), and the recording's tally is said at the end.
   void Finish() {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (const auto& c : pipeline_->Flush()) Record(c);
-    if (writer_) writer_->Drain();
+    for (const auto& c : pipeline_->Flush()) Record(c, /*wait_for_room=*/true);
+    if (!writer_) {
+      if (not_recorded_ > 0)
+        ROS_WARN("clip_buffer: %llu clips not recorded (no recording folder open: %s)",
+                 static_cast<unsigned long long>(not_recorded_), recording_error_.c_str());
+      return;
+    }
+    writer_->Drain();
+    const auto s = writer_->stats();
+    ROS_INFO("clip_buffer: recording into %s ends: %llu clips written, %llu failed, %llu dropped (queue full), "
+             "%llu not recorded (no folder open)",
+             writer_->root().c_str(), static_cast<unsigned long long>(s.written),
+             static_cast<unsigned long long>(s.failed), static_cast<unsigned long long>(s.dropped),
+             static_cast<unsigned long long>(not_recorded_));
   }
 
  private:
@@ -282,7 +297,7 @@ class ClipBufferNode {
 
   static constexpr double kLatestStamp = 4294967295.0 - 3600.0;  // [s] ROS time's end, less an hour
 
-  void Record(const sensors::LabelledClip& c) {
+  void Record(const sensors::LabelledClip& c, bool wait_for_room = false) {
     if (record_dir_.empty()) return;
     if (!writer_) {
       ++not_recorded_;
@@ -290,7 +305,7 @@ class ClipBufferNode {
     }
     source_.frame_id = frame_id_;
     source_.wind_frame_id = wind_frame_.frame_id();
-    writer_->Enqueue(c, source_);  // a full queue is counted by the writer, reported by OnTimer
+    writer_->Enqueue(c, source_, wait_for_room);  // a full queue is counted by the writer, reported by OnTimer
   }
 
   // The clock to check stamps against; none while simulated time has not started.
@@ -424,6 +439,9 @@ class ClipBufferNode {
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "clip_buffer");
+  // SIGTERM (systemd, docker stop, roslaunch's escalation) ends the spin like SIGINT, so the
+  // clips still waiting are labelled and recorded rather than lost with the process.
+  std::signal(SIGTERM, [](int) { ros::requestShutdown(); });
   ros::NodeHandle nh, pnh("~");
   clothwind::ros_bridge::StrictParams params(pnh);
   try {

@@ -23,12 +23,14 @@ AsyncDatasetWriter::~AsyncDatasetWriter() {
     stop_ = true;
   }
   wake_.notify_all();
+  room_.notify_all();
   thread_.join();
 }
 
-bool AsyncDatasetWriter::Enqueue(LabelledClip clip, ClipSourceInfo source) {
+bool AsyncDatasetWriter::Enqueue(LabelledClip clip, ClipSourceInfo source, bool wait_for_room) {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (wait_for_room) room_.wait(lock, [this] { return queue_.size() < max_queue_ || stop_; });
     if (queue_.size() >= max_queue_) {
       ++stats_.dropped;
       return false;
@@ -105,6 +107,7 @@ void AsyncDatasetWriter::Run() {
     queue_.pop_front();
     busy_ = true;
     lock.unlock();
+    room_.notify_all();
     const auto start = std::chrono::steady_clock::now();
     std::string error;
     try {

@@ -46,8 +46,10 @@ class AsyncDatasetWriter {
   AsyncDatasetWriter& operator=(const AsyncDatasetWriter&) = delete;
 
   // Queues one clip (its frames are shared, not copied: they must not be changed afterwards).
-  // Returns false when the queue was full (counted in dropped).
-  bool Enqueue(LabelledClip clip, ClipSourceInfo source);
+  // Returns false when the queue was full (counted in dropped). With `wait_for_room` it waits for
+  // the thread to take a clip instead: for the last clips at shutdown, which a full queue of a
+  // slow disk dropped without a word (no report came after them).
+  bool Enqueue(LabelledClip clip, ClipSourceInfo source, bool wait_for_room = false);
 
   // Blocks until every queued clip is recorded (or failed) and index.json lists them (or its
   // rewrite failed: stats().index_error).
@@ -70,7 +72,7 @@ class AsyncDatasetWriter {
   const std::string root_;
   const size_t size_at_open_, recovered_;
   mutable std::mutex mutex_;
-  std::condition_variable wake_, idle_;
+  std::condition_variable wake_, idle_, room_;
   std::deque<std::pair<LabelledClip, ClipSourceInfo>> queue_;
   bool busy_ = false, stop_ = false, flush_requested_ = false, flushing_ = false;
   // Rewrites the index now if clips are unlisted (thread only, mutex not held); updates stats_.

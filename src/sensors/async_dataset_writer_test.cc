@@ -66,6 +66,17 @@ TEST_F(AsyncDatasetWriterTest, FullQueueDropsAndCounts) {
   EXPECT_EQ(IndexSize(), s.written);
 }
 
+TEST_F(AsyncDatasetWriterTest, WaitingForRoomDropsNothing) {
+  // The clips flushed at shutdown: a full queue dropped them, and no report came after.
+  AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string()), 1);
+  for (uint64_t k = 0; k < 50; ++k) EXPECT_TRUE(w.Enqueue(MakeClip(k), {}, /*wait_for_room=*/true)) << k;
+  w.Drain();
+  const auto s = w.stats();
+  EXPECT_EQ(s.written, 50u);
+  EXPECT_EQ(s.dropped, 0u);
+  EXPECT_EQ(IndexSize(), 50u);
+}
+
 TEST_F(AsyncDatasetWriterTest, FailedWriteIsCountedWithItsReason) {
   AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string()));
   ASSERT_TRUE(w.Enqueue(MakeClip(0, 0), {}));  // no frames: DatasetWriter refuses it
