@@ -348,10 +348,12 @@ class ClipBufferNode {
     const double wall = ros::SteadyTime::now().toSec();
     if (wall - repeat_base_wall_ >= 10.0) {
       repeat_reason_ = sensors::ClipRepeatReason(repeat_base_, s, pipeline_->options());
+      loss_reason_ = sensors::ClipLossReason(repeat_base_, s, pipeline_->options());
       repeat_base_ = s;
       repeat_base_wall_ = wall;
     }
     if (!repeat_reason_.empty()) stat.mergeSummary(DiagnosticStatus::WARN, repeat_reason_);
+    if (!loss_reason_.empty()) stat.mergeSummary(DiagnosticStatus::WARN, loss_reason_);
     if (s.unlabelled_run > 0)
       stat.mergeSummaryf(DiagnosticStatus::WARN, "the last %lu clip(s) have no anemometer reading in their %.0f s window",
                          static_cast<unsigned long>(s.unlabelled_run), pipeline_->options().label_window);
@@ -370,6 +372,7 @@ class ClipBufferNode {
     stat.add("frames stamped back in time (dropped)", s.frames_stale);
     stat.add("frames out (25 fps)", s.frames_out);
     stat.add("gaps", s.gaps);
+    stat.add("frames out thrown away with clips a gap broke", s.frames_discarded);
     stat.add("last gap [s]", s.last_gap);
     stat.add("time jumps back", s.time_jumps);
     stat.add("clips labelled at a time jump", s.clips_at_jumps);
@@ -407,6 +410,7 @@ class ClipBufferNode {
   sensors::ClipPipelineStats repeat_base_;  // the counters at the start of the repeat window
   double repeat_base_wall_ = 0;             // its wall time [s]
   std::string repeat_reason_;               // ClipRepeatReason of the last whole window
+  std::string loss_reason_;                 // ClipLossReason of the same window
   std::unique_ptr<sensors::AsyncDatasetWriter> writer_;
   sensors::ClipSourceInfo source_;
   std::string frame_id_;

@@ -56,7 +56,7 @@ bool ClipPipeline::RefusedByClock(double stamp, double now, uint64_t* future, ui
 
 void ClipPipeline::Reset() {
   resampler_.Reset();
-  assembler_.Break();
+  BreakClip();
   previous_.release();
   pending_.clear();
   released_at_jump_.clear();
@@ -82,7 +82,7 @@ bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
       source_width_ = image.cols;
       source_height_ = image.rows;
       resampler_.Reset();  // a new image size is a new stream
-      assembler_.Break();
+      BreakClip();
     }
     processed = PreprocessClipFrame(image, encoding, roi_, options_.size, options_.colour);
   } catch (...) {
@@ -141,9 +141,9 @@ void ClipPipeline::PushFrame(double stamp, const cv::Mat& processed) {
   if (r.gap) {
     ++stats_.gaps;
     stats_.last_gap = stamp - last_frame_;
-    assembler_.Break();
+    BreakClip();
   }
-  if (r.restarted) assembler_.Break();
+  if (r.restarted) BreakClip();
   if (r.jumped_back || went_back) {
     // Time went back (a bag restarted or looped): the old timeline's readings must not label the
     // new one's clips. Its waiting clips are labelled now with what it has (as Flush does at the
@@ -163,6 +163,11 @@ void ClipPipeline::PushFrame(double stamp, const cv::Mat& processed) {
   previous_ = processed;
   last_frame_ = stamp;
   data_time_ = std::max(data_time_, stamp);
+}
+
+void ClipPipeline::BreakClip() {
+  assembler_.Break();
+  stats_.frames_discarded = assembler_.frames_discarded();
 }
 
 void ClipPipeline::Emit(const FrameResampler::Tick& tick, const cv::Mat& image) {
@@ -269,6 +274,25 @@ std::vector<LabelledClip> ClipPipeline::Flush() {
     pending_.pop_front();
   }
   return ready;
+}
+
+std::string ClipLossReason(const ClipPipelineStats& since, const ClipPipelineStats& now,
+                           const ClipPipelineOptions& options) {
+  const uint64_t out = now.frames_out - since.frames_out;
+  const uint64_t lost = now.frames_discarded - since.frames_discarded;
+  const uint64_t gaps = now.gaps - since.gaps;
+  if (out < 2 * static_cast<uint64_t>(options.num_frames) || lost == 0) return "";
+  // The frames clips would use: all of them with a stride of num_frames or less, a share with a
+  // wider stride (the frames between sparse clips are not lost, only unused).
+  const double used = static_cast<double>(out) * options.num_frames / std::max(options.stride, options.num_frames);
+  if (5.0 * static_cast<double>(lost) <= used) return "";
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "%llu of the last %llu frames out were thrown away with the clips %llu holes longer than "
+                "gap_tolerance %.3g s broke (frames lost in bursts: a USB camera, or a bag recorded with drops?)",
+                static_cast<unsigned long long>(lost), static_cast<unsigned long long>(out),
+                static_cast<unsigned long long>(gaps), options.gap_tolerance);
+  return text;
 }
 
 std::string ClipRepeatReason(const ClipPipelineStats& since, const ClipPipelineStats& now,

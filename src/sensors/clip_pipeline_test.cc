@@ -109,6 +109,27 @@ TEST(ClipPipelineTest, StallReasonNamesHolesThatBreakEveryClip) {
   EXPECT_EQ(ClipStallReason(after_first, waiting.stats(), sparse), "");
 }
 
+TEST(ClipPipelineTest, LossReasonNamesFramesThrownAwayWithBrokenClips) {
+  // 30 fps losing 4 frames in every 50: clips are still made (no stall), but a large share of the
+  // frames goes with the clips the holes broke, which said nothing.
+  ClipPipelineOptions o = SmallOptions();
+  o.num_frames = 30;
+  o.stride = 30;
+  ClipPipeline lossy(o);
+  for (int i = 0; i < 60 * 30; ++i)
+    if (i % 50 < 46) lossy.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  EXPECT_GT(lossy.stats().clips_made, 0u);
+  EXPECT_EQ(ClipStallReason(ClipPipelineStats(), lossy.stats(), o), "");
+  const std::string why = ClipLossReason(ClipPipelineStats(), lossy.stats(), o);
+  EXPECT_NE(why.find("frames out were thrown away with the clips"), std::string::npos) << why;
+  EXPECT_GT(5 * lossy.stats().frames_discarded, lossy.stats().frames_out);
+  // A stream without holes throws nothing away, and says nothing.
+  ClipPipeline whole(o);
+  for (int i = 0; i < 60 * 30; ++i) whole.AddFrame(kT0 + i / 30.0, Numbered(i), ClipSourceEncoding::kMono8);
+  EXPECT_EQ(whole.stats().frames_discarded, 0u);
+  EXPECT_EQ(ClipLossReason(ClipPipelineStats(), whole.stats(), o), "");
+}
+
 TEST(ClipPipelineTest, GapBreaksTheClip) {
   ClipPipeline p(SmallOptions());
   int i = 0;
