@@ -224,7 +224,7 @@ class MonitorNodesTest(unittest.TestCase):
         self.wind_pub.publish(late)
         invalid = WindMeasurement()
         invalid.header.stamp, invalid.header.frame_id = rospy.Time.now(), "anemometer"
-        invalid.speed, invalid.valid = 3.0, False
+        invalid.speed, invalid.valid = 30.0, False  # a speed of its own: used, it would move the mean
         self.wind_pub.publish(invalid)
         wild = WindMeasurement()
         wild.header.stamp, wild.header.frame_id = rospy.Time.now(), "anemometer"
