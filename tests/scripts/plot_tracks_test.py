@@ -59,6 +59,40 @@ class PlotTracksTest(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertEqual(png_size(out), (600, 330))
 
+    def test_each_panel_shows_its_own_frame_and_points(self):
+        # The PNG's size says only how many panels there are: a script plotting frames 0 and 1 for
+        # --frames 2,3, or no points at all, passed. A gnuplot stub keeps the script and its data.
+        stub, capture = os.path.join(self.tmp.name, 'bin'), os.path.join(self.tmp.name, 'capture')
+        os.makedirs(stub)
+        os.makedirs(capture)
+        with open(os.path.join(stub, 'gnuplot'), 'w') as f:
+            f.write('#!/usr/bin/python3\n'
+                    'import os, re, shutil, sys\n'
+                    'text = sys.stdin.read()\n'
+                    'cap = os.environ["CAPTURE"]\n'
+                    'open(os.path.join(cap, "script.gp"), "w").write(text)\n'
+                    'for path in re.findall(r"\'([^\']*\\.dat)\'", text):\n'
+                    '    shutil.copy(path, cap)\n'
+                    'open(re.search(r"set output \'([^\']*)\'", text).group(1), "w").write("stub")\n')
+        os.chmod(os.path.join(stub, 'gnuplot'), 0o755)
+        out = os.path.join(self.tmp.name, 'a.png')
+        r = subprocess.run([SCRIPT, self.example, out, '--frames', '2,3'], capture_output=True, text=True,
+                           env=dict(os.environ, CAPTURE=capture, PATH=stub + os.pathsep + os.environ['PATH']))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(capture, 'script.gp')) as f:
+            script = f.read()
+        titles = [line for line in script.splitlines() if line.startswith('set title')]
+        self.assertEqual(titles, ["set title 'frame 2'", "set title 'frame 3'"])
+        self.assertIn(os.path.join(self.example, '002.png'), script)
+        self.assertIn(os.path.join(self.example, '003.png'), script)
+        self.assertNotIn('000.png', script)
+        for k in (2, 3):  # frame k's two points: (10 + k, 8) and (10 + k, 24)
+            with open(os.path.join(capture, f'{k}.dat')) as f:
+                self.assertEqual(f.read(), f'{10 + k} 8\n{10 + k} 24\n')
+        with open(os.path.join(capture, 'paths.dat')) as f:  # each point's path over all 4 frames
+            self.assertEqual(f.read(), ''.join(f'{10 + k} 8\n' for k in range(4)) + '\n' +
+                             ''.join(f'{10 + k} 24\n' for k in range(4)) + '\n')
+
     def test_refusals_name_what_is_wrong(self):
         out = os.path.join(self.tmp.name, 'b.png')
         r = self.run_script(out, '--frames', '0,4')
