@@ -265,7 +265,7 @@ class SdnNode {
       if (latencies_.size() > 50) latencies_.pop_front();
       last_estimate_wall_ = ros::SteadyTime::now().toSec();
       stamps_.push_back(last_estimate_wall_);
-      TrimRate(last_estimate_wall_);
+      TrimRecent(last_estimate_wall_);
       clip_error_.clear();
     } catch (const std::exception& e) {
       // Frames the model cannot read (a grey clip for a colour model, too few frames) are the
@@ -311,8 +311,8 @@ class SdnNode {
     if (malformed_since_good_.size() < 4096) malformed_since_good_.insert(sequence);
   }
 
-  // The estimates' wall times over the last 30 s, for the rate.
-  void TrimRate(double now) {
+  // The last 30 s of wall time: the estimates' times (for the rate) and the gaps in the sequence.
+  void TrimRecent(double now) {
     while (!stamps_.empty() && now - stamps_.front() > 30.0) stamps_.pop_front();
     while (!recent_missing_.empty() && now - recent_missing_.front().first > 30.0) recent_missing_.pop_front();
   }
@@ -378,7 +378,7 @@ class SdnNode {
     }
     if (!latencies_.empty()) mean /= latencies_.size();
     const double now = ros::SteadyTime::now().toSec();
-    TrimRate(now);
+    TrimRecent(now);
     // Estimates over the last 30 s: the intervals between them, N - 1 over the time they span
     // (N over the time since the first one overstated it until the window filled).
     const double rate =

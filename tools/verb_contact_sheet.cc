@@ -1,7 +1,5 @@
 // clothwind contact-sheet DIR: a grid of a dataset's middle frames labelled with their wind speed
 // (any dataset in the docs/dataset.md format: simulated or recorded), to check it at a glance.
-#include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -12,6 +10,7 @@
 #include "data/dataset_index.h"
 #include "output_paths.h"
 #include "progress_bar.h"
+#include "render/sensor_model.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -26,12 +25,8 @@ struct ContactSheetArgs {
 int Run(const ContactSheetArgs& a) {
   // The sheet is written as PNG or JPEG by its name's extension (any case): another failed only
   // after every tile was read, naming WriteFrameAtomic rather than --out.
-  if (!a.out.empty()) {
-    std::string ext = std::filesystem::path(a.out).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext != ".png" && ext != ".jpg" && ext != ".jpeg")
-      throw std::invalid_argument("--out " + a.out + ": expected a file name ending in .png, .jpg or .jpeg");
-  }
+  if (!a.out.empty() && !render::IsFrameFileName(a.out))
+    throw std::invalid_argument("--out " + a.out + ": expected a file name ending in .png, .jpg or .jpeg");
   const nlohmann::json index = data::ReadIndex(a.dir);
   if (index.is_null()) throw std::runtime_error(a.dir + "/index.json not found: not a dataset folder");
   const std::string out =

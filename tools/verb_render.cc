@@ -130,16 +130,13 @@ int Run(const RenderArgs& a) {
   // or, where a photo of that name happened to be, another photo rendered without a word.
   // Made absolute, so the zeta.json written below renders the same photo from any folder.
   const std::filesystem::path photo = zeta.background_image;
+  // A path with a folder (as an older render wrote it) is taken from the current folder.
   if (!photo.empty() && photo.is_relative()) {
-    if (!a.backgrounds.empty()) {
-      zeta.background_image =
-          std::filesystem::absolute(std::filesystem::path(a.backgrounds) / photo).lexically_normal().string();
-    } else if (!photo.has_parent_path()) {
+    if (a.backgrounds.empty() && !photo.has_parent_path())
       throw std::invalid_argument("--zeta " + a.zeta + " names its background photo '" + zeta.background_image +
                                   "' by file name: pass --backgrounds DIR, the folder make-dataset was given");
-    } else {
-      zeta.background_image = std::filesystem::absolute(photo).lexically_normal().string();  // as an older render wrote it
-    }
+    zeta.background_image =
+        std::filesystem::absolute(std::filesystem::path(a.backgrounds) / photo).lexically_normal().string();
   }
   if (a.samples > 0) zeta.samples = a.samples;
   zeta.fps = a.fps;

@@ -141,10 +141,16 @@ std::vector<uint8_t> EncodeFrame(const cv::Mat& bgr8, const std::string& ext, in
   return bytes;
 }
 
+bool IsFrameFileName(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  return ext == ".jpg" || ext == ".jpeg" || ext == ".png";
+}
+
 void WriteFrameAtomic(const std::string& path, const cv::Mat& bgr8, int jpeg_quality) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  if (ext != ".jpg" && ext != ".jpeg" && ext != ".png")
+  if (!IsFrameFileName(path))
     throw std::runtime_error("WriteFrameAtomic: '" + path + "' must end in .jpg, .jpeg or .png");
   const std::vector<uint8_t> bytes = EncodeFrame(bgr8, ext == ".png" ? ".png" : ".jpg", jpeg_quality);
   clothwind::WriteFileAtomically(path, bytes.data(), bytes.size());

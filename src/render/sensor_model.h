@@ -55,6 +55,9 @@ cv::Mat ApplySensorModel(const std::vector<cv::Mat>& linear_subframes,
 // Encodes an 8-bit frame as ".jpg" (quality 1..100) or ".png" bytes.
 std::vector<uint8_t> EncodeFrame(const cv::Mat& bgr8, const std::string& ext, int jpeg_quality = 95);
 
+// Whether WriteFrameAtomic can write `path`: its extension, in any case, is .jpg, .jpeg or .png.
+bool IsFrameFileName(const std::string& path);
+
 // Writes an 8-bit frame atomically (temporary name in the same folder, then rename); the
 // format follows the extension of `path` (.jpg/.jpeg/.png). Throws std::runtime_error naming
 // the path on failure.

@@ -95,7 +95,7 @@ bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
   // was a lone stale stamp, which restarted the labeller and released the waiting clips early.
   // Strictly after: the same stale frame delivered twice confirmed itself as a new timeline.
   if (backward_) {
-    BackwardFrame held = std::move(*backward_);
+    HeldFrame held = std::move(*backward_);
     backward_.reset();
     if (std::isfinite(stamp) && stamp > held.stamp && stamp - held.stamp <= options_.gap_tolerance) {
       PushFrame(held.stamp, held.processed);
@@ -107,7 +107,7 @@ bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
   // A frame after a hole waits for the next likewise: time going on from it confirms it; time
   // coming back before it (one frame stamped 0.15 s ahead at 30 fps) drops it as stale.
   if (forward_) {
-    BackwardFrame held = std::move(*forward_);
+    HeldFrame held = std::move(*forward_);
     forward_.reset();
     if (std::isfinite(stamp) && stamp > held.stamp) {
       PushFrame(held.stamp, held.processed);
@@ -117,11 +117,11 @@ bool ClipPipeline::AddFrame(double stamp, const cv::Mat& image, ClipSourceEncodi
     }
   }
   if (last_frame_ > 0 && std::isfinite(stamp) && stamp < last_frame_ - options_.gap_tolerance) {
-    backward_ = BackwardFrame{stamp, processed};
+    backward_ = HeldFrame{stamp, processed};
     return true;
   }
   if (last_frame_ > 0 && std::isfinite(stamp) && stamp - last_frame_ > options_.gap_tolerance) {
-    forward_ = BackwardFrame{stamp, processed};
+    forward_ = HeldFrame{stamp, processed};
     return true;
   }
   PushFrame(stamp, processed);

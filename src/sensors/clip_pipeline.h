@@ -187,17 +187,17 @@ class ClipPipeline {
   // counted late).
   static constexpr size_t kMaxHeldReadings = 4096;
   std::deque<LabelReading> held_;
-  // A frame stamped back in time, held until the next frame says whether a new timeline starts
-  // there (a looped bag) or it was a lone stale stamp.
-  struct BackwardFrame {
+  // A frame held until the next frame says whether time goes on from it. backward_: stamped back
+  // in time, a new timeline (a looped bag) or a lone stale stamp.
+  struct HeldFrame {
     double stamp;
     cv::Mat processed;
   };
-  std::optional<BackwardFrame> backward_;
+  std::optional<HeldFrame> backward_;
   // A frame stamped more than gap_tolerance after the last, held until the next frame says whether
   // time goes on from it (a real hole, or a slow camera) or comes back (a lone frame stamped
   // ahead: taken, it made the next frames a jump back and reset the labeller's readings).
-  std::optional<BackwardFrame> forward_;
+  std::optional<HeldFrame> forward_;
   ClipPipelineStats stats_;
 };
 
