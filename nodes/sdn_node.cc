@@ -181,6 +181,12 @@ class SdnNode {
         predictor->set_flag_flies(*told_flag_flies_);
       }
       LoadFlyJudge(*predictor);
+      // A ~fly_judge is asked only under auto: beside right, left or wind it loads and is never
+      // asked, which a launch file's author, who likely meant auto, would not see otherwise.
+      if (!fly_judge_path_.empty() && (follow_wind_ || predictor->flag_flies() != clothwind::learn::FlagFlies::kAuto)) {
+        ROS_WARN("sdn_node: ~fly_judge is set but ~flag_flies is %s, not auto: the judge is not asked",
+                 follow_wind_ ? "wind" : clothwind::learn::FlagFliesName(predictor->flag_flies()).c_str());
+      }
       model_name_ = c.Name() + " (" + model_path_ + ")";
       ROS_INFO("sdn_node: model %s on %s, %d threads, warm-up %.0f ms, flag flies %s", model_name_.c_str(),
                predictor->device().c_str(), threads_, 1e3 * warm,
@@ -450,8 +456,11 @@ class SdnNode {
     const std::string way = predictor_ ? clothwind::learn::FlagFliesName(predictor_->flag_flies()) : "-";
     stat.add("flag flies", follow_wind_ ? "wind: " + way : way);
     if (predictor_) {
-      stat.add("fly judge (for auto)", predictor_->fly_judge() ? predictor_->fly_judge_path().string()
-                                                               : std::string("none: the clip's motion cues"));
+      const bool judge_asked = !follow_wind_ && predictor_->flag_flies() == clothwind::learn::FlagFlies::kAuto;
+      stat.add("fly judge (for auto)",
+               (predictor_->fly_judge() ? predictor_->fly_judge_path().string()
+                                        : std::string("none: the clip's motion cues")) +
+                   (judge_asked ? "" : " (not asked: ~flag_flies is " + (follow_wind_ ? "wind" : way) + ")"));
     }
     if (follow_wind_) stat.add("clips with the wind end-on or unknown", wind_unknown_);
     stat.add("clips turned round (flag flying left)", turned_);

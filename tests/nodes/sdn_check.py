@@ -388,6 +388,9 @@ class SdnNodeTest(unittest.TestCase):
             speeds = {e.clip_sequence: e.speed for e in self.wind_estimates}
         self.assertEqual(values["flag flies"], "wind: left")
         self.assertEqual(values["clips with the wind end-on or unknown"], "2")
+        # ~fly_judge beside ~flag_flies wind loads but is never asked: said, not silently kept.
+        self.assertTrue(values["fly judge (for auto)"].endswith("models/fly_judge.pt (not asked: ~flag_flies is wind)"),
+                        values)
         self.assertAlmostEqual(speeds[1], speeds[2], places=5)
         self.assertAlmostEqual(speeds[1], speeds[3], places=5)
 
