@@ -71,5 +71,27 @@ bool FramePacer::WaitNext(double max_wait_s, int64_t* stamp_ns) {
   return true;
 }
 
+void PacedFrameSlot::Fill(Frame frame) {
+  frame_ = std::move(frame);
+  frame_valid_ = true;
+}
+
+void PacedFrameSlot::FillBad() { bad_ = true; }
+
+void PacedFrameSlot::Clear() { frame_valid_ = bad_ = false; }
+
+ReadStatus PacedFrameSlot::ReleaseWhenDue(FramePacer* pacer, double max_wait_s, Frame* frame) {
+  int64_t stamp = 0;
+  if (!pacer->WaitNext(max_wait_s, &stamp)) return ReadStatus::kNoFrame;
+  if (bad_) {
+    bad_ = false;
+    return ReadStatus::kBadFrame;
+  }
+  *frame = std::move(frame_);
+  frame->stamp_ns = stamp;
+  frame_valid_ = false;
+  return ReadStatus::kFrame;
+}
+
 }  // namespace sensors
 }  // namespace clothwind

@@ -107,6 +107,32 @@ class FramePacer {
   int64_t index_ = 0;
 };
 
+// A recording's next frame, read ahead of its due instant, or an unreadable one that keeps its
+// slot in time (and its sequence number, as a camera's lost frame does): it is reported when its
+// frame was due, so the frame after it keeps its own slot's stamp. Taking neither stamped the
+// frames after it one period early: 31 intervals in a 30-slot clip read every frequency 3 % high.
+class PacedFrameSlot {
+ public:
+  // True when nothing waits: the source reads the next frame.
+  bool empty() const { return !frame_valid_ && !bad_; }
+  // A frame read (its sequence set, its stamp not yet).
+  void Fill(Frame frame);
+  // An unreadable frame.
+  void FillBad();
+  void Clear();
+  // Waits until the slot's frame is due, but at most max_wait_s [s] (see FramePacer::WaitNext).
+  // Outputs:
+  //   frame  the frame, stamped with its due instant (only when kFrame is returned)
+  // Returns kNoFrame while not yet due (the slot stays filled), then kBadFrame for an unreadable
+  // frame or kFrame; either empties the slot.
+  ReadStatus ReleaseWhenDue(FramePacer* pacer, double max_wait_s, Frame* frame);
+
+ private:
+  bool frame_valid_ = false;
+  bool bad_ = false;
+  Frame frame_;
+};
+
 // Options to build any FrameSource (the node's parameters).
 struct FrameSourceOptions {
   std::string source = "v4l2";  // "v4l2", "video" or "folder"

@@ -116,8 +116,7 @@ bool ImageFolderSource::LoadNext(std::string* why) {
     return false;
   }
   f.sequence = sequence_++;
-  pending_ = std::move(f);
-  pending_valid_ = true;
+  slot_.Fill(std::move(f));
   ++next_;
   return true;
 }
@@ -127,7 +126,7 @@ ReadStatus ImageFolderSource::Read(Frame* frame, double max_wait_s) {
     error_ = "image folder " + folder_ + " is not open";
     return ReadStatus::kError;
   }
-  if (!pending_valid_ && !bad_pending_) {
+  if (slot_.empty()) {
     if (next_ >= files_.size()) {
       if (!loop_) return ReadStatus::kEnd;
       next_ = 0;
@@ -142,31 +141,19 @@ ReadStatus ImageFolderSource::Read(Frame* frame, double max_wait_s) {
         Close();
         return ReadStatus::kError;
       }
-      // The image was a frame of the recording: it keeps its slot in time and its sequence number,
-      // as a camera's lost frame does. Taking neither stamped the frames after it one period
-      // early: 31 intervals in a 30-slot clip read every frequency 3 % high.
+      // The image was a frame of the recording: it keeps its slot in time and its sequence number.
       ++sequence_;
-      bad_pending_ = true;
+      slot_.FillBad();
     } else {
       consecutive_failures_ = 0;
     }
   }
-  int64_t stamp = 0;
-  if (!pacer_.WaitNext(max_wait_s, &stamp)) return ReadStatus::kNoFrame;
-  if (bad_pending_) {
-    bad_pending_ = false;
-    return ReadStatus::kBadFrame;
-  }
-  *frame = std::move(pending_);
-  frame->stamp_ns = stamp;
-  pending_valid_ = false;
-  return ReadStatus::kFrame;
+  return slot_.ReleaseWhenDue(&pacer_, max_wait_s, frame);
 }
 
 void ImageFolderSource::Close() {
   open_ = false;
-  pending_valid_ = false;
-  bad_pending_ = false;
+  slot_.Clear();
 }
 
 std::string ImageFolderSource::Describe() const {

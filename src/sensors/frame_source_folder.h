@@ -47,11 +47,7 @@ class ImageFolderSource : public FrameSource {
   size_t consecutive_failures_ = 0;
   uint64_t sequence_ = 0;
   bool open_ = false;
-  bool pending_valid_ = false;
-  // An unreadable image waiting for its slot: it is reported (kBadFrame) when its frame was due,
-  // so the next image keeps its own slot's stamp rather than taking this one's.
-  bool bad_pending_ = false;
-  Frame pending_;
+  PacedFrameSlot slot_;  // the next image, or an unreadable one, waiting for its due instant
   int first_cols_ = 0, first_rows_ = 0;
   std::string first_encoding_;
   std::string error_;

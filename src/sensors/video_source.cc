@@ -60,7 +60,7 @@ ReadStatus VideoFileSource::Read(Frame* frame, double max_wait_s) {
     error_ = "video " + path_ + " is not open";
     return ReadStatus::kError;
   }
-  if (!pending_valid_ && !bad_pending_) {
+  if (slot_.empty()) {
     cv::Mat raw;
     if (!capture_.read(raw) || raw.empty()) {
       // A file that opens but yields no frame at all (a broken stream, a codec OpenCV lacks) is
@@ -85,31 +85,20 @@ ReadStatus VideoFileSource::Read(Frame* frame, double max_wait_s) {
                " channels, expected 1, 3 or 4";
       // Its slot and sequence number are kept (the frames after it were stamped a period early).
       ++sequence_;
-      bad_pending_ = true;
+      slot_.FillBad();
     } else {
       f.sequence = sequence_++;
       ++usable_frames_;
-      pending_ = std::move(f);
-      pending_valid_ = true;
+      slot_.Fill(std::move(f));
     }
   }
-  int64_t stamp = 0;
-  if (!pacer_->WaitNext(max_wait_s, &stamp)) return ReadStatus::kNoFrame;
-  if (bad_pending_) {
-    bad_pending_ = false;
-    return ReadStatus::kBadFrame;
-  }
-  *frame = std::move(pending_);
-  frame->stamp_ns = stamp;
-  pending_valid_ = false;
-  return ReadStatus::kFrame;
+  return slot_.ReleaseWhenDue(pacer_.get(), max_wait_s, frame);
 }
 
 void VideoFileSource::Close() {
   capture_.release();
   open_ = false;
-  pending_valid_ = false;
-  bad_pending_ = false;
+  slot_.Clear();
 }
 
 std::string VideoFileSource::Describe() const {

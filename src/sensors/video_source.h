@@ -43,9 +43,7 @@ class VideoFileSource : public FrameSource {
   std::unique_ptr<FramePacer> pacer_;
   cv::VideoCapture capture_;
   bool open_ = false;
-  bool pending_valid_ = false;
-  bool bad_pending_ = false;  // an undecodable frame waiting for its slot (see frame_source_folder.h)
-  Frame pending_;
+  PacedFrameSlot slot_;  // the next frame, or an undecodable one, waiting for its due instant
   uint64_t sequence_ = 0;
   uint64_t usable_frames_ = 0;  // frames decoded and usable since Open (a file with none is an error)
   int loops_ = 0;
