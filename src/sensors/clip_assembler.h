@@ -43,7 +43,8 @@ class ClipAssembler {
 
   uint64_t clips_made() const { return next_sequence_; }
   uint64_t breaks() const { return breaks_; }
-  // Frames that were in partial clips when they were broken (lost to gaps).
+  // Frames that were in partial clips when they were broken (lost to gaps): frames the next clip
+  // would have held, not those a stride wider than num_frames skips anyway.
   uint64_t frames_discarded() const { return frames_discarded_; }
   int num_frames() const { return num_frames_; }
   int stride() const { return stride_; }

@@ -55,6 +55,20 @@ TEST(ClipAssemblerTest, BreakDiscardsPartialClip) {
   EXPECT_EQ(Starts(a, 0, 40), (std::vector<int64_t>{0}));
 }
 
+TEST(ClipAssemblerTest, BreakWithAWideStrideDiscardsOnlyTheNextClipsFrames) {
+  ClipAssembler a(30, 150);  // clips end at frames 30, 180, 330, ...: the next one holds 151-180
+  EXPECT_EQ(Starts(a, 0, 100), (std::vector<int64_t>{0}));
+  a.Break();  // frames 31-100 belong to no clip
+  EXPECT_EQ(a.frames_discarded(), 0u);
+  EXPECT_EQ(Starts(a, 0, 160), (std::vector<int64_t>{0}));
+  a.Break();  // frames 151-160 were the next clip's first 10
+  EXPECT_EQ(a.frames_discarded(), 10u);
+  EXPECT_EQ(Starts(a, 0, 20).size(), 0u);
+  a.Break();  // before the first clip: all 20
+  EXPECT_EQ(a.frames_discarded(), 30u);
+  EXPECT_EQ(a.breaks(), 3u);
+}
+
 TEST(ClipAssemblerTest, NonConsecutiveTickBreaks) {
   ClipAssembler a(5, 5);
   EXPECT_TRUE(Starts(a, 0, 4).empty());
