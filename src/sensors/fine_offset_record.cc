@@ -84,6 +84,13 @@ ParseResult ParseFineOffsetHex(const std::string& hex) {
     res.error = "fine_offset: record is not hex text: '" + hex.substr(0, 40) + "'";
     return res;
   }
+  // One whole record: a longer one was cut to its first 16 bytes without a word, and two records
+  // run together read as the first, the second lost.
+  if (bytes.size() != kFineOffsetRecordSize && bytes.size() != 20) {
+    res.error = "fine_offset: record has " + std::to_string(bytes.size()) +
+                " bytes, expected 16 (WH1080) or 20 (WH3080): one record per message";
+    return res;
+  }
   FineOffsetRecord rec;
   if (!ParseFineOffsetRecord(bytes, &rec, &res.error)) return res;
   res.reading = FineOffsetToReading(rec);

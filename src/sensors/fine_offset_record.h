@@ -77,10 +77,11 @@ bool ParseFineOffsetRecord(const std::vector<uint8_t>& bytes, FineOffsetRecord* 
 // Returns the reading (source "fine_offset").
 WindReading FineOffsetToReading(const FineOffsetRecord& record);
 
-// Parses a record given as hex text (how RawSentence carries binary records), e.g. 32 hex digits.
+// Parses a record given as hex text (how RawSentence carries binary records): 32 hex digits
+// (WH1080) or 40 (WH3080).
 // Inputs:
 //   hex  hex digits, upper or lower case, optional spaces
-// Returns kOk with the reading, or kMalformed naming the problem.
+// Returns kOk with the reading, or kMalformed naming the problem (another length among them).
 ParseResult ParseFineOffsetHex(const std::string& hex);
 
 // The 8-byte read command the station expects (sent as a HID SET_REPORT control transfer):

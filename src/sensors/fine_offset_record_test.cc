@@ -140,6 +140,16 @@ TEST(FineOffsetRecord, ReadCommandAndHex) {
   ASSERT_EQ(p.status, ParseStatus::kOk) << p.error;
   EXPECT_NEAR(p.reading.speed, 2.8, 1e-9);
   EXPECT_EQ(ParseFineOffsetHex("zz").status, ParseStatus::kMalformed);
+  // A WH3080 record (20 bytes, the same first 16) reads the same wind.
+  const ParseResult wh3080 = ParseFineOffsetHex(hex + "00000000");
+  ASSERT_EQ(wh3080.status, ParseStatus::kOk) << wh3080.error;
+  EXPECT_NEAR(wh3080.reading.speed, 2.8, 1e-9);
+  // Any other length is no one record: 17 bytes, two records run together, 15 bytes.
+  for (const std::string& bad : {hex + "FF", hex + hex, hex.substr(0, 30)}) {
+    const ParseResult p2 = ParseFineOffsetHex(bad);
+    EXPECT_EQ(p2.status, ParseStatus::kMalformed) << bad;
+    EXPECT_NE(p2.error.find("expected 16"), std::string::npos) << p2.error;
+  }
 }
 
 }  // namespace
