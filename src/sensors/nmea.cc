@@ -120,7 +120,11 @@ ParseResult ParseMwd(const NmeaSentence& s) {
   if (std::isfinite(v[3])) w.speed = v[3];
   else if (std::isfinite(v[2])) w.speed = SpeedToMetresPerSecond(v[2], SpeedUnit::kKnots);
   else return Fail(ParseStatus::kMalformed, where + ": neither knots (field 5) nor m/s (field 7) speed given");
-  if (w.speed < 0.0) return Fail(ParseStatus::kMalformed, where + ": negative speed");
+  if (w.speed < 0.0) {
+    const bool metres = std::isfinite(v[3]);
+    return Fail(ParseStatus::kMalformed, where + (metres ? " field 7 (speed, m/s)" : " field 5 (speed, knots)") +
+                                             ": expected >= 0, got " + s.fields[metres ? 6 : 4]);
+  }
   r.status = ParseStatus::kOk;
   return r;
 }
@@ -175,7 +179,9 @@ ParseResult ParseXdr(const NmeaSentence& s) {
         return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] +
                                                  "': speed units expected M, N, K or S, got '" + units + "'");
       if (value < 0.0)
-        return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] + "': negative speed");
+        return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] + "' field " +
+                                                 std::to_string(q + 2) + " (speed): expected >= 0, got " +
+                                                 s.fields[q + 1]);
       if (name.find("GUST") != std::string::npos) w.gust = SpeedToMetresPerSecond(value, unit);
       else w.speed = SpeedToMetresPerSecond(value, unit);
       any = true;

@@ -197,5 +197,18 @@ TEST(Nmea, MwdDirectionOutOfRangeNamesTheFieldAndValue) {
   EXPECT_NE(r.error.find("-7"), std::string::npos) << r.error;
 }
 
+TEST(Nmea, NegativeSpeedNamesTheFieldAndValue) {
+  // MWD reads m/s (field 7) before knots (field 5): the field read is the one named.
+  ParseResult r = ParseNmea(WithNmeaChecksum("WIMWD,270.0,T,265.5,M,10.0,N,-5.1,M"));
+  ASSERT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("field 7 (speed, m/s): expected >= 0, got -5.1"), std::string::npos) << r.error;
+  r = ParseNmea(WithNmeaChecksum("WIMWD,270.0,T,265.5,M,-10.0,N,,M"));
+  ASSERT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("field 5 (speed, knots): expected >= 0, got -10.0"), std::string::npos) << r.error;
+  r = ParseNmea(WithNmeaChecksum("WIXDR,A,225.0,D,WINDDIR,N,-7.5,M,WINDSPEED"));
+  ASSERT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("'WINDSPEED' field 6 (speed): expected >= 0, got -7.5"), std::string::npos) << r.error;
+}
+
 }  // namespace
 }  // namespace clothwind::sensors
