@@ -35,6 +35,7 @@ class UsbReadHealth {
   int errors_before_reopen_;
   int errors_in_row_ = 0;
   bool failing_ = false;
+  bool reopen_asked_ = false;         // ReadFailed asked for a reopen that has not happened yet
   bool reopened_for_errors_ = false;
   std::string last_error_;
 };

@@ -14,6 +14,9 @@ TEST(UsbReadHealth, FailedReadsWarnThenReopenThenErrorUntilAReadSucceeds) {
   EXPECT_NE(h.message().find("LIBUSB_ERROR_TIMEOUT"), std::string::npos) << h.message();
   EXPECT_FALSE(h.ReadFailed("LIBUSB_ERROR_TIMEOUT"));
   EXPECT_TRUE(h.ReadFailed("LIBUSB_ERROR_TIMEOUT"));  // the third in a row: reopen
+  // Not yet reopened (the node backs off first): still a WARN, not "even after reopening".
+  EXPECT_EQ(h.level(), UsbReadHealth::Level::kWarn);
+  EXPECT_EQ(h.message().find("reopening"), std::string::npos) << h.message();
   // A successful open is not an answer: the station that opens but stays silent is an error, not
   // "connected" and OK (the node used to reset everything on open).
   h.Opened();
