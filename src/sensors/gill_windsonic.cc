@@ -101,9 +101,14 @@ ParseResult ParseGillWindSonic(const std::string& record) {
   std::string err;
   if (!ParseOptionalNumber(f[1], &a, &err)) return Fail(ParseStatus::kMalformed, "field 2: " + err);
   if (!ParseOptionalNumber(f[2], &b, &err)) return Fail(ParseStatus::kMalformed, "field 3: " + err);
-  const bool uv = !f[1].empty() && (f[1][0] == '+' || f[1][0] == '-');
+  // UV signs both components; polar signs neither. A sign on either field is UV: "Q,,+002.00,M,00"
+  // (U lost) read as polar, 2 m/s with no direction, under status OK.
+  const auto signed_field = [](const std::string& s) { return !s.empty() && (s[0] == '+' || s[0] == '-'); };
+  const bool uv = signed_field(f[1]) || signed_field(f[2]);
   if (uv) {
-    if (!std::isfinite(a) || !std::isfinite(b)) return Fail(ParseStatus::kMalformed, "UV: U or V empty");
+    if (!std::isfinite(a) || !std::isfinite(b))
+      return Fail(ParseStatus::kMalformed, std::string("UV: field ") + (std::isfinite(a) ? "3 (V)" : "2 (U)") +
+                                               " empty, expected a signed speed");
     const double u = SpeedToMetresPerSecond(a, unit), v = SpeedToMetresPerSecond(b, unit);
     w.speed = std::hypot(u, v);
     if (w.speed > 0.0) {
@@ -119,7 +124,7 @@ ParseResult ParseGillWindSonic(const std::string& record) {
     if (!std::isfinite(b)) {
       if (status_ok) return Fail(ParseStatus::kMalformed, "field 3 (speed) empty with status " + status);
     } else {
-      if (b < 0.0) return Fail(ParseStatus::kMalformed, "field 3 (speed): negative");
+      if (b < 0.0) return Fail(ParseStatus::kMalformed, "field 3 (speed): expected >= 0, got '" + f[2] + "'");
       w.speed = SpeedToMetresPerSecond(b, unit);
     }
     w.from_angle_deg = a;  // empty (NaN) in calm air

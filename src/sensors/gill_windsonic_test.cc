@@ -108,6 +108,13 @@ TEST(GillWindSonic, UvAgreesWithPolar) {
   const auto v = WindVelocity(r.reading);
   EXPECT_NEAR(v[0], 1.59, 1e-9);
   EXPECT_NEAR(v[1], -2.74, 1e-9);
+  // A UV record that lost a component is malformed, named, not a polar reading without direction.
+  for (const auto& [body, field] : {std::pair<std::string, std::string>{"Q,,+002.00,M,00,", "field 2 (U)"},
+                                    {"Q,+002.00,,M,00,", "field 3 (V)"}}) {
+    r = ParseGillWindSonic(FrameGillRecord(body));
+    EXPECT_EQ(r.status, ParseStatus::kMalformed) << body;
+    EXPECT_NE(r.error.find(field), std::string::npos) << r.error;
+  }
 }
 
 }  // namespace
