@@ -211,7 +211,10 @@ std::string WithNmeaChecksum(const std::string& body) {
   return "$" + body + "*" + hex;
 }
 
-bool SplitNmeaSentence(const std::string& record, NmeaSentence* out, ParseResult* error) {
+bool SplitNmeaSentence(const std::string& raw_record, NmeaSentence* out, ParseResult* error) {
+  // Trailing blanks are line noise, as the Gill parser treats them: "...*39 " was refused as a
+  // checksum of three characters.
+  const std::string record = raw_record.substr(0, raw_record.find_last_not_of(" \t") + 1);
   auto fail = [&](ParseStatus s, const std::string& m) {
     *error = Fail(s, "NMEA: " + m);
     return false;

@@ -197,6 +197,13 @@ TEST(Nmea, MwdDirectionOutOfRangeNamesTheFieldAndValue) {
   EXPECT_NE(r.error.find("-7"), std::string::npos) << r.error;
 }
 
+TEST(Nmea, TrailingBlanksAreIgnored) {
+  for (const std::string& s : {std::string("$IIMWV,229.0,R,5.8,N,A*39 "), std::string("$IIMWV,229.0,R,5.8,N,A \t")}) {
+    const ParseResult r = ParseNmea(s);
+    EXPECT_EQ(r.status, ParseStatus::kOk) << r.error;
+  }
+}
+
 TEST(Nmea, NegativeSpeedNamesTheFieldAndValue) {
   // MWD reads m/s (field 7) before knots (field 5): the field read is the one named.
   ParseResult r = ParseNmea(WithNmeaChecksum("WIMWD,270.0,T,265.5,M,10.0,N,-5.1,M"));
