@@ -666,6 +666,19 @@ void CheckExampleLabel(const std::string& dir, int64_t i, int v, const DatasetOp
                              " s (resume with its settings, or use another --out)");
 }
 
+// Says which examples the index left out for frames missing (BuildIndex), so that a merge whose
+// copy has not finished, or a deleted frame, is seen rather than silently smaller.
+void SayIncomplete(const char* who, const std::vector<std::string>& incomplete) {
+  if (incomplete.empty()) return;
+  std::string names;
+  for (size_t k = 0; k < incomplete.size() && k < 5; ++k) names += (k ? ", " : "") + incomplete[k];
+  std::fprintf(stderr, "%s: %zu example%s left out of the index, %s frames not all there: %s%s (a run of %s "
+               "shard makes %s again)\n",
+               who, incomplete.size(), incomplete.size() == 1 ? "" : "s", incomplete.size() == 1 ? "its" : "their",
+               names.c_str(), incomplete.size() > 5 ? ", ..." : "", incomplete.size() == 1 ? "its" : "their",
+               incomplete.size() == 1 ? "it" : "them");
+}
+
 }  // namespace
 
 std::vector<Fabric> LoadFabrics(const std::string& folder, const std::string& scene_path,
@@ -730,7 +743,9 @@ int64_t ReindexDataset(const std::string& dir, bool contact_sheet, const std::fu
                              ", expected \"flag\" or \"cloth\" (only simulated datasets are re-indexed)");
   const IndexLock lock(dir);
   RemoveIndexTemporariesOfStoppedRuns(dir);
-  index = BuildIndex(dir, index, progress);
+  std::vector<std::string> incomplete;
+  index = BuildIndex(dir, index, progress, &incomplete);
+  SayIncomplete("make-dataset --reindex", incomplete);
   // The header's "tracks" says every example has its tracks.json: not when a merged shard was made
   // without them (the claim was kept, and training with --aux-tracks failed on the first such).
   if (index.contains("dataset") && index["dataset"].is_object() && index["dataset"].contains("tracks")) {
@@ -932,7 +947,9 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   // Every run rebuilds the index from the folders present: shards and resumed runs converge.
   const IndexLock lock(o.out);
   RemoveIndexTemporariesOfStoppedRuns(o.out);
-  nlohmann::json index = BuildIndex(o.out, IndexHeader(o, settings), index_progress);
+  std::vector<std::string> incomplete;
+  nlohmann::json index = BuildIndex(o.out, IndexHeader(o, settings), index_progress, &incomplete);
+  SayIncomplete("make-dataset", incomplete);
   if (o.add_tracks) {
     // The header's "tracks" says every example has its tracks.json: not while a replay failed or
     // another split still waits for its tracks (a later --add-tracks run completes it; a run with

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -157,9 +158,10 @@ namespace {
 
 // Throws unless `label` (read from `path`) agrees with a make-dataset header's settings block
 // `settings` on what both record: kind, seed, views, frames, size, format, rate, generator
-// version, and the split its seed falls in. A field either lacks (an older generator's) is not
-// compared. Why: a merge copies other machines' shards into the folder, and a shard run with
-// another --seed, --size or binary was indexed under this header without a word.
+// version, scene, warm-up, largest edge, the split its seed falls in, and a wind inside the
+// header's range. A field either lacks (an older generator's) is not compared. Why: a merge
+// copies other machines' shards into the folder, and a shard run with another --seed, --size,
+// --warmup, --wind-max or binary was indexed under this header without a word.
 void CheckLabelAgainstSettings(const std::string& path, const nlohmann::json& label, const nlohmann::json& settings) {
   const auto field = [](const nlohmann::json& j, const char* key) {
     return j.is_object() && j.contains(key) ? j[key] : nlohmann::json();
@@ -184,9 +186,27 @@ void CheckLabelAgainstSettings(const std::string& path, const nlohmann::json& la
   for (const auto& [name, got, header] : pairs)
     if (!got.is_null() && !header.is_null() && got != header) refuse(name, got, header);
   const nlohmann::json rate = field(label, "frame_rate"), fps = field(settings, "fps");
-  if (rate.is_number() && fps.is_number() &&
-      std::abs(rate.get<double>() - fps.get<double>()) > 1e-9 * std::max(1.0, std::abs(fps.get<double>())))
-    refuse("frame_rate", rate, fps);
+  const auto near = [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(b)); };
+  if (rate.is_number() && fps.is_number() && !near(rate.get<double>(), fps.get<double>())) refuse("frame_rate", rate, fps);
+  const nlohmann::json sim = field(label, "simulation_settings");
+  const nlohmann::json scene = field(sim, "scene"), header_scene = field(settings, "scene");
+  if (!scene.is_null() && !header_scene.is_null() && scene != header_scene)
+    refuse("simulation_settings.scene", scene, header_scene);
+  const nlohmann::json max_edge = field(sim, "max_edge"), header_edge = field(settings, "max_edge");
+  if (max_edge.is_number() && header_edge.is_number() && !near(max_edge.get<double>(), header_edge.get<double>()))
+    refuse("simulation_settings.max_edge", max_edge, header_edge);
+  // The generator rounds the warm-up to whole frames, and the label records it so.
+  const nlohmann::json warmup = field(sim, "warmup"), header_warmup = field(settings, "warmup");
+  if (warmup.is_number() && header_warmup.is_number() && fps.is_number() && fps.get<double>() > 0) {
+    const double frame_time = 1.0 / fps.get<double>();
+    const double expected = std::round(header_warmup.get<double>() / frame_time) * frame_time;
+    if (!near(warmup.get<double>(), expected)) refuse("simulation_settings.warmup", warmup, expected);
+  }
+  const nlohmann::json wind = field(label, "wind_speed"), ranges = field(settings, "ranges");
+  const nlohmann::json wind_min = field(ranges, "wind_min"), wind_max = field(ranges, "wind_max");
+  if (wind.is_number() && wind_min.is_number() && wind_max.is_number() &&
+      !(wind.get<double>() >= wind_min.get<double>() - 1e-9 && wind.get<double>() <= wind_max.get<double>() + 1e-9))
+    refuse("wind_speed", wind, "within " + wind_min.dump() + ".." + wind_max.dump() + " m/s (ranges.wind_min..wind_max)");
   const nlohmann::json seed = field(label, "seed"), split = field(label, "split");
   const nlohmann::json val = field(settings, "val_fraction"), test = field(settings, "test_fraction");
   if (seed.is_number_unsigned() && split.is_string() && val.is_number() && test.is_number()) {
@@ -197,8 +217,24 @@ void CheckLabelAgainstSettings(const std::string& path, const nlohmann::json& la
 
 }  // namespace
 
+namespace {
+
+// Whether every frame `label` (checked by ReadLabel: a valid pattern) names is in `folder`.
+bool LabelledFramesPresent(const fs::path& folder, const nlohmann::json& label) {
+  const std::string pattern = label["frame_pattern"].get<std::string>();
+  const int64_t frames = label["num_frames"].get<int64_t>();
+  std::vector<char> name(pattern.size() + 32);
+  for (int64_t k = 0; k < frames; ++k) {
+    std::snprintf(name.data(), name.size(), pattern.c_str(), static_cast<int>(k));
+    if (!fs::exists(folder / name.data())) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
-                          const std::function<void(int, int)>& progress) {
+                          const std::function<void(int, int)>& progress, std::vector<std::string>* incomplete) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
@@ -216,6 +252,22 @@ nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
     if (label["name"] != name)
       throw std::runtime_error(path + ": field 'name' is " + label["name"].dump() +
                                ", expected the folder's name \"" + name + "\"");
+    // A simulation beyond the header's count: a folder of a larger run (the e5 recipe copies
+    // examples and drops the index, so the generator's own count check never saw them).
+    const nlohmann::json count = header.is_object() ? header.value("count", nlohmann::json()) : nlohmann::json();
+    const nlohmann::json simulation = label.value("simulation", nlohmann::json());
+    if (count.is_number_integer() && simulation.is_number_integer() && simulation.get<int64_t>() >= count.get<int64_t>())
+      throw std::runtime_error(path + ": field 'simulation' is " + simulation.dump() + ", beyond the header's count " +
+                               count.dump() + " (an example of a larger run: remove it, or make the dataset with --count " +
+                               std::to_string(simulation.get<int64_t>() + 1) + " or more)");
+    // Frames missing (a copy not finished, a frame deleted): not listed, as the generator makes
+    // such an example again; a reader of the index would fail on it.
+    if (label.contains("num_frames") && label.contains("frame_pattern") &&
+        !LabelledFramesPresent(fs::path(dir) / name, label)) {
+      if (incomplete) incomplete->push_back(name);
+      if (progress) progress(static_cast<int>(clips.size()), static_cast<int>(names.size()));
+      continue;
+    }
     clips.push_back(IndexEntry(label));
     if (progress) progress(static_cast<int>(clips.size()), static_cast<int>(names.size()));
   }

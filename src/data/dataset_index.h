@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -64,15 +65,20 @@ nlohmann::json IndexEntry(const nlohmann::json& label);
 // Rebuilds index.json of `dir` from the example folders present (every non-hidden subfolder
 // with a label.json), sorted by name, so that any set of runs (shards, resumed runs) that left
 // the same folders gives the same index. `header` supplies the top-level fields (format,
-// version, kind, generator, dataset settings); "clips" is filled in. A label that contradicts the
-// header's settings (kind, seed, views, frames, size, format, rate, generator version, the split
-// of its seed) is refused naming it and the field: a shard made elsewhere with other settings.
+// version, kind, generator, dataset settings, count); "clips" is filled in. A label that
+// contradicts the header's settings (kind, seed, views, frames, size, format, rate, generator
+// version, scene, warm-up, largest edge, the split of its seed, a wind outside the range) or
+// whose simulation is beyond the header's count is refused naming it and the field: a shard
+// made elsewhere with other settings. An example whose frames are not all there is left out.
 // `progress`, when set, is called with (0, labels found) once the folder is listed and with
 // (labels read, labels found) after each label (a dataset of 20,000 examples takes tens of
 // seconds).
+// Outputs:
+//   incomplete  (optional) the names of the examples left out for missing frames
 // Throws std::runtime_error naming a label.json that cannot be read.
 nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
-                          const std::function<void(int, int)>& progress = {});
+                          const std::function<void(int, int)>& progress = {},
+                          std::vector<std::string>* incomplete = nullptr);
 
 // Writes index.json atomically (temporary file + rename).
 void WriteIndex(const std::string& dir, const nlohmann::json& index);
