@@ -33,4 +33,14 @@ refused "--wind-min: expected a finite number" --wind-min nan
 refused "--camera-angle: expected a finite number" --camera-angle nan
 refused --frames --frames 100001
 refused --frames --frames 100000 --size 4096
+# --reindex rebuilds the index under the dataset's own header: any other option was accepted and
+# ignored (--count 99 --kind cloth --tracks 9x9 rebuilt the same index, exit 0).
+for option in "--count 99" "--kind cloth" "--tracks 9x9" "--size 999" "--seed 7"; do
+  status=0
+  # shellcheck disable=SC2086
+  "$bin" make-dataset --reindex --out "$work/none" $option >"$work/msg.txt" 2>&1 || status=$?
+  [ "$status" -ne 0 ] && [ "$status" -lt 128 ] || fail "make-dataset --reindex $option exited $status"
+  grep -q -- "${option%% *} is not used by --reindex" "$work/msg.txt" ||
+    fail "make-dataset --reindex $option: the message does not name ${option%% *}: $(cat "$work/msg.txt")"
+done
 echo "make_dataset_cli_test: OK"

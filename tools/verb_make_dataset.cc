@@ -231,7 +231,17 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
                   "only this split's simulations, as the whole dataset has them (test: to evaluate a model "
                   "without making its training data; with --add-tracks, train: what --aux-tracks reads)")
       ->check(CLI::IsMember({"train", "val", "test"}));
-  return [a] {
+  return [a, sub] {
+    // --reindex reads the header and labels as they are: any other option was accepted and
+    // ignored (--count 99 --kind cloth --tracks 9x9 rebuilt the same index under the old header).
+    if (a->reindex) {
+      for (const CLI::Option* option : sub->get_options()) {
+        const std::string name = option->get_name();
+        if (option->count() > 0 && name != "--out" && name != "--reindex" && name != "--no-contact-sheet")
+          throw std::invalid_argument(name + " is not used by --reindex, which rebuilds the index under the header "
+                                      "the dataset was made with (give only --out and --no-contact-sheet)");
+      }
+    }
     if (!a->reindex && a->o.count <= 0) throw std::invalid_argument("--count N (N >= 1) is required");
     return Run(*a);
   };

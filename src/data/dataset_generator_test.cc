@@ -677,6 +677,8 @@ TEST_F(DatasetGeneratorTest, ReindexRefusesAShardOfOtherSettingsAndClaimsOnlyTra
   fs::rename(root_ / "001.jpg", frame);
   nlohmann::json index = ReadIndex(dir.string());
   index["dataset"]["tracks"] = {4, 3};
+  // A header's largest edge 0 is the scene's own: any edge a label records agrees with it.
+  index["dataset"]["max_edge"] = 0.0;
   std::ofstream(dir / "index.json") << index.dump(2) << "\n";
   EXPECT_EQ(ReindexDataset(dir.string(), false), 3);
   EXPECT_FALSE(ReadIndex(dir.string())["dataset"].contains("tracks"));

@@ -193,7 +193,9 @@ void CheckLabelAgainstSettings(const std::string& path, const nlohmann::json& la
   if (!scene.is_null() && !header_scene.is_null() && scene != header_scene)
     refuse("simulation_settings.scene", scene, header_scene);
   const nlohmann::json max_edge = field(sim, "max_edge"), header_edge = field(settings, "max_edge");
-  if (max_edge.is_number() && header_edge.is_number() && !near(max_edge.get<double>(), header_edge.get<double>()))
+  // A header's 0 is "the scene's own" (the label records the edge used).
+  if (max_edge.is_number() && header_edge.is_number() && header_edge.get<double>() > 0 &&
+      !near(max_edge.get<double>(), header_edge.get<double>()))
     refuse("simulation_settings.max_edge", max_edge, header_edge);
   // The generator rounds the warm-up to whole frames, and the label records it so.
   const nlohmann::json warmup = field(sim, "warmup"), header_warmup = field(settings, "warmup");
