@@ -208,7 +208,7 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
   sub->add_option("--camera-height", a->camera_height,
                   "camera height above the ground MIN:MAX [m] (default: flag 0.2:3, cloth 0.5:2)");
   sub->add_option("--camera-radius", a->camera_radius,
-                  "camera distance to the mesh's centre MIN:MAX [m] (default: flag 4:6, cloth 1:2.5)");
+                  "camera's horizontal distance from the mesh's centre MIN:MAX [m] (default: flag 4:6, cloth 1:2.5)");
   sub->add_option("--camera-angle", a->camera_angle,
                   "camera angle off side-on, +-DEG (default: flag 15, cloth 5)")
       ->check(CLI::Range(0.0, 89.9));

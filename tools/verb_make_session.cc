@@ -272,8 +272,8 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
   sub->add_flag("--overwrite", args->overwrite, "replace an existing --out");
   sub->add_option("--seed", args->seed, "random seed")->capture_default_str();
   sub->add_option("--fps", args->fps, "camera rate [Hz] (10 to 1000: a slower camera's intervals break every clip)")->capture_default_str();
-  sub->add_option("--width", args->width, "image width [px] (16..16384)")->capture_default_str();
-  sub->add_option("--height", args->height, "image height [px] (16..16384)")->capture_default_str();
+  sub->add_option("--width", args->width, "image width [px] (16..16384; rendered: 16..8192)")->capture_default_str();
+  sub->add_option("--height", args->height, "image height [px] (16..16384; rendered: 16..8192)")->capture_default_str();
   sub->add_option("--wind-mean", args->wind_mean, "long-term mean wind [m/s] (0..60)")->capture_default_str();
   sub->add_option("--drop-probability", args->drop_probability, "chance a frame is lost, in [0, 1)")->capture_default_str();
   sub->add_option("--start-time", args->start_time, "stamp of the session start [s since epoch, >= 1]")
@@ -297,7 +297,7 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
           ->capture_default_str(),
       sub->add_option("--zeta-seed", args->zeta_seed,
                       "rendered: seed of sun, sky, backdrop and flag design (default: --seed)"),
-      sub->add_option("--camera-distance", args->rendered.camera_radius, "rendered: camera's distance to the flag [m]")
+      sub->add_option("--camera-distance", args->rendered.camera_radius, "rendered: camera's horizontal distance from the flag's centre [m] (0.1..10000)")
           ->capture_default_str()};
   return [args, rendered_only] {
     std::vector<std::string> given;

@@ -28,7 +28,20 @@ RenderedFlagGenerator::RenderedFlagGenerator(const sensors::SyntheticSessionOpti
   zeta_.width = session.width;
   zeta_.height = session.height;
   zeta_.fps = session.fps;
-  render::ValidateRenderParams(zeta_);
+  try {
+    render::ValidateRenderParams(zeta_);
+  } catch (const std::invalid_argument& e) {
+    // Named after the option the user gave: "field 'camera_radius'" names no option of make-session.
+    const std::string what = e.what();
+    for (const auto& [field, option] : {std::pair<const char*, const char*>{"'camera_radius'", "--camera-distance"},
+                                        {"'samples'", "--render-samples"},
+                                        {"'width'", "--width"},
+                                        {"'height'", "--height"},
+                                        {"'fps'", "--fps"}})
+      if (what.find(field) != std::string::npos)
+        throw std::invalid_argument("rendered session: " + std::string(option) + ": " + what);
+    throw;
+  }
 
   sim::TurbulenceParams turbulence = options.turbulence;
   turbulence.seed = HashSeed(session.seed, 0x7e4b);

@@ -126,6 +126,24 @@ TEST(SessionWindFieldTest, FollowsTheSessionsSpeedAndDirection) {
   EXPECT_EQ(shifted.Velocity(Eigen::Vector3d(0, 0, 1), 1.5), a);
 }
 
+// make-session's options, named as the user gave them: the render parameters' own field names
+// ("field 'camera_radius' is 0.05") named no option of make-session.
+TEST(RenderedFlagGeneratorTest, BadCameraOrSamplesAreRefusedNamingTheOption) {
+  RenderedSessionOptions near = Coarse();
+  near.camera_radius = 0.05;
+  RenderedSessionOptions no_samples = Coarse();
+  no_samples.samples = 0;
+  for (const auto& [options, option] : {std::pair<RenderedSessionOptions, std::string>{near, "--camera-distance"},
+                                        {no_samples, "--render-samples"}}) {
+    try {
+      RenderedFlagGenerator(SmallSession(), options);
+      ADD_FAILURE() << option << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("rendered session: " + option + ": ", 0), 0u) << e.what();
+    }
+  }
+}
+
 TEST(RenderedFlagGeneratorTest, RendersTheSimulatedFlagInTimeOrder) {
   const sensors::SyntheticSessionOptions o = SmallSession();
   const auto gen = std::make_shared<RenderedFlagGenerator>(o, Coarse());
