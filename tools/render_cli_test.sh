@@ -42,6 +42,8 @@ left="$(cd "$work/rerun" && LC_ALL=C ls)"
   fail "a shorter rerun left files of the earlier run: $left"
 cp "$work/rerun/0000_00.obj" "$work/rerun/0000_01.obj"
 cp "$work/rerun/trajectory.cwtraj" "$work/rerun/trajectory_1.cwtraj"
+# (and a killed run's temporary, of a pid no process has: it stayed for ever)
+echo x >"$work/rerun/trajectory.cwtraj.tmp-999999999-3"
 "$bin" simulate "$src/config/scenes/flag.json" --out "$work/rerun" --duration 0.04 --max-edge 1 --no-obj >/dev/null 2>"$work/out.txt"
 left="$(cd "$work/rerun" && LC_ALL=C ls)"
 [ "$left" = "$(printf 'summary.json\ntrajectory.cwtraj')" ] || fail "a --no-obj rerun left files of the earlier run: $left"
@@ -113,6 +115,13 @@ status=0
 (cd "$work" && "$bin" render sim --out inf --count 1 --samples 1 --threads 1 >out.txt 2>&1) ||
   fail "render --out inf was refused: $(cat "$work/out.txt")"
 [ -f "$work/inf/000.jpg" ] || fail "render --out inf wrote no frame"
+# A killed run's temporaries (of a pid no process has) go with a rerun; they stayed for ever.
+echo x >"$work/inf/000.jpg.tmp-999999999-3"
+echo x >"$work/inf/zeta.json.tmp-999999999-4"
+(cd "$work" && "$bin" render sim --out inf --count 1 --samples 1 --threads 1 >out.txt 2>&1) ||
+  fail "render --out inf again: $(cat "$work/out.txt")"
+left="$(cd "$work/inf" && LC_ALL=C ls)"
+[ "$left" = "$(printf '000.jpg\nzeta.json')" ] || fail "a rerun left a killed run's temporaries: $left"
 
 # A rerun that fails after it starts writing (frame 1 cannot take its place: a folder holds its
 # name) leaves no zeta.json beside its new frame 0 and the earlier run's frame 2.

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/atomic_file.h"
 #include "data/cloth_animation.h"
 #include "progress_bar.h"
 #include "stale_frames.h"
@@ -170,15 +171,17 @@ int Run(const RenderArgs& a) {
   ro.threads = a.threads;
   render::Renderer renderer(zeta, ro);  // may still refuse ζ: the earlier run stays whole
   fs::remove(fs::path(a.out) / "zeta.json");
-  // Frames of an earlier run beyond this one's (or in the other format) would read as its own.
+  // Frames of an earlier run beyond this one's (or in the other format) would read as its own; a
+  // killed run's temporaries (frames, zeta.json) stayed for ever.
   const int stale = RemoveStaleFrames(a.out, [&](const std::string& name) {
+    if (IsTemporaryOfStoppedProcess(name)) return true;
     for (const char* ext : {".jpg", ".png"}) {
       const auto n = FrameNumber(name, 3, ext);
       if (n && (*n >= count || a.format != std::string(ext + 1))) return true;
     }
     return false;
   });
-  if (stale > 0) std::fprintf(stderr, "render: removed %d frames left by an earlier run\n", stale);
+  if (stale > 0) std::fprintf(stderr, "render: removed %d frames and temporaries left by an earlier run\n", stale);
   ProgressBar::Options bo;
   bo.label = "render";
   bo.unit = "frames";

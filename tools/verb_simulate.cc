@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/atomic_file.h"
 #include "sim/mesh.h"
 #include "sim/parameters.h"
 #include "sim/scene.h"
@@ -120,8 +121,11 @@ int Run(const SimulateArgs& a) {
   // beside the new summary, and `render DIR --obj` (or --cloth c) rendered the old cloth.
   {
     const int stale = RemoveStaleFrames(
-        a.out, [](const std::string& name) { return ObjFrameAndCloth(name) || IsSimulateTrajectory(name); });
-    if (stale > 0) std::fprintf(stderr, "simulate: removed %d frame OBJs and trajectories left by an earlier run\n", stale);
+        a.out, [](const std::string& name) {
+          return ObjFrameAndCloth(name) || IsSimulateTrajectory(name) || IsTemporaryOfStoppedProcess(name);
+        });
+    if (stale > 0)
+      std::fprintf(stderr, "simulate: removed %d frame OBJs, trajectories and temporaries left by an earlier run\n", stale);
   }
 
   nlohmann::json summary;
