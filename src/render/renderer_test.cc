@@ -597,7 +597,14 @@ TEST(Backdrop, PhotographComesOutAsItself) {
   const std::string dir = testing::TempDir() + "/render_bg_test_" + std::to_string(::getpid());
   std::filesystem::create_directories(dir);
   const std::string file = dir + "/wall.png";
-  cv::Mat photo(60, 120, CV_8UC3, cv::Scalar(40, 120, 200));  // B, G, R
+  // Four quadrants of their own colours (B, G, R): a photo of one colour came out as itself upside
+  // down or mirrored too.
+  const cv::Scalar top_left(40, 120, 200), top_right(200, 40, 120), bottom_left(120, 200, 40), bottom_right(90, 60, 30);
+  cv::Mat photo(60, 120, CV_8UC3);
+  photo(cv::Rect(0, 0, 60, 30)).setTo(top_left);
+  photo(cv::Rect(60, 0, 60, 30)).setTo(top_right);
+  photo(cv::Rect(0, 30, 60, 30)).setTo(bottom_left);
+  photo(cv::Rect(60, 30, 60, 30)).setTo(bottom_right);
   ASSERT_TRUE(cv::imwrite(file, photo));
   const std::vector<std::string> files = ListBackgroundImages(dir);
   ASSERT_EQ(files.size(), 1u);
@@ -614,15 +621,23 @@ TEST(Backdrop, PhotographComesOutAsItself) {
   const Eigen::Vector3f foot(static_cast<float>(c.x()), static_cast<float>(c.y()), 0.0f);
   EXPECT_NEAR((b.origin - foot).dot(b.across), 13.0f, 1e-3f);
   EXPECT_NEAR((b.origin - foot).dot(-b.normal), Backdrop::kBackdropDistance, 1e-3f);
+  // The photo's right is the camera's right, its top is up: each quadrant's centre shows its colour.
+  EXPECT_GT(b.across.dot(F3(r.camera().right)), 0.99f);
   const Eigen::Vector3f cam = F3(r.camera().position);
-  const Eigen::Vector3f aim = b.origin + Eigen::Vector3f(0, 0, 0.5f * b.height);
-  float t, alpha;
-  Rgb rad;
-  ASSERT_TRUE(b.Intersect(cam, (aim - cam).normalized(), &t, &rad, &alpha));
-  EXPECT_NEAR(alpha, 1.0f, 1e-6f);
-  EXPECT_NEAR(ToSrgb8(Tone(rad[0])), 200, 1);
-  EXPECT_NEAR(ToSrgb8(Tone(rad[1])), 120, 1);
-  EXPECT_NEAR(ToSrgb8(Tone(rad[2])), 40, 1);
+  for (const auto& [side, up, bgr] : {std::tuple<float, float, cv::Scalar>{-1, 1, top_left},
+                                      {1, 1, top_right},
+                                      {-1, -1, bottom_left},
+                                      {1, -1, bottom_right}}) {
+    const Eigen::Vector3f aim =
+        b.origin + side * 0.25f * b.width * b.across + Eigen::Vector3f(0, 0, (0.5f + up * 0.25f) * b.height);
+    float t, alpha;
+    Rgb rad;
+    ASSERT_TRUE(b.Intersect(cam, (aim - cam).normalized(), &t, &rad, &alpha));
+    EXPECT_NEAR(alpha, 1.0f, 1e-6f);
+    EXPECT_NEAR(ToSrgb8(Tone(rad[0])), bgr[2], 1) << side << " " << up;
+    EXPECT_NEAR(ToSrgb8(Tone(rad[1])), bgr[1], 1) << side << " " << up;
+    EXPECT_NEAR(ToSrgb8(Tone(rad[2])), bgr[0], 1) << side << " " << up;
+  }
   std::filesystem::remove_all(dir);
 }
 
