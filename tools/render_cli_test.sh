@@ -122,6 +122,15 @@ echo x >"$work/inf/zeta.json.tmp-999999999-4"
   fail "render --out inf again: $(cat "$work/out.txt")"
 left="$(cd "$work/inf" && LC_ALL=C ls)"
 [ "$left" = "$(printf '000.jpg\nzeta.json')" ] || fail "a rerun left a killed run's temporaries: $left"
+# --format jpeg is jpg, as make-dataset takes it (it was refused); --jpeg-quality beside png is
+# refused (it was accepted and ignored).
+(cd "$work" && "$bin" render sim --out jpeg --format jpeg --count 1 --samples 1 --threads 1 >out.txt 2>&1) ||
+  fail "render --format jpeg was refused: $(cat "$work/out.txt")"
+[ -f "$work/jpeg/000.jpg" ] || fail "render --format jpeg wrote no 000.jpg: $(ls "$work/jpeg")"
+status=0
+"$bin" render "$work/sim" --out "$work/q" --format png --jpeg-quality 50 --count 1 >"$work/out.txt" 2>&1 || status=$?
+[ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "--jpeg-quality is for JPEG" "$work/out.txt" ||
+  fail "render --format png --jpeg-quality 50 was not refused naming --jpeg-quality: $(cat "$work/out.txt")"
 
 # A rerun that fails after it starts writing (frame 1 cannot take its place: a folder holds its
 # name) leaves no zeta.json beside its new frame 0 and the earlier run's frame 2.

@@ -142,7 +142,8 @@ int Run(const RenderArgs& a) {
   if (a.samples > 0) zeta.samples = a.samples;
   zeta.fps = a.fps;
   render::ValidateRenderParams(zeta);
-  if (a.format != "jpg" && a.format != "png") throw std::invalid_argument("--format: jpg or png");
+  if (a.format != "jpg" && a.format != "png")
+    throw std::invalid_argument("--format: expected jpg (or jpeg) or png, got '" + a.format + "'");
   std::string what;
   const data::ClothAnimation anim = LoadInput(a, &what);
   FitMeshSize(anim, a, &zeta);
@@ -228,8 +229,9 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
   sub->add_option("--backgrounds", a->backgrounds,
                   "folder of the background photo a --zeta names by file name (make-dataset --backgrounds)")
       ->needs(zeta);
-  sub->add_option("--format", a->format, "jpg or png")->capture_default_str();
-  sub->add_option("--jpeg-quality", a->jpeg_quality, "JPEG quality")->check(CLI::Range(1, 100))->capture_default_str();
+  sub->add_option("--format", a->format, "jpg (or jpeg) or png")->capture_default_str();
+  auto* quality =
+      sub->add_option("--jpeg-quality", a->jpeg_quality, "JPEG quality")->check(CLI::Range(1, 100))->capture_default_str();
   sub->add_option("--start", a->start, "first frame's time in the animation [s]")->capture_default_str();
   sub->add_option("--count", a->count, "frames to render (0: to the end)")
       ->check(CLI::Range(0, 1000000))
@@ -247,7 +249,13 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
   sub->add_option("--threads", a->threads, "render threads (0: all cores; at most 1024)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
-  return [a] { return Run(*a); };
+  return [a, quality] {
+    // PNG is lossless: a quality beside it was accepted and ignored.
+    if (a->format == "jpeg") a->format = "jpg";  // as make-dataset takes it
+    if (quality->count() > 0 && a->format == "png")
+      throw std::invalid_argument("--jpeg-quality is for JPEG frames; --format png is lossless");
+    return Run(*a);
+  };
 }};
 
 }  // namespace
