@@ -426,6 +426,18 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
     throw std::runtime_error(abs_path + ":" + std::to_string(line) + ": not valid JSON near `" +
                              shown + "` (numbers must be finite: NaN/Infinity are not JSON): " +
                              e.what());
+  } catch (const json::exception& e) {
+    // A number beyond a double ("1e400": out_of_range 406, which carries no position): named by
+    // the line that holds the number the message quotes, else by the file alone.
+    std::string where = abs_path;
+    const std::string what = e.what();
+    const size_t quote = what.find("parsing '");
+    if (quote != std::string::npos) {
+      const size_t from = quote + 9, to = what.find('\'', from);
+      const size_t at = to == std::string::npos ? std::string::npos : text.find(what.substr(from, to - from));
+      if (at != std::string::npos) where += ":" + std::to_string(1 + std::count(text.begin(), text.begin() + at, '\n'));
+    }
+    throw std::runtime_error(where + ": not valid JSON: " + what);
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(abs_path + ": " + e.what());
   }

@@ -250,6 +250,9 @@ TEST_F(SceneFiles, ArcSimsTimingFormsEndAtTheFirstLimitReached) {
   // A limit out of range is named by the key that set it.
   const std::string d = scene("d.json", "\"frame_time\": 0.04, \"end_frame\": 3000000");
   ExpectErrorNaming([&] { LoadScene(d); }, {d, "end_frame", "at most 86400 s"});
+  // A number beyond a double is named by file and line (it was nlohmann's bare out_of_range).
+  const std::string e = Write("conf/e.json", Replace(SceneText(), "\"duration\": 1", "\"duration\": 1e400"));
+  ExpectErrorNaming([&] { LoadScene(e); }, {e + ":2: not valid JSON", "1e400"});
 }
 
 TEST_F(SceneFiles, DisabledArcSimModulesAreSwitchedOffOrNamed) {
