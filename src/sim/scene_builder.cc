@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
@@ -56,6 +57,21 @@ SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
     // Rest coordinates scale with the cloth so a scaled cloth starts unstressed.
     mesh.U *= sc.transform.scale;
     mesh.V = ApplyTransform(sc.transform, mesh.V);
+    // Within 100 m of the origin, where the crossing resolver's single-precision padding holds
+    // (crossing_resolver.h): a transform scaling by 1e308 was blamed on the OBJ's vertices, by a
+    // number one below the OBJ's, and one by 1e300 read as a degenerate face.
+    if (mesh.V.rows() > 0) {
+      Eigen::Index row = 0;
+      const double farthest = mesh.V.cwiseAbs().rowwise().maxCoeff().maxCoeff(&row);
+      if (!(farthest <= kMaxSceneCoordinate)) {
+        const bool moved = sc.transform.scale != 1.0 || sc.transform.rotate_deg != 0.0 || !sc.transform.translate.isZero();
+        std::ostringstream what;
+        what << (moved ? "the transform puts" : "the mesh has") << " a vertex at (" << mesh.V(row, 0) << ", "
+             << mesh.V(row, 1) << ", " << mesh.V(row, 2) << "), expected every coordinate within +-"
+             << kMaxSceneCoordinate << " m of the origin";
+        fail(key + (moved ? ".transform" : ".mesh"), what.str());
+      }
+    }
     try {
       ValidateMesh(mesh, sc.mesh);
     } catch (const std::exception& e) {

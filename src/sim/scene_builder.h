@@ -56,6 +56,10 @@ struct BuildOptions {
 // written as texture coordinates in 0..1 make it start stretched many times over.
 constexpr double kMaxInitialAreaRatio = 2.0;
 
+// A cloth's vertices after the scene transform lie within this many metres of the origin on
+// every axis: the crossing resolver's single-precision padding holds there (crossing_resolver.h).
+constexpr double kMaxSceneCoordinate = 100.0;
+
 // Loads meshes and materials and derives simulator settings.
 // Inputs:
 //   scene    parsed scene (LoadScene)
@@ -63,7 +67,8 @@ constexpr double kMaxInitialAreaRatio = 2.0;
 // Returns the setup. Throws std::runtime_error naming the scene file and the key (e.g.
 // "cloths[0].mesh", "handles[0].nodes[1]") when a mesh or material cannot be read or is invalid
 // (degenerate triangles, NaN, faces oriented inconsistently, unused vertices, an area more than
-// kMaxInitialAreaRatio from the rest area), or a handle node is out of range.
+// kMaxInitialAreaRatio from the rest area, a vertex beyond kMaxSceneCoordinate, named under
+// ".transform" when the transform put it there), or a handle node is out of range.
 SceneSetup BuildScene(const Scene& scene, const BuildOptions& options = {});
 
 // The default resolution BuildScene picks for a remeshing block (see BuildOptions::max_edge):

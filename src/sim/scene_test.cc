@@ -215,6 +215,13 @@ TEST_F(SceneFiles, ValidSceneWithCommentsTransformAndExtensions) {
   // x -> translate + Rz(90) (2 x): (1, 0, 0) -> (1, 2 + 2, 3).
   EXPECT_LT((m.V.row(1) - Eigen::RowVector3d(1, 4, 3)).norm(), 1e-9);
   EXPECT_NEAR(RestArea(m), 4.0, 1e-9);  // rest shape scaled too
+  // A transform that puts the cloth beyond 100 m (or past a double) is named as the transform's:
+  // it was the OBJ's "vertex 2 has a non-finite position" (one below the OBJ's own number), or a
+  // degenerate face at scale 1e300.
+  for (const std::string transform : {"\"scale\": 1e308", "\"scale\": 1e300", "\"translate\": [0, 150, 0]"}) {
+    const std::string far = Write("conf/far.json", SceneText("", "\"transform\": {" + transform + "},"));
+    ExpectErrorNaming([&] { BuildScene(LoadScene(far)); }, {far, "cloths[0].transform", "within +-100 m"});
+  }
 }
 
 TEST_F(SceneFiles, UnknownKeysWarnNamingKeyAndFile) {
