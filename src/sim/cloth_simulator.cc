@@ -71,10 +71,24 @@ struct ClothSimulator::Impl {
   StepStats stats;
   std::string failure;  // why the state blew up ("" while it has not)
   double max_relative_air = 0;  // largest |wind - face velocity| of the last force evaluation [m/s]
-  // The first force evaluation whose explicit wind was unstable (dt density |v_rel| / area weight
-  // above 2): its step (-1: none yet), ratio and relative air speed, for the blow-up's message.
+  // The first step whose explicit wind was unstable (dt density |v_rel| / area weight, or the
+  // tangential drag's dt drag / area weight, above 2): its step (-1: none since the state was
+  // set), ratios and relative air speed, for the blow-up's message.
   long wind_unstable_step = -1;
-  double wind_unstable_ratio = 0, wind_unstable_air = 0;
+  double wind_unstable_ratio = 0, wind_unstable_air = 0, drag_unstable_ratio = 0;
+
+  // Records the step's explicit wind stability (see wind_unstable_step), after its forces.
+  void CheckWindStability() {
+    if (wind_unstable_step >= 0) return;
+    const double ratio = options.dt * options.wind_density * max_relative_air / material.density;
+    const double drag_ratio = options.dt * options.wind_drag / material.density;
+    if (ratio > 2.0 || drag_ratio > 2.0) {
+      wind_unstable_step = steps + 1;
+      wind_unstable_ratio = ratio;
+      wind_unstable_air = max_relative_air;
+      drag_unstable_ratio = drag_ratio;
+    }
+  }
 
   // Block-sparse (3x3 blocks) symmetric system matrix with a fixed pattern, stored in full.
   std::vector<int> row_start;   // nv + 1
@@ -311,14 +325,6 @@ void ClothSimulator::Impl::ComputeForces(bool with_jacobian, bool with_repulsion
     if (with_jacobian)
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) J[face.block[3 * i + j]] += blocks[3 * i + j];
-  }
-  if (wind_unstable_step < 0 && options.wind_density > 0) {
-    const double ratio = options.dt * options.wind_density * max_relative_air / material.density;
-    if (ratio > 2.0) {
-      wind_unstable_step = steps + 1;
-      wind_unstable_ratio = ratio;
-      wind_unstable_air = max_relative_air;
-    }
   }
   // Bending, per hinge (ArcSim's bending_force, inlined so the dihedral is evaluated once).
   for (const Hinge& h : hinges) {
@@ -566,11 +572,19 @@ void ClothSimulator::Impl::BlowUp(long step, const std::string& what) {
   std::string why;
   if (wind_unstable_step >= 0) {
     char hint[360];
-    std::snprintf(hint, sizeof(hint),
-                  "; the explicit wind force was unstable from step %ld: dt * wind density * |wind - cloth| / area "
-                  "weight = %.3g > 2 (%.3g m/s, %.3g kg/m^2, dt %.3g s): a heavier cloth, a weaker wind or a shorter "
-                  "step (more frame_steps) holds it",
-                  wind_unstable_step, wind_unstable_ratio, wind_unstable_air, material.density, options.dt);
+    if (drag_unstable_ratio > 2.0) {  // the drag holds at any air speed: named first
+      std::snprintf(hint, sizeof(hint),
+                    "; the explicit wind drag was unstable from step %ld: dt * drag / area weight = %.3g > 2 "
+                    "(drag %.3g kg/(m^2 s), %.3g kg/m^2, dt %.3g s): a smaller drag, a heavier cloth or a shorter "
+                    "step (more frame_steps) holds it",
+                    wind_unstable_step, drag_unstable_ratio, options.wind_drag, material.density, options.dt);
+    } else {
+      std::snprintf(hint, sizeof(hint),
+                    "; the explicit wind force was unstable from step %ld: dt * wind density * |wind - cloth| / "
+                    "area weight = %.3g > 2 (%.3g m/s, %.3g kg/m^2, dt %.3g s): a heavier cloth, a weaker wind or a "
+                    "shorter step (more frame_steps) holds it",
+                    wind_unstable_step, wind_unstable_ratio, wind_unstable_air, material.density, options.dt);
+    }
     why = hint;
   }
   failure = std::string(head) + what + tail + why;
@@ -641,6 +655,8 @@ void ClothSimulator::Step() {
   s.stats.strain_limit_converged = true;
   s.stats.crossings_resolved = 0;
   s.ComputeForces(/*with_jacobian=*/true, repel);
+  // Here, not in ComputeForces: Forces() and Energy() of a state that never steps set it too.
+  s.CheckWindStability();
   const auto t2 = Clock::now();
   s.Solve();
   for (int i = 0; i < s.nv; ++i) {
@@ -706,6 +722,7 @@ void ClothSimulator::SetState(const Eigen::MatrixX3d& positions, const Eigen::Ma
     if (s.pinned[i]) s.v.row(i).setZero();
   s.dv.setZero();
   s.failure.clear();
+  s.wind_unstable_step = -1;  // the new state's own stability: a hint of the old one named a gone wind
   s.proximity_from_resolver = false;  // the resolver's candidates were for the old positions
 }
 
