@@ -62,10 +62,16 @@ TEST(MaterialTest, StiffnessGrowsWithStretchTowardsDirectionalRow) {
   const Eigen::Vector4d k = m.StretchingStiffness(G);
   const Eigen::Vector4d row1 = 2 * Table6x4(10).row(1).transpose();
   EXPECT_LT((k - row1).norm(), 0.05 * row1.norm()) << k.transpose();
-  // Along v: row 5 (90 degrees) is stiffer in this table.
+  // Along v: row 5 (90 degrees), and along the diagonal row 3 (45 degrees), each that row and not
+  // a neighbour (rows 1 apart differ by 10 in k0 here; "stiffer than along u" passed a direction
+  // read as 45 degrees at 90).
   Eigen::Matrix2d Gv = Eigen::Matrix2d::Zero();
   Gv(1, 1) = G(0, 0);
-  EXPECT_GT(m.StretchingStiffness(Gv)[0], k[0]);
+  const Eigen::Vector4d row5 = 2 * Table6x4(10).row(5).transpose();
+  EXPECT_LT((m.StretchingStiffness(Gv) - row5).norm(), 0.05 * row5.norm()) << m.StretchingStiffness(Gv).transpose();
+  const Eigen::Matrix2d Gd = Eigen::Matrix2d::Constant(0.5 * G(0, 0));  // (s^2 - 1) / 2 along (1, 1) / sqrt 2
+  const Eigen::Vector4d row3 = 2 * Table6x4(10).row(3).transpose();
+  EXPECT_LT((m.StretchingStiffness(Gd) - row3).norm(), 0.05 * row3.norm()) << m.StretchingStiffness(Gd).transpose();
   // Monotone in between.
   Eigen::Matrix2d Gh = 0.5 * G;
   EXPECT_GT(m.StretchingStiffness(Gh)[0], m.StretchingStiffness(Eigen::Matrix2d::Zero())[0]);
