@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 namespace clothwind::sim {
@@ -58,6 +59,29 @@ TEST(TurbulentWind, VarianceIsIntensityTimesSpeedSquared) {
     // 2000 L/U scatters by ~sqrt(2 T_int / T) ~ 3% plus the slowest modes' partial periods.
     EXPECT_NEAR(Variance(s), expected, 0.10 * expected) << "component " << c;
     EXPECT_NEAR(Mean(s), 0.0, 0.1 * sigma_u) << "component " << c;
+  }
+}
+
+// A mean wind off the x axis (the cloth scene's is diagonal): the along, across and up variances
+// hold along the wind's own directions, taken here from the mean, not from w.frame() (a frame fixed
+// to x, y, z passed the test above, which reads along w.frame(), with 0.82 sigma^2 along this wind).
+TEST(TurbulentWind, VarianceHoldsAlongAWindOffTheXAxis) {
+  TurbulenceParams p;
+  p.intensity = 0.15;
+  p.length_scale = 10.0;
+  p.seed = 11;
+  const Eigen::Vector3d mean(6, 8, 0);  // 10 m/s, 53 degrees off x
+  const TurbulentWind w(p, mean);
+  const Eigen::Vector3d along = mean.normalized(), up = Eigen::Vector3d::UnitZ(), across = up.cross(along);
+  const double sigma_u = p.intensity * mean.norm();
+  const Eigen::Vector3d directions[3] = {along, across, up};
+  const double dt = 0.1;  // 0.1 L/U, 2000 L/U in all
+  const int n = 20000;
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> s(n);
+    for (int i = 0; i < n; ++i) s[i] = directions[c].dot(w.Velocity(Eigen::Vector3d(0.3, -0.2, 1.0), i * dt));
+    const double expected = std::pow(sigma_u * p.component_ratios[c], 2);
+    EXPECT_NEAR(Variance(s), expected, 0.10 * expected) << "component " << c;
   }
 }
 
