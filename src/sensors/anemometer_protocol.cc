@@ -71,11 +71,10 @@ ParseResult AnemometerDecoder::Decode(const std::string& record, AnemometerProto
   if (used) *used = p;
   ParseResult r = ParseAnemometerRecord(record, p);
   const bool good = r.status == ParseStatus::kOk || r.status == ParseStatus::kNotWind;
-  if (auto_mode() && !(p != AnemometerProtocol::kAuto && good)) {
-    // In a row: a record that is not good (unrecognised, malformed, a checksum failure) breaks the
-    // run. Gill, garbage, a bad NMEA checksum, Gill, garbage, Gill locked onto Gill.
-    candidate_count_ = 0;
-  } else if (auto_mode()) {
+  // Good records of one protocol with none of another between them: line noise and checksum
+  // failures between them count neither way (a noisy line still locks), but a good record of
+  // another protocol starts the count again.
+  if (auto_mode() && p != AnemometerProtocol::kAuto && good) {
     if (p == candidate_) ++candidate_count_;
     else candidate_ = p, candidate_count_ = 1;
     if (locked_ == AnemometerProtocol::kAuto && candidate_count_ >= lock_after_) locked_ = p;

@@ -96,20 +96,21 @@ TEST(AnemometerDecoder, BadRecordsDoNotLock) {
   EXPECT_EQ(d.counters().parse_errors, 1u);
 }
 
-TEST(AnemometerDecoder, LocksOnlyAfterGoodRecordsInARow) {
+TEST(AnemometerDecoder, LocksAfterGoodRecordsWithNoneOfAnotherProtocolBetween) {
   AnemometerDecoder d;
   std::string bad_checksum = kMwv;
   bad_checksum.back() = '8';
-  // Good Gill records with garbage and a checksum failure between them: never three in a row.
-  for (const std::string& r : {kGill, std::string("\x01\x02garbage"), bad_checksum, kGill, std::string("hello"), kGill})
-    d.Decode(r);
+  // A good CSV record between Gill records starts the count again: not locked after 3 Gill.
+  for (const std::string& r : {kGill, kGill, std::string("1.5,45"), kGill}) d.Decode(r);
+  EXPECT_EQ(d.protocol(), AnemometerProtocol::kAuto);
+  // Garbage and a checksum failure between Gill records count neither way: a noisy line locks.
+  for (const std::string& r : {std::string("\x01\x02garbage"), bad_checksum, kGill}) d.Decode(r);
   EXPECT_EQ(d.protocol(), AnemometerProtocol::kAuto);
   d.Decode(kGill);
-  d.Decode(kGill);
   EXPECT_EQ(d.protocol(), AnemometerProtocol::kGill);
-  // Switching needs ten in a row of the new protocol too: nine, garbage, one more.
+  // Switching: ten good records of the new protocol with no good Gill record between them.
   for (int i = 0; i < 9; ++i) d.Decode(kMwv);
-  d.Decode("hello");
+  d.Decode(kGill);
   d.Decode(kMwv);
   EXPECT_EQ(d.protocol(), AnemometerProtocol::kGill);
 }
