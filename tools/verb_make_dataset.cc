@@ -105,8 +105,9 @@ int Run(MakeDatasetArgs& a) {
   ProgressBar::Options bar_options;
   bar_options.label = "make-dataset";
   bar_options.unit = "simulations";
-  bar_options.rate_scale = 60.0 * o.views;
-  bar_options.rate_unit = "clips/min";
+  // --add-tracks renders no clip: its pace is in simulations replayed.
+  bar_options.rate_scale = o.add_tracks ? 60.0 : 60.0 * o.views;
+  bar_options.rate_unit = o.add_tracks ? "simulations/min" : "clips/min";
   ProgressBar bar(bar_options);
   std::fprintf(stderr, "make-dataset: %s, %lld simulations x %d views, seed %llu, shard %d/%d, %s\n",
                a.kind.c_str(), static_cast<long long>(o.count), o.views,
