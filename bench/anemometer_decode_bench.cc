@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_args.h"
 #include "sensors/anemometer_protocol.h"
 #include "sensors/anemometer_stream.h"
 #include "sensors/gill_windsonic.h"
@@ -40,7 +41,7 @@ void Run(const char* name, const std::string& record, int n) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int Main(int argc, char** argv) {
   const int n = argc > 1 ? std::atoi(argv[1]) : 200000;
   std::printf("%-14s %9s %9s %12s %10s\n", "protocol", "records", "readings", "records/s", "us/record");
   Run("nmea_mwv", "$IIMWV,229.0,R,5.8,N,A*39", n);
@@ -51,3 +52,5 @@ int main(int argc, char** argv) {
   Run("fine_offset", "052DD200508A007E271C2A1006240100", n);
   return 0;
 }
+
+int main(int argc, char** argv) { return clothwind::bench::Guarded("anemometer_decode_bench", argc, argv, Main); }

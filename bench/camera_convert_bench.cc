@@ -14,6 +14,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bench_args.h"
 #include "sensors/pixel_format.h"
 
 namespace {
@@ -61,7 +62,7 @@ std::vector<uint8_t> Buffer(PixelFormat f, const cv::Mat& bgr) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int Main(int argc, char** argv) {
   const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 50;
   cv::setNumThreads(1);  // the node converts on its capture thread
   std::printf("%-6s %-10s %10s %12s %10s\n", "format", "size", "bytes", "ms/frame", "max fps");
@@ -86,3 +87,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+int main(int argc, char** argv) { return clothwind::bench::Guarded("camera_convert_bench", argc, argv, Main); }

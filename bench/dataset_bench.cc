@@ -18,6 +18,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <unistd.h>
 
+#include "bench_args.h"
 #include "bench_clock.h"
 #include "data/cloth_animation.h"
 #include "data/dataset_generator.h"
@@ -35,7 +36,7 @@ namespace cs = clothwind::sim;
 using clothwind::bench::ThreadCpuSeconds;
 using clothwind::bench::WallMs;
 
-int main(int argc, char** argv) {
+int Main(int argc, char** argv) {
   std::string kind_name = "flag";
   int count = 4, views = 2, jobs = 0;
   double max_edge = 0.0;
@@ -148,3 +149,5 @@ int main(int argc, char** argv) {
   std::filesystem::remove_all(dir);
   return sum.failed > 0 ? 1 : 0;
 }
+
+int main(int argc, char** argv) { return clothwind::bench::Guarded("dataset_bench", argc, argv, Main); }

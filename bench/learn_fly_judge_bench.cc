@@ -22,6 +22,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bench_args.h"
 #include "learn/dataset.h"
 #include "learn/fly_direction.h"
 #include "learn/fly_judge.h"
@@ -106,7 +107,7 @@ BENCHMARK(BM_MotionMapOnly)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int Main(int argc, char** argv) {
   // --judge FILE is ours; everything else is Google Benchmark's.
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
@@ -147,3 +148,5 @@ int main(int argc, char** argv) {
   benchmark::RunSpecifiedBenchmarks();
   return 0;
 }
+
+int main(int argc, char** argv) { return clothwind::bench::Guarded("learn_fly_judge_bench", argc, argv, Main); }

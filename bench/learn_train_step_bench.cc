@@ -34,6 +34,7 @@
 #include <torch/cuda.h>
 #include <torch/torch.h>
 
+#include "bench_args.h"
 #include "bench_clock.h"
 #include "omp_wait_policy.h"
 #include "learn/heap_reuse.h"
@@ -94,7 +95,7 @@ Timing Measure(int repeats, bool cuda, F&& f) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int Main(int argc, char** argv) {
   const char* omp_wait_policy = clothwind::bench::EnsureOmpWaitPolicy(argv);
   int repeats = 10, threads = 2, batch = 16, width = 48;
   std::string device_name = "cpu";
@@ -192,3 +193,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+int main(int argc, char** argv) { return clothwind::bench::Guarded("learn_train_step_bench", argc, argv, Main); }

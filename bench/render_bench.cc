@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_args.h"
 #include "bench_clock.h"
 #include "render/render_params.h"
 #include "render/renderer.h"
@@ -78,7 +79,7 @@ Timing RunClip(const cr::RenderParams& p, int threads, int frames, const std::st
 }
 }  // namespace
 
-int main(int argc, char** argv) {
+int Main(int argc, char** argv) {
   int frames = 60, samples = 4;
   uint64_t seed = 1;
   std::string write_dir;
@@ -135,3 +136,5 @@ int main(int argc, char** argv) {
               one.ClipWallMs() / 1000.0);
   return 0;
 }
+
+int main(int argc, char** argv) { return clothwind::bench::Guarded("render_bench", argc, argv, Main); }

@@ -28,6 +28,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "bench_args.h"
 #include "bench_clock.h"
 #include "omp_wait_policy.h"
 #include "learn/predictor.h"
@@ -48,7 +49,7 @@ struct Case {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int Main(int argc, char** argv) {
   const char* omp_wait_policy = clothwind::bench::EnsureOmpWaitPolicy(argv);
   int repeats = 20;
   bool quick = false;
@@ -68,6 +69,9 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  // Before the cases are made and timed: a missing model ended the run with SIGABRT after them.
+  for (const fs::path& model : given)
+    if (!fs::is_regular_file(model)) throw std::invalid_argument("--model " + model.string() + ": no such file");
   cl::FlagFlies way = cl::FlagFlies::kRight;
   try {
     if (!flag_flies.empty()) way = cl::FlagFliesFromName(flag_flies, "--flag-flies");
@@ -138,3 +142,5 @@ int main(int argc, char** argv) {
   fs::remove_all(dir);
   return 0;
 }
+
+int main(int argc, char** argv) { return clothwind::bench::Guarded("sdn_bench", argc, argv, Main); }

@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "bench_args.h"
 #include "sensors/clip_pipeline.h"
 #include "sensors/dataset_writer.h"
 
@@ -23,7 +24,7 @@ double Seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::d
 
 }  // namespace
 
-int main() {
+int Main(int, char**) {
   std::printf("%-22s %8s %12s %12s %14s\n", "camera", "frames", "ms/frame", "realtime x", "clips");
   struct Case {
     int width, height;
@@ -63,3 +64,5 @@ int main() {
               1e3 * s / clips.size());
   return 0;
 }
+
+int main(int argc, char** argv) { return clothwind::bench::Guarded("sensors_clip_bench", argc, argv, Main); }

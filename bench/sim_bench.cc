@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "bench_clock.h"
+#include "bench_args.h"
 #include "sim/flag_metrics.h"
 #include "sim/simulate.h"
 #include "sim/strain_limiter.h"
@@ -31,14 +32,28 @@ using namespace clothwind::sim;
 
 namespace {
 
-std::string DefaultScene() {
-  for (const char* env : {"CLOTHWIND_SHARED_DIR"}) {
-    const char* d = std::getenv(env);
-    const std::string p = std::string(d ? d : "/work/shared") + "/arcsim/conf/flag.json";
-    if (fs::exists(p)) return p;
-  }
+// The source tree: $CLOTHWIND_SOURCE_DIR (scripts/env.sh), else the one this bench was built from.
+std::string SourceDir() {
   const char* src = std::getenv("CLOTHWIND_SOURCE_DIR");
-  return std::string(src ? src : ".") + "/config/scenes/flag.json";
+  return src && *src ? src : CLOTHWIND_BENCH_SOURCE_DIR;
+}
+
+// ArcSim's own flag scene ($CLOTHWIND_SHARED_DIR, default ../shared beside the source tree), the
+// one the "x faster than ArcSim" column compares like with like; else the project's flag. (A fixed
+// /work/shared and a scene relative to the working folder aborted the bench anywhere else.)
+std::string DefaultScene() {
+  const char* d = std::getenv("CLOTHWIND_SHARED_DIR");
+  const std::string shared = d && *d ? d : SourceDir() + "/../shared";
+  const std::string arcsim = shared + "/arcsim/conf/flag.json";
+  if (fs::exists(arcsim)) return arcsim;
+  return SourceDir() + "/config/scenes/flag.json";
+}
+
+// Whether `path` is ArcSim's own flag scene, whose wall times ArcSimWallPerSimSecond holds.
+bool IsArcSimFlag(const std::string& path) {
+  const fs::path p(path);
+  return p.filename() == "flag.json" && p.parent_path().filename() == "conf" &&
+         p.parent_path().parent_path().filename() == "arcsim";
 }
 
 // ArcSim's wall seconds per simulated second on the flag (the reference's table, its lower
@@ -68,7 +83,9 @@ double StretchPercentile(const Trajectory& t, const Mesh& mesh, int first, doubl
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int Main(int argc, char** argv) {
+  using clothwind::bench::Integer;
+  using clothwind::bench::Number;
   std::string scene_path = DefaultScene();
   double duration = 4.0, max_edge = 0.0, cg_tolerance = 0.0;
   int crossing_sweeps = -1;  // -1: the scene's (SimOptions default)
@@ -89,21 +106,21 @@ int main(int argc, char** argv) {
     if (a == "--scene") {
       scene_path = next();
     } else if (a == "--duration") {
-      duration = std::stod(next());
+      duration = Number(a, next());
     } else if (a == "--max-edge") {
-      max_edge = std::stod(next());
+      max_edge = Number(a, next());
     } else if (a == "--split-edge") {
-      build.split_edge = std::stod(next());
+      build.split_edge = Number(a, next());
     } else if (a == "--frame-steps") {
-      build.frame_steps = std::stoi(next());
+      build.frame_steps = Integer(a, next());
     } else if (a == "--cg-tolerance") {
-      cg_tolerance = std::stod(next());
+      cg_tolerance = Number(a, next());
     } else if (a == "--crossing-sweeps") {
-      crossing_sweeps = std::stoi(next());
+      crossing_sweeps = Integer(a, next());
     } else if (a == "--strain-sweeps") {
-      strain_sweeps = std::stoi(next());
+      strain_sweeps = Integer(a, next());
     } else if (a == "--strain-tolerance") {
-      strain_tolerance = std::stod(next());
+      strain_tolerance = Number(a, next());
     } else if (a == "--strain-method") {
       const std::string m = next();
       if (m != "sweeps" && m != "global") {
@@ -115,7 +132,8 @@ int main(int argc, char** argv) {
       winds.clear();
       std::stringstream ss(next());
       std::string item;
-      while (std::getline(ss, item, ',')) winds.push_back(std::stod(item));
+      while (std::getline(ss, item, ',')) winds.push_back(Number("--winds", item));
+      if (winds.empty()) throw std::invalid_argument("--winds: expected wind speeds like 1,3,6,10, got none");
     } else {
       std::fprintf(stderr,
                    "usage: sim_bench [--scene FLAG.json] [--duration S] [--max-edge M] [--split-edge M] [--winds 1,3,6,10] [--frame-steps N] [--cg-tolerance T] [--crossing-sweeps N] [--strain-sweeps N] [--strain-tolerance T] [--strain-method sweeps|global]\n");
@@ -124,6 +142,10 @@ int main(int argc, char** argv) {
   }
   build.max_edge = max_edge;
   SceneSetup setup = BuildScene(LoadScene(scene_path), build);
+  // The motion is measured over the last half: 4 frames at least (0.2 s simulated, then refused).
+  if (!(duration >= 8 * setup.scene.frame_time))
+    throw std::invalid_argument("--duration " + std::to_string(duration) + " s: expected at least 8 frames (" +
+                                std::to_string(8 * setup.scene.frame_time) + " s), the last half measured");
   if (cg_tolerance > 0) {
     for (auto& c : setup.cloths) c.options.cg_tolerance = cg_tolerance;
   }
@@ -147,6 +169,9 @@ int main(int argc, char** argv) {
   std::printf("scene %s, %.1f s simulated per wind, dt %.4f s, edges <= %.3f m, CG tolerance %g, one thread\n",
               scene_path.c_str(), duration, setup.cloths[0].options.dt, setup.cloths[0].max_edge,
               setup.cloths[0].options.cg_tolerance);
+  const bool arcsim_scene = IsArcSimFlag(scene_path);
+  if (!arcsim_scene)
+    std::printf("(not ArcSim's own flag scene: no \"x faster than ArcSim\" figures; set CLOTHWIND_SHARED_DIR)\n");
   std::printf("droop/RMS/frequency over the last half (cf. ArcSim: droop ~80/52/10 deg at 1/3/10 m/s, ~1.5 Hz at 10)\n\n");
   std::printf("| wind (m/s) | vertices | faces | steps | wall s / sim s | CPU s / sim s | x real time (wall) | x real time (CPU) | x faster than ArcSim | droop (deg) | lateral RMS (m) | vertical RMS (m) | frequency (Hz) | CG iterations / step | strain sweeps / step | steps unconverged (%%) | p99 stretch |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
@@ -164,7 +189,7 @@ int main(int argc, char** argv) {
     const FlagMotion m = MeasureFlagMotion(t, setup.wind.velocity.norm() > 0 ? setup.wind.velocity
                                                                             : Eigen::Vector3d::UnitX(),
                                            t.num_frames() / 2);
-    const double arcsim = ArcSimWallPerSimSecond(wind);
+    const double arcsim = arcsim_scene ? ArcSimWallPerSimSecond(wind) : 0.0;
     char vs[32] = "n/a";
     if (arcsim > 0) std::snprintf(vs, sizeof(vs), "%.0f", arcsim / per);
     const double steps = static_cast<double>(std::max<int64_t>(1, t.steps));
@@ -184,3 +209,5 @@ int main(int argc, char** argv) {
               all_fast_cpu ? "met" : "NOT met", all_fast_wall ? "met" : "NOT met");
   return 0;
 }
+
+int main(int argc, char** argv) { return clothwind::bench::Guarded("sim_bench", argc, argv, Main); }

@@ -1,0 +1,52 @@
+// Command-line numbers and the guard around a bench program's main, shared by the bench
+// programs: a bad value is said naming its option, and any error ends the program with its
+// message and status 1 (an uncaught exception ended it with SIGABRT and "terminate called after
+// throwing ... what(): stod", naming no option).
+#ifndef CLOTHWIND_BENCH_BENCH_ARGS_H_
+#define CLOTHWIND_BENCH_BENCH_ARGS_H_
+
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <stdexcept>
+#include <string>
+
+namespace clothwind::bench {
+
+// `text` as a finite number, the value of `option`.
+// Throws std::invalid_argument naming the option and the text when it is not one.
+inline double Number(const std::string& option, const std::string& text) {
+  size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(v))
+    throw std::invalid_argument(option + ": expected a finite number, got '" + text + "'");
+  return v;
+}
+
+// `text` as a whole number, the value of `option`. Throws as Number does.
+inline int Integer(const std::string& option, const std::string& text) {
+  const double v = Number(option, text);
+  if (v != std::floor(v) || std::abs(v) > 2e9)
+    throw std::invalid_argument(option + ": expected a whole number, got '" + text + "'");
+  return static_cast<int>(v);
+}
+
+// Runs body(argc, argv) and returns its status; an exception is printed as
+// "<name>: error: <what>" and gives status 1.
+inline int Guarded(const char* name, int argc, char** argv, int (*body)(int, char**)) {
+  try {
+    return body(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", name, e.what());
+    return 1;
+  }
+}
+
+}  // namespace clothwind::bench
+
+#endif  // CLOTHWIND_BENCH_BENCH_ARGS_H_

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Every bench program runs on its quickest settings and prints its table, and refuses a bad
+# number naming the option with status 1 (no SIGABRT): a bench that broke left `make test` green,
+# and benches ended with "terminate called ... stod". The figures are not checked: speed is read
+# by hand from Release builds (docs), not asserted in tests. Usage: bench_smoke_test.sh BIN_DIR
+set -euo pipefail
+bin="$1"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+fail() { echo "bench_smoke_test: FAIL: $*" >&2; exit 1; }
+cd "$work"  # any folder: the benches find the source tree's scenes themselves
+
+runs() {  # runs EXPECTED_TEXT BENCH ARGS...: exits 0 and prints the text
+  local text="$1" name="$2"
+  shift 2
+  [ -x "$bin/$name" ] || { echo "bench_smoke_test: $name not built (skipped)"; return 0; }
+  "$bin/$name" "$@" >out.txt 2>&1 || fail "$name $*: status $?: $(tail -5 out.txt)"
+  grep -qF -- "$text" out.txt || fail "$name $*: no '$text' in its output: $(tail -5 out.txt)"
+}
+refuses() {  # refuses OPTION BENCH ARGS...: status 1 (not a signal), the message names OPTION
+  local option="$1" name="$2" status=0
+  shift 2
+  [ -x "$bin/$name" ] || return 0
+  "$bin/$name" "$@" >out.txt 2>&1 || status=$?
+  [ "$status" -eq 1 ] || fail "$name $*: status $status, expected 1: $(tail -3 out.txt)"
+  grep -qF -- "$option" out.txt || fail "$name $*: the message does not name $option: $(tail -3 out.txt)"
+}
+
+runs "| 3 |" sim_bench --duration 0.4 --winds 3
+runs "fine_offset" anemometer_decode_bench 2000
+runs "GREY" camera_convert_bench 1
+runs "ms/clip" sensors_clip_bench
+runs "60-frame clip" render_bench --frames 2 --samples 1
+runs "clips/min" dataset_bench --count 1 --views 1 --max-edge 0.5 --samples 1
+runs "mean [ms]" sdn_bench --quick --repeats 1
+runs "128" learn_train_step_bench --repeats 1 --batch 2 --width 8
+runs "BM_MotionMapOnly" learn_fly_judge_bench --benchmark_min_time=0.01
+
+refuses "--duration: expected a finite number" sim_bench --duration x
+refuses "--winds" sim_bench --winds ,
+refuses "--duration" sim_bench --duration 0.2 --winds 3
+refuses "--model /nonexistent.pt" sdn_bench --model /nonexistent.pt
+echo "bench_smoke_test: OK"
