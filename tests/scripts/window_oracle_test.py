@@ -294,6 +294,22 @@ class MainTest(unittest.TestCase):
             self.assertIn(f'--folds: expected 2 .. --sims (4) with --estimator boost, got {folds}', str(e.exception.code))
             self.assertFalse(simulate.called)  # refused before anything is simulated
 
+    def test_settings_that_fail_after_the_simulations_are_refused_before_them(self):
+        # Each ended in a traceback (or a table of NaN with status 0) after every simulation ran.
+        for extra, said in ((('--seconds', '0.4', '--warmup', '0.4'), '--seconds: expected at least one window'),
+                            (('--estimator', 'boost', '--features', 'motion', '--folds', '2', '--stride', '0'),
+                             '--stride: expected >= 1'),
+                            (('--k', '0'), '--k: expected at least 1')):
+            with mock.patch.object(oracle, 'simulate') as simulate, self.assertRaises(SystemExit) as e:
+                self.main('--sims', '4', *extra)
+            self.assertIn(said, str(e.exception.code))
+            self.assertFalse(simulate.called)
+        # --bins are the motion features': a shape run with a window of 4 frames is not refused by them.
+        with mock.patch.object(oracle, 'simulate', side_effect=SystemExit('simulated')) as simulate, \
+                self.assertRaises(SystemExit) as e:
+            self.main('--sims', '4', '--window', '4')
+        self.assertEqual(str(e.exception.code), 'simulated')
+
 
 if __name__ == '__main__':
     unittest.main()
