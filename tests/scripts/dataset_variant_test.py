@@ -133,6 +133,11 @@ class DatasetVariantTest(unittest.TestCase):
         r = run(self.src, os.path.join(self.tmp.name, 'out'))  # no change named
         self.assertNotEqual(r.returncode, 0)
         self.assertFalse(os.path.exists(os.path.join(self.tmp.name, 'out')))
+        # A DST whose parent is not there: said naming it (a FileNotFoundError traceback).
+        r = run(self.src, os.path.join(self.tmp.name, 'nodir', 'x'), '--split-by-clip')
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn('nodir/x.tmp: cannot create it', r.stderr)
+        self.assertNotIn('Traceback', r.stderr)
 
     def edit_index(self, change):
         path = os.path.join(self.src, 'index.json')
