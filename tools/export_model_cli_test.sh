@@ -30,5 +30,23 @@ grep -q -- "--calibrate-std $work/noval: the dataset has no val split" "$work/ms
 "$bin" export-model --model "$work/run/model.pt" --out "$work/export/sdn.pt" --calibrate-std "$work/toy" \
   --threads 1 >"$work/msg.txt" 2>&1 || fail "with a val split: $(cat "$work/msg.txt")"
 grep -q "std calibration on" "$work/msg.txt" || fail "with a val split: no calibration said: $(cat "$work/msg.txt")"
-grep -q '"std_scale"' "$work/export/sdn.json" || fail "no std_scale in $(cat "$work/export/sdn.json")"
+# The stored scale is the model's own times the factor said (ToJson writes a std_scale whatever
+# happened, so its presence alone passed an export that never applied the calibration, or one
+# that replaced a model's scale instead of scaling it). Calibrated again, the new factor (near 1 on
+# the same clips) multiplies the first.
+scaled() {  # scaled SOURCE_JSON MESSAGE EXPORTED_JSON: exported std_scale == source's x the factor (printed
+  # to 4 digits), the source's own scale not 1 or the factor not 1
+  /usr/bin/python3 - "$@" <<'PY' || fail "the stored std_scale is not the source's times the factor said"
+import json, re, sys
+source = json.load(open(sys.argv[1])).get('std_scale', 1.0)
+factor = float(re.search(r'scale ([0-9.eE+-]+)', open(sys.argv[2]).read()).group(1))
+stored = json.load(open(sys.argv[3]))['std_scale']
+print(f'source {source}, factor {factor}, stored {stored}')
+sys.exit(0 if (factor != 1.0 or source != 1.0) and abs(stored - source * factor) <= 1e-3 * abs(source * factor) else 1)
+PY
+}
+scaled "$work/run/model.json" "$work/msg.txt" "$work/export/sdn.json"
+"$bin" export-model --model "$work/export/sdn.pt" --out "$work/export2/sdn.pt" --calibrate-std "$work/toy" \
+  --precision float32 --threads 1 >"$work/msg.txt" 2>&1 || fail "calibrating again: $(cat "$work/msg.txt")"
+scaled "$work/export/sdn.json" "$work/msg.txt" "$work/export2/sdn.json"
 echo "export_model_cli_test: OK"
