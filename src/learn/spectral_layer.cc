@@ -168,7 +168,12 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
     throw std::invalid_argument("SpectralDecomposition: mode_shape needs the detrended spectrum (include_dc off)");
   }
   // [N_b C H W, N_t]: one row per pixel signal.
-  at::Tensor signals = x.permute({0, 1, 3, 4, 2}).reshape({-1, nt});
+  // Contiguous whatever the batch: for one clip of one channel the reshape is a transposed view
+  // (its rows the pixels, 1 apart), whose mean is reduced across rows in another order than a
+  // batch's copied rows. A still pixel's detrended signal is that rounding only, and its
+  // "strongest" bin followed it: the same clip read other frequencies on thousands of pixels, and
+  // its estimate moved by up to 0.1 m/s between sdn_node (one clip) and eval or the calibration.
+  at::Tensor signals = x.permute({0, 1, 3, 4, 2}).reshape({-1, nt}).contiguous();
   at::Tensor window = at::hann_window(nt, /*periodic=*/true, x.options());
   // Without the DC bin the pixel's mean is removed first (else it leaks through the Hann window
   // into bin 1); with it, the signal is taken as it is (Algorithm 1 verbatim), so the DC bin

@@ -515,6 +515,29 @@ TEST(SpectralLayer, BatchEqualsPerExample) {
   }
 }
 
+TEST(SpectralLayer, AClipWithStillPixelsGetsTheSameMapsInAnyBatch) {
+  // FlagSim's frames hold many pixels that do not change; normalised per clip, their value is no
+  // binary fraction. Their detrended signal is rounding only, and which of its near-zero bins is
+  // "strongest" followed the rounding of a mean computed over the whole batch: the same clip read
+  // frequencies up to 12.5 Hz apart on thousands of pixels, and its estimate moved by up to
+  // 0.1 m/s between sdn_node (one clip), eval (8) and the calibration (16). Float, as inference.
+  at::manual_seed(3);
+  at::Tensor clip = at::randn({1, 1, 30, 16, 16}, at::kFloat);
+  clip.narrow(3, 0, 8).fill_(-0.7312345f);  // the top half still
+  const at::Tensor batch = at::cat({clip, at::randn({15, 1, 30, 16, 16}, at::kFloat)}, 0);
+  for (const bool one_pass : {true, false}) {
+    SCOPED_TRACE(one_pass ? "one pass" : "tensor path");
+    SpectralOptions o;
+    o.k = 3;
+    o.phase_steps = true;
+    o.one_pass = one_pass;
+    const SpectralMaps alone = SpectralDecomposition(clip, o), batched = SpectralDecomposition(batch, o);
+    EXPECT_TRUE(at::equal(batched.frequency.narrow(0, 0, 1), alone.frequency));
+    EXPECT_TRUE(at::equal(batched.power.narrow(0, 0, 1), alone.power));
+    EXPECT_TRUE(at::equal(batched.phase.narrow(0, 0, 1), alone.phase));
+  }
+}
+
 TEST(SpectralLayer, CommutesWithCropAndHorizontalFlip) {
   // The layer is per pixel, so caching its output and augmenting afterwards is equivalent to
   // augmenting the clip first, for crops and flips (not for resampling).
