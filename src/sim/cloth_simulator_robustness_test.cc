@@ -41,6 +41,18 @@ class PoisonedWind final : public WindField {
   double from_;
 };
 
+// Runs `sim` until it throws (at most 200 steps); returns the message ("" if it never did).
+std::string StepUntilItThrows(ClothSimulator& sim) {
+  for (int i = 0; i < 200; ++i) {
+    try {
+      sim.Step();
+    } catch (const std::exception& e) {
+      return e.what();
+    }
+  }
+  return "";
+}
+
 // The flag's area weight far below the forces' scale (1e-300 kg/m^2 in a 10 m/s wind): the
 // linear solve diverges, its residual 15.6 against the 1 of dv = 0. The step was taken all the
 // same and the run failed later as a vertex too fast, naming no cause.
@@ -67,32 +79,13 @@ TEST(ClothSimulatorRobustness, AnUnstableWindStepIsNamedWhenItBlowsUp) {
   WindSpec wind;
   wind.velocity = Eigen::Vector3d(10, 0, 0);
   ClothSimulator sim(cloth.mesh, cloth.material, cloth.options, MakeWindField(wind));
-  std::string message;
-  for (int i = 0; i < 200 && message.empty(); ++i) {
-    try {
-      sim.Step();
-    } catch (const std::exception& e) {
-      message = e.what();
-    }
-  }
+  const std::string message = StepUntilItThrows(sim);
   ASSERT_FALSE(message.empty()) << "no blow-up in 200 steps";
   EXPECT_NE(message.find("the explicit wind force was unstable from step 1: dt * wind density * |wind - cloth| / area weight = 2.5 > 2 (10 m/s"), std::string::npos) << message;
   // A heavier cloth in the same wind runs (its ratio 0.18).
   ClothSetup heavy = FlagSetup();
   ClothSimulator fine(heavy.mesh, heavy.material, heavy.options, MakeWindField(wind));
   for (int i = 0; i < 200; ++i) fine.Step();
-}
-
-// Runs `sim` until it throws (at most 200 steps); returns the message ("" if it never did).
-std::string StepUntilItThrows(ClothSimulator& sim) {
-  for (int i = 0; i < 200; ++i) {
-    try {
-      sim.Step();
-    } catch (const std::exception& e) {
-      return e.what();
-    }
-  }
-  return "";
 }
 
 // The tangential drag is explicit too: dt drag / area weight above 2 overshoots at any air speed
