@@ -92,6 +92,13 @@ TEST(ClipTracksTest, FramesBetweenAnimationFramesAreInterpolatedAsTheRendererDra
     EXPECT_NEAR(t.xy(4, i), t25.xy(2, i), 1e-6);
   }
   EXPECT_GT(std::abs(t.xy(2, 0) - t.xy(0, 0)), 1.0);  // the points move between those frames
+  // At 100 fps a frame a quarter of the way: three quarters of the earlier simulated frame (at
+  // the midpoint alone, the two frames' weights swapped gave the same blend).
+  render::RenderParams p100 = p;
+  p100.fps = 100;
+  const ClipTracks t100 = ProjectTracks(FlatFlag(9, 7, 3, 0.2), p100, TrackGrid{2, 2}, 5);
+  for (int i = 0; i < t100.xy.cols(); ++i)
+    EXPECT_NEAR(t100.xy(1, i), 0.75 * t100.xy(0, i) + 0.25 * t100.xy(4, i), 1e-3);
 }
 
 TEST(ClipTracksTest, APointBehindTheCameraIsAnError) {
@@ -102,6 +109,14 @@ TEST(ClipTracksTest, APointBehindTheCameraIsAnError) {
 }
 
 TEST(ClipTracksTest, JsonHoldsTheGridAndEveryFramesPixelsToAHundredthOfAPixel) {
+  // Frames wider than high: the readers (scripts/track-oracle, plot-tracks) scale by these two,
+  // and a square frame hid them swapped.
+  render::RenderParams wide = SideOn(5.0);
+  wide.width = 160;
+  wide.height = 96;
+  const nlohmann::json jw = TracksJson(ProjectTracks(FlatFlag(9, 7, 2, 0.1), wide, TrackGrid{4, 3}, 2));
+  EXPECT_EQ(jw.at("width"), 160);
+  EXPECT_EQ(jw.at("height"), 96);
   const ClipTracks t = ProjectTracks(FlatFlag(9, 7, 2, 0.1), SideOn(5.0), TrackGrid{4, 3}, 2);
   const nlohmann::json j = TracksJson(t);
   EXPECT_EQ(j.at("format"), "clothwind-tracks");

@@ -88,6 +88,11 @@ TEST(ClothAnimationTest, FrameAtInterpolatesAndHandlesRemeshing) {
   const Eigen::MatrixXd expect = 0.5 * (t.frames[1].cast<double>() + t.frames[2].cast<double>());
   EXPECT_LT((mid.V - expect).cwiseAbs().maxCoeff(), 1e-9);
   EXPECT_EQ(mid.F, a.F);
+  // A quarter of the way: three quarters of the earlier frame (at the midpoint, weights swapped
+  // between the two frames gave the same blend).
+  const ClothFrame quarter = FrameAt(a, 1.25 * t.frame_time);
+  const Eigen::MatrixXd expect_quarter = 0.75 * t.frames[1].cast<double>() + 0.25 * t.frames[2].cast<double>();
+  EXPECT_LT((quarter.V - expect_quarter).cwiseAbs().maxCoeff(), 1e-9);
   // Clamped outside the animation.
   EXPECT_EQ(FrameAt(a, -1.0).V, a.frames[0].V);
   EXPECT_EQ(FrameAt(a, 99.0).V, a.frames.back().V);

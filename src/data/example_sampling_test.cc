@@ -71,7 +71,7 @@ TEST(ExampleSamplingTest, SimulationSeedDependsOnGlobalSeedAndIndexOnly) {
 TEST(ExampleSamplingTest, FlagDrawsStayInTheirRangesAndCoverThem) {
   const SamplingRanges r = DefaultRanges(render::SceneKind::kFlag);
   const sim::Theta base = BaseTheta();
-  double wind_lo = 1e9, wind_hi = -1e9, aw_lo = 1e9, aw_hi = -1e9;
+  double wind_lo = 1e9, wind_hi = -1e9, aw_lo = 1e9, aw_hi = -1e9, bend_lo = 1e9, bend_hi = -1e9;
   for (int i = 0; i < 2000; ++i) {
     const SimulationSample s = SampleFlagSimulation(base, 3, i, r);
     EXPECT_EQ(s.index, i);
@@ -83,6 +83,13 @@ TEST(ExampleSamplingTest, FlagDrawsStayInTheirRangesAndCoverThem) {
       const double f = s.theta[k] / base[k];
       EXPECT_GE(f, 1.0 / (4 * 1.25) - 1e-12);
       EXPECT_LE(f, 4 * 1.25 + 1e-12);
+      // One stiffness shared by the entries, each jittered by at most 1.25 either way: two
+      // entries' factors are within 1.25^2 of each other (the jitter alone passed the range above).
+      const double ratio = f / (s.theta[1] / base[1]);
+      EXPECT_GE(ratio, 1.0 / (1.25 * 1.25) - 1e-12);
+      EXPECT_LE(ratio, 1.25 * 1.25 + 1e-12);
+      bend_lo = std::min(bend_lo, f);
+      bend_hi = std::max(bend_hi, f);
     }
     EXPECT_GE(s.theta[16], 0.0);
     EXPECT_LT(s.theta[16], 10.0);
@@ -98,6 +105,9 @@ TEST(ExampleSamplingTest, FlagDrawsStayInTheirRangesAndCoverThem) {
   EXPECT_GT(wind_hi, 9.9);
   EXPECT_LT(aw_lo, 0.55);
   EXPECT_GT(aw_hi, 1.8);
+  // The shared stiffness covers [1/4, 4] (a draw of 1 left only the jitter's 0.8-1.25).
+  EXPECT_LT(bend_lo, 0.3);
+  EXPECT_GT(bend_hi, 3.5);
   // Bending entries are not all scaled alike (the table's shape varies).
   const SimulationSample s = SampleFlagSimulation(base, 3, 0, r);
   EXPECT_GT(std::abs(s.theta[1] / base[1] - s.theta[2] / base[2]), 1e-6);
