@@ -44,6 +44,7 @@ TEST(CameraInfoForTest, NoCalibrationGivesTheImageSizeOnlyAndNoReason) {
   const auto info = CameraInfoFor(sensor_msgs::CameraInfo(), Image(320, 240), &reason);
   EXPECT_EQ(reason, "");
   EXPECT_EQ(info->width, 320u);
+  EXPECT_EQ(info->height, 240u);  // (the width alone passed a height left 0, or set from the width)
   EXPECT_EQ(info->K[0], 0);
 }
 
@@ -53,6 +54,7 @@ TEST(CameraInfoForTest, ACalibrationForAnotherSizeIsLeftOutSayingWhy) {
   EXPECT_NE(reason.find("640x480"), std::string::npos) << reason;
   EXPECT_EQ(info->K[0], 0);
   EXPECT_EQ(info->width, 320u);
+  EXPECT_EQ(info->height, 240u);
 }
 
 TEST(CameraInfoForTest, ACalibrationWithANonFiniteValueIsLeftOutNamingIt) {

@@ -3,6 +3,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 namespace clothwind::ros_bridge {
@@ -123,7 +125,21 @@ TEST(ToWindEstimateTest, TheEstimateSpansTheFramesTheModelRead) {
   p.speed_std = 0.5;
   clothwind::Clip clip = GreyClip(40);
   // Without frame stamps: the last 30 of 40 frames at 25 fps start 10 periods after the first.
+  clip.sequence = 17;
   clothwind::WindEstimate e = ToWindEstimate(clip, p, 0.01, "m", 30);
+  // What it carries over: each field its own source (the window's stamps aside, only the rostests
+  // saw these, and a std copied from the speed passed here).
+  EXPECT_EQ(e.speed, 3.0);
+  EXPECT_EQ(e.speed_std, 0.5);
+  EXPECT_EQ(e.latency, 0.01);
+  EXPECT_EQ(e.model, "m");
+  EXPECT_EQ(e.clip_sequence, 17u);
+  EXPECT_EQ(e.header.frame_id, "camera_optical");
+  EXPECT_TRUE(std::isnan(e.reference_speed));  // no anemometer reading in the clip's window
+  clip.wind_count = 2;
+  clip.wind_mean = 4.2;
+  EXPECT_EQ(ToWindEstimate(clip, p, 0.01, "m", 30).reference_speed, 4.2);
+  clip.wind_count = 0;
   EXPECT_NEAR((e.clip_start - clip.header.stamp).toSec(), 0.4, 1e-6);
   EXPECT_NEAR((e.clip_end - clip.header.stamp).toSec(), 39 * 0.04, 1e-6);
   EXPECT_EQ(e.header.stamp, e.clip_end);

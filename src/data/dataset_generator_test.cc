@@ -650,7 +650,8 @@ TEST_F(DatasetGeneratorTest, ReindexRefusesAShardOfOtherSettingsAndClaimsOnlyTra
   // simulation beyond the header's count were merged without a word (a shard made with --warmup
   // 0.8 or --wind-max 3, or a larger run's folder).
   for (const auto& [pointer, value] : std::vector<std::pair<std::string, nlohmann::json>>{
-           {"/dataset_seed", 2}, {"/width", 32}, {"/num_frames", 5}, {"/split", "elsewhere"},
+           {"/dataset_seed", 2}, {"/width", 32}, {"/height", 32}, {"/num_frames", 5}, {"/split", "elsewhere"},
+           {"/views", 2}, {"/frame_rate", 30}, {"/frame_pattern", "%03d.png"},
            {"/simulation_settings/warmup", 0.8}, {"/simulation_settings/max_edge", 0.5},
            {"/simulation_settings/scene", "other.json"}, {"/wind_speed", 12.5}, {"/simulation", 3}}) {
     std::string field = pointer.substr(1);

@@ -21,8 +21,13 @@ TEST(ClipPreprocessTest, DefaultRoiIsCentredSquare) {
 
 TEST(ClipPreprocessTest, RoiOutsideImageIsAnError) {
   EXPECT_NO_THROW(ResolveRoi({20, 10, 230}, 320, 240));
-  EXPECT_THROW(ResolveRoi({100, 10, 240}, 320, 240), std::invalid_argument);
+  // One edge at a time (a case past two edges passed with either check gone), and the exact fits.
+  EXPECT_THROW(ResolveRoi({100, 0, 230}, 320, 240), std::invalid_argument);  // right edge only
+  EXPECT_THROW(ResolveRoi({0, 20, 230}, 320, 240), std::invalid_argument);   // bottom edge only
   EXPECT_THROW(ResolveRoi({-1, 0, 10}, 320, 240), std::invalid_argument);
+  EXPECT_THROW(ResolveRoi({0, -1, 10}, 320, 240), std::invalid_argument);
+  EXPECT_NO_THROW(ResolveRoi({80, 0, 240}, 320, 240));   // touching the right edge
+  EXPECT_NO_THROW(ResolveRoi({0, 10, 230}, 320, 240));   // touching the bottom edge
 }
 
 TEST(ClipPreprocessTest, CropsGreysAndResizes) {
