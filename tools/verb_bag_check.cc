@@ -1,19 +1,23 @@
 // clothwind bag-check: is a recorded session bag fit for replay (launch/replay.launch)? Per topic:
 // message count, rate, span, header stamps monotonic and near their bag times; camera holes
-// longer than the clip buffer's gap tolerance; anemometer sentences decoded. Exit status 1 when
-// the replay would make no labelled clip or would not start: a required topic missing, stamped 0
-// or far ahead of the bag's time (the replay's clock), no usable anemometer reading (one that
-// decodes, is not flagged void and is a speed of 0..150 m/s, as the clip buffer takes them) with a
-// stamp in any clip's label window, no stretch of video without holes long enough for a clip, or
-// a topic no replay node reads (replay.launch waits for a subscriber on every topic unless
-// wait:=false). Stamps that go back or repeat are warnings naming the first (message index and
-// bag time): the nodes drop such a frame (the resampler a repeated or slightly early one, the clip
-// buffer a lone stale one) and go on, so a driver's one duplicated frame must not refuse a field
-// bag; what they cost is counted in the holes and the longest stretch without one.
+// longer than the clip buffer's gap tolerance; camera frames the clip buffer can read; anemometer
+// sentences decoded. Exit status 1 when the replay would make no labelled clip or would not
+// start: a required topic missing, every message of one stamped 0 or far ahead of the bag's time
+// (the replay's clock), no camera frame the clip buffer can read, no usable anemometer reading
+// (one that decodes, is not flagged void and is a speed of 0..150 m/s, as the clip buffer takes
+// them) with a stamp in any clip's label window that arrives before the clip is labelled, no
+// stretch of video without holes long enough for a clip, or a topic no replay node reads
+// (replay.launch waits for a subscriber on every topic unless wait:=false). What the nodes drop
+// one message at a time and go on (stamps that go back, repeat, lie far ahead or are 0, a lone
+// frame stamped ahead or behind, an unreadable frame) is a warning naming the first (message
+// index and bag time), so a driver's one bad frame must not refuse a field bag; what it costs is
+// counted in the holes and the longest stretch without one. camera_info's stamps are not checked:
+// the clip buffer copies its calibration and reads no stamp of it.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -30,6 +34,7 @@
 #include <clothwind/RawSentence.h>
 
 #include "progress_bar.h"
+#include "ros_bridge/clip_conversions.h"
 #include "sensors/anemometer_protocol.h"
 #include "verb_registry.h"
 
@@ -42,6 +47,12 @@ struct BagCheckArgs {
   double max_future = 5.0;     // clip_buffer's ~max_future [s]
   double clip_duration = 1.16; // a clip's first to last frame [s]: 30 frames at 25 fps
   double label_window = 60.0;  // clip_buffer's ~label_window [s]
+  // How long after a clip's last frame the clip buffer labels it (its ~label_delay plus the
+  // pipeline's wait) [s]: a reading recorded later than that labels nothing.
+  double label_delay = 1.5;
+  // With no input this long the clip buffer labels its waiting clips with what it holds (its
+  // ~flush_after, in wall seconds; as bag seconds here, the replay at rate 1) [s].
+  double flush_after = 3.0;
 };
 
 // The topics replay.launch's nodes read (clip_buffer: the camera's two; the anemometer node in
@@ -67,7 +78,16 @@ struct TopicStats {
   size_t backwards = 0;       // header stamp before the previous one
   std::string first_backwards, first_repeated;  // where the first of each is: "message N (bag time T s)"
   std::optional<double> held;  // a camera frame more than the tolerance back, waiting for the next
+  std::optional<double> held_ahead;  // one more than the tolerance ahead, waiting likewise
+  std::string held_ahead_where;
   size_t stale = 0;            // such frames the next did not follow: lone stale stamps, dropped
+  size_t stale_ahead = 0;      // of them, frames stamped ahead
+  std::string first_stale_ahead;
+  size_t kept = 0;             // messages on the timeline (not dropped for a 0 or far-ahead stamp)
+  std::string first_dropped;   // where the first message stamped 0 or far ahead is
+  size_t unreadable = 0;       // camera frames the clip buffer cannot read (ImageView refuses them)
+  std::string first_unreadable;
+  size_t late = 0;             // usable readings recorded after the clips they would label went out
   size_t repeated = 0;        // header stamp equal to the previous one (records of one serial read
                               // share it; camera frames must not: the clip buffer drops them)
   size_t bag_time_off = 0;    // |bag time - header stamp| > 1 ms
@@ -79,19 +99,35 @@ struct TopicStats {
   double run_start = NAN;
   size_t decoded = 0, undecoded = 0;  // anemometer sentences that give a reading, and that do not
   size_t void_readings = 0;           // decoded, but flagged void or a speed outside 0..150 m/s
-  std::vector<double> usable;  // stamps of the readings a clip can be labelled by (sorted after the read)
+  // The readings a clip can be labelled by: (stamp, the camera's data time when the replay
+  // delivers it: the latest frame stamp before it in the bag) [s].
+  std::vector<std::pair<double, double>> usable;
   std::string first_error;
   size_t holes = 0;           // header stamp intervals > gap tolerance
   double widest = 0.0;        // largest interval [s]
   std::string first_data;     // first raw sentence / image encoding and size
 };
 
+// Whether the replay's nodes drop a message of this stamp: 0, or more than max_future ahead of
+// its bag time (the replay's clock).
+bool DroppedStamp(double stamp, double bag_time, double max_future) {
+  return stamp == 0 || stamp - bag_time > max_future;
+}
+
 void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, double max_future, size_t index) {
-  if (stamp == 0) ++s.zero;
+  ++s.count;
   if (std::fabs(bag_time - stamp) > 1e-3) ++s.bag_time_off;
-  if (stamp - bag_time > max_future) ++s.far_from_bag_time;
+  char where[96];
+  std::snprintf(where, sizeof where, "message %zu (bag time %.3f s)", index, bag_time);
+  // Dropped one at a time by the nodes, which go on: counted, and not on the timeline (one frame
+  // stamped 10 s ahead refused a field bag that replays whole).
+  if (DroppedStamp(stamp, bag_time, max_future)) {
+    ++(stamp == 0 ? s.zero : s.far_from_bag_time);
+    if (s.first_dropped.empty()) s.first_dropped = where;
+    return;
+  }
   s.last = std::max(std::isnan(s.last) ? stamp : s.last, stamp);
-  if (s.count++ == 0) {
+  if (s.kept++ == 0) {
     s.first = s.run_start = s.previous = stamp;
     return;
   }
@@ -110,13 +146,32 @@ void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, do
       ++s.stale;
     }
   }
+  // One more than the tolerance ahead likewise (ClipPipeline's forward hold): time going on from
+  // it confirms a hole; time coming back before it drops it as a lone stale stamp, the run going
+  // on. (Counted as a hole, its next frame then read as going back: two holes and a broken run
+  // for a frame the clip buffer drops.)
+  if (frames && s.held_ahead) {
+    const double held = *s.held_ahead;
+    s.held_ahead.reset();
+    if (stamp > held) {
+      ++s.holes;
+      s.widest = std::max(s.widest, held - s.previous);
+      s.run_start = s.previous = held;
+    } else {
+      ++s.stale;
+      if (s.stale_ahead++ == 0) s.first_stale_ahead = s.held_ahead_where;
+    }
+  }
   const double dt = stamp - s.previous;
-  char where[96];
-  std::snprintf(where, sizeof where, "message %zu (bag time %.3f s)", index, bag_time);
   if (dt < 0 && s.backwards++ == 0) s.first_backwards = where;
   if (dt == 0 && s.repeated++ == 0) s.first_repeated = where;
   if (frames && dt < -gap_tolerance) {
     s.held = stamp;
+    return;
+  }
+  if (frames && dt > gap_tolerance) {
+    s.held_ahead = stamp;
+    s.held_ahead_where = where;
     return;
   }
   if (dt > gap_tolerance) {
@@ -129,15 +184,29 @@ void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, do
 }
 
 // Counts one message into its topic's stats (ros::Exception when its bytes do not deserialise).
+//   data_time  the latest camera frame stamp before this message (-inf before the first)
 void NoteMessage(const rosbag::MessageInstance& m, TopicStats& s, double t, const BagCheckArgs& a,
-                 sensors::AnemometerDecoder& decoder, size_t index) {
+                 sensors::AnemometerDecoder& decoder, size_t index, double data_time) {
   if (auto img = m.instantiate<sensor_msgs::Image>()) {
-    Note(s, img->header.stamp.toSec(), t, a.gap_tolerance, a.max_future, index);
     if (s.first_data.empty())
       s.first_data = img->encoding + " " + std::to_string(img->width) + "x" + std::to_string(img->height) +
                      " frame " + img->header.frame_id;
+    // As the clip buffer reads it (an encoding it cannot convert, a step or data too short): a
+    // frame it drops, which "ok for replay" passed when no frame could be read.
+    try {
+      cv::Mat view;
+      sensors::ClipSourceEncoding encoding;
+      ros_bridge::ImageView(*img, &view, &encoding);
+    } catch (const std::exception& e) {
+      ++s.count;
+      if (s.unreadable++ == 0)
+        s.first_unreadable = "message " + std::to_string(index) + " (bag time " + std::to_string(t) + " s): " + e.what();
+      return;
+    }
+    Note(s, img->header.stamp.toSec(), t, a.gap_tolerance, a.max_future, index);
   } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
-    Note(s, info->header.stamp.toSec(), t, 1e9, a.max_future, index);
+    // By its bag time: the clip buffer copies the calibration and reads no stamp of it.
+    Note(s, t, t, 1e9, a.max_future, index);
     if (s.first_data.empty())
       s.first_data = std::to_string(info->width) + "x" + std::to_string(info->height) + " " + info->distortion_model;
   } else if (auto raw = m.instantiate<clothwind::RawSentence>()) {
@@ -150,8 +219,11 @@ void NoteMessage(const rosbag::MessageInstance& m, TopicStats& s, double t, cons
       // As the clip buffer's labeller takes a reading (ToLabelReading): a void one (NMEA status V,
       // a Gill error code) or an impossible speed labels nothing.
       const double v = r.reading.speed;
-      if (r.reading.valid && std::isfinite(v) && v >= 0 && v <= 150) {
-        s.usable.push_back(raw->header.stamp.toSec());
+      const double stamp = raw->header.stamp.toSec();
+      if (DroppedStamp(stamp, t, a.max_future)) {
+        // dropped by the anemometer node: no label from it
+      } else if (r.reading.valid && std::isfinite(v) && v >= 0 && v <= 150) {
+        s.usable.emplace_back(stamp, data_time);
       } else {
         ++s.void_readings;
       }
@@ -178,6 +250,10 @@ int Run(const BagCheckArgs& a) {
     throw std::invalid_argument("--clip-duration must be in (0, 3600] s, got " + std::to_string(a.clip_duration));
   if (!in(a.label_window, 86400))
     throw std::invalid_argument("--label-window must be in (0, 86400] s, got " + std::to_string(a.label_window));
+  if (!(a.label_delay >= 0 && a.label_delay <= 86400))
+    throw std::invalid_argument("--label-delay must be in [0, 86400] s, got " + std::to_string(a.label_delay));
+  if (!in(a.flush_after, 86400))
+    throw std::invalid_argument("--flush-after must be in (0, 86400] s, got " + std::to_string(a.flush_after));
   {
     // A file that is no bag at all: rosbag says "Error reading version line", which the repair
     // hint below also matched.
@@ -208,6 +284,8 @@ int Check(const BagCheckArgs& a) {
   for (const auto* c : view.getConnections()) topics[WithoutLeadingSlash(c->topic)].type = c->datatype;
   sensors::AnemometerDecoder decoder;
   size_t index = 0;
+  double last_input = NAN;  // bag time of the last camera frame or anemometer record
+  double flushed = -std::numeric_limits<double>::infinity();  // camera data time at the last flush
   // A field session of hours is gigabytes, read for minutes: progress on stderr for bags of
   // 256 MiB and more (small ones, a test's or make run's, stay quiet).
   std::error_code size_error;
@@ -229,8 +307,20 @@ int Check(const BagCheckArgs& a) {
     if (m.size() > (1u << 30))
       throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " of the bag (on " + m.getTopic() + ")" + " is " +
                                std::to_string(m.size()) + " bytes (a corrupt record?)");
+    const std::string topic = WithoutLeadingSlash(m.getTopic());
+    const auto camera_topic = topics.find("camera/image_raw");
+    const double camera_time = camera_topic != topics.end() && camera_topic->second.kept > 0
+                                   ? camera_topic->second.last
+                                   : -std::numeric_limits<double>::infinity();
+    // A pause in the input longer than flush_after: the clips waiting then went out with the
+    // readings held, and a reading that comes after labels none of them.
+    if (topic == "camera/image_raw" || topic == "anemometer/raw") {
+      if (std::isfinite(last_input) && t - last_input > a.flush_after) flushed = camera_time;
+      last_input = t;
+    }
+    const double data_time = std::max(camera_time, flushed + a.label_delay + 1e-6);
     try {
-      NoteMessage(m, s, t, a, decoder, index);
+      NoteMessage(m, s, t, a, decoder, index, data_time);
     } catch (const ros::Exception& e) {
       throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " of the bag (on " + m.getTopic() + ")" + " (" +
                                m.getDataType() + ", bag time " + std::to_string(t) + " s) does not deserialise: " +
@@ -239,7 +329,6 @@ int Check(const BagCheckArgs& a) {
   }
   bag.close();
   if (bar) bar->Finish();
-  for (auto& [name, s] : topics) std::sort(s.usable.begin(), s.usable.end());
   std::printf("%s\n", a.bag.c_str());
   std::printf("  %-22s %-28s %7s %8s %8s %6s %6s %6s %6s  %s\n", "topic", "type", "count", "rate Hz", "span s",
               "back", "same", "holes", "bagt", "first");
@@ -255,8 +344,11 @@ int Check(const BagCheckArgs& a) {
     if (s.backwards > 0)
       warn(name + ": " + std::to_string(s.backwards) + " header stamps go back (the first at " + s.first_backwards +
            (camera ? "; a frame a little early is dropped; one more than the gap tolerance back is dropped as stale (" +
-                         std::to_string(s.stale) + " here) unless the next follows it, a new timeline)"
+                         std::to_string(s.stale - s.stale_ahead) + " here) unless the next follows it, a new timeline)"
                    : ")"));
+    if (camera && s.stale_ahead > 0)
+      warn(name + ": " + std::to_string(s.stale_ahead) + " lone frames stamped more than the gap tolerance ahead of "
+           "the next (the first at " + s.first_stale_ahead + "); the clip buffer drops them as stale");
     if (camera && s.repeated > 0)
       warn(name + ": " + std::to_string(s.repeated) + " frames repeat a stamp (the first at " + s.first_repeated +
            "; the clip buffer drops them)");
@@ -269,10 +361,21 @@ int Check(const BagCheckArgs& a) {
     if (s.type != ReplayTopicType(name))
       fail(name + ": recorded as " + s.type + ", the replay subscribes to it as " + ReplayTopicType(name) +
            " (it would receive nothing)");
-    if (s.zero > 0) fail(name + ": " + std::to_string(s.zero) + " messages stamped 0");
-    if (s.far_from_bag_time > 0)
-      fail(name + ": " + std::to_string(s.far_from_bag_time) + " header stamps more than " +
-           std::to_string(a.max_future) + " s ahead of their bag time (the replay's clock; another time base?)");
+    // Every message dropped for its stamp: the topic is as good as missing. Some: said, as the
+    // nodes drop them one at a time and go on.
+    const size_t dropped = s.zero + s.far_from_bag_time;
+    if (dropped > 0) {
+      const std::string what = name + ": " + std::to_string(s.zero) + " messages stamped 0 and " +
+                               std::to_string(s.far_from_bag_time) + " more than " + std::to_string(a.max_future) +
+                               " s ahead of their bag time (the replay's clock; another time base?), the first at " +
+                               s.first_dropped + "; the nodes drop them";
+      if (dropped == s.count) fail(what + ": every message"); else warn(what);
+    }
+    if (s.unreadable > 0) {
+      const std::string what = name + ": " + std::to_string(s.unreadable) + " of " + std::to_string(s.count) +
+                               " frames the clip buffer cannot read (the first, " + s.first_unreadable + ")";
+      if (s.unreadable == s.count) fail(what); else warn(what);
+    }
   }
   const auto camera = topics.find("camera/image_raw"), wind = topics.find("anemometer/raw");
   for (const char* required : {"camera/image_raw", "anemometer/raw"})
@@ -284,22 +387,30 @@ int Check(const BagCheckArgs& a) {
   if (wind != topics.end() && wind->second.count > 0 && wind->second.decoded == 0)
     fail("anemometer/raw: no sentence gives a wind reading (" + std::to_string(wind->second.undecoded) +
          " refused, the first: " + wind->second.first_error + ")");
-  else if (wind != topics.end() && wind->second.decoded > 0 && wind->second.usable.empty())
+  else if (wind != topics.end() && wind->second.decoded > 0 && wind->second.usable.empty() &&
+           wind->second.void_readings > 0)
     fail("anemometer/raw: every reading is void (the instrument's status V or error code, or a speed outside "
          "0..150 m/s: " + std::to_string(wind->second.void_readings) + "), and the clip buffer labels no clip with one");
-  // A clip ending at e is labelled by the usable readings in [e - label window, e]; clips end from
-  // the first frame + a clip's duration to the last frame, so some usable reading must lie in
-  // [first + duration - window, last]. (Comparing only the earliest and latest usable stamps passed
-  // a bag with usable readings before and after the video and only void ones during it.)
-  const auto labels_a_clip = [&](const std::vector<double>& usable) {
-    const auto it = std::lower_bound(usable.begin(), usable.end(),
-                                     camera->second.first + a.clip_duration - a.label_window);
-    return it != usable.end() && *it <= camera->second.last;
+  // A clip ending at e is labelled by the usable readings stamped in [e - label window, e] that
+  // the replay has delivered when the clip goes out, once the camera's data time passes e +
+  // label_delay; clips end from the first frame + a clip's duration to the last frame. So a
+  // reading stamped r and delivered at data time D labels a clip when some e in
+  // [max(r, first + duration, D - delay), min(r + window, last)] exists (a camera and an
+  // anemometer equally late in the bag are no later to each other). (Comparing only the earliest and latest usable stamps passed a bag with usable
+  // readings before and after the video and only void ones during it; stamps alone passed one
+  // whose readings were recorded 40 s late, and no clip was labelled.)
+  const auto labels_a_clip = [&](const std::vector<std::pair<double, double>>& usable) {
+    for (const auto& [r, delivered] : usable) {
+      const double lo = std::max({r, camera->second.first + a.clip_duration, delivered - a.label_delay});
+      if (lo <= std::min(r + a.label_window, camera->second.last)) return true;
+    }
+    return false;
   };
   if (camera != topics.end() && wind != topics.end() && camera->second.count > 0 && !wind->second.usable.empty() &&
       !labels_a_clip(wind->second.usable))
     fail("no usable anemometer/raw reading's stamp falls in a clip's label window (the " + std::to_string(a.label_window) +
-         " s up to its last frame, over camera/image_raw's stamps): no clip gets a label");
+         " s up to its last frame, over camera/image_raw's stamps) and is recorded before that clip is labelled (" +
+         std::to_string(a.label_delay) + " s after its last frame): no clip gets a label");
   std::printf("  (back: header stamps going back; same: equal to the previous (fine for anemometer records of "
               "one serial read, not for camera frames); holes: camera intervals > %.3f s, which break clips; "
               "bagt: bag time != header stamp)\n",
@@ -330,6 +441,14 @@ const VerbRegistrar kRegistrar{"bag-check", [](CLI::App& app) -> std::function<i
       ->capture_default_str();
   sub->add_option("--label-window", args->label_window,
                   "a clip is labelled by the anemometer readings this long [s] up to its last frame (clip_buffer's)")
+      ->capture_default_str();
+  sub->add_option("--label-delay", args->label_delay,
+                  "a clip is labelled this long [s] after its last frame (clip_buffer's); a reading recorded later "
+                  "labels nothing")
+      ->capture_default_str();
+  sub->add_option("--flush-after", args->flush_after,
+                  "with no input this long [s] the clip buffer labels its waiting clips (clip_buffer's; taken as "
+                  "bag seconds)")
       ->capture_default_str();
   return [args] { return Run(*args); };
 }};

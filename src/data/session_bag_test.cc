@@ -418,6 +418,10 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
       // A lone frame stamped 1 s back every 25 frames (0.83 s): the clip buffer drops each as
       // stale and goes on; counted as holes, no stretch lasted a clip and the bag was refused.
       if (frame % 25 == 12) m.header.stamp = ros::Time(t - 1.0);
+      // And one stamped 1 s ahead (two holes each, and the next frame read as going back).
+      if (frame % 25 == 5) m.header.stamp = ros::Time(t + 1.0);
+      // One frame 10 s ahead of its bag time (the clip buffer's ~max_future refuses it alone).
+      if (frame == 100) m.header.stamp = ros::Time(t + 10.0);
       previous = t;
       ++frame;
     }
@@ -430,6 +434,42 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
         << out;
     EXPECT_NE(out.find("header stamps go back (the first at message"), std::string::npos) << out;
     EXPECT_NE(out.find("dropped as stale (7 here)"), std::string::npos) << out;
+    EXPECT_NE(out.find("lone frames stamped more than the gap tolerance ahead of the next"), std::string::npos) << out;
+    EXPECT_NE(out.find("warning: camera/image_raw: 0 messages stamped 0 and 1 more than"), std::string::npos) << out;
+  }
+  // camera_info stamped 0 throughout (the clip buffer reads no stamp of it), and one sentence
+  // stamped 0: the bag replays whole (both were refused).
+  const std::string info_zero = (dir / "info_zero.bag").string();
+  int sentences = 0;
+  RewriteBag(good, info_zero, [&](auto& m) {
+    using T = std::decay_t<decltype(m)>;
+    if constexpr (std::is_same_v<T, sensor_msgs::CameraInfo>) m.header.stamp = ros::Time();
+    if constexpr (std::is_same_v<T, clothwind::RawSentence>)
+      if (sentences++ == 2) m.header.stamp = ros::Time();
+    return true;
+  });
+  {
+    const auto [rc, out] = check(info_zero);
+    EXPECT_EQ(rc, 0) << out;
+    EXPECT_NE(out.find("warning: anemometer/raw: 1 messages stamped 0"), std::string::npos) << out;
+  }
+  // Frames the clip buffer cannot read (an encoding it cannot convert), and sentences recorded
+  // 40 s after their stamps (replayed after every clip of this 6 s session went out): both passed.
+  RewriteBag(good, (dir / "float.bag").string(), [](auto& m) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(m)>, sensor_msgs::Image>) m.encoding = "32FC1";
+    return true;
+  });
+  {
+    rosbag::Bag src(good, rosbag::bagmode::Read), dst((dir / "late.bag").string(), rosbag::bagmode::Write);
+    for (const rosbag::MessageInstance& m : rosbag::View(src)) {
+      if (auto raw = m.instantiate<clothwind::RawSentence>()) {
+        dst.write(m.getTopic(), raw->header.stamp + ros::Duration(40), *raw);
+      } else if (auto img = m.instantiate<sensor_msgs::Image>()) {
+        dst.write(m.getTopic(), m.getTime(), *img);
+      } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
+        dst.write(m.getTopic(), m.getTime(), *info);
+      }
+    }
   }
   // Every anemometer sentence flagged void (NMEA status V, its checksum right): decoded, and no
   // clip labelled by any. (It passed as "ok for replay".)
@@ -454,6 +494,8 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
                         Case{"apart.bag", "falls in a clip's label window"},
                         Case{"after.bag", "falls in a clip's label window"},
                         Case{"around.bag", "falls in a clip's label window"},
+                        Case{"float.bag", "frames the clip buffer cannot read"},
+                        Case{"late.bag", "is recorded before that clip is labelled"},
                         Case{"compressed.bag", "recorded as sensor_msgs/CompressedImage, the replay subscribes to it "
                                                "as sensor_msgs/Image"}}) {
     const auto [rc, out] = check((dir / c.name).string());
