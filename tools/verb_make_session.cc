@@ -79,6 +79,27 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
     throw std::invalid_argument("--minutes must be in 0.05..1440 (3 s to a day), got " + std::to_string(a.minutes));
   if (!(std::isfinite(a.wind_mean) && a.wind_mean >= 0 && a.wind_mean <= 60))
     throw std::invalid_argument("--wind-mean must be in 0..60 m/s, got " + std::to_string(a.wind_mean));
+  // The session's own checks, named by option before the work (they said "synthetic session:
+  // image must be ..." naming none, or came after a scene build).
+  if (!(a.fps <= 1000.0)) throw std::invalid_argument("--fps must be at most 1000 Hz, got " + std::to_string(a.fps));
+  for (const auto& [option, value] : {std::pair<const char*, int>{"--width", a.width}, {"--height", a.height}})
+    if (value < 16 || value > 16384)
+      throw std::invalid_argument(std::string(option) + " must be in 16..16384 px, got " + std::to_string(value));
+  if (!(a.start_time >= 1.0 && a.start_time + a.minutes * 60.0 + 10.0 < 4294967295.0))
+    throw std::invalid_argument("--start-time must be >= 1 s and leave the session within ROS time's 32-bit seconds, got " +
+                                std::to_string(a.start_time));
+  if (!(a.drop_probability >= 0.0 && a.drop_probability < 1.0))
+    throw std::invalid_argument("--drop-probability must be in [0, 1), got " + std::to_string(a.drop_probability));
+  if (!(std::isfinite(a.rendered.max_edge) && a.rendered.max_edge >= 0))
+    throw std::invalid_argument("--max-edge must be a finite length >= 0 m (0: the scene's), got " +
+                                std::to_string(a.rendered.max_edge));
+  // A bag file's name: "" and "dir/" generated the whole session and failed at the final rename
+  // (the latter leaving dir/ made and empty).
+  {
+    const std::string name = std::filesystem::path(a.out).filename().string();
+    if (name.empty() || name == "." || name == "..")
+      throw std::invalid_argument("--out '" + a.out + "': expected a bag file name (e.g. session.bag)");
+  }
   // The clip buffer's gap tolerance (0.1 s by default) makes every interval of a slower camera a
   // hole: such a session replays into no clip at all (exit 0, an empty report).
   if (!(a.fps >= 10.0))
@@ -270,11 +291,14 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
   sub->add_option("--minutes", args->minutes, "session length [min] (0.05..1440)")->capture_default_str();
   sub->add_option("--out", args->out, "output bag (refused if it exists, unless --overwrite)")->required();
   sub->add_flag("--overwrite", args->overwrite, "replace an existing --out");
-  sub->add_option("--seed", args->seed, "random seed")->capture_default_str();
+  sub->add_option("--seed", args->seed, "random seed (0..2^64-1)")->check(CLI::NonNegativeNumber)->capture_default_str();
   sub->add_option("--fps", args->fps, "camera rate [Hz] (10 to 1000: a slower camera's intervals break every clip)")->capture_default_str();
   sub->add_option("--width", args->width, "image width [px] (16..16384; rendered: 16..8192)")->capture_default_str();
   sub->add_option("--height", args->height, "image height [px] (16..16384; rendered: 16..8192)")->capture_default_str();
-  sub->add_option("--wind-mean", args->wind_mean, "long-term mean wind [m/s] (0..60)")->capture_default_str();
+  sub->add_option("--wind-mean", args->wind_mean,
+                  "long-term mean wind [m/s] (0..60; the wind is floored near calm, so below ~1 m/s the session's "
+                  "mean comes out higher: 0 gives ~0.8)")
+      ->capture_default_str();
   sub->add_option("--drop-probability", args->drop_probability, "chance a frame is lost, in [0, 1)")->capture_default_str();
   sub->add_option("--start-time", args->start_time, "stamp of the session start [s since epoch, >= 1]")
       ->capture_default_str();

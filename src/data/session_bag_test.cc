@@ -240,6 +240,14 @@ TEST(SessionBagTest, AnExistingOutOrAFolderIsRefusedBeforeTheWork) {
   EXPECT_NE(status, 0);
   EXPECT_NE(text.find("is a folder"), std::string::npos) << text;
   EXPECT_EQ(text.find("frames"), std::string::npos) << "refused before the work: " << text;
+  // A name ending in a slash (a folder not made yet) or none: refused before the work too (the
+  // session was made, then the rename failed, leaving the folder made and empty).
+  for (const std::string out : {(dir / "new_folder").string() + "/", std::string("''")}) {
+    std::tie(status, text) = run(out, "");
+    EXPECT_NE(status, 0);
+    EXPECT_NE(text.find("expected a bag file name"), std::string::npos) << text;
+  }
+  EXPECT_FALSE(fs::exists(dir / "new_folder"));
   std::tie(status, text) = run(bag.string(), " --overwrite");
   EXPECT_EQ(status, 0) << text;
   EXPECT_GT(fs::file_size(bag), 1000u);
