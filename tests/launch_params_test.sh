@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# The launch files' parameters as roslaunch resolves them (--dump-params: no master, no node):
+# a record_dir set in the clip buffer's YAML (clip_config) is kept unless record_dir:= is given
+# (an empty arg used to replace it, and a field session set up to record recorded nothing, its
+# diagnostics OK), and one given as a number stays text. Usage: launch_params_test.sh
+set -euo pipefail
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+fail() { echo "launch_params_test: FAIL: $*" >&2; exit 1; }
+config="$(rospack find clothwind)/config/clip_buffer.yaml"
+sed 's#^record_dir: ""#record_dir: /data/from-yaml#' "$config" >"$work/clip_buffer.yaml"
+grep -q '^record_dir: /data/from-yaml' "$work/clip_buffer.yaml" || fail "no record_dir line to set in $config"
+for launch in "replay.launch bag:=/tmp/none.bag" "field.launch"; do
+  # shellcheck disable=SC2086
+  roslaunch --dump-params clothwind $launch clip_config:="$work/clip_buffer.yaml" >"$work/params.txt" 2>&1 ||
+    fail "roslaunch --dump-params $launch: $(cat "$work/params.txt")"
+  grep -q '^/clip_buffer/record_dir: /data/from-yaml$' "$work/params.txt" ||
+    fail "$launch dropped the YAML's record_dir: $(grep record_dir "$work/params.txt")"
+  # shellcheck disable=SC2086
+  roslaunch --dump-params clothwind $launch clip_config:="$work/clip_buffer.yaml" record_dir:=20261206 \
+    >"$work/params.txt" 2>&1 || fail "roslaunch --dump-params $launch record_dir:=20261206: $(cat "$work/params.txt")"
+  grep -q "^/clip_buffer/record_dir: '20261206'$" "$work/params.txt" ||
+    fail "$launch record_dir:=20261206 is not the text given: $(grep record_dir "$work/params.txt")"
+done
+echo "launch_params_test: OK"
