@@ -19,6 +19,7 @@
 // docs/camera.md.
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -119,16 +120,26 @@ int main(int argc, char** argv) {
   }
 
   ros::NodeHandle camera_nh(nh, "camera");
-  // Constructed without the URL, which it would read lazily: the file is checked first (see
-  // ros_bridge/camera_calibration_file.h), as a folder or a matrix of another shape aborted the
-  // node inside the parser. A refused file leaves camera_info without calibration, said in
-  // diagnostics, rather than falling back to camera_info_manager's default file, which is not
-  // the calibration asked for either.
-  camera_info_manager::CameraInfoManager info_manager(camera_nh, camera_name, "");
+  // Given the URL, where set_camera_info (the calibration tool's COMMIT) saves: constructed with
+  // none, a calibration committed while ~camera_info_url was refused went to the default file,
+  // which the next start, refusing the URL again, never read. The manager reads its URL lazily,
+  // so the file is checked first (see ros_bridge/camera_calibration_file.h), as a folder or a
+  // matrix of another shape aborted the node inside the parser, and a refused file is replaced
+  // by an empty calibration before anything asks for it. A refused file leaves camera_info
+  // without calibration, said in diagnostics, rather than falling back to camera_info_manager's
+  // default file, which is not the calibration asked for either; a COMMIT then writes the URL's
+  // file, or answers that it cannot.
+  camera_info_manager::CameraInfoManager info_manager(camera_nh, camera_name, camera_info_url);
   const std::string url = camera_info_url.empty() ? clothwind::ros_bridge::kDefaultCameraInfoUrl : camera_info_url;
-  const std::string calibration_refused = clothwind::ros_bridge::CheckCalibrationFile(
-      clothwind::ros_bridge::CalibrationFilePath(info_manager.resolveURL(url, camera_name), ros::package::getPath));
-  if (calibration_refused.empty()) {
+  const std::string calibration_path =
+      clothwind::ros_bridge::CalibrationFilePath(info_manager.resolveURL(url, camera_name), ros::package::getPath);
+  const std::string calibration_refused = clothwind::ros_bridge::CheckCalibrationFile(calibration_path);
+  std::error_code no_file;
+  if (calibration_refused.empty() && !calibration_path.empty() && !std::filesystem::exists(calibration_path, no_file)) {
+    // None yet (set_camera_info writes it): no calibration, and no word, as docs/camera.md says;
+    // camera_info_manager's own load warned "calibration file ... not found" at every start.
+    info_manager.setCameraInfo(sensor_msgs::CameraInfo());
+  } else if (calibration_refused.empty()) {
     info_manager.loadCameraInfo(camera_info_url);
     if (!camera_info_url.empty() && !info_manager.isCalibrated()) {
       ROS_WARN_STREAM("camera_node: no calibration loaded from '" << camera_info_url
@@ -136,7 +147,7 @@ int main(int argc, char** argv) {
     }
   } else {
     // An empty calibration, set: the manager loads nothing more (set_camera_info still stores a
-    // new one, at the default URL).
+    // new one, at ~camera_info_url).
     info_manager.setCameraInfo(sensor_msgs::CameraInfo());
     ROS_WARN_STREAM("camera_node: calibration not loaded from '" << url << "'"
                     << (camera_info_url.empty() ? " (~camera_info_url empty: camera_info_manager's default)" : "")

@@ -286,6 +286,16 @@ class CameraFolderTest(unittest.TestCase):
             self.assertIn(reason, found.message)
             values = {kv.key: kv.value for kv in found.values}
             self.assertIn(reason, values["calibration"])
+        # A calibration committed to the node whose ~camera_info_url is a folder: refused, as it
+        # cannot be stored where the next start reads it (it was stored at the default URL, with
+        # success, and lost at the next start).
+        rospy.wait_for_service("/badurl/camera/set_camera_info", timeout=10.0)
+        c = CameraInfo(width=24, height=16, distortion_model="plumb_bob", D=[0.0] * 5)
+        c.K = [30.0, 0.0, 11.5, 0.0, 30.0, 7.5, 0.0, 0.0, 1.0]
+        c.R = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+        c.P = [30.0, 0.0, 11.5, 0.0, 0.0, 30.0, 7.5, 0.0, 0.0, 0.0, 1.0, 0.0]
+        answer = rospy.ServiceProxy("/badurl/camera/set_camera_info", SetCameraInfo)(c)
+        self.assertFalse(answer.success, answer.status_message)
 
     def test_a_folder_of_unreadable_images_is_reopened_with_a_backoff(self):
         # After its images appeared: opened, failed a round later (3 images: 2 unreadable frames,
