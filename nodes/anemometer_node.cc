@@ -385,10 +385,13 @@ class AnemometerNode {
     // Compass bearings (a Fine Offset vane, MWD) in the instrument's default frame name, which
     // config/anemometer.yaml defines as x towards the instrument's north mark: a TF tree that
     // mounts it so turns every bearing by the mark's heading.
+    // In topic mode a record's own frame wins over ~frame_id (a replay keeps the recorded one):
+    // the advice to set ~frame_id changed nothing there.
     if (saw_earth_ && !saw_instrument_ && last_earth_frame_ == kDefaultFrameId)
       stat.mergeSummary(DiagnosticStatus::WARN, "compass bearings published in frame " + last_earth_frame_ +
-                                                    " (the instrument's default name): set ~earth_frame_id or "
-                                                    "~frame_id to the ENU frame they are in");
+                                                    " (the instrument's default name): set ~earth_frame_id" +
+                                                    (input_ == "topic" ? std::string() : std::string(" or ~frame_id")) +
+                                                    " to the ENU frame they are in");
     if (saw_earth_ && saw_instrument_ && earth_frame_id_.empty())
       stat.mergeSummary(DiagnosticStatus::WARN, "instrument-relative and earth-referenced directions share frame " +
                                                     frame_id_ + ": set ~earth_frame_id");
@@ -417,7 +420,9 @@ class AnemometerNode {
     stat.add("instrument status", last_status_.empty() ? "(none yet)" : last_status_);
     stat.add("magnetic declination [deg]",
              std::isfinite(magnetic_declination_) ? std::to_string(magnetic_declination_) : "(not set)");
-    stat.add("earth frame", earth_frame_id_.empty() ? frame_id_ + " (~frame_id)" : earth_frame_id_);
+    stat.add("earth frame", !earth_frame_id_.empty() ? earth_frame_id_
+                            : input_ == "topic"  ? "each record's own (" + frame_id_ + ", ~frame_id, for records without one)"
+                                                 : frame_id_ + " (~frame_id)");
     stat.add("connects", connects_);
     stat.add("disconnects", disconnects_);
     if (have_valid_) {
