@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <deque>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -340,7 +341,14 @@ class AnemometerNode {
       if (r.reading.valid) {
         last_valid_ = r.reading;
         last_valid_wall_ = ros::SteadyTime::now();
+        last_valid_ros_ = ros::Time::now().toSec();
         have_valid_ = true;
+      }
+      {
+        const double t = ros::Time::isSimTime() ? ros::Time::now().toSec() : ros::SteadyTime::now().toSec();
+        if (!reading_times_.empty() && t < reading_times_.back()) reading_times_.clear();  // the clock went back
+        reading_times_.push_back(t);
+        if (reading_times_.size() > 4096) reading_times_.pop_front();
       }
     } else if (r.status != ParseStatus::kNotWind) {
       last_error_ = r.error;
@@ -351,16 +359,24 @@ class AnemometerNode {
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
     const auto& c = decoder_.counters();
     const ros::SteadyTime now = ros::SteadyTime::now();
-    double rate = 0.0;
-    if (!last_diag_wall_.isZero()) {
-      const double dt = (now - last_diag_wall_).toSec();
-      if (dt > 0.0) rate = static_cast<double>(c.readings - last_diag_readings_) / dt;
-    }
+    // Under simulated time (a replay) on the replay's clock: on the wall clock a healthy 1 Hz
+    // instrument replayed at rate 0.15 turned "stale" every 6.5 s and its rate read 0 and 1 in
+    // turn; a paused replay is not a silent instrument either. (A clock that went back counts 0.)
+    const bool sim = ros::Time::isSimTime();
+    const double ros_now = ros::Time::now().toSec();
+    // Over the readings of the last 10 s (per report, a replay at -r 0.15 read 0 and 6.6 Hz in turn).
+    const double clock_now = sim ? ros_now : now.toSec();
+    while (!reading_times_.empty() && (clock_now - reading_times_.front() > 10.0 || clock_now < reading_times_.front()))
+      reading_times_.pop_front();
+    const double rate = reading_times_.size() >= 2 && reading_times_.back() > reading_times_.front()
+                            ? static_cast<double>(reading_times_.size() - 1) /
+                                  (reading_times_.back() - reading_times_.front())
+                            : 0.0;
     const bool new_errors = c.checksum_failures + c.parse_errors > last_diag_errors_;
-    last_diag_wall_ = now;
-    last_diag_readings_ = c.readings;
     last_diag_errors_ = c.checksum_failures + c.parse_errors;
-    const double age = have_valid_ ? (now - last_valid_wall_).toSec() : -1.0;
+    const double age = !have_valid_ ? -1.0
+                       : sim        ? std::max(0.0, ros_now - last_valid_ros_)
+                                    : (now - last_valid_wall_).toSec();
 
     const bool connected = input_ == "topic" || port_.is_open() || usb_.is_open();
     using diagnostic_msgs::DiagnosticStatus;
@@ -456,7 +472,9 @@ class AnemometerNode {
   Backoff backoff_;
   // Steady (monotonic) time: the wall clock steps back under NTP, and a next-due instant then held
   // every poll and reconnect (and the USB gate's 48 s) until it caught up.
-  ros::SteadyTime next_attempt_, next_poll_, last_valid_wall_, last_diag_wall_;
+  ros::SteadyTime next_attempt_, next_poll_, last_valid_wall_;
+  double last_valid_ros_ = 0.0;  // the same in ROS time [s], for replays
+  std::deque<double> reading_times_;  // arrival of the readings of about the last 10 s (ROS time in a replay) [s]
   double stale_timeout_ = 5.0;
   bool stale_timeout_given_ = false;  // ~stale_timeout set: kept whatever the instrument
   double usb_poll_period_ = 10.0;
@@ -469,7 +487,7 @@ class AnemometerNode {
   uint64_t previous_pass_ = 0;              // topic mode: records of a looped bag's previous pass
   clothwind::sensors::ClockCourse clock_;  // topic mode: where the clock was before it went back
   std::string last_odd_stamp_;
-  uint64_t last_diag_readings_ = 0, last_diag_errors_ = 0;
+  uint64_t last_diag_errors_ = 0;
   clothwind::sensors::WindReading last_valid_;
   bool have_valid_ = false;
 };
