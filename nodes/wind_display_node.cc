@@ -8,7 +8,9 @@
 //   monitor/wind_plot (sensor_msgs/Image, bgr8): estimate (with ±std band) vs anemometer over the
 //     last ~plot_window seconds, in the anemometer's frame, stamped with the display's now (ROS
 //     time, never before the newest input's stamp).
-// Inputs: wind/estimate (clothwind/WindEstimate), anemometer/wind (clothwind/WindMeasurement).
+// Inputs: wind/estimate (clothwind/WindEstimate), anemometer/wind (clothwind/WindMeasurement),
+//   wind/estimate_mean (sdn_node's trailing mean: shown as the estimates' mean when it is the
+//   latest estimate's, being of the network's outputs before the clamp at 0).
 // Parameters: ~mean_window [s] (60), ~plot_window [s] (180), ~plot_width/~plot_height [px]
 // (640x320), ~rate [Hz] (2), ~frame_id ("" = the anemometer's frame, else this one),
 // ~fixed_frame ("" = none): when set, a latched /tf_static hangs this frame, the display's own,
@@ -102,6 +104,7 @@ class WindDisplayNode {
       if (FrameId() != fixed_frame_) PublishFixedFrame(FrameId());
     }
     estimate_sub_ = nh.subscribe("wind/estimate", 10, &WindDisplayNode::OnEstimate, this);
+    mean_sub_ = nh.subscribe("wind/estimate_mean", 10, &WindDisplayNode::OnEstimateMean, this);
     wind_sub_ = nh.subscribe("anemometer/wind", 50, &WindDisplayNode::OnWind, this);
     // Redraw on a timer, not per message: the plot scrolls with time even when inputs pause. A wall
     // timer: a ROS timer stops with /clock when a bag ends, and the last estimate stayed "live".
@@ -127,6 +130,16 @@ class WindDisplayNode {
       last_estimate_wall_ = ros::SteadyTime::now();
     }
     have_estimate_ = true;
+  }
+
+  // sdn_node's trailing mean of the same estimates: of the network's outputs before the clamp at 0,
+  // where the mean of the clamped estimates reads high in calm air.
+  void OnEstimateMean(const clothwind::WindEstimate::ConstPtr& msg) {
+    if (!Plausible(msg->speed)) return;
+    if (!have_mean_ || msg->header.stamp >= last_mean_.header.stamp) {
+      last_mean_ = *msg;
+      have_mean_ = true;
+    }
   }
 
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
@@ -252,7 +265,7 @@ class WindDisplayNode {
   void Restart(double previous_end) {
     estimates_ = WindHistory(span_);
     anemometer_ = WindHistory(span_);
-    have_estimate_ = have_wind_ = have_vector_ = false;
+    have_estimate_ = have_wind_ = have_vector_ = have_mean_ = false;
     newest_estimate_ = newest_wind_ = ros::Time();
     clock_before_restart_ = previous_end;
     ++restarts_;
@@ -379,7 +392,12 @@ class WindDisplayNode {
     text.scale.z = 0.6;  // [m] letter height
     text.color.r = text.color.g = text.color.b = 1.0;
     text.color.a = 1.0;
-    const double est_mean = est_live ? estimates_.Mean(t_now, mean_window_) : std::nan("");
+    // sdn_node's own mean when it is of the latest estimate (its window is ~mean_window too under
+    // monitor.launch); else the mean of the estimates received.
+    const double est_mean = !est_live ? std::nan("")
+                            : have_mean_ && last_mean_.header.stamp == last_estimate_.header.stamp
+                                ? last_mean_.speed
+                                : estimates_.Mean(t_now, mean_window_);
     text.text = clothwind::sensors::WindSummaryText(est, est_std, mean, mean_window_, est_mean);
     const size_t bar = text.text.find(" | ");  // two lines: the 3-D view is narrow beside the images
     if (bar != std::string::npos) text.text.replace(bar, 3, "\n");
@@ -458,9 +476,10 @@ class WindDisplayNode {
   ros::SteadyTime last_estimate_wall_, last_wind_wall_, last_vector_wall_;  // when they arrived
   std::string first_wind_frame_;  // header.frame_id of the first valid reading
   clothwind::sensors::WindDirectionFrameGate frame_gate_;
-  bool have_estimate_ = false, have_wind_ = false, have_vector_ = false;
+  bool have_estimate_ = false, have_wind_ = false, have_vector_ = false, have_mean_ = false;
+  clothwind::WindEstimate last_mean_;  // sdn_node's latest trailing mean
   ros::Publisher markers_pub_, plot_pub_, tf_pub_;
-  ros::Subscriber estimate_sub_, wind_sub_;
+  ros::Subscriber estimate_sub_, mean_sub_, wind_sub_;
   ros::SteadyTimer timer_;
 };
 

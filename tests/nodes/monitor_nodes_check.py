@@ -34,10 +34,12 @@ class MonitorNodesTest(unittest.TestCase):
         rospy.Subscriber("monitor/wind_markers", MarkerArray, self.keep(self.markers), queue_size=10)
         rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics, queue_size=50)
         self.est_pub = rospy.Publisher("wind/estimate", WindEstimate, queue_size=20)
+        self.mean_pub = rospy.Publisher("wind/estimate_mean", WindEstimate, queue_size=20)
         self.wind_pub = rospy.Publisher("anemometer/wind", WindMeasurement, queue_size=20)
         self.clip_pub = rospy.Publisher("clips", Clip, queue_size=5)
         deadline = time.time() + 20
         while time.time() < deadline and (self.est_pub.get_num_connections() < 2 or
+                                          self.mean_pub.get_num_connections() < 1 or
                                           self.wind_pub.get_num_connections() < 1):
             time.sleep(0.1)
 
@@ -201,6 +203,15 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertIn("estimate 4.0 \u00b1 0.3 m/s", text)
         self.assertIn("anemometer 3.0 m/s", text)
         self.assertEqual(arrow, 0)  # ADD
+        # sdn_node's trailing mean of the latest estimate (of the outputs before the clamp) is the
+        # one shown: the mean of the clamped estimates read high in calm air.
+        mean = WindEstimate()
+        mean.header.stamp, mean.clip_sequence = e.header.stamp, e.clip_sequence
+        mean.speed, mean.speed_std = 3.7, 0.2
+        self.mean_pub.publish(mean)
+        self.wait_redraw()
+        text, _ = self.text()
+        self.assertIn("s mean 3.7", text)
 
         # An estimate 6 s behind the readings (a clip's span and a backlogged model): no restart
         # of the display (it used to wipe the anemometer's history and show "no reading yet").
