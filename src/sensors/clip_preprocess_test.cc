@@ -105,6 +105,12 @@ TEST(ClipPreprocessTest, Mono16ScaledToEightBitsAndOutputIsACopy) {
   cv::Mat image(300, 300, CV_16UC1, cv::Scalar(256 * 123));
   const cv::Mat out = PreprocessClipFrame(image, ClipSourceEncoding::kMono16, {}, 300);
   EXPECT_EQ(out.at<uint8_t>(150, 150), 123);
+  // 0xFF00 is 255 by the high byte (1/256); 1/257 or 1/255, which 123's value could not tell
+  // apart, give 254 or 256.
+  const cv::Mat top = PreprocessClipFrame(cv::Mat(300, 300, CV_16UC1, cv::Scalar(0xFF00)), ClipSourceEncoding::kMono16, {}, 300);
+  EXPECT_EQ(top.at<uint8_t>(150, 150), 255);
+  const cv::Mat low = PreprocessClipFrame(cv::Mat(300, 300, CV_16UC1, cv::Scalar(0x8000)), ClipSourceEncoding::kMono16, {}, 300);
+  EXPECT_EQ(low.at<uint8_t>(150, 150), 128);
   cv::Mat mono(300, 300, CV_8UC1, cv::Scalar(7));
   const cv::Mat copy = PreprocessClipFrame(mono, ClipSourceEncoding::kMono8, {}, 300);
   mono.setTo(9);

@@ -89,9 +89,22 @@ TEST_F(DatasetWriterTest, WritesFramesLabelAndIndex) {
   EXPECT_EQ(label["roi"]["x"], 40);
   EXPECT_EQ(label["source"]["frame_id"], "camera_optical_frame");
   EXPECT_NEAR(label["frame_stamps"][3].get<double>() - label["frame_stamps"][0].get<double>(), 0.12, 1e-6);
+  // The camera's own stamps beside the resampled ones (3 ms apart here), the roi and the source's
+  // size, each from its own field (none was read: a copy of the resampled stamps passed).
+  EXPECT_NEAR(label["source_frame_stamps"][0].get<double>() - label["frame_stamps"][0].get<double>(), 0.003, 1e-6);
+  EXPECT_EQ(label["roi"]["y"], 0);
+  EXPECT_EQ(label["roi"]["size"], 240);
+  EXPECT_EQ(label["source"]["width"], 320);
+  EXPECT_EQ(label["source"]["height"], 240);
+  EXPECT_DOUBLE_EQ(label["start"].get<double>(), 1700000000.5);
+  EXPECT_NEAR(label["end"].get<double>(), 1700000000.5 + 3 / 25.0, 1e-9);
   const auto index = Read(root_ / "index.json");
   ASSERT_EQ(index["clips"].size(), 1u);
   EXPECT_EQ(index["clips"][0]["name"], fs::path(dir).filename().string());
+  EXPECT_EQ(index["clips"][0]["wind_std"], label["wind"]["std"]);
+  EXPECT_EQ(index["clips"][0]["wind_count"], 2);
+  EXPECT_EQ(index["clips"][0]["start"], label["start"]);
+  EXPECT_EQ(index["clips"][0]["end"], label["end"]);
   EXPECT_EQ(index["clips"][0]["split"], "test");
   EXPECT_EQ(index["kind"], "real");
   EXPECT_EQ(label["kind"], "real");

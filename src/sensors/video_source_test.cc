@@ -47,6 +47,7 @@ TEST_F(VideoSourceTest, PlaysAtTheFileRateToTheEnd) {
     ASSERT_EQ(f.image.cols, 64);
     ASSERT_EQ(f.image.rows, 48);
     EXPECT_NEAR(f.image.at<cv::Vec3b>(24, 32)[0], 20 * k, 6);  // frame order survives
+    EXPECT_EQ(f.sequence, static_cast<uint64_t>(k));  // (never read: every frame could say 0)
     if (k > 0) {
       EXPECT_EQ(f.stamp_ns - previous, 80 * kMs);
     }
@@ -65,6 +66,7 @@ TEST_F(VideoSourceTest, LoopsWithIncreasingStamps) {
     Frame f;
     ASSERT_EQ(source.Read(&f, 1.0), ReadStatus::kFrame) << k << " " << source.error();
     EXPECT_NEAR(f.image.at<cv::Vec3b>(24, 32)[0], 20 * (k % 8), 6) << k;
+    EXPECT_EQ(f.sequence, static_cast<uint64_t>(k)) << "the sequence runs on across loops";
     EXPECT_GT(f.stamp_ns, previous);
     previous = f.stamp_ns;
   }
