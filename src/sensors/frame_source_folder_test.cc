@@ -45,6 +45,8 @@ TEST(ImageFolderSourceTest, PlaysImagesInNameOrderAtTheRate) {
   TempDir dir;
   WriteFrames(dir.path(), 12, 1);
   std::ofstream(dir.path() + "/notes.txt") << "ignored";
+  // A writer's hidden temporary (renamed into place when whole) is no frame either.
+  fs::copy_file(dir.path() + "/frame_0005.png", dir.path() + "/.frame_0005.png");
   FakeClock clock;
   ImageFolderSource source(dir.path(), 25.0, false, &clock);
   ASSERT_TRUE(source.Open()) << source.error();
@@ -188,6 +190,26 @@ TEST(ImageFolderSourceTest, ClosesItselfWhenNothingIsReadableAnyMore) {
     EXPECT_NE(source.error().find("no image readable any more"), std::string::npos) << source.error();
     EXPECT_FALSE(source.Open());
   }
+}
+
+TEST(ImageFolderSourceTest, OneBadImageInALoopedFolderNeverClosesIt) {
+  // A good image between bad ones restarts the count of failures in a row: a looped folder of
+  // three with one unreadable image read for ever (without the restart it closed after 3 bad reads).
+  FakeClock clock;
+  TempDir dir;
+  WriteFrames(dir.path(), 3, 1);
+  std::ofstream(dir.path() + "/frame_0001.png", std::ios::trunc) << "not a png";
+  ImageFolderSource source(dir.path(), 10.0, true, &clock);
+  ASSERT_TRUE(source.Open());
+  int bad = 0;
+  for (int k = 0; k < 12; ++k) {
+    Frame f;
+    const ReadStatus s = source.Read(&f, 1.0);
+    ASSERT_NE(s, ReadStatus::kError) << k << " " << source.error();
+    bad += s == ReadStatus::kBadFrame;
+  }
+  EXPECT_EQ(bad, 4);
+  EXPECT_TRUE(source.IsOpen());
 }
 
 TEST(ImageFolderSourceTest, NormalizesSixteenBitAndAlpha) {
