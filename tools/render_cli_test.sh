@@ -73,6 +73,14 @@ for bad in "--start nan" "--start inf" "--start -1" "--fps 1e300" "--fps nan" "-
   [ "$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")" = "$before" ] || fail "render $bad changed the earlier run's files"
 done
 
+# A --start past the animation's end (0.2 s): the parser's finite-number check refuses NaN and inf
+# before the verb does, so this is the case that reaches the verb's own range check.
+status=0
+"$bin" render "$work/sim" --out "$work/fr" --start 5 --samples 1 --threads 1 >"$work/out.txt" 2>&1 || status=$?
+[ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "--start 5.000000 s is outside the animation's" "$work/out.txt" ||
+  fail "render --start 5 on a 0.2 s animation was not refused naming it: $(cat "$work/out.txt")"
+[ "$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")" = "$before" ] || fail "render --start 5 changed the earlier run's files"
+
 # Options given and then ignored are refused naming them, before --out is touched: --backgrounds
 # (only a --zeta names a photo) and --keep-zeta without --zeta, and --seed or --kind beside a
 # --zeta (rendered as given). Each ran as if not given.
