@@ -216,14 +216,15 @@ class ReuseTest(unittest.TestCase):
     def tearDown(self):
         self.tmp.cleanup()
 
-    def write_summary(self, bending_scale=1.0, edge=0.3, theta=None):
+    def write_summary(self, bending_scale=1.0, edge=0.3, theta=None, speed=None, seconds=None):
         folder = os.path.join(self.tmp.name, 's0')
         os.makedirs(folder, exist_ok=True)
         theta = theta or {n: v * (bending_scale if n.startswith('bending_') else 1)
                           for n, v in self.base['theta'].items()}
         with open(os.path.join(folder, 'summary.json'), 'w') as f:
-            json.dump({'wind': {'velocity': [round(self.SPEED, 4), 0, 0]},
-                       'cloths': [{'simulated_seconds': self.args.warmup + self.args.seconds,
+            json.dump({'wind': {'velocity': [round(self.SPEED if speed is None else speed, 4), 0, 0]},
+                       'cloths': [{'simulated_seconds': self.args.warmup + self.args.seconds
+                                   if seconds is None else seconds,
                                    'max_edge_m': edge, 'theta': theta}]}, f)
 
     def simulated(self, bending=None):
@@ -237,6 +238,13 @@ class ReuseTest(unittest.TestCase):
     def test_the_same_simulation_is_reused(self):
         self.write_summary()
         self.assertFalse(self.simulated())
+
+    def test_another_wind_or_length_is_simulated_again(self):
+        # Every summary above had this call's wind and length, so neither clause was ever needed.
+        self.write_summary(speed=3.3)
+        self.assertTrue(self.simulated())
+        self.write_summary(seconds=20.0)
+        self.assertTrue(self.simulated())
 
     def test_other_bending_is_simulated_again_without_a_spread(self):
         # This call has the scene's bending (no --bending-spread): a run with bending x3.7 is not it.
