@@ -35,8 +35,8 @@ class PlotTracksTest(unittest.TestCase):
         self.example = os.path.join(self.tmp.name, 'flag-000000-v0')
         os.makedirs(self.example)
         for k in range(4):
-            write_png(os.path.join(self.example, f'{k:03d}.png'), 32, 32, 40 * k)
-        self.tracks = {'format': 'clothwind-tracks', 'version': 1, 'grid': [1, 2], 'width': 32, 'height': 32,
+            write_png(os.path.join(self.example, f'{k:03d}.png'), 48, 32, 40 * k)  # wider than high
+        self.tracks = {'format': 'clothwind-tracks', 'version': 1, 'grid': [1, 2], 'width': 48, 'height': 32,
                        'vertices': [0, 1], 'xy': [[10 + k, 8, 10 + k, 24] for k in range(4)]}
         self.write_tracks()
 
@@ -81,6 +81,9 @@ class PlotTracksTest(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         with open(os.path.join(capture, 'script.gp')) as f:
             script = f.read()
+        # The picture's axes: x across its width, y down its height (an upward y axis, or the two
+        # swapped, plotted every point off its place; square frames hid the swap).
+        self.assertIn('set xrange [0:48]; set yrange [32:0]', script)
         titles = [line for line in script.splitlines() if line.startswith('set title')]
         self.assertEqual(titles, ["set title 'frame 2'", "set title 'frame 3'"])
         self.assertIn(os.path.join(self.example, '002.png'), script)
