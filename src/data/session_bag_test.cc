@@ -168,7 +168,7 @@ TEST(SessionBagTest, ADurationThatMakesNoSessionIsRefused) {
     std::ifstream in(log);
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     EXPECT_TRUE(text.find("--fps") != std::string::npos || text.find("frames") != std::string::npos ||
-                text.find("start time") != std::string::npos) << args << ": " << text;
+                text.find("--start-time") != std::string::npos) << args << ": " << text;
   }
   fs::remove_all(dir);
 }
