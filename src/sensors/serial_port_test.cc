@@ -70,10 +70,28 @@ TEST(SerialPort, RoundTripThroughPty) {
   EXPECT_EQ(std::string(back, 3), "Q\r\n");
 }
 
+TEST(SerialPort, BytesFromBeforeTheOpenAreDropped) {
+  // Bytes the instrument sent before the node listened (half a record, a boot banner) are
+  // flushed at Open, not read as the first record.
+  Pty pty;
+  ASSERT_FALSE(pty.path().empty());
+  // The slave must be open for the master's bytes to be queued: as a previous reader left it.
+  const int earlier = ::open(pty.path().c_str(), O_RDWR | O_NOCTTY);
+  ASSERT_GE(earlier, 0);
+  const std::string stale = "stale,half a record";
+  ASSERT_EQ(::write(pty.master(), stale.data(), stale.size()), static_cast<ssize_t>(stale.size()));
+  ::usleep(50000);
+  SerialPort port;
+  std::string err;
+  ASSERT_TRUE(port.Open({pty.path(), 9600, 8, 'N', 1}, &err)) << err;
+  EXPECT_EQ(ReadAll(&port, stale.size(), 200), "");
+  ::close(earlier);
+}
+
 TEST(SerialPort, ConfigureTermiosSetsLineSettings) {
   termios t{};
   t.c_lflag = ICANON | ECHO;
-  t.c_iflag = IXON | ICRNL;
+  t.c_iflag = IXON | IXOFF | IXANY | ICRNL;  // flow control a previous program left (cfmakeraw keeps IXOFF, IXANY)
   t.c_cflag = CRTSCTS;
   ConfigureTermios({"x", 4800, 7, 'O', 2}, &t);
   EXPECT_EQ(::cfgetispeed(&t), static_cast<speed_t>(B4800));
@@ -86,7 +104,7 @@ TEST(SerialPort, ConfigureTermiosSetsLineSettings) {
   EXPECT_TRUE(t.c_cflag & CLOCAL);
   EXPECT_TRUE(t.c_cflag & CREAD);
   EXPECT_FALSE(t.c_lflag & (ICANON | ECHO));
-  EXPECT_FALSE(t.c_iflag & (IXON | ICRNL));
+  EXPECT_FALSE(t.c_iflag & (IXON | IXOFF | IXANY | ICRNL));
   ConfigureTermios({"x", 115200, 8, 'E', 1}, &t);
   EXPECT_EQ(::cfgetispeed(&t), static_cast<speed_t>(B115200));
   EXPECT_EQ(t.c_cflag & CSIZE, static_cast<tcflag_t>(CS8));
