@@ -94,6 +94,8 @@ class TrackOracleTest(unittest.TestCase):
             test = [c for c in clips if c['split'] == 'test']
             self.assertEqual([r[3] for r in rows], [c['name'] for c in test])
             truth = np.array([float(r[0]) for r in rows])
+            # The true speed first (RMSE is symmetric: the columns swapped passed every figure).
+            np.testing.assert_allclose(truth, [c['wind_speed'] for c in test], atol=1e-4)
             error = np.array([float(r[1]) for r in rows]) - truth
             # A guess of the mean wind would err by the spread of the speeds; the tracks say more.
             self.assertLess(np.sqrt((error ** 2).mean()), 0.5 * truth.std(), coords)
@@ -103,12 +105,16 @@ class TrackOracleTest(unittest.TestCase):
     def test_image_tracks_scale_to_the_unit_square_and_mirror_as_the_flip(self):
         make_dataset(self.data, sims_per_split=(1, 1, 1), views=1)
         path = os.path.join(self.data, 'flag-000000-v0', 'tracks.json')
+        # Frames wider than high: x scales by the width, y by the height (square frames hid them swapped).
+        t = read_json(path)
+        t['width'], t['height'] = 160, 120
+        write_json(path, t)
         image = oracle.read_tracks(path, 'image')
         world = oracle.read_tracks(path, 'world')
         self.assertEqual(image.shape, (FRAMES, 6, 2))
         self.assertEqual(world.shape, (FRAMES, 6, 3))
         raw = np.array(read_json(path)['xy']).reshape(FRAMES, 6, 2)
-        np.testing.assert_allclose(image, raw / SIZE * 2 - 1)
+        np.testing.assert_allclose(image, raw / np.array([160.0, 120.0]) * 2 - 1)
         np.testing.assert_allclose(oracle.mirrored(image, 'image')[..., 0], -image[..., 0])
         np.testing.assert_allclose(oracle.mirrored(world, 'world')[..., 1], -world[..., 1])
         np.testing.assert_allclose(oracle.mirrored(world, 'world')[..., [0, 2]], world[..., [0, 2]])
