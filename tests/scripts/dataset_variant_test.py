@@ -19,7 +19,7 @@ variant = importlib.util.module_from_spec(importlib.util.spec_from_loader('datas
 _loader.exec_module(variant)
 
 
-def make_dataset(folder, sims, views=4):
+def make_dataset(folder, sims, views=4, val=0.1, test=0.2):
     """A clothwind-dataset index whose splits are per simulation, as make-dataset writes them."""
     clips = []
     for s in range(sims):
@@ -32,7 +32,7 @@ def make_dataset(folder, sims, views=4):
                     out.write(name)
             clips.append({'name': name, 'wind_speed': 0.01 * s, 'split': split, 'simulation': s, 'view': v})
     index = {'format': 'clothwind-dataset', 'version': 1, 'count': sims,
-             'dataset': {'views': views, 'val_fraction': 0.1, 'test_fraction': 0.2}, 'clips': clips}
+             'dataset': {'views': views, 'val_fraction': val, 'test_fraction': test}, 'clips': clips}
     with open(os.path.join(folder, 'index.json'), 'w') as out:
         json.dump(index, out)
     return index
@@ -75,6 +75,19 @@ class DatasetVariantTest(unittest.TestCase):
         for old, new in zip(self.source_index['clips'], index['clips']):
             self.assertEqual({k: v for k, v in old.items() if k != 'split'},
                              {k: v for k, v in new.items() if k != 'split'})
+
+    def test_the_fractions_are_the_sources_own(self):
+        # Other fractions than the script's defaults (make-dataset's 0.1 and 0.2, which every
+        # source here had, so fractions fixed in the script passed).
+        src = os.path.join(self.tmp.name, 'src2')
+        make_dataset(src, sims=250, val=0.3, test=0.15)
+        dst = os.path.join(self.tmp.name, 'dst2')
+        r = run(src, dst, '--split-by-clip')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(dst, 'index.json')) as f:
+            splits = [c['split'] for c in json.load(f)['clips']]
+        self.assertLess(abs(splits.count('val') - 300), 5 * 14.5)   # Binomial(1000, 0.3)
+        self.assertLess(abs(splits.count('test') - 150), 5 * 11.3)  # Binomial(1000, 0.15)
 
     def test_the_draw_is_reproducible(self):
         _, a = self.resplit('a')
