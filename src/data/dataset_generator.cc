@@ -744,8 +744,13 @@ int64_t ReindexDataset(const std::string& dir, bool contact_sheet, const std::fu
   const IndexLock lock(dir);
   RemoveIndexTemporariesOfStoppedRuns(dir);
   std::vector<std::string> incomplete;
+  const nlohmann::json count_before = index.value("count", nlohmann::json());
   index = BuildIndex(dir, index, progress, &incomplete);
   SayIncomplete("make-dataset --reindex", incomplete);
+  if (index.value("count", nlohmann::json()) != count_before)
+    std::fprintf(stderr, "make-dataset --reindex: the header's count raised from %s to %s, the simulations the folder "
+                 "holds (a larger run's, stopped before it rewrote the header, or copied in)\n",
+                 count_before.dump().c_str(), index.value("count", nlohmann::json()).dump().c_str());
   // The header's "tracks" says every example has its tracks.json: not when a merged shard was made
   // without them (the claim was kept, and training with --aux-tracks failed on the first such).
   if (index.contains("dataset") && index["dataset"].is_object() && index["dataset"].contains("tracks")) {
@@ -950,6 +955,9 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   std::vector<std::string> incomplete;
   nlohmann::json index = BuildIndex(o.out, IndexHeader(o, settings), index_progress, &incomplete);
   SayIncomplete("make-dataset", incomplete);
+  if (index.value("count", nlohmann::json()) != nlohmann::json(o.count))
+    std::fprintf(stderr, "make-dataset: the folder holds simulations past --count %lld; the index's count is %s\n",
+                 static_cast<long long>(o.count), index.value("count", nlohmann::json()).dump().c_str());
   if (o.add_tracks) {
     // The header's "tracks" says every example has its tracks.json: not while a replay failed or
     // another split still waits for its tracks (a later --add-tracks run completes it; a run with

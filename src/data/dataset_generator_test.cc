@@ -653,7 +653,7 @@ TEST_F(DatasetGeneratorTest, ReindexRefusesAShardOfOtherSettingsAndClaimsOnlyTra
            {"/dataset_seed", 2}, {"/width", 32}, {"/height", 32}, {"/num_frames", 5}, {"/split", "elsewhere"},
            {"/views", 2}, {"/frame_rate", 30}, {"/frame_pattern", "%03d.png"},
            {"/simulation_settings/warmup", 0.8}, {"/simulation_settings/max_edge", 0.5},
-           {"/simulation_settings/scene", "other.json"}, {"/wind_speed", 12.5}, {"/simulation", 3}}) {
+           {"/simulation_settings/scene", "other.json"}, {"/wind_speed", 12.5}}) {
     std::string field = pointer.substr(1);
     std::replace(field.begin(), field.end(), '/', '.');
     nlohmann::json label = nlohmann::json::parse(bytes);
@@ -669,6 +669,20 @@ TEST_F(DatasetGeneratorTest, ReindexRefusesAShardOfOtherSettingsAndClaimsOnlyTra
     }
   }
   std::ofstream(file, std::ios::binary) << bytes;
+  // A larger run's folder (simulation 5 of a header counting 3: a run extending the dataset,
+  // stopped before it rewrote the header) is listed and the count raised to cover it; refusing
+  // it broke the reindex of a stopped run, which is what the reindex is for.
+  {
+    const fs::path larger = dir / "flag-000005-v0";
+    fs::copy(dir / "flag-000002-v0", larger, fs::copy_options::recursive);
+    nlohmann::json label = nlohmann::json::parse(bytes);
+    label["name"] = "flag-000005-v0";
+    label["simulation"] = 5;
+    std::ofstream(larger / "label.json") << label.dump(2) << "\n";
+    EXPECT_EQ(ReindexDataset(dir.string(), false), 4);
+    EXPECT_EQ(ReadIndex(dir.string())["count"], 6);
+    fs::remove_all(larger);
+  }
   // An example with a frame missing (a copy not finished) is left out, not listed for a reader to
   // fail on, and comes back once its frame does.
   const fs::path frame = dir / "flag-000001-v0" / "001.jpg";

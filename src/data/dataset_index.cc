@@ -254,14 +254,14 @@ nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
     if (label["name"] != name)
       throw std::runtime_error(path + ": field 'name' is " + label["name"].dump() +
                                ", expected the folder's name \"" + name + "\"");
-    // A simulation beyond the header's count: a folder of a larger run (the e5 recipe copies
-    // examples and drops the index, so the generator's own count check never saw them).
-    const nlohmann::json count = header.is_object() ? header.value("count", nlohmann::json()) : nlohmann::json();
+    // A simulation beyond the header's count: a larger run's folder (one extending the dataset,
+    // stopped before it rewrote the header, or copied in). The header's count is raised to cover
+    // it, so it never counts fewer simulations than it lists; refusing it broke `--reindex` of a
+    // stopped run, which is what the reindex is for.
     const nlohmann::json simulation = label.value("simulation", nlohmann::json());
-    if (count.is_number_integer() && simulation.is_number_integer() && simulation.get<int64_t>() >= count.get<int64_t>())
-      throw std::runtime_error(path + ": field 'simulation' is " + simulation.dump() + ", beyond the header's count " +
-                               count.dump() + " (an example of a larger run: remove it, or make the dataset with --count " +
-                               std::to_string(simulation.get<int64_t>() + 1) + " or more)");
+    if (header.is_object() && header.contains("count") && header["count"].is_number_integer() &&
+        simulation.is_number_integer() && simulation.get<int64_t>() >= header["count"].get<int64_t>())
+      header["count"] = simulation.get<int64_t>() + 1;
     // Frames missing (a copy not finished, a frame deleted): not listed, as the generator makes
     // such an example again; a reader of the index would fail on it.
     if (label.contains("num_frames") && label.contains("frame_pattern") &&

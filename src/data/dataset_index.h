@@ -67,9 +67,10 @@ nlohmann::json IndexEntry(const nlohmann::json& label);
 // the same folders gives the same index. `header` supplies the top-level fields (format,
 // version, kind, generator, dataset settings, count); "clips" is filled in. A label that
 // contradicts the header's settings (kind, seed, views, frames, size, format, rate, generator
-// version, scene, warm-up, largest edge, the split of its seed, a wind outside the range) or
-// whose simulation is beyond the header's count is refused naming it and the field: a shard
-// made elsewhere with other settings. An example whose frames are not all there is left out.
+// version, scene, warm-up, largest edge, the split of its seed, a wind outside the range) is
+// refused naming it and the field: a shard made elsewhere with other settings. A simulation
+// beyond the header's count raises the count to cover it (a larger run's folder, stopped before
+// it rewrote the header). An example whose frames are not all there is left out.
 // `progress`, when set, is called with (0, labels found) once the folder is listed and with
 // (labels read, labels found) after each label (a dataset of 20,000 examples takes tens of
 // seconds).
