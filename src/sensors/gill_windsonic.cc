@@ -101,10 +101,12 @@ ParseResult ParseGillWindSonic(const std::string& record) {
   std::string err;
   if (!ParseOptionalNumber(f[1], &a, &err)) return Fail(ParseStatus::kMalformed, "field 2: " + err);
   if (!ParseOptionalNumber(f[2], &b, &err)) return Fail(ParseStatus::kMalformed, "field 3: " + err);
-  // UV signs both components; polar signs neither. A sign on either field is UV: "Q,,+002.00,M,00"
-  // (U lost) read as polar, 2 m/s with no direction, under status OK.
+  // UV signs both components; polar signs neither. A signed field 2, or an empty one beside a
+  // signed field 3, is UV: "Q,,+002.00,M,00" (U lost) read as polar, 2 m/s with no direction,
+  // under status OK. A polar direction beside a signed speed stays polar, its negative speed
+  // refused ("Q,045,-002.00" read as UV gave 45 m/s).
   const auto signed_field = [](const std::string& s) { return !s.empty() && (s[0] == '+' || s[0] == '-'); };
-  const bool uv = signed_field(f[1]) || signed_field(f[2]);
+  const bool uv = signed_field(f[1]) || (f[1].empty() && signed_field(f[2]));
   if (uv) {
     if (!std::isfinite(a) || !std::isfinite(b))
       return Fail(ParseStatus::kMalformed, std::string("UV: field ") + (std::isfinite(a) ? "3 (V)" : "2 (U)") +

@@ -115,6 +115,10 @@ TEST(GillWindSonic, UvAgreesWithPolar) {
     EXPECT_EQ(r.status, ParseStatus::kMalformed) << body;
     EXPECT_NE(r.error.find(field), std::string::npos) << r.error;
   }
+  // A polar direction beside a negative speed: the speed refused, not read as U = 45, V = -2.
+  r = ParseGillWindSonic(FrameGillRecord("Q,045,-002.00,M,00,"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("field 3 (speed): expected >= 0, got '-002.00'"), std::string::npos) << r.error;
 }
 
 }  // namespace
