@@ -87,7 +87,6 @@ struct TopicStats {
   std::string first_dropped;   // where the first message stamped 0 or far ahead is
   size_t unreadable = 0;       // camera frames the clip buffer cannot read (ImageView refuses them)
   std::string first_unreadable;
-  size_t late = 0;             // usable readings recorded after the clips they would label went out
   size_t repeated = 0;        // header stamp equal to the previous one (records of one serial read
                               // share it; camera frames must not: the clip buffer drops them)
   size_t bag_time_off = 0;    // |bag time - header stamp| > 1 ms
@@ -126,8 +125,8 @@ void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, do
     if (s.first_dropped.empty()) s.first_dropped = where;
     return;
   }
-  s.last = std::max(std::isnan(s.last) ? stamp : s.last, stamp);
   if (s.kept++ == 0) {
+    s.last = stamp;
     s.first = s.run_start = s.previous = stamp;
     return;
   }
@@ -157,6 +156,7 @@ void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, do
       ++s.holes;
       s.widest = std::max(s.widest, held - s.previous);
       s.run_start = s.previous = held;
+      s.last = std::max(s.last, held);
     } else {
       ++s.stale;
       if (s.stale_ahead++ == 0) s.first_stale_ahead = s.held_ahead_where;
@@ -174,6 +174,9 @@ void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, do
     s.held_ahead_where = where;
     return;
   }
+  // On the timeline (a frame held ahead only once the next confirms it: a lone one the clip
+  // buffer drops extended the span and the clips' last end).
+  s.last = std::max(s.last, stamp);
   if (dt > gap_tolerance) {
     ++s.holes;
     s.run_start = stamp;
@@ -387,10 +390,10 @@ int Check(const BagCheckArgs& a) {
   if (wind != topics.end() && wind->second.count > 0 && wind->second.decoded == 0)
     fail("anemometer/raw: no sentence gives a wind reading (" + std::to_string(wind->second.undecoded) +
          " refused, the first: " + wind->second.first_error + ")");
-  else if (wind != topics.end() && wind->second.decoded > 0 && wind->second.usable.empty() &&
-           wind->second.void_readings > 0)
-    fail("anemometer/raw: every reading is void (the instrument's status V or error code, or a speed outside "
-         "0..150 m/s: " + std::to_string(wind->second.void_readings) + "), and the clip buffer labels no clip with one");
+  else if (wind != topics.end() && wind->second.decoded > 0 && wind->second.usable.empty())
+    fail("anemometer/raw: no reading the clip buffer can label with: " + std::to_string(wind->second.void_readings) +
+         " void (the instrument's status V or error code, or a speed outside 0..150 m/s), the rest stamped 0 or far "
+         "ahead (dropped by the anemometer node)");
   // A clip ending at e is labelled by the usable readings stamped in [e - label window, e] that
   // the replay has delivered when the clip goes out, once the camera's data time passes e +
   // label_delay; clips end from the first frame + a clip's duration to the last frame. So a

@@ -461,6 +461,16 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
     EXPECT_EQ(rc, 0) << out;
     EXPECT_NE(out.find("warning: anemometer/raw: 1 messages stamped 0"), std::string::npos) << out;
   }
+  // One sentence with a bad checksum, the rest stamped 0: no reading labels a clip, though neither
+  // rule alone fails the bag (not every message is dropped, none is void). It passed.
+  int wind_sentence = 0;
+  RewriteBag(good, (dir / "zero_wind.bag").string(), [&](auto& m) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(m)>, clothwind::RawSentence>) {
+      if (wind_sentence++ == 0) m.data = m.data.substr(0, m.data.find('*')) + "*00";
+      else m.header.stamp = ros::Time();
+    }
+    return true;
+  });
   // Frames the clip buffer cannot read (an encoding it cannot convert), and sentences recorded
   // 40 s after their stamps (replayed after every clip of this 6 s session went out): both passed.
   RewriteBag(good, (dir / "float.bag").string(), [](auto& m) {
@@ -497,7 +507,8 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
   }
   for (const Case& c : {Case{"ahead.bag", "ahead of their bag time"}, Case{"zero.bag", "stamped 0"},
                         Case{"checksum.bag", "no sentence gives a wind reading"},
-                        Case{"void.bag", "every reading is void"},
+                        Case{"void.bag", "no reading the clip buffer can label with: 5 void"},
+                        Case{"zero_wind.bag", "no reading the clip buffer can label with: 0 void"},
                         Case{"extra.bag", "wait:=false"}, Case{"slow.bag", "no stretch of frames without a hole"},
                         Case{"apart.bag", "falls in a clip's label window"},
                         Case{"after.bag", "falls in a clip's label window"},
