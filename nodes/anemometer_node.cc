@@ -364,9 +364,13 @@ class AnemometerNode {
     // turn; a paused replay is not a silent instrument either. (A clock that went back counts 0.)
     const bool sim = ros::Time::isSimTime();
     const double ros_now = ros::Time::now().toSec();
-    // Over the readings of the last 10 s (per report, a replay at -r 0.15 read 0 and 6.6 Hz in turn).
+    // Over the readings of the last 10 s, or of ~stale_timeout when longer (a Fine Offset station's
+    // 144 s: one reading per 48 s read 0 Hz over 10 s); per report, a replay at -r 0.15 read 0 and
+    // 6.6 Hz in turn.
     const double clock_now = sim ? ros_now : now.toSec();
-    while (!reading_times_.empty() && (clock_now - reading_times_.front() > 10.0 || clock_now < reading_times_.front()))
+    const double rate_window = std::max(10.0, stale_timeout_);
+    while (!reading_times_.empty() &&
+           (clock_now - reading_times_.front() > rate_window || clock_now < reading_times_.front()))
       reading_times_.pop_front();
     const double rate = reading_times_.size() >= 2 && reading_times_.back() > reading_times_.front()
                             ? static_cast<double>(reading_times_.size() - 1) /

@@ -33,7 +33,8 @@ RenderedFlagGenerator::RenderedFlagGenerator(const sensors::SyntheticSessionOpti
   } catch (const std::invalid_argument& e) {
     // Named after the option the user gave: "field 'camera_radius'" names no option of make-session.
     const std::string what = e.what();
-    for (const auto& [field, option] : {std::pair<const char*, const char*>{"'camera_radius'", "--camera-distance"},
+    for (const auto& [field, option] : {std::pair<const char*, const char*>{"'width' x 'height'", "--width x --height"},
+                                        {"'camera_radius'", "--camera-distance"},
                                         {"'samples'", "--render-samples"},
                                         {"'width'", "--width"},
                                         {"'height'", "--height"},

@@ -207,7 +207,13 @@ class MonitorNodesTest(unittest.TestCase):
         # one shown: the mean of the clamped estimates read high in calm air.
         mean = WindEstimate()
         mean.header.stamp, mean.clip_sequence = e.header.stamp, e.clip_sequence
-        mean.speed, mean.speed_std = 3.7, 0.2
+        # Over another window than the display's (3 s here): not taken, or its label would lie.
+        mean.speed, mean.speed_std, mean.model = 3.2, 0.2, "m [trailing 120 s mean of 4 clips]"
+        self.mean_pub.publish(mean)
+        self.wait_redraw()
+        text, _ = self.text()
+        self.assertIn("s mean 4.0", text)
+        mean.speed, mean.model = 3.7, "m [trailing 3 s mean of 2 clips]"
         self.mean_pub.publish(mean)
         self.wait_redraw()
         text, _ = self.text()
