@@ -347,6 +347,7 @@ class AnemometerNode {
       {
         const double t = ros::Time::isSimTime() ? ros::Time::now().toSec() : ros::SteadyTime::now().toSec();
         if (!reading_times_.empty() && t < reading_times_.back()) reading_times_.clear();  // the clock went back
+        if (reading_times_.empty() && (first_reading_time_ <= 0 || t < first_reading_time_)) first_reading_time_ = t;
         reading_times_.push_back(t);
         if (reading_times_.size() > 4096) reading_times_.pop_front();
       }
@@ -372,10 +373,14 @@ class AnemometerNode {
     while (!reading_times_.empty() &&
            (clock_now - reading_times_.front() > rate_window || clock_now < reading_times_.front()))
       reading_times_.pop_front();
-    const double rate = reading_times_.size() >= 2 && reading_times_.back() > reading_times_.front()
-                            ? static_cast<double>(reading_times_.size() - 1) /
-                                  (reading_times_.back() - reading_times_.front())
-                            : 0.0;
+    // The readings in the window over the window (or the time since the first reading, before the
+    // window has filled), so an instrument that falls silent reads slower as its readings age out
+    // (readings over their own span kept its last rate).
+    const double since_first = clock_now - first_reading_time_;
+    const double n = static_cast<double>(reading_times_.size());
+    const double rate = since_first >= rate_window ? n / rate_window
+                        : n >= 2 && since_first > 0 ? (n - 1) / since_first
+                                                    : 0.0;
     const bool new_errors = c.checksum_failures + c.parse_errors > last_diag_errors_;
     last_diag_errors_ = c.checksum_failures + c.parse_errors;
     const double age = !have_valid_ ? -1.0
@@ -479,6 +484,7 @@ class AnemometerNode {
   ros::SteadyTime next_attempt_, next_poll_, last_valid_wall_;
   double last_valid_ros_ = 0.0;  // the same in ROS time [s], for replays
   std::deque<double> reading_times_;  // arrival of the readings of about the last 10 s (ROS time in a replay) [s]
+  double first_reading_time_ = 0.0;   // the first reading's, on the same clock (since the clock last went back) [s]
   double stale_timeout_ = 5.0;
   bool stale_timeout_given_ = false;  // ~stale_timeout set: kept whatever the instrument
   double usb_poll_period_ = 10.0;

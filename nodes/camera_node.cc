@@ -136,9 +136,13 @@ int main(int argc, char** argv) {
   const std::string calibration_refused = clothwind::ros_bridge::CheckCalibrationFile(calibration_path);
   std::error_code no_file;
   if (calibration_refused.empty() && !calibration_path.empty() && !std::filesystem::exists(calibration_path, no_file)) {
-    // None yet (set_camera_info writes it): no calibration, and no word, as docs/camera.md says;
-    // camera_info_manager's own load warned "calibration file ... not found" at every start.
+    // None yet (set_camera_info writes it): no calibration. The default file's absence is no
+    // news (camera_info_manager's own load warned "not found" at every start); a URL given is
+    // said, as a mistyped path would otherwise pass for an uncalibrated camera.
     info_manager.setCameraInfo(sensor_msgs::CameraInfo());
+    if (!camera_info_url.empty())
+      ROS_WARN_STREAM("camera_node: no calibration file at '" << camera_info_url
+                      << "' yet (set_camera_info writes it there); camera_info carries the image size only");
   } else if (calibration_refused.empty()) {
     info_manager.loadCameraInfo(camera_info_url);
     if (!camera_info_url.empty() && !info_manager.isCalibrated()) {

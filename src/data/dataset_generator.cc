@@ -952,12 +952,13 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   // Every run rebuilds the index from the folders present: shards and resumed runs converge.
   const IndexLock lock(o.out);
   RemoveIndexTemporariesOfStoppedRuns(o.out);
-  std::vector<std::string> incomplete;
-  nlohmann::json index = BuildIndex(o.out, IndexHeader(o, settings), index_progress, &incomplete);
+  std::vector<std::string> incomplete, beyond;
+  nlohmann::json index = BuildIndex(o.out, IndexHeader(o, settings), index_progress, &incomplete, &beyond);
   SayIncomplete("make-dataset", incomplete);
-  if (index.value("count", nlohmann::json()) != nlohmann::json(o.count))
-    std::fprintf(stderr, "make-dataset: the folder holds simulations past --count %lld; the index's count is %s\n",
-                 static_cast<long long>(o.count), index.value("count", nlohmann::json()).dump().c_str());
+  if (!beyond.empty())
+    std::fprintf(stderr, "make-dataset: %zu example folder%s of simulations past --count %lld left out of the index "
+                 "(the first: %s; a larger run's: `--reindex` lists them under a raised count)\n",
+                 beyond.size(), beyond.size() == 1 ? "" : "s", static_cast<long long>(o.count), beyond.front().c_str());
   if (o.add_tracks) {
     // The header's "tracks" says every example has its tracks.json: not while a replay failed or
     // another split still waits for its tracks (a later --add-tracks run completes it; a run with

@@ -679,6 +679,10 @@ TEST_F(DatasetGeneratorTest, ReindexRefusesAShardOfOtherSettingsAndClaimsOnlyTra
     label["name"] = "flag-000005-v0";
     label["simulation"] = 5;
     std::ofstream(larger / "label.json") << label.dump(2) << "\n";
+    // A generating run of --count 3 leaves it out: it checks only its own simulations, and a
+    // raised count would refuse its next run.
+    EXPECT_EQ(GenerateDataset(Tiny(dir.string())).examples_in_index, 3);
+    EXPECT_EQ(ReadIndex(dir.string())["count"], 3);
     EXPECT_EQ(ReindexDataset(dir.string(), false), 4);
     EXPECT_EQ(ReadIndex(dir.string())["count"], 6);
     fs::remove_all(larger);

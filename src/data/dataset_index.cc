@@ -236,7 +236,8 @@ bool LabelledFramesPresent(const fs::path& folder, const nlohmann::json& label) 
 }  // namespace
 
 nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
-                          const std::function<void(int, int)>& progress, std::vector<std::string>* incomplete) {
+                          const std::function<void(int, int)>& progress, std::vector<std::string>* incomplete,
+                          std::vector<std::string>* beyond_count) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
@@ -258,10 +259,18 @@ nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
     // stopped before it rewrote the header, or copied in). The header's count is raised to cover
     // it, so it never counts fewer simulations than it lists; refusing it broke `--reindex` of a
     // stopped run, which is what the reindex is for.
+    // A generator run (beyond_count given) leaves such folders out instead: it checked only the
+    // simulations of its --count against its settings, and a raised count refused its next run.
     const nlohmann::json simulation = label.value("simulation", nlohmann::json());
     if (header.is_object() && header.contains("count") && header["count"].is_number_integer() &&
-        simulation.is_number_integer() && simulation.get<int64_t>() >= header["count"].get<int64_t>())
+        simulation.is_number_integer() && simulation.get<int64_t>() >= header["count"].get<int64_t>()) {
+      if (beyond_count) {
+        beyond_count->push_back(name);
+        if (progress) progress(static_cast<int>(clips.size()), static_cast<int>(names.size()));
+        continue;
+      }
       header["count"] = simulation.get<int64_t>() + 1;
+    }
     // Frames missing (a copy not finished, a frame deleted): not listed, as the generator makes
     // such an example again; a reader of the index would fail on it.
     if (label.contains("num_frames") && label.contains("frame_pattern") &&

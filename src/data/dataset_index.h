@@ -70,7 +70,8 @@ nlohmann::json IndexEntry(const nlohmann::json& label);
 // version, scene, warm-up, largest edge, the split of its seed, a wind outside the range) is
 // refused naming it and the field: a shard made elsewhere with other settings. A simulation
 // beyond the header's count raises the count to cover it (a larger run's folder, stopped before
-// it rewrote the header). An example whose frames are not all there is left out.
+// it rewrote the header), or, when beyond_count is given (a generator run), is left out and
+// named there. An example whose frames are not all there is left out.
 // `progress`, when set, is called with (0, labels found) once the folder is listed and with
 // (labels read, labels found) after each label (a dataset of 20,000 examples takes tens of
 // seconds).
@@ -79,7 +80,8 @@ nlohmann::json IndexEntry(const nlohmann::json& label);
 // Throws std::runtime_error naming a label.json that cannot be read.
 nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
                           const std::function<void(int, int)>& progress = {},
-                          std::vector<std::string>* incomplete = nullptr);
+                          std::vector<std::string>* incomplete = nullptr,
+                          std::vector<std::string>* beyond_count = nullptr);
 
 // Writes index.json atomically (temporary file + rename).
 void WriteIndex(const std::string& dir, const nlohmann::json& index);

@@ -242,7 +242,7 @@ TEST(SessionBagTest, AnExistingOutOrAFolderIsRefusedBeforeTheWork) {
   EXPECT_EQ(text.find("frames"), std::string::npos) << "refused before the work: " << text;
   // A name ending in a slash (a folder not made yet) or none: refused before the work too (the
   // session was made, then the rename failed, leaving the folder made and empty).
-  for (const std::string out : {(dir / "new_folder").string() + "/", std::string("''")}) {
+  for (const std::string& out : {(dir / "new_folder").string() + "/", std::string("''")}) {
     std::tie(status, text) = run(out, "");
     EXPECT_NE(status, 0);
     EXPECT_NE(text.find("expected a bag file name"), std::string::npos) << text;
@@ -427,7 +427,7 @@ TEST(SessionBagTest, BagCheckRefusesBagsTheReplayCannotUse) {
       // stale and goes on; counted as holes, no stretch lasted a clip and the bag was refused.
       if (frame % 25 == 12) m.header.stamp = ros::Time(t - 1.0);
       // And one stamped 1 s ahead (two holes each, and the next frame read as going back).
-      if (frame % 25 == 5) m.header.stamp = ros::Time(t + 1.0);
+      if (frame % 25 == 7) m.header.stamp = ros::Time(t + 1.0);  // (not 5: frame 80 is the early one)
       // One frame 10 s ahead of its bag time (the clip buffer's ~max_future refuses it alone).
       if (frame == 100) m.header.stamp = ros::Time(t + 10.0);
       previous = t;

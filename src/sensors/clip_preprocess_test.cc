@@ -105,8 +105,8 @@ TEST(ClipPreprocessTest, Mono16ScaledToEightBitsAndOutputIsACopy) {
   cv::Mat image(300, 300, CV_16UC1, cv::Scalar(256 * 123));
   const cv::Mat out = PreprocessClipFrame(image, ClipSourceEncoding::kMono16, {}, 300);
   EXPECT_EQ(out.at<uint8_t>(150, 150), 123);
-  // 0xFF00 is 255 by the high byte (1/256); 1/257 or 1/255, which 123's value could not tell
-  // apart, give 254 or 256.
+  // 0xFF00 is 255 by the high byte (1/256) and 1/257 gives 254; 0x8000 is 128, and 1/255 gives
+  // 129. (123's value could not tell the three apart.)
   const cv::Mat top = PreprocessClipFrame(cv::Mat(300, 300, CV_16UC1, cv::Scalar(0xFF00)), ClipSourceEncoding::kMono16, {}, 300);
   EXPECT_EQ(top.at<uint8_t>(150, 150), 255);
   const cv::Mat low = PreprocessClipFrame(cv::Mat(300, 300, CV_16UC1, cv::Scalar(0x8000)), ClipSourceEncoding::kMono16, {}, 300);
