@@ -51,8 +51,9 @@ struct BagCheckArgs {
   // pipeline's wait) [s]: a reading recorded later than that labels nothing.
   double label_delay = 1.5;
   // With no input this long the clip buffer labels its waiting clips with what it holds (its
-  // ~flush_after, in wall seconds; as bag seconds here, the replay at rate 1) [s].
+  // ~flush_after, in wall seconds) [s]; times replay_rate, the bag seconds that pass meanwhile.
   double flush_after = 3.0;
+  double replay_rate = 1.0;  // the rate the bag will be played at (rosbag play -r)
 };
 
 // The topics replay.launch's nodes read (clip_buffer: the camera's two; the anemometer node in
@@ -257,6 +258,8 @@ int Run(const BagCheckArgs& a) {
     throw std::invalid_argument("--label-delay must be in [0, 86400] s, got " + std::to_string(a.label_delay));
   if (!in(a.flush_after, 86400))
     throw std::invalid_argument("--flush-after must be in (0, 86400] s, got " + std::to_string(a.flush_after));
+  if (!in(a.replay_rate, 1000))
+    throw std::invalid_argument("--replay-rate must be in (0, 1000], got " + std::to_string(a.replay_rate));
   {
     // A file that is no bag at all: rosbag says "Error reading version line", which the repair
     // hint below also matched.
@@ -318,7 +321,7 @@ int Check(const BagCheckArgs& a) {
     // A pause in the input longer than flush_after: the clips waiting then went out with the
     // readings held, and a reading that comes after labels none of them.
     if (topic == "camera/image_raw" || topic == "anemometer/raw") {
-      if (std::isfinite(last_input) && t - last_input > a.flush_after) flushed = camera_time;
+      if (std::isfinite(last_input) && t - last_input > a.flush_after * a.replay_rate) flushed = camera_time;
       last_input = t;
     }
     const double data_time = std::max(camera_time, flushed + a.label_delay + 1e-6);
@@ -409,7 +412,7 @@ int Check(const BagCheckArgs& a) {
     }
     return false;
   };
-  if (camera != topics.end() && wind != topics.end() && camera->second.count > 0 && !wind->second.usable.empty() &&
+  if (camera != topics.end() && wind != topics.end() && camera->second.kept > 0 && !wind->second.usable.empty() &&
       !labels_a_clip(wind->second.usable))
     fail("no usable anemometer/raw reading's stamp falls in a clip's label window (the " + std::to_string(a.label_window) +
          " s up to its last frame, over camera/image_raw's stamps) and is recorded before that clip is labelled (" +
@@ -450,8 +453,11 @@ const VerbRegistrar kRegistrar{"bag-check", [](CLI::App& app) -> std::function<i
                   "labels nothing")
       ->capture_default_str();
   sub->add_option("--flush-after", args->flush_after,
-                  "with no input this long [s] the clip buffer labels its waiting clips (clip_buffer's; taken as "
-                  "bag seconds)")
+                  "with no input this long [s, wall] the clip buffer labels its waiting clips (clip_buffer's)")
+      ->capture_default_str();
+  sub->add_option("--replay-rate", args->replay_rate,
+                  "the rate the bag will be played at (rosbag play -r; replay.launch rate:=): how much bag time "
+                  "--flush-after spans")
       ->capture_default_str();
   return [args] { return Run(*args); };
 }};
