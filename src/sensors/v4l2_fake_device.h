@@ -46,6 +46,11 @@ struct FakeV4l2Config {
   int64_t jitter_ns = 4000000;    // latency varies by 0..4 steps of this, deterministically
   bool monotonic = true;          // V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC (else _UNKNOWN)
   std::map<uint64_t, uint32_t> skip_before;  // before capture k, the driver loses n frames
+  uint32_t first_sequence = 0;                // the driver's frame counter at the first capture
+  // GREY frames vary by row and column (value + r + 2 c, mod 256) instead of being uniform, so a
+  // reader that takes the row padding for image shows.
+  bool gradient = false;
+  std::set<uint64_t> sequence_restart_before;  // before capture k the counter restarts at 0 (one open)
   // Capture k reports bytesused n instead of the frame's size (0: an empty frame; fewer: a frame
   // cut short), its buffer filled as usual.
   std::map<uint64_t, uint32_t> bytesused_of;
@@ -60,7 +65,8 @@ struct FakeV4l2Config {
 
 class FakeV4l2Device : public V4l2Io {
  public:
-  FakeV4l2Device(FakeClock* clock, FakeV4l2Config config) : clock_(clock), config_(config) {}
+  FakeV4l2Device(FakeClock* clock, FakeV4l2Config config)
+      : clock_(clock), config_(config), sequence_(config.first_sequence) {}
 
   // --- test controls ---
   void Unplug() { present_ = false; }
@@ -325,6 +331,7 @@ class FakeV4l2Device : public V4l2Io {
     queue_.pop_front();
     FakeBuffer& buf = buffers_[index];
     buf.queued = false;
+    if (config_.sequence_restart_before.count(captures_)) sequence_ = 0;
     const uint8_t value = FrameValue(captures_);
     uint32_t bytes = Fill(&buf.mem, value);
     if (auto it = config_.bytesused_of.find(captures_); it != config_.bytesused_of.end()) bytes = it->second;
@@ -363,7 +370,9 @@ class FakeV4l2Device : public V4l2Io {
     std::fill(mem->begin(), mem->end(), 0xEE);  // row padding stays visible garbage
     for (int r = 0; r < h; ++r) {
       uint8_t* row = mem->data() + r * stride;
-      if (pf == V4L2_PIX_FMT_GREY) {
+      if (pf == V4L2_PIX_FMT_GREY && config_.gradient) {
+        for (int c = 0; c < w; ++c) row[c] = static_cast<uint8_t>(value + r + 2 * c);
+      } else if (pf == V4L2_PIX_FMT_GREY) {
         std::memset(row, value, w);
       } else {  // YUYV, neutral chroma
         for (int c = 0; c < w; ++c) {
