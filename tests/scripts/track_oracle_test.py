@@ -102,6 +102,20 @@ class TrackOracleTest(unittest.TestCase):
             self.assertIn('| 12 |', done.stdout)  # 6 test simulations x 2 views, one row
             self.assertIn('(6) |', done.stdout)   # per-simulation RMSE over the 6 simulations
 
+    def test_test_clips_give_one_row_per_window(self):
+        # --windows 3 reads three windows of each test clip (eval's starts), one window reads one;
+        # the protocol line alone echoed the option, and a script reading one window passed.
+        clips = make_dataset(self.data, sims_per_split=(1, 1, 1), views=1)
+        import argparse
+        args = argparse.Namespace(coords='image', features='motion', track_noise=0.0, track_size=64, window=30,
+                                  windows=3, stride=5, bins=6, seed=1)
+        test = [c for c in clips if c['split'] == 'test']
+        _, _, owner = oracle.rows_of(test, self.data, args, True)
+        self.assertEqual(list(owner), [0, 0, 0])
+        args.windows = 1
+        _, _, owner = oracle.rows_of(test, self.data, args, True)
+        self.assertEqual(list(owner), [0])
+
     def test_image_tracks_scale_to_the_unit_square_and_mirror_as_the_flip(self):
         make_dataset(self.data, sims_per_split=(1, 1, 1), views=1)
         path = os.path.join(self.data, 'flag-000000-v0', 'tracks.json')
