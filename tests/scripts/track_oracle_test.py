@@ -2,6 +2,7 @@
 """Tests of scripts/track-oracle on a small dataset of generated tracks whose motion encodes the
 wind: the trees learn it from the train split and read held-out simulations; windows, mirrors and
 per-clip means are eval's; bad input is refused naming the file and field."""
+import argparse
 import importlib.machinery
 import importlib.util
 import json
@@ -106,7 +107,6 @@ class TrackOracleTest(unittest.TestCase):
         # --windows 3 reads three windows of each test clip (eval's starts), one window reads one;
         # the protocol line alone echoed the option, and a script reading one window passed.
         clips = make_dataset(self.data, sims_per_split=(1, 1, 1), views=1)
-        import argparse
         args = argparse.Namespace(coords='image', features='motion', track_noise=0.0, track_size=64, window=30,
                                   windows=3, stride=5, bins=6, seed=1)
         test = [c for c in clips if c['split'] == 'test']
