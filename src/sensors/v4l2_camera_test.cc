@@ -139,29 +139,23 @@ TEST(V4l2CameraTest, CountsDroppedFramesFromSequenceGaps) {
 // across the wrap counts only the frames lost, a step back counts none. (The only backward step
 // the tests made came with a reopen, whose reset hid a dropped check, and none wrapped.)
 TEST(V4l2CameraTest, ASequenceThatWrapsOrRestartsCountsOnlyTheLostFrames) {
-  {
-    FakeV4l2Config config;
-    config.first_sequence = 0xFFFFFFFEu;
-    config.skip_before = {{3, 1}};  // FFFFFFFE, FFFFFFFF, 0, (1 lost), 2, 3
+  // The drops counted over `frames` frames of a driver set up by `config`.
+  const auto drops = [](const FakeV4l2Config& config, int frames) {
     Rig rig(config, Ask(PixelFormat::kGrey, 320, 240, 15));
-    ASSERT_TRUE(rig.camera.Open());
-    for (int i = 0; i < 5; ++i) {
+    EXPECT_TRUE(rig.camera.Open());
+    for (int i = 0; i < frames; ++i) {
       Frame f;
-      ASSERT_EQ(rig.ReadFrame(&f), ReadStatus::kFrame) << i;
+      EXPECT_EQ(rig.ReadFrame(&f), ReadStatus::kFrame) << i;
     }
-    EXPECT_EQ(rig.camera.stats().drops, 1u);
-  }
-  {
-    FakeV4l2Config config;
-    config.sequence_restart_before = {5};  // 0..4, then 0, 1, ...
-    Rig rig(config, Ask(PixelFormat::kGrey, 320, 240, 15));
-    ASSERT_TRUE(rig.camera.Open());
-    for (int i = 0; i < 10; ++i) {
-      Frame f;
-      ASSERT_EQ(rig.ReadFrame(&f), ReadStatus::kFrame) << i;
-    }
-    EXPECT_EQ(rig.camera.stats().drops, 0u);
-  }
+    return rig.camera.stats().drops;
+  };
+  FakeV4l2Config wraps;
+  wraps.first_sequence = 0xFFFFFFFEu;
+  wraps.skip_before = {{3, 1}};  // FFFFFFFE, FFFFFFFF, 0, (1 lost), 2, 3
+  EXPECT_EQ(drops(wraps, 5), 1u);
+  FakeV4l2Config restarts;
+  restarts.sequence_restart_before = {5};  // 0..4, then 0, 1, ...
+  EXPECT_EQ(drops(restarts, 10), 0u);
 }
 
 // Rows are read by the driver's bytesperline (320 pixels and 16 bytes of padding here): frames
