@@ -292,15 +292,15 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
   sub->add_option("--out", args->out, "output bag (refused if it exists, unless --overwrite)")->required();
   sub->add_flag("--overwrite", args->overwrite, "replace an existing --out");
   sub->add_option("--seed", args->seed, "random seed (0..2^64-1)")->check(CLI::NonNegativeNumber)->capture_default_str();
-  sub->add_option("--fps", args->fps, "camera rate [Hz] (10 to 1000: a slower camera's intervals break every clip)")->capture_default_str();
-  sub->add_option("--width", args->width, "image width [px] (16..16384; rendered: 16..8192)")->capture_default_str();
+  sub->add_option("--fps", args->fps, "camera rate [Hz] (above 10 to 1000: at 10, with the camera's jitter, no stretch lasts a clip)")->capture_default_str();
+  sub->add_option("--width", args->width, "image width [px] (16..16384; rendered: 16..8192, width x height at most 2^24)")->capture_default_str();
   sub->add_option("--height", args->height, "image height [px] (16..16384; rendered: 16..8192)")->capture_default_str();
   sub->add_option("--wind-mean", args->wind_mean,
                   "long-term mean wind [m/s] (0..60; the wind is floored near calm, so below ~1 m/s the session's "
                   "mean comes out higher: 0 gives ~0.8)")
       ->capture_default_str();
   sub->add_option("--drop-probability", args->drop_probability, "chance a frame is lost, in [0, 1)")->capture_default_str();
-  sub->add_option("--start-time", args->start_time, "stamp of the session start [s since epoch, >= 1]")
+  sub->add_option("--start-time", args->start_time, "stamp of the session start [s since epoch, >= 1; the session must end before 2^32 s]")
       ->capture_default_str();
   // Checked when parsed: a bad value used to leave the temporary bag behind.
   sub->add_option("--compression", args->compression, "none | lz4 | bz2")
