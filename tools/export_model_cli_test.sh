@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# CLI test of `clothwind export-model --calibrate-std`: a dataset without a val split (which the
+# CLI test of `clothwind export-model --calibrate-std` (and of train's refusals of options it would
+# ignore, on the same toy data): a dataset without a val split (which the
 # calibration reads) is refused before any work, naming the option and the way out; one with a
 # val split is calibrated and its scale stored beside the exported weights.
 # Usage: export_model_cli_test.sh CLOTHWIND_BINARY
@@ -14,6 +15,20 @@ fail() { echo "export_model_cli_test: FAIL: $*" >&2; exit 1; }
 grep -q '"split": "val"' "$work/toy/index.json" || fail "the toy dataset drew no val clip: $(cat "$work/toy/index.json")"
 "$bin" train --model sdn --frames 30 --data "$work/toy" --out "$work/run" --input-size 32 --width 8 --k 3 \
   --threads 1 --init-only >"$work/msg.txt" 2>&1 || fail "train --init-only: $(cat "$work/msg.txt")"
+
+# (train's options that were accepted and ignored, or wrapped: refused naming them.)
+for case in "--lr-decay-epoch|--lr-schedule cosine --lr-decay-epoch 5" "--overwrite|--resume --overwrite" \
+            "--seed|--seed -1"; do
+  option="${case%%|*}"
+  bad="${case#*|}"
+  status=0
+  # shellcheck disable=SC2086
+  "$bin" train --model sdn --frames 30 --data "$work/toy" --out "$work/bad" --input-size 32 --width 8 --k 3 \
+    --threads 1 --epochs 1 $bad >"$work/msg.txt" 2>&1 || status=$?
+  [ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "$option" "$work/msg.txt" ||
+    fail "train $bad: not refused naming $option (status $status): $(cat "$work/msg.txt")"
+  [ ! -e "$work/bad/model.pt" ] || fail "train $bad trained"
+done
 
 # The same clips with the val split moved to train.
 cp -r "$work/toy" "$work/noval"

@@ -24,7 +24,7 @@ VerbRegistrar registrar("make-toy-dataset", [](CLI::App& app) -> std::function<i
   sub->add_option("--clips", a->o.clips, "examples")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--frames", a->o.frames, "frames per example")->check(CLI::Range(2, 1000))->capture_default_str();
   sub->add_option("--size", a->o.size, "frame side [px]")->check(CLI::Range(16, 2048))->capture_default_str();
-  sub->add_option("--seed", a->o.seed, "seed")->capture_default_str();
+  sub->add_option("--seed", a->o.seed, "seed (0..2^64-1)")->check(CLI::NonNegativeNumber)->capture_default_str();
   return [a]() {
     ProgressBar::Options b;
     b.label = "make-toy-dataset";

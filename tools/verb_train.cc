@@ -107,8 +107,10 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
       ->capture_default_str();
   CLI::Option* resume = sub->add_flag("--resume", o.resume, "continue the run in --out from its last epoch");
+  // Not beside --resume: the pair resumed, --overwrite ignored without a word.
   sub->add_flag("--overwrite", o.overwrite,
-                "start again in an --out that holds a run (without it, or --resume, such an --out is refused)");
+                "start again in an --out that holds a run (without it, or --resume, such an --out is refused)")
+      ->excludes(resume);
   sub->add_flag("--cache-frames", o.cache_frames,
                 "keep every frame decoded at the input size in memory after its first read: the same samples, "
                 "no rereading of a dataset larger than the page cache (needs --crop-scales 1; clips x frames x "
@@ -145,7 +147,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                   "step (the seed's: divide by 10 once) or cosine (from --lr down to 0 over the epochs)")
       ->check(CLI::IsMember({"step", "cosine"}))
       ->capture_default_str();
-  sub->add_option("--lr-decay-epoch", o.lr_decay_epoch,
+  CLI::Option* lr_decay_epoch = sub->add_option("--lr-decay-epoch", o.lr_decay_epoch,
                   "step: epochs at the initial rate before dividing it by 10 (-1: half the epochs, 20 of 40 as the seed)")
       ->capture_default_str();
   sub->add_option("--crop-scales", o.crop_scales,
@@ -161,8 +163,14 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--grad-clip", o.grad_clip, "max gradient norm (0: off; -1: the seed's, 10 for lstm and off otherwise)")
       ->check(CLI::Range(-1.0, 1e9))
       ->capture_default_str();
-  sub->add_option("--seed", o.seed, "seed of initialisation, data order and augmentation")->capture_default_str();
-  return [args]() {
+  // -1 wrapped to 2^64-1: one fixed seed, not the "random" it reads as.
+  sub->add_option("--seed", o.seed, "seed of initialisation, data order and augmentation (0..2^64-1)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  return [args, lr_decay_epoch]() {
+    // The cosine schedule has no decay epoch: accepted, recorded in state.json and never used.
+    if (lr_decay_epoch->count() > 0 && args->o.lr_schedule == "cosine")
+      throw std::invalid_argument("--lr-decay-epoch is the step schedule's; --lr-schedule cosine decays over every epoch");
     // Every batch allocates and frees the same tensors: keep the freed memory instead of faulting
     // its pages in again (a training step 7 % faster at 64 px, 13 % at 96, on 2 cores).
     learn::KeepFreedHeapForReuse();

@@ -72,7 +72,9 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
       sub->add_option("--batch", a->train.batch, "maps per Adam step")->check(CLI::PositiveNumber)->capture_default_str(),
       sub->add_option("--lr", a->train.learning_rate, "Adam's learning rate")->check(CLI::PositiveNumber)->capture_default_str(),
       sub->add_option("--weight-decay", a->train.weight_decay, "Adam's L2 term")->check(CLI::NonNegativeNumber)->capture_default_str(),
-      sub->add_option("--seed", a->train.seed, "initialisation and order")->capture_default_str(),
+      sub->add_option("--seed", a->train.seed, "initialisation and order (0..2^64-1)")
+          ->check(CLI::NonNegativeNumber)
+          ->capture_default_str(),
       sub->add_option("--shift", a->train.shift,
                       "slide each training map by a random offset of up to this many cells of 16 each way (a camera "
                       "that does not centre the flag, as FlagSim's all do; 0: as collected)")

@@ -425,7 +425,8 @@ void LoadNamingTheFile(T& into, const fs::path& file) {
     torch::load(into, file.string(), at::Device(at::kCPU));
   } catch (const c10::Error& e) {
     throw std::runtime_error(file.string() + ": cannot read this checkpoint (" + e.what_without_backtrace() +
-                             "); a run stopped while writing it? Train again with --overwrite");
+                             "); a run stopped while writing it? Copy out the run's model.pt and the checkpoints' "
+                             "model.pt you want to keep, then train again with --overwrite, which deletes them");
   }
 }
 
