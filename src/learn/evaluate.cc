@@ -380,7 +380,8 @@ bool Plotting(std::string* error, F body) {
 
 bool RunGnuplot(const std::string& script, const fs::path& png, std::string* error) {
   return Plotting(error, [&] {
-  const std::string tmp = png.string() + ".tmp" + std::to_string(::getpid()) + ".png";
+  // "<png>.tmp-<pid>.png": the temporary form a run's --overwrite clears (".tmp<pid>" was left behind).
+  const std::string tmp = png.string() + ".tmp-" + std::to_string(::getpid()) + ".png";
   const fs::path script_path = png.string() + ".gp";
   WriteFileAtomically(script_path, "set terminal pngcairo size 800,600 noenhanced\nset output " + GnuplotQuoted(tmp) +
                                        "\n" + script);
