@@ -338,37 +338,35 @@ class AnemometerNode {
                                                                  magnetic_declination_));
       last_status_ = r.reading.status;
       last_reading_void_ = !r.reading.valid;
+      const double t = DiagnosticClock();
       if (r.reading.valid) {
         last_valid_ = r.reading;
-        last_valid_wall_ = ros::SteadyTime::now();
-        last_valid_ros_ = ros::Time::now().toSec();
+        last_valid_time_ = t;
         have_valid_ = true;
       }
-      {
-        const double t = ros::Time::isSimTime() ? ros::Time::now().toSec() : ros::SteadyTime::now().toSec();
-        if (!reading_times_.empty() && t < reading_times_.back()) reading_times_.clear();  // the clock went back
-        if (reading_times_.empty() && (first_reading_time_ <= 0 || t < first_reading_time_)) first_reading_time_ = t;
-        reading_times_.push_back(t);
-        if (reading_times_.size() > 4096) reading_times_.pop_front();
-      }
+      if (!reading_times_.empty() && t < reading_times_.back()) reading_times_.clear();  // the clock went back
+      if (reading_times_.empty() && (first_reading_time_ <= 0 || t < first_reading_time_)) first_reading_time_ = t;
+      reading_times_.push_back(t);
+      if (reading_times_.size() > 4096) reading_times_.pop_front();
     } else if (r.status != ParseStatus::kNotWind) {
       last_error_ = r.error;
       ROS_DEBUG("anemometer_node: %s", r.error.c_str());
     }
   }
 
+  // The clock of the readings' age and rate [s]: under simulated time (a replay) the replay's, as
+  // on the wall clock a healthy 1 Hz instrument replayed at rate 0.15 turned "stale" every 6.5 s
+  // and a paused replay read as a silent instrument; else the monotonic clock.
+  static double DiagnosticClock() {
+    return ros::Time::isSimTime() ? ros::Time::now().toSec() : ros::SteadyTime::now().toSec();
+  }
+
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
     const auto& c = decoder_.counters();
-    const ros::SteadyTime now = ros::SteadyTime::now();
-    // Under simulated time (a replay) on the replay's clock: on the wall clock a healthy 1 Hz
-    // instrument replayed at rate 0.15 turned "stale" every 6.5 s and its rate read 0 and 1 in
-    // turn; a paused replay is not a silent instrument either. (A clock that went back counts 0.)
-    const bool sim = ros::Time::isSimTime();
-    const double ros_now = ros::Time::now().toSec();
     // Over the readings of the last 10 s, or of ~stale_timeout when longer (a Fine Offset station's
     // 144 s: one reading per 48 s read 0 Hz over 10 s); per report, a replay at -r 0.15 read 0 and
     // 6.6 Hz in turn.
-    const double clock_now = sim ? ros_now : now.toSec();
+    const double clock_now = DiagnosticClock();
     const double rate_window = std::max(10.0, stale_timeout_);
     while (!reading_times_.empty() &&
            (clock_now - reading_times_.front() > rate_window || clock_now < reading_times_.front()))
@@ -383,9 +381,8 @@ class AnemometerNode {
                                                     : 0.0;
     const bool new_errors = c.checksum_failures + c.parse_errors > last_diag_errors_;
     last_diag_errors_ = c.checksum_failures + c.parse_errors;
-    const double age = !have_valid_ ? -1.0
-                       : sim        ? std::max(0.0, ros_now - last_valid_ros_)
-                                    : (now - last_valid_wall_).toSec();
+    // (A clock that went back counts 0.)
+    const double age = have_valid_ ? std::max(0.0, clock_now - last_valid_time_) : -1.0;
 
     const bool connected = input_ == "topic" || port_.is_open() || usb_.is_open();
     using diagnostic_msgs::DiagnosticStatus;
@@ -481,10 +478,12 @@ class AnemometerNode {
   Backoff backoff_;
   // Steady (monotonic) time: the wall clock steps back under NTP, and a next-due instant then held
   // every poll and reconnect (and the USB gate's 48 s) until it caught up.
-  ros::SteadyTime next_attempt_, next_poll_, last_valid_wall_;
-  double last_valid_ros_ = 0.0;  // the same in ROS time [s], for replays
-  std::deque<double> reading_times_;  // arrival of the readings of about the last 10 s (ROS time in a replay) [s]
-  double first_reading_time_ = 0.0;   // the first reading's, on the same clock (since the clock last went back) [s]
+  ros::SteadyTime next_attempt_, next_poll_;
+  // On DiagnosticClock [s]: the last valid reading's arrival, the readings' of the rate window
+  // (10 s, or ~stale_timeout), and the first reading's since the clock last went back.
+  double last_valid_time_ = 0.0;
+  std::deque<double> reading_times_;
+  double first_reading_time_ = 0.0;
   double stale_timeout_ = 5.0;
   bool stale_timeout_given_ = false;  // ~stale_timeout set: kept whatever the instrument
   double usb_poll_period_ = 10.0;

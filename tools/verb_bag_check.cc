@@ -108,6 +108,13 @@ struct TopicStats {
   std::string first_data;     // first raw sentence / image encoding and size
 };
 
+// Where a message is, for the warnings: "message N (bag time T s)".
+std::string Where(size_t index, double bag_time) {
+  char where[96];
+  std::snprintf(where, sizeof where, "message %zu (bag time %.3f s)", index, bag_time);
+  return where;
+}
+
 // Whether the replay's nodes drop a message of this stamp: 0, or more than max_future ahead of
 // its bag time (the replay's clock).
 bool DroppedStamp(double stamp, double bag_time, double max_future) {
@@ -117,8 +124,7 @@ bool DroppedStamp(double stamp, double bag_time, double max_future) {
 void Note(TopicStats& s, double stamp, double bag_time, double gap_tolerance, double max_future, size_t index) {
   ++s.count;
   if (std::fabs(bag_time - stamp) > 1e-3) ++s.bag_time_off;
-  char where[96];
-  std::snprintf(where, sizeof where, "message %zu (bag time %.3f s)", index, bag_time);
+  const std::string where = Where(index, bag_time);
   // Dropped one at a time by the nodes, which go on: counted, and not on the timeline (one frame
   // stamped 10 s ahead refused a field bag that replays whole).
   if (DroppedStamp(stamp, bag_time, max_future)) {
@@ -204,7 +210,7 @@ void NoteMessage(const rosbag::MessageInstance& m, TopicStats& s, double t, cons
     } catch (const std::exception& e) {
       ++s.count;
       if (s.unreadable++ == 0)
-        s.first_unreadable = "message " + std::to_string(index) + " (bag time " + std::to_string(t) + " s): " + e.what();
+        s.first_unreadable = Where(index, t) + ": " + e.what();
       return;
     }
     Note(s, img->header.stamp.toSec(), t, a.gap_tolerance, a.max_future, index);
@@ -303,8 +309,11 @@ int Check(const BagCheckArgs& a) {
     bar = std::make_unique<ProgressBar>(o);
   }
   const size_t total = bar ? view.size() : 0;
+  // Every topic is in the map from the connections on, so this stays valid (end() when none).
+  const auto camera_topic = topics.find("camera/image_raw");
   for (const rosbag::MessageInstance& m : view) {
-    TopicStats& s = topics[WithoutLeadingSlash(m.getTopic())];
+    const std::string topic = WithoutLeadingSlash(m.getTopic());
+    TopicStats& s = topics[topic];
     const double t = m.getTime().toSec();
     ++index;
     if (bar) bar->Update(static_cast<int64_t>(index), static_cast<int64_t>(total));
@@ -313,8 +322,6 @@ int Check(const BagCheckArgs& a) {
     if (m.size() > (1u << 30))
       throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " of the bag (on " + m.getTopic() + ")" + " is " +
                                std::to_string(m.size()) + " bytes (a corrupt record?)");
-    const std::string topic = WithoutLeadingSlash(m.getTopic());
-    const auto camera_topic = topics.find("camera/image_raw");
     const double camera_time = camera_topic != topics.end() && camera_topic->second.kept > 0
                                    ? camera_topic->second.last
                                    : -std::numeric_limits<double>::infinity();
@@ -402,9 +409,10 @@ int Check(const BagCheckArgs& a) {
   // label_delay; clips end from the first frame + a clip's duration to the last frame. So a
   // reading stamped r and delivered at data time D labels a clip when some e in
   // [max(r, first + duration, D - delay), min(r + window, last)] exists (a camera and an
-  // anemometer equally late in the bag are no later to each other). (Comparing only the earliest and latest usable stamps passed a bag with usable
-  // readings before and after the video and only void ones during it; stamps alone passed one
-  // whose readings were recorded 40 s late, and no clip was labelled.)
+  // anemometer equally late in the bag are no later to each other). (Comparing only the earliest
+  // and latest usable stamps passed a bag with usable readings before and after the video and only
+  // void ones during it; stamps alone passed one whose readings were recorded 40 s late, and no
+  // clip was labelled.)
   const auto labels_a_clip = [&](const std::vector<std::pair<double, double>>& usable) {
     for (const auto& [r, delivered] : usable) {
       const double lo = std::max({r, camera->second.first + a.clip_duration, delivered - a.label_delay});

@@ -304,14 +304,6 @@ std::string ExampleFrameFile(size_t k, const std::string& ext) {
   return file + ext;
 }
 
-// Whether every one of an example's `frames` frame files (000.<ext> ...) is in `folder`: an
-// interrupted copy (cp goes in the folder's hashed order, so label.json can come before 047.jpg)
-// left a label beside missing frames, counted complete at a resume and indexed.
-bool FramesPresent(const fs::path& folder, int frames, const std::string& ext) {
-  for (int k = 0; k < frames; ++k)
-    if (!fs::exists(folder / ExampleFrameFile(k, ext))) return false;
-  return true;
-}
 
 // Whether two label values agree: numbers within a relative 1e-9 (a label's doubles come back
 // from their JSON text), objects and arrays element by element, the rest exactly.
@@ -462,7 +454,7 @@ void WriteExample(const std::string& out, const std::string& name, const std::ve
     const fs::path target = fs::path(out) / name;
     if (fs::exists(target)) {
       const bool labelled = fs::exists(target / "label.json");
-      if (labelled && FramesPresent(target, static_cast<int>(images.size()), o.frame_ext))
+      if (labelled && FramesPresent(target, static_cast<int>(images.size()), FramePattern(o.frame_ext)))
         throw std::runtime_error(target.string() + " is already complete: not replaced");
       std::fprintf(stderr, "make-dataset: %s has %s (unfinished): made again\n", target.c_str(),
                    labelled ? "frames missing" : "no label.json");
@@ -618,7 +610,7 @@ void CheckExampleLabel(const std::string& dir, int64_t i, int v, const DatasetOp
       {"num_frames", {label.value("num_frames", nlohmann::json()), o.frames}},
       {"width", {label.value("width", nlohmann::json()), o.size}},
       {"height", {label.value("height", nlohmann::json()), o.size}},
-      {"frame_pattern", {label.value("frame_pattern", nlohmann::json()), "%03d." + o.frame_ext}},
+      {"frame_pattern", {label.value("frame_pattern", nlohmann::json()), FramePattern(o.frame_ext)}},
       {"simulation_settings.scene", {sim.value("scene", nlohmann::json()), p.scene_name}},
       {"simulation_settings.vertices", {sim.value("vertices", nlohmann::json()), p.setup.cloths[0].mesh.V.rows()}},
       {"views", {label.value("views", nlohmann::json()), o.views}},
@@ -651,7 +643,7 @@ void CheckExampleLabel(const std::string& dir, int64_t i, int v, const DatasetOp
                                "theirs, or use another --out)");
   }
   // Asked of a finished example only: one whose frames a copy has not brought yet is made again.
-  if (o.tracks && !o.add_tracks && FramesPresent(fs::path(dir) / name, o.frames, o.frame_ext) &&
+  if (o.tracks && !o.add_tracks && FramesPresent(fs::path(dir) / name, o.frames, FramePattern(o.frame_ext)) &&
       !fs::exists(fs::path(dir) / name / "tracks.json"))
     throw std::runtime_error((fs::path(dir) / name).string() +
                              " has no tracks.json, and this run makes tracks (give the examples theirs with "
@@ -820,7 +812,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   auto view_done = [&](int64_t i, int v) {
     if (!o.add_tracks)
       return has(i, v, "label.json") &&
-             FramesPresent(fs::path(o.out) / ExampleName(o.kind, i, v), o.frames, o.frame_ext);
+             FramesPresent(fs::path(o.out) / ExampleName(o.kind, i, v), o.frames, FramePattern(o.frame_ext));
     return !has(i, v, "label.json") ||
            TracksHaveWorld(fs::path(o.out) / ExampleName(o.kind, i, v) / "tracks.json", *o.tracks);
   };

@@ -46,7 +46,7 @@ nlohmann::json SimExampleLabel(const std::string& name, const SimulationSample& 
   j["width"] = zeta.width;
   j["height"] = zeta.height;
   j["encoding"] = info.frame_ext == "pgm" ? "mono8" : "rgb8";
-  j["frame_pattern"] = "%03d." + info.frame_ext;
+  j["frame_pattern"] = FramePattern(info.frame_ext);
   j["wind_speed"] = s.theta[sim::kWindSpeedIndex];
   j["theta"] = theta;
   j["theta_names"] = names;
@@ -180,7 +180,7 @@ void CheckLabelAgainstSettings(const std::string& path, const nlohmann::json& la
       {"width", field(label, "width"), field(settings, "size")},
       {"height", field(label, "height"), field(settings, "size")},
       {"frame_pattern", field(label, "frame_pattern"),
-       format.is_string() ? nlohmann::json("%03d." + format.get<std::string>()) : nlohmann::json()},
+       format.is_string() ? nlohmann::json(FramePattern(format.get<std::string>())) : nlohmann::json()},
       {"generator.version", field(field(label, "generator"), "version"), field(settings, "generator_version")},
   };
   for (const auto& [name, got, header] : pairs)
@@ -219,12 +219,9 @@ void CheckLabelAgainstSettings(const std::string& path, const nlohmann::json& la
 
 }  // namespace
 
-namespace {
+std::string FramePattern(const std::string& ext) { return "%03d." + ext; }
 
-// Whether every frame `label` (checked by ReadLabel: a valid pattern) names is in `folder`.
-bool LabelledFramesPresent(const fs::path& folder, const nlohmann::json& label) {
-  const std::string pattern = label["frame_pattern"].get<std::string>();
-  const int64_t frames = label["num_frames"].get<int64_t>();
+bool FramesPresent(const fs::path& folder, int64_t frames, const std::string& pattern) {
   std::vector<char> name(pattern.size() + 32);
   for (int64_t k = 0; k < frames; ++k) {
     std::snprintf(name.data(), name.size(), pattern.c_str(), static_cast<int>(k));
@@ -232,8 +229,6 @@ bool LabelledFramesPresent(const fs::path& folder, const nlohmann::json& label) 
   }
   return true;
 }
-
-}  // namespace
 
 nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
                           const std::function<void(int, int)>& progress, std::vector<std::string>* incomplete,
@@ -261,25 +256,21 @@ nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
     // stopped run, which is what the reindex is for.
     // A generator run (beyond_count given) leaves such folders out instead: it checked only the
     // simulations of its --count against its settings, and a raised count refused its next run.
-    const nlohmann::json simulation = label.value("simulation", nlohmann::json());
-    if (header.is_object() && header.contains("count") && header["count"].is_number_integer() &&
-        simulation.is_number_integer() && simulation.get<int64_t>() >= header["count"].get<int64_t>()) {
-      if (beyond_count) {
-        beyond_count->push_back(name);
-        if (progress) progress(static_cast<int>(clips.size()), static_cast<int>(names.size()));
-        continue;
-      }
-      header["count"] = simulation.get<int64_t>() + 1;
-    }
     // Frames missing (a copy not finished, a frame deleted): not listed, as the generator makes
-    // such an example again; a reader of the index would fail on it.
-    if (label.contains("num_frames") && label.contains("frame_pattern") &&
-        !LabelledFramesPresent(fs::path(dir) / name, label)) {
-      if (incomplete) incomplete->push_back(name);
-      if (progress) progress(static_cast<int>(clips.size()), static_cast<int>(names.size()));
-      continue;
+    // such an example again; a reader of the index would fail on it. (ReadLabel checked both
+    // fields: a whole count and a valid pattern.)
+    const nlohmann::json simulation = label.value("simulation", nlohmann::json());
+    const bool beyond = header.is_object() && header.contains("count") && header["count"].is_number_integer() &&
+                        simulation.is_number_integer() && simulation.get<int64_t>() >= header["count"].get<int64_t>();
+    if (beyond && beyond_count) {
+      beyond_count->push_back(name);
+    } else {
+      if (beyond) header["count"] = simulation.get<int64_t>() + 1;
+      if (FramesPresent(fs::path(dir) / name, label["num_frames"].get<int64_t>(), label["frame_pattern"].get<std::string>()))
+        clips.push_back(IndexEntry(label));
+      else if (incomplete)
+        incomplete->push_back(name);
     }
-    clips.push_back(IndexEntry(label));
     if (progress) progress(static_cast<int>(clips.size()), static_cast<int>(names.size()));
   }
   header["clips"] = clips;

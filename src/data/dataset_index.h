@@ -1,6 +1,7 @@
 #ifndef CLOTHWIND_DATA_DATASET_INDEX_H_
 #define CLOTHWIND_DATA_DATASET_INDEX_H_
 
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -61,6 +62,19 @@ render::RenderParams LabelZeta(const nlohmann::json& label);
 // The index entry of a label: name, wind_speed, split, and for simulated examples seed,
 // simulation, view, area_weight, fabric.
 nlohmann::json IndexEntry(const nlohmann::json& label);
+
+// The frame file pattern of a generated example whose frames are .<ext> files: "%03d.<ext>",
+// label.json's frame_pattern.
+std::string FramePattern(const std::string& ext);
+
+// Whether an example folder holds all its frames: an interrupted copy (cp goes in the folder's
+// hashed order, so label.json can come before 047.jpg) leaves a label beside missing frames.
+// Inputs:
+//   folder   the example's folder
+//   frames   how many (0 .. frames-1)
+//   pattern  the frame file pattern, label.json's frame_pattern (a valid one: ValidFramePattern)
+// Returns false at the first frame file that is not there.
+bool FramesPresent(const std::filesystem::path& folder, int64_t frames, const std::string& pattern);
 
 // Rebuilds index.json of `dir` from the example folders present (every non-hidden subfolder
 // with a label.json), sorted by name, so that any set of runs (shards, resumed runs) that left
