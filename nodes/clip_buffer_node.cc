@@ -16,6 +16,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <chrono>
 #include <vector>
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -132,23 +133,40 @@ class ClipBufferNode {
 
   // Labels and records whatever is still waiting (called on shutdown; nothing is published then).
   // The last clips wait for room in the writer's queue (a full queue of a slow disk dropped them
-  // with no report after), and the recording's tally is said at the end.
+  // with no report after), for kShutdownBudget s at most: roslaunch sends SIGTERM 15 s after
+  // Ctrl-C and SIGKILL 2 s later, and a kill mid-way lost the clips on disk since the last
+  // index rewrite with no word (the writer now lists each clip as it lands). Clips given up are
+  // named, and the tally, with the last write or index error, is said at the end.
   void Finish() {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (const auto& c : pipeline_->Flush()) Record(c, /*wait_for_room=*/true);
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                               std::chrono::duration<double>(kShutdownBudget));
+    std::vector<std::string> abandoned;
+    const auto waiting = pipeline_->Flush();
+    if (writer_ && (!waiting.empty() || writer_->stats().queued > 0))
+      ROS_INFO("clip_buffer: recording the last %zu clips into %s (at most %.0f s)",
+               waiting.size() + writer_->stats().queued, writer_->root().c_str(), kShutdownBudget);
+    for (const auto& c : waiting) Record(c, deadline, &abandoned);
     if (!writer_) {
       if (not_recorded_ > 0)
         ROS_WARN("clip_buffer: %llu clips not recorded (no recording folder open: %s)",
                  static_cast<unsigned long long>(not_recorded_), recording_error_.c_str());
       return;
     }
-    writer_->Drain();
+    writer_->DrainBy(deadline, &abandoned);
     const auto s = writer_->stats();
+    if (!abandoned.empty())
+      ROS_ERROR("clip_buffer: %zu clips not recorded: the disk did not write them within %.0f s of shutdown "
+                "(roslaunch kills a node 17 s after Ctrl-C): %s",
+                abandoned.size(), kShutdownBudget, JoinNames(abandoned).c_str());
+    if (s.failed > 0) ROS_ERROR("clip_buffer: last failed clip write: %s", s.last_error.c_str());
+    if (!s.index_error.empty()) ROS_ERROR("clip_buffer: index.json not rewritten: %s", s.index_error.c_str());
     ROS_INFO("clip_buffer: recording into %s ends: %llu clips written, %llu failed, %llu dropped (queue full), "
-             "%llu not recorded (no folder open)",
+             "%zu given up at shutdown, %llu not recorded (no folder open)",
              writer_->root().c_str(), static_cast<unsigned long long>(s.written),
              static_cast<unsigned long long>(s.failed), static_cast<unsigned long long>(s.dropped),
-             static_cast<unsigned long long>(not_recorded_));
+             abandoned.size(), static_cast<unsigned long long>(not_recorded_));
   }
 
  private:
@@ -297,7 +315,7 @@ class ClipBufferNode {
 
   static constexpr double kLatestStamp = 4294967295.0 - 3600.0;  // [s] ROS time's end, less an hour
 
-  void Record(const sensors::LabelledClip& c, bool wait_for_room = false) {
+  void Record(const sensors::LabelledClip& c) {
     if (record_dir_.empty()) return;
     if (!writer_) {
       ++not_recorded_;
@@ -305,7 +323,32 @@ class ClipBufferNode {
     }
     source_.frame_id = frame_id_;
     source_.wind_frame_id = wind_frame_.frame_id();
-    writer_->Enqueue(c, source_, wait_for_room);  // a full queue is counted by the writer, reported by OnTimer
+    writer_->Enqueue(c, source_);  // a full queue is counted by the writer, reported by OnTimer
+  }
+
+  // At shutdown: waits for room in the queue until `deadline`; a clip that finds none is named in
+  // *abandoned.
+  void Record(const sensors::LabelledClip& c, std::chrono::steady_clock::time_point deadline,
+              std::vector<std::string>* abandoned) {
+    if (record_dir_.empty()) return;
+    if (!writer_) {
+      ++not_recorded_;
+      return;
+    }
+    source_.frame_id = frame_id_;
+    source_.wind_frame_id = wind_frame_.frame_id();
+    if (!writer_->Enqueue(c, source_, deadline) && !c.clip.frames.empty())
+      abandoned->push_back(sensors::ClipFolderName(c.clip.frames.front().stamp));
+  }
+
+  // "a, b, c" or "a, b, ... (n more), z": the log line stays readable with hundreds of clips.
+  static std::string JoinNames(const std::vector<std::string>& names) {
+    std::string out;
+    const size_t shown = names.size() <= 6 ? names.size() : 4;
+    for (size_t i = 0; i < shown; ++i) out += (i ? ", " : "") + names[i];
+    if (shown < names.size())
+      out += ", ... (" + std::to_string(names.size() - shown - 1) + " more), " + names.back();
+    return out;
   }
 
   // The clock to check stamps against; none while simulated time has not started.
@@ -401,6 +444,7 @@ class ClipBufferNode {
 
   static constexpr double kErrorHold = 10.0;   // [s] wall
   static constexpr double kReopenEvery = 10.0; // [s] wall
+  static constexpr double kShutdownBudget = 12.0;  // [s] wall, within roslaunch's 15 s before SIGTERM
   static constexpr size_t kRecordQueue = 16;   // clips (16 x 30 x 300^2 B = 43 MB of mono8 at most)
 
   ros::NodeHandle nh_;

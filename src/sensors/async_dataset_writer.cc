@@ -41,11 +41,46 @@ bool AsyncDatasetWriter::Enqueue(LabelledClip clip, ClipSourceInfo source, bool 
   return true;
 }
 
+bool AsyncDatasetWriter::Enqueue(LabelledClip clip, ClipSourceInfo source,
+                                 std::chrono::steady_clock::time_point room_deadline) {
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    room_.wait_until(lock, room_deadline, [this] { return queue_.size() < max_queue_ || stop_; });
+    if (queue_.size() >= max_queue_) {
+      ++stats_.dropped;
+      return false;
+    }
+    queue_.emplace_back(std::move(clip), std::move(source));
+  }
+  wake_.notify_one();
+  return true;
+}
+
 void AsyncDatasetWriter::Drain() {
   std::unique_lock<std::mutex> lock(mutex_);
   flush_requested_ = true;
   wake_.notify_one();
   idle_.wait(lock, [this] { return queue_.empty() && !busy_ && !flush_requested_ && !flushing_; });
+}
+
+bool AsyncDatasetWriter::DrainBy(std::chrono::steady_clock::time_point deadline,
+                                 std::vector<std::string>* abandoned) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  list_each_clip_ = true;
+  flush_first_ = true;
+  flush_requested_ = true;
+  wake_.notify_one();
+  auto done = [this] { return queue_.empty() && !busy_ && !flush_requested_ && !flush_first_ && !flushing_; };
+  if (idle_.wait_until(lock, deadline, done)) return true;
+  for (const auto& item : queue_) {
+    ++stats_.abandoned;
+    if (abandoned)
+      abandoned->push_back(item.first.clip.frames.empty() ? "(a clip with no frames)"
+                                                          : ClipFolderName(item.first.clip.frames.front().stamp));
+  }
+  queue_.clear();
+  room_.notify_all();
+  return false;
 }
 
 void AsyncDatasetWriter::RequestIndexFlush() {
@@ -82,7 +117,7 @@ void AsyncDatasetWriter::FlushIndex(std::unique_lock<std::mutex>* lock) {
 void AsyncDatasetWriter::Run() {
   std::unique_lock<std::mutex> lock(mutex_);
   const auto interval = std::chrono::duration<double>(writer_->index_interval());
-  auto has_work = [this] { return stop_ || flush_requested_ || !queue_.empty(); };
+  auto has_work = [this] { return stop_ || flush_requested_ || flush_first_ || !queue_.empty(); };
   for (;;) {
     // Clips waiting to be listed: wake after the interval even if nothing else comes.
     if (stats_.unlisted > 0 && interval.count() > 0) {
@@ -92,6 +127,12 @@ void AsyncDatasetWriter::Run() {
       }
     } else {
       wake_.wait(lock, has_work);
+    }
+    if (flush_first_) {  // DrainBy: what is on disk listed before the next clip
+      flush_first_ = false;
+      FlushIndex(&lock);
+      idle_.notify_all();
+      continue;
     }
     if (queue_.empty()) {  // stop_ or a flush asked for, and nothing left to write
       // Cleared before the rewrite, so a request made while it runs (FlushIndex unlocks) is
@@ -124,6 +165,7 @@ void AsyncDatasetWriter::Run() {
     stats_.max_write_s = std::max(stats_.max_write_s, seconds);
     if (error.empty()) {
       ++stats_.written;
+      if (list_each_clip_) FlushIndex(&lock);
     } else {
       ++stats_.failed;
       stats_.last_error = error;

@@ -1,6 +1,7 @@
 #ifndef CLOTHWIND_SENSORS_ASYNC_DATASET_WRITER_H_
 #define CLOTHWIND_SENSORS_ASYNC_DATASET_WRITER_H_
 
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -9,6 +10,7 @@
 #include <string>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "sensors/dataset_writer.h"
 
@@ -24,6 +26,7 @@ class AsyncDatasetWriter {
     uint64_t written = 0;          // clips recorded
     uint64_t failed = 0;           // clips DatasetWriter::Write refused (last_error says why)
     uint64_t dropped = 0;          // clips not queued: the queue was full
+    uint64_t abandoned = 0;        // clips queued but not recorded: DrainBy's deadline came first
     size_t queued = 0;             // clips waiting now
     double last_write_s = 0.0;     // wall time the last write took [s]
     double max_write_s = 0.0;      // the longest write so far [s]
@@ -50,10 +53,22 @@ class AsyncDatasetWriter {
   // the thread to take a clip instead: for the last clips at shutdown, which a full queue of a
   // slow disk dropped without a word (no report came after them).
   bool Enqueue(LabelledClip clip, ClipSourceInfo source, bool wait_for_room = false);
+  // The same, waiting for room until `room_deadline` at most (then counted in dropped).
+  bool Enqueue(LabelledClip clip, ClipSourceInfo source, std::chrono::steady_clock::time_point room_deadline);
 
   // Blocks until every queued clip is recorded (or failed) and index.json lists them (or its
   // rewrite failed: stats().index_error).
   void Drain();
+  // Drain for a shutdown that may be cut short (roslaunch kills a node 17 s after Ctrl-C): the
+  // index is rewritten before the next clip and after each one, so whatever is on disk when the
+  // process dies is listed; clips still queued at `deadline` are not recorded.
+  // Inputs:
+  //   deadline   when to give up on the clips still queued
+  // Outputs:
+  //   abandoned  (appended) folder names of the clips given up, for the log; may be null
+  // Returns true when every queued clip was recorded (or failed) and listed by the deadline. On
+  // false a clip being written at the deadline is still finished by the thread (and listed).
+  bool DrainBy(std::chrono::steady_clock::time_point deadline, std::vector<std::string>* abandoned);
 
   // Asks the thread to rewrite index.json once the clips queued now are written (if any clip is
   // unlisted then); returns at once.
@@ -75,6 +90,8 @@ class AsyncDatasetWriter {
   std::condition_variable wake_, idle_, room_;
   std::deque<std::pair<LabelledClip, ClipSourceInfo>> queue_;
   bool busy_ = false, stop_ = false, flush_requested_ = false, flushing_ = false;
+  bool list_each_clip_ = false;  // DrainBy: rewrite the index before the next clip and after each
+  bool flush_first_ = false;     // DrainBy: rewrite it before the next clip
   // Rewrites the index now if clips are unlisted (thread only, mutex not held); updates stats_.
   void FlushIndex(std::unique_lock<std::mutex>* lock);
   Stats stats_;

@@ -1,7 +1,10 @@
 #include "sensors/async_dataset_writer.h"
 
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <chrono>
 #include <fstream>
@@ -32,6 +35,7 @@ class AsyncDatasetWriterTest : public ::testing::Test {
   }
 
   size_t IndexSize() const {
+    if (!fs::exists(root_ / "index.json")) return 0;  // no clip written yet
     std::ifstream in(root_ / "index.json");
     return nlohmann::json::parse(in)["clips"].size();
   }
@@ -136,6 +140,82 @@ TEST_F(AsyncDatasetWriterTest, DrainListsAClipWrittenWhileAnIndexRewriteRan) {
     w.Drain();
     ASSERT_EQ(IndexSize(), k + 1) << "clip " << k;
   }
+}
+
+TEST_F(AsyncDatasetWriterTest, DrainByRecordsAndListsEverythingBeforeItsDeadline) {
+  AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string(), 95, 3600.0), 16);
+  for (uint64_t k = 0; k < 5; ++k) ASSERT_TRUE(w.Enqueue(MakeClip(k), {}));
+  std::vector<std::string> abandoned;
+  EXPECT_TRUE(w.DrainBy(std::chrono::steady_clock::now() + std::chrono::seconds(60), &abandoned));
+  EXPECT_TRUE(abandoned.empty());
+  EXPECT_EQ(w.stats().written, 5u);
+  EXPECT_EQ(w.stats().abandoned, 0u);
+  EXPECT_EQ(IndexSize(), 5u);
+}
+
+// A shutdown whose deadline comes before the disk is done: the clips still queued are given up
+// and named (roslaunch's SIGKILL would take them anyway, unnamed), and every clip that did land
+// is listed: the clips written, the given up, and the folders on disk add up.
+TEST_F(AsyncDatasetWriterTest, DrainByGivesUpWhatIsQueuedAtItsDeadlineAndNamesIt) {
+  std::vector<std::string> abandoned;
+  {
+    AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string(), 95, 3600.0), 16);
+    // 16 clips queue in microseconds; each takes milliseconds (30 fsync'ed JPEGs).
+    for (uint64_t k = 0; k < 16; ++k) ASSERT_TRUE(w.Enqueue(MakeClip(k), {}));
+    EXPECT_FALSE(w.DrainBy(std::chrono::steady_clock::now(), &abandoned));
+    EXPECT_EQ(w.stats().abandoned, abandoned.size());
+  }
+  ASSERT_FALSE(abandoned.empty());
+  size_t on_disk = 0;
+  for (uint64_t k = 0; k < 16; ++k) {
+    const std::string name = ClipFolderName(1700000000.0 + 1.2 * static_cast<double>(k));
+    const bool given_up = std::find(abandoned.begin(), abandoned.end(), name) != abandoned.end();
+    EXPECT_NE(fs::exists(root_ / name), given_up) << name;
+    on_disk += given_up ? 0 : 1;
+  }
+  EXPECT_EQ(on_disk + abandoned.size(), 16u);
+  EXPECT_EQ(IndexSize(), on_disk);
+}
+
+// A shutdown drain killed mid-way (roslaunch's SIGKILL 17 s after Ctrl-C, a slow card): every
+// clip folder on disk is listed, bar the one whose folder landed just before the kill. Before
+// DrainBy listed each clip, the index kept only what its interval had let through (here the
+// first clip) and the rest vanished from train and eval, which read the index only.
+TEST_F(AsyncDatasetWriterTest, ADrainKilledMidwayLeavesEveryClipOnDiskListed) {
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {  // the recording process: no gtest assertions here, only its exit or kill
+    AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string(), 95, 3600.0), 64);
+    for (uint64_t k = 0; k < 60; ++k) w.Enqueue(MakeClip(k), {});
+    w.DrainBy(std::chrono::steady_clock::now() + std::chrono::seconds(120), nullptr);
+    ::_exit(0);
+  }
+  auto clips_on_disk = [this] {
+    size_t n = 0;
+    std::error_code ec;
+    for (fs::directory_iterator it(root_, ec), end; !ec && it != end; it.increment(ec))
+      n += it->path().filename().string().rfind("clip-", 0) == 0 ? 1 : 0;
+    return n;
+  };
+  for (int i = 0; i < 4000 && clips_on_disk() < 8; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the drain ended before the kill: too few clips to catch it mid-way";
+  const size_t on_disk = clips_on_disk();
+  ASSERT_GE(on_disk, 8u);
+  EXPECT_GE(IndexSize() + 1, on_disk);
+}
+
+TEST_F(AsyncDatasetWriterTest, EnqueueGivesUpWaitingForRoomAtItsDeadline) {
+  AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string()), 1);
+  int accepted = 0;
+  const auto past = std::chrono::steady_clock::now();
+  for (uint64_t k = 0; k < 20; ++k) accepted += w.Enqueue(MakeClip(k), {}, past) ? 1 : 0;
+  w.Drain();
+  EXPECT_LT(accepted, 20);
+  EXPECT_EQ(w.stats().dropped, 20u - static_cast<uint64_t>(accepted));
+  EXPECT_EQ(w.stats().written, static_cast<uint64_t>(accepted));
 }
 
 TEST_F(AsyncDatasetWriterTest, DestructorRecordsWhatIsQueued) {
