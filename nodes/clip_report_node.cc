@@ -15,6 +15,7 @@
 // writes what it has; a file it cannot write is an error that does not cost the others.
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <limits>
@@ -54,9 +55,13 @@ class ClipReport {
     estimate_wait_ = params.Get("estimate_wait", 60.0);
     max_wall_ = params.Get("max_wall", 0.0);
     start_timeout_ = params.Get("start_timeout", 60.0);
-    summary_path_ = clothwind::ros_bridge::AbsolutePathParam("clip_report: ~summary", params.Get("summary", ""));
+    summary_path_ = clothwind::ros_bridge::OutputFileParam("~summary", params.Get("summary", ""));
     want_estimates_ = params.Get("estimates", false);
-    estimate_plot_path_ = clothwind::ros_bridge::AbsolutePathParam("clip_report: ~estimate_plot", params.Get("estimate_plot", ""));
+    estimate_plot_path_ = clothwind::ros_bridge::OutputFileParam("~estimate_plot", params.Get("estimate_plot", ""));
+    // The plot is of the estimates: without them it was silently not drawn.
+    if (!estimate_plot_path_.empty() && !want_estimates_)
+      throw std::invalid_argument("~estimate_plot " + estimate_plot_path_ +
+                                  " plots the estimates: it needs ~estimates true (replay.launch: model:=)");
     auto finite = [](double v) { return std::isfinite(v); };
     if (!(finite(idle_timeout_) && idle_timeout_ > 0))
       throw std::invalid_argument("~idle_timeout must be a finite time > 0 s, got " + std::to_string(idle_timeout_));
@@ -282,6 +287,9 @@ class ClipReport {
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "clip_report");
+  // SIGTERM (systemd, docker stop, a plain kill) ends the spin like Ctrl-C, so the report is still
+  // printed and its files written rather than lost with the process.
+  std::signal(SIGTERM, [](int) { ros::requestShutdown(); });
   ros::NodeHandle pnh("~");
   clothwind::ros_bridge::StrictParams params(pnh);
   try {

@@ -196,4 +196,17 @@ std::string AbsolutePathParam(const std::string& what, const std::string& value)
   return absolute;
 }
 
+std::string OutputFileParam(const std::string& what, const std::string& value) {
+  const std::string path = AbsolutePathParam(what, value);
+  if (path.empty()) return path;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw std::invalid_argument(what + " '" + path + "' is a folder; expected a file name");
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  if (!std::filesystem::is_directory(folder, ec))
+    throw std::invalid_argument(what + " '" + path + "': its folder " + folder.string() +
+                                (std::filesystem::exists(folder, ec) ? " is not a folder" : " does not exist"));
+  return path;
+}
+
 }  // namespace clothwind::ros_bridge

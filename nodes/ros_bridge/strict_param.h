@@ -60,6 +60,11 @@ T ParamValue(const XmlRpc::XmlRpcValue& v, const std::string& name, std::string*
 // "cannot open runs/x/model.json", and a relative summary went to ROS_HOME while its name was printed.
 std::string AbsolutePathParam(const std::string& what, const std::string& value);
 
+// AbsolutePathParam for a file the node writes when it ends (a report's summary, a plot): throws
+// std::invalid_argument naming `what` when the path is a folder or its folder does not exist, so
+// a mistyped path fails at start rather than after the whole replay, with a temporary name.
+std::string OutputFileParam(const std::string& what, const std::string& value);
+
 // The private parameters among `names` (full names, as ros::param::getParamNames gives them)
 // that lie under `private_ns` ("/clip_buffer") and whose first key below it is not in `asked`.
 // Returns each such key once, sorted, as "~key" ("/clip_buffer/rate/x" gives "~rate").

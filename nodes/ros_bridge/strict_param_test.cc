@@ -2,7 +2,10 @@
 // reading of a wrong-typed parameter end to end is tests/node_params.test.
 #include "ros_bridge/strict_param.h"
 
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -109,6 +112,28 @@ TEST(StrictParamTest, UnreadParamsAreTheNodesOwnKeysNotAskedFor) {
 }
 
 }  // namespace
+TEST(OutputFileParamTest, AFolderOrAMissingFolderIsRefusedNamingTheParameter) {
+  const std::string tmp = std::filesystem::temp_directory_path().string();
+  EXPECT_EQ(OutputFileParam("~summary", tmp + "/summary.json"), tmp + "/summary.json");
+  EXPECT_EQ(OutputFileParam("~summary", ""), "");
+  auto message = [](const std::string& value) {
+    try {
+      OutputFileParam("~summary", value);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  EXPECT_NE(message(tmp).find("~summary '" + tmp + "' is a folder"), std::string::npos) << message(tmp);
+  const std::string missing = tmp + "/clothwind-no-such-folder-" + std::to_string(::getpid()) + "/s.json";
+  EXPECT_NE(message(missing).find("does not exist"), std::string::npos) << message(missing);
+  EXPECT_NE(message(missing).find("~summary"), std::string::npos) << message(missing);
+  const std::string file = tmp + "/clothwind-output-param-" + std::to_string(::getpid());
+  std::ofstream(file) << "x";
+  EXPECT_NE(message(file + "/s.json").find("is not a folder"), std::string::npos) << message(file + "/s.json");
+  std::filesystem::remove(file);
+}
+
 TEST(AbsolutePathParamTest, ARelativePathIsMadeAbsoluteFromTheWorkingFolder) {
   const std::string cwd = std::filesystem::current_path().string();
   EXPECT_EQ(AbsolutePathParam("node: ~model", "runs/x/../y/model.pt"), cwd + "/runs/y/model.pt");

@@ -299,13 +299,19 @@ class MonitorNodesTest(unittest.TestCase):
         self.assertIn("no anemometer reading in the mean window", status.message)  # still WARN for that
         self.assertEqual(values["messages stamped 0 dropped"], "2")
 
-        # The report ends after max_wall (30 s; wall time never idles) and writes its summary
-        # although the plot's path lies under a file.
+        # The report ends after max_wall (30 s; wall time never idles) and writes its summary and
+        # its plot.
         summary = rospy.get_param("~summary")
+        plot = rospy.get_param("~estimate_plot")
         deadline = time.time() + 45
         while time.time() < deadline and not os.path.exists(summary):
             time.sleep(0.2)
         self.assertTrue(os.path.exists(summary), "no summary written")
+        deadline = time.time() + 10
+        while time.time() < deadline and not os.path.exists(plot):
+            time.sleep(0.2)
+        self.assertTrue(os.path.exists(plot), "no plot written")
+        os.remove(plot)
         with open(summary) as f:
             j = json.load(f)
         # The one stamped 0 is compared (it has no time, not no label), 47 m/s off.

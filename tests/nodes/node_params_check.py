@@ -19,7 +19,7 @@ import roslib.packages
 import rospy
 import rostest
 import yaml
-from clothwind.msg import WindMeasurement
+from clothwind.msg import Clip, WindMeasurement
 from sensor_msgs.msg import Image
 
 WIDTH, HEIGHT = 64, 48
@@ -154,6 +154,40 @@ class NodeParamsTest(unittest.TestCase):
             self.assertEqual(status, 1, "%s did not end on a bad parameter; it said:\n%s" % (node, s.output()))
             self.assertIn(message, s.output(), node)
             self.assertIn("FATAL", s.output(), node)
+
+    # The report's output files are checked at start: a mistyped folder failed only after the whole
+    # replay, naming a temporary file; a plot asked for without estimates was silently not drawn.
+    def test_the_report_refuses_output_paths_it_cannot_write_at_start(self):
+        cases = [
+            ({"summary": os.path.join(self.folder, "no-such-folder", "s.json")}, "~summary"),
+            ({"summary": self.folder}, "is a folder; expected a file name"),
+            ({"estimate_plot": os.path.join(self.folder, "p.png")}, "it needs ~estimates true"),
+        ]
+        for i, (params, message) in enumerate(cases):
+            name = "/bad_report_%d" % i
+            for key, value in params.items():
+                rospy.set_param(name + "/" + key, value)
+            s = self.spawn("clip_report_node", ["__name:=" + name.lstrip("/")], cwd=self.folder)
+            status = s.wait(30)
+            s.reader.join(5)
+            self.assertEqual(status, 1, "clip_report %s did not end; it said:\n%s" % (params, s.output()))
+            self.assertIn(message, s.output(), params)
+            self.assertIn("FATAL", s.output(), params)
+
+    # SIGTERM (systemd, docker stop, kill) ends the report as Ctrl-C does: printed and written.
+    def test_the_report_writes_its_summary_on_sigterm(self):
+        summary = os.path.join(self.folder, "summary.json")
+        rospy.set_param("/term_report/summary", summary)
+        s = self.spawn("clip_report_node", ["__name:=term_report"], cwd=self.folder)
+        clips = rospy.Publisher("/clips", Clip, queue_size=1)
+        deadline = time.time() + 20
+        while time.time() < deadline and clips.get_num_connections() == 0:
+            time.sleep(0.1)
+        self.assertGreater(clips.get_num_connections(), 0, s.output())  # up and spinning
+        s.process.send_signal(signal.SIGTERM)
+        status = s.wait(30)
+        self.assertEqual(status, 0, s.output())
+        self.assertTrue(os.path.exists(summary), "no summary on SIGTERM; it said:\n%s" % s.output())
 
     # A misspelt key is named at start, not silently left to its default.
     def test_a_parameter_the_node_does_not_read_is_named(self):
