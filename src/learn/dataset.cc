@@ -39,22 +39,26 @@ nlohmann::json ReadJson(const fs::path& path) {
 
 namespace {
 
+// j[key] as T. Throws std::runtime_error naming the file, the field (after `where`, e.g.
+// "clips[5].": which of thousands of index entries) and what was expected.
 template <typename T>
-T Field(const nlohmann::json& j, const char* key, const fs::path& file, const char* expected) {
+T Field(const nlohmann::json& j, const char* key, const fs::path& file, const char* expected,
+        const std::string& where = "") {
   if (!j.is_object() || !j.contains(key)) {
-    throw std::runtime_error(file.string() + ": missing field \"" + key + "\" (" + expected + ")");
+    throw std::runtime_error(file.string() + ": missing field \"" + where + key + "\" (" + expected + ")");
   }
   if constexpr (std::is_integral_v<T>) {
     // get<int> truncates 30.7 and wraps 4294967326 to 30: an integer in range or an error.
     const nlohmann::json& v = j.at(key);
     if (!v.is_number_integer() || v.get<int64_t>() < std::numeric_limits<T>::min() ||
         v.get<int64_t>() > std::numeric_limits<T>::max())
-      throw std::runtime_error(file.string() + ": field \"" + key + "\" must be " + expected + ", got " + v.dump());
+      throw std::runtime_error(file.string() + ": field \"" + where + key + "\" must be " + expected + ", got " +
+                               v.dump());
   }
   try {
     return j.at(key).get<T>();
   } catch (const nlohmann::json::exception&) {
-    throw std::runtime_error(file.string() + ": field \"" + key + "\" must be " + expected +
+    throw std::runtime_error(file.string() + ": field \"" + where + key + "\" must be " + expected +
                              ", got " + j.at(key).dump());
   }
 }
@@ -72,7 +76,8 @@ std::string FrameName(const ClipInfo& clip, int index) {
 std::string ReadClipSplit(const nlohmann::json& entry, const nlohmann::json& label, size_t i,
                           const fs::path& index_path, const fs::path& label_path, bool split_by_clip) {
   const std::string split =
-      entry.contains("split")   ? Field<std::string>(entry, "split", index_path, "\"train\", \"val\" or \"test\"")
+      entry.contains("split")   ? Field<std::string>(entry, "split", index_path, "\"train\", \"val\" or \"test\"",
+                                                     "clips[" + std::to_string(i) + "].")
       : label.contains("split") ? Field<std::string>(label, "split", label_path, "\"train\", \"val\" or \"test\"")
                                 : std::string("train");
   if (split != "train" && split != "val" && split != "test") {
@@ -118,7 +123,8 @@ Dataset ReadDataset(const fs::path& dir) {
   for (size_t i = 0; i < index["clips"].size(); ++i) {
     const nlohmann::json& entry = index["clips"][i];
     ClipInfo clip;
-    clip.name = Field<std::string>(entry, "name", index_path, "a string");
+    const std::string where = "clips[" + std::to_string(i) + "].";
+    clip.name = Field<std::string>(entry, "name", index_path, "a string", where);
     if (!ValidClipName(clip.name)) {
       throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
                                "].name must be a folder name, got \"" + clip.name + "\"");
@@ -130,7 +136,7 @@ Dataset ReadDataset(const fs::path& dir) {
     }
     clip.dir = dir / clip.name;
     if (entry.contains("simulation")) {
-      clip.simulation = Field<int>(entry, "simulation", index_path, "a simulation index >= 0");
+      clip.simulation = Field<int>(entry, "simulation", index_path, "a simulation index >= 0", where);
       if (clip.simulation < 0) {
         throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) +
                                  "].simulation must be >= 0, got " + std::to_string(clip.simulation));
@@ -175,7 +181,7 @@ Dataset ReadDataset(const fs::path& dir) {
     // mean one file was edited or belongs to another dataset, and which one the scores used
     // would be a guess.
     if (entry.contains("wind_speed")) {
-      const double listed = Field<double>(entry, "wind_speed", index_path, "a number [m/s]");
+      const double listed = Field<double>(entry, "wind_speed", index_path, "a number [m/s]", where);
       if (!(std::abs(listed - clip.wind_speed) <= 1e-6 * std::max(1.0, std::abs(clip.wind_speed)))) {
         throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) + "].wind_speed is " +
                                  std::to_string(listed) + " m/s but " + label_path.string() + " says " +

@@ -59,6 +59,27 @@ void EditJson(const fs::path& file, const std::function<void(nlohmann::json&)>& 
   std::ofstream(file) << j.dump();
 }
 
+// An index entry's field error says which of its (thousands of) entries: "missing field
+// \"name\"" alone left the user to search the file.
+TEST_F(DatasetTest, AnIndexEntrysFieldErrorNamesTheEntry) {
+  const fs::path bad = Copy("entry_field");
+  EditJson(bad / "index.json", [](nlohmann::json& j) { j["clips"][5].erase("name"); });
+  try {
+    ReadDataset(bad);
+    FAIL() << "an entry without a name was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("index.json: missing field \"clips[5].name\""));
+  }
+  const fs::path wrong = Copy("entry_type");
+  EditJson(wrong / "index.json", [](nlohmann::json& j) { j["clips"][3]["wind_speed"] = "3.1"; });
+  try {
+    ReadDataset(wrong);
+    FAIL() << "a wind speed given as text was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("field \"clips[3].wind_speed\" must be a number [m/s], got \"3.1\""));
+  }
+}
+
 TEST_F(DatasetTest, ReadsIndexLabelsAndFrames) {
   const Dataset d = ReadDataset(*dir_);
   ASSERT_EQ(d.clips.size(), 10u);

@@ -7,6 +7,7 @@
 #include <limits>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 #include <unistd.h>
@@ -266,26 +267,28 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
     throw std::runtime_error(where + ": field \"arch\" must be \"sdn\", \"resnet18\" or \"lstm\", got \"" +
                              c.arch + "\"");
   }
-  if (c.frames < 1 || c.channels < 1 || c.width < 1 || c.input_size < 16 || c.k < 1 ||
-      !(c.frame_rate > 0) || !(c.label_std > 0) || !(c.std_scale > 0)) {
-    throw std::runtime_error(where + ": frames, channels, width, k must be >= 1, input_size >= 16, "
-                             "frame_rate, label_std and std_scale > 0");
-  }
-  // Upper bounds far above any model here, so a typo fails here and not as an allocation of
-  // terabytes (width 100000 asked for 360 GB).
-  if (c.frames > 1000 || c.width > 512 || c.input_size > 1024 || c.k > 64 || c.flow_size > 1024 ||
-      c.dft_size > 100000 || c.aux_outputs > 100000 || c.point_maps > 10000 ||
-      !(c.frame_rate <= 1000) || !std::isfinite(c.label_mean) || !std::isfinite(c.label_std) ||
-      !std::isfinite(c.std_scale)) {
-    throw std::runtime_error(where + ": expected frames <= 1000, width <= 512, input_size <= 1024, k <= 64, "
-                             "flow_size <= 1024, dft_size <= 100000, aux_outputs <= 100000, point_maps <= 10000, "
-                             "frame_rate <= 1000 and finite label_mean, label_std, std_scale; "
-                             "got frames " + std::to_string(c.frames) + ", width " + std::to_string(c.width) +
-                             ", input_size " + std::to_string(c.input_size) + ", k " + std::to_string(c.k) +
-                             ", flow_size " + std::to_string(c.flow_size) + ", dft_size " + std::to_string(c.dft_size) +
-                             ", aux_outputs " + std::to_string(c.aux_outputs) + ", point_maps " +
-                             std::to_string(c.point_maps));
-  }
+  // Each field in its range, named with its value when not. The upper bounds lie far above any
+  // model here, so a typo fails here and not as an allocation of terabytes (width 100000 asked
+  // for 360 GB).
+  auto check = [&where](const char* field, double value, bool ok, const char* expected) {
+    if (ok) return;
+    std::ostringstream got;
+    got << std::setprecision(15) << value;  // counts in full (2147483647, not 2.14748e+09)
+    throw std::runtime_error(where + ": field \"" + field + "\" must be " + expected + ", got " + got.str());
+  };
+  check("frames", c.frames, c.frames >= 1 && c.frames <= 1000, "in 1..1000");
+  check("channels", c.channels, c.channels >= 1, ">= 1");
+  check("width", c.width, c.width >= 1 && c.width <= 512, "in 1..512");
+  check("input_size", c.input_size, c.input_size >= 16 && c.input_size <= 1024, "in 16..1024");
+  check("k", c.k, c.k >= 1 && c.k <= 64, "in 1..64");
+  check("flow_size", c.flow_size, c.flow_size <= 1024, "<= 1024");
+  check("dft_size", c.dft_size, c.dft_size <= 100000, "<= 100000");
+  check("aux_outputs", c.aux_outputs, c.aux_outputs <= 100000, "<= 100000");
+  check("point_maps", c.point_maps, c.point_maps <= 10000, "<= 10000");
+  check("frame_rate", c.frame_rate, c.frame_rate > 0 && c.frame_rate <= 1000, "in (0, 1000] Hz");
+  check("label_mean", c.label_mean, std::isfinite(c.label_mean), "finite [m/s]");
+  check("label_std", c.label_std, std::isfinite(c.label_std) && c.label_std > 0, "finite and > 0 [m/s]");
+  check("std_scale", c.std_scale, std::isfinite(c.std_scale) && c.std_scale > 0, "finite and > 0");
   if (const std::string field = c.SpectralOptionOffSdn(); !field.empty()) {
     throw std::runtime_error(where + ": field \"" + field + "\" is an option of the spectral layer, which \"arch\" \"" +
                              c.arch + "\" does not have");

@@ -445,7 +445,20 @@ TEST(WindNet, OnlyTheMeanMapSeesAStillPose) {
   EXPECT_DOUBLE_EQ(ModelConfigFromJson(old, "x.json").std_scale, 1.0);
   nlohmann::json bad = ToJson(c);
   bad["std_scale"] = 0.0;
-  EXPECT_THROW(ModelConfigFromJson(bad, "x.json"), std::runtime_error);
+  ExpectFieldRefused(bad, "std_scale", " must be finite and > 0, got 0");
+  // Each field out of range is named with its value (one message listed them all, naming none).
+  for (const auto& [field, value, saying] : std::vector<std::tuple<std::string, double, std::string>>{
+           {"label_std", 0.0, " must be finite and > 0 [m/s], got 0"},
+           {"frame_rate", 0.0, " must be in (0, 1000] Hz, got 0"},
+           {"frames", 0, " must be in 1..1000, got 0"},
+           {"width", 100000, " must be in 1..512, got 100000"},
+           {"input_size", 8, " must be in 16..1024, got 8"},
+           {"k", 65, " must be in 1..64, got 65"}}) {
+    nlohmann::json j = ToJson(c);
+    j[field] = value;
+    if (field != "label_std" && field != "frame_rate") j[field] = static_cast<int>(value);
+    ExpectFieldRefused(j, field, saying);
+  }
 }
 
 TEST(WindNet, FrameChannelsAreTheWindowsOwnFramesAfterTheSpectra) {
@@ -765,8 +778,9 @@ TEST(ModelConfig, CountsThatWouldAllocateTerabytesAreRefusedNamingTheFile) {
       ModelConfigFromJson(j, "m.json");
       ADD_FAILURE() << key << " = " << value << " was accepted";
     } catch (const std::runtime_error& e) {
-      EXPECT_NE(std::string(e.what()).find("m.json: expected"), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(key + " <= "), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("m.json: field \"" + key + "\" must be <= "), std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find("got " + std::to_string(value)), std::string::npos) << e.what();
     }
   }
 }
@@ -1501,7 +1515,7 @@ TEST_F(TrainTest, NotANumberOrHugeOptionsAreRefusedBeforeTheRunFolder) {
       {[&](TrainOptions& t) { t.weight_decay = nan; }, "--weight-decay"},
       {[&](TrainOptions& t) { t.aux_tracks = nan; }, "--aux-tracks"},
       {[&](TrainOptions& t) { t.lr_decay_epoch = -5; }, "--lr-decay-epoch"},
-      {[&](TrainOptions& t) { t.model.width = 100000; }, "width 100000"},
+      {[&](TrainOptions& t) { t.model.width = 100000; }, "\"width\" must be in 1..512, got 100000"},
       {[&](TrainOptions& t) { t.model.head_hidden = 2147483647; }, "head_hidden"},
   };
   for (const auto& [change, names] : cases) {
