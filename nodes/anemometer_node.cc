@@ -107,6 +107,12 @@ class AnemometerNode {
       return false;
     }
     if (input_ == "usb" && protocol == AnemometerProtocol::kAuto) protocol = AnemometerProtocol::kFineOffset;
+    // A station's records are Fine Offset's: any other decoder refused every one, and no wind came.
+    if (input_ == "usb" && protocol != AnemometerProtocol::kFineOffset) {
+      ROS_FATAL("~protocol: '%s' cannot read ~input: usb, which reads a Fine Offset station (expected auto or "
+                "fine_offset)", protocol_name.c_str());
+      return false;
+    }
     decoder_ = AnemometerDecoder(protocol);
     if (!PositiveSeconds("reconnect_initial_delay", initial) || !PositiveSeconds("reconnect_max_delay", maximum)) {
       return false;

@@ -27,6 +27,7 @@
 #include <clothwind/Clip.h>
 #include <clothwind/WindMeasurement.h>
 
+#include "common/formatted.h"
 #include "ros_bridge/clip_conversions.h"
 #include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_diagnostics.h"
@@ -56,9 +57,19 @@ class ClipBufferNode {
     if (roi.size() != 3 && !roi.empty())
       throw std::invalid_argument("~roi: expected a list [x, y, size] in source pixels (or [] for the centred "
                                   "square)");
-    if (roi.size() == 3)
-      o.roi = {static_cast<int>(std::lround(roi[0])), static_cast<int>(std::lround(roi[1])),
-               static_cast<int>(std::lround(roi[2]))};
+    if (roi.size() == 3) {
+      // Whole pixels in range, taken as given: 10.6 was rounded without a word, 3e9 wrapped to a
+      // negative number the error then showed, and x, y beside size 0 were dropped for the
+      // centred square.
+      for (double v : roi)
+        if (!(v >= 0 && v <= 1 << 20 && v == std::floor(v)))
+          throw std::invalid_argument("~roi: expected [x, y, size] in whole source pixels from 0 to 1048576, got [" +
+                                      Formatted("%.15g, %.15g, %.15g", roi[0], roi[1], roi[2]) + "]");
+      if (roi[2] == 0 && (roi[0] != 0 || roi[1] != 0))
+        throw std::invalid_argument("~roi: size 0 means the centred square, which takes no x, y; got [" +
+                                    Formatted("%.15g, %.15g", roi[0], roi[1]) + ", 0] (give a size, or [])");
+      o.roi = {static_cast<int>(roi[0]), static_cast<int>(roi[1]), static_cast<int>(roi[2])};
+    }
     flush_after_ = params.Get("flush_after", 3.0);
     frame_id_ = params.Get("frame_id", "");
     wind_frame_ = sensors::WindDirectionFrameGate(params.Get("wind_frame_id", ""));

@@ -56,6 +56,7 @@
 
 #include "sensors/wind_direction_frame.h"
 #include "sensors/wind_plot.h"
+#include "common/formatted.h"
 #include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wall_throttle.h"
@@ -80,6 +81,9 @@ class WindDisplayNode {
     max_future_ = params.Get("max_future", 5.0);
     drop_warn_for_ = params.Get("drop_warn_for", 30.0);
     auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+    // ~rate's bound: 1/rate must be a WallDuration (1e-12 Hz ended the node naming no parameter).
+    if (!(rate >= 1e-3 && rate <= 1000))
+      throw std::invalid_argument("~rate must be from 0.001 to 1000 Hz, got " + clothwind::Formatted("%g", rate));
     if (!positive(mean_window_) || !positive(plot_window_) || !positive(rate) || !positive(stale_after_) ||
         !positive(max_future_) || !positive(drop_warn_for_) ||
         plot_width_ < 160 || plot_height_ < 120 || plot_width_ > 4096 || plot_height_ > 4096) {

@@ -13,12 +13,13 @@
 #include <clothwind/WindEstimate.h>
 
 #include "learn/predictor.h"
+#include "sensors/clip_pipeline.h"
 
 namespace clothwind::ros_bridge {
 
-// Bounds of a Clip message's sizes (a 16K camera; the datasets' bound on frames per clip).
-constexpr uint32_t kMaxClipSide = 16384;
-constexpr uint32_t kMaxClipFrames = 100000;
+// Bounds of a Clip message's sizes: the clip buffer's (sensors/clip_pipeline.h).
+constexpr uint32_t kMaxClipSide = sensors::kMaxClipSide;
+constexpr uint32_t kMaxClipFrames = sensors::kMaxClipFrames;
 
 // The frames of a Clip as num_frames images viewing msg.data (no copy: valid while `msg` lives):
 // CV_8UC1 for a mono8 clip, CV_8UC3 BGR for a bgr8 one. Throws std::invalid_argument naming the

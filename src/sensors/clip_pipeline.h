@@ -18,6 +18,11 @@
 
 namespace clothwind::sensors {
 
+// Bounds of a clip's sizes (a 16K camera; the datasets' bound on frames per clip): sdn_node,
+// train and eval refuse clips beyond them, so the clip buffer refuses to make them.
+constexpr int kMaxClipSide = 16384;     // [px]
+constexpr int kMaxClipFrames = 100000;
+
 // Settings of the clip buffer (ROS parameters of clip_buffer_node of the same names).
 struct ClipPipelineOptions {
   double frame_rate = 25.0;    // output rate [Hz]

@@ -522,6 +522,13 @@ TEST(ClipPipelineTest, OptionsOutOfRangeAreNamed) {
   EXPECT_NE(message([](auto& o) { o.num_frames = 0; }).find("num_frames"), std::string::npos);
   EXPECT_NE(message([](auto& o) { o.stride = 0; }).find("stride"), std::string::npos);
   EXPECT_NE(message([](auto& o) { o.size = 0; }).find("size"), std::string::npos);
+  // Clips sdn_node, train and eval would refuse are not made (16385 px started, then every clip
+  // was dropped downstream).
+  EXPECT_NE(message([](auto& o) { o.size = kMaxClipSide + 1; }).find("size must be in 1..16384 px, got 16385"),
+            std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.num_frames = kMaxClipFrames + 1; }).find("num_frames must be in 1..100000"),
+            std::string::npos);
+  EXPECT_EQ(message([](auto& o) { o.size = kMaxClipSide; }), "accepted");
   EXPECT_NE(message([](auto& o) { o.roi = {-1, 0, 10}; }).find("roi"), std::string::npos);
   EXPECT_NE(message([](auto& o) { o.label_window = std::numeric_limits<double>::infinity(); }).find("label_window"),
             std::string::npos);

@@ -155,6 +155,32 @@ class NodeParamsTest(unittest.TestCase):
             self.assertIn(message, s.output(), node)
             self.assertIn("FATAL", s.output(), node)
 
+    # Values out of range end the node naming the parameter and the value given: ~roi's 10.6 was
+    # rounded, [100, 50, 0] dropped x and y without a word; a USB station read with the NMEA
+    # decoder refused every record and published nothing; ~rate 1e-12 ended the display naming
+    # no parameter.
+    def test_values_out_of_range_end_the_node_naming_them(self):
+        cases = [
+            ("clip_buffer_node", {"roi": [10.6, 20.0, 100.0]},
+             "~roi: expected [x, y, size] in whole source pixels from 0 to 1048576, got [10.6, 20, 100]"),
+            ("clip_buffer_node", {"roi": [100, 50, 0]}, "~roi: size 0 means the centred square"),
+            ("clip_buffer_node", {"size": 20000}, "size must be in 1..16384 px, got 20000"),
+            ("anemometer_node", {"input": "usb", "protocol": "nmea"}, "~protocol: 'nmea' cannot read ~input: usb"),
+            ("wind_display_node", {"rate": 1e-12}, "~rate must be from 0.001 to 1000 Hz, got 1e-12"),
+        ]
+        started = []
+        for i, (node, params, _) in enumerate(cases):
+            name = "/range_%d" % i
+            for key, value in params.items():
+                rospy.set_param(name + "/" + key, value)
+            started.append(self.spawn(node, ["__name:=" + name.lstrip("/")], cwd=self.folder))
+        for (node, params, message), s in zip(cases, started):
+            status = s.wait(30)
+            s.reader.join(5)
+            self.assertEqual(status, 1, "%s %s did not end; it said:\n%s" % (node, params, s.output()))
+            self.assertIn(message, s.output(), (node, params))
+            self.assertIn("FATAL", s.output(), (node, params))
+
     # The report's output files are checked at start: a mistyped folder failed only after the whole
     # replay, naming a temporary file; a plot asked for without estimates was silently not drawn.
     def test_the_report_refuses_output_paths_it_cannot_write_at_start(self):
