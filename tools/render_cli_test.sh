@@ -95,6 +95,20 @@ for bad in "--backgrounds $work" "--keep-zeta" "--zeta $work/zeta-3m.json --seed
   grep -q -- "--$option" "$work/out.txt" || fail "render $bad: the message does not name --$option: $(cat "$work/out.txt")"
   [ "$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")" = "$before" ] || fail "render $bad changed the earlier run's files"
 done
+# Input options that do not apply to the input are refused naming them: --cloth, --obj and
+# --frame-time beside a trajectory file (one cloth, its own times), --frame-time beside a folder's
+# trajectory. Each rendered as if not given.
+for bad in "$work/sim/trajectory.cwtraj --cloth 3" "$work/sim/trajectory.cwtraj --obj" \
+           "$work/sim/trajectory.cwtraj --frame-time 0.1" "$work/sim --frame-time 0.1"; do
+  status=0
+  # shellcheck disable=SC2086
+  "$bin" render $bad --out "$work/fr" --count 1 --samples 1 --threads 1 >"$work/out.txt" 2>&1 || status=$?
+  [ "$status" -ne 0 ] && [ "$status" -lt 128 ] || fail "render $bad exited $status: $(cat "$work/out.txt")"
+  option="--${bad##* --}"
+  option="${option%% *}"
+  grep -q -- "$option is for" "$work/out.txt" || fail "render $bad: the message does not name $option: $(cat "$work/out.txt")"
+  [ "$(md5sum "$work/fr"/*.jpg "$work/fr/zeta.json")" = "$before" ] || fail "render $bad changed the earlier run's files"
+done
 # A --zeta naming its background photo by file name needs --backgrounds: it was looked up in the
 # current folder ("no such file" naming no option, or another photo of that name rendered).
 sed 's/"background_image": *"[^"]*"/"background_image": "sky.png"/' "$work/zeta-3m.json" >"$work/zeta-photo.json"

@@ -43,6 +43,7 @@ struct RenderArgs {
   double frame_time = 0.04;  // of an OBJ sequence [s]
   int cloth = 0;
   bool obj = false;
+  bool frame_time_given = false, cloth_given = false;  // on the command line (for LoadInput's refusals)
   int samples = 0;
   int threads = 0;
 };
@@ -75,9 +76,17 @@ data::ClothAnimation AnimationOfTrajectory(const fs::path& file) {
   }
 }
 
+// Options that do not apply to the input found are refused, not ignored: --cloth 3 on a
+// trajectory file rendered its one cloth, --frame-time beside a trajectory (which has its own
+// times) changed nothing.
 data::ClothAnimation LoadInput(const RenderArgs& a, std::string* what) {
   const fs::path in(a.input);
   if (fs::is_regular_file(in)) {
+    for (const auto& [given, option] : {std::pair{a.cloth_given, "--cloth"}, std::pair{a.obj, "--obj"},
+                                        std::pair{a.frame_time_given, "--frame-time"}})
+      if (given)
+        throw std::invalid_argument(std::string(option) + " is for a simulation folder; " + a.input +
+                                    " is a trajectory file (one cloth, its own frame times)");
     *what = "trajectory " + in.string();
     return AnimationOfTrajectory(in);
   }
@@ -85,6 +94,9 @@ data::ClothAnimation LoadInput(const RenderArgs& a, std::string* what) {
   const fs::path traj = in / (a.cloth == 0 ? std::string("trajectory.cwtraj")
                                             : "trajectory_" + std::to_string(a.cloth) + ".cwtraj");
   if (!a.obj && fs::exists(traj)) {
+    if (a.frame_time_given)
+      throw std::invalid_argument("--frame-time is for OBJ frames; " + traj.string() +
+                                  " has its own frame times (give --obj to render the OBJ frames)");
     *what = "trajectory " + traj.string();
     return AnimationOfTrajectory(traj);
   }
@@ -237,10 +249,10 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
       ->check(CLI::Range(0, 1000000))
       ->capture_default_str();
   sub->add_option("--fps", a->fps, "output frame rate [Hz]")->check(CLI::Range(1e-3, 1000.0))->capture_default_str();
-  sub->add_option("--frame-time", a->frame_time, "time between OBJ frames [s] (0.001..10)")
-      ->check(CLI::Range(1e-3, 10.0))
-      ->capture_default_str();
-  sub->add_option("--cloth", a->cloth, "which cloth (the CC of NNNN_CC.obj)")->capture_default_str();
+  CLI::Option* frame_time = sub->add_option("--frame-time", a->frame_time, "time between OBJ frames [s] (0.001..10)")
+                                ->check(CLI::Range(1e-3, 10.0))
+                                ->capture_default_str();
+  CLI::Option* cloth = sub->add_option("--cloth", a->cloth, "which cloth (the CC of NNNN_CC.obj)")->capture_default_str();
   sub->add_flag("--obj", a->obj, "read the folder's OBJ frames even if it has a trajectory");
   sub->add_option("--samples", a->samples, "anti-aliasing samples per pixel (0: zeta's; at most 1024)")
       ->check(CLI::Range(0, 1024))
@@ -249,7 +261,9 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
   sub->add_option("--threads", a->threads, "render threads (0: all cores; at most 1024)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
-  return [a, quality] {
+  return [a, quality, frame_time, cloth] {
+    a->frame_time_given = frame_time->count() > 0;
+    a->cloth_given = cloth->count() > 0;
     // PNG is lossless: a quality beside it was accepted and ignored.
     if (a->format == "jpeg") a->format = "jpg";  // as make-dataset takes it
     if (quality->count() > 0 && a->format == "png")
