@@ -30,6 +30,20 @@ for case in "--lr-decay-epoch|--lr-schedule cosine --lr-decay-epoch 5" "--overwr
   [ ! -e "$work/bad/model.pt" ] || fail "train $bad trained"
 done
 
+# --k off the SDN: a resnet18 or lstm sweep over k made identical runs.
+status=0
+"$bin" train --model resnet18 --frames 30 --data "$work/toy" --out "$work/bad" --input-size 32 --k 3 \
+  --threads 1 --epochs 1 >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "--k is the SDN's" "$work/msg.txt" ||
+  fail "train --model resnet18 --k 3: not refused naming --k (status $status): $(cat "$work/msg.txt")"
+[ ! -e "$work/bad/model.pt" ] || fail "train --model resnet18 --k 3 trained"
+# eval's --track-head-window without --track-head was accepted and ignored.
+status=0
+"$bin" eval --model "$work/run/model.pt" --data "$work/toy" --split all --track-head-window 30 --threads 1 \
+  >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "--track-head-window needs --track-head" "$work/msg.txt" ||
+  fail "eval --track-head-window 30: not refused (status $status): $(cat "$work/msg.txt")"
+
 # The same clips with the val split moved to train.
 cp -r "$work/toy" "$work/noval"
 sed -i 's/"split": "val"/"split": "train"/' "$work/noval/index.json" "$work"/noval/*/label.json

@@ -25,6 +25,8 @@ refused --bending-spread --kind cloth --bending-spread 2
 refused --bending-jitter --kind cloth --bending-jitter 2
 refused --materials --kind flag --materials "$work"
 refused --seed --seed -1
+refused --jpeg-quality --format png --jpeg-quality 5  # lossless: unused, yet written into the header
+refused --jpeg-quality --format pgm --jpeg-quality 5
 refused --warmup --warmup 0.019
 # More frames than a label may hold ran for hours, then every example was refused by the index; a
 # size whose frames need terabytes of memory, likewise.

@@ -82,6 +82,10 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       std::cerr << "clothwind eval: --track-head-rows needs --track-head\n";
       return 2;
     }
+    if (a->track_head_window != 0 && !a->track_head) {  // accepted and ignored
+      std::cerr << "clothwind eval: --track-head-window needs --track-head\n";
+      return 2;
+    }
     if (!a->fly_judge.empty() && a->flag_flies != "auto") {
       std::cerr << "clothwind eval: --fly-judge decides only with --flag-flies auto\n";
       return 2;

@@ -187,7 +187,7 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
                   "frame format (pgm: 8-bit grey as the SDN reads it, lossless, readable without an image codec)")
       ->check(CLI::IsMember({"jpg", "jpeg", "png", "pgm"}))
       ->capture_default_str();
-  sub->add_option("--jpeg-quality", a->o.jpeg_quality, "JPEG quality 1..100")->capture_default_str();
+  CLI::Option* quality = sub->add_option("--jpeg-quality", a->o.jpeg_quality, "JPEG quality 1..100")->capture_default_str();
   sub->add_option("--wind-min", a->wind_min, "lowest wind speed [m/s] (default: flag 0, cloth 0)")
       ->check(CLI::Range(0.0, 100.0));
   sub->add_option("--wind-max", a->wind_max, "highest wind speed [m/s] (default: flag 10, cloth 5)")
@@ -232,7 +232,10 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
                   "only this split's simulations, as the whole dataset has them (test: to evaluate a model "
                   "without making its training data; with --add-tracks, train: what --aux-tracks reads)")
       ->check(CLI::IsMember({"train", "val", "test"}));
-  return [a, sub] {
+  return [a, sub, quality] {
+    // Lossless frames take no quality: it was accepted, unused, and written into the header.
+    if (quality->count() > 0 && (a->format == "png" || a->format == "pgm"))
+      throw std::invalid_argument("--jpeg-quality is for JPEG frames; --format " + a->format + " is lossless");
     // --reindex reads the header and labels as they are: any other option was accepted and
     // ignored (--count 99 --kind cloth --tracks 9x9 rebuilt the same index under the old header).
     if (a->reindex) {

@@ -44,7 +44,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--width", o.model.width, "ResNet-18 base width (64 as the original)")
       ->check(CLI::Range(1, 512))
       ->capture_default_str();
-  sub->add_option("--k", o.model.k, "SDN: spectral peaks per pixel")->check(CLI::Range(1, 64))->capture_default_str();
+  CLI::Option* k = sub->add_option("--k", o.model.k, "SDN: spectral peaks per pixel")->check(CLI::Range(1, 64))->capture_default_str();
   sub->add_flag("--include-dc", o.model.include_dc,
                 "SDN: the DC bin competes for the k peaks, signals not detrended (Algorithm 1 verbatim)");
   sub->add_option("--dft-size", o.model.dft_size,
@@ -167,7 +167,12 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
   sub->add_option("--seed", o.seed, "seed of initialisation, data order and augmentation (0..2^64-1)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  return [args, lr_decay_epoch]() {
+  return [args, lr_decay_epoch, k]() {
+    // k has a default, so ModelConfig cannot tell it given: a resnet18 or lstm sweep over --k
+    // made identical runs, each recording its k.
+    if (k->count() > 0 && args->o.model.arch != "sdn")
+      throw std::invalid_argument("--k is the SDN's (spectral peaks per pixel); --model " + args->o.model.arch +
+                                  " has no spectral layer");
     // The cosine schedule has no decay epoch: accepted, recorded in state.json and never used.
     if (lr_decay_epoch->count() > 0 && args->o.lr_schedule == "cosine")
       throw std::invalid_argument("--lr-decay-epoch is the step schedule's; --lr-schedule cosine decays over every epoch");
