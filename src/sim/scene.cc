@@ -37,6 +37,13 @@ constexpr double kMaxTurbulence = 10;      // turbulence intensity and component
 
 const char* TypeName(const json& j) { return j.type_name(); }
 
+// A value as the message shows it: a number or short text as written (-1, 8.5, "3"), anything
+// else by its type ("got array"), so an error says what was found.
+std::string Shown(const json& j) {
+  if (j.is_number() || j.is_boolean() || (j.is_string() && j.get<std::string>().size() <= 40)) return j.dump();
+  return j.type_name();
+}
+
 // Walks the JSON with the file name and the JSON path at hand, so every message names both.
 class Reader {
  public:
@@ -86,7 +93,11 @@ class Reader {
     return v;
   }
   int Integer(const json& j, const std::string& path) const {
-    if (!j.is_number_integer()) Fail(path, std::string("expected an integer, got ") + TypeName(j));
+    // A whole number written with a point (8.0) is the integer, as ArcSim's JSON reader takes it.
+    if (j.is_number_float() && std::isfinite(j.get<double>()) && j.get<double>() == std::floor(j.get<double>()) &&
+        std::abs(j.get<double>()) <= std::numeric_limits<int>::max())
+      return static_cast<int>(j.get<double>());
+    if (!j.is_number_integer()) Fail(path, "expected an integer, got " + Shown(j));
     // get<int> wraps 4294967297 to 1: out of int's range is an error, not another number.
     const bool in_range = j.is_number_unsigned()
                               ? j.get<uint64_t>() <= static_cast<uint64_t>(std::numeric_limits<int>::max())
@@ -322,7 +333,7 @@ ShearProfile ParseShear(const Reader& r, const json& j, const std::string& path)
 
 uint64_t Seed(const Reader& r, const json& j, const std::string& path) {
   if (!j.is_number_unsigned() && !(j.is_number_integer() && j.get<int64_t>() >= 0)) {
-    r.Fail(path, std::string("expected an integer >= 0, got ") + TypeName(j));
+    r.Fail(path, "expected an integer >= 0, got " + Shown(j));
   }
   return j.get<uint64_t>();
 }

@@ -313,7 +313,10 @@ TEST_F(SceneFiles, WrongTypesNameTheJsonPathAndFile) {
   const std::string b = Write("conf/b.json", text);
   ExpectErrorNaming([&] { LoadScene(b); }, {b, "cloths[0].materials[0].data", "expected a string"});
   const std::string c = Write("conf/c.json", Replace(SceneText(), "\"frame_steps\": 4", "\"frame_steps\": 2.5"));
-  ExpectErrorNaming([&] { LoadScene(c); }, {c, "frame_steps"});
+  ExpectErrorNaming([&] { LoadScene(c); }, {c, "frame_steps", "expected an integer, got 2.5"});
+  // A whole number with a point is the integer, as ArcSim's reader takes it.
+  const std::string whole = Write("conf/whole.json", Replace(SceneText(), "\"frame_steps\": 4", "\"frame_steps\": 8.0"));
+  EXPECT_EQ(LoadScene(whole).frame_steps, 8);
   const std::string d = Write("conf/d.json", SceneText("", "\"transform\": {\"rotate\": [90, 1, 1]},"));
   ExpectErrorNaming([&] { LoadScene(d); }, {d, "cloths[0].transform.rotate", "4 numbers"});
   const std::string e = Write("conf/e.json", "{\"frame_time\": 0.04}");
