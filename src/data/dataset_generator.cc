@@ -185,6 +185,10 @@ Prepared Prepare(const DatasetOptions& o) {
   const sim::Scene scene = sim::LoadScene(
       scene_path, [](const std::string& w) { std::fprintf(stderr, "make-dataset: warning: %s\n", w.c_str()); });
   if (scene.cloths.empty()) throw std::runtime_error(scene_path + ": field 'cloths' is empty");
+  // One cloth is simulated, rendered and labelled: the others were dropped without a word.
+  if (scene.cloths.size() > 1)
+    throw std::runtime_error(scene_path + ": field 'cloths' holds " + std::to_string(scene.cloths.size()) +
+                             " cloths; make-dataset makes examples of one (give a scene with one cloth)");
   if (std::abs(scene.frame_time * o.fps - 1.0) > 1e-9)
     throw std::runtime_error(scene_path + ": field 'frame_time' is " + std::to_string(scene.frame_time) +
                              " s, expected 1/fps = " + std::to_string(1.0 / o.fps) + " s");

@@ -200,6 +200,14 @@ std::vector<std::string> ListBackgroundImages(const std::string& folder) {
     throw std::runtime_error("background folder '" + folder +
                              "' holds no .jpg/.jpeg/.png/.bmp image");
   std::sort(out.begin(), out.end());
+  // Each read whole now: one that cannot be read was found only when a simulation drew it, after
+  // its simulation, and every simulation that drew it failed.
+  for (const std::string& image : out) {
+    std::string why;
+    if (common::ReadImageFile(image, cv::IMREAD_REDUCED_COLOR_8, &why).empty())
+      throw std::runtime_error("background folder '" + folder + "': cannot read " + image + " as an image (" + why +
+                               ")");
+  }
   return out;
 }
 

@@ -49,8 +49,10 @@ Backdrop MakeBackdrop(const RenderParams& p, const PinholeCamera& camera);
 // Inputs: seed; width, height  texels (the picture is 2:1, 90 m by 45 m at scale 1).
 Texture ProceduralBackdrop(uint64_t seed, int width = 1024, int height = 512);
 
-// The images (.jpg .jpeg .png .bmp, any case) directly in `folder`, sorted by name.
-// Throws std::runtime_error naming the folder if it does not exist or holds no image.
+// The images (.jpg .jpeg .png .bmp, any case) directly in `folder`, sorted by name, each read
+// once whole (at 1/8 size) to check it.
+// Throws std::runtime_error naming the folder if it does not exist or holds no image, and the
+// file if one cannot be read as an image.
 std::vector<std::string> ListBackgroundImages(const std::string& folder);
 
 }  // namespace clothwind::render

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 
@@ -651,6 +652,23 @@ TEST(Backdrop, MissingFilesAreNamed) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/photo.jpg"), std::string::npos);
   }
   EXPECT_THROW(ListBackgroundImages("/nonexistent/folder"), std::runtime_error);
+}
+
+// An image that cannot be read is named when the folder is listed: make-dataset found it only when
+// a simulation drew it, after the simulation's work, and failed every simulation that drew it.
+TEST(Backdrop, AFolderHoldingAnUnreadableImageIsRefusedNamingIt) {
+  const std::string dir = testing::TempDir() + "/render_bg_bad_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  ASSERT_TRUE(cv::imwrite(dir + "/a.png", cv::Mat(8, 16, CV_8UC3, cv::Scalar(10, 20, 30))));
+  EXPECT_EQ(ListBackgroundImages(dir).size(), 1u);
+  std::ofstream(dir + "/b.jpg") << "notanimage";
+  try {
+    ListBackgroundImages(dir);
+    ADD_FAILURE() << "a folder with an unreadable b.jpg was listed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(dir + "/b.jpg as an image"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Backdrop, ProceduralHasGroundThingsBelowAndSkyAbove) {
