@@ -194,6 +194,56 @@ inline void WriteFileAtomically(const std::string& path, const std::string& byte
   WriteFileAtomically(path, bytes.data(), bytes.size());
 }
 
+// Writes two files that are read as a pair (a model's weights and its model.json): both
+// temporaries are written whole before either is renamed into place, and if the second rename
+// fails the first file is put back as it was (or removed, if it was not there), so a failure never
+// leaves new weights beside an old configuration, which the loader then refuses.
+// Inputs: first, second  the paths; first_bytes, second_bytes  their contents.
+// Throws std::runtime_error naming the file that could not be written or renamed.
+inline void WriteFilePairAtomically(const std::string& first, const std::string& first_bytes, const std::string& second,
+                                    const std::string& second_bytes) {
+  namespace fs = std::filesystem;
+  const std::string tmp_first = TemporaryNameFor(first);
+  const std::string tmp_second = TemporaryNameFor(second);
+  std::error_code ignored;
+  try {
+    WriteFileDurably(tmp_first, first_bytes.data(), first_bytes.size());
+    WriteFileDurably(tmp_second, second_bytes.data(), second_bytes.size());
+  } catch (...) {
+    fs::remove(tmp_first, ignored);
+    fs::remove(tmp_second, ignored);
+    throw;
+  }
+  // The first file's old content, kept under a hard link until the pair is in place.
+  const std::string backup = TemporaryNameFor(first + ".old");
+  const bool had_first = ::link(first.c_str(), backup.c_str()) == 0;
+  std::error_code ec;
+  fs::rename(tmp_first, first, ec);
+  if (ec) {
+    const std::string why = ec.message();
+    fs::remove(tmp_first, ignored);
+    fs::remove(tmp_second, ignored);
+    if (had_first) fs::remove(backup, ignored);
+    throw std::runtime_error("cannot rename " + tmp_first + " to " + first + ": " + why);
+  }
+  fs::rename(tmp_second, second, ec);
+  if (ec) {
+    const std::string why = ec.message();
+    fs::remove(tmp_second, ignored);
+    if (had_first)
+      fs::rename(backup, first, ignored);
+    else
+      fs::remove(first, ignored);
+    SyncDirectory(fs::path(first).parent_path().string());
+    throw std::runtime_error("cannot rename " + tmp_second + " to " + second + ": " + why + " (" + first +
+                             " is left as it was)");
+  }
+  if (had_first) fs::remove(backup, ignored);
+  SyncDirectory(fs::path(first).parent_path().string());
+  if (fs::path(second).parent_path() != fs::path(first).parent_path())
+    SyncDirectory(fs::path(second).parent_path().string());
+}
+
 }  // namespace clothwind
 
 #endif  // CLOTHWIND_COMMON_ATOMIC_FILE_H_

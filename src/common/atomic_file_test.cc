@@ -78,6 +78,38 @@ TEST_F(AtomicFileTest, AFailedWriteKeepsTheOldContentAndLeavesNoTemporary) {
   EXPECT_EQ(Entries(), 1u);
 }
 
+// A model's weights and its model.json as a pair: both in place, or neither changed. A second
+// file that cannot take its place (a folder holds its name) puts the first back; the weights
+// used to be replaced already, beside an old model.json the loader then refused.
+TEST_F(AtomicFileTest, APairIsWrittenWholeOrNotAtAll) {
+  const std::string weights = (dir_ / "model.pt").string(), config = (dir_ / "model.json").string();
+  WriteFilePairAtomically(weights, "weights 1", config, "config 1");
+  EXPECT_EQ(Read(weights), "weights 1");
+  EXPECT_EQ(Read(config), "config 1");
+  WriteFilePairAtomically(weights, "weights 2", config, "config 2");
+  EXPECT_EQ(Read(weights), "weights 2");
+  EXPECT_EQ(Read(config), "config 2");
+  EXPECT_EQ(Entries(), 2u);  // no temporary or backup left
+
+  const std::string blocked = (dir_ / "blocked.json").string();
+  fs::create_directories(fs::path(blocked) / "inside");  // rename() cannot replace a non-empty folder
+  std::string message;
+  try {
+    WriteFilePairAtomically(weights, "weights 3", blocked, "config 3");
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("blocked.json"), std::string::npos) << message;
+  EXPECT_EQ(Read(weights), "weights 2");  // put back
+  EXPECT_EQ(Entries(), 3u);               // model.pt, model.json and the folder: nothing else
+
+  // A first file that was not there before is removed again.
+  const std::string fresh = (dir_ / "fresh.pt").string();
+  EXPECT_THROW(WriteFilePairAtomically(fresh, "w", blocked, "c"), std::runtime_error);
+  EXPECT_FALSE(fs::exists(fresh));
+  EXPECT_EQ(Entries(), 3u);
+}
+
 TEST_F(AtomicFileTest, TemporaryNamesDiffer) {
   EXPECT_NE(TemporaryNameFor("x"), TemporaryNameFor("x"));
   EXPECT_EQ(TemporaryNameFor("x").rfind("x.tmp-" + ProcessTag() + "-", 0), 0u);

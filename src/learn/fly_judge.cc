@@ -10,6 +10,7 @@
 #include <torch/nn/module.h>
 #include <torch/nn/modules/linear.h>
 
+#include "common/atomic_file.h"
 #include "learn/dataset.h"
 #include "learn/model_config.h"
 #include "learn/weights_io.h"
@@ -158,12 +159,13 @@ void FlyJudge::Save(const std::filesystem::path& path, nlohmann::json card) cons
     module.output->weight.copy_(torch::from_blob(w2.data(), {1, h}, torch::kFloat));
     module.output->bias.fill_(output_bias_);
   }
-  SaveModuleWeights(module, path, WeightPrecision::kFloat32);
   card["hidden"] = h;
   card["grid"] = kMotionMapGrid;
   card["side"] = kMotionMapSide;
   card["margin"] = margin_;
-  WriteFileAtomically(ConfigPathFor(path), card.dump(2) + "\n");
+  // The weights and their card as a pair (WriteFilePairAtomically), as a model's.
+  clothwind::WriteFilePairAtomically(path.string(), SerializeModuleWeights(module, WeightPrecision::kFloat32),
+                          ConfigPathFor(path).string(), card.dump(2) + "\n");
 }
 
 double FlyJudge::Logit(const Eigen::VectorXf& map) const {

@@ -10,6 +10,7 @@
 
 #include <ATen/ATen.h>
 
+#include "common/atomic_file.h"
 #include "common/regular_file.h"
 #include "learn/track_targets.h"
 #include "learn/weight_average.h"
@@ -270,9 +271,11 @@ void SaveWindNet(WindNet& net, const std::filesystem::path& weights, WeightPreci
   // The configuration goes into the weights file as well as beside it: most of it (input size,
   // frames, frame rate, label scale, ...) shapes no tensor, so weights loaded under another
   // model.json would load without complaint and answer wrongly.
+  // Written as a pair: a failure between the two left new weights beside the old model.json,
+  // a pair the loader refuses, where a good model had been.
   const nlohmann::json config = ToJson(net->config());
-  SaveModuleWeights(*net, weights, precision, config.dump());
-  WriteFileAtomically(ConfigPathFor(weights), config.dump(2) + "\n");
+  clothwind::WriteFilePairAtomically(weights.string(), SerializeModuleWeights(*net, precision, config.dump()),
+                          ConfigPathFor(weights).string(), config.dump(2) + "\n");
 }
 
 WindNet WithoutAuxHead(WindNet& net) {

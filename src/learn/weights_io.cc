@@ -100,14 +100,19 @@ WeightPrecision ParseWeightPrecision(const std::string& name) {
   throw std::invalid_argument("weight precision must be float32 or float16, got \"" + name + "\"");
 }
 
-void SaveModuleWeights(const torch::nn::Module& module, const std::filesystem::path& path,
-                       WeightPrecision precision, const std::string& metadata) {
+std::string SerializeModuleWeights(const torch::nn::Module& module, WeightPrecision precision,
+                                   const std::string& metadata) {
   torch::serialize::OutputArchive archive;
   Write(module, "", precision, archive);
   if (!metadata.empty()) archive.write(kMetadataKey, c10::IValue(metadata));
   std::ostringstream bytes;
   archive.save_to(bytes);
-  WriteFileAtomically(path, bytes.str());
+  return bytes.str();
+}
+
+void SaveModuleWeights(const torch::nn::Module& module, const std::filesystem::path& path,
+                       WeightPrecision precision, const std::string& metadata) {
+  WriteFileAtomically(path, SerializeModuleWeights(module, precision, metadata));
 }
 
 WeightPrecision LoadModuleWeights(torch::nn::Module& module, const std::filesystem::path& path,

@@ -34,6 +34,11 @@ WeightPrecision ParseWeightPrecision(const std::string& name);
 void SaveModuleWeights(const torch::nn::Module& module, const std::filesystem::path& path,
                        WeightPrecision precision, const std::string& metadata = "");
 
+// The bytes SaveModuleWeights writes (for a caller that writes them with another file as a pair:
+// WriteFilePairAtomically). Same inputs and throws, less the path.
+std::string SerializeModuleWeights(const torch::nn::Module& module, WeightPrecision precision,
+                                   const std::string& metadata = "");
+
 // Reads a file written by SaveModuleWeights or torch::save into `module` (on the CPU),
 // converting floating-point tensors to the module's dtype.
 // Outputs: the precision the file's parameters were stored in; *metadata (when not null) the
