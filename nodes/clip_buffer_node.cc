@@ -270,8 +270,27 @@ class ClipBufferNode {
                flush_after_, pipeline_->pending());
       Publish(pipeline_->Flush());
     }
-    if (!writer_ && !record_dir_.empty() && (ros::SteadyTime::now() - last_open_attempt_).toSec() >= kReopenEvery)
-      OpenRecording();
+    // The folder lost (a disk unplugged, or replugged and mounted again): the writer refused every
+    // later clip until the node restarted. It is closed and the folder reopened once it is back;
+    // not created again, so clips never land on a bare mount point.
+    if (writer_) {
+      if (const std::string lost = writer_->FolderLost(); !lost.empty()) {
+        NoteError(lost + "; reopening it every " + std::to_string(static_cast<int>(kReopenEvery)) + " s once it is there");
+        writer_.reset();  // its queued clips fail (the folder is gone), counted in its tally
+        folder_lost_ = true;
+        recording_error_ = lost;
+        last_open_attempt_ = ros::SteadyTime::now();
+      }
+    }
+    if (!writer_ && !record_dir_.empty() && (ros::SteadyTime::now() - last_open_attempt_).toSec() >= kReopenEvery) {
+      std::error_code ec;
+      if (folder_lost_ && !std::filesystem::is_directory(record_dir_, ec)) {
+        last_open_attempt_ = ros::SteadyTime::now();
+        recording_error_ = "the recording folder " + record_dir_ + " is gone; waiting for it to come back";
+      } else {
+        OpenRecording();
+      }
+    }
     // Input stopped (a replay ended, the camera paused): list the clips recorded since the last
     // index rewrite now rather than after ~index_interval (after the clips just flushed).
     if (writer_ && !index_flush_asked_ && (ros::SteadyTime::now() - last_input_).toSec() > flush_after_) {
@@ -480,6 +499,7 @@ class ClipBufferNode {
   std::string index_error_seen_;
   bool index_flush_asked_ = false;  // since the last input
   std::string recording_error_;  // why record_dir_ is not open; empty when it is (or not set)
+  bool folder_lost_ = false;     // it was open and went: reopened only once it exists again
   ros::SteadyTime last_open_attempt_;
   std::string last_error_;
   ros::SteadyTime last_error_time_, last_future_;

@@ -75,6 +75,8 @@ class AsyncDatasetWriter {
   void RequestIndexFlush();
 
   Stats stats() const;
+  // DatasetWriter::FolderLost of the folder being written (any thread).
+  std::string FolderLost() const { return writer_->FolderLost(); }
   const std::string& root() const { return root_; }
   size_t size_at_open() const { return size_at_open_; }
   size_t recovered() const { return recovered_; }

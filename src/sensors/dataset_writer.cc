@@ -194,15 +194,18 @@ DatasetWriter::LockFile::~LockFile() {
   if (fd >= 0) ::close(fd);  // releases the lock
 }
 
-void DatasetWriter::CheckSameFolder() const {
+std::string DatasetWriter::FolderLost() const {
   struct stat st{};
   if (::stat(root_.c_str(), &st) != 0)
-    throw std::runtime_error("the dataset folder " + root_ + " is gone (" + std::strerror(errno) +
-                             "): recording stopped");
+    return "the dataset folder " + root_ + " is gone (" + std::strerror(errno) + "): recording stopped";
   if (static_cast<unsigned long long>(st.st_dev) != device_ || static_cast<unsigned long long>(st.st_ino) != inode_)
-    throw std::runtime_error("the dataset folder " + root_ + " is no longer the one opened (a disk mounted over it, "
-                             "or the folder moved): recording stopped, so its index.json is not replaced by this "
-                             "one's");
+    return "the dataset folder " + root_ + " is no longer the one opened (a disk mounted over it, or the folder "
+           "moved): recording stopped, so its index.json is not replaced by this one's";
+  return "";
+}
+
+void DatasetWriter::CheckSameFolder() const {
+  if (const std::string lost = FolderLost(); !lost.empty()) throw std::runtime_error(lost);
 }
 
 size_t DatasetWriter::ReindexUnlisted() {

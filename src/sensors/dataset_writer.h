@@ -108,6 +108,13 @@ class DatasetWriter {
   // Throws unless root_ is still the folder opened (device and inode).
   void CheckSameFolder() const;
 
+ public:
+  // Why the folder is no longer the one opened ("" while it is): gone, or another in its place
+  // (a disk replugged and mounted again). Safe from any thread (reads what the constructor set).
+  std::string FolderLost() const;
+
+ private:
+
   std::string root_;
   int jpeg_quality_;
   nlohmann::json index_;

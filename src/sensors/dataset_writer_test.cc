@@ -365,8 +365,10 @@ TEST_F(DatasetWriterTest, AMissingParentOrASwappedFolderStopsTheRecording) {
   const fs::path folder = root_ / "flagreal";
   DatasetWriter w(folder.string());
   w.Write(MakeClip(0, 1700000000.0), {});
+  EXPECT_EQ(w.FolderLost(), "");
   // Another folder in its place, holding yesterday's index.
   fs::rename(folder, root_ / "moved");
+  EXPECT_NE(w.FolderLost().find("is gone"), std::string::npos) << w.FolderLost();
   fs::create_directories(folder);
   std::ofstream(folder / "index.json") << R"({"format": "clothwind-dataset", "version": 1, "kind": "real", "clips": [{"name": "clip-yesterday"}]})";
   try {
@@ -377,6 +379,7 @@ TEST_F(DatasetWriterTest, AMissingParentOrASwappedFolderStopsTheRecording) {
   }
   EXPECT_EQ(Read(folder / "index.json")["clips"].size(), 1u);
   EXPECT_EQ(Read(folder / "index.json")["clips"][0]["name"], "clip-yesterday");
+  EXPECT_NE(w.FolderLost().find("no longer the one opened"), std::string::npos) << w.FolderLost();
 }
 
 // A writer that died between a clip's rename into place and its index update: the clip is whole

@@ -129,6 +129,48 @@ class NodeParamsTest(unittest.TestCase):
                         "no clip recorded into %s; node said:\n%s" % (record, node.output()))
         self.assertIn('~record_dir is set to the int 20261206, read as the text "20261206"', node.output())
 
+    # A recording folder lost and back (a USB disk replugged and mounted again: here moved aside
+    # and made anew) is reopened: the writer refused every later clip until the node restarted.
+    def test_a_recording_folder_lost_and_back_is_recorded_into_again(self):
+        record = os.path.join(self.folder, "rec")
+        node = self.spawn("clip_buffer_node", [
+            "__ns:=lost", "_record_dir:=" + record, "_num_frames:=10", "_stride:=10", "_size:=32",
+            "_label_window:=2.0", "_label_delay:=0.5", "_flush_after:=1.0"], cwd=self.folder)
+        images = rospy.Publisher("/lost/camera/image_raw", Image, queue_size=100)
+        winds = rospy.Publisher("/lost/anemometer/wind", WindMeasurement, queue_size=20)
+        deadline = time.time() + 20
+        while time.time() < deadline and (images.get_num_connections() == 0 or winds.get_num_connections() == 0):
+            time.sleep(0.1)
+        self.assertGreater(images.get_num_connections(), 0, node.output())
+        frame = [0]
+
+        def stream_until(done, seconds):
+            deadline = time.time() + seconds
+            while time.time() < deadline and not done():
+                stamp = rospy.Time.now()
+                img = Image()
+                img.header.stamp, img.header.frame_id = stamp, "camera_optical"
+                img.height, img.width, img.encoding, img.step = HEIGHT, WIDTH, "mono8", WIDTH
+                img.data = bytes([frame[0] % 256]) * (WIDTH * HEIGHT)
+                images.publish(img)
+                if frame[0] % 15 == 0:
+                    wind = WindMeasurement()
+                    wind.header.stamp, wind.header.frame_id = stamp, "anemometer"
+                    wind.speed, wind.direction, wind.valid = 4.0, 0.0, True
+                    winds.publish(wind)
+                frame[0] += 1
+                time.sleep(1.0 / 30)
+            return done()
+
+        self.assertTrue(stream_until(lambda: glob.glob(os.path.join(record, "*", "label.json")), 30),
+                        "no clip recorded into %s; node said:\n%s" % (record, node.output()))
+        os.rename(record, record + ".old")
+        os.mkdir(record)
+        self.assertTrue(stream_until(lambda: glob.glob(os.path.join(record, "*", "label.json")), 40),
+                        "nothing recorded into the folder made again; node said:\n%s" % node.output())
+        self.assertIn("no longer the one opened", node.output())  # said (stderr; INFO is buffered)
+        self.assertIn("reopening it every 10 s once it is there", node.output())
+
     # A wrong-typed parameter ends each node with a FATAL naming it, the type found and the one
     # expected (YAML `rate: "5"` left camera_node at 30 Hz; roscpp's param() takes its default).
     def test_a_wrong_typed_parameter_ends_the_node_naming_it(self):
