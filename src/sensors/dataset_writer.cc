@@ -51,6 +51,24 @@ void WriteFileAtomically(const std::string& path, const std::string& text) {
   clothwind::WriteFileAtomically(path, text);
 }
 
+namespace {
+
+// Whether the clip labelled in `label_path` starts with the camera frame stamped `source_stamp`
+// (its label's source_frame_stamps[0]; an unreadable label is taken as another clip's, kept).
+bool StartsWithFrame(const std::string& label_path, double source_stamp) {
+  try {
+    std::ifstream in(label_path);
+    if (!in) return false;
+    const nlohmann::json label = nlohmann::json::parse(in);
+    const auto& stamps = label.at("source_frame_stamps");
+    return !stamps.empty() && stamps.at(0).is_number() && stamps.at(0).get<double>() == source_stamp;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 std::string ClipFolderName(double first_stamp) {
   const double whole = std::floor(first_stamp);
   const std::time_t seconds = static_cast<std::time_t>(whole);
@@ -237,7 +255,16 @@ size_t DatasetWriter::ReindexUnlisted() {
 std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo& source) {
   if (clip.clip.frames.empty()) throw std::invalid_argument("cannot record an empty clip");
   CheckSameFolder();
-  const std::string name = ClipFolderName(clip.clip.frames.front().stamp);
+  // A folder of this name is the same clip when its first camera frame is (a session replayed
+  // again: replaced); another clip that starts in the same millisecond (the wall clock stepped
+  // back during a live recording, and a new timeline ran over the old) gets a name of its own
+  // ("-2", "-3", ...): it silently replaced the recorded clip.
+  const std::string base = ClipFolderName(clip.clip.frames.front().stamp);
+  std::string name = base;
+  for (int k = 2; fs::exists(root_ + "/" + name) &&
+                  !StartsWithFrame(root_ + "/" + name + "/label.json", clip.clip.frames.front().source_stamp);
+       ++k)
+    name = base + "-" + std::to_string(k);
   const std::string final_dir = root_ + "/" + name;
   const std::string tmp_dir = TemporaryNameFor(root_ + "/." + name);
   bool replaced = false;

@@ -163,6 +163,27 @@ TEST_F(DatasetWriterTest, ReopenAppendsAndRewriteReplaces) {
   EXPECT_EQ(folders, 3);
 }
 
+// Another clip that starts in the same millisecond (the wall clock stepped back live, a new
+// timeline over the old) is kept beside the first under a name of its own; it replaced it.
+TEST_F(DatasetWriterTest, AnotherClipOfTheSameStartKeepsBoth) {
+  DatasetWriter w(root_.string());
+  const LabelledClip first = MakeClip(0, 1700000000.0);
+  LabelledClip other = MakeClip(7, 1700000000.0);
+  for (auto& f : other.clip.frames) f.source_stamp += 0.0004;  // another camera frame, same millisecond
+  w.Write(first, {});
+  const std::string second_path = w.Write(other, {});
+  const std::string base = ClipFolderName(1700000000.0);
+  EXPECT_EQ(fs::path(second_path).filename().string(), base + "-2");
+  EXPECT_TRUE(fs::exists(root_ / base / "label.json"));
+  EXPECT_EQ(Read(root_ / (base + "-2") / "label.json")["name"], base + "-2");
+  EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 2u);
+  // Each again (a replay of the session) replaces its own folder, and adds none.
+  w.Write(other, {});
+  w.Write(first, {});
+  EXPECT_EQ(w.size(), 2u);
+  EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 2u);
+}
+
 TEST_F(DatasetWriterTest, WithAnIndexIntervalClipsAreListedByTheNextRewriteFlushOrClose) {
   // index_interval a day: the first clip's write rewrites the index (none written yet, however
   // long the machine has been up: the steady clock starts at boot, so the clock here starts at
