@@ -5,7 +5,8 @@
 //             image_transport), camera/camera_info (sensor_msgs/CameraInfo, same stamp),
 //             /diagnostics (rate and stamp age of camera/image_raw, source state, negotiated
 //             format, dropped and unreadable frames, reconnects)
-// Services    camera/set_camera_info (camera_info_manager: camera_calibration stores here)
+// Services    camera/set_camera_info (camera_calibration's COMMIT: used at once, and stored at
+//             ~camera_info_url through a temporary file; success false, saying why, when it is not)
 // Parameters  ~source (v4l2 | video | folder), ~device (/dev/video0), ~path (video file or image
 //             folder), ~pixel_format (YUYV | MJPEG | GREY), ~width, ~height [px], ~fps [Hz],
 //             ~rate [Hz] (folder rate; default ~fps), ~loop, ~buffers, ~timeout [s],
@@ -21,17 +22,21 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include <camera_calibration_parsers/parse_yml.h>
 #include <camera_info_manager/camera_info_manager.h>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/publisher.h>
 #include <image_transport/image_transport.h>
 #include <ros/package.h>
 #include <ros/ros.h>
+#include <sensor_msgs/SetCameraInfo.h>
 
+#include "common/atomic_file.h"
 #include "ros_bridge/camera_calibration_file.h"
 #include "ros_bridge/image_conversions.h"
 #include "ros_bridge/strict_param.h"
@@ -129,7 +134,13 @@ int main(int argc, char** argv) {
   // without calibration, said in diagnostics, rather than falling back to camera_info_manager's
   // default file, which is not the calibration asked for either; a COMMIT then writes the URL's
   // file, or answers that it cannot.
-  camera_info_manager::CameraInfoManager info_manager(camera_nh, camera_name, camera_info_url);
+  // The manager serves set_camera_info in the namespace it is given: given one of its own, which
+  // no tool calls, and camera/set_camera_info is served below. Its writer truncated the file in
+  // place and answered success whatever the write did (camera_calibration_parsers: "always
+  // returns true"), so a full disk or a crash mid-write lost the calibration the tool was told
+  // was stored.
+  ros::NodeHandle manager_nh(camera_nh, "camera_info_manager");
+  camera_info_manager::CameraInfoManager info_manager(manager_nh, camera_name, camera_info_url);
   const std::string url = camera_info_url.empty() ? clothwind::ros_bridge::kDefaultCameraInfoUrl : camera_info_url;
   const std::string calibration_path =
       clothwind::ros_bridge::CalibrationFilePath(info_manager.resolveURL(url, camera_name), ros::package::getPath);
@@ -158,6 +169,35 @@ int main(int argc, char** argv) {
                     << ": " << calibration_refused
                     << "; publishing camera_info without calibration");
   }
+  // set_camera_info: the calibration is used from now on (as camera_info_manager did) and stored
+  // whole or not at all, the answer saying which.
+  ros::ServiceServer set_camera_info = camera_nh.advertiseService<sensor_msgs::SetCameraInfo::Request,
+                                                                  sensor_msgs::SetCameraInfo::Response>(
+      "set_camera_info", [&](sensor_msgs::SetCameraInfo::Request& req, sensor_msgs::SetCameraInfo::Response& rsp) {
+        info_manager.setCameraInfo(req.camera_info);
+        rsp.success = false;
+        if (calibration_path.empty()) {
+          rsp.status_message = "the calibration is used but not stored: " + url + " is not a file:// or package:// URL";
+        } else {
+          std::ostringstream yaml;
+          try {
+            if (!camera_calibration_parsers::writeCalibrationYml(yaml, camera_name, req.camera_info))
+              throw std::runtime_error("cannot write the calibration as YAML");
+            std::error_code ec;
+            std::filesystem::create_directories(std::filesystem::path(calibration_path).parent_path(), ec);
+            clothwind::WriteFileAtomically(calibration_path, yaml.str());
+            rsp.success = true;
+            rsp.status_message = "stored in " + calibration_path;
+          } catch (const std::exception& e) {
+            rsp.status_message = std::string("the calibration is used but not stored: ") + e.what();
+          }
+        }
+        if (rsp.success)
+          ROS_INFO_STREAM("camera_node: calibration " << rsp.status_message);
+        else
+          ROS_ERROR_STREAM("camera_node: " << rsp.status_message);
+        return true;
+      });
   image_transport::ImageTransport transport(nh);
   image_transport::CameraPublisher publisher = transport.advertiseCamera("camera/image_raw", 1);
   // After advertising: a node named "camera" publishes /camera/image_raw, where image_transport's

@@ -14,6 +14,8 @@ import tempfile
 import threading
 import time
 import unittest
+
+import yaml
 import zlib
 
 import rospy
@@ -253,8 +255,19 @@ class CameraFolderTest(unittest.TestCase):
         status = source_status(t)
         self.assertEqual(status.level, DiagnosticStatus.WARN)
         self.assertIn("K[4] is nan", status.message)
-        # A good calibration for the images' size is then published.
-        self.assertTrue(set_info(calibration(31.0)).success)
+        # A good calibration for the images' size is then published, and stored whole where the
+        # next start reads it (written by the node through a temporary file; camera_info_manager's
+        # writer truncated the file in place and answered success whatever the write did).
+        answer = set_info(calibration(31.0))
+        self.assertTrue(answer.success, answer.status_message)
+        path = rospy.get_param("/calib/camera_node/camera_info_url")[len("file://"):]
+        self.assertIn("stored in " + path, answer.status_message)
+        with open(path) as f:
+            stored = yaml.safe_load(f)
+        self.assertEqual(stored["camera_matrix"]["data"][4], 31.0)
+        self.assertEqual((stored["image_width"], stored["image_height"]), (24, 16))
+        self.assertEqual([n for n in os.listdir(os.path.dirname(path))
+                          if os.path.basename(path) in n and n != os.path.basename(path)], [])
         t = rospy.get_time() + 0.2
         for info in infos_after(t, 3):
             self.assertEqual(info.K[4], 31.0)
