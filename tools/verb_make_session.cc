@@ -90,6 +90,9 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
                                 std::to_string(a.start_time));
   if (!(a.drop_probability >= 0.0 && a.drop_probability < 1.0))
     throw std::invalid_argument("--drop-probability must be in [0, 1), got " + std::to_string(a.drop_probability));
+  // Every message carries its frame (REP 103): an empty one made a bag bag-check passed.
+  if (a.camera_frame.empty()) throw std::invalid_argument("--camera-frame must not be empty");
+  if (a.anemometer_frame.empty()) throw std::invalid_argument("--anemometer-frame must not be empty");
   if (!(std::isfinite(a.rendered.max_edge) && a.rendered.max_edge >= 0))
     throw std::invalid_argument("--max-edge must be a finite length >= 0 m (0: the scene's), got " +
                                 std::to_string(a.rendered.max_edge));

@@ -109,6 +109,15 @@ std::string CheckCalibrationFile(const std::string& path) {
     const std::string problem = CheckMatrix(doc, key, rows, cols);
     if (!problem.empty()) return path + ": " + problem;
   }
+  // The models image_geometry undistorts with: another name (a typo, "plumb_bobb") was taken, and
+  // every consumer then rectified with no distortion at all.
+  if (doc["distortion_model"]) {
+    const YAML::Node model = doc["distortion_model"];
+    const std::string name = model.IsScalar() ? model.as<std::string>() : std::string("(not text)");
+    if (!name.empty() && name != "plumb_bob" && name != "rational_polynomial" && name != "equidistant")
+      return path + ": distortion_model is '" + name +
+             "', expected plumb_bob, rational_polynomial, equidistant or empty (no distortion)";
+  }
   return "";
 }
 

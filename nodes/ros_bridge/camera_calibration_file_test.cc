@@ -89,6 +89,20 @@ TEST_F(CameraCalibrationFileTest, BrokenYamlAndNonNumbersAreRefused) {
   EXPECT_EQ(CheckCalibrationFile(Write("c.ini", "[image]\n")), "");
 }
 
+// A distortion model image_geometry does not know (a typo) was taken, and every consumer then
+// rectified with no distortion at all.
+TEST_F(CameraCalibrationFileTest, AnUnknownDistortionModelIsRefused) {
+  std::string typo = Calibration();
+  typo.replace(typo.find("plumb_bob"), 9, "plumb_bobb");
+  EXPECT_THAT(CheckCalibrationFile(Write("typo.yaml", typo)),
+              AllOf(HasSubstr("typo.yaml"), HasSubstr("distortion_model is 'plumb_bobb', expected plumb_bob")));
+  for (const std::string model : {"rational_polynomial", "equidistant", "''"}) {
+    std::string other = Calibration();
+    other.replace(other.find("plumb_bob"), 9, model);
+    EXPECT_EQ(CheckCalibrationFile(Write("other.yaml", other)), "") << model;
+  }
+}
+
 TEST(CalibrationFilePathTest, FileAndPackageUrlsNameTheirFile) {
   const auto packages = [](const std::string& name) { return name == "clothwind" ? "/src/clothwind" : ""; };
   EXPECT_EQ(CalibrationFilePath("file:///a/b.yaml", packages), "/a/b.yaml");

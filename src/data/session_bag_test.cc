@@ -170,6 +170,18 @@ TEST(SessionBagTest, ADurationThatMakesNoSessionIsRefused) {
     EXPECT_TRUE(text.find("--fps") != std::string::npos || text.find("frames") != std::string::npos ||
                 text.find("--start-time") != std::string::npos) << args << ": " << text;
   }
+  // An empty frame id: every message carries one.
+  for (const char* option : {"--camera-frame", "--anemometer-frame"}) {
+    const fs::path bag = dir / "bad.bag";
+    const std::string log = (dir / "log").string();
+    const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes 0.1 " + option + " '' --out " +
+                            bag.string() + " > " + log + " 2>&1";
+    EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
+    EXPECT_FALSE(fs::exists(bag)) << option;
+    std::ifstream in(log);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find(std::string(option) + " must not be empty"), std::string::npos) << text;
+  }
   fs::remove_all(dir);
 }
 
