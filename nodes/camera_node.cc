@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include <camera_calibration_parsers/parse_ini.h>
 #include <camera_calibration_parsers/parse_yml.h>
 #include <camera_info_manager/camera_info_manager.h>
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -179,13 +180,21 @@ int main(int argc, char** argv) {
         if (calibration_path.empty()) {
           rsp.status_message = "the calibration is used but not stored: " + url + " is not a file:// or package:// URL";
         } else {
-          std::ostringstream yaml;
+          // In the format its extension names, as camera_info_manager chose (and refused others):
+          // YAML written into a .ini was unreadable at the next start.
+          std::string extension = std::filesystem::path(calibration_path).extension().string();
+          std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
+          std::ostringstream text;
           try {
-            if (!camera_calibration_parsers::writeCalibrationYml(yaml, camera_name, req.camera_info))
-              throw std::runtime_error("cannot write the calibration as YAML");
+            const bool ini = extension == ".ini";
+            if (!ini && extension != ".yaml" && extension != ".yml")
+              throw std::runtime_error(calibration_path + ": expected a .yaml, .yml or .ini file name");
+            const bool written = ini ? camera_calibration_parsers::writeCalibrationIni(text, camera_name, req.camera_info)
+                                     : camera_calibration_parsers::writeCalibrationYml(text, camera_name, req.camera_info);
+            if (!written) throw std::runtime_error(std::string("cannot write the calibration as ") + (ini ? "INI" : "YAML"));
             std::error_code ec;
             std::filesystem::create_directories(std::filesystem::path(calibration_path).parent_path(), ec);
-            clothwind::WriteFileAtomically(calibration_path, yaml.str());
+            clothwind::WriteFileAtomically(calibration_path, text.str());
             rsp.success = true;
             rsp.status_message = "stored in " + calibration_path;
           } catch (const std::exception& e) {

@@ -268,6 +268,16 @@ class CameraFolderTest(unittest.TestCase):
         self.assertEqual((stored["image_width"], stored["image_height"]), (24, 16))
         self.assertEqual([n for n in os.listdir(os.path.dirname(path))
                           if os.path.basename(path) in n and n != os.path.basename(path)], [])
+        # Into a .ini URL: the INI format, which camera_info_manager reads back there.
+        rospy.wait_for_service("/calib_ini/camera/set_camera_info", timeout=10.0)
+        answer = rospy.ServiceProxy("/calib_ini/camera/set_camera_info", SetCameraInfo)(calibration(31.0))
+        self.assertTrue(answer.success, answer.status_message)
+        ini = rospy.get_param("/calib_ini/camera_node/camera_info_url")[len("file://"):]
+        with open(ini) as f:
+            text = f.read()
+        self.assertIn("[image]", text)
+        self.assertNotIn("camera_matrix:", text)
+        os.remove(ini)
         t = rospy.get_time() + 0.2
         for info in infos_after(t, 3):
             self.assertEqual(info.K[4], 31.0)
