@@ -10,12 +10,14 @@
 // up the camera callback.
 #include <cmath>
 #include <csignal>
+#include <sys/stat.h>
 #include <filesystem>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <chrono>
 #include <vector>
 
@@ -129,6 +131,7 @@ class ClipBufferNode {
           std::make_unique<sensors::DatasetWriter>(record_dir_, jpeg_quality_, index_interval_), kRecordQueue);
       if (!recording_error_.empty()) ROS_INFO("clip_buffer: recording works again");
       recording_error_.clear();
+      record_dir_mounted_ = IsMountPoint(record_dir_);
       ROS_INFO("clip_buffer: recording clips to %s (%zu already there%s)", record_dir_.c_str(),
                writer_->size_at_open(),
                writer_->recovered() > 0
@@ -148,8 +151,13 @@ class ClipBufferNode {
   // Ctrl-C and SIGKILL 2 s later, and a kill mid-way lost the clips on disk since the last
   // index rewrite with no word (the writer now lists each clip as it lands). Clips given up are
   // named, and the tally, with the last write or index error, is said at the end.
+  ~ClipBufferNode() {
+    if (closer_.joinable()) closer_.join();
+  }
+
   void Finish() {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (closer_.joinable()) closer_.join();
     const auto deadline =
         std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                std::chrono::duration<double>(kShutdownBudget));
@@ -175,9 +183,10 @@ class ClipBufferNode {
     if (!s.index_error.empty()) ROS_ERROR("clip_buffer: index.json not rewritten: %s", s.index_error.c_str());
     ROS_INFO("clip_buffer: recording into %s ends: %llu clips written, %llu failed, %llu dropped (queue full), "
              "%zu given up at shutdown, %llu not recorded (no folder open)",
-             writer_->root().c_str(), static_cast<unsigned long long>(s.written),
-             static_cast<unsigned long long>(s.failed), static_cast<unsigned long long>(s.dropped),
-             abandoned.size(), static_cast<unsigned long long>(not_recorded_));
+             writer_->root().c_str(), static_cast<unsigned long long>(written_before_ + s.written),
+             static_cast<unsigned long long>(failed_before_ + s.failed),
+             static_cast<unsigned long long>(dropped_before_ + s.dropped), abandoned.size(),
+             static_cast<unsigned long long>(not_recorded_));
   }
 
  private:
@@ -276,7 +285,18 @@ class ClipBufferNode {
     if (writer_) {
       if (const std::string lost = writer_->FolderLost(); !lost.empty()) {
         NoteError(lost + "; reopening it every " + std::to_string(static_cast<int>(kReopenEvery)) + " s once it is there");
-        writer_.reset();  // its queued clips fail (the folder is gone), counted in its tally
+        // Its tally kept, its queued clips counted as not recorded; closed off this thread, as
+        // closing waits for the clip being written (seconds on a slow card), which held the
+        // camera callbacks and broke the clips being published.
+        const auto r = writer_->stats();
+        written_before_ += r.written;
+        failed_before_ += r.failed;
+        dropped_before_ += r.dropped;
+        not_recorded_ += r.queued;
+        failed_seen_ = dropped_seen_ = 0;
+        index_error_seen_.clear();
+        if (closer_.joinable()) closer_.join();
+        closer_ = std::thread([lost_writer = std::move(writer_)]() mutable { lost_writer.reset(); });
         folder_lost_ = true;
         recording_error_ = lost;
         last_open_attempt_ = ros::SteadyTime::now();
@@ -287,6 +307,10 @@ class ClipBufferNode {
       if (folder_lost_ && !std::filesystem::is_directory(record_dir_, ec)) {
         last_open_attempt_ = ros::SteadyTime::now();
         recording_error_ = "the recording folder " + record_dir_ + " is gone; waiting for it to come back";
+      } else if (folder_lost_ && record_dir_mounted_ && !IsMountPoint(record_dir_)) {
+        // A disk was mounted there: its bare mount point (an fstab entry) is not the disk.
+        last_open_attempt_ = ros::SteadyTime::now();
+        recording_error_ = "the disk mounted at " + record_dir_ + " is not there; waiting for it to come back";
       } else {
         OpenRecording();
       }
@@ -369,6 +393,16 @@ class ClipBufferNode {
     source_.wind_frame_id = wind_frame_.frame_id();
     if (!writer_->Enqueue(c, source_, deadline) && !c.clip.frames.empty())
       abandoned->push_back(sensors::ClipFolderName(c.clip.frames.front().stamp));
+  }
+
+  // Whether `dir` is a mount point: another device than its parent folder's.
+  static bool IsMountPoint(const std::string& dir) {
+    struct stat here {}, parent {};
+    std::filesystem::path folder = std::filesystem::absolute(dir).lexically_normal();
+    if (!folder.has_filename() && folder.has_relative_path()) folder = folder.parent_path();  // "/data/rec/"
+    const std::string up = folder.parent_path().string();
+    return ::stat(dir.c_str(), &here) == 0 && ::stat(up.empty() ? "/" : up.c_str(), &parent) == 0 &&
+           here.st_dev != parent.st_dev;
   }
 
   // "a, b, c" or "a, b, ... (n more), z": the log line stays readable with hundreds of clips.
@@ -462,8 +496,8 @@ class ClipBufferNode {
       stat.add("last other direction frame", wind_frame_.last_rejected_frame());
     stat.add("record folder", record_dir_.empty() ? "(not recording)" : record_dir_);
     const auto r = writer_ ? writer_->stats() : sensors::AsyncDatasetWriter::Stats();
-    stat.add("clips recorded", r.written);
-    stat.add("clips not recorded", not_recorded_ + r.failed + r.dropped);
+    stat.add("clips recorded", written_before_ + r.written);
+    stat.add("clips not recorded", not_recorded_ + failed_before_ + dropped_before_ + r.failed + r.dropped);
     stat.add("clips waiting to be written", r.queued);
     stat.add("clips not yet in index.json", r.unlisted);
     stat.addf("slowest clip write [s]", "%.3f", r.max_write_s);
@@ -500,6 +534,9 @@ class ClipBufferNode {
   bool index_flush_asked_ = false;  // since the last input
   std::string recording_error_;  // why record_dir_ is not open; empty when it is (or not set)
   bool folder_lost_ = false;     // it was open and went: reopened only once it exists again
+  bool record_dir_mounted_ = false;  // record_dir_ was a mount point when it was opened
+  std::thread closer_;               // closes a lost folder's writer off the spinner thread
+  uint64_t written_before_ = 0, failed_before_ = 0, dropped_before_ = 0;  // lost writers' tallies
   ros::SteadyTime last_open_attempt_;
   std::string last_error_;
   ros::SteadyTime last_error_time_, last_future_;

@@ -214,10 +214,22 @@ inline void WriteFilePairAtomically(const std::string& first, const std::string&
     fs::remove(tmp_second, ignored);
     throw;
   }
-  // The first file's old content, kept under a hard link until the pair is in place.
+  // The first file's old content, kept under a hard link (a copy where the filesystem has none:
+  // vfat, exFAT, some network mounts) until the pair is in place. Without it nothing is renamed:
+  // a failed second rename would then have no way back.
   const std::string backup = TemporaryNameFor(first + ".old");
-  const bool had_first = ::link(first.c_str(), backup.c_str()) == 0;
   std::error_code ec;
+  const bool had_first = fs::exists(first, ec);
+  if (had_first && ::link(first.c_str(), backup.c_str()) != 0) {
+    fs::copy_file(first, backup, ec);
+    if (ec) {
+      const std::string why = ec.message();
+      fs::remove(tmp_first, ignored);
+      fs::remove(tmp_second, ignored);
+      fs::remove(backup, ignored);
+      throw std::runtime_error("cannot keep " + first + " aside while its pair is replaced: " + why);
+    }
+  }
   fs::rename(tmp_first, first, ec);
   if (ec) {
     const std::string why = ec.message();

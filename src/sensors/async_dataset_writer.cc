@@ -47,7 +47,7 @@ bool AsyncDatasetWriter::Enqueue(LabelledClip clip, ClipSourceInfo source,
     std::unique_lock<std::mutex> lock(mutex_);
     room_.wait_until(lock, room_deadline, [this] { return queue_.size() < max_queue_ || stop_; });
     if (queue_.size() >= max_queue_) {
-      ++stats_.dropped;
+      ++stats_.abandoned;  // given up at the deadline (a shutdown's), not dropped by a full queue
       return false;
     }
     queue_.emplace_back(std::move(clip), std::move(source));

@@ -53,7 +53,8 @@ class AsyncDatasetWriter {
   // the thread to take a clip instead: for the last clips at shutdown, which a full queue of a
   // slow disk dropped without a word (no report came after them).
   bool Enqueue(LabelledClip clip, ClipSourceInfo source, bool wait_for_room = false);
-  // The same, waiting for room until `room_deadline` at most (then counted in dropped).
+  // The same, waiting for room until `room_deadline` at most (then counted in abandoned, as the
+  // clips DrainBy gives up).
   bool Enqueue(LabelledClip clip, ClipSourceInfo source, std::chrono::steady_clock::time_point room_deadline);
 
   // Blocks until every queued clip is recorded (or failed) and index.json lists them (or its

@@ -19,7 +19,7 @@ import roslib.packages
 import rospy
 import rostest
 import yaml
-from clothwind.msg import Clip, WindMeasurement
+from clothwind.msg import Clip, WindEstimate, WindMeasurement
 from sensor_msgs.msg import Image
 
 WIDTH, HEIGHT = 64, 48
@@ -256,6 +256,37 @@ class NodeParamsTest(unittest.TestCase):
         status = s.wait(30)
         self.assertEqual(status, 0, s.output())
         self.assertTrue(os.path.exists(summary), "no summary on SIGTERM; it said:\n%s" % s.output())
+
+    # A plot that cannot be written when the report ends (its folder gone since the start) costs only
+    # the plot: the summary is written, and the exit status says a file failed.
+    def test_a_plot_that_fails_at_the_end_costs_only_the_plot(self):
+        summary = os.path.join(self.folder, "summary.json")
+        plots = os.path.join(self.folder, "plots")
+        os.mkdir(plots)
+        rospy.set_param("/late_report/summary", summary)
+        rospy.set_param("/late_report/estimates", True)
+        rospy.set_param("/late_report/estimate_plot", os.path.join(plots, "p.png"))
+        s = self.spawn("clip_report_node", ["__name:=late_report"], cwd=self.folder)
+        clips = rospy.Publisher("/clips", Clip, queue_size=1)
+        deadline = time.time() + 20
+        while time.time() < deadline and clips.get_num_connections() == 0:
+            time.sleep(0.1)
+        self.assertGreater(clips.get_num_connections(), 0, s.output())
+        estimates = rospy.Publisher("/wind/estimate", WindEstimate, queue_size=5)
+        deadline = time.time() + 20
+        while time.time() < deadline and estimates.get_num_connections() == 0:
+            time.sleep(0.1)
+        e = WindEstimate()
+        e.header.stamp = e.clip_end = rospy.Time(1700000000, 0)
+        e.speed, e.speed_std, e.reference_speed = 4.0, 0.3, 4.5
+        estimates.publish(e)  # an estimate to plot
+        time.sleep(1.0)
+        shutil.rmtree(plots)
+        s.process.send_signal(signal.SIGTERM)
+        status = s.wait(30)
+        s.reader.join(5)
+        self.assertEqual(status, 1, s.output())
+        self.assertTrue(os.path.exists(summary), "the plot's failure cost the summary:\n%s" % s.output())
 
     # A misspelt key is named at start, not silently left to its default.
     def test_a_parameter_the_node_does_not_read_is_named(self):
