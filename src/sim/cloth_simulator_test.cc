@@ -659,6 +659,44 @@ Mesh TwoSheetsInContact() {
   return m;
 }
 
+// The repulsion's scale against ArcSim's rule evaluated by hand: collision_stiffness times the
+// smaller of the vertex's area (a third of its faces' rest areas) and the face's. A small
+// triangle's three corners hover 5 mm over a large one, so the vertex area is 1/800 of the
+// face's; the finite-difference tests cancel the scale, so max() or the face's area alone passed.
+TEST(ClothSimulatorTest, RepulsionStiffnessIsTheSmallerOfTheVertexAndFaceAreas) {
+  Mesh m;
+  m.V.resize(6, 3);
+  m.V << 0, 0, 0, 0.4, 0, 0, 0, 0.4, 0,  // face 0: 0.08 m^2
+      0.1, 0.1, 0.005, 0.13, 0.1, 0.005, 0.1, 0.12, 0.005;  // face 1: 3e-4 m^2, over face 0
+  m.U = m.V.leftCols(2);
+  m.F.resize(2, 3);
+  m.F << 0, 1, 2, 3, 4, 5;
+  SimOptions o = QuietOptions();
+  o.gravity.setZero();
+  ClothSimulator apart(m, ConstantStiffnessMaterial(), o, nullptr);
+  o.self_collision = true;
+  ClothSimulator close(m, ConstantStiffnessMaterial(), o, nullptr);
+  const Eigen::MatrixX3d repulsion = close.Forces() - apart.Forces();
+
+  const Eigen::Vector3d a = m.V.row(0).transpose(), b = m.V.row(1).transpose(), c = m.V.row(2).transpose();
+  const double face_area = 0.5 * (b - a).cross(c - a).norm();
+  const double vertex_area = 0.5 * (m.V.row(4) - m.V.row(3)).cross(m.V.row(5) - m.V.row(3)).norm() / 3.0;
+  ASSERT_LT(800 * vertex_area, 1.01 * face_area);
+  const double stiffness = o.collision_stiffness * std::min(vertex_area, face_area);
+  Eigen::MatrixX3d expected = Eigen::MatrixX3d::Zero(6, 3);
+  for (int p = 3; p < 6; ++p) {
+    Vector12d x;
+    x << m.V.row(p).transpose(), a, b, c;
+    const double side = (b - a).cross(c - a).dot(m.V.row(p).transpose() - a) > 0 ? 1.0 : -1.0;
+    const Vector12d f = RepulsionForce(x, side, o.repulsion_thickness, stiffness).force;
+    expected.row(p) += f.segment<3>(0).transpose();
+    for (int k = 0; k < 3; ++k) expected.row(k) += f.segment<3>(3 + 3 * k).transpose();
+  }
+  ASSERT_GT(expected.norm(), 0.0);
+  EXPECT_LT((repulsion - expected).norm(), 1e-9 * expected.norm()) << "repulsion\n" << repulsion << "\nexpected\n"
+                                                                   << expected;
+}
+
 TEST(ClothSimulatorTest, RepulsionInTheAssembledForcesIsMinusItsEnergysGradient) {
   // The element test checks the repulsion force against its own energy; this checks it inside the
   // simulator (pairs found, forces added at the vertex and its face's three) and that Energy()
