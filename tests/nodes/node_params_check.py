@@ -32,6 +32,42 @@ def node_path(name):
     return found[0]
 
 
+class ClipFeed:
+    """A clip buffer's inputs under namespace `ns`: 30 fps grey frames and a 4 m/s reading every
+    half second, stamped now, fed until a condition holds."""
+
+    def __init__(self, ns):
+        self.images = rospy.Publisher("/%s/camera/image_raw" % ns, Image, queue_size=100)
+        self.winds = rospy.Publisher("/%s/anemometer/wind" % ns, WindMeasurement, queue_size=20)
+        self.frame = 0
+
+    def connected(self, timeout):
+        deadline = time.time() + timeout
+        while time.time() < deadline and (self.images.get_num_connections() == 0 or
+                                          self.winds.get_num_connections() == 0):
+            time.sleep(0.1)
+        return self.images.get_num_connections() > 0
+
+    def until(self, done, seconds):
+        """Feeds until done() or `seconds` pass; returns done()."""
+        deadline = time.time() + seconds
+        while time.time() < deadline and not done():
+            stamp = rospy.Time.now()
+            img = Image()
+            img.header.stamp, img.header.frame_id = stamp, "camera_optical"
+            img.height, img.width, img.encoding, img.step = HEIGHT, WIDTH, "mono8", WIDTH
+            img.data = bytes([self.frame % 256]) * (WIDTH * HEIGHT)
+            self.images.publish(img)
+            if self.frame % 15 == 0:
+                wind = WindMeasurement()
+                wind.header.stamp, wind.header.frame_id = stamp, "anemometer"
+                wind.speed, wind.direction, wind.valid = 4.0, 0.0, True
+                self.winds.publish(wind)
+            self.frame += 1
+            time.sleep(1.0 / 30)
+        return done()
+
+
 class Spawned:
     """A node started from here, its console (stdout and stderr) kept as it comes."""
 
@@ -102,29 +138,10 @@ class NodeParamsTest(unittest.TestCase):
         node = self.spawn("clip_buffer_node", [
             "__ns:=numeric", "_record_dir:=20261206", "_num_frames:=10", "_stride:=10", "_size:=32",
             "_label_window:=2.0", "_label_delay:=0.5", "_flush_after:=1.0"], cwd=self.folder)
-        images = rospy.Publisher("/numeric/camera/image_raw", Image, queue_size=100)
-        winds = rospy.Publisher("/numeric/anemometer/wind", WindMeasurement, queue_size=20)
-        deadline = time.time() + 20
-        while time.time() < deadline and (images.get_num_connections() == 0 or winds.get_num_connections() == 0):
-            time.sleep(0.1)
-        self.assertGreater(images.get_num_connections(), 0, node.output())
+        feed = ClipFeed("numeric")
+        self.assertTrue(feed.connected(20), node.output())
         record = os.path.join(self.folder, "20261206")
-        deadline = time.time() + 30
-        frame = 0
-        while time.time() < deadline and not glob.glob(os.path.join(record, "*", "label.json")):
-            stamp = rospy.Time.now()
-            img = Image()
-            img.header.stamp, img.header.frame_id = stamp, "camera_optical"
-            img.height, img.width, img.encoding, img.step = HEIGHT, WIDTH, "mono8", WIDTH
-            img.data = bytes([frame % 256]) * (WIDTH * HEIGHT)
-            images.publish(img)
-            if frame % 15 == 0:
-                wind = WindMeasurement()
-                wind.header.stamp, wind.header.frame_id = stamp, "anemometer"
-                wind.speed, wind.direction, wind.valid = 4.0, 0.0, True
-                winds.publish(wind)
-            frame += 1
-            time.sleep(1.0 / 30)
+        feed.until(lambda: glob.glob(os.path.join(record, "*", "label.json")), 30)
         self.assertTrue(glob.glob(os.path.join(record, "*", "label.json")),
                         "no clip recorded into %s; node said:\n%s" % (record, node.output()))
         self.assertIn('~record_dir is set to the int 20261206, read as the text "20261206"', node.output())
@@ -136,37 +153,13 @@ class NodeParamsTest(unittest.TestCase):
         node = self.spawn("clip_buffer_node", [
             "__ns:=lost", "_record_dir:=" + record, "_num_frames:=10", "_stride:=10", "_size:=32",
             "_label_window:=2.0", "_label_delay:=0.5", "_flush_after:=1.0"], cwd=self.folder)
-        images = rospy.Publisher("/lost/camera/image_raw", Image, queue_size=100)
-        winds = rospy.Publisher("/lost/anemometer/wind", WindMeasurement, queue_size=20)
-        deadline = time.time() + 20
-        while time.time() < deadline and (images.get_num_connections() == 0 or winds.get_num_connections() == 0):
-            time.sleep(0.1)
-        self.assertGreater(images.get_num_connections(), 0, node.output())
-        frame = [0]
-
-        def stream_until(done, seconds):
-            deadline = time.time() + seconds
-            while time.time() < deadline and not done():
-                stamp = rospy.Time.now()
-                img = Image()
-                img.header.stamp, img.header.frame_id = stamp, "camera_optical"
-                img.height, img.width, img.encoding, img.step = HEIGHT, WIDTH, "mono8", WIDTH
-                img.data = bytes([frame[0] % 256]) * (WIDTH * HEIGHT)
-                images.publish(img)
-                if frame[0] % 15 == 0:
-                    wind = WindMeasurement()
-                    wind.header.stamp, wind.header.frame_id = stamp, "anemometer"
-                    wind.speed, wind.direction, wind.valid = 4.0, 0.0, True
-                    winds.publish(wind)
-                frame[0] += 1
-                time.sleep(1.0 / 30)
-            return done()
-
-        self.assertTrue(stream_until(lambda: glob.glob(os.path.join(record, "*", "label.json")), 30),
+        feed = ClipFeed("lost")
+        self.assertTrue(feed.connected(20), node.output())
+        self.assertTrue(feed.until(lambda: glob.glob(os.path.join(record, "*", "label.json")), 30),
                         "no clip recorded into %s; node said:\n%s" % (record, node.output()))
         os.rename(record, record + ".old")
         os.mkdir(record)
-        self.assertTrue(stream_until(lambda: glob.glob(os.path.join(record, "*", "label.json")), 40),
+        self.assertTrue(feed.until(lambda: glob.glob(os.path.join(record, "*", "label.json")), 40),
                         "nothing recorded into the folder made again; node said:\n%s" % node.output())
         self.assertIn("no longer the one opened", node.output())  # said (stderr; INFO is buffered)
         self.assertIn("reopening it every 10 s once it is there", node.output())
