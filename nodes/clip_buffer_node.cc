@@ -369,7 +369,12 @@ class ClipBufferNode {
 
   static constexpr double kLatestStamp = 4294967295.0 - 3600.0;  // [s] ROS time's end, less an hour
 
-  void Record(const sensors::LabelledClip& c) {
+  // Queues a clip for the recording (a full queue is counted by the writer, reported by OnTimer).
+  // At shutdown (`abandoned` given) it waits for room until `deadline`, and a clip that finds none
+  // is named in *abandoned.
+  void Record(const sensors::LabelledClip& c,
+              std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point(),
+              std::vector<std::string>* abandoned = nullptr) {
     if (record_dir_.empty()) return;
     if (!writer_) {
       ++not_recorded_;
@@ -377,23 +382,13 @@ class ClipBufferNode {
     }
     source_.frame_id = frame_id_;
     source_.wind_frame_id = wind_frame_.frame_id();
-    writer_->Enqueue(c, source_);  // a full queue is counted by the writer, reported by OnTimer
+    if (!abandoned) {
+      writer_->Enqueue(c, source_);
+    } else if (!writer_->Enqueue(c, source_, deadline) && !c.clip.frames.empty()) {
+      abandoned->push_back(sensors::ClipFolderName(c.clip.frames.front().stamp));
+    }
   }
 
-  // At shutdown: waits for room in the queue until `deadline`; a clip that finds none is named in
-  // *abandoned.
-  void Record(const sensors::LabelledClip& c, std::chrono::steady_clock::time_point deadline,
-              std::vector<std::string>* abandoned) {
-    if (record_dir_.empty()) return;
-    if (!writer_) {
-      ++not_recorded_;
-      return;
-    }
-    source_.frame_id = frame_id_;
-    source_.wind_frame_id = wind_frame_.frame_id();
-    if (!writer_->Enqueue(c, source_, deadline) && !c.clip.frames.empty())
-      abandoned->push_back(sensors::ClipFolderName(c.clip.frames.front().stamp));
-  }
 
   // Whether `dir` is a mount point: another device than its parent folder's.
   static bool IsMountPoint(const std::string& dir) {

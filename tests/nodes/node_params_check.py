@@ -131,6 +131,22 @@ class NodeParamsTest(unittest.TestCase):
         self.spawned.append(s)
         return s
 
+    def expect_refused(self, cases, prefix):
+        """Starts each (node, private parameters, message) at once as /<prefix>_<i> and expects it
+        to end with status 1 and a FATAL holding the message."""
+        started = []
+        for i, (node, params, _) in enumerate(cases):
+            name = "/%s_%d" % (prefix, i)
+            for key, value in params.items():
+                rospy.set_param(name + "/" + key, value)
+            started.append(self.spawn(node, ["__name:=" + name.lstrip("/")], cwd=self.folder))
+        for (node, params, message), s in zip(cases, started):
+            status = s.wait(30)
+            s.reader.join(5)
+            self.assertEqual(status, 1, "%s %s did not end; it said:\n%s" % (node, params, s.output()))
+            self.assertIn(message, s.output(), (node, params))
+            self.assertIn("FATAL", s.output(), (node, params))
+
     # `rosrun clothwind clip_buffer_node _record_dir:=20261206` (and roslaunch's record_dir:=20261206
     # before its launch files said type="str") stores an int: the node read no text, left
     # record_dir empty and recorded nothing, without a word.
@@ -177,18 +193,7 @@ class NodeParamsTest(unittest.TestCase):
              "~baud is set to a double (9600), expected an int"),
             ("sdn_node", {"model": self.folder, "threads": "2"}, '~threads is set to a string ("2"), expected an int'),
         ]
-        started = []
-        for node, params, _ in cases:
-            name = "/bad_" + node
-            for key, value in params.items():
-                rospy.set_param(name + "/" + key, value)
-            started.append(self.spawn(node, ["__name:=" + name.lstrip("/")], cwd=self.folder))
-        for (node, _, message), s in zip(cases, started):
-            status = s.wait(30)
-            s.reader.join(5)
-            self.assertEqual(status, 1, "%s did not end on a bad parameter; it said:\n%s" % (node, s.output()))
-            self.assertIn(message, s.output(), node)
-            self.assertIn("FATAL", s.output(), node)
+        self.expect_refused(cases, "bad")
 
     # Values out of range end the node naming the parameter and the value given: ~roi's 10.6 was
     # rounded, [100, 50, 0] dropped x and y without a word; a USB station read with the NMEA
@@ -203,37 +208,16 @@ class NodeParamsTest(unittest.TestCase):
             ("anemometer_node", {"input": "usb", "protocol": "nmea"}, "~protocol: 'nmea' cannot read ~input: usb"),
             ("wind_display_node", {"rate": 1e-12}, "~rate must be from 0.001 to 1000 Hz, got 1e-12"),
         ]
-        started = []
-        for i, (node, params, _) in enumerate(cases):
-            name = "/range_%d" % i
-            for key, value in params.items():
-                rospy.set_param(name + "/" + key, value)
-            started.append(self.spawn(node, ["__name:=" + name.lstrip("/")], cwd=self.folder))
-        for (node, params, message), s in zip(cases, started):
-            status = s.wait(30)
-            s.reader.join(5)
-            self.assertEqual(status, 1, "%s %s did not end; it said:\n%s" % (node, params, s.output()))
-            self.assertIn(message, s.output(), (node, params))
-            self.assertIn("FATAL", s.output(), (node, params))
+        self.expect_refused(cases, "range")
 
     # The report's output files are checked at start: a mistyped folder failed only after the whole
     # replay, naming a temporary file; a plot asked for without estimates was silently not drawn.
     def test_the_report_refuses_output_paths_it_cannot_write_at_start(self):
-        cases = [
-            ({"summary": os.path.join(self.folder, "no-such-folder", "s.json")}, "~summary"),
-            ({"summary": self.folder}, "is a folder; expected a file name"),
-            ({"estimate_plot": os.path.join(self.folder, "p.png")}, "it needs ~estimates true"),
-        ]
-        for i, (params, message) in enumerate(cases):
-            name = "/bad_report_%d" % i
-            for key, value in params.items():
-                rospy.set_param(name + "/" + key, value)
-            s = self.spawn("clip_report_node", ["__name:=" + name.lstrip("/")], cwd=self.folder)
-            status = s.wait(30)
-            s.reader.join(5)
-            self.assertEqual(status, 1, "clip_report %s did not end; it said:\n%s" % (params, s.output()))
-            self.assertIn(message, s.output(), params)
-            self.assertIn("FATAL", s.output(), params)
+        self.expect_refused([
+            ("clip_report_node", {"summary": os.path.join(self.folder, "no-such-folder", "s.json")}, "~summary"),
+            ("clip_report_node", {"summary": self.folder}, "is a folder; expected a file name"),
+            ("clip_report_node", {"estimate_plot": os.path.join(self.folder, "p.png")}, "it needs ~estimates true"),
+        ], "bad_report")
 
     # SIGTERM (systemd, docker stop, kill) ends the report as Ctrl-C does: printed and written.
     def test_the_report_writes_its_summary_on_sigterm(self):
