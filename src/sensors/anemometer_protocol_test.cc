@@ -198,7 +198,7 @@ TEST(AnemometerDecoder, ImplausibleReadingsAreParseErrors) {
   const std::vector<Case> cases = {
       {WithNmeaChecksum("IIMWV,229.0,R,500.0,M,A"), "speed 500"},
       {WithNmeaChecksum("IIMWV,229.0,R,175.0,N,A"), "speed 90.0"},  // 175 kn = 90.03 m/s
-      {WithNmeaChecksum("WIXDR,A,400.0,D,WINDDIR,N,7.5,M,WINDSPEED"), "direction 400"},
+      {WithNmeaChecksum("WIXDR,A,400.0,D,WINDDIR,N,7.5,M,WINDSPEED"), "'WINDDIR' field 2 (direction): expected 0..360 deg, got 400.0"},
       {WithNmeaChecksum("WIXDR,N,7.5,M,WINDSPEED,N,120,M,WINDGUST"), "gust 120"},
       {GillRecord("Q,229,095.00,M,00,"), "speed 95"},
       {"3.25,270,91", "gust 91"},

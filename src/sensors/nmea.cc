@@ -170,6 +170,11 @@ ParseResult ParseXdr(const NmeaSentence& s) {
       if (units != "D")
         return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] +
                                                  "': direction units expected D (degrees), got '" + units + "'");
+      // As MWV's angle: named here with its field (ImplausibleWindReason refused it later, unplaced).
+      if (value < 0.0 || value > 360.0)
+        return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] + "' field " +
+                                                 std::to_string(q + 2) + " (direction): expected 0..360 deg, got " +
+                                                 s.fields[q + 1]);
       w.from_angle_deg = value;
       w.reference = AngleReference::kInstrument;
       any = true;

@@ -215,6 +215,10 @@ TEST(Nmea, NegativeSpeedNamesTheFieldAndValue) {
   r = ParseNmea(WithNmeaChecksum("WIXDR,A,225.0,D,WINDDIR,N,-7.5,M,WINDSPEED"));
   ASSERT_EQ(r.status, ParseStatus::kMalformed);
   EXPECT_NE(r.error.find("'WINDSPEED' field 6 (speed): expected >= 0, got -7.5"), std::string::npos) << r.error;
+  // A direction out of 0..360 is named with its field here, as MWV's angle is.
+  r = ParseNmea(WithNmeaChecksum("WIXDR,A,-10.0,D,WINDDIR,N,7.5,M,WINDSPEED"));
+  ASSERT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("'WINDDIR' field 2 (direction): expected 0..360 deg, got -10.0"), std::string::npos) << r.error;
 }
 
 }  // namespace
