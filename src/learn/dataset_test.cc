@@ -223,7 +223,7 @@ TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
   {
     const fs::path d = Copy("split_type");
     EditJson(d / "index.json", [](nlohmann::json& j) { j["clips"][1]["split"] = 5; });
-    expect_error(d, (d / "index.json").string(), "\"split\" must be");
+    expect_error(d, (d / "index.json").string(), "\"clips[1].split\" must be");
   }
   {
     const fs::path d = Copy("label_folder");
