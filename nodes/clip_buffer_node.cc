@@ -10,7 +10,6 @@
 // up the camera callback.
 #include <cmath>
 #include <csignal>
-#include <sys/stat.h>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -18,6 +17,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <atomic>
 #include <chrono>
 #include <vector>
 
@@ -131,7 +131,7 @@ class ClipBufferNode {
           std::make_unique<sensors::DatasetWriter>(record_dir_, jpeg_quality_, index_interval_), kRecordQueue);
       if (!recording_error_.empty()) ROS_INFO("clip_buffer: recording works again");
       recording_error_.clear();
-      record_dir_mounted_ = IsMountPoint(record_dir_);
+      record_dir_mounted_ = sensors::IsMountPoint(record_dir_);
       ROS_INFO("clip_buffer: recording clips to %s (%zu already there%s)", record_dir_.c_str(),
                writer_->size_at_open(),
                writer_->recovered() > 0
@@ -157,7 +157,8 @@ class ClipBufferNode {
 
   void Finish() {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (closer_.joinable()) closer_.join();
+    // (A lost folder's writer still closing is joined by the destructor, after the last clips: a
+    // yanked disk's write can hang past roslaunch's SIGKILL.)
     const auto deadline =
         std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                std::chrono::duration<double>(kShutdownBudget));
@@ -171,6 +172,11 @@ class ClipBufferNode {
       if (not_recorded_ > 0)
         ROS_WARN("clip_buffer: %llu clips not recorded (no recording folder open: %s)",
                  static_cast<unsigned long long>(not_recorded_), recording_error_.c_str());
+      if (written_before_ + failed_before_ + dropped_before_ > 0)
+        ROS_INFO("clip_buffer: recording into %s ends with its folder lost: %llu clips written, %llu failed, "
+                 "%llu dropped (queue full) before",
+                 record_dir_.c_str(), static_cast<unsigned long long>(written_before_),
+                 static_cast<unsigned long long>(failed_before_), static_cast<unsigned long long>(dropped_before_));
       return;
     }
     writer_->DrainBy(deadline, &abandoned);
@@ -295,8 +301,12 @@ class ClipBufferNode {
         not_recorded_ += r.queued;
         failed_seen_ = dropped_seen_ = 0;
         index_error_seen_.clear();
-        if (closer_.joinable()) closer_.join();
-        closer_ = std::thread([lost_writer = std::move(writer_)]() mutable { lost_writer.reset(); });
+        if (closer_.joinable()) closer_.join();  // done: no reopen before it closed (below)
+        closer_closed_ = false;
+        closer_ = std::thread([this, lost_writer = std::move(writer_)]() mutable {
+          lost_writer.reset();
+          closer_closed_ = true;
+        });
         folder_lost_ = true;
         recording_error_ = lost;
         last_open_attempt_ = ros::SteadyTime::now();
@@ -304,10 +314,14 @@ class ClipBufferNode {
     }
     if (!writer_ && !record_dir_.empty() && (ros::SteadyTime::now() - last_open_attempt_).toSec() >= kReopenEvery) {
       std::error_code ec;
-      if (folder_lost_ && !std::filesystem::is_directory(record_dir_, ec)) {
+      if (!closer_closed_) {
+        // The lost writer still finishing its clip: two writers in one path would each rewrite
+        // the index from their own list.
+        last_open_attempt_ = ros::SteadyTime::now();
+      } else if (folder_lost_ && !std::filesystem::is_directory(record_dir_, ec)) {
         last_open_attempt_ = ros::SteadyTime::now();
         recording_error_ = "the recording folder " + record_dir_ + " is gone; waiting for it to come back";
-      } else if (folder_lost_ && record_dir_mounted_ && !IsMountPoint(record_dir_)) {
+      } else if (folder_lost_ && record_dir_mounted_ && !sensors::IsMountPoint(record_dir_)) {
         // A disk was mounted there: its bare mount point (an fstab entry) is not the disk.
         last_open_attempt_ = ros::SteadyTime::now();
         recording_error_ = "the disk mounted at " + record_dir_ + " is not there; waiting for it to come back";
@@ -390,15 +404,6 @@ class ClipBufferNode {
   }
 
 
-  // Whether `dir` is a mount point: another device than its parent folder's.
-  static bool IsMountPoint(const std::string& dir) {
-    struct stat here {}, parent {};
-    std::filesystem::path folder = std::filesystem::absolute(dir).lexically_normal();
-    if (!folder.has_filename() && folder.has_relative_path()) folder = folder.parent_path();  // "/data/rec/"
-    const std::string up = folder.parent_path().string();
-    return ::stat(dir.c_str(), &here) == 0 && ::stat(up.empty() ? "/" : up.c_str(), &parent) == 0 &&
-           here.st_dev != parent.st_dev;
-  }
 
   // "a, b, c" or "a, b, ... (n more), z": the log line stays readable with hundreds of clips.
   static std::string JoinNames(const std::vector<std::string>& names) {
@@ -531,6 +536,7 @@ class ClipBufferNode {
   bool folder_lost_ = false;     // it was open and went: reopened only once it exists again
   bool record_dir_mounted_ = false;  // record_dir_ was a mount point when it was opened
   std::thread closer_;               // closes a lost folder's writer off the spinner thread
+  std::atomic<bool> closer_closed_{true};  // it has (no writer closing now)
   uint64_t written_before_ = 0, failed_before_ = 0, dropped_before_ = 0;  // lost writers' tallies
   ros::SteadyTime last_open_attempt_;
   std::string last_error_;

@@ -15,6 +15,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 
@@ -221,9 +223,17 @@ inline void WriteFilePairAtomically(const std::string& first, const std::string&
   std::error_code ec;
   const bool had_first = fs::exists(first, ec);
   if (had_first && ::link(first.c_str(), backup.c_str()) != 0) {
-    fs::copy_file(first, backup, ec);
-    if (ec) {
-      const std::string why = ec.message();
+    // Durably, as the file it may be put back as.
+    std::string why;
+    try {
+      std::ifstream in(first, std::ios::binary);
+      const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      if (!in.good() && !in.eof()) throw std::runtime_error("cannot read " + first);
+      WriteFileDurably(backup, bytes.data(), bytes.size());
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+    if (!why.empty()) {
       fs::remove(tmp_first, ignored);
       fs::remove(tmp_second, ignored);
       fs::remove(backup, ignored);

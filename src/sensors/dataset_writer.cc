@@ -69,6 +69,16 @@ bool StartsWithFrame(const std::string& label_path, double source_stamp) {
 
 }  // namespace
 
+bool IsMountPoint(const std::string& dir) {
+  struct stat here {}, parent {};
+  std::error_code ec;
+  fs::path folder = fs::absolute(dir, ec).lexically_normal();
+  if (!folder.has_filename() && folder.has_relative_path()) folder = folder.parent_path();  // "/data/rec/"
+  const std::string up = folder.parent_path().string();
+  return ::stat(folder.c_str(), &here) == 0 && ::stat(up.empty() ? "/" : up.c_str(), &parent) == 0 &&
+         here.st_dev != parent.st_dev;
+}
+
 std::string ClipFolderName(double first_stamp) {
   const double whole = std::floor(first_stamp);
   const std::time_t seconds = static_cast<std::time_t>(whole);

@@ -32,6 +32,12 @@ struct ClipSourceInfo {
 // counted them once a pass.)
 std::string ClipFolderName(double first_stamp);
 
+// Whether `dir` is a mount point: on another device than its parent folder ("/" is not; a
+// trailing separator names the same folder). A recording folder that was one is reopened after
+// a loss only once a disk is mounted there again (its bare mount point is not the disk).
+// Inputs: dir  a folder path. Returns false when either cannot be stat'ed.
+bool IsMountPoint(const std::string& dir);
+
 // label.json of a recorded clip (format "clothwind-clip", version 1; see docs/clips.md).
 nlohmann::json ClipLabelJson(const LabelledClip& clip, const ClipSourceInfo& source, const std::string& name);
 

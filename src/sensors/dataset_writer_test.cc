@@ -1,5 +1,6 @@
 #include "sensors/dataset_writer.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -401,6 +402,20 @@ TEST_F(DatasetWriterTest, AMissingParentOrASwappedFolderStopsTheRecording) {
   EXPECT_EQ(Read(folder / "index.json")["clips"].size(), 1u);
   EXPECT_EQ(Read(folder / "index.json")["clips"][0]["name"], "clip-yesterday");
   EXPECT_NE(w.FolderLost().find("no longer the one opened"), std::string::npos) << w.FolderLost();
+}
+
+TEST(IsMountPointTest, AFolderOnItsParentsDeviceIsNotAndProcIs) {
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_mount_point_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  EXPECT_FALSE(IsMountPoint(dir.string()));
+  EXPECT_FALSE(IsMountPoint(dir.string() + "/"));
+  EXPECT_FALSE(IsMountPoint("/"));
+  EXPECT_FALSE(IsMountPoint((dir / "missing").string()));
+  fs::remove_all(dir);
+  struct stat proc {}, root {};
+  if (::stat("/proc", &proc) == 0 && ::stat("/", &root) == 0 && proc.st_dev != root.st_dev) {
+    EXPECT_TRUE(IsMountPoint("/proc"));
+  }
 }
 
 // A writer that died between a clip's rename into place and its index update: the clip is whole

@@ -249,10 +249,11 @@ class NodeParamsTest(unittest.TestCase):
         while time.time() < deadline and clips.get_num_connections() == 0:
             time.sleep(0.1)
         self.assertGreater(clips.get_num_connections(), 0, s.output())
-        estimates = rospy.Publisher("/wind/estimate", WindEstimate, queue_size=5)
+        estimates = rospy.Publisher("/wind/estimate", WindEstimate, queue_size=5, latch=True)
         deadline = time.time() + 20
         while time.time() < deadline and estimates.get_num_connections() == 0:
             time.sleep(0.1)
+        self.assertGreater(estimates.get_num_connections(), 0, s.output())
         e = WindEstimate()
         e.header.stamp = e.clip_end = rospy.Time(1700000000, 0)
         e.speed, e.speed_std, e.reference_speed = 4.0, 0.3, 4.5
