@@ -22,13 +22,10 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include <camera_calibration_parsers/parse_ini.h>
-#include <camera_calibration_parsers/parse_yml.h>
 #include <camera_info_manager/camera_info_manager.h>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/publisher.h>
@@ -134,9 +131,8 @@ int main(int argc, char** argv) {
   // by an empty calibration before anything asks for it. A refused file leaves camera_info
   // without calibration, said in diagnostics, rather than falling back to camera_info_manager's
   // default file, which is not the calibration asked for either; a COMMIT then writes the URL's
-  // file, or answers that it cannot.
-  // The manager serves set_camera_info in the namespace it is given: given one of its own, which
-  // no tool calls, and camera/set_camera_info is served below. Its writer truncated the file in
+  // file, or answers that it cannot. The manager serves set_camera_info in the namespace it is
+  // given: given one of its own, which no tool calls, and camera/set_camera_info is served below. Its writer truncated the file in
   // place and answered success whatever the write did (camera_calibration_parsers: "always
   // returns true"), so a full disk or a crash mid-write lost the calibration the tool was told
   // was stored.
@@ -180,21 +176,14 @@ int main(int argc, char** argv) {
         if (calibration_path.empty()) {
           rsp.status_message = "the calibration is used but not stored: " + url + " is not a file:// or package:// URL";
         } else {
-          // In the format its extension names, as camera_info_manager chose (and refused others):
-          // YAML written into a .ini was unreadable at the next start.
-          std::string extension = std::filesystem::path(calibration_path).extension().string();
-          std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
-          std::ostringstream text;
           try {
-            const bool ini = extension == ".ini";
-            if (!ini && extension != ".yaml" && extension != ".yml")
-              throw std::runtime_error(calibration_path + ": expected a .yaml, .yml or .ini file name");
-            const bool written = ini ? camera_calibration_parsers::writeCalibrationIni(text, camera_name, req.camera_info)
-                                     : camera_calibration_parsers::writeCalibrationYml(text, camera_name, req.camera_info);
-            if (!written) throw std::runtime_error(std::string("cannot write the calibration as ") + (ini ? "INI" : "YAML"));
+            // In the format its extension names: YAML written into a .ini was unreadable at the
+            // next start.
+            const std::string text =
+                clothwind::ros_bridge::CalibrationFileText(calibration_path, camera_name, req.camera_info);
             std::error_code ec;
             std::filesystem::create_directories(std::filesystem::path(calibration_path).parent_path(), ec);
-            clothwind::WriteFileAtomically(calibration_path, text.str());
+            clothwind::WriteFileAtomically(calibration_path, text);
             rsp.success = true;
             rsp.status_message = "stored in " + calibration_path;
           } catch (const std::exception& e) {

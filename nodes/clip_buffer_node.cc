@@ -8,6 +8,8 @@
 // All the logic is in sensors::ClipPipeline and sensors::DatasetWriter (see docs/clips.md); clips
 // are recorded on a thread of their own (sensors::AsyncDatasetWriter), so a slow disk never holds
 // up the camera callback.
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
@@ -17,8 +19,6 @@
 #include <optional>
 #include <string>
 #include <thread>
-#include <atomic>
-#include <chrono>
 #include <vector>
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -122,6 +122,10 @@ class ClipBufferNode {
              o.label_window, o.label_delay, o.gap_tolerance);
   }
 
+  ~ClipBufferNode() {
+    if (closer_.joinable()) closer_.join();
+  }
+
   // Opens record_dir_ (when set and not open yet); on failure keeps why for the diagnostics.
   void OpenRecording() {
     if (record_dir_.empty() || writer_) return;
@@ -151,10 +155,6 @@ class ClipBufferNode {
   // Ctrl-C and SIGKILL 2 s later, and a kill mid-way lost the clips on disk since the last
   // index rewrite with no word (the writer now lists each clip as it lands). Clips given up are
   // named, and the tally, with the last write or index error, is said at the end.
-  ~ClipBufferNode() {
-    if (closer_.joinable()) closer_.join();
-  }
-
   void Finish() {
     std::lock_guard<std::mutex> lock(mutex_);
     // (A lost folder's writer still closing is joined by the destructor, after the last clips: a
@@ -402,8 +402,6 @@ class ClipBufferNode {
       abandoned->push_back(sensors::ClipFolderName(c.clip.frames.front().stamp));
     }
   }
-
-
 
   // "a, b, c" or "a, b, ... (n more), z": the log line stays readable with hundreds of clips.
   static std::string JoinNames(const std::vector<std::string>& names) {

@@ -7,8 +7,12 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <sstream>
+#include <stdexcept>
 #include <tuple>
 
+#include <camera_calibration_parsers/parse_ini.h>
+#include <camera_calibration_parsers/parse_yml.h>
 #include <yaml-cpp/yaml.h>
 
 namespace clothwind::ros_bridge {
@@ -119,6 +123,19 @@ std::string CheckCalibrationFile(const std::string& path) {
              "', expected plumb_bob, rational_polynomial, equidistant or empty (no distortion)";
   }
   return "";
+}
+
+std::string CalibrationFileText(const std::string& path, const std::string& camera_name,
+                                const sensor_msgs::CameraInfo& info) {
+  const std::string lower = Lower(path);
+  const bool ini = EndsWith(lower, ".ini");
+  if (!ini && !EndsWith(lower, ".yaml") && !EndsWith(lower, ".yml"))
+    throw std::runtime_error(path + ": expected a .yaml, .yml or .ini file name");
+  std::ostringstream text;
+  const bool written = ini ? camera_calibration_parsers::writeCalibrationIni(text, camera_name, info)
+                           : camera_calibration_parsers::writeCalibrationYml(text, camera_name, info);
+  if (!written) throw std::runtime_error(std::string("cannot write the calibration as ") + (ini ? "INI" : "YAML"));
+  return text.str();
 }
 
 }  // namespace clothwind::ros_bridge

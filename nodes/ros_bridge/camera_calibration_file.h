@@ -12,6 +12,8 @@
 #include <functional>
 #include <string>
 
+#include <sensor_msgs/CameraInfo.h>
+
 namespace clothwind::ros_bridge {
 
 // camera_info_manager's URL when ~camera_info_url is empty.
@@ -36,6 +38,14 @@ std::string CalibrationFilePath(const std::string& resolved_url,
 // CameraInfo's (K and R 3x3, P 3x4; D any), rows x cols other than the length of data, or data
 // that are not numbers. A matrix left out is not judged (the parser fails on that harmlessly).
 std::string CheckCalibrationFile(const std::string& path);
+
+// A calibration as the text of the file at `path`, in the format its extension names (as
+// camera_info_manager chose it: .yaml or .yml YAML, .ini INI).
+// Inputs: path  the file it is for; camera_name  its camera_name; info  the calibration.
+// Returns the text. Throws std::runtime_error naming the file for another extension, or when
+// camera_calibration_parsers cannot write it.
+std::string CalibrationFileText(const std::string& path, const std::string& camera_name,
+                                const sensor_msgs::CameraInfo& info);
 
 }  // namespace clothwind::ros_bridge
 

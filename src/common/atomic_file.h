@@ -15,8 +15,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <stdexcept>
 #include <string>
 
@@ -207,55 +205,41 @@ inline void WriteFilePairAtomically(const std::string& first, const std::string&
   namespace fs = std::filesystem;
   const std::string tmp_first = TemporaryNameFor(first);
   const std::string tmp_second = TemporaryNameFor(second);
-  std::error_code ignored;
+  const std::string backup = TemporaryNameFor(first + ".old");
+  std::error_code ignored, ec;
+  auto remove_temporaries = [&] {
+    for (const std::string* p : {&tmp_first, &tmp_second, &backup}) fs::remove(*p, ignored);
+  };
+  // The first file's old content is kept under a hard link (a durable copy where the filesystem
+  // has none: vfat, exFAT, some network mounts) until the pair is in place. Without it nothing is
+  // renamed: a failed second rename would then have no way back.
+  const bool had_first = fs::exists(first, ec);
   try {
     WriteFileDurably(tmp_first, first_bytes.data(), first_bytes.size());
     WriteFileDurably(tmp_second, second_bytes.data(), second_bytes.size());
+    if (had_first && ::link(first.c_str(), backup.c_str()) != 0) {
+      fs::copy_file(first, backup, ec);
+      if (ec) throw std::runtime_error("cannot keep " + first + " aside while its pair is replaced: " + ec.message());
+      SyncFile(backup);
+    }
   } catch (...) {
-    fs::remove(tmp_first, ignored);
-    fs::remove(tmp_second, ignored);
+    remove_temporaries();
     throw;
-  }
-  // The first file's old content, kept under a hard link (a copy where the filesystem has none:
-  // vfat, exFAT, some network mounts) until the pair is in place. Without it nothing is renamed:
-  // a failed second rename would then have no way back.
-  const std::string backup = TemporaryNameFor(first + ".old");
-  std::error_code ec;
-  const bool had_first = fs::exists(first, ec);
-  if (had_first && ::link(first.c_str(), backup.c_str()) != 0) {
-    // Durably, as the file it may be put back as.
-    std::string why;
-    try {
-      std::ifstream in(first, std::ios::binary);
-      const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-      if (!in.good() && !in.eof()) throw std::runtime_error("cannot read " + first);
-      WriteFileDurably(backup, bytes.data(), bytes.size());
-    } catch (const std::exception& e) {
-      why = e.what();
-    }
-    if (!why.empty()) {
-      fs::remove(tmp_first, ignored);
-      fs::remove(tmp_second, ignored);
-      fs::remove(backup, ignored);
-      throw std::runtime_error("cannot keep " + first + " aside while its pair is replaced: " + why);
-    }
   }
   fs::rename(tmp_first, first, ec);
   if (ec) {
     const std::string why = ec.message();
-    fs::remove(tmp_first, ignored);
-    fs::remove(tmp_second, ignored);
-    if (had_first) fs::remove(backup, ignored);
+    remove_temporaries();
     throw std::runtime_error("cannot rename " + tmp_first + " to " + first + ": " + why);
   }
   fs::rename(tmp_second, second, ec);
   if (ec) {
     const std::string why = ec.message();
-    fs::remove(tmp_second, ignored);
     if (had_first)
       fs::rename(backup, first, ignored);
     else
       fs::remove(first, ignored);
+    remove_temporaries();
     SyncDirectory(fs::path(first).parent_path().string());
     throw std::runtime_error("cannot rename " + tmp_second + " to " + second + ": " + why + " (" + first +
                              " is left as it was)");

@@ -148,38 +148,29 @@ TEST(SessionBagTest, ADurationThatMakesNoSessionIsRefused) {
   // Infinity (a frame count of undefined size) and a few milliseconds wrote an empty bag, exit 0.
   const fs::path dir = fs::temp_directory_path() / ("clothwind_session_bad_" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  for (const char* minutes : {"inf", "nan", "0.0001", "1e30"}) {
+  // Runs make-session with `args`; expects it refused, no bag left, and returns what it said.
+  auto refused = [&dir](const std::string& args) {
     const fs::path bag = dir / "bad.bag";
-    const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes " + minutes + " --out " +
-                            bag.string() + " > " + (dir / "log").string() + " 2>&1";
+    const std::string log = (dir / "log").string();
+    const std::string cmd =
+        std::string(CLOTHWIND_BIN) + " make-session " + args + " --out " + bag.string() + " > " + log + " 2>&1";
     EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
-    EXPECT_FALSE(fs::exists(bag)) << minutes;
-  }
+    EXPECT_FALSE(fs::exists(bag)) << args;
+    std::ifstream in(log);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  for (const char* minutes : {"inf", "nan", "0.0001", "1e30"}) refused(std::string("--minutes ") + minutes);
   // A camera too slow for a clip (every interval a hole; at 10 fps its jitter makes half of them
   // holes, and no stretch lasts a clip), nearly every frame dropped (no images),
   // a start so early a frame's jitter put it before time 0 (failed mid-write for some seeds).
   for (const char* args : {"--fps 8", "--fps 10", "--drop-probability 0.9999", "--start-time 0.001 --seed 3"}) {
-    const fs::path bag = dir / "bad.bag";
-    const std::string log = (dir / "log").string();
-    const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes 0.1 " + args + " --out " +
-                            bag.string() + " > " + log + " 2>&1";
-    EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
-    EXPECT_FALSE(fs::exists(bag)) << args;
-    std::ifstream in(log);
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string text = refused(std::string("--minutes 0.1 ") + args);
     EXPECT_TRUE(text.find("--fps") != std::string::npos || text.find("frames") != std::string::npos ||
                 text.find("--start-time") != std::string::npos) << args << ": " << text;
   }
   // An empty frame id: every message carries one.
   for (const char* option : {"--camera-frame", "--anemometer-frame"}) {
-    const fs::path bag = dir / "bad.bag";
-    const std::string log = (dir / "log").string();
-    const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes 0.1 " + option + " '' --out " +
-                            bag.string() + " > " + log + " 2>&1";
-    EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
-    EXPECT_FALSE(fs::exists(bag)) << option;
-    std::ifstream in(log);
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string text = refused(std::string("--minutes 0.1 ") + option + " ''");
     EXPECT_NE(text.find(std::string(option) + " must not be empty"), std::string::npos) << text;
   }
   fs::remove_all(dir);

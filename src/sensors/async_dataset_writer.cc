@@ -28,30 +28,27 @@ AsyncDatasetWriter::~AsyncDatasetWriter() {
 }
 
 bool AsyncDatasetWriter::Enqueue(LabelledClip clip, ClipSourceInfo source, bool wait_for_room) {
-  {
-    std::unique_lock<std::mutex> lock(mutex_);
-    if (wait_for_room) room_.wait(lock, [this] { return queue_.size() < max_queue_ || stop_; });
-    if (queue_.size() >= max_queue_) {
-      ++stats_.dropped;
-      return false;
-    }
-    queue_.emplace_back(std::move(clip), std::move(source));
-  }
-  wake_.notify_one();
-  return true;
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (wait_for_room) room_.wait(lock, [this] { return HasRoom(); });
+  return Queue(std::move(clip), std::move(source), &lock, &stats_.dropped);
 }
 
 bool AsyncDatasetWriter::Enqueue(LabelledClip clip, ClipSourceInfo source,
                                  std::chrono::steady_clock::time_point room_deadline) {
-  {
-    std::unique_lock<std::mutex> lock(mutex_);
-    room_.wait_until(lock, room_deadline, [this] { return queue_.size() < max_queue_ || stop_; });
-    if (queue_.size() >= max_queue_) {
-      ++stats_.abandoned;  // given up at the deadline (a shutdown's), not dropped by a full queue
-      return false;
-    }
-    queue_.emplace_back(std::move(clip), std::move(source));
+  std::unique_lock<std::mutex> lock(mutex_);
+  room_.wait_until(lock, room_deadline, [this] { return HasRoom(); });
+  // Given up at the deadline (a shutdown's), not dropped by a full queue.
+  return Queue(std::move(clip), std::move(source), &lock, &stats_.abandoned);
+}
+
+bool AsyncDatasetWriter::Queue(LabelledClip clip, ClipSourceInfo source, std::unique_lock<std::mutex>* lock,
+                               uint64_t* refused) {
+  if (queue_.size() >= max_queue_) {
+    ++*refused;
+    return false;
   }
+  queue_.emplace_back(std::move(clip), std::move(source));
+  lock->unlock();
   wake_.notify_one();
   return true;
 }

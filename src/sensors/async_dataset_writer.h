@@ -84,6 +84,10 @@ class AsyncDatasetWriter {
 
  private:
   void Run();
+  bool HasRoom() const { return queue_.size() < max_queue_ || stop_; }  // (mutex held)
+  // Queues the clip if there is room, else counts it in *refused; unlocks `lock` (held) when queued
+  // and wakes the thread. Returns whether it was queued.
+  bool Queue(LabelledClip clip, ClipSourceInfo source, std::unique_lock<std::mutex>* lock, uint64_t* refused);
 
   std::unique_ptr<DatasetWriter> writer_;  // used by the thread only, after construction
   const size_t max_queue_;
