@@ -38,7 +38,6 @@
 #include <limits>
 #include <memory>
 #include <optional>
-#include <set>
 #include <string>
 #include <utility>
 
@@ -55,6 +54,7 @@
 #include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wall_throttle.h"
+#include "sensors/sequence_gaps.h"
 #include "sensors/trailing_mean.h"
 
 namespace {
@@ -227,10 +227,10 @@ class SdnNode {
         camera_frames = clothwind::ros_bridge::ClipFrames(*clip);
         clothwind::ros_bridge::CheckClipFrameRate(*clip, predictor_->config().frame_rate);
       } catch (const std::invalid_argument& e) {
-        CountMalformedSequence(clip->sequence);
+        sequence_gaps_.Malformed(clip->sequence);
         throw MalformedClip(e.what());
       }
-      CountSequence(clip->sequence);
+      sequence_gaps_.Good(clip->sequence, ros::SteadyTime::now().toSec());
       if (follow_wind_) {  // a clip that passed the checks only
         // ~camera_heading is an angle in one frame: a direction in another says nothing of the way.
         const bool same_frame = camera_heading_frame_.empty() || clip->wind_direction_frame_id == camera_heading_frame_;
@@ -271,7 +271,7 @@ class SdnNode {
       if (latencies_.size() > 50) latencies_.pop_front();
       last_estimate_wall_ = ros::SteadyTime::now().toSec();
       stamps_.push_back(last_estimate_wall_);
-      TrimRecent(last_estimate_wall_);
+      TrimStamps(last_estimate_wall_);
       clip_error_.clear();
     } catch (const std::exception& e) {
       // Frames the model cannot read (a grey clip for a colour model, too few frames) are the
@@ -290,37 +290,9 @@ class SdnNode {
     using std::invalid_argument::invalid_argument;
   };
 
-  // Clips missing between two received ones (dropped by this node's queue when it lags, or
-  // upstream); a sequence that starts again (a restarted buffer or bag) counts nothing.
-  // A jump of more than a day's clips (at 25 fps with a stride of 1) is a new numbering, not
-  // losses: sequence 2^63 then 0, 1, 2 read as 9.2e18 clips missing.
-  // Counted for clips that pass the checks: a malformed clip's own number, however stray, does
-  // not move the sequence (one numbered 1000 between clips 1 and 2 read as 998 missing), and the
-  // malformed clips between two good ones arrived, so they are not missing either.
-  void CountSequence(uint64_t sequence) {
-    constexpr uint64_t kMaxGap = 25ull * 86400;
-    if (have_sequence_ && sequence > last_sequence_ + 1 && sequence - last_sequence_ - 1 <= kMaxGap) {
-      uint64_t gap = sequence - last_sequence_ - 1;
-      for (uint64_t m : malformed_since_good_) gap -= m > last_sequence_ && m < sequence;
-      if (gap > 0) {
-        missing_ += gap;
-        recent_missing_.emplace_back(ros::SteadyTime::now().toSec(), gap);
-      }
-    }
-    malformed_since_good_.clear();
-    last_sequence_ = sequence;
-    have_sequence_ = true;
-  }
-
-  // Bounded: a stream of malformed clips only (a colour model fed grey clips) would grow it for ever.
-  void CountMalformedSequence(uint64_t sequence) {
-    if (malformed_since_good_.size() < 4096) malformed_since_good_.insert(sequence);
-  }
-
-  // The last 30 s of wall time: the estimates' times (for the rate) and the gaps in the sequence.
-  void TrimRecent(double now) {
+  // The estimates' wall times over the last 30 s, for the rate.
+  void TrimStamps(double now) {
     while (!stamps_.empty() && now - stamps_.front() > 30.0) stamps_.pop_front();
-    while (!recent_missing_.empty() && now - recent_missing_.front().first > 30.0) recent_missing_.pop_front();
   }
 
   // ~flag_flies wind: the way the anemometer's wind makes the flag fly; a wind end-on to the
@@ -339,17 +311,11 @@ class SdnNode {
   // The trailing mean up to this estimate; its clip_start is the first frame of the oldest clip
   // averaged, clip_end and the stamp those of this one. It averages the network's outputs before
   // the clamp at 0 (`raw_speed`) and clamps the mean: a mean of clamped calm estimates is biased up.
+  // Clip time going back (a new bag, or a loop) starts it afresh.
   void PublishMean(const clothwind::WindEstimate& estimate, double raw_speed) {
-    const double end = estimate.clip_end.toSec();
-    if (!starts_.empty() && end < starts_.back().first) {  // clip time went back: a new bag, or a loop
-      starts_.clear();
-      ++mean_restarts_;
-    }
-    trailing_.Add(end, raw_speed, estimate.speed_std);
-    starts_.emplace_back(end, estimate.clip_start);
-    while (starts_.front().first < trailing_.Oldest()) starts_.pop_front();
+    trailing_.Add(estimate.clip_end.toSec(), raw_speed, estimate.speed_std, estimate.clip_start.toNSec());
     clothwind::WindEstimate mean = estimate;
-    mean.clip_start = starts_.front().second;
+    mean.clip_start.fromNSec(trailing_.OldestTag());
     mean.speed = clothwind::learn::ClampSpeed(trailing_.Mean());
     mean.speed_std = trailing_.Std();
     char model[64];
@@ -384,7 +350,7 @@ class SdnNode {
     }
     if (!latencies_.empty()) mean /= latencies_.size();
     const double now = ros::SteadyTime::now().toSec();
-    TrimRecent(now);
+    TrimStamps(now);
     // Estimates over the last 30 s: the intervals between them, N - 1 over the time they span
     // (N over the time since the first one overstated it until the window filled).
     const double rate =
@@ -409,8 +375,7 @@ class SdnNode {
       }
       // Clips lost while estimating: the counter alone left an OK over a model slower than the
       // clips come, its queue dropping most of them.
-      uint64_t missing = 0;
-      for (const auto& m : recent_missing_) missing += m.second;
+      const uint64_t missing = sequence_gaps_.RecentMissing(now);
       if (missing > 0) {
         char what[224];
         std::snprintf(what, sizeof what,
@@ -470,8 +435,8 @@ class SdnNode {
     stat.add("malformed clips", errors_);
     stat.add("clips the model failed on", model_errors_);
     stat.add("clips dropped (no model)", dropped_);
-    stat.add("clips missing from the sequence (queue or upstream)", missing_);
-    stat.add("trailing mean restarts (clip time went back)", mean_restarts_);
+    stat.add("clips missing from the sequence (queue or upstream)", sequence_gaps_.Missing());
+    stat.add("trailing mean restarts (clip time went back)", trailing_.Restarts());
     stat.add("seconds since the last estimate", idle);
     stat.add("last error", last_error_);
     std::string parameters;
@@ -496,15 +461,11 @@ class SdnNode {
   int threads_ = 2;
   std::unique_ptr<clothwind::learn::Predictor> predictor_;
   int queue_size_ = 2;
-  std::set<uint64_t> malformed_since_good_;  // sequence numbers of malformed clips since the last good one
-  std::deque<std::pair<double, uint64_t>> recent_missing_;  // (wall time [s], clips missing) of each gap
+  clothwind::sensors::SequenceGaps sequence_gaps_;  // clips missing, on the wall clock
   std::deque<double> latencies_, stamps_, ages_;  // ages_: [s] ROS time from clip end to its estimate
-  clothwind::sensors::TrailingMean trailing_;
-  std::deque<std::pair<double, ros::Time>> starts_;  // (clip end [s], clip start) of the averaged clips
+  clothwind::sensors::TrailingMean trailing_;  // tagged with each clip's start [ns]
   uint64_t estimates_ = 0, errors_ = 0, model_errors_ = 0, dropped_ = 0, turned_ = 0, undecided_ = 0,
            wind_unknown_ = 0;
-  uint64_t missing_ = 0, mean_restarts_ = 0, last_sequence_ = 0;
-  bool have_sequence_ = false;
   double last_estimate_wall_ = 0;                  // [s] wall time of the last estimate
   double loaded_wall_ = 0;                         // [s] wall time the model loaded
   std::string clip_error_;                          // the last clip's failure; cleared by a good clip

@@ -13,10 +13,13 @@ TrailingMean::TrailingMean(double window) : window_(window) {
   if (!(window > 0) || !std::isfinite(window)) throw std::invalid_argument("TrailingMean: window must be > 0 s");
 }
 
-void TrailingMean::Add(double t, double value, double std) {
-  if (!entries_.empty() && t < entries_.back().t) entries_.clear();
+void TrailingMean::Add(double t, double value, double std, std::uint64_t tag) {
+  if (!entries_.empty() && t < entries_.back().t) {
+    entries_.clear();
+    ++restarts_;
+  }
   const bool finite = std::isfinite(value);
-  entries_.push_back({t, finite ? value : kNaN, std::isfinite(std) ? std * std : kNaN});
+  entries_.push_back({t, finite ? value : kNaN, std::isfinite(std) ? std * std : kNaN, tag});
   while (!entries_.empty() && entries_.front().t <= t - window_) entries_.pop_front();
   // Sums over the window recomputed from its entries (a minute holds ~50 clips): running sums
   // kept by adding and subtracting lose a small value beside a huge one for good (one outlier of
@@ -43,5 +46,7 @@ double TrailingMean::Std() const {
 }
 
 double TrailingMean::Oldest() const { return entries_.empty() ? kNaN : entries_.front().t; }
+
+std::uint64_t TrailingMean::OldestTag() const { return entries_.empty() ? 0 : entries_.front().tag; }
 
 }  // namespace clothwind::sensors

@@ -5,6 +5,7 @@
 #define CLOTHWIND_SENSORS_TRAILING_MEAN_H_
 
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 
 namespace clothwind::sensors {
@@ -17,8 +18,10 @@ class TrailingMean {
 
   // Adds `value` (with its standard deviation `std`, NaN if none) at time t [s]. A non-finite value
   // is left out of the mean but still moves the window on. A t earlier than the newest (a replay
-  // that loops, a clock that jumped back) starts the window afresh.
-  void Add(double t, double value, double std = 0.0);
+  // that loops, a clock that jumped back) starts the window afresh and counts a restart.
+  // `tag` is carried with the entry and read back by OldestTag (sdn_node: the clip's first frame
+  // stamp in nanoseconds, which a double of seconds would round).
+  void Add(double t, double value, double std = 0.0, std::uint64_t tag = 0);
 
   // Values in the window (finite ones only).
   std::size_t Count() const { return count_; }
@@ -30,16 +33,22 @@ class TrailingMean {
   double Std() const;
   // Time of the oldest entry still in the window (finite value or not); NaN when empty.
   double Oldest() const;
+  // The tag given with that entry; 0 when empty.
+  std::uint64_t OldestTag() const;
+  // Times Add started the window afresh because time went back.
+  std::size_t Restarts() const { return restarts_; }
   double window() const { return window_; }
 
  private:
   struct Entry {
     double t, value, var;
+    std::uint64_t tag;
   };
   double window_;
   std::deque<Entry> entries_;
   std::size_t count_ = 0;   // finite values in entries_
   std::size_t no_std_ = 0;  // finite values without a finite std
+  std::size_t restarts_ = 0;
   double sum_ = 0, sum_var_ = 0;
 };
 

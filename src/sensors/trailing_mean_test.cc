@@ -1,6 +1,7 @@
 #include "sensors/trailing_mean.h"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -59,6 +60,30 @@ TEST(TrailingMeanTest, TimeGoingBackStartsAfresh) {
   EXPECT_EQ(m.Count(), 1u);
   EXPECT_DOUBLE_EQ(m.Mean(), 2.0);
   EXPECT_DOUBLE_EQ(m.Oldest(), 50.0);
+  EXPECT_EQ(m.Restarts(), 1u);
+  m.Add(50.0, 3.0, 0.1);  // the same time again is not going back
+  EXPECT_EQ(m.Restarts(), 1u);
+  EXPECT_EQ(m.Count(), 2u);
+}
+
+// sdn_node's wind/estimate_mean starts at the first frame of the oldest clip averaged: the tag
+// follows the window's oldest entry as entries leave it and when time goes back.
+TEST(TrailingMeanTest, TheOldestTagFollowsTheWindow) {
+  TrailingMean m(3.0);
+  EXPECT_EQ(m.OldestTag(), 0u);
+  // Stamps in nanoseconds beyond a double's 53 bits: they come back exactly.
+  const std::uint64_t ns = 1'765'000'000'123'456'789ull;
+  m.Add(10.0, 1.0, 0.1, ns);
+  m.Add(11.0, 1.0, 0.1, ns + 1);
+  EXPECT_EQ(m.OldestTag(), ns);
+  m.Add(13.0, kNaN, kNaN, ns + 3);  // (10, 13]: the entry of t = 10 leaves
+  EXPECT_EQ(m.OldestTag(), ns + 1);
+  EXPECT_EQ(m.Count(), 1u);  // a non-finite value is an entry of the window, not of the mean
+  m.Add(16.5, 2.0, 0.1, ns + 7);  // only the newest stays
+  EXPECT_EQ(m.OldestTag(), ns + 7);
+  m.Add(5.0, 2.0, 0.1, 42);  // time went back
+  EXPECT_EQ(m.OldestTag(), 42u);
+  EXPECT_EQ(m.Restarts(), 1u);
 }
 
 TEST(TrailingMeanTest, MatchesABruteForceMeanOverALongRandomStream) {
