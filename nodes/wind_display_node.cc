@@ -37,7 +37,8 @@
 // while the clock has not gone back (a second publisher, a relay, a bad stamp) is dropped as
 // late; a late one within 5 s joins the history but is not shown as the latest. Lazy, as
 // image_pipeline's nodes: nothing is drawn while neither display has a subscriber.
-// Drawing and averaging are the ROS-free sensors/wind_plot.
+// Drawing and averaging are the ROS-free sensors/wind_plot; which stamps are shown, when the display
+// restarts and its now, sensors/display_clock.
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -54,6 +55,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "sensors/display_clock.h"
 #include "sensors/wind_direction_frame.h"
 #include "sensors/wind_plot.h"
 #include "common/formatted.h"
@@ -69,7 +71,7 @@ using clothwind::sensors::WindSample;
 class WindDisplayNode {
  public:
   WindDisplayNode(ros::NodeHandle nh, clothwind::ros_bridge::StrictParams& params)
-      : estimates_(1.0), anemometer_(1.0) {
+      : clock_(kInputs, 1.0, WindHistory::kRestartAfter), estimates_(1.0), anemometer_(1.0) {
     mean_window_ = params.Get("mean_window", 60.0);
     plot_window_ = params.Get("plot_window", 180.0);
     plot_width_ = params.Get("plot_width", 640);
@@ -95,6 +97,7 @@ class WindDisplayNode {
                     plot_height_);
       throw std::invalid_argument(what);
     }
+    clock_ = clothwind::sensors::DisplayClock(kInputs, max_future_, WindHistory::kRestartAfter);
     span_ = std::max(mean_window_, plot_window_) + 10.0;
     estimates_ = WindHistory(span_);
     anemometer_ = WindHistory(span_);
@@ -126,7 +129,7 @@ class WindDisplayNode {
   void OnEstimate(const clothwind::WindEstimate::ConstPtr& msg) {
     // speed_std NaN means none (WindEstimate.msg); 1e300 filled the text with 300 digits.
     if (!Plausible(msg->speed) || !(std::isnan(msg->speed_std) || Plausible(msg->speed_std))) return;
-    if (!AdmitStamp(msg->header.stamp, &newest_estimate_)) return;
+    if (!AdmitStamp(msg->header.stamp, kEstimateInput)) return;
     estimates_.Add({msg->header.stamp.toSec(), msg->speed, msg->speed_std});
     // The latest by stamp, not by arrival: a late estimate joins the history only (shown as the
     // latest, it hid the newer one and aged the display).
@@ -160,7 +163,7 @@ class WindDisplayNode {
       return;
     }
     if (!Plausible(msg->speed)) return;
-    if (!AdmitStamp(msg->header.stamp, &newest_wind_)) return;
+    if (!AdmitStamp(msg->header.stamp, kWindInput)) return;
     anemometer_.Add({msg->header.stamp.toSec(), msg->speed, 0.0});
     const bool newest = !have_wind_ || msg->header.stamp >= last_wind_.header.stamp;
     if (newest) {
@@ -196,47 +199,34 @@ class WindDisplayNode {
     }
   }
 
-  // Whether an input's stamp may be shown; keeps each input's newest stamp (the newer of the two
-  // stamps the displays: bag time on replay, so rviz on sim time shows them in step with the images).
-  // Refused (counted): stamp 0 (it would stamp the displays 0 and empty the plot), and a stamp more
-  // than ~max_future ahead of a running clock (one reading stamped TIME_MAX made every later age
-  // a Duration out of range, which killed the node; one 100 s ahead moved the display's now and
-  // wiped the history), unless it is of the pass before the clock went back. A stamp more than
-  // kRestartAfter behind the newest of the same input is dropped as late while the clock runs
-  // (the clock going back is CheckClock's restart); with no clock yet it restarts the display.
-  // (Per input: estimates lag the readings by a clip's span and the model's queue, which is no
-  // restart.) All in double seconds: ros::Time arithmetic throws on results beyond 32 bits.
-  bool AdmitStamp(const ros::Time& stamp, ros::Time* newest_of_input) {
-    CheckClock();  // a new pass's first message may come before the next tick notices the jump
-    if (stamp.isZero()) {
-      Dropped(&unstamped_, kUnstamped);
-      return false;
-    }
-    const double now = ros::Time::now().toSec(), t = stamp.toSec();
-    if (now > 0 && t > now + max_future_) {
-      // Stamped before the clock last went back: the previous pass's, not a clock fault.
-      if (t <= clock_before_restart_ + max_future_) {
+  // Whether an input's stamp may be shown (sensors/display_clock.h says which stamps are refused
+  // and when the display restarts); the refused are counted, by cause.
+  bool AdmitStamp(const ros::Time& stamp, int input) {
+    bool restarted = false;
+    const auto verdict = clock_.Admit(input, stamp.toNSec(), ros::Time::now().toNSec(), &restarted);
+    if (restarted) ForgetShown();
+    using Verdict = clothwind::sensors::DisplayClock::Verdict;
+    switch (verdict) {
+      case Verdict::kShow:
+        return true;
+      case Verdict::kUnstamped:
+        Dropped(&unstamped_, kUnstamped);
+        return false;
+      case Verdict::kPreviousPass:
         ++previous_pass_;
         return false;
-      }
-      Dropped(&future_stamped_, kFuture);
-      WALL_WARN_THROTTLE(10.0, "wind_display: input stamped %.1f s ahead of the clock dropped", t - now);
-      return false;
-    }
-    const double newest = newest_of_input->toSec();
-    if (t + WindHistory::kRestartAfter < newest) {
-      // The replay restarted when the clock went back too (or has not started); otherwise this one
-      // message is late and wiping the display for it was wrong.
-      if (now > 0 && now + WindHistory::kRestartAfter >= newest) {
+      case Verdict::kFuture:
+        Dropped(&future_stamped_, kFuture);
+        WALL_WARN_THROTTLE(10.0, "wind_display: input stamped %.1f s ahead of the clock dropped",
+                           stamp.toSec() - ros::Time::now().toSec());
+        return false;
+      case Verdict::kLate:
         Dropped(&late_, kLate);
         WALL_WARN_THROTTLE(10.0, "wind_display: input stamped %.1f s behind the newest of its kind dropped",
-                           newest - t);
+                           ros::Time().fromNSec(clock_.Newest(input)).toSec() - stamp.toSec());
         return false;
-      }
-      Restart(std::max(newest, last_clock_));
     }
-    *newest_of_input = std::max(*newest_of_input, stamp);
-    return true;
+    return false;
   }
 
   // A speed an anemometer can read (0..100 m/s, as the clip labels take): others are dropped and
@@ -261,36 +251,14 @@ class WindDisplayNode {
     last_drop_wall_[cause] = ros::SteadyTime::now();
   }
 
-  // Restarts the display when ROS time went back more than kRestartAfter since it was last read
-  // (a replay played again), once: from the first message of the new pass or the next tick,
-  // whichever comes first (both restarted, and the new pass's first reading was wiped).
-  void CheckClock() {
-    const double clock = ros::Time::now().toSec();
-    if (clock > 0 && last_clock_ > 0 && clock + WindHistory::kRestartAfter < last_clock_) {
-      Restart(std::max(last_clock_, std::max(newest_estimate_, newest_wind_).toSec()));
-    }
-    if (clock > 0) last_clock_ = clock;
-  }
-
-  // Forgets what is shown: the clock or the inputs went back (a replay restarted). `previous_end`
-  // [s] is the previous pass's latest time: messages stamped up to it are that pass's.
-  void Restart(double previous_end) {
+  // Forgets what is shown: the clock or the inputs went back (a replay restarted).
+  void ForgetShown() {
     estimates_ = WindHistory(span_);
     anemometer_ = WindHistory(span_);
     have_estimate_ = have_wind_ = have_vector_ = have_mean_ = false;
-    newest_estimate_ = newest_wind_ = ros::Time();
-    clock_before_restart_ = previous_end;
-    ++restarts_;
   }
 
-  // The display's "now": ROS time (so the plot scrolls and old values age while inputs pause), but
-  // never before the newest input (latency) and the newest input while time has not started or
-  // has just gone back (a replay restarting, until its first message moves the newest stamp back).
-  ros::Time DisplayNow() const {
-    const ros::Time now = ros::Time::now(), latest = std::max(newest_estimate_, newest_wind_);
-    if (now.isZero() || now.toSec() + WindHistory::kRestartAfter < latest.toSec()) return latest;
-    return std::max(now, latest);
-  }
+  ros::Time DisplayNow() const { return ros::Time().fromNSec(clock_.DisplayNow(ros::Time::now().toNSec())); }
 
   // Age of an input [s] at `now` (the display's); infinity when there was none.
   static double Age(bool have, const ros::Time& stamp, const ros::Time& now) {
@@ -328,7 +296,7 @@ class WindDisplayNode {
     stat.addf("anemometer age [s]", "%.1f", wind_age);
     stat.add("messages stamped 0 dropped", unstamped_);
     stat.add("messages stamped more than ~max_future ahead dropped", future_stamped_);
-    stat.add("restarts (clock or inputs went back)", restarts_);  // key kept for the tests and tools reading it
+    stat.add("restarts (clock or inputs went back)", clock_.Restarts());  // key kept for the tests and tools reading it
     stat.add("speeds or stds outside 0..100 m/s dropped", implausible_);
     stat.add("messages more than 5 s behind the newest of their input dropped (clock steady)", late_);
     stat.add("messages of the previous pass dropped (after the clock went back)", previous_pass_);
@@ -354,7 +322,7 @@ class WindDisplayNode {
   void Publish(const ros::SteadyTimerEvent& event) {
     // The clock went back (a replay restarted) before any input of the new pass came: what is
     // shown is the previous pass's.
-    CheckClock();
+    if (clock_.CheckClock(ros::Time::now().toNSec())) ForgetShown();
     const std::string frame = FrameId();
     if (!fixed_frame_.empty() && frame != tf_parent_ && frame != fixed_frame_) PublishFixedFrame(frame);
     // Lazy: the plot is a 640x320 image drawn at ~rate; nobody looking, nothing drawn. A new
@@ -470,12 +438,11 @@ class WindDisplayNode {
 
   double mean_window_ = 60.0, plot_window_ = 180.0, stale_after_ = 10.0, max_future_ = 5.0, span_ = 1.0;
   double drop_warn_for_ = 30.0;
-  uint64_t unstamped_ = 0, future_stamped_ = 0, restarts_ = 0, implausible_ = 0, late_ = 0, previous_pass_ = 0,
+  uint64_t unstamped_ = 0, future_stamped_ = 0, implausible_ = 0, late_ = 0, previous_pass_ = 0,
            invalid_ = 0, implausible_velocity_ = 0, drawn_ = 0;
   ros::SteadyTime last_drop_wall_[kDropCauses];  // when each cause last dropped a message (zero: never)
-  double clock_before_restart_ = -std::numeric_limits<double>::infinity();  // [s] previous pass's end
-  double last_clock_ = 0;          // ROS time when last read (CheckClock) [s]
-  ros::Time newest_estimate_, newest_wind_;  // each input's newest stamp since the last restart
+  enum Input { kEstimateInput, kWindInput, kInputs };
+  clothwind::sensors::DisplayClock clock_;  // each input's newest stamp, restarts, the display's now
   std::string publish_error_;      // why the last draw failed ("" when it did not)
   diagnostic_updater::Updater updater_;
   ros::SteadyTimer diagnostics_timer_;
