@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <deque>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -28,10 +27,13 @@
 #include "ros_bridge/wall_throttle.h"
 #include "sensors/anemometer_protocol.h"
 #include "sensors/anemometer_stream.h"
+#include "sensors/backoff.h"
 #include "sensors/clock_course.h"
 #include "sensors/fine_offset_memory.h"
 #include "sensors/fine_offset_record.h"
 #include "sensors/fine_offset_usb.h"
+#include "sensors/reading_frames.h"
+#include "sensors/reading_rate.h"
 #include "sensors/serial_port.h"
 #include "sensors/usb_read_health.h"
 
@@ -45,21 +47,6 @@ using clothwind::sensors::ParseStatus;
 
 // ~frame_id's default: the instrument's own frame (x towards its north mark).
 constexpr const char* kDefaultFrameId = "anemometer";
-
-// Retry delays for opening the device: short first (a udev symlink appearing), then longer.
-class Backoff {
- public:
-  Backoff(double initial, double maximum) : initial_(initial), max_(maximum), delay_(initial) {}
-  void Reset() { delay_ = initial_; }
-  double Next() {
-    const double d = delay_;
-    delay_ = std::min(delay_ * 2.0, max_);
-    return d;
-  }
-
- private:
-  double initial_, max_, delay_;
-};
 
 class AnemometerNode {
  public:
@@ -98,6 +85,7 @@ class AnemometerNode {
       ROS_FATAL("anemometer_node: %s", e.what());
       return false;
     }
+    frames_ = clothwind::sensors::ReadingFrames(earth_frame_id_, kDefaultFrameId);
     params.Known("diagnostic_period");  // read by diagnostic_updater: the wall timer's period (ros_bridge/wall_diagnostics.h)
     params.WarnUnread("anemometer_node");
 
@@ -117,7 +105,8 @@ class AnemometerNode {
     if (!PositiveSeconds("reconnect_initial_delay", initial) || !PositiveSeconds("reconnect_max_delay", maximum)) {
       return false;
     }
-    backoff_ = Backoff(std::max(0.01, initial), std::max(initial, maximum));
+    const double first_delay = std::max(0.01, initial);
+    backoff_ = clothwind::sensors::Backoff(first_delay, std::max(first_delay, maximum));
 
     updater_.add("anemometer", this, &AnemometerNode::Diagnose);
     if (input_ == "serial") {
@@ -309,24 +298,6 @@ class AnemometerNode {
     HandleRecord(clothwind::ros_bridge::RawSentenceBytes(*msg), msg->header.stamp, frame, false);
   }
 
-  // The frame a reading's direction is in: earth-referenced bearings (NMEA MWD, a north-aligned
-  // station) in ~earth_frame_id when set, instrument-relative angles in the instrument's. A
-  // reading of such a record type without a direction (calm, or bearings left empty) goes with
-  // its type's others: in ~frame_id, a station's calm first reading made wind_display adopt the
-  // instrument's frame and leave every later bearing out of the arrow for the whole session.
-  std::string FrameFor(const clothwind::sensors::WindReading& r, const std::string& instrument_frame) {
-    using clothwind::sensors::AngleReference;
-    const bool earth_type = r.source == "nmea_mwd" || r.source == "fine_offset";
-    const bool earth = r.reference == AngleReference::kEarth || r.reference == AngleReference::kMagnetic ||
-                       (r.reference == AngleReference::kNone && earth_type);
-    if (earth) saw_earth_ = true;
-    if (r.reference == AngleReference::kInstrument) saw_instrument_ = true;
-    if (r.reference == AngleReference::kMagnetic) saw_magnetic_ = true;
-    const std::string frame = earth && !earth_frame_id_.empty() ? earth_frame_id_ : instrument_frame;
-    if (earth) last_earth_frame_ = frame;
-    return frame;
-  }
-
   void HandleRecord(const std::string& data, const ros::Time& stamp, const std::string& frame, bool publish_raw) {
     AnemometerProtocol used = AnemometerProtocol::kAuto;
     const ParseResult r = decoder_.Decode(data, &used);
@@ -340,7 +311,7 @@ class AnemometerNode {
         stale_timeout_ < 3.0 * clothwind::sensors::kFineOffsetSensorPeriod)
       stale_timeout_ = 3.0 * clothwind::sensors::kFineOffsetSensorPeriod;
     if (r.status == ParseStatus::kOk) {
-      wind_pub_.publish(clothwind::ros_bridge::ToWindMeasurement(r.reading, stamp, FrameFor(r.reading, frame),
+      wind_pub_.publish(clothwind::ros_bridge::ToWindMeasurement(r.reading, stamp, frames_.FrameFor(r.reading, frame),
                                                                  magnetic_declination_));
       last_status_ = r.reading.status;
       last_reading_void_ = !r.reading.valid;
@@ -350,10 +321,7 @@ class AnemometerNode {
         last_valid_time_ = t;
         have_valid_ = true;
       }
-      if (!reading_times_.empty() && t < reading_times_.back()) reading_times_.clear();  // the clock went back
-      if (reading_times_.empty() && (first_reading_time_ <= 0 || t < first_reading_time_)) first_reading_time_ = t;
-      reading_times_.push_back(t);
-      if (reading_times_.size() > 4096) reading_times_.pop_front();
+      reading_rate_.Add(t);
     } else if (r.status != ParseStatus::kNotWind) {
       last_error_ = r.error;
       ROS_DEBUG("anemometer_node: %s", r.error.c_str());
@@ -373,18 +341,7 @@ class AnemometerNode {
     // 144 s: one reading per 48 s read 0 Hz over 10 s); per report, a replay at -r 0.15 read 0 and
     // 6.6 Hz in turn.
     const double clock_now = DiagnosticClock();
-    const double rate_window = std::max(10.0, stale_timeout_);
-    while (!reading_times_.empty() &&
-           (clock_now - reading_times_.front() > rate_window || clock_now < reading_times_.front()))
-      reading_times_.pop_front();
-    // The readings in the window over the window (or the time since the first reading, before the
-    // window has filled), so an instrument that falls silent reads slower as its readings age out
-    // (readings over their own span kept its last rate).
-    const double since_first = clock_now - first_reading_time_;
-    const double n = static_cast<double>(reading_times_.size());
-    const double rate = since_first >= rate_window ? n / rate_window
-                        : n >= 2 && since_first > 0 ? (n - 1) / since_first
-                                                    : 0.0;
+    const double rate = reading_rate_.Rate(clock_now, std::max(10.0, stale_timeout_));
     const bool new_errors = c.checksum_failures + c.parse_errors > last_diag_errors_;
     last_diag_errors_ = c.checksum_failures + c.parse_errors;
     // (A clock that went back counts 0.)
@@ -407,22 +364,8 @@ class AnemometerNode {
                         usb_health_.message());
     if (connected && last_reading_void_)
       stat.mergeSummary(DiagnosticStatus::WARN, "instrument flags its readings void: " + last_status_);
-    if (saw_magnetic_ && !std::isfinite(magnetic_declination_))
-      stat.mergeSummary(DiagnosticStatus::WARN,
-                        "magnetic bearings (MWD) published without direction: set ~magnetic_declination");
-    // Compass bearings (a Fine Offset vane, MWD) in the instrument's default frame name, which
-    // config/anemometer.yaml defines as x towards the instrument's north mark: a TF tree that
-    // mounts it so turns every bearing by the mark's heading.
-    // In topic mode a record's own frame wins over ~frame_id (a replay keeps the recorded one):
-    // the advice to set ~frame_id changed nothing there.
-    if (saw_earth_ && !saw_instrument_ && last_earth_frame_ == kDefaultFrameId)
-      stat.mergeSummary(DiagnosticStatus::WARN, "compass bearings published in frame " + last_earth_frame_ +
-                                                    " (the instrument's default name): set ~earth_frame_id" +
-                                                    (input_ == "topic" ? std::string() : std::string(" or ~frame_id")) +
-                                                    " to the ENU frame they are in");
-    if (saw_earth_ && saw_instrument_ && earth_frame_id_.empty())
-      stat.mergeSummary(DiagnosticStatus::WARN, "instrument-relative and earth-referenced directions share frame " +
-                                                    frame_id_ + ": set ~earth_frame_id");
+    for (const std::string& w : frames_.Warnings(std::isfinite(magnetic_declination_), frame_id_, input_ == "topic"))
+      stat.mergeSummary(DiagnosticStatus::WARN, w);
 
     if (odd_stamps_ > last_diag_odd_stamps_)
       stat.mergeSummaryf(DiagnosticStatus::WARN, "%llu records dropped since last report: %s",
@@ -474,27 +417,26 @@ class AnemometerNode {
   clothwind::ros_bridge::WallDiagnostics wall_diagnostics_{&updater_};  // every wall second
   std::string input_, frame_id_, earth_frame_id_, state_, last_error_, last_status_;
   double magnetic_declination_ = std::numeric_limits<double>::quiet_NaN();  // [deg] east; NaN: unknown
-  bool last_reading_void_ = false, saw_earth_ = false, saw_instrument_ = false, saw_magnetic_ = false;
+  bool last_reading_void_ = false;
+  clothwind::sensors::ReadingFrames frames_{"", kDefaultFrameId};  // set in Init
   clothwind::sensors::UsbReadHealth usb_health_{3};  // reopen after 3 failed reads in a row
   clothwind::sensors::SerialConfig serial_;
   clothwind::sensors::SerialPort port_;
   clothwind::sensors::FineOffsetUsb usb_;
   clothwind::sensors::RecordFramer framer_;
   AnemometerDecoder decoder_;
-  Backoff backoff_;
+  clothwind::sensors::Backoff backoff_;
   // Steady (monotonic) time: the wall clock steps back under NTP, and a next-due instant then held
   // every poll and reconnect (and the USB gate's 48 s) until it caught up.
   ros::SteadyTime next_attempt_, next_poll_;
-  // On DiagnosticClock [s]: the last valid reading's arrival, the readings' of the rate window
-  // (10 s, or ~stale_timeout), and the first reading's since the clock last went back.
+  // On DiagnosticClock [s]: the last valid reading's arrival, and the readings' for their rate over
+  // 10 s or ~stale_timeout, whichever is longer.
   double last_valid_time_ = 0.0;
-  std::deque<double> reading_times_;
-  double first_reading_time_ = 0.0;
+  clothwind::sensors::ReadingRate reading_rate_;
   double stale_timeout_ = 5.0;
   bool stale_timeout_given_ = false;  // ~stale_timeout set: kept whatever the instrument
   double usb_poll_period_ = 10.0;
   clothwind::sensors::FineOffsetPublishGate usb_gate_;  // which polled USB records are published
-  std::string last_earth_frame_;     // the frame the last compass bearing was published in
   uint64_t connects_ = 0, disconnects_ = 0, usb_read_errors_ = 0;
   // Topic mode: records dropped for their stamps (OnRaw), and the last one's reason.
   static constexpr double kMaxFutureStamp = 5.0;  // [s]

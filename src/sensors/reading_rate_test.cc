@@ -1,0 +1,46 @@
+#include "sensors/reading_rate.h"
+
+#include <gtest/gtest.h>
+
+namespace clothwind::sensors {
+namespace {
+
+TEST(ReadingRateTest, ReadsTheRateBeforeAndAfterTheWindowFills) {
+  ReadingRate rate;
+  EXPECT_EQ(rate.Rate(100.0, 10.0), 0.0);  // no reading
+  rate.Add(100.0);
+  EXPECT_EQ(rate.Rate(100.5, 10.0), 0.0);  // one reading has no rate yet
+  for (int i = 1; i <= 4; ++i) rate.Add(100.0 + 0.5 * i);  // 2 Hz
+  EXPECT_DOUBLE_EQ(rate.Rate(102.0, 10.0), 2.0);  // 4 intervals over 2 s
+  for (int i = 5; i <= 40; ++i) rate.Add(100.0 + 0.5 * i);
+  EXPECT_DOUBLE_EQ(rate.Rate(120.1, 10.0), 2.0);  // 20 readings in [110.1, 120.1]
+}
+
+TEST(ReadingRateTest, ASilentInstrumentReadsSlowerAsItsReadingsAgeOut) {
+  ReadingRate rate;
+  for (int i = 0; i <= 40; ++i) rate.Add(0.5 * i);  // 2 Hz up to t = 20
+  EXPECT_DOUBLE_EQ(rate.Rate(20.1, 10.0), 2.0);
+  EXPECT_DOUBLE_EQ(rate.Rate(25.1, 10.0), 1.0);  // 10 readings left in [15.1, 25.1]
+  EXPECT_EQ(rate.Rate(31.0, 10.0), 0.0);
+  rate.Add(31.5);  // back: the rate over the window, not over the new reading alone
+  EXPECT_DOUBLE_EQ(rate.Rate(32.0, 10.0), 0.1);
+}
+
+TEST(ReadingRateTest, TheClockGoingBackStartsAfresh) {
+  ReadingRate rate;
+  for (int i = 0; i <= 40; ++i) rate.Add(1000.0 + 0.5 * i);
+  // A looped replay: the clock is back at 10 and the readings come at 1 Hz.
+  for (int i = 0; i <= 4; ++i) rate.Add(10.0 + i);
+  EXPECT_DOUBLE_EQ(rate.Rate(14.0, 10.0), 1.0);  // 4 intervals over 4 s, none of the old pass's
+}
+
+TEST(ReadingRateTest, KeepsAtMostItsLimit) {
+  ReadingRate rate(/*max_kept=*/5);
+  for (int i = 0; i < 100; ++i) rate.Add(0.01 * i);
+  EXPECT_DOUBLE_EQ(rate.Rate(20.0, 10.0), 0.0);
+  for (int i = 0; i < 100; ++i) rate.Add(20.0 + 0.01 * i);
+  EXPECT_DOUBLE_EQ(rate.Rate(21.0, 10.0), 0.5);  // the 5 kept over the filled window
+}
+
+}  // namespace
+}  // namespace clothwind::sensors
