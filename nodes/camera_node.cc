@@ -40,6 +40,7 @@
 #include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wall_throttle.h"
+#include "sensors/backoff.h"
 #include "sensors/frame_read_tally.h"
 #include "sensors/frame_source.h"
 #include "sensors/frame_source_factory.h"
@@ -276,7 +277,7 @@ int main(int argc, char** argv) {
     last_ros_now = now;
     wall_diagnostics.Update();
   };
-  double open_backoff_s = 0.25;
+  clothwind::sensors::Backoff open_backoff(0.25, 5.0);  // [s] between attempts to open the source
   ros::SteadyTime next_open;  // steady: a wall clock stepped back by NTP held the reopen until it caught up
   while (ros::ok()) {
     if (!opened) {
@@ -304,8 +305,7 @@ int main(int argc, char** argv) {
         tally.SourceFailed(last_error);
         WALL_ERROR_STREAM_THROTTLE(5.0, "camera_node: " << last_error << " (retrying)");
         update_diagnostics();
-        next_open = ros::SteadyTime::now() + ros::WallDuration(open_backoff_s);
-        open_backoff_s = std::min(open_backoff_s * 2.0, 5.0);
+        next_open = ros::SteadyTime::now() + ros::WallDuration(open_backoff.Next());
         ros::spinOnce();
         continue;
       }
@@ -317,7 +317,7 @@ int main(int argc, char** argv) {
       const ReadStatus status = source->Read(&frame, 0.1);
       const bool failed = status == ReadStatus::kBadFrame || status == ReadStatus::kError;
       tally.Record(status, failed ? source->error() : std::string());
-      if (status == ReadStatus::kFrame) open_backoff_s = 0.25;  // reading again: the next failure retries soon
+      if (status == ReadStatus::kFrame) open_backoff.Reset();  // reading again: the next failure retries soon
       if (status == ReadStatus::kFrame && publisher.getNumSubscribers() == 0) {
         // The frame is read and decoded (the driver's buffers must keep moving) and counted at the
         // camera's rate, but no message is built for nobody.
@@ -356,8 +356,7 @@ int main(int argc, char** argv) {
           // frame is read (a folder whose files all fail still opens, and reopening it at once
           // spun through it thousands of times a second).
           opened = false;
-          next_open = ros::SteadyTime::now() + ros::WallDuration(open_backoff_s);
-          open_backoff_s = std::min(open_backoff_s * 2.0, 5.0);
+          next_open = ros::SteadyTime::now() + ros::WallDuration(open_backoff.Next());
         }
       } else if (status == ReadStatus::kEnd) {
         ended = true;
