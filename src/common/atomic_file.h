@@ -198,10 +198,12 @@ inline void WriteFileAtomically(const std::string& path, const std::string& byte
 // temporaries are written whole before either is renamed into place, and if the second rename
 // fails the first file is put back as it was (or removed, if it was not there), so a failure never
 // leaves new weights beside an old configuration, which the loader then refuses.
-// Inputs: first, second  the paths; first_bytes, second_bytes  their contents.
+// Inputs: first, second  the paths; first_bytes, second_bytes  their contents; hard_link  makes
+// the first file's backup (::link; tests pass one that fails, as on vfat, to reach the copy).
 // Throws std::runtime_error naming the file that could not be written or renamed.
 inline void WriteFilePairAtomically(const std::string& first, const std::string& first_bytes, const std::string& second,
-                                    const std::string& second_bytes) {
+                                    const std::string& second_bytes,
+                                    int (*hard_link)(const char* from, const char* to) = ::link) {
   namespace fs = std::filesystem;
   const std::string tmp_first = TemporaryNameFor(first);
   const std::string tmp_second = TemporaryNameFor(second);
@@ -217,7 +219,7 @@ inline void WriteFilePairAtomically(const std::string& first, const std::string&
   try {
     WriteFileDurably(tmp_first, first_bytes.data(), first_bytes.size());
     WriteFileDurably(tmp_second, second_bytes.data(), second_bytes.size());
-    if (had_first && ::link(first.c_str(), backup.c_str()) != 0) {
+    if (had_first && hard_link(first.c_str(), backup.c_str()) != 0) {
       fs::copy_file(first, backup, ec);
       if (ec) throw std::runtime_error("cannot keep " + first + " aside while its pair is replaced: " + ec.message());
       SyncFile(backup);

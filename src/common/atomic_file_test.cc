@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <fstream>
 #include <sstream>
 
@@ -107,6 +108,28 @@ TEST_F(AtomicFileTest, APairIsWrittenWholeOrNotAtAll) {
   const std::string fresh = (dir_ / "fresh.pt").string();
   EXPECT_THROW(WriteFilePairAtomically(fresh, "w", blocked, "c"), std::runtime_error);
   EXPECT_FALSE(fs::exists(fresh));
+  EXPECT_EQ(Entries(), 3u);
+}
+
+// Where the filesystem has no hard links (vfat, exFAT, some network mounts), the first file's old
+// content is kept aside by a durable copy instead, and put back from it when the second fails.
+int NoHardLinks(const char*, const char*) {
+  errno = EPERM;
+  return -1;
+}
+
+TEST_F(AtomicFileTest, APairIsWrittenWholeWhereTheFilesystemHasNoHardLinks) {
+  const std::string weights = (dir_ / "model.pt").string(), config = (dir_ / "model.json").string();
+  WriteFilePairAtomically(weights, "weights 1", config, "config 1", NoHardLinks);
+  WriteFilePairAtomically(weights, "weights 2", config, "config 2", NoHardLinks);
+  EXPECT_EQ(Read(weights), "weights 2");
+  EXPECT_EQ(Read(config), "config 2");
+  EXPECT_EQ(Entries(), 2u);  // the copy is gone once the pair is in place
+
+  const std::string blocked = (dir_ / "blocked.json").string();
+  fs::create_directories(fs::path(blocked) / "inside");
+  EXPECT_THROW(WriteFilePairAtomically(weights, "weights 3", blocked, "config 3", NoHardLinks), std::runtime_error);
+  EXPECT_EQ(Read(weights), "weights 2");  // put back from the copy
   EXPECT_EQ(Entries(), 3u);
 }
 
