@@ -109,6 +109,19 @@ class AnemometerNode {
     backoff_ = clothwind::sensors::Backoff(first_delay, std::max(first_delay, maximum));
 
     updater_.add("anemometer", this, &AnemometerNode::Diagnose);
+    // The serial settings are unused by usb and topic input, but a replay of the field's YAML is
+    // where a bad one is best found: a WARN naming it, where serial input ends on it.
+    if (input_ != "serial") {
+      std::string error;
+      if (!clothwind::sensors::ParseParity(parity, &serial_.parity)) {
+        error = "parity: '" + parity + "' unknown (expected none, even or odd)";
+      } else {
+        clothwind::sensors::ValidateSerialConfig(serial_, &error);
+      }
+      if (!error.empty())
+        ROS_WARN("anemometer_node: ~%s; unused with ~input %s, but a serial input would end on it", error.c_str(),
+                 input_.c_str());
+    }
     if (input_ == "serial") {
       if (!clothwind::sensors::ParseParity(parity, &serial_.parity)) {
         ROS_FATAL("~parity: '%s' unknown (expected none, even or odd)", parity.c_str());

@@ -210,6 +210,17 @@ class NodeParamsTest(unittest.TestCase):
         ]
         self.expect_refused(cases, "range")
 
+    # The serial settings are unused by a replay (topic input) or a USB station, but a bad one in
+    # the field's YAML is said there, where serial input would end on it; the node runs on.
+    def test_a_bad_serial_setting_is_said_where_it_is_unused(self):
+        for i, (args, said) in enumerate([
+                (["_input:=topic", "_baud:=4801"], "~baud: 4801"),
+                (["_input:=usb", "_parity:=mark"], "~parity: 'mark' unknown")]):
+            node = self.spawn("anemometer_node", ["__name:=unused_serial_%d" % i] + args, cwd=self.folder)
+            self.assertTrue(node.wait_for_output("a serial input would end on it", 20), node.output())
+            self.assertIn(said, node.output())
+            self.assertIsNone(node.process.poll(), "it ended:\n" + node.output())
+
     # The report's output files are checked at start: a mistyped folder failed only after the whole
     # replay, naming a temporary file; a plot asked for without estimates was silently not drawn.
     def test_the_report_refuses_output_paths_it_cannot_write_at_start(self):
