@@ -1,6 +1,6 @@
 // Retry delays for opening a device: short first (a udev symlink appearing), doubling up to a
 // ceiling (a device unplugged for long stretches is not polled without pause). ROS-free;
-// anemometer_node reopens its serial port and USB station with it.
+// anemometer_node reopens its serial port and USB station with it, camera_node its source.
 #ifndef CLOTHWIND_SENSORS_BACKOFF_H_
 #define CLOTHWIND_SENSORS_BACKOFF_H_
 

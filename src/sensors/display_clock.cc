@@ -7,7 +7,11 @@
 
 namespace clothwind::sensors {
 namespace {
-double Seconds(std::uint64_t ns) { return static_cast<double>(ns) * 1e-9; }
+// As ros::Time::toSec() rounds (whole seconds plus nanoseconds), so a stamp exactly max_future
+// ahead is judged as the node judged it before this class ((double)ns * 1e-9 rounds some up).
+double Seconds(std::uint64_t ns) {
+  return static_cast<double>(ns / 1000000000ull) + 1e-9 * static_cast<double>(ns % 1000000000ull);
+}
 }  // namespace
 
 DisplayClock::DisplayClock(int inputs, double max_future, double restart_after)

@@ -39,6 +39,9 @@ TEST(DisplayClockTest, RefusesUnstampedAndFutureStampsOfARunningClock) {
   EXPECT_EQ(clock.Admit(kWind, 0, S(100), &restarted), Verdict::kUnstamped);
   EXPECT_EQ(clock.Admit(kWind, S(105.5), S(100), &restarted), Verdict::kFuture);
   EXPECT_EQ(clock.Admit(kWind, S(104.9), S(100), &restarted), Verdict::kShow);  // within max_future
+  // Exactly max_future ahead is shown, as ros::Time's seconds compare (15e9 * 1e-9 rounds above 15).
+  DisplayClock early = Clock();
+  EXPECT_EQ(early.Admit(kWind, 15'000'000'000ull, 10'000'000'000ull, &restarted), Verdict::kShow);
   // TIME_MAX (2^32 - 1 s): refused, and nothing overflows.
   EXPECT_EQ(clock.Admit(kEstimate, 4294967295ull * 1000000000ull + 999999999ull, S(100), &restarted),
             Verdict::kFuture);
@@ -72,9 +75,11 @@ TEST(DisplayClockTest, TheFirstMessageOfANewPassRestartsBeforeTheTickDoes) {
   DisplayClock clock = Clock();
   bool restarted = false;
   clock.Admit(kWind, S(300), S(300), &restarted);
-  EXPECT_EQ(clock.Admit(kWind, S(50), S(50), &restarted), Verdict::kShow);
+  // The new pass's first estimate: its own input has no newest yet, so only the clock says so.
+  EXPECT_EQ(clock.Admit(kEstimate, S(50), S(50), &restarted), Verdict::kShow);
   EXPECT_TRUE(restarted);
-  EXPECT_EQ(clock.Newest(kWind), S(50));
+  EXPECT_EQ(clock.Newest(kWind), 0u);  // the previous pass's reading is forgotten
+  EXPECT_EQ(clock.Newest(kEstimate), S(50));
   EXPECT_FALSE(clock.CheckClock(S(50.5)));  // the tick after it does not restart again
   EXPECT_EQ(clock.Restarts(), 1u);
 }

@@ -11,6 +11,7 @@
 #define CLOTHWIND_SENSORS_READING_FRAMES_H_
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sensors/wind_reading.h"

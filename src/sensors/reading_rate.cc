@@ -4,17 +4,15 @@ namespace clothwind::sensors {
 
 void ReadingRate::Add(double t) {
   if (!times_.empty() && t < times_.back()) times_.clear();  // the clock went back
-  if (times_.empty() && (!have_first_ || t < first_)) {
-    first_ = t;
-    have_first_ = true;
-  }
+  // A reading stamped 0 (topic input before a replay's /clock) is no first time: the rate would
+  // read over the whole time since 0 once the clock starts.
+  if (times_.empty() && (first_ <= 0 || t < first_)) first_ = t;
   times_.push_back(t);
   if (times_.size() > max_kept_) times_.pop_front();
 }
 
 double ReadingRate::Rate(double now, double window) {
   while (!times_.empty() && (now - times_.front() > window || now < times_.front())) times_.pop_front();
-  if (!have_first_) return 0.0;
   const double since_first = now - first_;
   const double n = static_cast<double>(times_.size());
   if (since_first >= window) return n / window;

@@ -26,8 +26,7 @@ class ReadingRate {
  private:
   std::size_t max_kept_;
   std::deque<double> times_;
-  double first_ = 0.0;  // the first reading's time since the clock last went back
-  bool have_first_ = false;
+  double first_ = 0.0;  // the first reading's time (> 0) since the clock last went back; 0: none
 };
 
 }  // namespace clothwind::sensors

@@ -18,12 +18,12 @@ TEST(ReadingRateTest, ReadsTheRateBeforeAndAfterTheWindowFills) {
 
 TEST(ReadingRateTest, ASilentInstrumentReadsSlowerAsItsReadingsAgeOut) {
   ReadingRate rate;
-  for (int i = 0; i <= 40; ++i) rate.Add(0.5 * i);  // 2 Hz up to t = 20
-  EXPECT_DOUBLE_EQ(rate.Rate(20.1, 10.0), 2.0);
-  EXPECT_DOUBLE_EQ(rate.Rate(25.1, 10.0), 1.0);  // 10 readings left in [15.1, 25.1]
-  EXPECT_EQ(rate.Rate(31.0, 10.0), 0.0);
-  rate.Add(31.5);  // back: the rate over the window, not over the new reading alone
-  EXPECT_DOUBLE_EQ(rate.Rate(32.0, 10.0), 0.1);
+  for (int i = 0; i <= 40; ++i) rate.Add(100.0 + 0.5 * i);  // 2 Hz up to t = 120
+  EXPECT_DOUBLE_EQ(rate.Rate(120.1, 10.0), 2.0);
+  EXPECT_DOUBLE_EQ(rate.Rate(125.1, 10.0), 1.0);  // 10 readings left in [115.1, 125.1]
+  EXPECT_EQ(rate.Rate(131.0, 10.0), 0.0);
+  rate.Add(131.5);  // back: the rate over the window, not over the new reading alone
+  EXPECT_DOUBLE_EQ(rate.Rate(132.0, 10.0), 0.1);
 }
 
 TEST(ReadingRateTest, TheClockGoingBackStartsAfresh) {
@@ -34,12 +34,22 @@ TEST(ReadingRateTest, TheClockGoingBackStartsAfresh) {
   EXPECT_DOUBLE_EQ(rate.Rate(14.0, 10.0), 1.0);  // 4 intervals over 4 s, none of the old pass's
 }
 
+TEST(ReadingRateTest, AReadingAtTimeZeroIsNoFirstTime) {
+  // Topic input on a replay's clock: a record before /clock is stamped 0, and the diagnostics at
+  // 1000 forget it; the rate from the readings at 2 Hz since 1000.5 is not read over 1003 s.
+  ReadingRate rate;
+  rate.Add(0.0);
+  EXPECT_EQ(rate.Rate(1000.0, 10.0), 0.0);
+  for (int i = 1; i <= 5; ++i) rate.Add(1000.0 + 0.5 * i);
+  EXPECT_DOUBLE_EQ(rate.Rate(1003.0, 10.0), 1.6);  // 4 intervals over the 2.5 s since 1000.5
+}
+
 TEST(ReadingRateTest, KeepsAtMostItsLimit) {
   ReadingRate rate(/*max_kept=*/5);
-  for (int i = 0; i < 100; ++i) rate.Add(0.01 * i);
-  EXPECT_DOUBLE_EQ(rate.Rate(20.0, 10.0), 0.0);
-  for (int i = 0; i < 100; ++i) rate.Add(20.0 + 0.01 * i);
-  EXPECT_DOUBLE_EQ(rate.Rate(21.0, 10.0), 0.5);  // the 5 kept over the filled window
+  for (int i = 0; i < 100; ++i) rate.Add(100.0 + 0.01 * i);
+  EXPECT_DOUBLE_EQ(rate.Rate(120.0, 10.0), 0.0);
+  for (int i = 0; i < 100; ++i) rate.Add(120.0 + 0.01 * i);
+  EXPECT_DOUBLE_EQ(rate.Rate(121.0, 10.0), 0.5);  // the 5 kept over the filled window
 }
 
 }  // namespace

@@ -26,6 +26,7 @@ std::uint64_t SequenceGaps::Good(std::uint64_t sequence, double now) {
       recent_.emplace_back(now, gap);
     }
   }
+  Trim(now);  // here too: a node that never asks (its model failing) must not grow the list
   malformed_since_good_.clear();
   last_ = sequence;
   have_last_ = true;
@@ -36,8 +37,12 @@ void SequenceGaps::Malformed(std::uint64_t sequence) {
   if (malformed_since_good_.size() < kMaxMalformed) malformed_since_good_.insert(sequence);
 }
 
+void SequenceGaps::Trim(double now) {
+  while (!recent_.empty() && now - recent_.front().first > recent_window_) recent_.pop_front();
+}
+
 std::uint64_t SequenceGaps::RecentMissing(double now) {
-  while (!recent_.empty() && now - recent_.front().first >= recent_window_) recent_.pop_front();
+  Trim(now);
   std::uint64_t missing = 0;
   for (const auto& gap : recent_) missing += gap.second;
   return missing;

@@ -34,12 +34,14 @@ class SequenceGaps {
 
   // All items missing so far.
   std::uint64_t Missing() const { return missing_; }
-  // Those found missing in (now - recent_window, now]; forgets older gaps.
+  // Those found missing in [now - recent_window, now]; forgets older gaps.
   std::uint64_t RecentMissing(double now);
 
   static constexpr std::size_t kMaxMalformed = 4096;
 
  private:
+  void Trim(double now);  // forgets gaps found before now - recent_window
+
   std::uint64_t max_gap_;
   double recent_window_;
   bool have_last_ = false;

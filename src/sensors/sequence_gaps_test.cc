@@ -58,7 +58,8 @@ TEST(SequenceGapsTest, RecentMissingForgetsGapsOlderThanItsWindow) {
   gaps.Good(5, 120.0);  // 1 missing at 120
   EXPECT_EQ(gaps.RecentMissing(125.0), 3u);
   EXPECT_EQ(gaps.RecentMissing(131.5), 1u);  // the gap at 101 is over 30 s old
-  EXPECT_EQ(gaps.RecentMissing(150.0), 0u);  // (120, 150]: the window is open at its start
+  EXPECT_EQ(gaps.RecentMissing(150.0), 1u);  // [120, 150]: closed at its start, as sdn_node's rate
+  EXPECT_EQ(gaps.RecentMissing(150.5), 0u);
   EXPECT_EQ(gaps.Missing(), 3u);             // the total keeps them
   EXPECT_THROW(SequenceGaps(10, 0.0), std::invalid_argument);
 }
