@@ -33,20 +33,12 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "ros_bridge/strict_param.h"
+#include "sensors/clip_report.h"
 #include "sensors/dataset_writer.h"
 #include "sensors/estimate_report.h"
 #include "sensors/replay_end.h"
 
 namespace {
-
-struct Row {
-  uint64_t sequence;
-  double start, end;
-  uint32_t frames;
-  double max_spacing_error;  // largest |frame interval - 1/rate| [s]
-  double mean, std, direction;
-  uint32_t count, width, height;
-};
 
 class ClipReport {
  public:
@@ -105,17 +97,16 @@ class ClipReport {
 
   void OnClip(const clothwind::Clip::ConstPtr& c) {
     end_->Activity(ros::SteadyTime::now().toSec());
-    Row r{};
+    clothwind::sensors::ClipRow r;
     r.sequence = c->sequence;
     r.frames = c->num_frames;
     r.start = c->frame_stamps.empty() ? NAN : c->frame_stamps.front().toSec();
     r.end = c->frame_stamps.empty() ? NAN : c->frame_stamps.back().toSec();
-    for (size_t i = 1; i < c->frame_stamps.size(); ++i) {
-      // In double seconds: ros::Time arithmetic throws beyond 32 bits, and one corrupt stamp
-      // (TIME_MAX) ended the node before it printed or wrote anything of the good clips.
-      const double dt = c->frame_stamps[i].toSec() - c->frame_stamps[i - 1].toSec();
-      r.max_spacing_error = std::max(r.max_spacing_error, std::fabs(dt - 1.0 / c->frame_rate));
-    }
+    // In double seconds: ros::Time arithmetic throws beyond 32 bits, and one corrupt stamp
+    // (TIME_MAX) ended the node before it printed or wrote anything of the good clips.
+    std::vector<double> stamps;
+    for (const ros::Time& t : c->frame_stamps) stamps.push_back(t.toSec());
+    r.max_spacing_error = clothwind::sensors::MaxSpacingError(stamps, c->frame_rate);
     r.mean = c->wind_mean;
     r.std = c->wind_std;
     r.count = c->wind_count;
@@ -186,15 +177,7 @@ class ClipReport {
   }
 
   // Clips that have come without their estimate (with ~estimates).
-  size_t Unestimated() const {
-    if (!want_estimates_) return 0;
-    std::vector<uint64_t> seen;
-    for (const auto& e : estimates_) seen.push_back(e.sequence);
-    std::sort(seen.begin(), seen.end());
-    size_t missing = 0;
-    for (const Row& r : rows_) missing += !std::binary_search(seen.begin(), seen.end(), r.sequence);
-    return missing;
-  }
+  size_t Unestimated() const { return want_estimates_ ? clothwind::sensors::Unestimated(rows_, estimates_) : 0; }
 
   // Prints and writes the report once (from the timer, or after spin() when interrupted).
   // Returns false when a file could not be written.
@@ -211,49 +194,12 @@ class ClipReport {
       std::printf("clip_report: %zu of %zu clips have no estimate (sdn_node still working, or it refused them): "
                   "the estimates' report covers the others\n", missing, rows_.size());
     std::printf("\nclip_report: %zu clip(s) from the replay\n", rows_.size());
-    std::printf("%5s  %-12s  %-12s  %6s  %7s  %9s  %8s  %8s  %5s  %8s\n", "seq", "start [s]", "end [s]",
-                "frames", "span", "dt err", "wind m/s", "std", "count", "dir rad");
-    // The earliest clip start there is (a clip without frame_stamps has none); else the first
-    // estimate's clip end; 0 when there is neither.
-    double t0 = std::numeric_limits<double>::infinity();
-    for (const auto& r : rows_)
-      if (std::isfinite(r.start) && r.start > 0) t0 = std::min(t0, r.start);
-    for (const auto& e : estimates_)
-      if (!std::isfinite(t0) && std::isfinite(e.end) && e.end > 0) t0 = e.end;
-    if (!std::isfinite(t0)) t0 = 0.0;
-    double label_sum = 0;
-    size_t labelled = 0, frames = 0;
-    double worst_spacing = 0;
-    nlohmann::json clips = nlohmann::json::array();
-    for (const auto& r : rows_) {
-      std::printf("%5llu  %12.3f  %12.3f  %6u  %6.3fs  %7.1fus  %8.3f  %8.3f  %5u  %8.3f\n",
-                  static_cast<unsigned long long>(r.sequence), r.start - t0, r.end - t0, r.frames, r.end - r.start,
-                  r.max_spacing_error * 1e6, r.mean, r.std, r.count, r.direction);
-      frames += r.frames;
-      worst_spacing = std::max(worst_spacing, r.max_spacing_error);
-      if (r.count > 0) {
-        label_sum += r.mean;
-        ++labelled;
-      }
-      clips.push_back({{"sequence", r.sequence}, {"start", r.start}, {"end", r.end}, {"frames", r.frames},
-                       {"width", r.width}, {"height", r.height}, {"max_spacing_error", r.max_spacing_error},
-                       {"wind_mean", std::isfinite(r.mean) ? nlohmann::json(r.mean) : nlohmann::json()},
-                       {"wind_std", std::isfinite(r.std) ? nlohmann::json(r.std) : nlohmann::json()},
-                       {"wind_count", r.count}});
-    }
-    const double covered = rows_.empty() ? 0.0 : rows_.back().end - rows_.front().start;
-    std::printf("totals: %zu clips, %zu frames at %.1f fps (%dx%d), %zu labelled (label window %.0f s, mean of "
-                "labels %.3f m/s), first to last frame %.2f s, worst frame spacing error %.1f us, wall %.1f s\n",
-                rows_.size(), frames, rate_, rows_.empty() ? 0 : static_cast<int>(rows_.front().width),
-                rows_.empty() ? 0 : static_cast<int>(rows_.front().height), labelled, window_,
-                labelled ? label_sum / labelled : NAN, covered, worst_spacing * 1e6, wall);
-    nlohmann::json j = {{"clips", clips},
-                        {"total_clips", rows_.size()},
-                        {"total_frames", frames},
-                        {"labelled_clips", labelled},
-                        {"frame_rate", rate_},
-                        {"label_window", window_},
-                        {"wall_seconds", wall}};
+    // Times from the earliest clip start there is (a clip without frame_stamps has none); else
+    // the first estimate's clip end; 0 when there is neither.
+    const double t0 = clothwind::sensors::ReportOrigin(rows_, estimates_);
+    const clothwind::sensors::ClipReportContext context{rate_, window_, wall};
+    std::printf("%s", clothwind::sensors::ClipTable(rows_, t0, context).c_str());
+    nlohmann::json j = clothwind::sensors::ClipJson(rows_, context);
     if (want_estimates_) PrintEstimates(t0, &j);
     std::fflush(stdout);
     ok_ = true;
@@ -279,7 +225,7 @@ class ClipReport {
   ros::SteadyTime start_wall_;
   std::optional<clothwind::sensors::ReplayEnd> end_;  // when the replay is over (sensors/replay_end.h)
   bool printed_ = false, ok_ = true;
-  std::vector<Row> rows_;
+  std::vector<clothwind::sensors::ClipRow> rows_;
   double rate_ = 0.0, window_ = 0.0;
 };
 
