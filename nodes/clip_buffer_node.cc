@@ -5,20 +5,18 @@
 // Publishes   clips (clothwind/Clip), clips/preview (sensor_msgs/Image mono8, or bgr8 with
 //             ~colour: the latest clip's middle frame, only built while someone subscribes),
 //             /diagnostics
-// All the logic is in sensors::ClipPipeline and sensors::DatasetWriter (see docs/clips.md); clips
-// are recorded on a thread of their own (sensors::AsyncDatasetWriter), so a slow disk never holds
-// up the camera callback.
-#include <atomic>
+// All the logic is in sensors::ClipPipeline and sensors::ClipRecording (see docs/clips.md): the
+// recording folder is opened, reopened when lost and drained at shutdown there, and clips are
+// written on a thread of their own (sensors::AsyncDatasetWriter), so a slow disk never holds up
+// the camera callback.
 #include <chrono>
 #include <cmath>
 #include <csignal>
-#include <filesystem>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -34,8 +32,8 @@
 #include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wall_throttle.h"
-#include "sensors/async_dataset_writer.h"
 #include "sensors/clip_pipeline.h"
+#include "sensors/clip_recording.h"
 #include "sensors/dataset_writer.h"
 #include "sensors/wind_direction_frame.h"
 
@@ -100,7 +98,22 @@ class ClipBufferNode {
     }
     // A record folder that cannot be opened (a disk not mounted yet, a damaged index) stops the
     // recording, not the clips: the node publishes, says why in its diagnostics and retries.
-    OpenRecording();
+    sensors::ClipRecording::Options recording;
+    recording.dir = record_dir_;
+    recording.jpeg_quality = jpeg_quality_;
+    recording.index_interval = index_interval_;
+    recording_ = std::make_unique<sensors::ClipRecording>(
+        recording,
+        [](sensors::LogLevel level, const std::string& text) {
+          if (level == sensors::LogLevel::kError) {
+            ROS_ERROR("clip_buffer: %s", text.c_str());
+          } else if (level == sensors::LogLevel::kWarn) {
+            ROS_WARN("clip_buffer: %s", text.c_str());
+          } else {
+            ROS_INFO("clip_buffer: %s", text.c_str());
+          }
+        },
+        ros::SteadyTime::now().toSec());
 
     clip_pub_ = nh.advertise<clothwind::Clip>("clips", 4);
     preview_pub_ = nh.advertise<sensor_msgs::Image>("clips/preview", 1, true);
@@ -122,33 +135,6 @@ class ClipBufferNode {
              o.label_window, o.label_delay, o.gap_tolerance);
   }
 
-  ~ClipBufferNode() {
-    if (closer_.joinable()) closer_.join();
-  }
-
-  // Opens record_dir_ (when set and not open yet); on failure keeps why for the diagnostics.
-  void OpenRecording() {
-    if (record_dir_.empty() || writer_) return;
-    last_open_attempt_ = ros::SteadyTime::now();
-    try {
-      writer_ = std::make_unique<sensors::AsyncDatasetWriter>(
-          std::make_unique<sensors::DatasetWriter>(record_dir_, jpeg_quality_, index_interval_), kRecordQueue);
-      if (!recording_error_.empty()) ROS_INFO("clip_buffer: recording works again");
-      recording_error_.clear();
-      record_dir_mounted_ = sensors::IsMountPoint(record_dir_);
-      ROS_INFO("clip_buffer: recording clips to %s (%zu already there%s)", record_dir_.c_str(),
-               writer_->size_at_open(),
-               writer_->recovered() > 0
-                   ? (", " + std::to_string(writer_->recovered()) + " leftovers of an earlier run cleared").c_str()
-                   : "");
-    } catch (const std::exception& e) {
-      if (recording_error_ != e.what())
-        ROS_ERROR("clip_buffer: not recording (publishing clips still; retrying every %.0f s): %s", kReopenEvery,
-                  e.what());
-      recording_error_ = e.what();
-    }
-  }
-
   // Labels and records whatever is still waiting (called on shutdown; nothing is published then).
   // The last clips wait for room in the writer's queue (a full queue of a slow disk dropped them
   // with no report after), for kShutdownBudget s at most: roslaunch sends SIGTERM 15 s after
@@ -157,42 +143,8 @@ class ClipBufferNode {
   // named, and the tally, with the last write or index error, is said at the end.
   void Finish() {
     std::lock_guard<std::mutex> lock(mutex_);
-    // (A lost folder's writer still closing is joined by the destructor, after the last clips: a
-    // yanked disk's write can hang past roslaunch's SIGKILL.)
-    const auto deadline =
-        std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                               std::chrono::duration<double>(kShutdownBudget));
-    std::vector<std::string> abandoned;
-    const auto waiting = pipeline_->Flush();
-    if (writer_ && (!waiting.empty() || writer_->stats().queued > 0))
-      ROS_INFO("clip_buffer: recording the last %zu clips into %s (at most %.0f s)",
-               waiting.size() + writer_->stats().queued, writer_->root().c_str(), kShutdownBudget);
-    for (const auto& c : waiting) Record(c, deadline, &abandoned);
-    if (!writer_) {
-      if (not_recorded_ > 0)
-        ROS_WARN("clip_buffer: %llu clips not recorded (no recording folder open: %s)",
-                 static_cast<unsigned long long>(not_recorded_), recording_error_.c_str());
-      if (written_before_ + failed_before_ + dropped_before_ > 0)
-        ROS_INFO("clip_buffer: recording into %s ends with its folder lost: %llu clips written, %llu failed, "
-                 "%llu dropped (queue full) before",
-                 record_dir_.c_str(), static_cast<unsigned long long>(written_before_),
-                 static_cast<unsigned long long>(failed_before_), static_cast<unsigned long long>(dropped_before_));
-      return;
-    }
-    writer_->DrainBy(deadline, &abandoned);
-    const auto s = writer_->stats();
-    if (!abandoned.empty())
-      ROS_ERROR("clip_buffer: %zu clips not recorded: the disk did not write them within %.0f s of shutdown "
-                "(roslaunch kills a node 17 s after Ctrl-C): %s",
-                abandoned.size(), kShutdownBudget, JoinNames(abandoned).c_str());
-    if (s.failed > 0) ROS_ERROR("clip_buffer: last failed clip write: %s", s.last_error.c_str());
-    if (!s.index_error.empty()) ROS_ERROR("clip_buffer: index.json not rewritten: %s", s.index_error.c_str());
-    ROS_INFO("clip_buffer: recording into %s ends: %llu clips written, %llu failed, %llu dropped (queue full), "
-             "%zu given up at shutdown, %llu not recorded (no folder open)",
-             writer_->root().c_str(), static_cast<unsigned long long>(written_before_ + s.written),
-             static_cast<unsigned long long>(failed_before_ + s.failed),
-             static_cast<unsigned long long>(dropped_before_ + s.dropped), abandoned.size(),
-             static_cast<unsigned long long>(not_recorded_));
+    UpdateSource();
+    recording_->Finish(pipeline_->Flush(), source_, kShutdownBudget);
   }
 
  private:
@@ -200,7 +152,7 @@ class ClipBufferNode {
     std::lock_guard<std::mutex> lock(mutex_);
     last_input_ = ros::SteadyTime::now();
     last_image_ = last_input_;
-    index_flush_asked_ = false;
+    recording_->InputArrived();
     // An unstamped frame is dropped before it touches anything: taken as a bag loop, one frame
     // stamped 0 forgot the minute of readings the labels need (and lent the clips its frame_id).
     if (msg->header.stamp.isZero()) {
@@ -238,7 +190,7 @@ class ClipBufferNode {
   void OnWind(const clothwind::WindMeasurement::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     last_input_ = ros::SteadyTime::now();
-    index_flush_asked_ = false;
+    recording_->InputArrived();
     if (msg->header.stamp.isZero()) {
       NoteError("anemometer reading dropped: header.stamp is 0");
       return;
@@ -273,7 +225,7 @@ class ClipBufferNode {
 
   void OnCameraInfo(const sensor_msgs::CameraInfo::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!writer_) return;
+    if (!recording_->open()) return;
     source_.camera = ros_bridge::CameraInfoJson(*msg);
   }
 
@@ -285,69 +237,11 @@ class ClipBufferNode {
                flush_after_, pipeline_->pending());
       Publish(pipeline_->Flush());
     }
-    // The folder lost (a disk unplugged, or replugged and mounted again): the writer refused every
-    // later clip until the node restarted. It is closed and the folder reopened once it is back;
-    // not created again, so clips never land on a bare mount point.
-    if (writer_) {
-      if (const std::string lost = writer_->FolderLost(); !lost.empty()) {
-        NoteError(lost + "; reopening it every " + std::to_string(static_cast<int>(kReopenEvery)) + " s once it is there");
-        // Its tally kept, its queued clips counted as not recorded; closed off this thread, as
-        // closing waits for the clip being written (seconds on a slow card), which held the
-        // camera callbacks and broke the clips being published.
-        const auto r = writer_->stats();
-        written_before_ += r.written;
-        failed_before_ += r.failed;
-        dropped_before_ += r.dropped;
-        not_recorded_ += r.queued;
-        failed_seen_ = dropped_seen_ = 0;
-        index_error_seen_.clear();
-        if (closer_.joinable()) closer_.join();  // done: no reopen before it closed (below)
-        closer_closed_ = false;
-        closer_ = std::thread([this, lost_writer = std::move(writer_)]() mutable {
-          lost_writer.reset();
-          closer_closed_ = true;
-        });
-        folder_lost_ = true;
-        recording_error_ = lost;
-        last_open_attempt_ = ros::SteadyTime::now();
-      }
-    }
-    if (!writer_ && !record_dir_.empty() && (ros::SteadyTime::now() - last_open_attempt_).toSec() >= kReopenEvery) {
-      std::error_code ec;
-      if (!closer_closed_) {
-        // The lost writer still finishing its clip: two writers in one path would each rewrite
-        // the index from their own list.
-        last_open_attempt_ = ros::SteadyTime::now();
-      } else if (folder_lost_ && !std::filesystem::is_directory(record_dir_, ec)) {
-        last_open_attempt_ = ros::SteadyTime::now();
-        recording_error_ = "the recording folder " + record_dir_ + " is gone; waiting for it to come back";
-      } else if (folder_lost_ && record_dir_mounted_ && !sensors::IsMountPoint(record_dir_)) {
-        // A disk was mounted there: its bare mount point (an fstab entry) is not the disk.
-        last_open_attempt_ = ros::SteadyTime::now();
-        recording_error_ = "the disk mounted at " + record_dir_ + " is not there; waiting for it to come back";
-      } else {
-        OpenRecording();
-      }
-    }
-    // Input stopped (a replay ended, the camera paused): list the clips recorded since the last
-    // index rewrite now rather than after ~index_interval (after the clips just flushed).
-    if (writer_ && !index_flush_asked_ && (ros::SteadyTime::now() - last_input_).toSec() > flush_after_) {
-      writer_->RequestIndexFlush();
-      index_flush_asked_ = true;
-    }
-    if (writer_) {  // the recording thread's failures, reported from here
-      const auto r = writer_->stats();
-      if (r.failed > failed_seen_) NoteError("recording failed: " + r.last_error);
-      if (r.dropped > dropped_seen_)
-        NoteError("recording too slow: " + std::to_string(r.dropped - dropped_seen_) +
-                  " clip(s) not recorded (queue of " + std::to_string(kRecordQueue) + " full)");
-      failed_seen_ = r.failed;
-      dropped_seen_ = r.dropped;
-      if (!r.index_error.empty() && r.index_error != index_error_seen_)
-        NoteError("index.json not rewritten (the clips are in place; the next rewrite or the next "
-                  "opening of the folder lists them): " + r.index_error);
-      index_error_seen_ = r.index_error;
-    }
+    // The folder lost (a disk unplugged, or replugged and mounted again) is reopened once it is
+    // back; input stopped (a replay ended), the clips recorded since the last index rewrite are
+    // listed now rather than after ~index_interval (after the clips just flushed).
+    const bool idle = (ros::SteadyTime::now() - last_input_).toSec() > flush_after_;
+    for (const std::string& problem : recording_->Poll(ros::SteadyTime::now().toSec(), idle)) NoteError(problem);
     // force_update once a wall second: Updater::update() waits for ROS time, which stands still
     // while a bag is paused and jumps back when it loops. (WallThrottle: again at once after the
     // wall clock steps back, which held every report until it caught up.)
@@ -384,33 +278,15 @@ class ClipBufferNode {
   static constexpr double kLatestStamp = 4294967295.0 - 3600.0;  // [s] ROS time's end, less an hour
 
   // Queues a clip for the recording (a full queue is counted by the writer, reported by OnTimer).
-  // At shutdown (`abandoned` given) it waits for room until `deadline`, and a clip that finds none
-  // is named in *abandoned.
-  void Record(const sensors::LabelledClip& c,
-              std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point(),
-              std::vector<std::string>* abandoned = nullptr) {
-    if (record_dir_.empty()) return;
-    if (!writer_) {
-      ++not_recorded_;
-      return;
-    }
-    source_.frame_id = frame_id_;
-    source_.wind_frame_id = wind_frame_.frame_id();
-    if (!abandoned) {
-      writer_->Enqueue(c, source_);
-    } else if (!writer_->Enqueue(c, source_, deadline) && !c.clip.frames.empty()) {
-      abandoned->push_back(sensors::ClipFolderName(c.clip.frames.front().stamp));
-    }
+  void Record(const sensors::LabelledClip& c) {
+    UpdateSource();
+    recording_->Record(c, source_);
   }
 
-  // "a, b, c" or "a, b, ... (n more), z": the log line stays readable with hundreds of clips.
-  static std::string JoinNames(const std::vector<std::string>& names) {
-    std::string out;
-    const size_t shown = names.size() <= 6 ? names.size() : 4;
-    for (size_t i = 0; i < shown; ++i) out += (i ? ", " : "") + names[i];
-    if (shown < names.size())
-      out += ", ... (" + std::to_string(names.size() - shown - 1) + " more), " + names.back();
-    return out;
+  // The frames the recorded clips are in, as last known.
+  void UpdateSource() {
+    source_.frame_id = frame_id_;
+    source_.wind_frame_id = wind_frame_.frame_id();
   }
 
   // The clock to check stamps against; none while simulated time has not started.
@@ -433,7 +309,7 @@ class ClipBufferNode {
     const auto& s = pipeline_->stats();
     stat.summary(DiagnosticStatus::OK, "making clips");
     // Each condition adds itself; the worst level wins and the messages are joined.
-    if (!recording_error_.empty()) stat.mergeSummary(DiagnosticStatus::ERROR, "not recording: " + recording_error_);
+    if (!recording_->error().empty()) stat.mergeSummary(DiagnosticStatus::ERROR, "not recording: " + recording_->error());
     // An error holds the ERROR for kErrorHold s, then stays in "last error" only: one bad frame an
     // hour ago is not a fault now.
     if (SecondsSince(last_error_time_) < kErrorHold) stat.mergeSummary(DiagnosticStatus::ERROR, last_error_);
@@ -493,10 +369,10 @@ class ClipBufferNode {
     if (wind_frame_.rejected() > 0)
       stat.add("last other direction frame", wind_frame_.last_rejected_frame());
     stat.add("record folder", record_dir_.empty() ? "(not recording)" : record_dir_);
-    const auto r = writer_ ? writer_->stats() : sensors::AsyncDatasetWriter::Stats();
-    stat.add("clips recorded", written_before_ + r.written);
-    stat.add("clips not recorded", not_recorded_ + failed_before_ + dropped_before_ + r.failed + r.dropped);
-    stat.add("clips waiting to be written", r.queued);
+    const auto r = recording_->tally();
+    stat.add("clips recorded", r.recorded);
+    stat.add("clips not recorded", r.not_recorded);
+    stat.add("clips waiting to be written", r.waiting);
     stat.add("clips not yet in index.json", r.unlisted);
     stat.addf("slowest clip write [s]", "%.3f", r.max_write_s);
     stat.add("errors", errors_);
@@ -505,9 +381,7 @@ class ClipBufferNode {
   }
 
   static constexpr double kErrorHold = 10.0;   // [s] wall
-  static constexpr double kReopenEvery = 10.0; // [s] wall
   static constexpr double kShutdownBudget = 12.0;  // [s] wall, within roslaunch's 15 s before SIGTERM
-  static constexpr size_t kRecordQueue = 16;   // clips (16 x 30 x 300^2 B = 43 MB of mono8 at most)
 
   ros::NodeHandle nh_;
   std::mutex mutex_;
@@ -517,7 +391,7 @@ class ClipBufferNode {
   double repeat_base_wall_ = 0;             // its wall time [s]
   std::string repeat_reason_;               // ClipRepeatReason of the last whole window
   std::string loss_reason_;                 // ClipLossReason of the same window
-  std::unique_ptr<sensors::AsyncDatasetWriter> writer_;
+  std::unique_ptr<sensors::ClipRecording> recording_;  // ~record_dir's folder
   sensors::ClipSourceInfo source_;
   std::string frame_id_;
   bool frame_id_from_msg_ = false;
@@ -528,19 +402,9 @@ class ClipBufferNode {
   std::string record_dir_;
   int jpeg_quality_ = 95;
   double index_interval_ = 30.0;  // [s] see sensors::DatasetWriter
-  std::string index_error_seen_;
-  bool index_flush_asked_ = false;  // since the last input
-  std::string recording_error_;  // why record_dir_ is not open; empty when it is (or not set)
-  bool folder_lost_ = false;     // it was open and went: reopened only once it exists again
-  bool record_dir_mounted_ = false;  // record_dir_ was a mount point when it was opened
-  std::thread closer_;               // closes a lost folder's writer off the spinner thread
-  std::atomic<bool> closer_closed_{true};  // it has (no writer closing now)
-  uint64_t written_before_ = 0, failed_before_ = 0, dropped_before_ = 0;  // lost writers' tallies
-  ros::SteadyTime last_open_attempt_;
   std::string last_error_;
   ros::SteadyTime last_error_time_, last_future_;
   uint64_t errors_ = 0;
-  uint64_t not_recorded_ = 0, failed_seen_ = 0, dropped_seen_ = 0;
   ros::Publisher clip_pub_, preview_pub_;
   ros::Subscriber image_sub_, info_sub_, wind_sub_;
   ros::SteadyTimer flush_timer_;

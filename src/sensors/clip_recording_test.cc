@@ -1,0 +1,203 @@
+#include "sensors/clip_recording.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace clothwind::sensors {
+namespace {
+namespace fs = std::filesystem;
+
+class ClipRecordingTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    base_ = fs::temp_directory_path() / ("clothwind_clip_recording_test_" + std::to_string(::getpid()));
+    fs::remove_all(base_);
+    fs::create_directories(base_);
+    dir_ = base_ / "clips";
+  }
+  void TearDown() override { fs::remove_all(base_); }
+
+  ClipRecording::Options Options() {
+    ClipRecording::Options o;
+    o.dir = dir_.string();
+    o.reopen_every = 10;
+    o.is_mount_point = [this](const std::string&) { return mounted_; };
+    return o;
+  }
+  LogFn Log() {
+    return [this](LogLevel level, const std::string& text) {
+      log_ += (level == LogLevel::kError ? "E " : level == LogLevel::kWarn ? "W " : "I ") + text + "\n";
+    };
+  }
+
+  static LabelledClip MakeClip(uint64_t sequence) {
+    LabelledClip c;
+    c.clip.sequence = sequence;
+    const double t0 = 1700000000.0 + 1.2 * static_cast<double>(sequence);
+    for (int i = 0; i < 30; ++i)
+      c.clip.frames.push_back({i, t0 + i / 25.0, t0 + i / 25.0, cv::Mat(32, 32, CV_8UC1, cv::Scalar(i * 8))});
+    c.label = ComputeWindLabel({{t0, 3.0, 0.0}}, t0 + 1.16, 60.0);
+    return c;
+  }
+
+  // Waits until the writer's thread has written what is queued.
+  static void WaitWritten(const ClipRecording& r) {
+    for (int i = 0; i < 500 && r.tally().waiting > 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ASSERT_EQ(r.tally().waiting, 0u);
+  }
+
+  static size_t Listed(const fs::path& dir) {
+    std::ifstream in(dir / "index.json");
+    if (!in) return 0;
+    return nlohmann::json::parse(in)["clips"].size();
+  }
+
+  fs::path base_, dir_;
+  bool mounted_ = false;
+  std::string log_;
+};
+
+TEST_F(ClipRecordingTest, RecordsTheClipsAndTheLastOnesAtShutdown) {
+  {
+    ClipRecording r(Options(), Log(), 100.0);
+    ASSERT_TRUE(r.open()) << r.error();
+    for (uint64_t k = 0; k < 3; ++k) r.Record(MakeClip(k), {});
+    const auto abandoned = r.Finish({MakeClip(3), MakeClip(4)}, {}, 12.0);
+    EXPECT_TRUE(abandoned.empty());
+    EXPECT_EQ(r.tally().recorded, 5u);
+    EXPECT_EQ(r.tally().not_recorded, 0u);
+  }
+  EXPECT_EQ(Listed(dir_), 5u);  // every clip listed: none lost to a kill after shutdown began
+  EXPECT_NE(log_.find("I recording into " + dir_.string() + " ends: 5 clips written, 0 failed"), std::string::npos)
+      << log_;
+}
+
+TEST_F(ClipRecordingTest, NotRecordingCountsNothingAndSaysNothing) {
+  ClipRecording::Options o = Options();
+  o.dir = "";
+  ClipRecording r(o, Log(), 100.0);
+  EXPECT_FALSE(r.enabled());
+  r.Record(MakeClip(0), {});
+  EXPECT_TRUE(r.Poll(200.0, true).empty());
+  EXPECT_TRUE(r.Finish({MakeClip(1)}, {}, 1.0).empty());
+  EXPECT_EQ(r.tally().not_recorded, 0u);
+  EXPECT_TRUE(log_.empty()) << log_;
+}
+
+// A folder that cannot be opened (here: its parent is a file) stops the recording, not the
+// clips: counted as not recorded, said once, and tried again every reopen_every seconds.
+TEST_F(ClipRecordingTest, AFolderThatCannotOpenIsTriedAgainEveryReopenEvery) {
+  std::ofstream(base_ / "file") << "x";
+  ClipRecording::Options o = Options();
+  dir_ = base_ / "file" / "clips";
+  o.dir = dir_.string();
+  ClipRecording r(o, Log(), 100.0);
+  EXPECT_FALSE(r.open());
+  EXPECT_FALSE(r.error().empty());
+  r.Record(MakeClip(0), {});
+  EXPECT_EQ(r.tally().not_recorded, 1u);
+  EXPECT_TRUE(r.Poll(105.0, false).empty());
+  EXPECT_TRUE(r.Poll(111.0, false).empty());  // tried again, failing the same way: said once
+  EXPECT_EQ(std::count(log_.begin(), log_.end(), '\n'), 1) << log_;
+  EXPECT_NE(log_.find("E not recording (publishing clips still; retrying every 10 s)"), std::string::npos) << log_;
+  fs::remove(base_ / "file");
+  fs::create_directories(base_ / "file");
+  r.Poll(115.0, false);
+  EXPECT_FALSE(r.open());  // not before reopen_every since the last attempt (111)
+  r.Poll(121.0, false);
+  EXPECT_TRUE(r.open()) << r.error();
+  EXPECT_TRUE(r.error().empty());
+  EXPECT_NE(log_.find("I recording works again"), std::string::npos) << log_;
+}
+
+// A folder lost (a disk unplugged) is closed off the caller's thread and reopened only once it is
+// a folder again, never made again; the tally runs on across the two.
+TEST_F(ClipRecordingTest, ALostFolderIsReopenedOnceItIsBackAndTheTallyRunsOn) {
+  ClipRecording r(Options(), Log(), 100.0);
+  ASSERT_TRUE(r.open());
+  r.Record(MakeClip(0), {});
+  r.Record(MakeClip(1), {});
+  WaitWritten(r);
+  fs::rename(dir_, base_ / "unplugged");
+  const auto problems = r.Poll(101.0, false);
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("reopening it every 10 s once it is there"), std::string::npos) << problems[0];
+  EXPECT_FALSE(r.open());
+  EXPECT_TRUE(r.Poll(102.0, false).empty());  // said once
+  r.Record(MakeClip(2), {});                   // no folder: not recorded
+  double now = 112.0;
+  for (int i = 0; i < 200 && r.error().find("is gone; waiting") == std::string::npos; ++i, now += 10) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));  // the lost writer closing
+    r.Poll(now, false);
+  }
+  EXPECT_FALSE(r.open());
+  EXPECT_FALSE(fs::exists(dir_));  // not made again: clips never land where the disk is not
+  EXPECT_NE(r.error().find("is gone; waiting for it to come back"), std::string::npos) << r.error();
+  fs::create_directories(dir_);
+  r.Poll(now + 10, false);
+  ASSERT_TRUE(r.open()) << r.error();
+  r.Record(MakeClip(3), {});
+  r.Finish({}, {}, 12.0);
+  EXPECT_EQ(r.tally().recorded, 3u);
+  EXPECT_EQ(r.tally().not_recorded, 1u);
+  // The two clips written before the disk went are on it (its index lists them when the folder is
+  // next opened: the closing writer could not reach it), the one after it came back in its index.
+  size_t on_unplugged = 0;
+  for (const auto& e : fs::directory_iterator(base_ / "unplugged")) on_unplugged += e.path().filename().string().rfind("clip-", 0) == 0;
+  EXPECT_EQ(on_unplugged, 2u);
+  EXPECT_EQ(Listed(dir_), 1u);
+}
+
+// A disk mounted at the folder: once lost, its bare mount point (an fstab entry) is a folder but
+// not the disk, and the recording waits for the disk.
+TEST_F(ClipRecordingTest, ABareMountPointIsNotTheDisk) {
+  mounted_ = true;
+  ClipRecording r(Options(), Log(), 100.0);
+  ASSERT_TRUE(r.open());
+  fs::rename(dir_, base_ / "unplugged");
+  fs::create_directories(dir_);  // the bare mount point
+  mounted_ = false;
+  r.Poll(101.0, false);
+  double now = 111.0;
+  for (int i = 0; i < 200 && r.error().find("is not there") == std::string::npos; ++i, now += 10) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));  // the lost writer closing
+    r.Poll(now, false);
+  }
+  EXPECT_FALSE(r.open());
+  EXPECT_NE(r.error().find("is not there; waiting for it to come back"), std::string::npos) << r.error();
+  mounted_ = true;  // the disk mounted again
+  r.Poll(now + 10, false);
+  EXPECT_TRUE(r.open()) << r.error();
+}
+
+// Input stopped (a replay ended): the clips written since the last index rewrite are listed now,
+// not after index_interval.
+TEST_F(ClipRecordingTest, InputStoppingListsTheClipsWritten) {
+  ClipRecording::Options o = Options();
+  o.index_interval = 3600;
+  ClipRecording r(o, Log(), 100.0);
+  ASSERT_TRUE(r.open());
+  for (uint64_t k = 0; k < 3; ++k) r.Record(MakeClip(k), {});
+  WaitWritten(r);
+  ASSERT_GT(r.tally().unlisted, 0u);
+  r.Poll(101.0, /*input_idle=*/true);
+  for (int i = 0; i < 500 && r.tally().unlisted > 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_EQ(r.tally().unlisted, 0u);
+  EXPECT_EQ(Listed(dir_), 3u);
+}
+
+TEST(ClipRecordingNamesTest, JoinNamesShortensLongLists) {
+  EXPECT_EQ(ClipRecording::JoinNames({"a", "b", "c"}), "a, b, c");
+  EXPECT_EQ(ClipRecording::JoinNames({"1", "2", "3", "4", "5", "6", "7", "8", "9"}), "1, 2, 3, 4, ... (4 more), 9");
+}
+
+}  // namespace
+}  // namespace clothwind::sensors
