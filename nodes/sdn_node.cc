@@ -318,6 +318,8 @@ class SdnNode {
     mean.clip_start.fromNSec(trailing_.OldestTag());
     mean.speed = clothwind::learn::ClampSpeed(trailing_.Mean());
     mean.speed_std = trailing_.Std();
+    mean.mean_window = trailing_.window();
+    mean.mean_count = static_cast<uint32_t>(trailing_.Count());
     char model[64];
     std::snprintf(model, sizeof model, " [trailing %.0f s mean of %zu clips]", trailing_.window(), trailing_.Count());
     mean.model += model;

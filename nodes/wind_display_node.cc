@@ -142,15 +142,11 @@ class WindDisplayNode {
 
   // sdn_node's trailing mean of the same estimates: of the network's outputs before the clamp at 0,
   // where the mean of the clamped estimates reads high in calm air.
-  // Taken only over this display's ~mean_window, which sdn_node names in the model field ("...
-  // [trailing 60 s mean of N clips]"): a 120 s mean was shown as the "60 s mean" otherwise.
+  // Taken only over this display's ~mean_window (the message's mean_window): a 120 s mean was shown
+  // as the "60 s mean" otherwise.
   void OnEstimateMean(const clothwind::WindEstimate::ConstPtr& msg) {
     if (!Plausible(msg->speed)) return;
-    const size_t at = msg->model.rfind("[trailing ");
-    double window = 0;
-    if (at == std::string::npos || std::sscanf(msg->model.c_str() + at, "[trailing %lf s mean", &window) != 1 ||
-        std::abs(window - mean_window_) > 0.5)
-      return;
+    if (!(msg->mean_window > 0) || std::abs(msg->mean_window - mean_window_) > 0.5) return;
     if (!have_mean_ || msg->header.stamp >= last_mean_.header.stamp) {
       last_mean_ = *msg;
       have_mean_ = true;

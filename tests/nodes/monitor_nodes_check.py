@@ -208,12 +208,12 @@ class MonitorNodesTest(unittest.TestCase):
         mean = WindEstimate()
         mean.header.stamp, mean.clip_sequence = e.header.stamp, e.clip_sequence
         # Over another window than the display's (3 s here): not taken, or its label would lie.
-        mean.speed, mean.speed_std, mean.model = 3.2, 0.2, "m [trailing 120 s mean of 4 clips]"
+        mean.speed, mean.speed_std, mean.mean_window, mean.mean_count = 3.2, 0.2, 120.0, 4
         self.mean_pub.publish(mean)
         self.wait_redraw()
         text, _ = self.text()
         self.assertIn("s mean 4.0", text)
-        mean.speed, mean.model = 3.7, "m [trailing 3 s mean of 2 clips]"
+        mean.speed, mean.mean_window, mean.mean_count = 3.7, 3.0, 2
         self.mean_pub.publish(mean)
         self.wait_redraw()
         text, _ = self.text()

@@ -280,6 +280,8 @@ class SdnNodeTest(unittest.TestCase):
             self.assertAlmostEqual(m.speed_std, math.sqrt(sum(o.speed_std ** 2 for o in inside) / len(inside)), places=6)
             self.assertEqual(m.clip_start, min(o.clip_start for o in inside))
             self.assertIn("trailing %.0f s mean of %d clips" % (window, len(inside)), m.model)
+            self.assertEqual((m.mean_window, m.mean_count), (window, len(inside)))
+            self.assertEqual((e.mean_window, e.mean_count), (0.0, 0))  # one clip's estimate
             if math.isnan(e.reference_speed):
                 self.assertTrue(math.isnan(m.reference_speed))
             else:
