@@ -143,8 +143,11 @@ class ClipBufferNode {
   // named, and the tally, with the last write or index error, is said at the end.
   void Finish() {
     std::lock_guard<std::mutex> lock(mutex_);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                                 std::chrono::duration<double>(kShutdownBudget));
+    const auto waiting = pipeline_->Flush();
     UpdateSource();
-    recording_->Finish(pipeline_->Flush(), source_, kShutdownBudget);
+    recording_->Finish(waiting, source_, deadline);
   }
 
  private:

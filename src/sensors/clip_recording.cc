@@ -124,11 +124,10 @@ ClipRecording::Tally ClipRecording::tally() const {
 }
 
 std::vector<std::string> ClipRecording::Finish(const std::vector<LabelledClip>& waiting, const ClipSourceInfo& source,
-                                               double budget) {
+                                               std::chrono::steady_clock::time_point deadline) {
   // (A lost folder's writer still closing is joined by the destructor, after the last clips: a
   // yanked disk's write can hang past roslaunch's SIGKILL.)
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(budget));
+  const double budget = std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
   std::vector<std::string> abandoned;
   if (!enabled()) return abandoned;
   if (writer_ && (!waiting.empty() || writer_->stats().queued > 0))

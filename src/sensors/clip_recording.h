@@ -57,25 +57,29 @@ class ClipRecording {
   // point, a mount point again (a bare mount point is not the disk): never created again, so clips
   // never land on a bare mount point. input_idle: input has stopped (a replay ended), so the clips
   // recorded since the last index rewrite are listed now, once per stop. Returns what newly went
-  // wrong (the folder lost, failed writes, a full queue, an index not rewritten), each once.
+  // wrong: the folder lost (once), writes that failed since the last call (with the last one's
+  // error), clips the full queue dropped since then, an index rewrite's error (once per error).
   std::vector<std::string> Poll(double now, bool input_idle);
   // Input came again: the next stop lists the index again.
   void InputArrived() { index_flush_asked_ = false; }
 
   struct Tally {
     uint64_t recorded = 0;      // clips written, over every folder opened
-    uint64_t not_recorded = 0;  // failed, dropped (queue full), or no folder open
+    // Failed, dropped (queue full), queued in a folder when it was lost, or with no folder open;
+    // not those given up at shutdown (Finish names them).
+    uint64_t not_recorded = 0;
     size_t waiting = 0;         // queued for the disk now
     size_t unlisted = 0;        // written, not yet in index.json
     double max_write_s = 0;     // the slowest clip write of the open writer [s]
   };
   Tally tally() const;
 
-  // At shutdown: records `waiting` (clips labelled now, with `source`), then waits for the queue
-  // to be written, until `budget` seconds from now at most; logs what was given up (named) and the
-  // tally. Returns the names of the clips given up.
+  // At shutdown: records `waiting` (clips labelled now, with `source`), waiting for room in the
+  // queue, then for the queue to be written, until `deadline` at most (taken before the waiting
+  // clips were labelled: the budget is the whole shutdown's); logs what was given up (named) and
+  // the tally. Returns the names of the clips given up.
   std::vector<std::string> Finish(const std::vector<LabelledClip>& waiting, const ClipSourceInfo& source,
-                                  double budget);
+                                  std::chrono::steady_clock::time_point deadline);
 
   // "a, b, c" or "a, b, ... (n more), z": a log line stays readable with hundreds of clips.
   static std::string JoinNames(const std::vector<std::string>& names);

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -60,6 +61,10 @@ class ClipRecordingTest : public ::testing::Test {
     return nlohmann::json::parse(in)["clips"].size();
   }
 
+  static std::chrono::steady_clock::time_point Deadline() {
+    return std::chrono::steady_clock::now() + std::chrono::seconds(12);
+  }
+
   fs::path base_, dir_;
   bool mounted_ = false;
   std::string log_;
@@ -70,7 +75,7 @@ TEST_F(ClipRecordingTest, RecordsTheClipsAndTheLastOnesAtShutdown) {
     ClipRecording r(Options(), Log(), 100.0);
     ASSERT_TRUE(r.open()) << r.error();
     for (uint64_t k = 0; k < 3; ++k) r.Record(MakeClip(k), {});
-    const auto abandoned = r.Finish({MakeClip(3), MakeClip(4)}, {}, 12.0);
+    const auto abandoned = r.Finish({MakeClip(3), MakeClip(4)}, {}, Deadline());
     EXPECT_TRUE(abandoned.empty());
     EXPECT_EQ(r.tally().recorded, 5u);
     EXPECT_EQ(r.tally().not_recorded, 0u);
@@ -80,6 +85,34 @@ TEST_F(ClipRecordingTest, RecordsTheClipsAndTheLastOnesAtShutdown) {
       << log_;
 }
 
+// The last clips at shutdown wait for room in the queue (a queue of one here): a full queue of a
+// slow disk dropped them, and no report came after.
+TEST_F(ClipRecordingTest, TheLastClipsWaitForRoomInTheQueue) {
+  ClipRecording::Options o = Options();
+  o.queue = 1;
+  {
+    ClipRecording r(o, Log(), 100.0);
+    std::vector<LabelledClip> waiting;
+    for (uint64_t k = 0; k < 8; ++k) waiting.push_back(MakeClip(k));
+    EXPECT_TRUE(r.Finish(waiting, {}, Deadline()).empty());
+    EXPECT_EQ(r.tally().recorded, 8u);
+    EXPECT_EQ(r.tally().not_recorded, 0u);
+  }
+  EXPECT_EQ(Listed(dir_), 8u);
+}
+
+// With no folder open at shutdown the last clips are counted and said, not silently lost.
+TEST_F(ClipRecordingTest, TheLastClipsWithNoFolderOpenAreCountedAndSaid) {
+  std::ofstream(base_ / "file") << "x";
+  ClipRecording::Options o = Options();
+  o.dir = (base_ / "file" / "clips").string();
+  ClipRecording r(o, Log(), 100.0);
+  ASSERT_FALSE(r.open());
+  r.Finish({MakeClip(0), MakeClip(1)}, {}, Deadline());
+  EXPECT_EQ(r.tally().not_recorded, 2u);
+  EXPECT_NE(log_.find("W 2 clips not recorded (no recording folder open: "), std::string::npos) << log_;
+}
+
 TEST_F(ClipRecordingTest, NotRecordingCountsNothingAndSaysNothing) {
   ClipRecording::Options o = Options();
   o.dir = "";
@@ -87,7 +120,7 @@ TEST_F(ClipRecordingTest, NotRecordingCountsNothingAndSaysNothing) {
   EXPECT_FALSE(r.enabled());
   r.Record(MakeClip(0), {});
   EXPECT_TRUE(r.Poll(200.0, true).empty());
-  EXPECT_TRUE(r.Finish({MakeClip(1)}, {}, 1.0).empty());
+  EXPECT_TRUE(r.Finish({MakeClip(1)}, {}, Deadline()).empty());
   EXPECT_EQ(r.tally().not_recorded, 0u);
   EXPECT_TRUE(log_.empty()) << log_;
 }
@@ -145,7 +178,7 @@ TEST_F(ClipRecordingTest, ALostFolderIsReopenedOnceItIsBackAndTheTallyRunsOn) {
   r.Poll(now + 10, false);
   ASSERT_TRUE(r.open()) << r.error();
   r.Record(MakeClip(3), {});
-  r.Finish({}, {}, 12.0);
+  r.Finish({}, {}, Deadline());
   EXPECT_EQ(r.tally().recorded, 3u);
   EXPECT_EQ(r.tally().not_recorded, 1u);
   // The two clips written before the disk went are on it (its index lists them when the folder is
@@ -154,6 +187,29 @@ TEST_F(ClipRecordingTest, ALostFolderIsReopenedOnceItIsBackAndTheTallyRunsOn) {
   for (const auto& e : fs::directory_iterator(base_ / "unplugged")) on_unplugged += e.path().filename().string().rfind("clip-", 0) == 0;
   EXPECT_EQ(on_unplugged, 2u);
   EXPECT_EQ(Listed(dir_), 1u);
+}
+
+// Lost twice (a disk replugged twice): the first lost writer's closing thread is joined before the
+// second's starts (a joinable std::thread replaced ends the process).
+TEST_F(ClipRecordingTest, AFolderLostTwiceIsReopenedTwice) {
+  ClipRecording r(Options(), Log(), 100.0);
+  double now = 100.0;
+  for (int loss = 0; loss < 2; ++loss) {
+    ASSERT_TRUE(r.open()) << loss;
+    r.Record(MakeClip(loss), {});
+    WaitWritten(r);
+    fs::rename(dir_, base_ / ("unplugged" + std::to_string(loss)));
+    now += 1;
+    ASSERT_EQ(r.Poll(now, false).size(), 1u) << loss;
+    fs::create_directories(dir_);
+    for (int i = 0; i < 200 && !r.open(); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));  // the lost writer closing
+      now += 10;
+      r.Poll(now, false);
+    }
+  }
+  ASSERT_TRUE(r.open()) << r.error();
+  EXPECT_EQ(r.tally().recorded, 2u);
 }
 
 // A disk mounted at the folder: once lost, its bare mount point (an fstab entry) is a folder but

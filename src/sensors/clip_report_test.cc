@@ -1,5 +1,6 @@
 #include "sensors/clip_report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -90,7 +91,7 @@ TEST(ClipReportTest, JsonCarriesEveryClipAndWritesAMissingLabelAsNull) {
   EXPECT_EQ(j.at("frame_rate"), 25.0);
   EXPECT_EQ(j.at("label_window"), 60.0);
   EXPECT_EQ(j.at("wall_seconds"), 12.5);
-  // It parses back as written (a NaN would have made dump() write invalid JSON or throw).
+  // It parses back as written (a NaN written as a number would come back as null, not equal).
   EXPECT_EQ(nlohmann::json::parse(j.dump()), j);
 }
 
