@@ -323,6 +323,39 @@ TEST(RepulsionForceTest, ForceIsMinusEnergyGradientOnBothSidesInRandomConfigurat
   }
 }
 
+TEST(RepulsionForceTest, GaussNewtonIsExactInThePointsOwnBlockAtAnyDepth) {
+  // f = k v^2 / (2h) g, g = dd/dx: the exact Jacobian is -k v / h g g^T + k v^2 / (2h) dg/dx, and
+  // the Gauss-Newton one drops the second term. The point's own block has none (its g is side * n,
+  // which depends on the face only), so there the Jacobian must be the forces' derivative at any
+  // depth, not only near the thickness where the other blocks' curvature term fades: a stiffness,
+  // thickness or sign wrong in the Jacobian alone shows here at every depth.
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> gap(-0.5, 0.9);
+  const double h = 0.01, k = 5e3;
+  for (const double side : {1.0, -1.0}) {
+    for (int trial = 0; trial < 10; ++trial) {
+      SCOPED_TRACE("side " + std::to_string(side) + ", trial " + std::to_string(trial));
+      const Vector12d x = RandomRepulsionPair(rng, side, gap(rng) * h);
+      const RepulsionTerms r = RepulsionForce(x, side, h, k);
+      ASSERT_TRUE(r.active);
+      auto point_force = [&](const Eigen::Vector3d& p) {
+        Vector12d y = x;
+        y.segment<3>(0) = p;
+        return Eigen::Vector3d(RepulsionForce(y, side, h, k).force.segment<3>(0));
+      };
+      Eigen::Matrix3d numeric;
+      for (int j = 0; j < 3; ++j) {
+        Eigen::Vector3d a = x.segment<3>(0), b = a;
+        a[j] += 1e-8;
+        b[j] -= 1e-8;
+        numeric.col(j) = (point_force(a) - point_force(b)) / 2e-8;
+      }
+      const Eigen::Matrix3d block = r.jacobian.block<3, 3>(0, 0);
+      EXPECT_LT((block - numeric).norm(), 1e-5 * block.norm()) << block << "\n" << numeric;
+    }
+  }
+}
+
 // A random triangle and corner velocities for the wind tests.
 struct WindCase {
   Vector9d x, v;
