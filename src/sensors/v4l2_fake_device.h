@@ -70,9 +70,10 @@ class FakeV4l2Device : public V4l2Io {
 
   // --- test controls ---
   void Unplug() { present_ = false; }
-  void Replug() {
+  // A new device instance counts from zero; first_sequence: one that counts on from elsewhere.
+  void Replug(uint32_t first_sequence = 0) {
     present_ = true;
-    sequence_ = 0;  // a new device instance counts from zero
+    sequence_ = first_sequence;
   }
   void Stall(bool stalled) { stalled_ = stalled; }
 
