@@ -5,6 +5,7 @@ The nodes are started from here (rosrun-style, `_name:=value` or parameters set 
 first), so each runs in a folder of the test's own and its exit status and console are seen.
 """
 import glob
+import json
 import os
 import shutil
 import signal
@@ -209,6 +210,30 @@ class NodeParamsTest(unittest.TestCase):
             ("wind_display_node", {"rate": 1e-12}, "~rate must be from 0.001 to 1000 Hz, got 1e-12"),
         ]
         self.expect_refused(cases, "range")
+
+    # SIGTERM (systemd, docker stop, roslaunch's escalation) ends clip_buffer as Ctrl-C does: the
+    # clips still waiting for their labels are labelled and recorded, and index.json lists every
+    # clip on disk (it ended on the signal, and the waiting clips were lost).
+    def test_sigterm_records_the_waiting_clips(self):
+        record = os.path.join(self.folder, "term")
+        node = self.spawn("clip_buffer_node", [
+            "__ns:=term", "_record_dir:=" + record, "_num_frames:=10", "_stride:=10", "_size:=32",
+            "_label_window:=2.0", "_label_delay:=3.0", "_flush_after:=10.0", "_index_interval:=600"],
+            cwd=self.folder)
+        published = []
+        rospy.Subscriber("/term/clips", Clip, lambda c: published.append(c.sequence), queue_size=100)
+        feed = ClipFeed("term")
+        self.assertTrue(feed.connected(20), node.output())
+        # Clips wait 3 s after their end for late readings: some are published, some still wait.
+        self.assertTrue(feed.until(lambda: len(published) >= 2, 40), node.output())
+        node.process.send_signal(signal.SIGTERM)
+        self.assertEqual(node.wait(30), 0, node.output())
+        folders = sorted(os.path.basename(os.path.dirname(p))
+                         for p in glob.glob(os.path.join(record, "clip-*", "label.json")))
+        self.assertGreater(len(folders), len(published), "the waiting clips were not recorded")
+        with open(os.path.join(record, "index.json")) as f:
+            listed = sorted(c["name"] for c in json.load(f)["clips"])
+        self.assertEqual(listed, folders)
 
     # The serial settings are unused by a replay (topic input) or a USB station, but a bad one in
     # the field's YAML is said there, where serial input would end on it; the node runs on.
