@@ -1136,6 +1136,13 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
   EXPECT_FALSE(fs::exists(*root_ / "resume2" / ".checkpoint-e0003.tmp"));
   EXPECT_NEAR(redo.log[2].train_loss, resumed.log[2].train_loss, 1e-5);
   EXPECT_NEAR(redo.log[2].val_rmse, resumed.log[2].val_rmse, 1e-5);
+  // ... and both are the run never stopped: two resumes that each reloaded nothing, or both
+  // started the data order or the schedule again, would agree with each other, not with this.
+  TrainOptions straight_options = Options("sdn", "straight");
+  straight_options.epochs = 3;
+  const TrainResult straight = Train(straight_options);
+  EXPECT_NEAR(straight.log[2].train_loss, resumed.log[2].train_loss, 1e-5);
+  EXPECT_NEAR(straight.log[2].val_rmse, resumed.log[2].val_rmse, 1e-5);
 
   // Training into the folder again without --resume (a command rerun after a crash) is refused
   // before anything is written; --overwrite starts it again.
