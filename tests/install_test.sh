@@ -24,7 +24,8 @@ for p in "${programs[@]}"; do
   [ -z "$missing" ] || fail "$p lacks libraries: $missing"
 done
 "${clean_env[@]}" "$prefix/bin/clothwind" --help >/dev/null || fail "the installed CLI does not start"
-for f in share/clothwind/config/scenes/flag.json share/clothwind/models/sdn.pt share/clothwind/launch/replay.launch; do
+for f in share/clothwind/config/scenes/flag.json share/clothwind/models/sdn.pt share/clothwind/launch/replay.launch \
+    share/clothwind/scripts/replay-player; do
   [ -f "$prefix/$f" ] || fail "$f is not installed"
 done
 
