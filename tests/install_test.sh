@@ -28,6 +28,7 @@ for f in share/clothwind/config/scenes/flag.json share/clothwind/models/sdn.pt s
     share/clothwind/scripts/replay-player; do
   [ -f "$prefix/$f" ] || fail "$f is not installed"
 done
+[ -x "$prefix/share/clothwind/scripts/replay-player" ] || fail "the installed replay-player is not executable"
 
 echo '{ "frame_time": ' > "$prefix/share/clothwind/config/scenes/flag.json"
 status=0

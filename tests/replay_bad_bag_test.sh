@@ -8,14 +8,27 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 fail() { echo "replay_bad_bag_test: FAIL: $*" >&2; exit 1; }
 export ROS_LOG_DIR="$work/log"
-port=$((20000 + RANDOM % 20000))
+# Our own master on a free port (as scripts/run-main): other tests' masters and nodes are left alone.
+port="$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])')"
 export ROS_MASTER_URI="http://localhost:$port"
 echo "not a bag" > "$work/text.bag"
-for bag in "$work/none.bag" "$work/text.bag"; do
+# A recording that was not closed: a version 2.0 header whose index_pos is 0 (rosbag play plays
+# nothing of it and exits with status 0).
+/usr/bin/python3 - "$work/unindexed.bag" <<'PY'
+import struct, sys
+fields = b"".join(struct.pack("<I", len(f)) + f for f in
+                  (b"op=\x03", b"index_pos=" + struct.pack("<Q", 0), b"conn_count=" + struct.pack("<I", 0),
+                   b"chunk_count=" + struct.pack("<I", 0)))
+with open(sys.argv[1], "wb") as f:
+    f.write(b"#ROSBAG V2.0\n" + struct.pack("<I", len(fields)) + fields + struct.pack("<I", 4096) + b" " * 4096)
+PY
+declare -A why=(["$work/none.bag"]="No such file or directory" ["$work/text.bag"]="not a ROS bag"
+                ["$work/unindexed.bag"]="rosbag reindex")
+for bag in "$work/none.bag" "$work/text.bag" "$work/unindexed.bag"; do
   status=0
   timeout 90 roslaunch -p "$port" clothwind replay.launch bag:="$bag" >"$work/out.txt" 2>&1 || status=$?
   [ "$status" -ne 124 ] || fail "replay.launch bag:=$bag was still up after 90 s: $(tail -5 "$work/out.txt")"
-  grep -q "replay.launch: cannot open the bag $bag" "$work/out.txt" ||
-    fail "replay.launch bag:=$bag did not name the bag: $(tail -20 "$work/out.txt")"
+  grep -q "replay.launch: cannot open the bag $bag: .*${why[$bag]}" "$work/out.txt" ||
+    fail "replay.launch bag:=$bag did not say why: $(tail -20 "$work/out.txt")"
 done
 echo "replay_bad_bag_test: OK"

@@ -328,9 +328,10 @@ TEST(RepulsionForceTest, GaussNewtonIsExactInThePointsOwnBlockAtAnyDepth) {
   // the Gauss-Newton one drops the second term. The point's own block has none (its g is side * n,
   // which depends on the face only), so there the Jacobian must be the forces' derivative at any
   // depth, not only near the thickness where the other blocks' curvature term fades: a stiffness,
-  // thickness or sign wrong in the Jacobian alone shows here at every depth.
+  // thickness or sign wrong in the Jacobian alone shows here at every depth: the point from 0.9 h
+  // over the face (near the thickness) to 2 h through it.
   std::mt19937 rng(77);
-  std::uniform_real_distribution<double> gap(-0.5, 0.9);
+  std::uniform_real_distribution<double> gap(-2.0, 0.9);
   const double h = 0.01, k = 5e3;
   for (const double side : {1.0, -1.0}) {
     for (int trial = 0; trial < 10; ++trial) {

@@ -44,12 +44,23 @@ class AnemometerSimTimeTest(unittest.TestCase):
         self.clock.publish(c)
         time.sleep(0.05)
 
-    def latest_status(self, wall_seconds):
-        """The node's last status after `wall_seconds` more of wall time (diagnostics come every
+    def statuses_for(self, wall_seconds):
+        """The node's statuses over the next `wall_seconds` of wall time (diagnostics come every
         wall second, clock or not)."""
+        start = len(self.statuses)
+        time.sleep(wall_seconds)
+        got = self.statuses[start:]
+        self.assertTrue(got, 'no diagnostics in %.0f s' % wall_seconds)
+        return got
+
+    def status_until(self, condition, wall_seconds):
+        """The first status from now on that meets `condition`, within `wall_seconds`; else the last."""
         start = len(self.statuses)
         deadline = time.time() + wall_seconds
         while time.time() < deadline:
+            for s in self.statuses[start:]:
+                if condition(s):
+                    return s
             time.sleep(0.1)
         self.assertGreater(len(self.statuses), start, 'no diagnostics in %.0f s' % wall_seconds)
         return self.statuses[-1]
@@ -70,14 +81,16 @@ class AnemometerSimTimeTest(unittest.TestCase):
             time.sleep(0.1)
         self.assertEqual(len(self.winds), 6)
         self.set_clock(t)
-        self.assertEqual(self.latest_status(1.5).level, DiagnosticStatus.OK)
-        # The replay paused: 5 s of wall time without /clock, past the 3 s ~stale_timeout.
-        status = self.latest_status(5.0)
-        self.assertNotIn('stale', status.message)
+        status = self.status_until(lambda s: s.level == DiagnosticStatus.OK, 5.0)
         self.assertEqual(status.level, DiagnosticStatus.OK, status.message)
+        # The replay paused: 5 s of wall time without /clock, past the 3 s ~stale_timeout. No
+        # status of those seconds says stale.
+        for status in self.statuses_for(5.0):
+            self.assertNotIn('stale', status.message)
+            self.assertEqual(status.level, DiagnosticStatus.OK, status.message)
         # The replay runs on 5 s of its own time without a reading: stale.
         self.set_clock(t + 5.0)
-        status = self.latest_status(2.0)
+        status = self.status_until(lambda s: 'valid readings stale' in s.message, 5.0)
         self.assertEqual(status.level, DiagnosticStatus.WARN, status.message)
         self.assertIn('valid readings stale', status.message)
 
