@@ -7,7 +7,6 @@ WindMeasurement per wind sentence, none for garbage), stamps (arrival time of th
 after the write, shortly), RawSentence/WindMeasurement stamp equality, survival of garbage, and
 reconnection after the device vanishes.
 """
-import functools
 import math
 import os
 import threading
@@ -20,12 +19,13 @@ import rostest
 from clothwind.msg import RawSentence, WindMeasurement
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 
+import wind_records
+
 KNOT = 1852.0 / 3600.0
 
 
 def nmea(body):
-    cs = functools.reduce(lambda a, c: a ^ c, body.encode('ascii'), 0)
-    return ('$%s*%02X\r\n' % (body, cs)).encode('ascii')
+    return (wind_records.nmea(body) + '\r\n').encode('ascii')
 
 
 def wrap(a):
@@ -229,9 +229,7 @@ class AnemometerPtySerialTest(unittest.TestCase):
     def test_4_gill_after_nmea_is_rejected_until_proven(self):
         # The decoder locked onto NMEA: a lone Gill record is treated as noise, not a reading.
         self.clear()
-        body = 'Q,229,002.74,M,00,'
-        cs = functools.reduce(lambda a, c: a ^ c, body.encode('ascii'), 0)
-        self.dev.write(b'\x02' + body.encode('ascii') + b'\x03' + ('%02X' % cs).encode('ascii') + b'\r\n')
+        self.dev.write((wind_records.gill('Q,229,002.74,M,00,') + '\r\n').encode('ascii'))
         time.sleep(0.5)
         self.dev.write(nmea('IIMWV,020.0,R,1.0,M,A'))
         deadline = time.time() + 10.0

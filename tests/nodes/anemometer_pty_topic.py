@@ -1,7 +1,6 @@
 #!/usr/bin/env python3
 """anemometer_node ~input:=topic (rosbag replay): RawSentence in, WindMeasurement out with the
 raw message's stamp and frame; garbage and bad checksums give nothing."""
-import functools
 import math
 import threading
 import time
@@ -11,11 +10,7 @@ import rospy
 import rostest
 from clothwind.msg import RawSentence, WindMeasurement
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-
-
-def nmea(body):
-    cs = functools.reduce(lambda a, c: a ^ c, body.encode('ascii'), 0)
-    return '$%s*%02X' % (body, cs)
+from wind_records import gill, nmea
 
 
 class AnemometerTopicTest(unittest.TestCase):
@@ -46,13 +41,11 @@ class AnemometerTopicTest(unittest.TestCase):
         time.sleep(0.2)
 
     def test_replay_keeps_stamps(self):
-        body = 'Q,229,002.74,M,00,'
-        cs = functools.reduce(lambda a, c: a ^ c, body.encode('ascii'), 0)
-        gill = '\x02' + body + '\x03' + '%02X' % cs
-        self.send(gill, 1234, 5678, 'gill')
+        record = gill('Q,229,002.74,M,00,')
+        self.send(record, 1234, 5678, 'gill')
         self.send('\\xFF\\x00 garbage', 1235, 0)
-        self.send(gill[:-1] + ('0' if gill[-1] != '0' else '1'), 1236, 0, 'gill')  # bad checksum
-        self.send(gill, 1237, 999999999, 'gill')
+        self.send(record[:-1] + ('0' if record[-1] != '0' else '1'), 1236, 0, 'gill')  # bad checksum
+        self.send(record, 1237, 999999999, 'gill')
         deadline = time.time() + 10.0
         while time.time() < deadline:
             with self.lock:
@@ -108,9 +101,7 @@ class AnemometerTopicTest(unittest.TestCase):
     def test_records_stamped_0_or_far_ahead_are_dropped_and_said(self):
         # They were republished as readings with those stamps, which the clip buffer refuses:
         # counted there, far from their cause.
-        body = 'Q,229,002.74,M,00,'
-        cs = functools.reduce(lambda a, c: a ^ c, body.encode('ascii'), 0)
-        gill = '\x02' + body + '\x03' + '%02X' % cs
+        record = gill('Q,229,002.74,M,00,')
         winds = []
         sub = rospy.Subscriber('/replay_odd/anemometer/wind', WindMeasurement, winds.append, queue_size=50)
         pub = rospy.Publisher('/replay_odd/anemometer/raw', RawSentence, queue_size=50)
@@ -124,7 +115,7 @@ class AnemometerTopicTest(unittest.TestCase):
             m = RawSentence()
             m.header.stamp = stamp
             m.header.frame_id = 'recorded_frame'
-            m.data = gill
+            m.data = record
             m.protocol = 'gill'
             pub.publish(m)
             time.sleep(0.2)

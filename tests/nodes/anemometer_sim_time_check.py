@@ -1,7 +1,6 @@
 #!/usr/bin/env python3
 """rostest (tests/anemometer_sim_time.test): anemometer_node ~input:=topic on a replay's clock ages
 its readings on ROS time, not the wall clock."""
-import functools
 import time
 import unittest
 
@@ -10,13 +9,9 @@ import rostest
 from clothwind.msg import RawSentence, WindMeasurement
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rosgraph_msgs.msg import Clock
+from wind_records import nmea
 
 HARDWARE_ID = 'topic:/anemometer/raw'
-
-
-def nmea(body):
-    cs = functools.reduce(lambda a, c: a ^ c, body.encode('ascii'), 0)
-    return '$%s*%02X' % (body, cs)
 
 
 class AnemometerSimTimeTest(unittest.TestCase):
