@@ -100,6 +100,67 @@ TEST(StretchingForceTest, DefiniteJacobianIsNegativeSemidefiniteAndExactUnderTen
   EXPECT_LT((Jd - Je).norm(), 1e-12 * Je.norm());
 }
 
+// ArcSim's definite Jacobian is the exact one with the strains' curvature kept only where it cannot
+// make the system indefinite: each normal strain's where it is tensile (max(G, 0)), the shear's
+// nowhere. The tests above check its sign (compressed) and that it is exact under uniform
+// tension; this one pins the formula itself in the mixed states between, stretched along one
+// material axis and compressed along the other, against an independent computation: the exact
+// Jacobian by finite differences of the force, the strains G = (F^T F - I)/2 and their Hessians by
+// finite differences of the test's own F = [x1 - x0, x2 - x0] Dm_inv, so
+//   J_definite - J_exact = -A sum_c (dW/dG_c at the clamped strains - at the true ones) d2G_c/dx2,
+// with W = (k0 G00^2 + 2 k1 G00 G11 + k2 G11^2 + 2 k3 G01^2) / 2.
+TEST(StretchingForceTest, DefiniteJacobianDropsExactlyTheCompressiveAndShearCurvature) {
+  const Eigen::Vector4d k(120.0, 30.0, 200.0, 45.0);
+  const Eigen::Vector2d u[3] = {{0, 0}, {0.1, 0.01}, {0.02, 0.09}};
+  const TriangleRest rest = MakeTriangleRest(u[0], u[1], u[2]);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, -2, 1).normalized()).toRotationMatrix();
+  // The three strains of positions y.
+  auto strains = [&](const Vector9d& y) {
+    Eigen::Matrix<double, 3, 2> E;
+    E.col(0) = y.segment<3>(3) - y.segment<3>(0);
+    E.col(1) = y.segment<3>(6) - y.segment<3>(0);
+    const Eigen::Matrix<double, 3, 2> F = E * rest.Dm_inv;
+    const Eigen::Matrix2d G = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
+    return Eigen::Vector3d(G(0, 0), G(1, 1), G(0, 1));
+  };
+  // dW/dG at the strains g (the shear counted twice, as W has it).
+  auto stress = [&](const Eigen::Vector3d& g) {
+    return Eigen::Vector3d(k[0] * g[0] + k[1] * g[1], k[1] * g[0] + k[2] * g[1], 2 * k[3] * g[2]);
+  };
+  // Stretched along u and compressed along v, then the other way round.
+  for (const Eigen::Vector2d& stretch : {Eigen::Vector2d(1.08, 0.93), Eigen::Vector2d(0.92, 1.07)}) {
+    SCOPED_TRACE("stretch " + std::to_string(stretch.x()) + ", " + std::to_string(stretch.y()));
+    Vector9d x;
+    for (int i = 0; i < 3; ++i)
+      x.segment<3>(3 * i) = R * Eigen::Vector3d(stretch.x() * u[i].x() + 0.02 * u[i].y(), stretch.y() * u[i].y(), 0);
+    const Eigen::Vector3d G = strains(x);
+    ASSERT_GT(std::abs(G[0]), 0.01);
+    ASSERT_LT(G[0] * G[1], -1e-4);  // one tensile, one compressed
+    ASSERT_GT(std::abs(G[2]), 1e-3);
+    // d2G_c/dx2 by central second differences (G is quadratic in x: exact but for rounding).
+    const double h = 1e-4;
+    Matrix9d H[3];
+    for (int a = 0; a < 9; ++a)
+      for (int b = 0; b < 9; ++b) {
+        Vector9d pp = x, pm = x, mp = x, mm = x;
+        pp[a] += h, pp[b] += h;
+        pm[a] += h, pm[b] -= h;
+        mp[a] -= h, mp[b] += h;
+        mm[a] -= h, mm[b] -= h;
+        const Eigen::Vector3d d2 = (strains(pp) - strains(pm) - strains(mp) + strains(mm)) / (4 * h * h);
+        for (int c = 0; c < 3; ++c) H[c](a, b) = d2[c];
+      }
+    const Eigen::Vector3d clamped(std::max(G[0], 0.0), std::max(G[1], 0.0), 0.0);
+    const Eigen::Vector3d ds = stress(clamped) - stress(G);
+    const Matrix9d expected_difference = -rest.area * (ds[0] * H[0] + ds[1] * H[1] + ds[2] * H[2]);
+    auto force = [&](const Vector9d& y) { return StretchingForce(y, rest, k, false).force; };
+    const Matrix9d exact = NumericJacobian<9>(x, force, 1e-7);
+    const Matrix9d definite = StretchingForce(x, rest, k, true).jacobian;
+    ASSERT_GT(expected_difference.norm(), 0.05 * definite.norm());  // the state tells them apart
+    EXPECT_LT((definite - exact - expected_difference).norm(), 1e-5 * definite.norm());
+  }
+}
+
 TEST(StretchingForceTest, BlockFormMatchesMatrixForm) {
   const Eigen::Vector4d k(120.0, 30.0, 200.0, 45.0);
   for (int seed = 0; seed < 5; ++seed)
