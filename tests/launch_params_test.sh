@@ -2,7 +2,8 @@
 # The launch files' parameters as roslaunch resolves them (--dump-params: no master, no node):
 # a record_dir set in the clip buffer's YAML (clip_config) is kept unless record_dir:= is given
 # (an empty arg used to replace it, and a field session set up to record recorded nothing, its
-# diagnostics OK), and one given as a number stays text. Usage: launch_params_test.sh
+# diagnostics OK), one given as a number stays text, and record:=false turns recording off.
+# Usage: launch_params_test.sh
 set -euo pipefail
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
@@ -21,5 +22,13 @@ for launch in "replay.launch bag:=/tmp/none.bag" "field.launch"; do
     >"$work/params.txt" 2>&1 || fail "roslaunch --dump-params $launch record_dir:=20261206: $(cat "$work/params.txt")"
   grep -q "^/clip_buffer/record_dir: '20261206'$" "$work/params.txt" ||
     fail "$launch record_dir:=20261206 is not the text given: $(grep record_dir "$work/params.txt")"
+  # record:=false turns the YAML's recording off, and a record_dir:= given beside it too.
+  for extra in "" "record_dir:=/data/given"; do
+    # shellcheck disable=SC2086
+    roslaunch --dump-params clothwind $launch clip_config:="$work/clip_buffer.yaml" record:=false $extra \
+      >"$work/params.txt" 2>&1 || fail "roslaunch --dump-params $launch record:=false $extra: $(cat "$work/params.txt")"
+    grep -q "^/clip_buffer/record_dir: ''$" "$work/params.txt" ||
+      fail "$launch record:=false $extra still records: $(grep record_dir "$work/params.txt")"
+  done
 done
 echo "launch_params_test: OK"
