@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/scoped_file_size_limit.h"
+
 namespace clothwind::sensors {
 namespace {
 namespace fs = std::filesystem;
@@ -232,6 +234,29 @@ TEST_F(ClipRecordingTest, ABareMountPointIsNotTheDisk) {
   mounted_ = true;  // the disk mounted again
   r.Poll(now + 10, false);
   EXPECT_TRUE(r.open()) << r.error();
+}
+
+// A disk that refuses the writes (full: here a file size limit, which binds root too, where
+// permissions do not): the failure is said by the next Poll with the writer's error, once, the
+// clip counted as not recorded, and the folder stays open for the next clip.
+TEST_F(ClipRecordingTest, AFailedWriteIsSaidOnceAndCounted) {
+  ClipRecording r(Options(), Log(), 100.0);
+  ASSERT_TRUE(r.open());
+  {
+    ScopedFileSizeLimit full(64);  // less than one JPEG frame
+    r.Record(MakeClip(0), {});
+    WaitWritten(r);
+  }
+  const auto problems = r.Poll(101.0, false);
+  ASSERT_FALSE(problems.empty());
+  EXPECT_EQ(problems[0].rfind("recording failed: ", 0), 0u) << problems[0];
+  EXPECT_TRUE(r.Poll(102.0, false).empty());
+  EXPECT_EQ(r.tally().not_recorded, 1u);
+  EXPECT_TRUE(r.open());
+  r.Record(MakeClip(1), {});
+  WaitWritten(r);
+  EXPECT_TRUE(r.Poll(103.0, false).empty());
+  EXPECT_EQ(r.tally().recorded, 1u);
 }
 
 // Input stopped (a replay ended): the clips written since the last index rewrite are listed now,
