@@ -109,27 +109,20 @@ class AnemometerNode {
     backoff_ = clothwind::sensors::Backoff(first_delay, std::max(first_delay, maximum));
 
     updater_.add("anemometer", this, &AnemometerNode::Diagnose);
-    // The serial settings are unused by usb and topic input, but a replay of the field's YAML is
-    // where a bad one is best found: a WARN naming it, where serial input ends on it.
-    if (input_ != "serial") {
-      std::string error;
-      if (!clothwind::sensors::ParseParity(parity, &serial_.parity)) {
-        error = "parity: '" + parity + "' unknown (expected none, even or odd)";
-      } else {
-        clothwind::sensors::ValidateSerialConfig(serial_, &error);
-      }
-      if (!error.empty())
-        ROS_WARN("anemometer_node: ~%s; unused with ~input %s, but a serial input would end on it", error.c_str(),
-                 input_.c_str());
+    // The serial settings end serial input when bad; usb and topic input do not use them, but a
+    // replay of the field's YAML is where a bad one is best found: a WARN naming it there.
+    std::string serial_error;
+    if (!clothwind::sensors::ParseParity(parity, &serial_.parity)) {
+      serial_error = "parity: '" + parity + "' unknown (expected none, even or odd)";
+    } else {
+      clothwind::sensors::ValidateSerialConfig(serial_, &serial_error);
     }
+    if (!serial_error.empty() && input_ != "serial")
+      ROS_WARN("anemometer_node: ~%s; unused with ~input %s, but a serial input would end on it",
+               serial_error.c_str(), input_.c_str());
     if (input_ == "serial") {
-      if (!clothwind::sensors::ParseParity(parity, &serial_.parity)) {
-        ROS_FATAL("~parity: '%s' unknown (expected none, even or odd)", parity.c_str());
-        return false;
-      }
-      std::string error;
-      if (!clothwind::sensors::ValidateSerialConfig(serial_, &error)) {
-        ROS_FATAL("~%s", error.c_str());
+      if (!serial_error.empty()) {
+        ROS_FATAL("~%s", serial_error.c_str());
         return false;
       }
       updater_.setHardwareID(serial_.port);

@@ -37,6 +37,7 @@
 #include "common/atomic_file.h"
 #include "ros_bridge/camera_calibration_file.h"
 #include "ros_bridge/image_conversions.h"
+#include "ros_bridge/ros_log.h"
 #include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wall_throttle.h"
@@ -51,7 +52,6 @@ namespace {
 using clothwind::sensors::Frame;
 using clothwind::sensors::FrameSource;
 using clothwind::sensors::FrameSourceOptions;
-using clothwind::sensors::LogLevel;
 using clothwind::sensors::ReadStatus;
 
 // Monotonic clock from the system, "ROS time" from ros::Time::now() (the wall clock, or /clock
@@ -86,14 +86,6 @@ FrameSourceOptions ReadOptions(clothwind::ros_bridge::StrictParams& params) {
   return o;
 }
 
-void RosLog(LogLevel level, const std::string& message) {
-  switch (level) {
-    case LogLevel::kInfo: ROS_INFO_STREAM(message); break;
-    case LogLevel::kWarn: ROS_WARN_STREAM(message); break;
-    case LogLevel::kError: ROS_ERROR_STREAM(message); break;
-  }
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -117,7 +109,7 @@ int main(int argc, char** argv) {
 
   RosClock clock;
   std::string error;
-  std::unique_ptr<FrameSource> source = clothwind::sensors::MakeFrameSource(options, &clock, RosLog, &error);
+  std::unique_ptr<FrameSource> source = clothwind::sensors::MakeFrameSource(options, &clock, clothwind::ros_bridge::RosLog, &error);
   if (!source) {
     ROS_FATAL_STREAM("camera_node: bad parameters: " << error);
     return 1;

@@ -29,6 +29,7 @@
 
 #include "common/formatted.h"
 #include "ros_bridge/clip_conversions.h"
+#include "ros_bridge/ros_log.h"
 #include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_diagnostics.h"
 #include "ros_bridge/wall_throttle.h"
@@ -104,15 +105,7 @@ class ClipBufferNode {
     recording.index_interval = index_interval_;
     recording_ = std::make_unique<sensors::ClipRecording>(
         recording,
-        [](sensors::LogLevel level, const std::string& text) {
-          if (level == sensors::LogLevel::kError) {
-            ROS_ERROR("clip_buffer: %s", text.c_str());
-          } else if (level == sensors::LogLevel::kWarn) {
-            ROS_WARN("clip_buffer: %s", text.c_str());
-          } else {
-            ROS_INFO("clip_buffer: %s", text.c_str());
-          }
-        },
+        [](sensors::LogLevel level, const std::string& text) { ros_bridge::RosLog(level, "clip_buffer: " + text); },
         ros::SteadyTime::now().toSec());
 
     clip_pub_ = nh.advertise<clothwind::Clip>("clips", 4);

@@ -13,12 +13,9 @@
 // off; sensors/replay_end.h), and says when the report ends with clips unestimated. ~max_wall bounds it;
 // ~start_timeout gives up when the clock never starts. Interrupted (Ctrl-C), it still prints and
 // writes what it has; a file it cannot write is an error that does not cost the others.
-#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <fstream>
-#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
