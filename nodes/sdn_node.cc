@@ -13,10 +13,12 @@
 // ~mean_window (60 s, the field protocol's label window), ~flag_flies (right | left | auto | wind;
 // unset: auto for a model trained without flips, which knows only flags flying right as FlagSim's
 // do, right, as filmed, for one trained with them; learn/fly_direction.h). wind: each clip's way
-// from its anemometer direction (wind_direction_mean) and ~camera_heading (the optical axis's angle
-// in the anemometer's frame [rad], required; ~camera_heading_frame names that frame, and a clip
-// whose direction is in another is not used), a wind within ~end_on_angle (20 deg) of the axis
-// keeping the way last known. auto asks ~fly_judge (a train-fly-judge file; unset: fly_judge.pt
+// from its anemometer direction (wind_direction_mean) and the camera's pose: its optical frame (the
+// clip's frame_id) looked up in tf2 in the direction's frame, the latest transform, so a camera
+// upside down or pitched is read right (learn::EquivalentCameraHeading); or, when set,
+// ~camera_heading (a level camera's optical axis in the anemometer's frame [rad];
+// ~camera_heading_frame names that frame, and a clip whose direction is in another is not used).
+// A wind within ~end_on_angle (20 deg) of the axis, or no pose, keeps the way last known. auto asks ~fly_judge (a train-fly-judge file; unset: fly_judge.pt
 // beside the model when there is one, as models/ ships it, else the clip's motion cues).
 // Clips may be mono8 or bgr8; a model trained with --colour needs bgr8 (clip_buffer ~colour) and
 // reports a grey clip as an ERROR naming that parameter.
@@ -41,10 +43,13 @@
 #include <string>
 #include <utility>
 
+#include <Eigen/Geometry>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <image_transport/image_transport.h>
 #include <opencv2/imgproc.hpp>
 #include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include <clothwind/Clip.h>
 #include <clothwind/WindEstimate.h>
@@ -139,11 +144,17 @@ class SdnNode {
       camera_heading_ = std::numeric_limits<double>::quiet_NaN();
     }
     if (name == "wind") {
-      follow_wind_ = std::isfinite(camera_heading_);
-      if (!follow_wind_) {
-        ParameterError("~flag_flies wind needs ~camera_heading (the optical axis's angle in the anemometer's "
-                       "frame [rad]); the model's way is used",
-                       0);
+      // Unset: the pose in tf. Out of range: not followed (a heading in degrees is no pose to
+      // replace silently).
+      follow_wind_ = std::isfinite(camera_heading_) || !params.Has("camera_heading");
+      pose_from_tf_ = follow_wind_ && !std::isfinite(camera_heading_);
+      if (pose_from_tf_) {
+        tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
+        tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
+        if (!camera_heading_frame_.empty())
+          ParameterError("~camera_heading_frame is set without ~camera_heading: the camera's pose comes from tf, "
+                         "in each clip's wind direction frame",
+                         0);
       }
     } else if (std::isfinite(camera_heading_)) {
       // Read but unused: a ~camera_heading given without ~flag_flies wind read every clip as
@@ -156,7 +167,7 @@ class SdnNode {
       try {
         told_flag_flies_ = clothwind::learn::FlagFliesFromName(name, "~flag_flies");
       } catch (const std::invalid_argument& e) {
-        ParameterError(std::string(e.what()) + " (or wind, with ~camera_heading); the model's way is used", 0);
+        ParameterError(std::string(e.what()) + " (or wind); the model's way is used", 0);
       }
     }
   }
@@ -231,7 +242,11 @@ class SdnNode {
         throw MalformedClip(e.what());
       }
       sequence_gaps_.Good(clip->sequence, ros::SteadyTime::now().toSec());
-      if (follow_wind_) {  // a clip that passed the checks only
+      if (follow_wind_ && pose_from_tf_) {  // a clip that passed the checks only
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        const double wind = clip->wind_direction_mean;
+        FollowTheWind(wind, std::isfinite(wind) ? CameraHeadingFromTf(*clip) : nan);
+      } else if (follow_wind_) {
         // ~camera_heading is an angle in one frame: a direction in another says nothing of the way.
         const bool same_frame = camera_heading_frame_.empty() || clip->wind_direction_frame_id == camera_heading_frame_;
         if (!same_frame) {
@@ -240,7 +255,8 @@ class SdnNode {
                             "the way the flag flies is kept as last known",
                             clip->wind_direction_frame_id.c_str(), camera_heading_frame_.c_str());
         }
-        FollowTheWind(same_frame ? clip->wind_direction_mean : std::numeric_limits<double>::quiet_NaN());
+        FollowTheWind(same_frame ? clip->wind_direction_mean : std::numeric_limits<double>::quiet_NaN(),
+                      camera_heading_);
       }
       const std::vector<cv::Mat> frames =
           clothwind::learn::CameraFramesForModel(camera_frames, predictor_->config().colour);
@@ -295,10 +311,46 @@ class SdnNode {
     while (!stamps_.empty() && now - stamps_.front() > 30.0) stamps_.pop_front();
   }
 
+  // The heading (FlyDirectionFromWind's) of the clip's camera from the latest transform of its optical
+  // frame into the frame of the clip's wind direction: a camera's mount is fixed, and a clip's own
+  // stamp is older than the first transform a static publisher sends. NaN, the reason kept for the
+  // diagnostics, when there is none or the camera lies on its side.
+  double CameraHeadingFromTf(const clothwind::Clip& clip) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (clip.header.frame_id.empty() || clip.wind_direction_frame_id.empty()) {
+      pose_error_ = std::string("the clip names no ") +
+                    (clip.header.frame_id.empty() ? "camera frame (header.frame_id)"
+                                                  : "wind direction frame (wind_direction_frame_id)");
+      return nan;
+    }
+    geometry_msgs::TransformStamped pose;
+    try {
+      pose = tf_buffer_->lookupTransform(clip.wind_direction_frame_id, clip.header.frame_id, ros::Time(0));
+    } catch (const tf2::TransformException& e) {
+      pose_error_ = std::string("no transform from '") + clip.header.frame_id + "' to '" +
+                    clip.wind_direction_frame_id + "' in tf: " + e.what();
+      return nan;
+    }
+    const auto& r = pose.transform.rotation;
+    const auto heading = clothwind::learn::EquivalentCameraHeading(
+        Eigen::Quaterniond(r.w, r.x, r.y, r.z).normalized().toRotationMatrix());
+    if (!heading) {
+      pose_error_ = "camera '" + clip.header.frame_id + "' lies on its side (its picture's right is more than 45 deg "
+                    "out of the horizontal) in '" + clip.wind_direction_frame_id + "'";
+      return nan;
+    }
+    pose_error_.clear();
+    char what[160];
+    std::snprintf(what, sizeof what, "%.1f deg (tf: '%s' in '%s')", *heading * 180.0 / M_PI,
+                  clip.header.frame_id.c_str(), clip.wind_direction_frame_id.c_str());
+    camera_heading_text_ = what;
+    return *heading;
+  }
+
   // ~flag_flies wind: the way the anemometer's wind makes the flag fly; a wind end-on to the
-  // camera, or none, keeps the way last known (as filmed until one is).
-  void FollowTheWind(double wind_direction) {
-    const auto way = clothwind::learn::FlyDirectionFromWind(wind_direction, camera_heading_, end_on_);
+  // camera, or none, or no camera heading (NaN), keeps the way last known (as filmed until one is).
+  void FollowTheWind(double wind_direction, double camera_heading) {
+    const auto way = clothwind::learn::FlyDirectionFromWind(wind_direction, camera_heading, end_on_);
     if (!way) {
       ++wind_unknown_;
     } else {
@@ -398,6 +450,9 @@ class SdnNode {
                                                                     "', not ~camera_heading_frame's '" +
                                                                     camera_heading_frame_ + "'") +
                                     "); clips are read as filmed");
+      // The last clip's camera pose: without it the way is kept, and may go stale as the wind turns.
+      if (pose_from_tf_ && !pose_error_.empty())
+        stat.mergeSummary(warn, "estimating; ~flag_flies wind: " + pose_error_ + "; the way last known is kept");
       if (!predictor_->fly_judge_error().empty()) stat.mergeSummary(warn, "estimating; " + predictor_->fly_judge_error());
       if (!parameter_errors_.empty())
         stat.mergeSummary(warn, "estimating with a default for a parameter out of range: " + parameter_errors_.front());
@@ -429,7 +484,15 @@ class SdnNode {
                                         : std::string("none: the clip's motion cues")) +
                    (judge_asked ? "" : " (not asked: ~flag_flies is " + (follow_wind_ ? "wind" : way) + ")"));
     }
-    if (follow_wind_) stat.add("clips with the wind end-on or unknown", wind_unknown_);
+    if (follow_wind_) {
+      stat.add("camera heading", !pose_from_tf_ ? "~camera_heading " + std::to_string(camera_heading_) + " rad" +
+                                                      (camera_heading_frame_.empty() ? std::string()
+                                                                                     : " in '" + camera_heading_frame_ + "'")
+                                 : !pose_error_.empty()        ? pose_error_
+                                 : camera_heading_text_.empty() ? std::string("tf: no clip with a wind direction yet")
+                                                                : camera_heading_text_);
+      stat.add("clips with the wind end-on or unknown", wind_unknown_);
+    }
     stat.add("clips turned round (flag flying left)", turned_);
     stat.add("clips the fly judge could not tell (the last way kept)", undecided_);
     stat.add("trailing mean [m/s]", trailing_.Mean());
@@ -460,6 +523,11 @@ class SdnNode {
   std::string last_wind_frame_;     // the last clip wind direction frame that was not ~camera_heading_frame's
   std::string camera_heading_frame_;  // the frame ~camera_heading is in ("": the clips' own)
   double camera_heading_ = 0, end_on_ = 0;                       // [rad], for follow_wind_
+  bool pose_from_tf_ = false;  // follow_wind_ with ~camera_heading unset: the camera's pose in tf
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;  // only then: no /tf subscription otherwise
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::string pose_error_;           // why the last clip had no camera heading from tf ("": it had)
+  std::string camera_heading_text_;  // the last heading from tf, with its frames
   int threads_ = 2;
   std::unique_ptr<clothwind::learn::Predictor> predictor_;
   int queue_size_ = 2;

@@ -224,9 +224,9 @@ TEST(EquivalentCameraHeading, ACameraOnItsSideOrANonFiniteRotationHasNone) {
 }
 
 TEST(EquivalentCameraHeading, ReadsAStaticTransformPublishersYawPitchRoll) {
-  // tests/sdn_node.test's camera: `static_transform_publisher 0 0 0 0 0 -1.5707963 ...`, a
-  // rotation Rz(yaw) Ry(pitch) Rx(roll): the optical axis along +y, the picture's right along +x,
-  // as a level camera facing +y.
+  // static_transform_publisher's `x y z yaw pitch roll` is the rotation Rz(yaw) Ry(pitch) Rx(roll):
+  // `0 0 0 0 0 -1.5707963` puts the optical axis along +y and the picture's right along +x, a
+  // level camera facing +y.
   const Eigen::Matrix3d camera = (Eigen::AngleAxisd(0.0, Eigen::Vector3d::UnitZ()) *
                                   Eigen::AngleAxisd(0.0, Eigen::Vector3d::UnitY()) *
                                   Eigen::AngleAxisd(-1.5707963, Eigen::Vector3d::UnitX()))
@@ -234,13 +234,19 @@ TEST(EquivalentCameraHeading, ReadsAStaticTransformPublishersYawPitchRoll) {
   EXPECT_NEAR((camera.col(2) - Eigen::Vector3d(0, 1, 0)).norm(), 0, 1e-6);
   ASSERT_TRUE(EquivalentCameraHeading(camera));
   EXPECT_NEAR(*EquivalentCameraHeading(camera), M_PI / 2, 1e-6);
-  // Its upside-down twin (`... 3.1415927 0 1.5707963 ...`), facing +y too: heading -pi/2.
-  const Eigen::Matrix3d flipped = (Eigen::AngleAxisd(3.1415927, Eigen::Vector3d::UnitZ()) *
-                                   Eigen::AngleAxisd(1.5707963, Eigen::Vector3d::UnitX()))
-                                      .toRotationMatrix();
-  EXPECT_NEAR((flipped.col(2) - Eigen::Vector3d(0, 1, 0)).norm(), 0, 1e-6);
-  ASSERT_TRUE(EquivalentCameraHeading(flipped));
-  EXPECT_NEAR(*EquivalentCameraHeading(flipped), -M_PI / 2, 1e-6);
+  // Its camera (`... 2.6179939 0 1.5707963 ...`): facing 60 deg, upside down, its picture's right
+  // toward 150 deg as a level camera facing -120 deg sees it. The inverse transform (frames
+  // swapped in the lookup) reads -90 deg, so a wind toward 60 deg is end-on only read right.
+  const Eigen::Matrix3d upside_down = (Eigen::AngleAxisd(2.6179939, Eigen::Vector3d::UnitZ()) *
+                                       Eigen::AngleAxisd(1.5707963, Eigen::Vector3d::UnitX()))
+                                          .toRotationMatrix();
+  EXPECT_NEAR((upside_down.col(2) - Eigen::Vector3d(std::cos(M_PI / 3), std::sin(M_PI / 3), 0)).norm(), 0, 1e-6);
+  ASSERT_TRUE(EquivalentCameraHeading(upside_down));
+  EXPECT_NEAR(*EquivalentCameraHeading(upside_down), -2 * M_PI / 3, 1e-6);
+  ASSERT_TRUE(EquivalentCameraHeading(upside_down.transpose()));
+  EXPECT_NEAR(*EquivalentCameraHeading(upside_down.transpose()), -M_PI / 2, 1e-6);
+  EXPECT_EQ(FlyDirectionFromWind(M_PI / 3, *EquivalentCameraHeading(upside_down), 0.35), std::nullopt);
+  EXPECT_EQ(FlyDirectionFromWind(0.0, *EquivalentCameraHeading(upside_down), 0.35), FlyDirection::kLeft);
 }
 
 }  // namespace

@@ -18,7 +18,7 @@ from sensor_msgs.msg import Image
 
 
 def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encoding="mono8", flag=None,
-              wind_direction=0.0):
+              wind_direction=0.0, wind_frame=""):
     clip = Clip()
     clip.header.frame_id = "camera_optical"
     clip.header.stamp = start
@@ -60,6 +60,7 @@ def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encod
     clip.wind_std = 0.3
     clip.wind_count = 60 if not math.isnan(wind_mean) else 0
     clip.wind_direction_mean = wind_direction
+    clip.wind_direction_frame_id = wind_frame
     return clip
 
 
@@ -161,6 +162,13 @@ class SdnNodeTest(unittest.TestCase):
         rospy.Subscriber("wind/wind/estimate", WindEstimate, lambda m: self.append(self.wind_estimates, m),
                          queue_size=10)
         self.wind_pub = rospy.Publisher("wind/clips", Clip, queue_size=10)
+        self.tf_statuses = []
+        self.tf_estimates = []
+        rospy.Subscriber("tf/wind/estimate", WindEstimate, lambda m: self.append(self.tf_estimates, m),
+                         queue_size=10)
+        self.tf_pub = rospy.Publisher("tf/clips", Clip, queue_size=10)
+        self.tf_messages = []
+        rospy.Subscriber("/tf", rospy.AnyMsg, lambda m: self.append(self.tf_messages, m), queue_size=10)
         self.judge_statuses = []
         self.judge_estimates = []
         rospy.Subscriber("judge/wind/estimate", WindEstimate, lambda m: self.append(self.judge_estimates, m),
@@ -190,6 +198,8 @@ class SdnNodeTest(unittest.TestCase):
                     self.no_flip_statuses.append(s)
                 elif s.name.startswith("wind/"):
                     self.wind_statuses.append(s)
+                elif s.name.startswith("tf/"):
+                    self.tf_statuses.append(s)
                 elif s.name.startswith("judge/"):
                     self.judge_statuses.append(s)
                 elif s.name.startswith("bad_judge/"):
@@ -395,6 +405,48 @@ class SdnNodeTest(unittest.TestCase):
                         values)
         self.assertAlmostEqual(speeds[1], speeds[2], places=5)
         self.assertAlmostEqual(speeds[1], speeds[3], places=5)
+
+    def test_no_flip_model_told_by_the_wind_and_the_camera_pose_in_tf(self):
+        """~flag_flies wind, ~camera_heading unset: the pose of the clips' camera comes from tf, a
+        camera facing 60 deg of the anemometer's frame mounted upside down (its picture's right
+        toward 150 deg). A flag flying left under a wind toward +x is turned round, where a level
+        camera facing the same way would read it as filmed; one flying right under a wind toward
+        -x stays; a wind along the axis (60 deg) keeps the way: with the transform taken the wrong
+        way round (heading -90 deg) it would not be end-on. A clip naming no wind frame, or one tf does not know, keeps
+        the way too, with a WARN saying why."""
+        size = 256
+        self.wait_for(lambda: self.tf_pub.get_num_connections() > 0, 120, "the tf-told sdn_node to subscribe")
+        self.wait_for(lambda: len(self.tf_messages) > 0, 30, "the camera's transform on /tf")
+        start = rospy.Time(1700000000, 0)
+        self.tf_pub.publish(make_clip(0, start, size, 3.0, 4.0, flag="right", wind_direction=0.0))
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.WARN and "the clip names no wind direction frame" in s.message
+                                  for s in self.tf_statuses), 30, "a WARN that the clip names no wind frame")
+        for seq, flag, direction in ((1, "left", 0.0), (2, "right", math.pi), (3, "right", math.pi / 3)):
+            self.tf_pub.publish(make_clip(seq, start + rospy.Duration.from_sec(2.0 * seq), size, 3.0, 4.0,
+                                          flag=flag, wind_direction=direction, wind_frame="anemometer"))
+        self.wait_for(lambda: len(self.tf_estimates) >= 4, 30, "estimates of the four clips")
+        with self.lock:
+            del self.tf_statuses[:]
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.OK for s in self.tf_statuses), 30,
+                      "an OK diagnostic from the tf-told node")
+        values = self.wait_for_turned(self.tf_statuses, 1)
+        with self.lock:
+            speeds = {e.clip_sequence: e.speed for e in self.tf_estimates}
+        self.assertEqual(values["flag flies"], "wind: right")
+        self.assertEqual(values["camera heading"], "-120.0 deg (tf: 'camera_optical' in 'anemometer')")
+        self.assertEqual(values["clips with the wind end-on or unknown"], "2")
+        self.assertAlmostEqual(speeds[0], speeds[1], places=5)
+        self.assertAlmostEqual(speeds[0], speeds[2], places=5)
+        self.assertAlmostEqual(speeds[0], speeds[3], places=5)
+        # A frame tf has never heard of: the way kept (this left-flying clip is not turned), said.
+        self.tf_pub.publish(make_clip(4, start + rospy.Duration.from_sec(8.0), size, 3.0, 4.0, flag="left",
+                                      wind_direction=0.0, wind_frame="elsewhere"))
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.WARN and
+                                  "no transform from 'camera_optical' to 'elsewhere' in tf" in s.message
+                                  for s in self.tf_statuses), 30, "a WARN that tf has no such transform")
+        values = self.wait_for_estimates(self.tf_statuses, 5)
+        self.assertEqual(values["clips turned round (flag flying left)"], "1")
+        self.assertEqual(values["clips with the wind end-on or unknown"], "3")
 
     def test_no_flip_model_with_the_fly_judge(self):
         """~fly_judge, the shipped judge: no WARN (the judge, not the motion cues, tells the way),
