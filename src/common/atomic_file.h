@@ -15,6 +15,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 
@@ -250,6 +252,29 @@ inline void WriteFilePairAtomically(const std::string& first, const std::string&
   SyncDirectory(fs::path(first).parent_path().string());
   if (fs::path(second).parent_path() != fs::path(first).parent_path())
     SyncDirectory(fs::path(second).parent_path().string());
+}
+
+// Copies `from` to `to` through a temporary and a rename (WriteFileAtomically): never half a file
+// at `to`. Throws std::runtime_error naming `from` when it cannot be read, or `to` when it cannot
+// be written.
+inline void CopyFileAtomically(const std::string& from, const std::string& to) {
+  std::ifstream in(from, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + from + " (to copy it to " + to + ")");
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw std::runtime_error("cannot read " + from + " (to copy it to " + to + ")");
+  WriteFileAtomically(to, bytes);
+}
+
+// Gives `to` (which must not exist) the content of `from` without copying it: a hard link, where
+// the filesystem has them; a durable copy (CopyFileAtomically) where it has none (vfat, exFAT, some
+// network mounts). For files that are only ever replaced by a rename, never rewritten in place, so
+// the two names cannot come to differ.
+// Inputs: from, to  the paths; hard_link  makes the link (::link; tests pass one that fails).
+// Throws std::runtime_error naming the file when neither works.
+inline void LinkOrCopyFile(const std::string& from, const std::string& to,
+                           int (*hard_link)(const char* from, const char* to) = ::link) {
+  if (hard_link(from.c_str(), to.c_str()) == 0) return;
+  CopyFileAtomically(from, to);
 }
 
 }  // namespace clothwind

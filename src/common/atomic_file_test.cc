@@ -133,6 +133,34 @@ TEST_F(AtomicFileTest, APairIsWrittenWholeWhereTheFilesystemHasNoHardLinks) {
   EXPECT_EQ(Entries(), 3u);
 }
 
+// A training run carries an unchanged best model into its next checkpoint: a hard link where the
+// filesystem has them, a whole copy where it has none, and a clear error where neither works.
+TEST_F(AtomicFileTest, LinkOrCopyLinksWhereItCanAndCopiesWholeWhereItCannot) {
+  const std::string from = (dir_ / "model.pt").string();
+  WriteFileAtomically(from, std::string("weights"));
+  const std::string linked = (dir_ / "linked.pt").string();
+  LinkOrCopyFile(from, linked);
+  EXPECT_TRUE(fs::equivalent(from, linked));
+  const std::string copied = (dir_ / "copied.pt").string();
+  LinkOrCopyFile(from, copied, NoHardLinks);
+  EXPECT_FALSE(fs::equivalent(from, copied));
+  EXPECT_EQ(Read(copied), "weights");
+  EXPECT_EQ(Entries(), 3u);  // no temporary left behind
+
+  try {
+    LinkOrCopyFile((dir_ / "missing.pt").string(), (dir_ / "nowhere.pt").string(), NoHardLinks);
+    FAIL() << "a missing file was copied";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot read " + (dir_ / "missing.pt").string()), std::string::npos) << e.what();
+  }
+  // A folder is no file to copy: refused, not copied as an empty file.
+  fs::create_directories(dir_ / "folder");
+  EXPECT_THROW(LinkOrCopyFile((dir_ / "folder").string(), (dir_ / "folder_copy").string(), NoHardLinks),
+               std::runtime_error);
+  EXPECT_FALSE(fs::exists(dir_ / "nowhere.pt"));
+  EXPECT_FALSE(fs::exists(dir_ / "folder_copy"));
+}
+
 TEST_F(AtomicFileTest, TemporaryNamesDiffer) {
   EXPECT_NE(TemporaryNameFor("x"), TemporaryNameFor("x"));
   EXPECT_EQ(TemporaryNameFor("x").rfind("x.tmp-" + ProcessTag() + "-", 0), 0u);

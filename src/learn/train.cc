@@ -27,6 +27,7 @@
 #include <torch/optim/adam.h>
 #include <torch/serialize.h>
 
+#include "common/atomic_file.h"
 #include "common/regular_file.h"
 #include "learn/aux_targets.h"
 #include "learn/dataset.h"
@@ -172,19 +173,11 @@ void SaveAtomically(T& object, const fs::path& path) {
 // state.json, and a run stopped between the two kept a model.pt of an epoch its log did not show.
 constexpr const char* kBestModelFiles[] = {"model.pt", "model.json", "raw_model.pt", "raw_model.json"};
 
-// Copies `from` to `to` through a temporary and a rename (never half a file at `to`).
-void CopyFileAtomically(const fs::path& from, const fs::path& to) {
-  std::ifstream in(from, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in.good() && !in.eof()) throw std::runtime_error("cannot read " + from.string());
-  WriteFileAtomically(to, bytes);
-}
-
 // Publishes the best models a checkpoint folder holds as the run's model.pt / raw_model.pt (and
 // their JSON); a checkpoint from before they were kept there holds none, and nothing is done.
 void PublishBestModels(const fs::path& checkpoint, const fs::path& out) {
   for (const char* name : kBestModelFiles)
-    if (fs::exists(checkpoint / name)) CopyFileAtomically(checkpoint / name, out / name);
+    if (fs::exists(checkpoint / name)) CopyFileAtomically((checkpoint / name).string(), (out / name).string());
 }
 
 // A run's state.json, parsed. Throws std::runtime_error naming it when it cannot be read.
@@ -866,11 +859,10 @@ TrainResult Train(const TrainOptions& o) {
     auto carry_over = [&](const char* weights, const char* json) {
       for (const char* name : {weights, json}) {
         if (previous.empty() || !fs::exists(previous / name)) continue;
-        std::error_code ec;
-        fs::create_hard_link(previous / name, checkpoint_tmp / name, ec);  // unchanged: no copy
-        // A copy (no hard links there) is synced like every file of the checkpoint: the rename
-        // below publishes the folder, and a crash must not leave it with a model cut short.
-        if (ec) CopyFileAtomically(previous / name, checkpoint_tmp / name);
+        // Unchanged: no copy. A copy (no hard links there) is synced like every file of the
+        // checkpoint: the rename below publishes the folder, and a crash must not leave it with a
+        // model cut short.
+        LinkOrCopyFile((previous / name).string(), (checkpoint_tmp / name).string());
       }
     };
     const bool better = record.val_rmse < result.best_val_rmse;
