@@ -137,7 +137,11 @@ class SdnNode {
       end_on_deg = ParameterError("~end_on_angle must be 0 to 90 degrees, got " + std::to_string(end_on_deg), 20);
     }
     end_on_ = end_on_deg * M_PI / 180.0;
-    if (std::isfinite(camera_heading_) && std::abs(camera_heading_) > 2 * M_PI) {
+    if (params.Has("camera_heading") && !std::isfinite(camera_heading_)) {
+      ParameterError(std::string("~camera_heading is not a finite angle [rad]; ") +
+                         (name == "wind" ? "~flag_flies wind is not followed" : "it is ignored"),
+                     0);
+    } else if (std::isfinite(camera_heading_) && std::abs(camera_heading_) > 2 * M_PI) {
       ParameterError("~camera_heading is " + std::to_string(camera_heading_) +
                          ", beyond 2 pi: it is in radians (degrees given?); ~flag_flies wind is not followed",
                      0);
@@ -243,9 +247,10 @@ class SdnNode {
       }
       sequence_gaps_.Good(clip->sequence, ros::SteadyTime::now().toSec());
       if (follow_wind_ && pose_from_tf_) {  // a clip that passed the checks only
-        const double nan = std::numeric_limits<double>::quiet_NaN();
-        const double wind = clip->wind_direction_mean;
-        FollowTheWind(wind, std::isfinite(wind) ? CameraHeadingFromTf(*clip) : nan);
+        // Looked up for a clip without a direction too, so the diagnostics follow the pose.
+        FollowTheWind(clip->wind_direction_mean, CameraHeadingFromTf(*clip));
+        if (!pose_error_.empty()) WALL_WARN_THROTTLE(30.0, "sdn_node: %s; the way the flag flies is kept as last known",
+                                                     pose_error_.c_str());
       } else if (follow_wind_) {
         // ~camera_heading is an angle in one frame: a direction in another says nothing of the way.
         const bool same_frame = camera_heading_frame_.empty() || clip->wind_direction_frame_id == camera_heading_frame_;
@@ -445,6 +450,7 @@ class SdnNode {
       if (follow_wind_ && !wind_told_ && wind_unknown_ > 0)
         stat.mergeSummary(warn, "estimating; ~flag_flies wind: no clip's wind has said which way the flag flies (" +
                                     std::to_string(wind_unknown_) + " clips: no direction, the wind end-on" +
+                                    (pose_from_tf_ ? ", no camera pose in tf" : "") +
                                     (last_wind_frame_.empty() ? std::string()
                                                               : ", or a direction in frame '" + last_wind_frame_ +
                                                                     "', not ~camera_heading_frame's '" +

@@ -188,7 +188,7 @@ TEST(EquivalentCameraHeading, ALevelCameraHasItsOwnHeadingAndTheSameWaysAsThePar
 TEST(EquivalentCameraHeading, PitchKeepsTheHeadingAndUpsideDownReversesTheWay) {
   const double north = M_PI / 2;
   const Eigen::Matrix3d level = LevelCamera(north);
-  // Pitched down 35 deg or up 20 deg (about the picture's right), rolled 30 deg (about the axis).
+  // Pitched up 35 deg or down 20 deg (about the picture's right), rolled 30 deg (about the axis).
   for (const Eigen::Matrix3d& camera :
        {Eigen::Matrix3d(level * Eigen::AngleAxisd(0.61, Eigen::Vector3d::UnitX())),
         Eigen::Matrix3d(level * Eigen::AngleAxisd(-0.35, Eigen::Vector3d::UnitX())),
@@ -234,6 +234,15 @@ TEST(EquivalentCameraHeading, ReadsAStaticTransformPublishersYawPitchRoll) {
   EXPECT_NEAR((camera.col(2) - Eigen::Vector3d(0, 1, 0)).norm(), 0, 1e-6);
   ASSERT_TRUE(EquivalentCameraHeading(camera));
   EXPECT_NEAR(*EquivalentCameraHeading(camera), M_PI / 2, 1e-6);
+  // docs/sdn.md's example, `3 0 0 -1.5707963 0 -1.5707963 anemometer ...`: a level camera facing the
+  // instrument's north mark (+x), its picture's right along -y: heading 0.
+  const Eigen::Matrix3d example = (Eigen::AngleAxisd(-1.5707963, Eigen::Vector3d::UnitZ()) *
+                                   Eigen::AngleAxisd(-1.5707963, Eigen::Vector3d::UnitX()))
+                                      .toRotationMatrix();
+  EXPECT_NEAR((example.col(2) - Eigen::Vector3d(1, 0, 0)).norm(), 0, 1e-6);
+  EXPECT_NEAR((example.col(0) - Eigen::Vector3d(0, -1, 0)).norm(), 0, 1e-6);
+  ASSERT_TRUE(EquivalentCameraHeading(example));
+  EXPECT_NEAR(*EquivalentCameraHeading(example), 0, 1e-6);
   // Its camera (`... 2.6179939 0 1.5707963 ...`): facing 60 deg, upside down, its picture's right
   // toward 150 deg as a level camera facing -120 deg sees it. The inverse transform (frames
   // swapped in the lookup) reads -90 deg, so a wind toward 60 deg is end-on only read right.

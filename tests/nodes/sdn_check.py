@@ -18,9 +18,9 @@ from sensor_msgs.msg import Image
 
 
 def make_clip(seq, start, size, frequency, wind_mean, count=30, rate=25.0, encoding="mono8", flag=None,
-              wind_direction=0.0, wind_frame=""):
+              wind_direction=0.0, wind_frame="", frame="camera_optical"):
     clip = Clip()
-    clip.header.frame_id = "camera_optical"
+    clip.header.frame_id = frame
     clip.header.stamp = start
     clip.sequence = seq
     clip.frame_stamps = [start + rospy.Duration.from_sec(i / rate) for i in range(count)]
@@ -400,6 +400,8 @@ class SdnNodeTest(unittest.TestCase):
             speeds = {e.clip_sequence: e.speed for e in self.wind_estimates}
         self.assertEqual(values["flag flies"], "wind: left")
         self.assertEqual(values["clips with the wind end-on or unknown"], "2")
+        # ~camera_heading given: used, not tf (this node has no /tf subscription).
+        self.assertEqual(values["camera heading"], "~camera_heading 1.570796 rad")
         # ~fly_judge beside ~flag_flies wind loads but is never asked: said, not silently kept.
         self.assertTrue(values["fly judge (for auto)"].endswith("models/fly_judge.pt (not asked: ~flag_flies is wind)"),
                         values)
@@ -447,6 +449,15 @@ class SdnNodeTest(unittest.TestCase):
         values = self.wait_for_estimates(self.tf_statuses, 5)
         self.assertEqual(values["clips turned round (flag flying left)"], "1")
         self.assertEqual(values["clips with the wind end-on or unknown"], "3")
+        # A camera on its side (its picture's right pointing up): no way to tell, kept, said.
+        self.tf_pub.publish(make_clip(5, start + rospy.Duration.from_sec(10.0), size, 3.0, 4.0, flag="left",
+                                      wind_direction=0.0, wind_frame="anemometer", frame="camera_on_its_side"))
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.WARN and
+                                  "camera 'camera_on_its_side' lies on its side" in s.message
+                                  for s in self.tf_statuses), 30, "a WARN that the camera lies on its side")
+        values = self.wait_for_estimates(self.tf_statuses, 6)
+        self.assertEqual(values["clips turned round (flag flying left)"], "1")
+        self.assertEqual(values["clips with the wind end-on or unknown"], "4")
 
     def test_no_flip_model_with_the_fly_judge(self):
         """~fly_judge, the shipped judge: no WARN (the judge, not the motion cues, tells the way),
