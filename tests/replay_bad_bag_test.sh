@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # replay.launch with a bag that cannot be opened (none there; a file that is not a bag) ends, naming
-# the bag, instead of leaving its nodes waiting for a replay that never comes (rosbag play exits
+# the bag (and one given player_required:=yes ends at once, naming the value), instead of leaving its nodes waiting for a replay that never comes (rosbag play exits
 # with status 0 when it cannot open its bag; scripts/replay-player checks it first).
 # Usage: replay_bad_bag_test.sh
 set -euo pipefail
@@ -31,4 +31,10 @@ for bag in "$work/none.bag" "$work/text.bag" "$work/unindexed.bag"; do
   grep -q "replay.launch: cannot open the bag $bag: .*${why[$bag]}" "$work/out.txt" ||
     fail "replay.launch bag:=$bag did not say why: $(tail -20 "$work/out.txt")"
 done
+# player_required takes true, false, 1 or 0, as roslaunch's own if does: "yes" read as true.
+status=0
+timeout 90 roslaunch -p "$port" clothwind replay.launch bag:="$work/text.bag" player_required:=yes >"$work/out.txt" 2>&1 ||
+  status=$?
+[ "$status" -ne 0 ] && [ "$status" -ne 124 ] || fail "player_required:=yes was not refused (status $status)"
+grep -q "yes is not a 'bool' type" "$work/out.txt" || fail "player_required:=yes: $(tail -5 "$work/out.txt")"
 echo "replay_bad_bag_test: OK"
