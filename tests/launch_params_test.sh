@@ -2,7 +2,8 @@
 # The launch files' parameters as roslaunch resolves them (--dump-params: no master, no node):
 # a record_dir set in the clip buffer's YAML (clip_config) is kept unless record_dir:= is given
 # (an empty arg used to replace it, and a field session set up to record recorded nothing, its
-# diagnostics OK), one given as a number stays text, and record:=false turns recording off.
+# diagnostics OK), one given as a number stays text, and record:=false turns recording off; bag:=true
+# watches the session bags it records.
 # Usage: launch_params_test.sh
 set -euo pipefail
 work="$(mktemp -d)"
@@ -31,4 +32,9 @@ for launch in "replay.launch bag:=/tmp/none.bag" "field.launch"; do
       fail "$launch record:=false $extra still records: $(grep record_dir "$work/params.txt")"
   done
 done
+# bag:=true runs the session recorder and its watch on the same prefix.
+roslaunch --dump-params clothwind field.launch bag:=true bag_prefix:=/data/session >"$work/params.txt" 2>&1 ||
+  fail "roslaunch --dump-params field.launch bag:=true: $(cat "$work/params.txt")"
+grep -q "^/session_bag_watch/bag_prefix: /data/session$" "$work/params.txt" ||
+  fail "field.launch bag:=true has no session_bag_watch on the bag's prefix: $(grep -i bag "$work/params.txt")"
 echo "launch_params_test: OK"
