@@ -40,16 +40,10 @@ bool ReadFineOffsetCurrentRecord(const FineOffsetBlockReader& read, std::vector<
                                  uint16_t* address, std::string* error) {
   std::vector<uint8_t> fixed;
   if (!ReadStable(read, 0x0000, 1, "the fixed block", &fixed, error)) return false;
-  const bool magic = (fixed[0] == 0x55 && fixed[1] == 0xAA) || (fixed[0] == 0xFF && fixed[1] == 0xFF);
-  if (!magic) {
-    char msg[160];
-    std::snprintf(msg, sizeof msg,
-                  "fine_offset: fixed block starts %02X %02X, expected 55 AA or FF FF (a read out of step with "
-                  "the console, or not a Fine Offset station)",
-                  fixed[0], fixed[1]);
-    *error = msg;
-    return false;
-  }
+  // The fixed block's first two bytes are not checked: consoles write 55 AA, FF FF, 55 55, C4 00,
+  // 01 1E, 44 BF and more (weewx's fousb.py lists those it met, "a brand new WS2080A console
+  // reports 44 bf ... but performs just fine"); refusing all but two made such a station unusable.
+  // The reads agreeing and the pointer on a record grid are what say a read is in step.
   if (!FineOffsetCurrentAddress(fixed, address, error)) return false;
   const unsigned from_start = *address - kFineOffsetDataStart;
   if (from_start % 16 != 0 && from_start % 20 != 0) {

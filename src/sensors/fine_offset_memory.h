@@ -1,7 +1,7 @@
 // How the current record is fetched from a Fine Offset station's memory, through any reader of
 // 32-byte blocks (fine_offset_usb.h's libusb one, or a memory image in tests). The console keeps
-// writing while it is read, so every block is read until two reads agree, as pywws does; the
-// fixed block's magic bytes say the reads are in step with the console.
+// writing while it is read, so every block is read until two reads agree, as pywws does, and the
+// pointer must lie on a record grid.
 #ifndef CLOTHWIND_SENSORS_FINE_OFFSET_MEMORY_H_
 #define CLOTHWIND_SENSORS_FINE_OFFSET_MEMORY_H_
 
@@ -17,7 +17,7 @@ using FineOffsetBlockReader =
     std::function<bool(uint16_t address, std::vector<uint8_t>* chunk, std::string* error)>;
 
 // The current record: the fixed block's first 32 bytes read until two reads agree (at most 3
-// pairs), its magic bytes 0x55 0xAA or 0xFF 0xFF, its pointer inside 0x0100..0xFFF0 on the
+// pairs; its first two bytes, which differ between consoles, are not checked), its pointer inside 0x0100..0xFFF0 on the
 // 16-byte (WH1080) or 20-byte (WH3080) record grid, then the 32-byte aligned block(s) holding the
 // record read until two reads agree, and the record sliced out. Why aligned: pywws and weewx read
 // only aligned blocks, and a console that ignores an address's low bits would answer an
@@ -27,7 +27,7 @@ using FineOffsetBlockReader =
 // Outputs:
 //   record   16 bytes of the current record
 //   address  its address
-//   error    why it failed (the reader's error, a bad magic or pointer, or a record or fixed
+//   error    why it failed (the reader's error, a bad pointer, or a record or fixed
 //            block that kept changing)
 // Returns true on success.
 bool ReadFineOffsetCurrentRecord(const FineOffsetBlockReader& read, std::vector<uint8_t>* record,

@@ -46,7 +46,9 @@ bool ParseFineOffsetRecord(const std::vector<uint8_t>& b, FineOffsetRecord* r, s
   const int p = b[7] | (b[8] << 8);
   r->pressure_abs = p == 0xFFFF ? kNaN : p * 0.1;
   // 12-bit speeds: the low byte plus a nibble of byte 11; all twelve bits set (0xFFF) mean no
-  // value, as in pywws. (A low byte 0xFF alone is 25.5 or 51.1 m/s, a gale, not "no data".)
+  // value, as weewx's fousb reads them. (pywws takes a low byte 0xFF alone as no value; here that
+  // is 25.5 or 51.1 m/s, a gale. Bytes from a station whose outdoor sensor is unplugged would
+  // settle which is right.)
   const int average = b[9] | ((b[11] & 0x0F) << 8), gust = b[10] | ((b[11] & 0xF0) << 4);
   if (average != 0xFFF) r->wind_average = average * 0.1;
   if (gust != 0xFFF) r->wind_gust = gust * 0.1;

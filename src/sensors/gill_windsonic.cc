@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <vector>
 
 #include "sensors/protocol_fields.h"
@@ -27,6 +28,11 @@ bool GillSpeedUnit(const std::string& f, SpeedUnit* unit) {
   else return false;
   return true;
 }
+
+// Below this speed [m/s] a WindSonic computes no direction (its K setting, 0.05 m/s by default):
+// polar records leave it empty in variable-field mode and freeze the last one in fixed-field mode
+// (manual 1405-PS-0019, 9.1), and a UV pair that small points anywhere.
+constexpr double kGillCalm = 0.05;
 
 }  // namespace
 
@@ -113,7 +119,7 @@ ParseResult ParseGillWindSonic(const std::string& record) {
                                                " empty, expected a signed speed");
     const double u = SpeedToMetresPerSecond(a, unit), v = SpeedToMetresPerSecond(b, unit);
     w.speed = std::hypot(u, v);
-    if (w.speed > 0.0) {
+    if (w.speed >= kGillCalm) {
       // velocity direction atan2(v, u) = pi - from  =>  from = pi - atan2(v, u), in [0, 360)
       double from = 180.0 - std::atan2(v, u) * 180.0 / M_PI;
       from = std::fmod(from + 360.0, 360.0);
@@ -121,15 +127,21 @@ ParseResult ParseGillWindSonic(const std::string& record) {
       w.reference = AngleReference::kInstrument;
     }
   } else {
-    if (std::isfinite(a) && (a < 0.0 || a > 360.0))
-      return Fail(ParseStatus::kMalformed, "field 2 (direction): expected 0..360 deg, got '" + f[1] + "'");
+    // Whole degrees: the WindObserver's tunnel record, "A,001.59,1,M,00," (speed, polarity), read
+    // as polar gave a wind from 1.59 deg at 1 m/s.
+    const bool whole = f[1].find_first_not_of("0123456789") == std::string::npos;
+    if (std::isfinite(a) && (!whole || a > 360.0))
+      return Fail(ParseStatus::kMalformed, "field 2 (direction): expected whole degrees 0..359, got '" + f[1] + "'");
     if (!std::isfinite(b)) {
       if (status_ok) return Fail(ParseStatus::kMalformed, "field 3 (speed) empty with status " + status);
     } else {
       if (b < 0.0) return Fail(ParseStatus::kMalformed, "field 3 (speed): expected >= 0, got '" + f[2] + "'");
       w.speed = SpeedToMetresPerSecond(b, unit);
     }
-    w.from_angle_deg = a;  // empty (NaN) in calm air
+    // Empty (NaN) in calm air; in fixed-field mode the last direction, frozen ("Q,133,000.02,M,00,"),
+    // is no direction either.
+    if (!(w.speed >= kGillCalm)) a = std::numeric_limits<double>::quiet_NaN();
+    w.from_angle_deg = a;
     w.reference = std::isfinite(a) ? AngleReference::kInstrument : AngleReference::kNone;
   }
   r.status = ParseStatus::kOk;

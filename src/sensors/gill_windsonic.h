@@ -40,8 +40,8 @@ std::string FrameGillRecord(const std::string& body);
 std::string GillStatusText(const std::string& code, bool* valid);
 
 // Parses one Gill ASCII record (starting with STX, without the line terminator).
-// Polar direction is "from", clockwise from the instrument's north mark (empty in calm air,
-// below 0.05 m/s). In UV mode +U is air moving towards the north mark and +V air moving
+// Polar direction is "from", in whole degrees clockwise from the instrument's north mark (none
+// below 0.05 m/s, where the instrument leaves it empty or, in fixed-field mode, frozen). In UV mode +U is air moving towards the north mark and +V air moving
 // towards the west side, i.e. (U, V) are the velocity's x and y in the REP 103 instrument frame
 // (x to the north mark, y left); the from-angle is derived from them.
 // Inputs:

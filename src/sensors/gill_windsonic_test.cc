@@ -78,18 +78,47 @@ TEST(GillWindSonic, StatusCodes) {
 }
 
 TEST(GillWindSonic, CalmAirHasNoDirection) {
-  const ParseResult r = ParseGillWindSonic(FrameGillRecord("Q,,000.03,M,00,"));
+  ParseResult r = ParseGillWindSonic(FrameGillRecord("Q,,000.03,M,00,"));
   ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
   EXPECT_DOUBLE_EQ(r.reading.speed, 0.03);
   EXPECT_TRUE(std::isnan(WindDirection(r.reading)));
+  // Fixed-field mode freezes the last direction below 0.05 m/s (the manual's own example, 9.1):
+  // a speed, no direction.
+  r = ParseGillWindSonic(FrameGillRecord("Q,133,000.02,M,00,"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_DOUBLE_EQ(r.reading.speed, 0.02);
+  EXPECT_EQ(r.reading.reference, AngleReference::kNone);
+  EXPECT_TRUE(std::isnan(WindDirection(r.reading)));
+  // A UV pair that small points anywhere.
+  r = ParseGillWindSonic(FrameGillRecord("Q,+000.01,-000.01,M,00,"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_NEAR(r.reading.speed, 0.0141, 1e-4);
+  EXPECT_EQ(r.reading.reference, AngleReference::kNone);
+  // From 0.05 m/s on, the direction is the instrument's.
+  r = ParseGillWindSonic(FrameGillRecord("Q,133,000.05,M,00,"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_DOUBLE_EQ(r.reading.from_angle_deg, 133.0);
+}
+
+TEST(GillWindSonic, AWindObserverTunnelRecordIsNotReadAsPolar) {
+  // WindObserver II tunnel mode: speed 1.59, polarity 1. Read as polar it was 1 m/s from 1.59 deg.
+  const ParseResult r = ParseGillWindSonic(FrameGillRecord("A,001.59,1,M,00,"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("field 2 (direction): expected whole degrees 0..359, got '001.59'"), std::string::npos)
+      << r.error;
 }
 
 TEST(GillWindSonic, UvAgreesWithPolar) {
-  // Wind from the instrument's east side (90 deg): air moves towards the west side, +V.
+  // Wind from the instrument's east side (90 deg): air moves towards the west side, +V
+  // (manual 9.2: V is the "East - West" axis, as U is "South - North").
   ParseResult r = ParseGillWindSonic(FrameGillRecord("Q,+000.00,+002.00,M,00,"));
   ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
   EXPECT_NEAR(r.reading.from_angle_deg, 90.0, 1e-9);
   EXPECT_NEAR(r.reading.speed, 2.0, 1e-12);
+  // "+U vector is a wind from the South direction" (manual 9.6): from 180 deg.
+  r = ParseGillWindSonic(FrameGillRecord("Q,+002.00,+000.00,M,00,"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_NEAR(r.reading.from_angle_deg, 180.0, 1e-9);
   // Every polar angle: UV components of the same wind give the same reading.
   for (int from = 0; from < 360; from += 15) {
     const double s = 3.0, d = DirectionFromInstrumentAngle(from);

@@ -23,6 +23,10 @@ bool NmeaSpeedUnit(const std::string& f, SpeedUnit* unit) {
   else if (f == "N") *unit = SpeedUnit::kKnots;
   else if (f == "K") *unit = SpeedUnit::kKilometresPerHour;
   else if (f == "S") *unit = SpeedUnit::kMilesPerHour;  // statute miles per hour
+  // Gill's WindSonic and WindObserver in NMEA mode write their own unit letters, P (mph) and F
+  // (ft/min), when set to those units (WindSonic manual 9.4: "as described in Section 9.1").
+  else if (f == "P") *unit = SpeedUnit::kMilesPerHour;
+  else if (f == "F") *unit = SpeedUnit::kFeetPerMinute;
   else return false;
   return true;
 }
@@ -68,7 +72,7 @@ ParseResult ParseMwv(const NmeaSentence& s) {
   SpeedUnit unit;
   if (std::isfinite(speed) && !NmeaSpeedUnit(s.fields[3], &unit))
     return Fail(ParseStatus::kMalformed,
-                where + " field 4 (unit): expected K, M, N or S, got '" + s.fields[3] + "'");
+                where + " field 4 (unit): expected K, M, N or S (or Gill's P, F), got '" + s.fields[3] + "'");
   if (std::isfinite(speed)) w.speed = SpeedToMetresPerSecond(speed, unit);
   // Calm air has no direction (a WindSonic leaves it empty below 0.05 m/s); a speed it must have.
   if (w.valid && !std::isfinite(speed))

@@ -45,6 +45,16 @@ TEST(Nmea, MwvUnits) {
   r = ParseNmea("$IIMWV,180.0,T,10.0,S,A*1E");
   ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
   EXPECT_NEAR(r.reading.speed, 4.4704, 1e-9);
+  // A Gill WindSonic in NMEA mode writes its own unit letters: P (mph), F (ft/min).
+  r = ParseNmea(WithNmeaChecksum("IIMWV,120,R,004.70,P,A"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_NEAR(r.reading.speed, 4.70 * 0.44704, 1e-9);
+  r = ParseNmea(WithNmeaChecksum("IIMWV,120,R,0500,F,A"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_NEAR(r.reading.speed, 500 * 0.00508, 1e-9);
+  r = ParseNmea(WithNmeaChecksum("IIMWV,120,R,004.70,Q,A"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("expected K, M, N or S (or Gill's P, F), got 'Q'"), std::string::npos) << r.error;
   // Lower-case checksum digits are accepted; a missing checksum too.
   EXPECT_EQ(ParseNmea("$IIMWV,180.0,T,10.0,S,A*1e").status, ParseStatus::kOk);
   EXPECT_EQ(ParseNmea("$IIMWV,180.0,T,10.0,S,A").status, ParseStatus::kOk);
