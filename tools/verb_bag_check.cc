@@ -36,6 +36,7 @@
 #include "progress_bar.h"
 #include "ros_bridge/clip_conversions.h"
 #include "sensors/anemometer_protocol.h"
+#include "sensors/wind_reading.h"
 #include "verb_registry.h"
 
 namespace clothwind::tools {
@@ -232,7 +233,7 @@ void NoteMessage(const rosbag::MessageInstance& m, TopicStats& s, double t, cons
       const double stamp = raw->header.stamp.toSec();
       if (DroppedStamp(stamp, t, a.max_future)) {
         // dropped by the anemometer node: no label from it
-      } else if (r.reading.valid && std::isfinite(v) && v >= 0 && v <= 150) {
+      } else if (r.reading.valid && std::isfinite(v) && v >= 0 && v <= sensors::kMaxPlausibleWindSpeed) {
         s.usable.emplace_back(stamp, data_time);
       } else {
         ++s.void_readings;

@@ -56,6 +56,11 @@ ParseResult ParseMwv(const NmeaSentence& s) {
     w.status = status;
   }
   const std::string& ref = s.fields[1];
+  // A void reading with every field empty ("$IIMWV,,,,,V"): said void, not malformed.
+  if (!w.valid && ref.empty() && s.fields[0].empty() && s.fields[2].empty() && s.fields[3].empty()) {
+    r.status = ParseStatus::kOk;
+    return r;
+  }
   if (ref != "R" && ref != "T")
     return Fail(ParseStatus::kMalformed, where + " field 2 (reference): expected R or T, got '" + ref + "'");
   w.relative = ref == "R";

@@ -60,6 +60,16 @@ TEST(Nmea, MwvUnits) {
   EXPECT_EQ(ParseNmea("$IIMWV,180.0,T,10.0,S,A").status, ParseStatus::kOk);
 }
 
+TEST(Nmea, MwvVoidWithEveryFieldEmptyIsAnInvalidReadingNotAMalformedOne) {
+  const ParseResult r = ParseNmea(WithNmeaChecksum("IIMWV,,,,,V"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_FALSE(r.reading.valid);
+  EXPECT_EQ(r.reading.status, "V");
+  EXPECT_TRUE(std::isnan(r.reading.speed));
+  // With status A an empty sentence is still malformed: a valid reading needs its fields.
+  EXPECT_EQ(ParseNmea(WithNmeaChecksum("IIMWV,,,,,A")).status, ParseStatus::kMalformed);
+}
+
 TEST(Nmea, MwvStatusVoidIsAnInvalidReading) {
   ParseResult r = ParseNmea("$IIMWV,270.0,R,3.0,N,V*2C");
   ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
