@@ -47,6 +47,18 @@ echo x >"$work/rerun/trajectory.cwtraj.tmp-999999999-3"
 "$bin" simulate "$src/config/scenes/flag.json" --out "$work/rerun" --duration 0.04 --max-edge 1 --no-obj >/dev/null 2>"$work/out.txt"
 left="$(cd "$work/rerun" && LC_ALL=C ls)"
 [ "$left" = "$(printf 'summary.json\ntrajectory.cwtraj')" ] || fail "a --no-obj rerun left files of the earlier run: $left"
+# A bad --param (not a number, unknown, out of range, no '=', given twice) is refused before the
+# earlier run is touched: it was refused only after its frames and summary were removed.
+for bad in "area_weight=abc" "nosuch=1" "area_weight=-1" "area_weight" "area_weight=0.2 --param area_weight=0.3"; do
+  status=0
+  # shellcheck disable=SC2086
+  "$bin" simulate "$src/config/scenes/flag.json" --out "$work/rerun" --duration 0.04 --max-edge 1 --param $bad \
+    >"$work/out.txt" 2>&1 || status=$?
+  [ "$status" -eq 1 ] && grep -q -- "--param\|parameter" "$work/out.txt" ||
+    fail "simulate --param $bad was not refused naming it (status $status): $(cat "$work/out.txt")"
+  left="$(cd "$work/rerun" && LC_ALL=C ls)"
+  [ "$left" = "$(printf 'summary.json\ntrajectory.cwtraj')" ] || fail "simulate --param $bad removed the earlier run: $left"
+done
 if "$bin" render "$work/rerun" --obj --out "$work/rerun-fr" --count 1 --samples 1 --threads 1 >"$work/out.txt" 2>&1; then
   fail "render --obj of a --no-obj run rendered an earlier run's frames"
 fi

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -108,6 +109,28 @@ int Run(const SimulateArgs& a) {
                                 std::to_string(a.duration / scene.frame_time) + " frames of " + a.scene +
                                 "'s frame_time " + std::to_string(scene.frame_time) + " s; at most 1e6");
   }
+  // Every cloth's theta, checked before anything of an earlier run is removed: a --param typo
+  // used to be refused only after the old run's frames and summary were gone.
+  std::map<int, double> given;  // --param's index -> value
+  for (const auto& p : a.params) {
+    const auto eq = p.find('=');
+    if (eq == std::string::npos) throw std::invalid_argument("--param: expected NAME=VALUE, got '" + p + "'");
+    const int index = sim::ParameterIndex(p.substr(0, eq));
+    if (given.count(index))
+      throw std::invalid_argument("--param " + p.substr(0, eq) + " is given twice (the last would silently win)");
+    given[index] = ParseList(p.substr(eq + 1), 1, "--param " + p)[0];
+  }
+  std::vector<sim::Theta> thetas;
+  for (int c = 0; c < static_cast<int>(setup.cloths.size()); ++c) {
+    sim::Theta theta = sim::SceneTheta(setup, c);
+    for (const auto& [index, value] : given) theta[index] = value;
+    try {
+      sim::ValidateTheta(theta);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string(given.empty() ? "" : "with --param: ") + e.what());
+    }
+    thetas.push_back(theta);
+  }
   fs::create_directories(a.out);
   // summary.json marks a finished run (scripts/window-oracle reuses a folder that has one): the
   // old run's goes before new frames are written, so a run stopped midway leaves none.
@@ -132,15 +155,9 @@ int Run(const SimulateArgs& a) {
   summary["scene"] = scene.path;
   summary["cloths"] = nlohmann::json::array();
   double total_wall = 0;
-  sim::Theta theta0 = sim::SceneTheta(setup, 0);
+  const sim::Theta& theta0 = thetas[0];
   for (int c = 0; c < static_cast<int>(setup.cloths.size()); ++c) {
-    sim::Theta theta = sim::SceneTheta(setup, c);
-    for (const auto& p : a.params) {
-      const auto eq = p.find('=');
-      if (eq == std::string::npos) throw std::invalid_argument("--param: expected NAME=VALUE, got '" + p + "'");
-      theta[sim::ParameterIndex(p.substr(0, eq))] = ParseList(p.substr(eq + 1), 1, "--param " + p)[0];
-    }
-    if (c == 0) theta0 = theta;
+    const sim::Theta& theta = thetas[c];
     options.cloth = c;
     ProgressBar::Options bar_options;
     bar_options.label = "simulate";
