@@ -25,6 +25,7 @@
 #include "data/rendered_flag_generator.h"
 #include "output_paths.h"
 #include "progress_bar.h"
+#include "remove_on_interrupt.h"
 #include "sensors/synthetic_session.h"
 #include "verb_registry.h"
 
@@ -129,6 +130,9 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
     const std::filesystem::path folder = std::filesystem::path(a.preview).parent_path();
     if (!folder.empty() && !std::filesystem::is_directory(folder))
       throw std::invalid_argument("--preview " + a.preview + ": folder " + folder.string() + " does not exist");
+    // The bag replaced the preview written beside it (exit 0, the image lost).
+    if (SameFile(a.preview, a.out))
+      throw std::invalid_argument("--preview " + a.preview + " is the bag --out names; give the image another name");
   }
   sensors::SyntheticSessionOptions o;
   o.duration = a.minutes * 60.0;
@@ -202,6 +206,8 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
   if (a.compression != "none" && a.compression != "lz4" && a.compression != "bz2")
     throw std::invalid_argument("--compression: expected none, lz4 or bz2, got '" + a.compression + "'");
   const std::string tmp = TemporaryNameFor(a.out);
+  // Ctrl-C midway removes the temporary bag (it stayed until a later run into the same name).
+  const RemoveOnInterrupt remove_on_interrupt(tmp);
   // Held by pointer: after a failed write (a full disk) the bag's close() throws again, and
   // rosbag::Bag's destructor calls close(), which then ended the program (std::terminate) and left
   // the temporary bag. On failure the object is abandoned instead (the verb is ending).

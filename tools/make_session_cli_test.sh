@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# CLI test of `clothwind make-session`'s outputs: a --preview that names the bag itself is refused
+# before the work (the bag replaced the image, exit 0), and Ctrl-C midway removes the temporary
+# bag (it stayed, hundreds of MB of a large session, until a later run into the same name) while
+# the process still ends by the signal (status 130).
+# Usage: make_session_cli_test.sh CLOTHWIND_BINARY
+set -euo pipefail
+bin="$1"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+fail() { echo "make_session_cli_test: FAIL: $*" >&2; exit 1; }
+cd "$work"
+status=0
+"$bin" make-session --minutes 0.05 --width 16 --height 16 --out same.png --preview same.png >out.txt 2>&1 || status=$?
+[ "$status" -eq 1 ] && grep -q -- "--preview same.png is the bag --out names" out.txt && [ ! -e same.png ] ||
+  fail "--preview equal to --out was not refused (status $status): $(cat out.txt)"
+
+"$bin" make-session --minutes 5 --width 512 --height 512 --out big.bag >out.txt 2>&1 &
+pid=$!
+for _ in $(seq 200); do
+  compgen -G "big.bag.tmp-*" >/dev/null && break
+  sleep 0.1
+done
+compgen -G "big.bag.tmp-*" >/dev/null || { kill "$pid"; fail "no temporary bag after 20 s: $(cat out.txt)"; }
+kill -INT "$pid"
+status=0
+wait "$pid" || status=$?
+[ "$status" -eq 130 ] || fail "make-session did not end by SIGINT (status $status): $(tail -3 out.txt)"
+left="$(ls)"
+[ "$left" = "out.txt" ] || fail "an interrupted make-session left: $left"
+echo "make_session_cli_test: OK"
