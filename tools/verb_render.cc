@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/atomic_file.h"
+#include "common/json_file.h"
 #include "data/cloth_animation.h"
 #include "progress_bar.h"
 #include "stale_frames.h"
@@ -49,14 +50,7 @@ struct RenderArgs {
 };
 
 render::RenderParams LoadZeta(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("--zeta: cannot open " + path);
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const std::exception& e) {
-    throw std::runtime_error("--zeta " + path + ": not valid JSON (" + e.what() + ")");
-  }
+  nlohmann::json j = ReadJsonFile(path, "--zeta");
   if (j.contains("zeta")) j = j["zeta"];  // a dataset example's label.json
   try {
     return render::RenderParamsFromJson(j);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/dataset_names.h"
+#include "common/json_file.h"
 #include "common/regular_file.h"
 #include "sim/trajectory_io.h"
 
@@ -76,18 +77,6 @@ void Require(const nlohmann::json& j, const char* field, bool ok, const std::str
     throw std::runtime_error(path + ": field '" + field + "' " +
                              (j.contains(field) ? "is " + j[field].dump() + ", expected " + expected
                                                 : std::string("is missing")));
-}
-
-nlohmann::json ReadJsonFile(const std::string& path) {
-  if (ExistsButNotARegularFile(path))
-    throw std::runtime_error(path + ": not a regular file (a folder, a pipe or a device)");
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw std::runtime_error(path + ": not valid JSON (" + e.what() + ")");
-  }
 }
 
 }  // namespace

@@ -79,7 +79,7 @@ TEST(ReadIndexTest, AFolderOrAWrongTypedFormatIsRefusedNamingTheFile) {
     }
     return std::string("accepted");
   };
-  EXPECT_NE(refusal().find((dir / "index.json").string() + ": not a regular file"), std::string::npos) << refusal();
+  EXPECT_NE(refusal().find((dir / "index.json").string() + ": a folder, expected a JSON file"), std::string::npos) << refusal();
   fs::remove(dir / "index.json");
   std::ofstream(dir / "index.json") << R"({"format": 3, "clips": []})";
   EXPECT_NE(refusal().find("index.json: field 'format' must be \"clothwind-dataset\""), std::string::npos)

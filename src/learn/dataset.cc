@@ -17,6 +17,7 @@
 
 #include "common/dataset_names.h"
 #include "common/image_file.h"
+#include "common/json_file.h"
 #include "common/random.h"
 #include "common/regular_file.h"
 #include "learn/fly_judge.h"
@@ -24,18 +25,7 @@
 
 namespace clothwind::learn {
 namespace fs = std::filesystem;
-nlohmann::json ReadJson(const fs::path& path) {
-  if (ExistsButNotARegularFile(path))
-    throw std::runtime_error(path.string() + ": " + (fs::is_directory(path) ? "a folder" : "not a regular file") +
-                             ", expected a JSON file");
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path.string() + ": cannot open");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const std::exception& e) {  // nlohmann's, and the stream's own (an unreadable file)
-    throw std::runtime_error(path.string() + ": not valid JSON: " + e.what());
-  }
-}
+nlohmann::json ReadJson(const fs::path& path) { return ReadJsonFile(path.string()); }
 
 namespace {
 

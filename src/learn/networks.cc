@@ -11,6 +11,7 @@
 #include <ATen/ATen.h>
 
 #include "common/atomic_file.h"
+#include "common/json_file.h"
 #include "common/regular_file.h"
 #include "learn/track_targets.h"
 #include "learn/weight_average.h"
@@ -298,7 +299,7 @@ void CheckConfigMatchesWeights(const ModelConfig& config, const std::filesystem:
   try {
     saved = ModelConfigFromJson(nlohmann::json::parse(stored), weights.string() + " (its saved configuration)");
   } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(weights.string() + ": its saved configuration is not valid JSON: " + e.what());
+    throw std::runtime_error(weights.string() + ": its saved configuration is not valid JSON: " + JsonErrorText(e));
   }
   // Compared through the struct, so keys a model.json may leave out (older files) compare as
   // their defaults.
@@ -332,16 +333,7 @@ WindNet BuildWindNet(const ModelConfig& config, const std::filesystem::path& con
 
 WindNet LoadWindNet(const std::filesystem::path& weights) {
   const std::filesystem::path config_path = ConfigPathFor(weights);
-  if (ExistsButNotARegularFile(config_path))
-    throw std::runtime_error(config_path.string() + ": not a regular file (the model's architecture)");
-  std::ifstream in(config_path);
-  if (!in) throw std::runtime_error(config_path.string() + ": cannot open (the model's architecture)");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(config_path.string() + ": not valid JSON: " + e.what());
-  }
+  const nlohmann::json j = ReadJsonFile(config_path.string(), "the model's architecture");
   WindNet net = BuildWindNet(ModelConfigFromJson(j, config_path.string()), config_path);
   std::string stored;
   try {

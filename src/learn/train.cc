@@ -28,6 +28,7 @@
 #include <torch/serialize.h>
 
 #include "common/atomic_file.h"
+#include "common/json_file.h"
 #include "common/regular_file.h"
 #include "learn/aux_targets.h"
 #include "learn/dataset.h"
@@ -190,7 +191,7 @@ nlohmann::json ReadState(const fs::path& state_path) {
   try {
     state = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(state_path.string() + ": " + e.what());
+    throw std::runtime_error(state_path.string() + ": not valid JSON: " + JsonErrorText(e));
   }
   // The type of every field a resume reads, checked here: they are read in many places after,
   // where a wrong one threw a bare "type must be string, but is number" naming neither the file
@@ -557,7 +558,7 @@ TrainResult Train(const TrainOptions& o) {
       for (size_t i = 0; i < log.size(); ++i)
         result.log.push_back(EpochFromJson(log[i], state_path.string() + ": log[" + std::to_string(i) + "]"));
     } catch (const nlohmann::json::exception& e) {
-      throw std::runtime_error(state_path.string() + ": " + e.what());
+      throw std::runtime_error(state_path.string() + ": " + JsonErrorText(e));
     }
     // A resumed run must keep the schedule it ran under: a cosine run resumed with other --epochs
     // (or any run with another --lr, --lr-schedule or --lr-decay-epoch) would silently become a

@@ -22,6 +22,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/atomic_file.h"
+#include "common/json_file.h"
 
 namespace clothwind::sensors {
 namespace fs = std::filesystem;
@@ -177,7 +178,7 @@ DatasetWriter::DatasetWriter(const std::string& root, int jpeg_quality, double i
     try {
       index_ = nlohmann::json::parse(in);
     } catch (const std::exception& e) {
-      throw std::runtime_error(index_path + ": not valid JSON (" + e.what() + ")");
+      throw std::runtime_error(index_path + ": not valid JSON: " + JsonErrorText(e));
     }
     if (!index_.is_object() || !index_.contains("clips") || !index_["clips"].is_array())
       throw std::runtime_error(index_path + ": expected an object with an array \"clips\"");

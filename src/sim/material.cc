@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/formatted.h"
+#include "common/json_file.h"
 #include "sim/json_comments.h"
 
 namespace clothwind::sim {
@@ -156,15 +157,12 @@ namespace {
 // The material file's JSON object (ArcSim's comments allowed). Throws std::runtime_error naming
 // the file when it cannot be read, parsed, or is not an object.
 nlohmann::json ReadMaterialJson(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open material file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  const std::string text = ReadTextFile(path, "a material file");
   nlohmann::json j;
   try {
-    j = ParseJsonWithComments(ss.str());
+    j = ParseJsonWithComments(text);
   } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(path + ": not valid JSON: " + e.what());
+    throw std::runtime_error(path + ": not valid JSON: " + JsonErrorText(e));
   } catch (const std::runtime_error& e) {  // an unclosed block comment
     throw std::runtime_error(path + ": " + e.what());
   }

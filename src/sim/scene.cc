@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "common/formatted.h"
+#include "common/json_file.h"
 #include "sim/json_comments.h"
 #include "sim/strain_limiter.h"
 
@@ -434,9 +435,13 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
     const size_t end = text.find('\n', start);
     std::string shown = text.substr(start, end == std::string::npos ? std::string::npos : end - start);
     shown.erase(0, shown.find_first_not_of(" \t"));
-    throw std::runtime_error(abs_path + ":" + std::to_string(line) + ": not valid JSON near `" +
-                             shown + "` (numbers must be finite: NaN/Infinity are not JSON): " +
-                             e.what());
+    // The hint only where it applies: an empty or truncated file was told of NaN too.
+    std::string lower = shown;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+    const bool non_finite = lower.find("nan") != std::string::npos || lower.find("inf") != std::string::npos;
+    throw std::runtime_error(abs_path + ":" + std::to_string(line) + ": not valid JSON near `" + shown + "`" +
+                             (non_finite ? " (numbers must be finite: NaN/Infinity are not JSON)" : "") + ": " +
+                             JsonErrorText(e));
   } catch (const json::exception& e) {
     // A number beyond a double ("1e400": out_of_range 406, which carries no position): named by
     // the line that holds the number the message quotes, else by the file alone.
@@ -448,7 +453,7 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
       const size_t at = to == std::string::npos ? std::string::npos : text.find(what.substr(from, to - from));
       if (at != std::string::npos) where += ":" + std::to_string(1 + std::count(text.begin(), text.begin() + at, '\n'));
     }
-    throw std::runtime_error(where + ": not valid JSON: " + what);
+    throw std::runtime_error(where + ": not valid JSON: " + JsonErrorText(e));
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(abs_path + ": " + e.what());
   }
@@ -585,11 +590,8 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
 }
 
 Scene LoadScene(const std::string& path, const WarningSink& warn) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot open scene file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ParseScene(ss.str(), path, warn);
+  // A folder, an unreadable or an empty file named as such (a folder read as an empty scene).
+  return ParseScene(ReadTextFile(path, "a scene file"), path, warn);
 }
 
 }  // namespace clothwind::sim
