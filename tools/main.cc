@@ -5,14 +5,18 @@
 #include <exception>
 #include <iostream>
 #include <map>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "closest_name.h"
 #include "verb_registry.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"clothwind: wind and cloth measurement through simulation (offline tools)"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("clothwind ") + CLOTHWIND_VERSION);
   auto& verbs = clothwind::tools::Verbs();
   std::sort(verbs.begin(), verbs.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   std::map<std::string, std::function<int()>> run;
@@ -33,6 +37,16 @@ int main(int argc, char** argv) {
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
     for (CLI::Option* option : sub->get_options())
       if (option->get_type_size() != 0 && option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
+  // A word where the verb goes that names none: CLI11 said only "A subcommand is required".
+  if (argc >= 2 && argv[1][0] != '-' && run.count(argv[1]) == 0) {
+    std::cerr << "clothwind: unknown verb '" << argv[1] << "'";
+    std::vector<std::string> names;
+    for (const auto& verb : verbs) names.push_back(verb.name);
+    const std::string closest = clothwind::tools::ClosestName(argv[1], names);
+    if (!closest.empty()) std::cerr << "; did you mean " << closest << "?";
+    std::cerr << " (clothwind --help lists the verbs)\n";
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
