@@ -1,5 +1,6 @@
 // clothwind <verb> ...: the offline tools behind one command line.
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <exception>
@@ -11,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "closest_name.h"
+#include "range_message.h"
 #include "verb_registry.h"
 
 int main(int argc, char** argv) {
@@ -34,9 +36,23 @@ int main(int argc, char** argv) {
         return "expected a finite number, got " + value;
       },
       "", "finite");
+  // An unsigned option (seeds, counts) takes digits within 0..2^64-1: "-1" wrapped to 2^64-1 and
+  // 2^64 or more was clamped to it, both run without a word (`render --seed -1`, `--seed 1e30`).
+  const CLI::Validator whole(
+      [](std::string& value) -> std::string {
+        const bool digits = !value.empty() && value.find_first_not_of("0123456789") == std::string::npos;
+        errno = 0;
+        if (digits) (void)std::strtoull(value.c_str(), nullptr, 10);
+        if (digits && errno != ERANGE) return "";
+        return "expected a whole number 0..18446744073709551615, got " + value;
+      },
+      "", "whole");
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
-    for (CLI::Option* option : sub->get_options())
-      if (option->get_type_size() != 0 && option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
+    for (CLI::Option* option : sub->get_options()) {
+      if (option->get_type_size() == 0) continue;
+      if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
+      if (option->get_type_name().rfind("UINT", 0) == 0) option->check(whole);
+    }
   // A word where the verb goes that names none: CLI11 said only "A subcommand is required".
   if (argc >= 2 && argv[1][0] != '-' && run.count(argv[1]) == 0) {
     std::cerr << "clothwind: unknown verb '" << argv[1] << "'";
@@ -49,6 +65,9 @@ int main(int argc, char** argv) {
   }
   try {
     app.parse(argc, argv);
+  } catch (const CLI::ValidationError& e) {
+    std::cerr << clothwind::tools::ReadableRangeMessage(e.what()) << "\nRun with --help for more information.\n";
+    return e.get_exit_code();
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # CLI test of `clothwind` itself: a mistyped verb is named with the verb it was likely meant to be
 # (it was told only "A subcommand is required"), an unknown word is named, status 2 for both;
-# --version prints package.xml's version.
+# unsigned options are refused beyond 0..2^64-1 (and ranges said readably); --version prints
+# package.xml's version.
 # Usage: main_cli_test.sh CLOTHWIND_BINARY SOURCE_DIR
 set -euo pipefail
 bin="$1"
@@ -15,6 +16,20 @@ status=0
 out="$("$bin" frobnicate 2>&1)" || status=$?
 [ "$status" -eq 2 ] && [ "$out" = "clothwind: unknown verb 'frobnicate' (clothwind --help lists the verbs)" ] ||
   fail "an unknown verb (status $status): $out"
+# Unsigned options take 0..2^64-1 in digits: -1 wrapped to 2^64-1 and 2^64 was clamped to it, both
+# without a word; unbounded ranges are said as a bound, not as 309 digits of the largest double.
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+for seed in -1 18446744073709551616 1e3; do
+  status=0
+  out="$("$bin" make-toy-dataset --seed "$seed" --out "$work/toy" 2>&1)" || status=$?
+  [ "$status" -ne 0 ] && [ ! -e "$work/toy" ] && grep -q -- "--seed: .*$seed" <<<"$out" ||
+    fail "make-toy-dataset --seed $seed was not refused naming it (status $status): $out"
+done
+out="$("$bin" make-toy-dataset --seed -1 --out "$work/toy" 2>&1)" || true
+grep -q -- "--seed: Value -1 must be >= 0$" <<<"$out" || fail "--seed -1: $out"
+"$bin" make-toy-dataset --seed 18446744073709551615 --clips 1 --frames 2 --size 16 --out "$work/toy" >/dev/null 2>&1 ||
+  fail "make-toy-dataset --seed 2^64-1 was refused"
 version="$(sed -n 's:.*<version>\(.*\)</version>.*:\1:p' "$src/package.xml")"
 [ "$("$bin" --version)" = "clothwind $version" ] || fail "--version: $("$bin" --version 2>&1)"
 echo "main_cli_test: OK"
