@@ -5,10 +5,17 @@
 #ifndef CLOTHWIND_TOOLS_OUTPUT_PATHS_H_
 #define CLOTHWIND_TOOLS_OUTPUT_PATHS_H_
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "common/atomic_file.h"
 
 namespace clothwind::tools {
 
@@ -39,8 +46,27 @@ inline void RefuseFolderAsOutput(const std::string& option, const std::filesyste
     throw std::invalid_argument(option + " " + output.string() + " is a folder; expected a file name");
 }
 
+// Throws std::invalid_argument naming `option` when no file can be made where `output` (empty: none)
+// goes: a file is made and removed in its folder, or in the nearest folder above that exists (a
+// verb that makes the missing ones). `eval --json /proc/x.json` ran the whole evaluation and then
+// failed to write.
+inline void RefuseUnwritableFolder(const std::string& option, const std::filesystem::path& output) {
+  if (output.empty()) return;
+  std::error_code ec;
+  std::filesystem::path folder = std::filesystem::absolute(output, ec).parent_path();
+  while (!folder.empty() && !std::filesystem::exists(folder, ec) && folder != folder.parent_path())
+    folder = folder.parent_path();
+  const std::string probe = TemporaryNameFor((folder / output.filename()).string());
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0)
+    throw std::invalid_argument(option + " " + output.string() + ": cannot write in " + folder.string() + " (" +
+                                std::strerror(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
 // Throws std::invalid_argument naming `option` unless `output` (empty: none) could be written: its
-// folder exists and it is not a folder itself. Checked before the work, which used to run to its
+// folder exists and takes a new file, and it is not a folder itself. Checked before the work, which used to run to its
 // end (a whole evaluation) and then fail to write or, for a plot, exit 0.
 inline void RefuseUnwritableOutput(const std::string& option, const std::filesystem::path& output) {
   if (output.empty()) return;
@@ -49,6 +75,7 @@ inline void RefuseUnwritableOutput(const std::string& option, const std::filesys
   if (!std::filesystem::is_directory(folder, ec))
     throw std::invalid_argument(option + " " + output.string() + ": folder " + folder.string() + " does not exist");
   RefuseFolderAsOutput(option, output);
+  RefuseUnwritableFolder(option, output);
 }
 
 }  // namespace clothwind::tools

@@ -50,6 +50,18 @@ TEST(OutputPathsTest, AnOutputInAMissingFolderOrOnAFolderIsRefusedBeforeTheWork)
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", dir / "sub" / "e.json"));
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", "e.json"));  // the working folder
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", fs::path()));
+  // A folder that takes no new file (root writes everywhere but /proc): refused before the work,
+  // and a probe that worked leaves nothing behind.
+  try {
+    RefuseUnwritableOutput("--json", "/proc/x.json");
+    ADD_FAILURE() << "/proc/x.json accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("--json /proc/x.json: cannot write in /proc (", 0), 0u) << e.what();
+  }
+  EXPECT_THROW(RefuseUnwritableFolder("--out", "/proc/new/m.pt"), std::invalid_argument);
+  EXPECT_NO_THROW(RefuseUnwritableFolder("--out", dir / "a" / "b" / "m.pt"));  // made by the verb
+  EXPECT_FALSE(fs::exists(dir / "a"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir / "sub"), {}), 0);
   // Verbs that make a missing folder themselves refuse only a folder.
   EXPECT_THROW(RefuseFolderAsOutput("--out", dir / "sub"), std::invalid_argument);
   EXPECT_NO_THROW(RefuseFolderAsOutput("--out", dir / "no_such_folder" / "m.pt"));

@@ -103,6 +103,7 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
       RefuseOutputOverInput("--out's card", card, {index});
       RefuseFolderAsOutput("--out", a->out);
       RefuseFolderAsOutput("--out's card", card);
+      RefuseUnwritableFolder("--out", a->out);
     }
     at::set_num_threads(a->threads);
     const learn::Dataset dataset = learn::ReadDataset(a->data);

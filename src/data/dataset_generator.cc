@@ -679,7 +679,8 @@ void SayIncomplete(const char* who, const std::vector<std::string>& incomplete) 
 
 std::vector<Fabric> LoadFabrics(const std::string& folder, const std::string& scene_path,
                                 const std::vector<std::string>& exclude) {
-  if (!fs::is_directory(folder)) throw std::runtime_error("materials folder " + folder + " not found");
+  if (!fs::is_directory(folder))
+    throw std::runtime_error("materials folder " + folder + (fs::exists(folder) ? " is a file, expected a folder of ArcSim material files" : " not found"));
   const sim::Scene scene = sim::LoadScene(scene_path, [](const std::string&) {});
   const sim::MaterialMultipliers mult =
       scene.cloths.at(0).materials.empty() ? sim::MaterialMultipliers{} : MultipliersOf(scene.cloths[0].materials[0]);

@@ -88,6 +88,7 @@ FlyJudge::FlyJudge(Eigen::MatrixXf hidden_weights, Eigen::VectorXf hidden_bias, 
 }
 
 FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
+  RefuseFolderAsWeightsFile(path, "a fly judge");
   const std::filesystem::path card_path = ConfigPathFor(path);
   const nlohmann::json card = ReadJson(card_path);
   // Bounded as train-fly-judge bounds it: the module is built from the card before the weights'

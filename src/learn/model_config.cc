@@ -341,6 +341,13 @@ std::filesystem::path ConfigPathFor(const std::filesystem::path& weights) {
   return p.replace_extension(".json");
 }
 
+void RefuseFolderAsWeightsFile(const std::filesystem::path& weights, const std::string& what) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(weights, ec))
+    throw std::runtime_error(weights.string() + ": a folder, expected " + what +
+                             "'s weights file (a .pt with its .json beside it)");
+}
+
 void WriteFileAtomically(const std::filesystem::path& path, const std::string& text) {
   clothwind::WriteFileAtomically(path.string(), text);
 }

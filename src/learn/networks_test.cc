@@ -95,6 +95,19 @@ TEST(UseChannelsLastTest, NetworkAnswersAsInTheDefaultOrder) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(LoadWindNetTest, AFolderGivenAsTheModelIsNamedAsOne) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("clothwind_networks_folder_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  try {
+    LoadWindNet(dir);
+    ADD_FAILURE() << "a folder loaded as a model";
+  } catch (const std::runtime_error& e) {
+    // It was told "<folder>.json: cannot open".
+    EXPECT_EQ(std::string(e.what()), dir.string() + ": a folder, expected a model's weights file (a .pt with its .json beside it)");
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(LoadWindNetTest, AModelJsonTheNetworkCannotBeBuiltFromIsNamed) {
   // "k": 20 on 30 frames passed the file's checks and stopped eval, export-model and sdn_node
   // with the constructor's std::invalid_argument, which named no file.

@@ -187,7 +187,8 @@ std::vector<std::string> ListBackgroundImages(const std::string& folder) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_directory(folder, ec))
-    throw std::runtime_error("background folder '" + folder + "' does not exist");
+    throw std::runtime_error("background folder '" + folder + "' " +
+                             (fs::exists(folder, ec) ? "is a file, expected a folder of images" : "does not exist"));
   std::vector<std::string> out;
   for (const auto& e : fs::directory_iterator(folder, ec)) {
     if (!e.is_regular_file()) continue;

@@ -505,6 +505,10 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
   // A day of simulated time at most, in at most a million frames (the frame count is an int and
   // its frames are reserved up front: 1e8 s failed in vector::reserve, 1e300 ran nothing, exit 0).
   if (!(s.duration <= 86400)) r.Fail(end_key, "expected at most 86400 s, got " + std::to_string(s.duration));
+  // A frame longer than the scene (frame_time 1e300 ran 0 steps and wrote one frame, exit 0).
+  if (!(s.frame_time <= s.duration))
+    r.Fail(frame_time_form ? "frame_time" : "timestep",
+           Formatted("a frame of %g s is longer than the scene's %g s (", s.frame_time, s.duration) + end_key + ")");
   if (!(s.duration / s.frame_time <= 1e6))
     r.Fail(frame_time_form ? "frame_time" : "timestep",
            "expected at most 1e6 frames over the duration, got " + std::to_string(s.duration / s.frame_time));

@@ -260,6 +260,13 @@ TEST_F(SceneFiles, ArcSimsTimingFormsEndAtTheFirstLimitReached) {
   // A number beyond a double is named by file and line (it was nlohmann's bare out_of_range).
   const std::string e = Write("conf/e.json", Replace(SceneText(), "\"duration\": 1", "\"duration\": 1e400"));
   ExpectErrorNaming([&] { LoadScene(e); }, {e + ":2: not valid JSON", "1e400"});
+  // A frame longer than the scene: 1e300 ran no step and wrote one frame, exit 0.
+  const std::string f = scene("f.json", "\"frame_time\": 1e300, \"duration\": 20");
+  ExpectErrorNaming([&] { LoadScene(f); }, {f, "frame_time", "a frame of 1e+300 s is longer than the scene's 20 s"});
+  // An empty file, or a folder, is named as such (an empty scene was told NaN is not JSON).
+  const std::string empty = Write("conf/empty.json", "\n");
+  ExpectErrorNaming([&] { LoadScene(empty); }, {empty, "the file is empty"});
+  ExpectErrorNaming([&] { LoadScene((root_ / "conf").string()); }, {"conf: a folder, expected a JSON file"});
 }
 
 TEST_F(SceneFiles, DisabledArcSimModulesAreSwitchedOffOrNamed) {
