@@ -652,6 +652,16 @@ TEST(Backdrop, MissingFilesAreNamed) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/photo.jpg"), std::string::npos);
   }
   EXPECT_THROW(ListBackgroundImages("/nonexistent/folder"), std::runtime_error);
+  // A file given as the folder is said to be one (it was "does not exist").
+  const std::string file = testing::TempDir() + "/render_bg_file_" + std::to_string(::getpid());
+  std::ofstream(file) << "x";
+  try {
+    ListBackgroundImages(file);
+    ADD_FAILURE() << "a file listed as a folder";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "background folder '" + file + "' is a file, expected a folder of images");
+  }
+  std::filesystem::remove(file);
 }
 
 // An image that cannot be read is named when the folder is listed: make-dataset found it only when
