@@ -44,6 +44,21 @@ status=0
 [ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "--track-head-window needs --track-head" "$work/msg.txt" ||
   fail "eval --track-head-window 30: not refused (status $status): $(cat "$work/msg.txt")"
 
+# train --out into the dataset (or a clip of it) wrote the run among its clips.
+for out in "$work/toy" "$work/toy/toy-00000"; do
+  status=0
+  "$bin" train --model sdn --frames 30 --data "$work/toy" --out "$out" --input-size 32 --width 8 --k 3 \
+    --threads 1 --init-only >"$work/msg.txt" 2>&1 || status=$?
+  [ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "--out $out is .*the dataset" "$work/msg.txt" &&
+    [ ! -e "$out/model.pt" ] || fail "train --out $out: not refused (status $status): $(cat "$work/msg.txt")"
+done
+# eval --plot draws a PNG whatever the name: p.txt was written as one.
+status=0
+"$bin" eval --model "$work/run/model.pt" --data "$work/toy" --split all --plot "$work/p.txt" --threads 1 \
+  >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "--plot $work/p.txt: expected a file name ending in .png" "$work/msg.txt" &&
+  [ ! -e "$work/p.txt" ] || fail "eval --plot p.txt: not refused (status $status): $(cat "$work/msg.txt")"
+
 # The same clips with the val split moved to train.
 cp -r "$work/toy" "$work/noval"
 sed -i 's/"split": "val"/"split": "train"/' "$work/noval/index.json" "$work"/noval/*/label.json

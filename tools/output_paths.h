@@ -8,6 +8,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -44,6 +45,23 @@ inline void RefuseFolderAsOutput(const std::string& option, const std::filesyste
   std::error_code ec;
   if (!output.empty() && std::filesystem::is_directory(output, ec))
     throw std::invalid_argument(option + " " + output.string() + " is a folder; expected a file name");
+}
+
+// Throws std::invalid_argument naming `option` when `output` is `folder` or lies inside it: `train
+// --out DATA` wrote its run among the dataset's clips.
+inline void RefuseOutputInsideFolder(const std::string& option, const std::filesystem::path& output,
+                                     const std::filesystem::path& folder, const std::string& what) {
+  if (output.empty() || folder.empty()) return;
+  std::error_code ec;
+  const auto normal = [&](const std::filesystem::path& p) {
+    const std::filesystem::path c = std::filesystem::weakly_canonical(p, ec);
+    return (ec ? std::filesystem::absolute(p) : c).lexically_normal();
+  };
+  const std::filesystem::path out = normal(output), in = normal(folder);
+  const auto mismatch = std::mismatch(in.begin(), in.end(), out.begin(), out.end());
+  if (mismatch.first == in.end())
+    throw std::invalid_argument(option + " " + output.string() + " is " + (mismatch.second == out.end() ? "" : "inside ") +
+                                what + " " + folder.string() + "; write it elsewhere");
 }
 
 // Throws std::invalid_argument naming `option` when no file can be made where `output` (empty: none)

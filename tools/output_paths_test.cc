@@ -62,6 +62,13 @@ TEST(OutputPathsTest, AnOutputInAMissingFolderOrOnAFolderIsRefusedBeforeTheWork)
   EXPECT_NO_THROW(RefuseUnwritableFolder("--out", dir / "a" / "b" / "m.pt"));  // made by the verb
   EXPECT_FALSE(fs::exists(dir / "a"));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir / "sub"), {}), 0);
+  // A run written into the dataset, or into one of its clips, is refused; beside it is not.
+  fs::create_directories(dir / "data" / "toy-00000");
+  EXPECT_THROW(RefuseOutputInsideFolder("--out", dir / "data", dir / "data", "the dataset"), std::invalid_argument);
+  EXPECT_THROW(RefuseOutputInsideFolder("--out", dir / "data" / "toy-00000" / "run", dir / "data" / ".", "the dataset"),
+               std::invalid_argument);
+  EXPECT_NO_THROW(RefuseOutputInsideFolder("--out", dir / "data-run", dir / "data", "the dataset"));
+  EXPECT_NO_THROW(RefuseOutputInsideFolder("--out", dir / "run", dir / "data", "the dataset"));
   // Verbs that make a missing folder themselves refuse only a folder.
   EXPECT_THROW(RefuseFolderAsOutput("--out", dir / "sub"), std::invalid_argument);
   EXPECT_NO_THROW(RefuseFolderAsOutput("--out", dir / "no_such_folder" / "m.pt"));

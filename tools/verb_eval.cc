@@ -112,6 +112,9 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
                                     "); write one of them elsewhere");
     RefuseUnwritableOutput("--json", a->json);
     RefuseUnwritableOutput("--plot", a->plot);
+    // gnuplot draws a PNG whatever the name: `--plot p.txt` wrote one named .txt.
+    if (!a->plot.empty() && std::filesystem::path(a->plot).extension() != ".png")
+      throw std::invalid_argument("--plot " + a->plot + ": expected a file name ending in .png (the plot is a PNG)");
     if (a->track_head) {
       // Before the evaluation, which ran whole and then lost its results to a model without a head,
       // a window of the wrong length or a rows file over the model's configuration.

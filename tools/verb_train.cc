@@ -8,6 +8,7 @@
 #include "learn/heap_reuse.h"
 #include "learn/track_targets.h"
 #include "learn/train.h"
+#include "output_paths.h"
 #include "progress_bar.h"
 #include "verb_registry.h"
 
@@ -185,6 +186,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
     o.still_floor_default = args->still_floor < 0;  // resumed, the run's own
     o.data = args->data;
     o.out = args->out;
+    RefuseOutputInsideFolder("--out", o.out, o.data, "the dataset");
     std::unique_ptr<ProgressBar> bar;
     int bar_epoch = 0;
     o.progress = [&](const learn::TrainProgress& p) {
