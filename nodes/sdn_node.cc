@@ -54,6 +54,7 @@
 #include <clothwind/Clip.h>
 #include <clothwind/WindEstimate.h>
 
+#include "learn/camera_heading.h"
 #include "learn/predictor.h"
 #include "ros_bridge/sdn_conversions.h"
 #include "ros_bridge/strict_param.h"

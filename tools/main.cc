@@ -15,6 +15,12 @@
 #include "range_message.h"
 #include "verb_registry.h"
 
+// package.xml's version, defined by tools/CMakeLists.txt; scripts/device-train compiles this file
+// without CMake.
+#ifndef CLOTHWIND_VERSION
+#define CLOTHWIND_VERSION "(version unknown: built outside CMake)"
+#endif
+
 int main(int argc, char** argv) {
   CLI::App app{"clothwind: wind and cloth measurement through simulation (offline tools)"};
   app.require_subcommand(1);

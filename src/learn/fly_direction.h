@@ -8,7 +8,6 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 namespace clothwind::learn {
@@ -84,20 +83,6 @@ cv::Mat TemporalStd(const std::vector<cv::Mat>& frames);
 //                   the camera, shows the flag end-on, with no side to fly to
 // Returns the way, or nothing when the wind is end-on or either angle is not finite.
 std::optional<FlyDirection> FlyDirectionFromWind(double wind_direction, double camera_heading, double end_on);
-
-// The heading to give FlyDirectionFromWind for a camera that need not be level: that of the level
-// camera whose picture's right points the same way across the ground, from the camera's
-// orientation in the anemometer's frame (a tf2 lookup). Its picture's right is what a flag flies
-// toward, so a camera pitched up or down keeps its heading and one mounted upside down gets the
-// opposite one (the flag crosses its picture the other way); the optical axis alone said neither.
-// Inputs:
-//   camera_axes  3x3 rotation whose columns are the camera's optical-frame axes (REP 103's
-//                "_optical" frames: x to the picture's right, y down it, z along the optical axis)
-//                in the anemometer's frame, z up
-// Returns the heading [rad] in [-pi, pi], counter-clockwise about +z from +x; nothing when the
-// picture's right leans more than 45 deg out of the horizontal (a camera on its side sees a flag
-// fly up or down its picture, which no side tells) or the rotation is not finite.
-std::optional<double> EquivalentCameraHeading(const Eigen::Matrix3d& camera_axes);
 
 }  // namespace clothwind::learn
 
