@@ -48,16 +48,19 @@ int main(int argc, char** argv) {
       [](std::string& value) -> std::string {
         const bool digits = !value.empty() && value.find_first_not_of("0123456789") == std::string::npos;
         errno = 0;
-        if (digits) (void)std::strtoull(value.c_str(), nullptr, 10);
-        if (digits && errno != ERANGE) return "";
-        return "expected a whole number 0..18446744073709551615, got " + value;
+        const unsigned long long v = digits ? std::strtoull(value.c_str(), nullptr, 10) : 0;
+        if (!digits || errno == ERANGE) return "expected a whole number 0..18446744073709551615, got " + value;
+        // Decimal, as written: CLI11 reads "010" as C's octal 8.
+        value = std::to_string(v);
+        return "";
       },
       "", "whole");
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
     for (CLI::Option* option : sub->get_options()) {
       if (option->get_type_size() == 0) continue;
       if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
-      if (option->get_type_name().rfind("UINT", 0) == 0) option->check(whole);
+      // transform, not check: a check may not change the value (010 must reach CLI11 as 10).
+      if (option->get_type_name().rfind("UINT", 0) == 0) option->transform(whole);
     }
   // A word where the verb goes that names none: CLI11 said only "A subcommand is required".
   if (argc >= 2 && argv[1][0] != '-' && run.count(argv[1]) == 0) {
@@ -72,7 +75,14 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ValidationError& e) {
-    std::cerr << clothwind::tools::ReadableRangeMessage(e.what()) << "\nRun with --help for more information.\n";
+    // Which option: a positive one's lower bound prints like a non-negative one's (0.000000).
+    const std::string what = e.what();
+    bool positive = false;
+    for (CLI::App* sub : app.get_subcommands())
+      for (const CLI::Option* option : sub->get_options())
+        if (what.rfind(option->get_name() + ":", 0) == 0)
+          positive = option->get_type_name().find(":POSITIVE") != std::string::npos;
+    std::cerr << clothwind::tools::ReadableRangeMessage(what, positive) << "\nRun with --help for more information.\n";
     return e.get_exit_code();
   } catch (const CLI::ParseError& e) {
     return app.exit(e);

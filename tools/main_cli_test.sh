@@ -26,8 +26,14 @@ for seed in -1 18446744073709551616 1e3; do
   [ "$status" -ne 0 ] && [ ! -e "$work/toy" ] && grep -q -- "--seed: .*$seed" <<<"$out" ||
     fail "make-toy-dataset --seed $seed was not refused naming it (status $status): $out"
 done
-out="$("$bin" make-toy-dataset --seed -1 --out "$work/toy" 2>&1)" || true
-grep -q -- "--seed: Value -1 must be >= 0$" <<<"$out" || fail "--seed -1: $out"
+# Decimal as written: CLI11 read 010 as C's octal 8.
+"$bin" make-toy-dataset --seed 010 --clips 1 --frames 2 --size 16 --out "$work/s010" >/dev/null 2>&1
+"$bin" make-toy-dataset --seed 8 --clips 1 --frames 2 --size 16 --out "$work/s8" >/dev/null 2>&1
+"$bin" make-toy-dataset --seed 10 --clips 1 --frames 2 --size 16 --out "$work/s10" >/dev/null 2>&1
+cmp -s "$work/s010/index.json" "$work/s10/index.json" && ! cmp -s "$work/s010/index.json" "$work/s8/index.json" ||
+  fail "--seed 010 is not seed 10"
+out="$("$bin" train --epochs -3 --data "$work" --out "$work/run" 2>&1)" || true
+grep -q -- "--epochs: Value -3 must be > 0$" <<<"$out" || fail "--epochs -3: $out"
 "$bin" make-toy-dataset --seed 18446744073709551615 --clips 1 --frames 2 --size 16 --out "$work/toy" >/dev/null 2>&1 ||
   fail "make-toy-dataset --seed 2^64-1 was refused"
 version="$(sed -n 's:.*<version>\(.*\)</version>.*:\1:p' "$src/package.xml")"

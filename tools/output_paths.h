@@ -54,8 +54,10 @@ inline void RefuseOutputInsideFolder(const std::string& option, const std::files
   if (output.empty() || folder.empty()) return;
   std::error_code ec;
   const auto normal = [&](const std::filesystem::path& p) {
-    const std::filesystem::path c = std::filesystem::weakly_canonical(p, ec);
-    return (ec ? std::filesystem::absolute(p) : c).lexically_normal();
+    // Absolute first: weakly_canonical("run") of a missing relative path stays relative.
+    const std::filesystem::path a = std::filesystem::absolute(p, ec);
+    const std::filesystem::path c = std::filesystem::weakly_canonical(a, ec);
+    return (ec ? a : c).lexically_normal();
   };
   const std::filesystem::path out = normal(output), in = normal(folder);
   const auto mismatch = std::mismatch(in.begin(), in.end(), out.begin(), out.end());

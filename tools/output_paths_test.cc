@@ -68,6 +68,11 @@ TEST(OutputPathsTest, AnOutputInAMissingFolderOrOnAFolderIsRefusedBeforeTheWork)
   EXPECT_THROW(RefuseOutputInsideFolder("--out", dir / "data" / "toy-00000" / "run", dir / "data" / ".", "the dataset"),
                std::invalid_argument);
   EXPECT_NO_THROW(RefuseOutputInsideFolder("--out", dir / "data-run", dir / "data", "the dataset"));
+  // A relative --out that does not exist yet, from inside the dataset (`--data . --out run`).
+  const fs::path here = fs::current_path();
+  fs::current_path(dir / "data");
+  EXPECT_THROW(RefuseOutputInsideFolder("--out", "run", ".", "the dataset"), std::invalid_argument);
+  fs::current_path(here);
   EXPECT_NO_THROW(RefuseOutputInsideFolder("--out", dir / "run", dir / "data", "the dataset"));
   // Verbs that make a missing folder themselves refuse only a folder.
   EXPECT_THROW(RefuseFolderAsOutput("--out", dir / "sub"), std::invalid_argument);

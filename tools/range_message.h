@@ -18,20 +18,22 @@ inline std::string TrimmedNumber(std::string s) {
   return s;
 }
 
-// Inputs: message  a CLI11 error message.
-// Returns it with "Value V not in range MIN to MAX" said readably: "Value V must be > MIN" or
-// ">= MIN" when MAX is the largest double (no upper bound; "> MIN" when V is MIN itself, which
-// only a positive-number check refuses), else "Value V not in range MIN to MAX" with the bounds
-// trimmed. Other messages are returned as they are.
-inline std::string ReadableRangeMessage(const std::string& message) {
+// Inputs: message  a CLI11 error message; positive  whether the option's check is CLI11's
+//         PositiveNumber (its bound, the smallest double, prints as 0.000000 like NonNegativeNumber's).
+// Returns it with "Value V not in range MIN to MAX" said readably: "Value V must be > 0" for a
+// positive option, "Value V must be >= MIN" for another with no upper bound (MAX the largest
+// double), else "Value V not in range MIN to MAX" with the bounds trimmed. Other messages are
+// returned as they are.
+inline std::string ReadableRangeMessage(const std::string& message, bool positive) {
   static const std::regex kRange(R"(Value (\S+) not in range (\S+) to (\S+))");
   std::smatch m;
   if (!std::regex_search(message, m, kRange)) return message;
   const std::string value = m[1], low = TrimmedNumber(m[2]), high = m[3];
   std::string said;
-  if (std::strtod(high.c_str(), nullptr) >= 1e300) {
-    const bool at_bound = std::strtod(value.c_str(), nullptr) == std::strtod(low.c_str(), nullptr);
-    said = "Value " + value + " must be " + (at_bound ? "> " : ">= ") + low;
+  if (positive) {
+    said = "Value " + value + " must be > 0";
+  } else if (std::strtod(high.c_str(), nullptr) >= 1e300) {
+    said = "Value " + value + " must be >= " + low;
   } else {
     said = "Value " + value + " not in range " + low + " to " + TrimmedNumber(high);
   }

@@ -37,7 +37,13 @@ RemoveOnInterrupt::RemoveOnInterrupt(const std::string& path) {
     std::memset(&action, 0, sizeof action);
     action.sa_handler = OnInterrupt;
     sigemptyset(&action.sa_mask);
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(sig, &action, nullptr);
+    // A signal the process ignores stays ignored: `nohup` (SIGHUP) and a shell's background jobs
+    // (SIGINT) must not start dying of it.
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+      struct sigaction old;
+      if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+      ::sigaction(sig, &action, nullptr);
+    }
     g_installed = true;
   }
   if (path.size() >= kPathMax) {

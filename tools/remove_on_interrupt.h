@@ -10,6 +10,7 @@
 namespace clothwind::tools {
 
 // Registers `path` while alive. At most 8 at once (more are not removed, and say so on stderr).
+// A signal the process ignores (nohup's SIGHUP, a background job's SIGINT) stays ignored.
 class RemoveOnInterrupt {
  public:
   // Inputs: path  the temporary file (it need not exist yet); the first registration installs

@@ -58,6 +58,24 @@ TEST_F(RemoveOnInterruptTest, AnInterruptRemovesTheRegisteredTemporaryAndEndsThe
   }
 }
 
+TEST_F(RemoveOnInterruptTest, AnIgnoredSignalStaysIgnored) {
+  // As under nohup: SIGHUP ignored before the registration; raised, the child lives on.
+  const fs::path tmp = dir_ / "session.bag.tmp-nohup";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::signal(SIGHUP, SIG_IGN);
+    RemoveOnInterrupt remove(tmp.string());
+    std::ofstream(tmp) << "half a bag";
+    ::raise(SIGHUP);
+    ::_exit(7);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 7);
+  EXPECT_TRUE(fs::exists(tmp));
+}
+
 TEST_F(RemoveOnInterruptTest, WithoutAnInterruptTheFileStays) {
   const fs::path tmp = dir_ / "session.bag.tmp-1";
   {

@@ -39,24 +39,28 @@ inline std::string JsonErrorText(const std::exception& e) {
   return text;
 }
 
-// The text of a file. Throws std::runtime_error "<path>: <why>" for a folder or other file that is
-// not a regular one, one that cannot be opened or read, and, unless `allow_empty`, an empty one.
+// The text of a file. Throws std::runtime_error "<path>: <why>" for a folder, a file that cannot be
+// opened or read, and, unless `allow_empty`, an empty one (or one of whitespace only). A pipe is
+// read (`simulate <(...)`, /dev/stdin).
 // Inputs: path; what  the file's role, appended to errors in brackets when not empty ("the model's
 // architecture").
 inline std::string ReadTextFile(const std::string& path, const std::string& what = "", bool allow_empty = false) {
   namespace fs = std::filesystem;
   const std::string role = what.empty() ? "" : " (" + what + ")";
   std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (fs::exists(st) && !fs::is_regular_file(st))
-    throw std::runtime_error(path + ": " + (fs::is_directory(st) ? "a folder" : "not a regular file") +
-                             ", expected a JSON file" + role);
+  if (fs::is_directory(path, ec)) throw std::runtime_error(path + ": a folder, expected a JSON file" + role);
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot open (" + std::strerror(errno) + ")" + role);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in) throw std::runtime_error(path + ": cannot open: " + std::strerror(errno) + role);
+  std::string text;
+  try {
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  } catch (const std::exception& e) {  // libstdc++'s filebuf throws on a read error (EIO)
+    throw std::runtime_error(path + ": cannot read: " + e.what() + role);
+  }
   if (in.bad()) throw std::runtime_error(path + ": cannot read" + role);
   if (!allow_empty && text.find_first_not_of(" \t\r\n") == std::string::npos)
-    throw std::runtime_error(path + ": the file is empty, expected JSON" + role);
+    throw std::runtime_error(path + ": the file is empty" + std::string(text.empty() ? "" : " but for whitespace") +
+                             ", expected JSON" + role);
   return text;
 }
 

@@ -44,11 +44,13 @@ TEST_F(JsonFileTest, ReadsAValidFile) {
 
 TEST_F(JsonFileTest, NamesTheFileAndWhatIsWrongWithoutLibraryText) {
   const std::string missing = (dir_ / "missing.json").string();
-  EXPECT_EQ(Error(missing), missing + ": cannot open (No such file or directory)");
+  EXPECT_EQ(Error(missing), missing + ": cannot open: No such file or directory");
   EXPECT_EQ(Error(dir_.string()), dir_.string() + ": a folder, expected a JSON file");
-  const std::string empty = Write("empty.json", "\n");
+  const std::string empty = Write("empty.json", "");
   EXPECT_EQ(Error(empty), empty + ": the file is empty, expected JSON");
-  EXPECT_EQ(Error(empty, "the model's architecture"), empty + ": the file is empty, expected JSON (the model's architecture)");
+  const std::string blank = Write("blank.json", "\n  \n");
+  EXPECT_EQ(Error(blank, "the model's architecture"),
+            blank + ": the file is empty but for whitespace, expected JSON (the model's architecture)");
   const std::string cut = Write("cut.json", "{\"speed\": ");
   EXPECT_EQ(Error(cut), cut + ": not valid JSON: line 1, column 11: unexpected end of input; expected '[', '{', or a literal");
   const std::string nan = Write("nan.json", "{\n  \"speed\": NaN\n}\n");
@@ -56,6 +58,17 @@ TEST_F(JsonFileTest, NamesTheFileAndWhatIsWrongWithoutLibraryText) {
   EXPECT_EQ(e.rfind(nan + ": not valid JSON: line 2, column 12: invalid literal", 0), 0u) << e;
   for (const std::string& message : {Error(missing), Error(empty), Error(cut), e})
     EXPECT_EQ(message.find("json.exception"), std::string::npos) << message;
+}
+
+TEST_F(JsonFileTest, ReadsAPipe) {
+  // `clothwind simulate <(...)`: a pipe is no regular file, and is read.
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const std::string text = "{\"a\": 1}";
+  ASSERT_EQ(::write(fds[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  ::close(fds[1]);
+  EXPECT_EQ(ReadJsonFile("/proc/self/fd/" + std::to_string(fds[0]))["a"], 1);
+  ::close(fds[0]);
 }
 
 TEST(JsonErrorText, DropsTheLibrarysTagAndGenericWords) {

@@ -131,7 +131,7 @@ ParseResult ParseGillWindSonic(const std::string& record) {
     // as polar gave a wind from 1.59 deg at 1 m/s.
     const bool whole = f[1].find_first_not_of("0123456789") == std::string::npos;
     if (std::isfinite(a) && (!whole || a > 360.0))
-      return Fail(ParseStatus::kMalformed, "field 2 (direction): expected whole degrees 0..359, got '" + f[1] + "'");
+      return Fail(ParseStatus::kMalformed, "field 2 (direction): expected whole degrees 0..360, got '" + f[1] + "'");
     if (!std::isfinite(b)) {
       if (status_ok) return Fail(ParseStatus::kMalformed, "field 3 (speed) empty with status " + status);
     } else {

@@ -104,7 +104,7 @@ TEST(GillWindSonic, AWindObserverTunnelRecordIsNotReadAsPolar) {
   // WindObserver II tunnel mode: speed 1.59, polarity 1. Read as polar it was 1 m/s from 1.59 deg.
   const ParseResult r = ParseGillWindSonic(FrameGillRecord("A,001.59,1,M,00,"));
   EXPECT_EQ(r.status, ParseStatus::kMalformed);
-  EXPECT_NE(r.error.find("field 2 (direction): expected whole degrees 0..359, got '001.59'"), std::string::npos)
+  EXPECT_NE(r.error.find("field 2 (direction): expected whole degrees 0..360, got '001.59'"), std::string::npos)
       << r.error;
 }
 

@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
+#include <regex>
 #include <stdexcept>
 #include <system_error>
 
@@ -35,6 +37,13 @@ bool EndsWith(const std::string& s, const std::string& end) {
   return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
 }
 
+// Whether `rest`, a file name after "<name>_", is rosbag record's "YYYY-MM-DD-HH-MM-SS[_N].bag" or
+// ".bag.active": another recorder's "<name>_cam2_<date>.bag" is not this one's.
+bool IsBagDateName(const std::string& rest) {
+  static const std::regex kDate(R"(\d{4}-\d{2}-\d{2}-\d{2}-\d{2}-\d{2}(_\d+)?\.bag(\.active)?)");
+  return std::regex_match(rest, kDate);
+}
+
 std::string Megabytes(double bytes) {
   char text[32];
   std::snprintf(text, sizeof text, "%.1f MB", bytes / 1e6);
@@ -57,12 +66,15 @@ std::string Duration(double seconds) {
 SessionBagWatch::SessionBagWatch(Options options,
                                  std::function<bool(const std::string&, DiskSpace*, std::string*)> disk_space)
     : options_(std::move(options)), disk_space_(std::move(disk_space)) {
+  if (options_.prefix.empty())
+    throw std::invalid_argument("the bag prefix must be rosbag record's -o (<folder>/<name>), got nothing");
   const fs::path prefix(options_.prefix);
-  if (options_.prefix.empty() || prefix.filename().empty())
-    throw std::invalid_argument("the bag prefix must name a file in a folder (rosbag record -o <folder>/<name>), got \"" +
-                                options_.prefix + "\"");
   folder_ = prefix.parent_path().empty() ? "." : prefix.parent_path().string();
-  name_ = prefix.filename().string() + "_";
+  // As rosbag: a ".bag" ending is dropped before "_<date>" is added, and "<folder>/" names
+  // "<folder>/_<date>.bag".
+  std::string name = prefix.filename().string();
+  if (EndsWith(name, ".bag")) name.resize(name.size() - 4);
+  name_ = name + "_";
   if (!(options_.stall_after > 0) || !std::isfinite(options_.stall_after))
     throw std::invalid_argument("stall_after must be a finite number of seconds > 0");
   if (!(options_.start_grace >= 0) || !std::isfinite(options_.start_grace))
@@ -84,7 +96,7 @@ SessionBagReport SessionBagWatch::Poll(double now) {
   std::set<std::string> closed;
   for (fs::directory_iterator it(folder_, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string file = it->path().filename().string();
-    if (file.compare(0, name_.size(), name_) != 0) continue;
+    if (file.compare(0, name_.size(), name_) != 0 || !IsBagDateName(file.substr(name_.size()))) continue;
     std::error_code file_ec;
     if (EndsWith(file, kActive)) {
       const uint64_t size = it->file_size(file_ec);
@@ -104,28 +116,35 @@ SessionBagReport SessionBagWatch::Poll(double now) {
     // with this watch may have opened its bag a moment before the first poll.
     started_ = true;
     start_ = now;
-    const fs::file_time_type old = fs::file_time_type::clock::now() -
-                                   std::chrono::duration_cast<fs::file_time_type::duration>(
-                                       std::chrono::duration<double>(options_.start_grace));
+    // Either way: a bag dated ahead (the clock stepped back since) is no more this session's.
+    const fs::file_time_type wall = fs::file_time_type::clock::now();
+    const auto grace = std::chrono::duration_cast<fs::file_time_type::duration>(
+        std::chrono::duration<double>(options_.start_grace));
+    const auto old = [&](fs::file_time_type t) { return t < wall - grace || t > wall + grace; };
     for (const auto& a : active)
-      if (a.second.second < old) before_.insert(a.first);
+      if (old(a.second.second)) before_.insert(a.first);
     for (const std::string& path : closed) {
       std::error_code time_ec;
       const fs::file_time_type written = fs::last_write_time(path, time_ec);
-      if (time_ec || written < old) before_.insert(path);
+      if (time_ec || old(written)) before_.insert(path);
     }
   }
 
-  // The bag being written is the one modified last: a bag a recorder left open before this
-  // session, or one it stopped writing, is older than a live recorder's.
+  // The bag being written: of this session's, the one that grew last on the monotonic clock (the
+  // last modified first, for bags not yet seen to grow). A bag from before the session is never
+  // it: a leftover, or one dated ahead by a clock stepped back, passed for the live one.
   std::string current;
+  double grew = -std::numeric_limits<double>::infinity();
   fs::file_time_type newest = fs::file_time_type::min();
   for (const auto& [path, a] : active) {
     const auto seen = sizes_.find(path);
     if (seen == sizes_.end() || seen->second.first != a.first) sizes_[path] = {a.first, now};  // new or grown
-    if (!before_.count(path)) begun_.insert(path);
-    if (current.empty() || a.second > newest) {
+    if (before_.count(path)) continue;
+    begun_.insert(path);
+    const double when = sizes_[path].second;
+    if (current.empty() || when > grew || (when == grew && a.second > newest)) {
       current = path;
+      grew = when;
       newest = a.second;
     }
   }

@@ -61,7 +61,8 @@ class SessionBagWatch {
   };
 
   // Inputs:
-  //   options     as above; prefix must name a file in a folder ("/data/session")
+  //   options     as above; prefix as rosbag record's -o takes it: "/data/session" (bags
+  //               /data/session_<date>.bag), "/data/session.bag" (the same) or "/data/" (/data/_<date>.bag)
   //   disk_space  how the free space is read (StatDiskSpace; tests pass their own)
   // Throws std::invalid_argument naming the option that is out of range.
   explicit SessionBagWatch(Options options,
