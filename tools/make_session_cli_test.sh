@@ -15,6 +15,12 @@ status=0
 [ "$status" -eq 1 ] && grep -q -- "--preview same.png is the bag --out names" out.txt && [ ! -e same.png ] ||
   fail "--preview equal to --out was not refused (status $status): $(cat out.txt)"
 
+# A --preview in a folder not there yet is made, as --out's folder is (it was refused).
+"$bin" make-session --minutes 0.05 --width 16 --height 16 --out bags/s.bag --preview previews/p.png >out.txt 2>&1 ||
+  fail "make-session --preview previews/p.png: $(cat out.txt)"
+[ -f bags/s.bag ] && [ -f previews/p.png ] || fail "make-session wrote $(ls -R)"
+rm -rf bags previews
+
 "$bin" make-session --minutes 5 --width 512 --height 512 --out big.bag >out.txt 2>&1 &
 pid=$!
 for _ in $(seq 200); do

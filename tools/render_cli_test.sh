@@ -242,4 +242,10 @@ PY
   fail "the stretched flag did not render: $(cat "$work/out.txt")"
 ! grep -q "mesh_width" "$work/out.txt" || fail "a stretched 3 m flag changed zeta's size: $(cat "$work/out.txt")"
 grep -q '"mesh_width": 3.0' "$work/stretched-seed/zeta.json" || fail "zeta of the stretched flag: $(cat "$work/stretched-seed/zeta.json")"
+# A key zeta does not have (misspelt) is named in a warning; it was ignored without a word.
+sed '0,/{/s//{"camera_hieght": 2.0,/' "$work/zeta-3m.json" >"$work/zeta-typo.json"
+"$bin" render "$work/sim" --out "$work/typo" --zeta "$work/zeta-typo.json" --keep-zeta --count 1 --samples 1 --threads 1 \
+  >"$work/out.txt" 2>&1 || true
+grep -q "key 'camera_hieght' is not a render parameter (ignored)" "$work/out.txt" ||
+  fail "a misspelt zeta key was not named: $(cat "$work/out.txt")"
 echo "render_cli_test: OK"

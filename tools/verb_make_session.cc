@@ -127,9 +127,10 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
     if (preview_extension.empty() || !cv::haveImageWriter(a.preview))
       throw std::invalid_argument("--preview " + a.preview +
                                   ": expected an image file name OpenCV can write (.png, .jpg, .ppm, ...)");
+    // Its folder made as --out's is (it was refused where --out's was made).
     const std::filesystem::path folder = std::filesystem::path(a.preview).parent_path();
-    if (!folder.empty() && !std::filesystem::is_directory(folder))
-      throw std::invalid_argument("--preview " + a.preview + ": folder " + folder.string() + " does not exist");
+    RefuseUnwritableFolder("--preview", a.preview);
+    if (!folder.empty()) std::filesystem::create_directories(folder);
     // The bag replaced the preview written beside it (exit 0, the image lost).
     if (SameFile(a.preview, a.out))
       throw std::invalid_argument("--preview " + a.preview + " is the bag --out names; give the image another name");

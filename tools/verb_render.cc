@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <memory>
 #include <string>
 
@@ -52,11 +53,19 @@ struct RenderArgs {
 render::RenderParams LoadZeta(const std::string& path) {
   nlohmann::json j = ReadJsonFile(path, "--zeta");
   if (j.contains("zeta")) j = j["zeta"];  // a dataset example's label.json
+  render::RenderParams p;
   try {
-    return render::RenderParamsFromJson(j);
+    p = render::RenderParamsFromJson(j);
   } catch (const std::exception& e) {
     throw std::runtime_error("--zeta " + path + ": " + e.what());
   }
+  // A key zeta does not have (a misspelt "camera_hieght") was ignored without a word.
+  const nlohmann::json known = render::ToJson(p);
+  if (j.is_object())
+    for (const auto& [key, value] : j.items())
+      if (!known.contains(key))
+        std::cerr << "warning: --zeta " << path << ": key '" << key << "' is not a render parameter (ignored)\n";
+  return p;
 }
 
 // The animation of a trajectory file, its errors naming the file (an animation's own checks,

@@ -134,6 +134,12 @@ Dataset ReadDataset(const fs::path& dir) {
     }
     const fs::path label_path = clip.dir / "label.json";
     const nlohmann::json label = ReadJson(label_path);
+    // The label is the clip's own: a folder copied under another name (or a label copied into
+    // it) read another clip's wind without a word. Checked where the label names itself.
+    if (label.is_object() && label.contains("name") && label["name"] != clip.name)
+      throw std::runtime_error(label_path.string() + ": field \"name\" is " + label["name"].dump() +
+                               ", expected the clip's \"" + clip.name + "\" (index.json's clips[" + std::to_string(i) +
+                               "]): a label of another clip");
     // Read before an unlabelled clip is left out, so that it is counted in its own split: counted
     // in none, eval --split test reported the train split's unlabelled clips as left out of it.
     clip.split = ReadClipSplit(entry, label, i, index_path, label_path, split_by_clip);

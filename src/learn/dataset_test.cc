@@ -188,6 +188,14 @@ TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
     std::ofstream(d / "toy-00000" / "label.json") << "{ not json";
     expect_error(d, (d / "toy-00000" / "label.json").string(), "not valid JSON");
   }
+  {
+    // Another clip's label copied in: its wind was read for this clip without a word.
+    const fs::path d = Copy("other_label");
+    fs::copy_file(d / "toy-00001" / "label.json", d / "toy-00000" / "label.json",
+                  fs::copy_options::overwrite_existing);
+    expect_error(d, (d / "toy-00000" / "label.json").string(),
+                 "field \"name\" is \"toy-00001\", expected the clip's \"toy-00000\"");
+  }
   // Integers that get<int> would truncate or wrap, winds no anemometer reads, a clip listed
   // twice, a split of the wrong type, a folder where the label should be, and an image whose
   // header claims more pixels than OpenCV allows (imread throws: it ended the replay camera).
