@@ -668,7 +668,7 @@ void SayIncomplete(const char* who, const std::vector<std::string>& incomplete) 
   if (incomplete.empty()) return;
   std::string names;
   for (size_t k = 0; k < incomplete.size() && k < 5; ++k) names += (k ? ", " : "") + incomplete[k];
-  std::fprintf(stderr, "%s: %zu example%s left out of the index, %s frames not all there: %s%s (a run of %s "
+  std::fprintf(stderr, "%s: %zu example%s left out of the index, %s frames or label.json not all there: %s%s (a run of %s "
                "shard makes %s again)\n",
                who, incomplete.size(), incomplete.size() == 1 ? "" : "s", incomplete.size() == 1 ? "its" : "their",
                names.c_str(), incomplete.size() > 5 ? ", ..." : "", incomplete.size() == 1 ? "its" : "their",

@@ -694,6 +694,16 @@ TEST_F(DatasetGeneratorTest, ReindexRefusesAShardOfOtherSettingsAndClaimsOnlyTra
   EXPECT_EQ(ReindexDataset(dir.string(), true), 2);
   for (const auto& clip : ReadIndex(dir.string())["clips"]) EXPECT_NE(clip["name"], "flag-000001-v0");
   fs::rename(root_ / "001.jpg", frame);
+  // An example whose label.json is gone (frames without it) is left out and named.
+  const fs::path label = dir / "flag-000001-v0" / "label.json";
+  fs::rename(label, root_ / "label.json");
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(ReindexDataset(dir.string(), false), 2);
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_NE(said.find("1 example left out of the index, its frames or label.json not all there: flag-000001-v0"),
+            std::string::npos)
+      << said;
+  fs::rename(root_ / "label.json", label);
   nlohmann::json index = ReadIndex(dir.string());
   index["dataset"]["tracks"] = {4, 3};
   // A header's largest edge 0 is the scene's own: any edge a label records agrees with it.

@@ -226,7 +226,10 @@ nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
     if (name.empty() || name[0] == '.' || !entry.is_directory()) continue;
-    if (fs::exists(entry.path() / "label.json")) names.push_back(name);
+    if (fs::exists(entry.path() / "label.json"))
+      names.push_back(name);
+    else if (incomplete && !fs::is_empty(entry.path()))
+      incomplete->push_back(name);  // frames without their label (it is written last): named, not silently dropped
   }
   std::sort(names.begin(), names.end());
   // (0, n) first, once the folder is listed: a progress bar paces the labels from there.

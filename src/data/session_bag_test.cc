@@ -183,7 +183,8 @@ TEST(SessionBagTest, APreviewOrZetaSeedItCannotUseIsRefusedBeforeTheWork) {
   fs::create_directories(dir);
   const std::string bag = (dir / "bad.bag").string(), log = (dir / "log").string();
   for (const std::string& args : {"--preview " + (dir / "first.notanimage").string(),
-                                 "--preview " + (dir / "no_such_folder" / "first.png").string(),
+                                 // (a missing folder is made, as --out's; one that takes no file is refused)
+                                 std::string("--preview /proc/first.png"),
                                  std::string("--frames rendered --zeta-seed -5")}) {
     const std::string cmd = std::string(CLOTHWIND_BIN) + " make-session --minutes 0.05 --out " + bag + " " + args +
                             " > " + log + " 2>&1";
