@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # CLI test of `clothwind train-fly-judge --measure`, which trains nothing: each training option
-# beside it (accepted and ignored) is refused naming both, before the dataset is read.
+# beside it (accepted and ignored) is refused naming both, before the dataset is read; and a
+# dataset of anything but FlagSim flags is refused.
 # Usage: train_fly_judge_cli_test.sh CLOTHWIND_BINARY
 set -euo pipefail
 bin="$1"
@@ -17,4 +18,10 @@ for option in "--hidden 8" "--epochs 2" "--batch 4" "--lr 0.01" "--weight-decay 
   grep -q -- "--measure excludes ${option%% *}" "$work/msg.txt" ||
     fail "--measure with $option: the message does not name both: $(cat "$work/msg.txt")"
 done
+# A dataset of anything but FlagSim flags (toy stripes here) trained a judge that scored 0 %, exit 0.
+"$bin" make-toy-dataset --out "$work/toy" --clips 4 --frames 30 --size 32 >/dev/null 2>&1
+status=0
+"$bin" train-fly-judge --data "$work/toy" --out "$work/judge/j.pt" >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "is a \"toy\" dataset; the fly judge is trained" "$work/msg.txt" &&
+  [ ! -e "$work/judge/j.pt" ] || fail "train-fly-judge on a toy dataset (status $status): $(cat "$work/msg.txt")"
 echo "train_fly_judge_cli_test: OK"
