@@ -560,6 +560,15 @@ TrainResult Train(const TrainOptions& o) {
     } catch (const nlohmann::json::exception& e) {
       throw std::runtime_error(state_path.string() + ": " + JsonErrorText(e));
     }
+    // The run resumes after its log's last epoch: an "epoch" that says otherwise (an edited or
+    // mixed-up state.json) resumed without a word.
+    const int64_t said = state.at("epoch").get<int64_t>();
+    bool numbered = said == static_cast<int64_t>(result.log.size());
+    for (size_t i = 0; i < result.log.size(); ++i) numbered = numbered && result.log[i].epoch == static_cast<int>(i) + 1;
+    if (!numbered)
+      throw std::runtime_error(state_path.string() + ": field \"epoch\" is " + std::to_string(said) + ", but its log holds " +
+                               std::to_string(result.log.size()) + " epochs numbered from 1 (a state.json edited or " +
+                               "mixed up; nothing to resume from)");
     // A resumed run must keep the schedule it ran under: a cosine run resumed with other --epochs
     // (or any run with another --lr, --lr-schedule or --lr-decay-epoch) would silently become a
     // different run from the one its log describes.

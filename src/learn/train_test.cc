@@ -1999,6 +1999,18 @@ TEST_F(TrainTest, AnEpochWhoseValidationIsNotFiniteResumesAndABadEpochFieldIsNam
     ExpectTrainRefused(resumed, std::string("log[0].") + field + " = " + value.dump() + " resumed",
                        {state.string() + ": log[0]." + field + ": expected "});
   }
+  // An "epoch" other than its log's length, or a log not numbered from 1, is refused (an edited
+  // state.json resumed after its log's last epoch, whatever it said).
+  for (const auto& [where, value] : {std::pair<std::string, int>{"epoch", 99}, {"epoch", -5}, {"log0", 3}}) {
+    nlohmann::json bad = good;  // one epoch, numbered 1
+    if (where == "epoch")
+      bad["epoch"] = value;
+    else
+      bad["log"][0]["epoch"] = value;
+    std::ofstream(state) << bad.dump(2);
+    ExpectTrainRefused(resumed, where + " = " + std::to_string(value) + " resumed",
+                       {state.string() + ": field \"epoch\" is ", "numbered from 1"});
+  }
 }
 
 TEST_F(TrainTest, InitOnlyWithResumeIsRefusedAndTheModelKept) {
