@@ -6,6 +6,7 @@
 // not growing longer is an ERROR), ~min_free_bytes (2e9: less free is a WARN), ~min_time_to_full
 // (600 s: a disk full sooner at the write rate is a WARN). Published every wall second
 // (~diagnostic_period); a parameter of the wrong type or out of range ends the node with a FATAL.
+#include <cmath>
 #include <string>
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -41,6 +42,9 @@ class SessionBagWatchNode {
     if (!(min_free >= 0 && min_free < 1e19)) throw std::invalid_argument("~min_free_bytes must be >= 0");
     o.min_available = static_cast<uint64_t>(min_free);
     o.min_seconds_to_full = params.Get("min_time_to_full", o.min_seconds_to_full);
+    // inf warned whenever a bag grew; 0 turns the warning off.
+    if (!(o.min_seconds_to_full >= 0 && std::isfinite(o.min_seconds_to_full)))
+      throw std::invalid_argument("~min_time_to_full must be a finite number of seconds >= 0 (0: no warning)");
     return o;
   }
 

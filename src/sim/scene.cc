@@ -436,8 +436,13 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
     std::string shown = text.substr(start, end == std::string::npos ? std::string::npos : end - start);
     shown.erase(0, shown.find_first_not_of(" \t"));
     // The hint only where it applies: an empty or truncated file was told of NaN too.
-    std::string lower = shown;
-    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+    // Outside strings: a name like "banana" or "info" is no number.
+    std::string lower;
+    bool in_string = false;
+    for (size_t k = 0; k < shown.size(); ++k) {
+      if (shown[k] == '"' && (k == 0 || shown[k - 1] != '\\')) in_string = !in_string;
+      if (!in_string && shown[k] != '"') lower += static_cast<char>(std::tolower(static_cast<unsigned char>(shown[k])));
+    }
     const bool non_finite = lower.find("nan") != std::string::npos || lower.find("inf") != std::string::npos;
     throw std::runtime_error(abs_path + ":" + std::to_string(line) + ": not valid JSON near `" + shown + "`" +
                              (non_finite ? " (numbers must be finite: NaN/Infinity are not JSON)" : "") + ": " +

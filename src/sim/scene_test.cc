@@ -453,7 +453,15 @@ TEST_F(SceneFiles, NaNIsRejectedNamingFileLineAndKey) {
   std::string text = SceneText();
   text.replace(text.find("0.04"), 4, "NaN");
   const std::string path = Write("conf/nan.json", text);
-  ExpectErrorNaming([&] { LoadScene(path); }, {path + ":2", "frame_time", "NaN"});
+  ExpectErrorNaming([&] { LoadScene(path); }, {path + ":2", "frame_time", "NaN", "numbers must be finite"});
+  // The hint only for a number: a syntax error on a line whose string holds "inf" gets none.
+  const std::string comma = Write("conf/comma.json", "{\"info\": \"banana\" \"x\": 1}");
+  try {
+    LoadScene(comma);
+    ADD_FAILURE() << "a missing comma was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()).find("numbers must be finite"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(SceneFiles, MissingFilesNameTheKeyAndWhereItLooked) {
