@@ -22,7 +22,7 @@ class SessionBagWatchNode {
  public:
   // Throws ParamError or std::invalid_argument for a parameter it cannot take (main ends on it).
   SessionBagWatchNode(ros::NodeHandle& nh, clothwind::ros_bridge::StrictParams& params)
-      : watch_(Options(params)) {
+      : watch_(Watch(params)) {
     updater_.setHardwareID("bag:" + params.Get("bag_prefix", ""));
     updater_.add("session bag", this, &SessionBagWatchNode::Diagnose);
     timer_ = nh.createSteadyTimer(ros::WallDuration(clothwind::ros_bridge::DiagnosticPeriod(updater_)),
@@ -31,6 +31,16 @@ class SessionBagWatchNode {
   }
 
  private:
+  // The watch, its options' errors named as parameters.
+  static clothwind::sensors::SessionBagWatch Watch(clothwind::ros_bridge::StrictParams& params) {
+    try {
+      return clothwind::sensors::SessionBagWatch(Options(params));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("a parameter: ") + e.what() +
+                                  " (~stall_after, ~min_free_bytes, ~min_time_to_full)");
+    }
+  }
+
   static clothwind::sensors::SessionBagWatch::Options Options(clothwind::ros_bridge::StrictParams& params) {
     clothwind::sensors::SessionBagWatch::Options o;
     o.prefix = params.Get("bag_prefix", "");
@@ -41,10 +51,7 @@ class SessionBagWatchNode {
     const double min_free = params.Get("min_free_bytes", static_cast<double>(o.min_available));
     if (!(min_free >= 0 && min_free < 1e19)) throw std::invalid_argument("~min_free_bytes must be >= 0");
     o.min_available = static_cast<uint64_t>(min_free);
-    o.min_seconds_to_full = params.Get("min_time_to_full", o.min_seconds_to_full);
-    // inf warned whenever a bag grew; 0 turns the warning off.
-    if (!(o.min_seconds_to_full >= 0 && std::isfinite(o.min_seconds_to_full)))
-      throw std::invalid_argument("~min_time_to_full must be a finite number of seconds >= 0 (0: no warning)");
+    o.min_seconds_to_full = params.Get("min_time_to_full", o.min_seconds_to_full);  // checked by the watch
     return o;
   }
 

@@ -246,6 +246,13 @@ grep -q '"mesh_width": 3.0' "$work/stretched-seed/zeta.json" || fail "zeta of th
 sed '0,/{/s//{"camera_hieght": 2.0,/' "$work/zeta-3m.json" >"$work/zeta-typo.json"
 "$bin" render "$work/sim" --out "$work/typo" --zeta "$work/zeta-typo.json" --keep-zeta --count 1 --samples 1 --threads 1 \
   >"$work/out.txt" 2>&1 || true
-grep -q "key 'camera_hieght' is not a render parameter (ignored)" "$work/out.txt" ||
+grep -q "key 'camera_hieght' is not a render parameter (did you mean camera_height?) (ignored)" "$work/out.txt" ||
   fail "a misspelt zeta key was not named: $(cat "$work/out.txt")"
+# Misspelt alone, the key is missing: the refusal names the misspelling too.
+sed 's/"camera_height"/"camera_hieght"/' "$work/zeta-3m.json" >"$work/zeta-typo2.json"
+status=0
+"$bin" render "$work/sim" --out "$work/typo2" --zeta "$work/zeta-typo2.json" --keep-zeta --count 1 --samples 1 --threads 1 \
+  >"$work/out.txt" 2>&1 || status=$?
+[ "$status" -ne 0 ] && grep -q "missing field 'camera_height'; key 'camera_hieght' is not a render parameter (did you mean camera_height?)" "$work/out.txt" ||
+  fail "a misspelt zeta key alone (status $status): $(cat "$work/out.txt")"
 echo "render_cli_test: OK"

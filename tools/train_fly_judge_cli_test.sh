@@ -18,10 +18,15 @@ for option in "--hidden 8" "--epochs 2" "--batch 4" "--lr 0.01" "--weight-decay 
   grep -q -- "--measure excludes ${option%% *}" "$work/msg.txt" ||
     fail "--measure with $option: the message does not name both: $(cat "$work/msg.txt")"
 done
-# A dataset of anything but FlagSim flags (toy stripes here) trained a judge that scored 0 %, exit 0.
+# A dataset with no flag (toy stripes here; a hanging cloth too) trained a judge that scored 0 %, exit 0,
+# and is refused for --measure as well.
 "$bin" make-toy-dataset --out "$work/toy" --clips 4 --frames 30 --size 32 >/dev/null 2>&1
 status=0
 "$bin" train-fly-judge --data "$work/toy" --out "$work/judge/j.pt" >"$work/msg.txt" 2>&1 || status=$?
-[ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "is a \"toy\" dataset; the fly judge is trained" "$work/msg.txt" &&
+[ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "is a \"toy\" dataset, with no flag; the fly judge is trained" "$work/msg.txt" &&
   [ ! -e "$work/judge/j.pt" ] || fail "train-fly-judge on a toy dataset (status $status): $(cat "$work/msg.txt")"
+status=0
+"$bin" train-fly-judge --data "$work/toy" --measure "$(dirname "$0")/../models/fly_judge.pt" >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "with no flag" "$work/msg.txt" ||
+  fail "train-fly-judge --measure on a toy dataset (status $status): $(cat "$work/msg.txt")"
 echo "train_fly_judge_cli_test: OK"

@@ -127,10 +127,8 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
     if (preview_extension.empty() || !cv::haveImageWriter(a.preview))
       throw std::invalid_argument("--preview " + a.preview +
                                   ": expected an image file name OpenCV can write (.png, .jpg, .ppm, ...)");
-    // Its folder made as --out's is (it was refused where --out's was made).
-    const std::filesystem::path folder = std::filesystem::path(a.preview).parent_path();
+    // Its folder is made as --out's is, after the checks (it was refused where --out's was made).
     RefuseUnwritableFolder("--preview", a.preview);
-    if (!folder.empty()) std::filesystem::create_directories(folder);
     // The bag replaced the preview written beside it (exit 0, the image lost).
     if (SameFile(a.preview, a.out))
       throw std::invalid_argument("--preview " + a.preview + " is the bag --out names; give the image another name");
@@ -192,6 +190,7 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
   namespace fs = std::filesystem;
   const fs::path out(a.out);
   if (out.has_parent_path()) fs::create_directories(out.parent_path());
+  if (fs::path(a.preview).has_parent_path()) fs::create_directories(fs::path(a.preview).parent_path());
   // A run killed mid-write (Ctrl-C) leaves its temporary bag: clear those of dead processes.
   {
     std::error_code ec;

@@ -3,6 +3,7 @@
 // file), so any simulator's cloth renders the same way. INPUT is our binary trajectory
 // (.cwtraj, or a `clothwind simulate` folder holding trajectory.cwtraj) or a folder of
 // ArcSim-style frame OBJs (0000_00.obj, 0001_00.obj, ...; --obj prefers them).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,10 +11,12 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "common/atomic_file.h"
+#include "closest_name.h"
 #include "common/json_file.h"
 #include "data/cloth_animation.h"
 #include "progress_bar.h"
@@ -53,18 +56,29 @@ struct RenderArgs {
 render::RenderParams LoadZeta(const std::string& path) {
   nlohmann::json j = ReadJsonFile(path, "--zeta");
   if (j.contains("zeta")) j = j["zeta"];  // a dataset example's label.json
+  // Keys zeta does not have (a misspelt "camera_hieght"), with the one each was likely meant to be:
+  // ignored without a word, and beside a missing key the likely cause of its absence.
+  render::RenderParams defaults;
+  defaults.has_look_at = true;  // the one optional key
+  std::vector<std::string> names;
+  const nlohmann::json known = render::ToJson(defaults);  // held: items() of a temporary dangles
+  for (const auto& [key, value] : known.items()) names.push_back(key);
+  std::string unknown;
+  if (j.is_object()) {
+    for (const auto& [key, value] : j.items()) {
+      if (std::find(names.begin(), names.end(), key) != names.end()) continue;
+      const std::string meant = ClosestName(key, names);
+      unknown += (unknown.empty() ? "" : "; ") + ("key '" + key + "' is not a render parameter") +
+                 (meant.empty() ? "" : " (did you mean " + meant + "?)");
+    }
+  }
   render::RenderParams p;
   try {
     p = render::RenderParamsFromJson(j);
   } catch (const std::exception& e) {
-    throw std::runtime_error("--zeta " + path + ": " + e.what());
+    throw std::runtime_error("--zeta " + path + ": " + e.what() + (unknown.empty() ? "" : "; " + unknown));
   }
-  // A key zeta does not have (a misspelt "camera_hieght") was ignored without a word.
-  const nlohmann::json known = render::ToJson(p);
-  if (j.is_object())
-    for (const auto& [key, value] : j.items())
-      if (!known.contains(key))
-        std::cerr << "warning: --zeta " << path << ": key '" << key << "' is not a render parameter (ignored)\n";
+  if (!unknown.empty()) std::cerr << "warning: --zeta " << path << ": " << unknown << " (ignored)\n";
   return p;
 }
 

@@ -107,13 +107,13 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
     }
     at::set_num_threads(a->threads);
     const learn::Dataset dataset = learn::ReadDataset(a->data);
-    // The judge learns which way a flag flies from FlagSim's flags, all flying right (mirrored for
-    // left): a toy dataset's stripes or recorded clips, which fly either way, trained a judge that
-    // scored 0 %, exit 0.
-    if (dataset.kind != "flag")
+    // The judge learns which way a flag flies from flags that all fly right (mirrored for left):
+    // FlagSim's, or recorded ones (make run's rendered session records such). A toy dataset's
+    // stripes or a hanging cloth show no flag: a judge trained on stripes scored 0 %, exit 0.
+    if (dataset.kind == "toy" || dataset.kind == "cloth")
       throw std::invalid_argument("--data " + a->data + " is a \"" + dataset.kind +
-                                  "\" dataset; the fly judge is trained and measured on FlagSim flags (make-dataset "
-                                  "--kind flag), which all fly right");
+                                  "\" dataset, with no flag; the fly judge is trained and measured on flags flying right "
+                                  "(a FlagSim dataset, make-dataset --kind flag, or recorded flags)");
     // Measured: the judge first, so a wrong path fails before the frames are read.
     std::optional<learn::FlyJudge> measured;
     if (!a->measure.empty()) {

@@ -668,7 +668,7 @@ void SayIncomplete(const char* who, const std::vector<std::string>& incomplete) 
   if (incomplete.empty()) return;
   std::string names;
   for (size_t k = 0; k < incomplete.size() && k < 5; ++k) names += (k ? ", " : "") + incomplete[k];
-  std::fprintf(stderr, "%s: %zu example%s left out of the index, %s frames or label.json not all there: %s%s (a run of %s "
+  std::fprintf(stderr, "%s: %zu example%s left out of the index, %s frames not all there: %s%s (a run of %s "
                "shard makes %s again)\n",
                who, incomplete.size(), incomplete.size() == 1 ? "" : "s", incomplete.size() == 1 ? "its" : "their",
                names.c_str(), incomplete.size() > 5 ? ", ..." : "", incomplete.size() == 1 ? "its" : "their",
@@ -740,10 +740,19 @@ int64_t ReindexDataset(const std::string& dir, bool contact_sheet, const std::fu
                              ", expected \"flag\" or \"cloth\" (only simulated datasets are re-indexed)");
   const IndexLock lock(dir);
   RemoveIndexTemporariesOfStoppedRuns(dir);
-  std::vector<std::string> incomplete;
+  std::vector<std::string> incomplete, unlabelled;
   const nlohmann::json count_before = index.value("count", nlohmann::json());
-  index = BuildIndex(dir, index, progress, &incomplete);
+  index = BuildIndex(dir, index, progress, &incomplete, nullptr, &unlabelled);
   SayIncomplete("make-dataset --reindex", incomplete);
+  // Left out without a word before: frames copied in without their label, or a folder that is no
+  // example. (A generating run does not say it: other shards' examples are being written.)
+  if (!unlabelled.empty()) {
+    std::string names;
+    for (size_t k = 0; k < unlabelled.size() && k < 5; ++k) names += (k ? ", " : "") + unlabelled[k];
+    std::fprintf(stderr, "make-dataset --reindex: %zu folder%s without a label.json left out of the index: %s%s (not "
+                 "an example, or one a run is still writing)\n",
+                 unlabelled.size(), unlabelled.size() == 1 ? "" : "s", names.c_str(), unlabelled.size() > 5 ? ", ..." : "");
+  }
   if (index.value("count", nlohmann::json()) != count_before)
     std::fprintf(stderr, "make-dataset --reindex: the header's count raised from %s to %s, the simulations the folder "
                  "holds (a larger run's, stopped before it rewrote the header, or copied in)\n",

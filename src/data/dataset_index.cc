@@ -221,15 +221,16 @@ bool FramesPresent(const fs::path& folder, int64_t frames, const std::string& pa
 
 nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
                           const std::function<void(int, int)>& progress, std::vector<std::string>* incomplete,
-                          std::vector<std::string>* beyond_count) {
+                          std::vector<std::string>* beyond_count, std::vector<std::string>* unlabelled) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
     if (name.empty() || name[0] == '.' || !entry.is_directory()) continue;
+    std::error_code ec;
     if (fs::exists(entry.path() / "label.json"))
       names.push_back(name);
-    else if (incomplete && !fs::is_empty(entry.path()))
-      incomplete->push_back(name);  // frames without their label (it is written last): named, not silently dropped
+    else if (unlabelled && !fs::is_empty(entry.path(), ec) && !ec)
+      unlabelled->push_back(name);  // not an example, or one still being written (its label comes last)
   }
   std::sort(names.begin(), names.end());
   // (0, n) first, once the folder is listed: a progress bar paces the labels from there.

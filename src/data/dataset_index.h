@@ -91,11 +91,14 @@ bool FramesPresent(const std::filesystem::path& folder, int64_t frames, const st
 // seconds).
 // Outputs:
 //   incomplete  (optional) the names of the examples left out for missing frames
+//   unlabelled  (optional) the names of the non-empty folders without a label.json: not examples,
+//               or examples still being written (a label is written last)
 // Throws std::runtime_error naming a label.json that cannot be read.
 nlohmann::json BuildIndex(const std::string& dir, nlohmann::json header,
                           const std::function<void(int, int)>& progress = {},
                           std::vector<std::string>* incomplete = nullptr,
-                          std::vector<std::string>* beyond_count = nullptr);
+                          std::vector<std::string>* beyond_count = nullptr,
+                          std::vector<std::string>* unlabelled = nullptr);
 
 // Writes index.json atomically (temporary file + rename).
 void WriteIndex(const std::string& dir, const nlohmann::json& index);

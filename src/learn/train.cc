@@ -562,7 +562,9 @@ TrainResult Train(const TrainOptions& o) {
     }
     // The run resumes after its log's last epoch: an "epoch" that says otherwise (an edited or
     // mixed-up state.json) resumed without a word.
-    const int64_t said = state.at("epoch").get<int64_t>();
+    if (!state.contains("epoch"))
+      throw std::runtime_error(state_path.string() + ": field \"epoch\" is missing (nothing to resume from)");
+    const int64_t said = state["epoch"].get<int64_t>();
     bool numbered = said == static_cast<int64_t>(result.log.size());
     for (size_t i = 0; i < result.log.size(); ++i) numbered = numbered && result.log[i].epoch == static_cast<int>(i) + 1;
     if (!numbered)

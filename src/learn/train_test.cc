@@ -2011,6 +2011,10 @@ TEST_F(TrainTest, AnEpochWhoseValidationIsNotFiniteResumesAndABadEpochFieldIsNam
     ExpectTrainRefused(resumed, where + " = " + std::to_string(value) + " resumed",
                        {state.string() + ": field \"epoch\" is ", "numbered from 1"});
   }
+  nlohmann::json no_epoch = good;
+  no_epoch.erase("epoch");
+  std::ofstream(state) << no_epoch.dump(2);
+  ExpectTrainRefused(resumed, "no epoch resumed", {state.string() + ": field \"epoch\" is missing"});
 }
 
 TEST_F(TrainTest, InitOnlyWithResumeIsRefusedAndTheModelKept) {

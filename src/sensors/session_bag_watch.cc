@@ -81,8 +81,8 @@ SessionBagWatch::SessionBagWatch(Options options,
     throw std::invalid_argument("start_grace must be a finite number of seconds >= 0");
   if (!(options_.rate_window > 0) || !std::isfinite(options_.rate_window))
     throw std::invalid_argument("rate_window must be a finite number of seconds > 0");
-  if (!(options_.min_seconds_to_full >= 0))
-    throw std::invalid_argument("min_seconds_to_full must be a number of seconds >= 0");
+  if (!(options_.min_seconds_to_full >= 0) || !std::isfinite(options_.min_seconds_to_full))
+    throw std::invalid_argument("min_seconds_to_full must be a finite number of seconds >= 0 (0: no warning)");
 }
 
 SessionBagReport SessionBagWatch::Poll(double now) {

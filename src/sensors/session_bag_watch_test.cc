@@ -8,6 +8,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -197,6 +198,9 @@ TEST_F(SessionBagWatchTest, AFolderThatCannotBeReadIsAnErrorAndBadOptionsAreRefu
   EXPECT_THROW(SessionBagWatch{o}, std::invalid_argument);
   o.prefix = "/data/session";
   o.stall_after = 0;
+  EXPECT_THROW(SessionBagWatch{o}, std::invalid_argument);
+  o.stall_after = 10;
+  o.min_seconds_to_full = std::numeric_limits<double>::infinity();  // it warned whenever a bag grew
   EXPECT_THROW(SessionBagWatch{o}, std::invalid_argument);
 }
 

@@ -436,12 +436,22 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
     std::string shown = text.substr(start, end == std::string::npos ? std::string::npos : end - start);
     shown.erase(0, shown.find_first_not_of(" \t"));
     // The hint only where it applies: an empty or truncated file was told of NaN too.
-    // Outside strings: a name like "banana" or "info" is no number.
+    // Outside strings and // comments: a name like "info" is no number.
     std::string lower;
     bool in_string = false;
     for (size_t k = 0; k < shown.size(); ++k) {
-      if (shown[k] == '"' && (k == 0 || shown[k - 1] != '\\')) in_string = !in_string;
-      if (!in_string && shown[k] != '"') lower += static_cast<char>(std::tolower(static_cast<unsigned char>(shown[k])));
+      const char c = shown[k];
+      if (in_string) {
+        if (c == '\\') ++k;  // an escaped character, \" or \\ included
+        else if (c == '"') in_string = false;
+        continue;
+      }
+      if (c == '"') {
+        in_string = true;
+        continue;
+      }
+      if (c == '/' && k + 1 < shown.size() && shown[k + 1] == '/') break;
+      lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     }
     const bool non_finite = lower.find("nan") != std::string::npos || lower.find("inf") != std::string::npos;
     throw std::runtime_error(abs_path + ":" + std::to_string(line) + ": not valid JSON near `" + shown + "`" +

@@ -455,13 +455,16 @@ TEST_F(SceneFiles, NaNIsRejectedNamingFileLineAndKey) {
   const std::string path = Write("conf/nan.json", text);
   ExpectErrorNaming([&] { LoadScene(path); }, {path + ":2", "frame_time", "NaN", "numbers must be finite"});
   // The hint only for a number: a syntax error on a line whose string holds "inf" gets none.
-  const std::string comma = Write("conf/comma.json", "{\"info\": \"banana\" \"x\": 1}");
+  const std::string comma = Write("conf/comma.json", "{\"info\": \"banana\" \"x\": 1 // infinite patience\n}");
   try {
     LoadScene(comma);
     ADD_FAILURE() << "a missing comma was accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()).find("numbers must be finite"), std::string::npos) << e.what();
   }
+  // A string ending in an escaped backslash still ends there: the NaN after it gets the hint.
+  const std::string escaped = Write("conf/escaped.json", "{\"note\": \"C:\\\\\", \"frame_time\": NaN}");
+  ExpectErrorNaming([&] { LoadScene(escaped); }, {"numbers must be finite"});
 }
 
 TEST_F(SceneFiles, MissingFilesNameTheKeyAndWhereItLooked) {
