@@ -55,6 +55,7 @@
 #include <clothwind/WindEstimate.h>
 
 #include "learn/camera_heading.h"
+#include "learn/flag_flies_settings.h"
 #include "learn/predictor.h"
 #include "ros_bridge/sdn_conversions.h"
 #include "ros_bridge/strict_param.h"
@@ -127,53 +128,24 @@ class SdnNode {
     return window;
   }
 
-  // ~flag_flies and, for wind, ~camera_heading and ~end_on_angle, checked once at start: a bad
-  // value is an ERROR and leaves the model's default.
+  // ~flag_flies and, for wind, ~camera_heading and ~end_on_angle, checked once at start
+  // (learn/flag_flies_settings.h): a bad value is an ERROR and leaves the model's default.
   void ReadFlagFlies(clothwind::ros_bridge::StrictParams& params) {
     const std::string name = params.Get("flag_flies", "");
-    camera_heading_ = params.Get("camera_heading", std::numeric_limits<double>::quiet_NaN());
+    const double heading = params.Get("camera_heading", std::numeric_limits<double>::quiet_NaN());
     camera_heading_frame_ = params.Get("camera_heading_frame", "");
-    double end_on_deg = params.Get("end_on_angle", 20.0);
-    if (!(end_on_deg >= 0 && end_on_deg <= 90)) {
-      end_on_deg = ParameterError("~end_on_angle must be 0 to 90 degrees, got " + std::to_string(end_on_deg), 20);
-    }
-    end_on_ = end_on_deg * M_PI / 180.0;
-    if (params.Has("camera_heading") && !std::isfinite(camera_heading_)) {
-      ParameterError(std::string("~camera_heading is not a finite angle [rad]; ") +
-                         (name == "wind" ? "~flag_flies wind is not followed" : "it is ignored"),
-                     0);
-    } else if (std::isfinite(camera_heading_) && std::abs(camera_heading_) > 2 * M_PI) {
-      ParameterError("~camera_heading is " + std::to_string(camera_heading_) +
-                         ", beyond 2 pi: it is in radians (degrees given?); ~flag_flies wind is not followed",
-                     0);
-      camera_heading_ = std::numeric_limits<double>::quiet_NaN();
-    }
-    if (name == "wind") {
-      // Unset: the pose in tf. Out of range: not followed (a heading in degrees is no pose to
-      // replace silently).
-      follow_wind_ = std::isfinite(camera_heading_) || !params.Has("camera_heading");
-      pose_from_tf_ = follow_wind_ && !std::isfinite(camera_heading_);
-      if (pose_from_tf_) {
-        tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
-        tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
-        if (!camera_heading_frame_.empty())
-          ParameterError("~camera_heading_frame is set without ~camera_heading: the camera's pose comes from tf, "
-                         "in each clip's wind direction frame",
-                         0);
-      }
-    } else if (std::isfinite(camera_heading_)) {
-      // Read but unused: a ~camera_heading given without ~flag_flies wind read every clip as
-      // filmed without a word (a flag flying left then reads ~2.5 m/s off).
-      ParameterError("~camera_heading is set but ~flag_flies is '" + name +
-                         "', not wind: the anemometer's direction is not used to tell the way the flag flies",
-                     0);
-    }
-    if (name != "wind" && !name.empty()) {
-      try {
-        told_flag_flies_ = clothwind::learn::FlagFliesFromName(name, "~flag_flies");
-      } catch (const std::invalid_argument& e) {
-        ParameterError(std::string(e.what()) + " (or wind); the model's way is used", 0);
-      }
+    const clothwind::learn::FlagFliesSettings s = clothwind::learn::ReadFlagFliesSettings(
+        name, params.Has("camera_heading") ? std::optional<double>(heading) : std::nullopt, camera_heading_frame_,
+        params.Get("end_on_angle", 20.0));
+    for (const std::string& error : s.errors) ParameterError(error, 0);
+    told_flag_flies_ = s.told;
+    follow_wind_ = s.follow_wind;
+    pose_from_tf_ = s.pose_from_tf;
+    camera_heading_ = s.camera_heading;
+    end_on_ = s.end_on;
+    if (pose_from_tf_) {
+      tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
+      tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
     }
   }
 
