@@ -54,6 +54,7 @@
 #include <clothwind/Clip.h>
 #include <clothwind/WindEstimate.h>
 
+#include "common/formatted.h"
 #include "learn/camera_heading.h"
 #include "learn/flag_flies_settings.h"
 #include "learn/predictor.h"
@@ -318,10 +319,8 @@ class SdnNode {
       return nan;
     }
     pose_error_.clear();
-    char what[160];
-    std::snprintf(what, sizeof what, "%.1f deg (tf: '%s' in '%s')", *heading * 180.0 / M_PI,
-                  clip.header.frame_id.c_str(), clip.wind_direction_frame_id.c_str());
-    camera_heading_text_ = what;
+    camera_heading_text_ = clothwind::Formatted("%.1f deg (tf: '%s' in '%s')", *heading * 180.0 / M_PI,
+                                                clip.header.frame_id.c_str(), clip.wind_direction_frame_id.c_str());
     return *heading;
   }
 

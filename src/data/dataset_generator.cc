@@ -662,16 +662,21 @@ void CheckExampleLabel(const std::string& dir, int64_t i, int v, const DatasetOp
                              " s (resume with its settings, or use another --out)");
 }
 
+// The first five names, comma-separated, and ", ..." when there are more.
+std::string FirstNames(const std::vector<std::string>& names) {
+  std::string listed;
+  for (size_t k = 0; k < names.size() && k < 5; ++k) listed += (k ? ", " : "") + names[k];
+  return names.size() > 5 ? listed + ", ..." : listed;
+}
+
 // Says which examples the index left out for frames missing (BuildIndex), so that a merge whose
 // copy has not finished, or a deleted frame, is seen rather than silently smaller.
 void SayIncomplete(const char* who, const std::vector<std::string>& incomplete) {
   if (incomplete.empty()) return;
-  std::string names;
-  for (size_t k = 0; k < incomplete.size() && k < 5; ++k) names += (k ? ", " : "") + incomplete[k];
-  std::fprintf(stderr, "%s: %zu example%s left out of the index, %s frames not all there: %s%s (a run of %s "
+  std::fprintf(stderr, "%s: %zu example%s left out of the index, %s frames not all there: %s (a run of %s "
                "shard makes %s again)\n",
                who, incomplete.size(), incomplete.size() == 1 ? "" : "s", incomplete.size() == 1 ? "its" : "their",
-               names.c_str(), incomplete.size() > 5 ? ", ..." : "", incomplete.size() == 1 ? "its" : "their",
+               FirstNames(incomplete).c_str(), incomplete.size() == 1 ? "its" : "their",
                incomplete.size() == 1 ? "it" : "them");
 }
 
@@ -746,13 +751,10 @@ int64_t ReindexDataset(const std::string& dir, bool contact_sheet, const std::fu
   SayIncomplete("make-dataset --reindex", incomplete);
   // Left out without a word before: frames copied in without their label, or a folder that is no
   // example. (A generating run does not say it: other shards' examples are being written.)
-  if (!unlabelled.empty()) {
-    std::string names;
-    for (size_t k = 0; k < unlabelled.size() && k < 5; ++k) names += (k ? ", " : "") + unlabelled[k];
-    std::fprintf(stderr, "make-dataset --reindex: %zu folder%s without a label.json left out of the index: %s%s (not "
+  if (!unlabelled.empty())
+    std::fprintf(stderr, "make-dataset --reindex: %zu folder%s without a label.json left out of the index: %s (not "
                  "an example, or one a run is still writing)\n",
-                 unlabelled.size(), unlabelled.size() == 1 ? "" : "s", names.c_str(), unlabelled.size() > 5 ? ", ..." : "");
-  }
+                 unlabelled.size(), unlabelled.size() == 1 ? "" : "s", FirstNames(unlabelled).c_str());
   if (index.value("count", nlohmann::json()) != count_before)
     std::fprintf(stderr, "make-dataset --reindex: the header's count raised from %s to %s, the simulations the folder "
                  "holds (a larger run's, stopped before it rewrote the header, or copied in)\n",

@@ -4,14 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 #include <tuple>
 #include <vector>
 
 #include "common/dataset_names.h"
 #include "common/json_file.h"
-#include "common/regular_file.h"
 #include "sim/trajectory_io.h"
 
 namespace clothwind::data {

@@ -19,7 +19,6 @@
 #include "common/image_file.h"
 #include "common/json_file.h"
 #include "common/random.h"
-#include "common/regular_file.h"
 #include "learn/fly_judge.h"
 #include "learn/model_config.h"
 

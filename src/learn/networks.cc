@@ -5,14 +5,12 @@
 #include <tuple>
 #include <vector>
 
-#include <fstream>
 #include <stdexcept>
 
 #include <ATen/ATen.h>
 
 #include "common/atomic_file.h"
 #include "common/json_file.h"
-#include "common/regular_file.h"
 #include "learn/track_targets.h"
 #include "learn/weight_average.h"
 

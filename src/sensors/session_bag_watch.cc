@@ -5,13 +5,14 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
 #include <regex>
 #include <stdexcept>
 #include <system_error>
+
+#include "common/formatted.h"
 
 namespace clothwind {
 namespace sensors {
@@ -44,21 +45,12 @@ bool IsBagDateName(const std::string& rest) {
   return std::regex_match(rest, kDate);
 }
 
-std::string Megabytes(double bytes) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f MB", bytes / 1e6);
-  return text;
-}
+std::string Megabytes(double bytes) { return Formatted("%.1f MB", bytes / 1e6); }
 
 std::string Duration(double seconds) {
-  char text[32];
-  if (seconds < 120)
-    std::snprintf(text, sizeof text, "%.0f s", seconds);
-  else if (seconds < 7200)
-    std::snprintf(text, sizeof text, "%.0f min", seconds / 60);
-  else
-    std::snprintf(text, sizeof text, "%.1f h", seconds / 3600);
-  return text;
+  if (seconds < 120) return Formatted("%.0f s", seconds);
+  if (seconds < 7200) return Formatted("%.0f min", seconds / 60);
+  return Formatted("%.1f h", seconds / 3600);
 }
 
 }  // namespace

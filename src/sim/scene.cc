@@ -6,10 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
+#include <regex>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
 #include "common/formatted.h"
@@ -436,23 +435,11 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
     std::string shown = text.substr(start, end == std::string::npos ? std::string::npos : end - start);
     shown.erase(0, shown.find_first_not_of(" \t"));
     // The hint only where it applies: an empty or truncated file was told of NaN too.
-    // Outside strings and // comments: a name like "info" is no number.
-    std::string lower;
-    bool in_string = false;
-    for (size_t k = 0; k < shown.size(); ++k) {
-      const char c = shown[k];
-      if (in_string) {
-        if (c == '\\') ++k;  // an escaped character, \" or \\ included
-        else if (c == '"') in_string = false;
-        continue;
-      }
-      if (c == '"') {
-        in_string = true;
-        continue;
-      }
-      if (c == '/' && k + 1 < shown.size() && shown[k + 1] == '/') break;
-      lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    }
+    // Outside strings (closed or running to the line's end) and // comments: a name like "info"
+    // is no number.
+    static const std::regex kStringsAndComments(R"("(\\.|[^"\\])*("|$)|//.*)");
+    std::string lower = std::regex_replace(shown, kStringsAndComments, "");
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
     const bool non_finite = lower.find("nan") != std::string::npos || lower.find("inf") != std::string::npos;
     throw std::runtime_error(abs_path + ":" + std::to_string(line) + ": not valid JSON near `" + shown + "`" +
                              (non_finite ? " (numbers must be finite: NaN/Infinity are not JSON)" : "") + ": " +
