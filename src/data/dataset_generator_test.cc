@@ -692,7 +692,9 @@ TEST_F(DatasetGeneratorTest, ReindexRefusesAShardOfOtherSettingsAndClaimsOnlyTra
   const fs::path frame = dir / "flag-000001-v0" / "001.jpg";
   fs::rename(frame, root_ / "001.jpg");
   EXPECT_EQ(ReindexDataset(dir.string(), true), 2);
-  for (const auto& clip : ReadIndex(dir.string())["clips"]) EXPECT_NE(clip["name"], "flag-000001-v0");
+  // (The index held in a name: a range-for over ReadIndex(...)["clips"] read a freed temporary.)
+  const nlohmann::json reindexed = ReadIndex(dir.string());
+  for (const auto& clip : reindexed["clips"]) EXPECT_NE(clip["name"], "flag-000001-v0");
   fs::rename(root_ / "001.jpg", frame);
   // An example whose label.json is gone (frames without it) is left out and named.
   const fs::path label = dir / "flag-000001-v0" / "label.json";
