@@ -10,6 +10,9 @@ set(CLOTHWIND_GTEST_SKIP_CODE 77)
 if(NOT TARGET clothwind_gtest_main)
   add_library(clothwind_gtest_main STATIC ${CMAKE_CURRENT_LIST_DIR}/../tests/gtest_main.cc)
   target_link_libraries(clothwind_gtest_main PUBLIC GTest::gtest)
+  if(CLOTHWIND_SANITIZE MATCHES "thread")  # tests/gtest_main.cc runs oneTBB serially under TSan
+    target_link_libraries(clothwind_gtest_main PUBLIC TBB::tbb)
+  endif()
 endif()
 
 # clothwind_capability(<cap> [DEPS <targets...>] [TEST_DEPS <targets...>])
