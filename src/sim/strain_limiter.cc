@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include <Eigen/LU>
 #include <Eigen/SparseCholesky>
@@ -377,6 +378,12 @@ StrainLimitResult StrainLimiter::Project(const StrainLimitSettings& settings, do
                                          Eigen::MatrixX3d* xp, Eigen::MatrixX3d* vp) {
   Eigen::MatrixX3d& x = *xp;
   const int n = static_cast<int>(x.rows());
+  // A non-finite position is refused before anything moves: the global step's solve would spread
+  // it to every vertex of the sheet (and a sweep would skip its faces without a word).
+  for (int i = 0; i < n; ++i)
+    if (!x.row(i).allFinite())
+      throw std::invalid_argument("strain limiter: vertex " + std::to_string(i) +
+                                  " has a non-finite position; expected finite positions [m]");
   // Work on an interleaved copy (x, y, z of a vertex adjacent in memory).
   work_.resize(3 * n);
   for (int i = 0; i < n; ++i)

@@ -102,7 +102,8 @@ class StrainLimiter {
   //             tolerance >= 0)
   //   dt        time step [s] (> 0) for the velocity update
   //   x, v      #V by 3 positions [m] and velocities [m/s], updated in place
-  // Returns what the sweeps did.
+  // Returns what the sweeps did. Throws std::invalid_argument, naming the vertex and changing
+  // nothing, when a position is not finite.
   StrainLimitResult Project(const StrainLimitSettings& settings, double dt, Eigen::MatrixX3d* x,
                             Eigen::MatrixX3d* v);
 

@@ -1,6 +1,8 @@
 #include "sim/strain_limiter.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
@@ -305,6 +307,44 @@ TEST(StrainLimiter, GlobalIterationsKeepTheMassCentreOfAFreeSheetAndLeaveOneWith
   EXPECT_TRUE(again.converged);
   EXPECT_EQ(again.sweeps, 1);
   EXPECT_TRUE(x == within && v == v_within) << "a sheet within the tolerance was moved";
+}
+
+// A NaN position is refused, naming its vertex, before anything moves. Under the global method
+// it would otherwise reach every vertex through the solve (checked when written: all 60 free
+// vertices of this strip came back NaN), and under the sweeps its faces would be skipped without
+// a word (a simulator step refuses non-finite forces before this; a direct caller gets the same).
+TEST(StrainLimiter, ANonFinitePositionIsRefusedNamingItsVertexAndNothingMoves) {
+  for (const StrainLimitMethod method : {StrainLimitMethod::kSweeps, StrainLimitMethod::kGlobal}) {
+    SCOPED_TRACE(method == StrainLimitMethod::kGlobal ? "global" : "sweeps");
+    const Strip strip = StretchedStrip(30, 1.10);
+    StrainLimiter limiter(strip.mesh, Eigen::VectorXd::Ones(strip.x.rows()), strip.pinned);
+    StrainLimitSettings settings = Limits(50);
+    settings.method = method;
+    for (const double bad : {std::nan(""), HUGE_VAL}) {
+      Eigen::MatrixX3d x = strip.x, v = Eigen::MatrixX3d::Ones(x.rows(), 3);
+      x(17, 1) = bad;
+      Eigen::MatrixX3d x_before = x;
+      try {
+        limiter.Project(settings, 0.01, &x, &v);
+        const auto finite_rows = x.array().isFinite().rowwise().all();
+        ADD_FAILURE() << "a non-finite position was taken; non-finite vertices after: "
+                      << x.rows() - finite_rows.count() << " of " << x.rows();
+      } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("vertex 17 "), std::string::npos) << e.what();
+      }
+      EXPECT_TRUE(v == Eigen::MatrixX3d::Ones(x.rows(), 3)) << "velocities changed";
+      x(17, 1) = x_before(17, 1) = 0;  // NaN != NaN: compare the rest
+      EXPECT_TRUE(x == x_before) << "positions changed";
+    }
+    // After refusing, the limiter does what a fresh one does (no half-updated scratch).
+    Eigen::MatrixX3d x = strip.x, v = Eigen::MatrixX3d::Zero(x.rows(), 3);
+    limiter.Project(settings, 0.01, &x, &v);
+    StrainLimiter fresh(strip.mesh, Eigen::VectorXd::Ones(strip.x.rows()), strip.pinned);
+    Eigen::MatrixX3d x_fresh = strip.x, v_fresh = Eigen::MatrixX3d::Zero(x.rows(), 3);
+    fresh.Project(settings, 0.01, &x_fresh, &v_fresh);
+    EXPECT_TRUE(x.allFinite() && x == x_fresh && v == v_fresh);
+    EXPECT_FALSE(x == strip.x) << "the test should move the vertices";
+  }
 }
 
 TEST(StrainLimiter, AFaceOutByLessThanTheToleranceIsProjectedAndEndsTheSweeps) {
