@@ -2,7 +2,8 @@
 # CLI test of `clothwind export-model --calibrate-std` (and of train's refusals of options it would
 # ignore, on the same toy data): a dataset without a val split (which the
 # calibration reads) is refused before any work, naming the option and the way out; one with a
-# val split is calibrated and its scale stored beside the exported weights.
+# val split is calibrated and its scale stored beside the exported weights, fitted on its clips
+# read as filmed.
 # Usage: export_model_cli_test.sh CLOTHWIND_BINARY
 set -euo pipefail
 bin="$1"
@@ -93,4 +94,32 @@ scaled "$work/run/model.json" "$work/msg.txt" "$work/export/sdn.json"
 "$bin" export-model --model "$work/export/sdn.pt" --out "$work/export2/sdn.pt" --calibrate-std "$work/toy" \
   --precision float32 --threads 1 >"$work/msg.txt" 2>&1 || fail "calibrating again: $(cat "$work/msg.txt")"
 scaled "$work/export/sdn.json" "$work/msg.txt" "$work/export2/sdn.json"
+
+# Calibration reads the val clips as filmed (FlagSim's flags fly right; docs/sdn.md says why), not
+# turned round as the node's auto turns them. With every clip mirrored (flags flying left), the
+# factor stored is the one eval fits reading them as filmed, not the one it fits after turning
+# them back by their motion (which the toy clips' cues do, every one).
+command -v mogrify >/dev/null || fail "ImageMagick's mogrify is missing (scripts/install-deps installs it)"
+cp -r "$work/toy" "$work/left"
+sed -i 's/"split": "[a-z]*"/"split": "val"/' "$work/left/index.json" "$work"/left/*/label.json
+for clip in "$work"/left/*/; do mogrify -flop "$clip"*.jpg; done
+"$bin" export-model --model "$work/run/model.pt" --out "$work/left-export/sdn.pt" --calibrate-std "$work/left" \
+  --precision float32 --threads 1 >"$work/msg.txt" 2>&1 || fail "flags flying left: $(cat "$work/msg.txt")"
+for flies in right auto; do
+  "$bin" eval --model "$work/run/model.pt" --data "$work/left" --split val --flag-flies "$flies" --threads 1 \
+    --batch 16 --json "$work/left-$flies.json" --plot "$work/left-$flies.png" >"$work/msg.txt" 2>&1 ||
+    fail "eval --flag-flies $flies: $(cat "$work/msg.txt")"
+done
+/usr/bin/python3 - "$work/run/model.json" "$work/left-right.json" "$work/left-auto.json" \
+  "$work/left-export/sdn.json" <<'PY' || fail "the calibration did not read the clips as filmed"
+import json, sys
+source = json.load(open(sys.argv[1])).get('std_scale', 1.0)
+right, auto, stored = (json.load(open(f)) for f in sys.argv[2:])
+print(f"fit as filmed {right['std_scale_fit']}, turned back ({auto['turned']} of {auto['count']}) "
+      f"{auto['std_scale_fit']}; stored {stored['std_scale']} over the source's {source}")
+# The case that tells the readings apart: every clip turned back, to a different fit.
+assert auto['turned'] == auto['count'] == right['count'] == 16, 'not every clip was judged flying left'
+assert abs(auto['std_scale_fit'] / right['std_scale_fit'] - 1) > 0.03, 'both readings fit the same scale'
+assert abs(stored['std_scale'] - source * right['std_scale_fit']) <= 1e-4 * source * right['std_scale_fit']
+PY
 echo "export_model_cli_test: OK"

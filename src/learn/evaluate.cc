@@ -251,6 +251,16 @@ EvalResult Evaluate(const fs::path& model, const fs::path& data, const std::stri
 namespace {
 // An empty group has no figures: null, not NaN (which JSON lacks).
 nlohmann::json Number(double x) { return std::isnan(x) ? nlohmann::json(nullptr) : nlohmann::json(x); }
+
+// CalibrationScale, NaN where it has nothing to fit (no stds, or one not positive).
+double CalibrationScaleOrNaN(const EvalResult& r) {
+  if (std::isnan(StdCoverage(r, 1))) return std::numeric_limits<double>::quiet_NaN();
+  try {
+    return CalibrationScale(r);
+  } catch (const std::invalid_argument&) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
 }  // namespace
 
 nlohmann::json MetricsJson(const Metrics& m) {
@@ -275,6 +285,7 @@ nlohmann::json EvalJson(const EvalResult& r) {
           {"fly_judge", r.fly_judge.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.fly_judge)},
           {"seconds", r.seconds},
           {"std_within_1", Number(StdCoverage(r, 1))}, {"std_within_2", Number(StdCoverage(r, 2))},
+          {"std_scale_fit", Number(CalibrationScaleOrNaN(r))},
           {"bands", bands},
           {"per_simulation", r.per_simulation.simulations == 0
                                  ? nlohmann::json(nullptr)
@@ -332,7 +343,8 @@ std::string EvalTable(const EvalResult& r) {
   s << ")\n";
   if (!r.predicted_std.empty()) {
     s << "  predicted std: errors within 1 std " << StdCoverage(r, 1) << ", within 2 std " << StdCoverage(r, 2)
-      << " (calibrated: 0.683, 0.954)\n";
+      << " (calibrated: 0.683, 0.954); std scale that calibrates it on these clips "
+      << CalibrationScaleOrNaN(r) << "\n";
   }
   for (const BandMetrics& b : r.bands) {
     if (b.metrics.count == 0) continue;

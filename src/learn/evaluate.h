@@ -120,7 +120,10 @@ nlohmann::json MetricsJson(const Metrics& metrics);
 // ("cpu" or "cuda"; null unset), mirror, mirror_clips,
 // flag_flies, turned, fly_judge (null unless flag_flies is auto), "bands" (a list of
 // {"lo", "hi", "rmse", "acc05", "bias", "count"}; NaNs of empty bands as null) and
-// "per_simulation" ({"rmse", "scatter", "simulations", "clips"}; null without simulation ids).
+// "per_simulation" ({"rmse", "scatter", "simulations", "clips"}; null without simulation ids),
+// "std_within_1", "std_within_2" (StdCoverage) and "std_scale_fit" (CalibrationScale: the factor
+// export-model --calibrate-std would apply, fitted on these clips read this way); each null
+// without predicted stds.
 nlohmann::json EvalJson(const EvalResult& result);
 
 // Table 1's layout: header and one row ("Model  Input Modality  RMSE  Acc@0.5"), a line of how

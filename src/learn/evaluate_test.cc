@@ -68,6 +68,22 @@ TEST(EvaluateTest, StdCoverageOfListsOfDifferentLengthsIsNaN) {
   r.predicted_std.pop_back();  // a result without (all) stds
   EXPECT_TRUE(std::isnan(StdCoverage(r, 1)));
   EXPECT_TRUE(EvalJson(r)["std_within_1"].is_null());
+  EXPECT_TRUE(EvalJson(r)["std_scale_fit"].is_null());
+}
+
+// eval --json carries the factor export-model --calibrate-std would fit on the same clips (its CLI
+// test compares the two), and null where there is nothing to fit.
+TEST(EvaluateTest, TheJsonCarriesTheStdScaleCalibrationWouldFit) {
+  EvalResult r;
+  r.truth = {1.0, 5.0, 3.0};
+  r.predicted = {2.0, 5.5, 2.0};
+  r.predicted_std = {0.5, 1.0, 2.0};  // errors of 2, 0.5 and 0.5 stds
+  const nlohmann::json j = EvalJson(r);
+  ASSERT_TRUE(j["std_scale_fit"].is_number()) << j.dump();
+  EXPECT_NEAR(j["std_scale_fit"].get<double>(), std::sqrt((4 + 0.25 + 0.25) / 3), 1e-12);
+  EXPECT_DOUBLE_EQ(j["std_scale_fit"].get<double>(), CalibrationScale(r));
+  r.predicted_std[1] = 0;  // nothing to fit: CalibrationScale refuses it, the JSON says null
+  EXPECT_TRUE(EvalJson(r)["std_scale_fit"].is_null());
 }
 
 TEST(EvaluateTest, BandsSplitByTrueSpeedAndKeepEmptyBands) {
