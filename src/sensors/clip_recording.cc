@@ -56,12 +56,13 @@ std::vector<std::string> ClipRecording::Poll(double now, bool input_idle) {
     if (const std::string lost = writer_->FolderLost(); !lost.empty()) {
       problems.push_back(lost + "; reopening it every " + std::to_string(static_cast<int>(options_.reopen_every)) +
                          " s once it is there");
-      // Its tally kept, its queued clips counted as not recorded.
+      // Its tally kept, its queued clips (the one being written among them) counted as not
+      // recorded: they are written into a folder that is gone, or is another, and fail.
       const auto r = writer_->stats();
       written_before_ += r.written;
       failed_before_ += r.failed;
       dropped_before_ += r.dropped;
-      not_recorded_ += r.queued;
+      lost_queued_ += r.queued;
       failed_seen_ = dropped_seen_ = 0;
       index_error_seen_.clear();
       if (closer_.joinable()) closer_.join();  // done: no reopen before it closed (below)
@@ -116,7 +117,7 @@ ClipRecording::Tally ClipRecording::tally() const {
   const auto r = writer_ ? writer_->stats() : AsyncDatasetWriter::Stats();
   Tally t;
   t.recorded = written_before_ + r.written;
-  t.not_recorded = not_recorded_ + failed_before_ + dropped_before_ + r.failed + r.dropped;
+  t.not_recorded = not_recorded_ + lost_queued_ + failed_before_ + dropped_before_ + r.failed + r.dropped;
   t.waiting = r.queued;
   t.unlisted = r.unlisted;
   t.max_write_s = r.max_write_s;
@@ -144,12 +145,13 @@ std::vector<std::string> ClipRecording::Finish(const std::vector<LabelledClip>& 
     if (not_recorded_ > 0)
       log_(LogLevel::kWarn, Formatted("%llu clips not recorded (no recording folder open: %s)",
                                       static_cast<unsigned long long>(not_recorded_), error_.c_str()));
-    if (written_before_ + failed_before_ + dropped_before_ > 0)
+    if (written_before_ + failed_before_ + dropped_before_ + lost_queued_ > 0)
       log_(LogLevel::kInfo,
            Formatted("recording into %s ends with its folder lost: %llu clips written, %llu failed, %llu dropped "
-                     "(queue full) before",
+                     "(queue full), %llu queued when a folder was lost, before",
                      options_.dir.c_str(), static_cast<unsigned long long>(written_before_),
-                     static_cast<unsigned long long>(failed_before_), static_cast<unsigned long long>(dropped_before_)));
+                     static_cast<unsigned long long>(failed_before_), static_cast<unsigned long long>(dropped_before_),
+                     static_cast<unsigned long long>(lost_queued_)));
     return abandoned;
   }
   writer_->DrainBy(deadline, &abandoned);
@@ -162,11 +164,11 @@ std::vector<std::string> ClipRecording::Finish(const std::vector<LabelledClip>& 
   if (!s.index_error.empty()) log_(LogLevel::kError, "index.json not rewritten: " + s.index_error);
   log_(LogLevel::kInfo,
        Formatted("recording into %s ends: %llu clips written, %llu failed, %llu dropped (queue full), %zu given up "
-                 "at shutdown, %llu not recorded (no folder open)",
+                 "at shutdown, %llu not recorded (no folder open), %llu queued when a folder was lost",
                  writer_->root().c_str(), static_cast<unsigned long long>(written_before_ + s.written),
                  static_cast<unsigned long long>(failed_before_ + s.failed),
                  static_cast<unsigned long long>(dropped_before_ + s.dropped), abandoned.size(),
-                 static_cast<unsigned long long>(not_recorded_)));
+                 static_cast<unsigned long long>(not_recorded_), static_cast<unsigned long long>(lost_queued_)));
   return abandoned;
 }
 

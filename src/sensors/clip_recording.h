@@ -98,6 +98,7 @@ class ClipRecording {
   std::atomic<bool> closer_closed_{true};  // it has (no writer closing now)
   uint64_t written_before_ = 0, failed_before_ = 0, dropped_before_ = 0;  // lost writers' tallies
   uint64_t not_recorded_ = 0;           // clips with no folder open
+  uint64_t lost_queued_ = 0;            // clips queued (or being written) when their folder was lost
   uint64_t failed_seen_ = 0, dropped_seen_ = 0;  // the open writer's, as last reported
   std::string index_error_seen_;
   bool index_flush_asked_ = false;      // since input last came

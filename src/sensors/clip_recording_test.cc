@@ -214,6 +214,43 @@ TEST_F(ClipRecordingTest, AFolderLostTwiceIsReopenedTwice) {
   EXPECT_EQ(r.tally().recorded, 2u);
 }
 
+// The clips queued when the folder goes (the one being written among them) are counted as not
+// recorded, once (they fail in the folder that went, which the lost writer's closing does not
+// count again), and the log says so apart from the clips that found no folder open. Their frames
+// are noise, slow to encode, so the loss finds them still queued.
+TEST_F(ClipRecordingTest, TheClipsQueuedWhenTheFolderGoesAreCountedOnceAsNotRecorded) {
+  ClipRecording r(Options(), Log(), 100.0);
+  ASSERT_TRUE(r.open());
+  cv::Mat noise(1024, 1024, CV_8UC1);
+  cv::randu(noise, 0, 256);
+  constexpr int kClips = 3;
+  for (uint64_t k = 0; k < kClips; ++k) {
+    LabelledClip c = MakeClip(k);
+    for (auto& f : c.clip.frames) f.image = noise;  // shared, not copied
+    r.Record(c, {});
+  }
+  ASSERT_GE(r.tally().waiting, 2u) << "the writer took the clips before the test could lose the folder";
+  fs::rename(dir_, base_ / "unplugged");
+  ASSERT_EQ(r.Poll(101.0, false).size(), 1u);
+  double now = 111.0;
+  for (int i = 0; i < 500 && r.error().find("is gone; waiting") == std::string::npos; ++i, now += 10) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));  // the lost writer closing
+    r.Poll(now, false);
+  }
+  ASSERT_NE(r.error().find("is gone; waiting"), std::string::npos) << r.error();
+  r.Record(MakeClip(kClips), {});  // no folder open
+  size_t on_unplugged = 0;
+  for (const auto& e : fs::directory_iterator(base_ / "unplugged"))
+    on_unplugged += e.path().filename().string().rfind("clip-", 0) == 0;
+  const ClipRecording::Tally t = r.tally();
+  EXPECT_EQ(t.recorded, on_unplugged) << "the clips on the unplugged disk are the ones counted recorded";
+  EXPECT_EQ(t.recorded + t.not_recorded, static_cast<uint64_t>(kClips + 1))
+      << "recorded " << t.recorded << ", not recorded " << t.not_recorded;
+  r.Finish({}, {}, Deadline());
+  EXPECT_NE(log_.find("1 clips not recorded (no recording folder open"), std::string::npos) << log_;
+  EXPECT_NE(log_.find(" queued when a folder was lost"), std::string::npos) << log_;
+}
+
 // A disk mounted at the folder: once lost, its bare mount point (an fstab entry) is a folder but
 // not the disk, and the recording waits for the disk.
 TEST_F(ClipRecordingTest, ABareMountPointIsNotTheDisk) {
