@@ -1,11 +1,17 @@
 #include "sensors/clip_recording.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <future>
 #include <string>
 #include <thread>
 #include <vector>
@@ -249,6 +255,69 @@ TEST_F(ClipRecordingTest, TheClipsQueuedWhenTheFolderGoesAreCountedOnceAsNotReco
   r.Finish({}, {}, Deadline());
   EXPECT_NE(log_.find("1 clips not recorded (no recording folder open"), std::string::npos) << log_;
   EXPECT_NE(log_.find(" queued when a folder was lost"), std::string::npos) << log_;
+}
+
+// A lost folder's writer can hang in its last write (a yanked disk's): it is closed off the
+// caller's thread, so Poll returns at once, and the folder, back already, is not reopened until
+// that writer has closed (two writers in one path would each rewrite the index). The hang is a
+// FIFO where the writer reads an earlier clip's label.json, which blocks until the test opens it.
+TEST_F(ClipRecordingTest, ALostWriterHangingInAWriteHoldsNeitherPollNorAReopenedFolder) {
+  ClipRecording r(Options(), Log(), 100.0);
+  ASSERT_TRUE(r.open());
+  const LabelledClip clip = MakeClip(0);
+  // Made after opening: the opening reads the label.json of every clip folder the index lacks.
+  const fs::path held = dir_ / ClipFolderName(clip.clip.frames.front().stamp);
+  fs::create_directories(held);
+  ASSERT_EQ(::mkfifo((held / "label.json").c_str(), 0600), 0) << std::strerror(errno);
+  // Lets the hanging read end (EOF), wherever the FIFO is by then and whatever the test's outcome
+  // (the writers' threads are joined at the end).
+  auto release = [this, name = held.filename()] {
+    for (const fs::path& fifo : {base_ / "unplugged" / name / "label.json", dir_ / name / "label.json"}) {
+      const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);  // fails (ENXIO) with no reader
+      if (fd >= 0) return ::close(fd) == 0;
+    }
+    return false;
+  };
+  struct Releaser {
+    std::function<bool()> release;
+    ~Releaser() { release(); }
+  } releaser{release};
+  r.Record(clip, {});
+  // The writer's thread blocks opening the FIFO (the kernel's wait_for_partner): before that, a
+  // loss would fail its write at once, and there would be no hang to test.
+  auto a_thread_waits_on_a_fifo = [] {
+    for (const auto& task : fs::directory_iterator("/proc/self/task")) {
+      std::ifstream wchan(task.path() / "wchan");
+      std::string where;
+      if (wchan >> where && where == "wait_for_partner") return true;
+    }
+    return false;
+  };
+  for (int i = 0; i < 500 && !a_thread_waits_on_a_fifo(); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_TRUE(a_thread_waits_on_a_fifo()) << "the writer did not reach the FIFO";
+  ASSERT_EQ(r.tally().waiting, 1u);
+  fs::rename(dir_, base_ / "unplugged");
+  auto poll = std::async(std::launch::async, [&r] { return r.Poll(101.0, false); });
+  if (poll.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
+    release();
+    FAIL() << "Poll waited for the lost writer's hanging write";
+  }
+  ASSERT_EQ(poll.get().size(), 1u);
+  EXPECT_FALSE(r.open());
+  fs::create_directories(dir_);  // the disk back, while the lost writer still hangs
+  r.Poll(111.0, false);
+  r.Poll(121.0, false);
+  EXPECT_FALSE(r.open()) << "reopened while the lost writer was still closing";
+  ASSERT_TRUE(release()) << "the lost writer was not reading the FIFO";
+  double now = 131.0;
+  for (int i = 0; i < 500 && !r.open(); ++i, now += 10) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));  // the lost writer closing
+    r.Poll(now, false);
+  }
+  EXPECT_TRUE(r.open()) << r.error();
+  const ClipRecording::Tally t = r.tally();
+  EXPECT_EQ(t.recorded + t.not_recorded, 1u);
 }
 
 // A disk mounted at the folder: once lost, its bare mount point (an fstab entry) is a folder but
