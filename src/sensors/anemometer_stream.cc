@@ -8,11 +8,24 @@ void RecordFramer::Reset() {
   dropped_bytes_ += partial_.size();
   partial_.clear();
   overlong_now_ = false;
+  synced_ = false;
 }
 
 void RecordFramer::Feed(const uint8_t* bytes, size_t n, double arrival, std::vector<RawRecord>* out) {
   for (size_t i = 0; i < n; ++i) {
     const char c = static_cast<char>(bytes[i]);
+    const bool starts = c == '$' || c == '!' || c == '\x02';
+    if (!synced_) {  // the tail of a record cut when the port opened
+      if (c == '\r' || c == '\n') {
+        synced_ = true;
+        continue;
+      }
+      if (!starts) {
+        ++dropped_bytes_;
+        continue;
+      }
+      synced_ = true;
+    }
     if (c == '\r' || c == '\n') {
       if (overlong_now_) {
         overlong_now_ = false;
@@ -22,7 +35,7 @@ void RecordFramer::Feed(const uint8_t* bytes, size_t n, double arrival, std::vec
       partial_.clear();
       continue;
     }
-    if (c == '$' || c == '!' || c == '\x02') {
+    if (starts) {
       // A start delimiter always begins a record; whatever came before it on this line is noise.
       dropped_bytes_ += partial_.size();
       partial_.clear();

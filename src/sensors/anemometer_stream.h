@@ -18,7 +18,11 @@ struct RawRecord {
 
 // Frames records: CR or LF ends a record (CR LF gives one record); '$', '!' and STX start a new
 // record, dropping a partial one before them (line noise, or a sentence cut when the port was
-// opened mid-stream); a record longer than `max_length` is dropped whole.
+// opened mid-stream); a record longer than `max_length` is dropped whole. A new framer, and one
+// Reset, takes the stream to start mid-record (a port opened, whose kernel buffer is flushed,
+// while the instrument is half-way through a line): its bytes are dropped up to the first line end
+// or start delimiter. A CSV record has no start delimiter, and its cut tail read as a reading of
+// its own: "35,270" of "12.35,270", 35 m/s.
 class RecordFramer {
  public:
   // Inputs:
@@ -33,10 +37,12 @@ class RecordFramer {
   //   out  complete records are appended
   void Feed(const uint8_t* bytes, size_t n, double arrival, std::vector<RawRecord>* out);
 
-  // Forgets a partial record (after a reconnect its continuation will never come).
+  // Forgets a partial record (after a reconnect its continuation will never come), and drops what
+  // comes next up to the first line end or start delimiter (the reopened port's first line may be
+  // cut).
   void Reset();
 
-  size_t dropped_bytes() const { return dropped_bytes_; }  // partial/overlong records dropped
+  size_t dropped_bytes() const { return dropped_bytes_; }  // partial/overlong/cut records dropped
   size_t overlong_records() const { return overlong_; }
 
  private:
@@ -44,6 +50,7 @@ class RecordFramer {
   std::string partial_;
   double partial_stamp_ = 0.0;
   bool overlong_now_ = false;
+  bool synced_ = false;  // a line end or start delimiter seen since construction or Reset
   size_t dropped_bytes_ = 0;
   size_t overlong_ = 0;
 };

@@ -48,20 +48,47 @@ TEST(RecordFramer, StartDelimiterDropsNoiseBeforeIt) {
 TEST(RecordFramer, OverlongRecordsAreDroppedWhole) {
   RecordFramer f(16);
   std::vector<RawRecord> out;
-  Feed(&f, std::string(100, 'x') + "\n1,2\n", 1.0, &out);
+  Feed(&f, "\n" + std::string(100, 'x') + "\n1,2\n", 1.0, &out);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].data, "1,2");
   EXPECT_EQ(f.overlong_records(), 1u);
 }
 
-TEST(RecordFramer, ResetForgetsPartialRecord) {
+// After Reset (a reconnect) the partial record is forgotten, and so is the reopened port's first
+// line, which may be cut: "0" was framed as a record of its own.
+TEST(RecordFramer, ResetForgetsPartialRecordAndTheCutLineAfterIt) {
   RecordFramer f;
   std::vector<RawRecord> out;
-  Feed(&f, "3.5,9", 1.0, &out);
+  Feed(&f, "\n3.5,9", 1.0, &out);
   f.Reset();
-  Feed(&f, "0\n", 2.0, &out);
+  const size_t dropped = f.dropped_bytes();
+  EXPECT_EQ(dropped, 5u);
+  Feed(&f, "0\n1.5,45\n", 2.0, &out);
   ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(out[0].data, "0");
+  EXPECT_EQ(out[0].data, "1.5,45");
+  EXPECT_EQ(f.dropped_bytes(), dropped + 1);
+}
+
+// A port opened while the instrument is half-way through a line: the CSV tail up to the first line
+// end is dropped (it read "35,270" of "12.35,270" as 35 m/s); a start delimiter needs no line end
+// first.
+TEST(RecordFramer, ANewFramerDropsTheCutFirstLine) {
+  RecordFramer csv;
+  std::vector<RawRecord> out;
+  Feed(&csv, "35,270\r\n12.40,271\r\n", 1.0, &out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].data, "12.40,271");
+  EXPECT_EQ(csv.dropped_bytes(), 6u);
+  RecordFramer nmea;
+  out.clear();
+  Feed(&nmea, "9*39$IIMWV,1\r\n", 1.0, &out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].data, "$IIMWV,1");
+  RecordFramer gill;
+  out.clear();
+  Feed(&gill, std::string("\x02") + "Q,229\r\n", 1.0, &out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(gill.dropped_bytes(), 0u);
 }
 
 }  // namespace
