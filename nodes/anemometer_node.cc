@@ -86,7 +86,7 @@ class AnemometerNode {
       return false;
     }
     frames_ = clothwind::sensors::ReadingFrames(earth_frame_id_, kDefaultFrameId);
-    params.Known("diagnostic_period");  // read by diagnostic_updater: the wall timer's period (ros_bridge/wall_diagnostics.h)
+    params.Known("diagnostic_period");  // checked in main, read by diagnostic_updater (ros_bridge/wall_diagnostics.h)
     params.WarnUnread("anemometer_node");
 
     AnemometerProtocol protocol;
@@ -459,7 +459,15 @@ class AnemometerNode {
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "anemometer_node");
-  AnemometerNode node{ros::NodeHandle(), ros::NodeHandle("~")};
+  ros::NodeHandle pnh("~");
+  try {  // before the node's diagnostic_updater reads it
+    clothwind::ros_bridge::StrictParams params(pnh);
+    clothwind::ros_bridge::CheckDiagnosticPeriod(params);
+  } catch (const std::exception& e) {
+    ROS_FATAL("anemometer_node: %s", e.what());
+    return 1;
+  }
+  AnemometerNode node{ros::NodeHandle(), pnh};
   if (!node.Init()) return 1;
   node.Run();
   return 0;

@@ -101,11 +101,11 @@ int main(int argc, char** argv) {
     frame_id = params.Get("frame_id", "camera_optical_frame");
     camera_name = params.Get("camera_name", "camera");
     camera_info_url = params.Get("camera_info_url", "");
+    clothwind::ros_bridge::CheckDiagnosticPeriod(params);  // read by diagnostic_updater below
   } catch (const std::exception& e) {
     ROS_FATAL("camera_node: %s", e.what());
     return 1;
   }
-  params.Known("diagnostic_period");  // read by diagnostic_updater: the wall timer's period (ros_bridge/wall_diagnostics.h)
 
   RosClock clock;
   std::string error;

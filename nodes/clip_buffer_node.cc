@@ -420,8 +420,8 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh, pnh("~");
   clothwind::ros_bridge::StrictParams params(pnh);
   try {
+    clothwind::ros_bridge::CheckDiagnosticPeriod(params);  // before the node's diagnostic_updater reads it
     clothwind::ClipBufferNode node(nh, params);
-    params.Known("diagnostic_period");  // read by diagnostic_updater: the wall timer's period (ros_bridge/wall_diagnostics.h)
     params.WarnUnread("clip_buffer");
     ros::spin();
     node.Finish();

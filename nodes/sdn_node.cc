@@ -529,12 +529,12 @@ int main(int argc, char** argv) {
   clothwind::ros_bridge::StrictParams params(pnh);
   std::unique_ptr<SdnNode> node;
   try {
+    clothwind::ros_bridge::CheckDiagnosticPeriod(params);  // before SdnNode's diagnostic_updater reads it
     node = std::make_unique<SdnNode>(nh, params);
   } catch (const clothwind::ros_bridge::ParamError& e) {
     ROS_FATAL("sdn_node: %s", e.what());
     return 1;
   }
-  params.Known("diagnostic_period");  // read by diagnostic_updater: the wall timer's period (ros_bridge/wall_diagnostics.h)
   params.WarnUnread("sdn_node");
   ros::spin();
   return 0;

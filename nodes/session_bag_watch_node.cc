@@ -89,8 +89,8 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh, pnh("~");
   clothwind::ros_bridge::StrictParams params(pnh);
   try {
+    clothwind::ros_bridge::CheckDiagnosticPeriod(params);  // before the node's diagnostic_updater reads it
     SessionBagWatchNode node(nh, params);
-    params.Known("diagnostic_period");  // read by diagnostic_updater (ros_bridge/wall_diagnostics.h)
     params.WarnUnread("session_bag_watch");
     ros::spin();
   } catch (const std::exception& e) {

@@ -467,8 +467,8 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh, pnh("~");
   clothwind::ros_bridge::StrictParams params(pnh);
   try {
+    clothwind::ros_bridge::CheckDiagnosticPeriod(params);  // before the node's diagnostic_updater reads it
     WindDisplayNode node(nh, params);
-    params.Known("diagnostic_period");  // read by diagnostic_updater: the wall timer's period (ros_bridge/wall_diagnostics.h)
     params.WarnUnread("wind_display");
     ros::spin();
   } catch (const std::exception& e) {

@@ -6,21 +6,42 @@
 #define CLOTHWIND_NODES_ROS_BRIDGE_WALL_DIAGNOSTICS_H_
 
 #include <cmath>
+#include <sstream>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/console.h>
 #include <ros/time.h>
 
+#include "ros_bridge/strict_param.h"
 #include "ros_bridge/wall_throttle.h"
 
 namespace clothwind::ros_bridge {
 
+// What ~diagnostic_period may be: a time in (0, 3600] s.
+inline bool DiagnosticPeriodIsValid(double period) { return std::isfinite(period) && period > 0 && period <= 3600; }
+
+// Reads ~diagnostic_period (counting it as read) before a diagnostic_updater::Updater does, and
+// throws ParamError naming it unless it is unset or valid. The Updater turns it into a
+// ros::Duration, which throws "Duration is out of dual 32-bit range", naming no parameter, for
+// NaN, inf or more than 2^31 s, in its constructor and again in every force_update: three nodes
+// ended in std::terminate on `_diagnostic_period:=1e10`, and camera_node's respawn looped on it.
+// Call it before constructing any Updater.
+inline void CheckDiagnosticPeriod(StrictParams& params) {
+  const double period = params.Get("diagnostic_period", 1.0);
+  if (!DiagnosticPeriodIsValid(period)) {
+    std::ostringstream what;
+    what << "~diagnostic_period: expected a time in (0, 3600] s, got " << period;
+    throw ParamError(what.str());
+  }
+}
+
 // The period [s] diagnostic_updater read from ~diagnostic_period (1 s unset). The nodes publish
 // on wall timers of their own, which ran every second whatever it said: `_diagnostic_period:=10`
-// was accepted and did nothing. Not finite, <= 0 or over an hour: 1 s, said once.
+// was accepted and did nothing. Checked at start (CheckDiagnosticPeriod); a value set while the
+// node runs that is not valid: 1 s, said once.
 inline double DiagnosticPeriod(diagnostic_updater::Updater& updater) {
   const double period = updater.getPeriod();
-  if (std::isfinite(period) && period > 0 && period <= 3600) return period;
+  if (DiagnosticPeriodIsValid(period)) return period;
   ROS_WARN_STREAM("~diagnostic_period must be a time in (0, 3600] s, got " << period << ": 1 s used");
   return 1.0;
 }

@@ -211,6 +211,23 @@ class NodeParamsTest(unittest.TestCase):
         ]
         self.expect_refused(cases, "range")
 
+    # ~diagnostic_period out of (0, 3600] s ends each node with diagnostics naming it. diagnostic_updater
+    # makes a ros::Duration of it, which throws for NaN, inf or past 2^31 s: anemometer_node,
+    # camera_node and sdn_node ended in std::terminate (a core dump, no parameter named), the others
+    # with "Duration is out of dual 32-bit range".
+    def test_a_diagnostic_period_out_of_range_ends_the_node_naming_it(self):
+        expected = "~diagnostic_period: expected a time in (0, 3600] s, got "
+        cases = [
+            ("anemometer_node", {"input": "topic", "diagnostic_period": 1e10}, expected + "1e+10"),
+            ("anemometer_node", {"input": "topic", "diagnostic_period": float("nan")}, expected + "nan"),
+            ("camera_node", {"source": "folder", "path": self.folder, "diagnostic_period": 1e10}, expected + "1e+10"),
+            ("sdn_node", {"model": self.folder, "diagnostic_period": float("inf")}, expected + "inf"),
+            ("clip_buffer_node", {"diagnostic_period": 1e10}, expected + "1e+10"),
+            ("wind_display_node", {"diagnostic_period": 0.0}, expected + "0"),
+            ("session_bag_watch_node", {"diagnostic_period": -1.0}, expected + "-1"),
+        ]
+        self.expect_refused(cases, "period")
+
     # SIGTERM (systemd, docker stop, roslaunch's escalation) ends clip_buffer as Ctrl-C does: the
     # clips still waiting for their labels are labelled and recorded, and index.json lists every
     # clip on disk (it ended on the signal, and the waiting clips were lost).
