@@ -253,6 +253,21 @@ fs::path CheckpointDir(const fs::path& out) { return CheckpointDirOf(ReadState(o
 
 namespace {
 
+// Whether `name` is one of a run's checkpoint folders, "checkpoint-e" and the epoch's digits, or
+// the temporary one it is built in (".checkpoint-eNNNN.tmp"). Exactly: a prefix took a user's
+// copy of a good checkpoint ("checkpoint-e0012-keep") at the next epoch.
+bool IsCheckpointName(const std::string& name) {
+  const bool hidden = !name.empty() && name[0] == '.';
+  std::string rest = name.substr(hidden ? 1 : 0);
+  if (hidden) {
+    if (rest.size() < 4 || rest.compare(rest.size() - 4, 4, ".tmp") != 0) return false;
+    rest.resize(rest.size() - 4);
+  }
+  const std::string prefix = "checkpoint-e";
+  if (rest.rfind(prefix, 0) != 0 || rest.size() < prefix.size() + 4) return false;
+  return std::all_of(rest.begin() + prefix.size(), rest.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
 // Deletes what a run writes in `out` (state, checkpoints, models, log, learning curve), leaving
 // anything else there alone.
 void RemoveRun(const fs::path& out) {
@@ -265,8 +280,7 @@ void RemoveRun(const fs::path& out) {
         "learning_curve.png.dat",      "learning_curve.png.gp",  "learning_curve.png.gp.err"};
     const size_t tmp = name.find(".tmp-");
     const std::string base = tmp == std::string::npos ? name : name.substr(0, tmp);
-    const bool run_file = kFiles.count(base) > 0 || name.rfind("checkpoint-e", 0) == 0 ||
-                          name.rfind(".checkpoint-e", 0) == 0;
+    const bool run_file = kFiles.count(base) > 0 || IsCheckpointName(name);
     if (run_file) fs::remove_all(entry.path());
   }
 }
@@ -914,7 +928,7 @@ TrainResult Train(const TrainOptions& o) {
     // names the new one.
     for (const auto& entry : fs::directory_iterator(o.out)) {
       const std::string name = entry.path().filename().string();
-      if ((name.rfind("checkpoint-e", 0) == 0 && name != checkpoint_name) || name == "last.pt" ||
+      if ((IsCheckpointName(name) && name[0] != '.' && name != checkpoint_name) || name == "last.pt" ||
           name == "last_optim.pt" || name == "last_average.pt")
         fs::remove_all(entry.path());
     }

@@ -1129,11 +1129,17 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
     fs::create_directories(*root_ / "resume2" / stray);
     std::ofstream(*root_ / "resume2" / stray / "last.pt") << "not a checkpoint";
   }
+  // The user's own folders that only start like a checkpoint's: a prefix match deleted them when
+  // the next epoch ended (a copy of a good checkpoint kept beside the run among them).
+  for (const char* own : {"checkpoint-e0002-keep", "checkpoint-eval-notes"})
+    fs::copy(*root_ / "resume2" / "checkpoint-e0002", *root_ / "resume2" / own);
   EXPECT_EQ(CheckpointDir(*root_ / "resume2").filename(), "checkpoint-e0002");
   const TrainResult redo = Train(u);
   EXPECT_EQ(CheckpointDir(*root_ / "resume2").filename(), "checkpoint-e0003");
   EXPECT_FALSE(fs::exists(*root_ / "resume2" / "checkpoint-e0002"));
   EXPECT_FALSE(fs::exists(*root_ / "resume2" / ".checkpoint-e0003.tmp"));
+  for (const char* own : {"checkpoint-e0002-keep", "checkpoint-eval-notes"})
+    EXPECT_TRUE(fs::exists(*root_ / "resume2" / own / "last.pt")) << own;
   EXPECT_NEAR(redo.log[2].train_loss, resumed.log[2].train_loss, 1e-5);
   EXPECT_NEAR(redo.log[2].val_rmse, resumed.log[2].val_rmse, 1e-5);
   // ... and both are the run never stopped: two resumes that each reloaded nothing, or both
@@ -1175,6 +1181,7 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
     // Names a run's files only start like: a prefix match took them too.
     std::ofstream(old_run.out / "model.onnx") << "the user's export";
     fs::create_directories(old_run.out / "last_eval");
+    fs::create_directories(old_run.out / "checkpoint-e0001-keep");
     TrainOptions again_run = old_run;
     again_run.overwrite = true;
     again_run.weight_average = 0;
@@ -1185,6 +1192,8 @@ TEST_F(TrainTest, ResumeContinuesTheRun) {
     EXPECT_TRUE(fs::exists(old_run.out / "notes.txt"));
     EXPECT_TRUE(fs::exists(old_run.out / "model.onnx"));
     EXPECT_TRUE(fs::exists(old_run.out / "last_eval"));
+    EXPECT_TRUE(fs::exists(old_run.out / "checkpoint-e0001-keep"));
+    EXPECT_FALSE(fs::exists(old_run.out / "checkpoint-e0001"));
     TrainOptions resume_it = again_run;
     resume_it.overwrite = false;
     resume_it.resume = true;
