@@ -116,6 +116,8 @@ TrackHeadReport EvaluateTrackHead(const fs::path& model, const fs::path& data, c
                              ": another dataset or run options than the model's");
   const std::vector<ClipInfo> clips = SelectSplit(dataset, split);
   if (clips.empty()) throw std::runtime_error((data / "index.json").string() + ": no examples in split " + split);
+  // As Evaluate and Train: clips at another rate, or grey for a colour model, are another input.
+  CheckClipsSuitModel(clips, r.config.frame_rate, r.config.colour, r.window);
   // The split's own tracks (the train split's are read already: not again, nor copied, ~1 GB on e5).
   AuxTargets read;
   if (split != "train") read = ReadAuxTargets(clips, options, phase_bins, world);

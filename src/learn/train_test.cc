@@ -1891,6 +1891,24 @@ TEST_F(TrainTest, TrackHeadEvaluationReadsTheHeadBackInTheTargetsUnits) {
   // A window longer than the clips, or not made of whole model inputs, is refused.
   EXPECT_THROW(EvaluateTrackHead(one.model, data, "val", 1, 2, {}, 61), std::runtime_error);
   EXPECT_THROW(EvaluateTrackHead(r.model, data, "val", 1, 2, {}, 45), std::invalid_argument);
+  // Clips at another rate than the model reads are refused naming the clip, as eval and train
+  // refuse them (the head's figures were reported for another input without a word).
+  {
+    const fs::path other_rate = *root_ / "data_head_5hz";
+    fs::copy(data, other_rate, fs::copy_options::recursive);
+    for (const auto& clip : fs::directory_iterator(other_rate)) {
+      if (!fs::exists(clip.path() / "label.json")) continue;
+      nlohmann::json label = nlohmann::json::parse(std::ifstream(clip.path() / "label.json"));
+      label["frame_rate"] = 5.0;
+      std::ofstream(clip.path() / "label.json") << label.dump();
+    }
+    try {
+      EvaluateTrackHead(r.model, other_rate, "val", 1, 2);
+      ADD_FAILURE() << "5 Hz clips were read by a 25 Hz model's head";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("the model reads clips at 25"), std::string::npos) << e.what();
+    }
+  }
   // The same refusals before any data is read (eval checks them before its evaluation, which ran
   // whole and then lost its results to them), and a state.json option of another type named.
   EXPECT_NO_THROW(CheckTrackHead(r.model, 0));
