@@ -56,8 +56,24 @@ ParseResult ParseMwv(const NmeaSentence& s) {
     w.status = status;
   }
   const std::string& ref = s.fields[1];
-  // A void reading with every field empty ("$IIMWV,,,,,V"): said void, not malformed.
-  if (!w.valid && ref.empty() && s.fields[0].empty() && s.fields[2].empty() && s.fields[3].empty()) {
+  if (!w.valid) {
+    // A void reading says what the instrument says in its status, whatever its fields hold: empty
+    // ("$IIMWV,,,,,V"), or a failed measurement's filler (a WindSonic with status codes pads them
+    // with 9s, "999,R,999.99,M,04", as its own format does). It keeps the values it can read and
+    // drops the rest (it was refused as malformed, naming the angle, and the failure went unsaid).
+    double angle = kNaN, speed = kNaN;
+    std::string ignored;
+    SpeedUnit unit;
+    if (ref == "R" || ref == "T") {
+      w.relative = ref == "R";
+      if (ParseOptionalNumber(s.fields[0], &angle, &ignored) && angle >= 0.0 && angle <= 360.0) {
+        w.from_angle_deg = angle;
+        w.reference = AngleReference::kInstrument;
+      }
+    }
+    if (ParseOptionalNumber(s.fields[2], &speed, &ignored) && speed >= 0.0 && NmeaSpeedUnit(s.fields[3], &unit) &&
+        SpeedToMetresPerSecond(speed, unit) <= kMaxPlausibleWindSpeed)
+      w.speed = SpeedToMetresPerSecond(speed, unit);
     r.status = ParseStatus::kOk;
     return r;
   }

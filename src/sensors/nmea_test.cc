@@ -81,6 +81,34 @@ TEST(Nmea, MwvStatusVoidIsAnInvalidReading) {
   EXPECT_TRUE(std::isnan(WindDirection(r.reading)));
 }
 
+// A void reading whose fields hold a failed measurement's filler (a WindSonic with status codes
+// pads them with 9s) or cannot be read: void, saying its status, not malformed naming a field. It
+// keeps what it can read.
+TEST(Nmea, MwvVoidWithFieldsOutOfRangeIsAnInvalidReadingNotAMalformedOne) {
+  ParseResult r = ParseNmea(WithNmeaChecksum("IIMWV,999,R,999.99,M,04"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_FALSE(r.reading.valid);
+  EXPECT_NE(r.reading.status.find("axis 1 and 2 failed"), std::string::npos) << r.reading.status;
+  EXPECT_TRUE(std::isnan(r.reading.speed));
+  EXPECT_TRUE(std::isnan(WindDirection(r.reading)));
+  for (const char* sentence : {"IIMWV,-5,R,-1.0,M,V", "IIMWV,12x,Q,abc,Z,V", "IIMWV,400,T,2.0,?,V"}) {
+    r = ParseNmea(WithNmeaChecksum(sentence));
+    ASSERT_EQ(r.status, ParseStatus::kOk) << sentence << ": " << r.error;
+    EXPECT_FALSE(r.reading.valid) << sentence;
+    EXPECT_TRUE(std::isnan(r.reading.speed)) << sentence;
+    EXPECT_TRUE(std::isnan(WindDirection(r.reading))) << sentence;
+  }
+  r = ParseNmea(WithNmeaChecksum("IIMWV,270.0,R,3.0,M,V"));  // readable: kept
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_FALSE(r.reading.valid);
+  EXPECT_DOUBLE_EQ(r.reading.speed, 3.0);
+  EXPECT_DOUBLE_EQ(r.reading.from_angle_deg, 270.0);
+  // The same fields under status A stay malformed, naming the field.
+  r = ParseNmea(WithNmeaChecksum("IIMWV,999,R,2.0,M,A"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("field 1 (angle)"), std::string::npos) << r.error;
+}
+
 TEST(Nmea, MwvWithAGillStatusCodeIsReadAsTheGillCode) {
   // A WindSonic in NMEA mode with Gill status codes (its manual's "$IIMWV,120,R,002.10,M,00"):
   // every record was refused as "expected A or V".
