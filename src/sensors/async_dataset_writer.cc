@@ -147,9 +147,11 @@ void AsyncDatasetWriter::Run() {
     lock.unlock();
     room_.notify_all();
     const auto start = std::chrono::steady_clock::now();
-    std::string error;
+    std::string error, problem;
     try {
       writer_->Write(item.first, item.second);
+    } catch (const ClipRecordedWithAProblem& e) {
+      problem = e.what();  // recorded: counted written, the problem said
     } catch (const std::exception& e) {
       error = e.what();
     }
@@ -162,6 +164,10 @@ void AsyncDatasetWriter::Run() {
     stats_.max_write_s = std::max(stats_.max_write_s, seconds);
     if (error.empty()) {
       ++stats_.written;
+      if (!problem.empty()) {
+        ++stats_.problems;
+        stats_.last_problem = problem;
+      }
       if (list_each_clip_) FlushIndex(&lock);
     } else {
       ++stats_.failed;

@@ -25,6 +25,10 @@ class AsyncDatasetWriter {
   struct Stats {
     uint64_t written = 0;          // clips recorded
     uint64_t failed = 0;           // clips DatasetWriter::Write refused (last_error says why)
+    // Of the written, those recorded with a problem after (ClipRecordedWithAProblem: an index
+    // rewrite, the replaced copy's removal, the folder's sync); last_problem says the last.
+    uint64_t problems = 0;
+    std::string last_problem;
     uint64_t dropped = 0;          // clips not queued: the queue was full
     uint64_t abandoned = 0;        // clips queued but not recorded: DrainBy's deadline came first
     size_t queued = 0;             // clips waiting now

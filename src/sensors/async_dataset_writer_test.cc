@@ -92,6 +92,24 @@ TEST_F(AsyncDatasetWriterTest, FailedWriteIsCountedWithItsReason) {
   EXPECT_NE(s.last_error.find("empty clip"), std::string::npos) << s.last_error;
 }
 
+// A clip in place whose index update failed (a folder stands where index.json goes) is written,
+// not failed: counted as a failed write, a recording's tally called a clip on disk not recorded.
+// The problem is counted and said apart.
+TEST_F(AsyncDatasetWriterTest, AClipRecordedWhoseIndexUpdateFailedIsWrittenWithItsProblem) {
+  AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string()));
+  fs::remove(root_ / "index.json");
+  fs::create_directories(root_ / "index.json" / "blocker");
+  ASSERT_TRUE(w.Enqueue(MakeClip(0), {}));
+  w.Drain();
+  const auto s = w.stats();
+  EXPECT_EQ(s.written, 1u);
+  EXPECT_EQ(s.failed, 0u);
+  EXPECT_EQ(s.problems, 1u);
+  EXPECT_NE(s.last_problem.find("recorded, but"), std::string::npos) << s.last_problem;
+  EXPECT_NE(s.last_problem.find("index.json not updated"), std::string::npos) << s.last_problem;
+  fs::remove_all(root_ / "index.json");
+}
+
 TEST_F(AsyncDatasetWriterTest, AnIdleWriterListsItsUnlistedClipsOnceTheIndexIntervalPasses) {
   // Interval 5 s: two clips queued at once, the second is written within the interval of the
   // first's index rewrite, so it waits unlisted; with no clip after it (a replay that ended) the

@@ -63,7 +63,7 @@ std::vector<std::string> ClipRecording::Poll(double now, bool input_idle) {
       failed_before_ += r.failed;
       dropped_before_ += r.dropped;
       lost_queued_ += r.queued;
-      failed_seen_ = dropped_seen_ = 0;
+      failed_seen_ = dropped_seen_ = problems_seen_ = 0;
       index_error_seen_.clear();
       if (closer_.joinable()) closer_.join();  // done: no reopen before it closed (below)
       closer_closed_ = false;
@@ -103,8 +103,10 @@ std::vector<std::string> ClipRecording::Poll(double now, bool input_idle) {
     if (r.dropped > dropped_seen_)
       problems.push_back("recording too slow: " + std::to_string(r.dropped - dropped_seen_) +
                          " clip(s) not recorded (queue of " + std::to_string(options_.queue) + " full)");
+    if (r.problems > problems_seen_) problems.push_back(r.last_problem);
     failed_seen_ = r.failed;
     dropped_seen_ = r.dropped;
+    problems_seen_ = r.problems;
     if (!r.index_error.empty() && r.index_error != index_error_seen_)
       problems.push_back("index.json not rewritten (the clips are in place; the next rewrite or the next opening of "
                          "the folder lists them): " + r.index_error);
@@ -161,6 +163,9 @@ std::vector<std::string> ClipRecording::Finish(const std::vector<LabelledClip>& 
                                      "(roslaunch kills a node 17 s after Ctrl-C): %s",
                                      abandoned.size(), budget, JoinNames(abandoned).c_str()));
   if (s.failed > 0) log_(LogLevel::kError, "last failed clip write: " + s.last_error);
+  if (s.problems > 0)
+    log_(LogLevel::kWarn, Formatted("%llu clips recorded with a problem after; the last: %s",
+                                    static_cast<unsigned long long>(s.problems), s.last_problem.c_str()));
   if (!s.index_error.empty()) log_(LogLevel::kError, "index.json not rewritten: " + s.index_error);
   log_(LogLevel::kInfo,
        Formatted("recording into %s ends: %llu clips written, %llu failed, %llu dropped (queue full), %zu given up "

@@ -58,7 +58,8 @@ class ClipRecording {
   // never land on a bare mount point. input_idle: input has stopped (a replay ended), so the clips
   // recorded since the last index rewrite are listed now, once per stop. Returns what newly went
   // wrong: the folder lost (once), writes that failed since the last call (with the last one's
-  // error), clips the full queue dropped since then, an index rewrite's error (once per error).
+  // error), clips recorded with a problem after (the last one's), clips the full queue dropped
+  // since then, an index rewrite's error (once per error).
   std::vector<std::string> Poll(double now, bool input_idle);
   // Input came again: the next stop lists the index again.
   void InputArrived() { index_flush_asked_ = false; }
@@ -99,7 +100,7 @@ class ClipRecording {
   uint64_t written_before_ = 0, failed_before_ = 0, dropped_before_ = 0;  // lost writers' tallies
   uint64_t not_recorded_ = 0;           // clips with no folder open
   uint64_t lost_queued_ = 0;            // clips queued (or being written) when their folder was lost
-  uint64_t failed_seen_ = 0, dropped_seen_ = 0;  // the open writer's, as last reported
+  uint64_t failed_seen_ = 0, dropped_seen_ = 0, problems_seen_ = 0;  // the open writer's, as last reported
   std::string index_error_seen_;
   bool index_flush_asked_ = false;      // since input last came
 };

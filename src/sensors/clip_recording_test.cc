@@ -365,6 +365,26 @@ TEST_F(ClipRecordingTest, AFailedWriteIsSaidOnceAndCounted) {
   EXPECT_EQ(r.tally().recorded, 1u);
 }
 
+// A clip recorded whose index update failed (a folder where index.json goes) is recorded, not
+// "not recorded", and the next Poll says the problem, once.
+TEST_F(ClipRecordingTest, AClipRecordedWithAProblemIsCountedRecordedAndTheProblemSaid) {
+  ClipRecording::Options o = Options();
+  o.index_interval = 0;  // every clip rewrites the index
+  ClipRecording r(o, Log(), 100.0);
+  ASSERT_TRUE(r.open());
+  fs::remove(dir_ / "index.json");
+  fs::create_directories(dir_ / "index.json" / "blocker");
+  r.Record(MakeClip(0), {});
+  WaitWritten(r);
+  const auto problems = r.Poll(101.0, false);
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("recorded, but"), std::string::npos) << problems[0];
+  EXPECT_TRUE(r.Poll(102.0, false).empty());
+  EXPECT_EQ(r.tally().recorded, 1u);
+  EXPECT_EQ(r.tally().not_recorded, 0u);
+  fs::remove_all(dir_ / "index.json");
+}
+
 // Input stopped (a replay ended): the clips written since the last index rewrite are listed now,
 // not after index_interval.
 TEST_F(ClipRecordingTest, InputStoppingListsTheClipsWritten) {

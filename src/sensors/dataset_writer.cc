@@ -279,6 +279,7 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
   const std::string final_dir = root_ + "/" + name;
   const std::string tmp_dir = TemporaryNameFor(root_ + "/." + name);
   bool replaced = false;
+  std::vector<std::string> problems;  // after the clip is in place
   std::error_code ec;
   fs::create_directory(tmp_dir, ec);
   if (ec) throw std::runtime_error("cannot create " + tmp_dir + ": " + ec.message());
@@ -309,11 +310,15 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
         fs::rename(old_dir, final_dir, ec);
         throw;
       }
-      fs::remove_all(old_dir);
+      // The clip is in place from here: a failure now is the old copy's, not the clip's (it was
+      // counted a failed write, and the index kept the old copy's entry for good).
+      fs::remove_all(old_dir, ec);
+      if (ec)
+        problems.push_back("the copy it replaced, " + old_dir + ", was not removed (" + ec.message() +
+                           "; the next opening of the folder removes it)");
     } else {
       fs::rename(tmp_dir, final_dir);
     }
-    SyncDirectory(root_);
     auto& clips = index_["clips"];
     for (auto it = clips.begin(); it != clips.end(); ++it) {
       if ((*it)["name"] == name) {
@@ -330,15 +335,25 @@ std::string DatasetWriter::Write(const LabelledClip& clip, const ClipSourceInfo&
     fs::remove_all(tmp_dir, ec);
     throw;
   }
-  if (index_interval_ > 0 && !replaced && last_index_write_ &&
-      now_() - *last_index_write_ < std::chrono::duration<double>(index_interval_))
-    return final_dir;  // listed by a later rewrite
   try {
-    WriteIndex();
+    SyncDirectory(root_);
   } catch (const std::exception& e) {
-    // The clip is in place and in the index held here: the next index written lists it.
-    throw std::runtime_error("clip " + name + " recorded but " + root_ + "/index.json not updated (the next clip's "
-                             "update will list it): " + e.what());
+    problems.push_back(std::string("its folder's entry may not survive a power cut: ") + e.what());
+  }
+  const bool index_due = !(index_interval_ > 0 && !replaced && last_index_write_ &&
+                           now_() - *last_index_write_ < std::chrono::duration<double>(index_interval_));
+  if (index_due) {  // else listed by a later rewrite
+    try {
+      WriteIndex();
+    } catch (const std::exception& e) {
+      // The clip is in place and in the index held here: the next index written lists it.
+      problems.push_back(root_ + "/index.json not updated (the next clip's update will list it): " + e.what());
+    }
+  }
+  if (!problems.empty()) {
+    std::string what = "clip " + name + " recorded, but ";
+    for (size_t i = 0; i < problems.size(); ++i) what += (i ? "; and " : "") + problems[i];
+    throw ClipRecordedWithAProblem(what);
   }
   return final_dir;
 }

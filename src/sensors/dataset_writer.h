@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,14 @@ struct ClipSourceInfo {
 // or a lost frame shifts: each pass recorded every clip again under new names, and datasets
 // counted them once a pass.)
 std::string ClipFolderName(double first_stamp);
+
+// DatasetWriter::Write's clip is recorded (in place, and in the index the writer holds) but what
+// followed failed: the message says what (an index rewrite, the replaced copy's removal, the
+// folder's sync). Not a failed write: counting it as one called a clip on disk not recorded.
+class ClipRecordedWithAProblem : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 // Whether `dir` is a mount point: on another device than its parent folder ("/" is not; a
 // trailing separator names the same folder). A recording folder that was one is reopened after
@@ -83,8 +92,10 @@ class DatasetWriter {
   // Writes one clip; returns the path of its folder. Refused when the folder is no longer the one
   // opened (a disk mounted over it, the folder moved): its index would replace the other's. A folder of the same name is replaced (the
   // same session replayed again; if that fails the old folder stays). Throws std::runtime_error
-  // naming the file that failed; nothing half-written is left behind. When only the index update
-  // failed the message says so: the clip is in place and the next index written lists it.
+  // naming the file that failed; nothing half-written is left behind. When the clip is in place
+  // but what follows failed (the index update, removing the copy it replaced, syncing the folder)
+  // it throws ClipRecordedWithAProblem saying what: the clip is recorded, in the index held here,
+  // and the next index written lists it.
   // index.json is rewritten unless the last rewrite was less than index_interval ago and the clip
   // is new (a clip replaced is listed at once: the next writer to open the folder would list a
   // missing clip, but not correct a stale entry).

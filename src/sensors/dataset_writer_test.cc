@@ -1,5 +1,8 @@
 #include "sensors/dataset_writer.h"
 
+#include <fcntl.h>
+#include <linux/fs.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -338,7 +341,7 @@ TEST_F(DatasetWriterTest, FailedIndexUpdateIsToldAndCaughtUpNextTime) {
   std::string message;
   try {
     w.Write(MakeClip(1, 1700000001.2), {});
-  } catch (const std::runtime_error& e) {
+  } catch (const ClipRecordedWithAProblem& e) {  // recorded: not a failed write
     message = e.what();
   }
   EXPECT_NE(message.find("index.json not updated"), std::string::npos) << message;
@@ -347,6 +350,44 @@ TEST_F(DatasetWriterTest, FailedIndexUpdateIsToldAndCaughtUpNextTime) {
   fs::remove_all(root_ / "index.json");
   w.Write(MakeClip(2, 1700000002.4), {});
   EXPECT_EQ(Read(root_ / "index.json")["clips"].size(), 3u);
+}
+
+// A clip replayed again replaces its folder; the old copy cannot be removed (a file of it made
+// immutable, which binds root, where permissions do not): the new clip is in place and listed, and
+// the problem is said as the old copy's (it was a failed write, and the index kept the old entry).
+TEST_F(DatasetWriterTest, AReplacedCopyThatCannotBeRemovedLeavesTheNewClipRecordedAndListed) {
+  DatasetWriter w(root_.string());
+  w.Write(MakeClip(0, 1700000000.0, 4), {});
+  const fs::path clip_dir = root_ / ClipFolderName(1700000000.0);
+  const fs::path pinned = clip_dir / "000.jpg";
+  auto set_immutable = [](const fs::path& file, bool on) {
+    const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return false;
+    int flags = 0;
+    bool ok = ::ioctl(fd, FS_IOC_GETFLAGS, &flags) == 0;
+    flags = on ? (flags | FS_IMMUTABLE_FL) : (flags & ~FS_IMMUTABLE_FL);
+    ok = ok && ::ioctl(fd, FS_IOC_SETFLAGS, &flags) == 0;
+    ::close(fd);
+    return ok;
+  };
+  if (!set_immutable(pinned, true)) GTEST_SKIP() << "cannot make a file immutable here (not root, or the filesystem)";
+  std::string message;
+  try {
+    w.Write(MakeClip(0, 1700000000.0, 6), {});  // the same first frame: the same clip, replaced
+    ADD_FAILURE() << "the old copy's removal failed and nothing was said";
+  } catch (const ClipRecordedWithAProblem& e) {
+    message = e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "the new clip counted as not recorded: " << e.what();
+  }
+  // Unpin the old copy (now under a hidden name) so that it, and the test's folder, can go.
+  for (const auto& entry : fs::directory_iterator(root_))
+    if (fs::exists(entry.path() / "000.jpg")) set_immutable(entry.path() / "000.jpg", false);
+  EXPECT_NE(message.find("the copy it replaced"), std::string::npos) << message;
+  EXPECT_EQ(Read(clip_dir / "label.json")["num_frames"], 6);  // the new copy in place
+  const nlohmann::json index = Read(root_ / "index.json");
+  ASSERT_EQ(index["clips"].size(), 1u);
+  EXPECT_EQ(index["clips"][0]["num_frames"], 6) << index.dump();
 }
 
 // One writer a folder (each rewrites the whole index from what it holds): a second is refused
