@@ -70,6 +70,20 @@ ParseResult AnemometerDecoder::Decode(const std::string& record, AnemometerProto
   if (p == AnemometerProtocol::kAuto) p = ClassifyAnemometerRecord(record);
   if (used) *used = p;
   ParseResult r = ParseAnemometerRecord(record, p);
+  if (p == AnemometerProtocol::kNmea && (r.status == ParseStatus::kOk || r.status == ParseStatus::kNotWind)) {
+    if (record.find('*') != std::string::npos) {
+      ++nmea_checksummed_;
+      nmea_unchecked_run_ = 0;
+    } else if (nmea_checksummed_ >= lock_after_) {
+      if (++nmea_unchecked_run_ >= unlock_after_) {
+        nmea_checksummed_ = nmea_unchecked_run_ = 0;  // reconfigured: sentences without are the norm now
+      } else {
+        r = ParseResult();
+        r.status = ParseStatus::kChecksumError;
+        r.error = "NMEA: no checksum, where this instrument's sentences carry one (its '*' lost to line noise?)";
+      }
+    }
+  }
   const bool good = r.status == ParseStatus::kOk || r.status == ParseStatus::kNotWind;
   // Good records of one protocol with none of another between them: line noise and checksum
   // failures between them count neither way (a noisy line still locks), but a good record of

@@ -51,7 +51,10 @@ struct DecoderCounters {
 // consecutive good records of one protocol the decoder locks onto it and rejects records of other
 // protocols (noise that happens to look like a CSV line cannot then produce readings). After
 // `unlock_after` consecutive good records of one other protocol it switches (the instrument was
-// reconfigured).
+// reconfigured). NMEA checksums are optional, but an instrument that sends them sends them on
+// every sentence: once `lock_after` good sentences carried one, a sentence without (its '*' lost
+// to line noise, and with it the check of every other byte) is a checksum failure, until
+// `unlock_after` such sentences in a row would have been good (the instrument was reconfigured).
 class AnemometerDecoder {
  public:
   // Inputs:
@@ -82,6 +85,8 @@ class AnemometerDecoder {
   int candidate_count_ = 0;
   int lock_after_;
   int unlock_after_;
+  int nmea_checksummed_ = 0;  // good NMEA sentences with a checksum since the last without were accepted
+  int nmea_unchecked_run_ = 0;  // good-looking NMEA sentences without one in a row, refused
   DecoderCounters counters_;
   std::string last_error_;
 };

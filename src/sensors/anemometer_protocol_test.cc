@@ -134,6 +134,30 @@ TEST(AnemometerDecoder, NmeaWithoutWindCountsTowardsLockButGivesNoReading) {
   EXPECT_EQ(d.counters().not_wind, 3u);
 }
 
+// An instrument that sends NMEA checksums sends them on every sentence: after three with one, a
+// sentence without (its '*' lost to line noise, so nothing of it was checked: an XDR's free-form
+// last field took "WINDSPEED+49" as a name) is a checksum failure. Ten good-looking sentences
+// without one in a row are an instrument reconfigured, and are read from then on; a stream that
+// never sent checksums is read throughout.
+TEST(AnemometerDecoder, NmeaWithoutAChecksumFromAnInstrumentThatSendsThemIsAChecksumFailure) {
+  const std::string bare = "$IIMWV,229.0,R,5.8,N,A";
+  AnemometerDecoder d;
+  for (int i = 0; i < 3; ++i) ASSERT_EQ(d.Decode(kMwv).status, ParseStatus::kOk);
+  const ParseResult r = d.Decode(bare);
+  EXPECT_EQ(r.status, ParseStatus::kChecksumError) << r.error;
+  EXPECT_NE(r.error.find("no checksum"), std::string::npos) << r.error;
+  EXPECT_EQ(d.counters().checksum_failures, 1u);
+  const std::string xdr = "$WIXDR,A,225.0,D,WINDDIR,N,7.5,M,WINDSPEED+49";  // the '*' flipped to '+'
+  EXPECT_EQ(d.Decode(xdr).status, ParseStatus::kChecksumError);
+  EXPECT_EQ(d.Decode("$IIMWV,12").status, ParseStatus::kMalformed);  // malformed is said as such
+  EXPECT_EQ(d.Decode(kMwv).status, ParseStatus::kOk);
+  // Reconfigured to send none: refused until ten in a row would have been good.
+  for (int i = 1; i < 10; ++i) EXPECT_EQ(d.Decode(bare).status, ParseStatus::kChecksumError) << i;
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(d.Decode(bare).status, ParseStatus::kOk) << i;
+  AnemometerDecoder never;
+  for (int i = 0; i < 20; ++i) EXPECT_EQ(never.Decode(bare).status, ParseStatus::kOk) << i;
+}
+
 TEST(AnemometerDecoder, FixedProtocolParsesEverythingWithIt) {
   AnemometerDecoder d(AnemometerProtocol::kCsv);
   EXPECT_EQ(d.protocol(), AnemometerProtocol::kCsv);
