@@ -59,6 +59,20 @@ for bad in "area_weight=abc" "nosuch=1" "area_weight=-1" "area_weight" "area_wei
   left="$(cd "$work/rerun" && LC_ALL=C ls)"
   [ "$left" = "$(printf 'summary.json\ntrajectory.cwtraj')" ] || fail "simulate --param $bad removed the earlier run: $left"
 done
+# So are a --warmup or --turbulence out of range, or a warm-up that is not whole frames (0.03 s
+# at 0.04 s frames ran as 0.04 s), naming the option: they were refused after the earlier run
+# was removed, naming no option, or ran and failed steps later ("non-finite force").
+for bad in "--warmup 4000" "--warmup nan" "--warmup 0.03" "--turbulence 50,1" "--turbulence 0.1,1e-300" \
+           "--turbulence -0.1,10"; do
+  status=0
+  # shellcheck disable=SC2086
+  "$bin" simulate "$src/config/scenes/flag.json" --out "$work/rerun" --duration 0.04 --max-edge 1 $bad \
+    >"$work/out.txt" 2>&1 || status=$?
+  [ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "${bad%% *}" "$work/out.txt" ||
+    fail "simulate $bad was not refused naming it (status $status): $(cat "$work/out.txt")"
+  left="$(cd "$work/rerun" && LC_ALL=C ls)"
+  [ "$left" = "$(printf 'summary.json\ntrajectory.cwtraj')" ] || fail "simulate $bad removed the earlier run: $left"
+done
 if "$bin" render "$work/rerun" --obj --out "$work/rerun-fr" --count 1 --samples 1 --threads 1 >"$work/out.txt" 2>&1; then
   fail "render --obj of a --no-obj run rendered an earlier run's frames"
 fi

@@ -20,6 +20,7 @@
 #include "sim/scene_builder.h"
 #include "sim/simulate.h"
 #include "sim/trajectory_io.h"
+#include "sim/turbulent_wind.h"
 #include "progress_bar.h"
 #include "stale_frames.h"
 #include "verb_registry.h"
@@ -87,11 +88,23 @@ int Run(const SimulateArgs& a) {
   }
   if (!a.turbulence.empty()) {
     const auto v = ParseList(a.turbulence, 2, "--turbulence");
-    if (v[0] < 0 || v[1] <= 0) throw std::invalid_argument("--turbulence: expected I >= 0, L > 0 [m]");
+    // The scene reader's bounds (sim/turbulent_wind.h): 50,1 or 0.1,1e-300 failed steps later
+    // naming neither the option nor the value, after the earlier run in --out was removed.
+    if (!(v[0] >= 0 && v[0] <= sim::kMaxTurbulenceIntensity && v[1] >= sim::kMinTurbulenceLengthScale &&
+          v[1] <= sim::kMaxTurbulenceLengthScale))
+      throw std::invalid_argument("--turbulence: expected I in 0..10 and L in 0.01..10000 m, got " + a.turbulence);
     setup.wind.turbulence.intensity = v[0];
     setup.wind.turbulence.length_scale = v[1];
   }
   sim::SimulateOptions options;
+  // Checked here, naming the option, before anything in --out is removed (SimulateTrajectory's
+  // own check came after, and named no option); a whole number of frames, as make-dataset's: a
+  // warm-up of 0.03 s at 0.04 s frames ran as 0.04 s without a word.
+  if (!(a.warmup >= 0 && a.warmup <= 3600))
+    throw std::invalid_argument("--warmup must be in 0..3600 s, got " + std::to_string(a.warmup));
+  if (std::abs(a.warmup / scene.frame_time - std::round(a.warmup / scene.frame_time)) > 1e-6)
+    throw std::invalid_argument("--warmup must be a whole number of " + a.scene + "'s frames (a multiple of " +
+                                std::to_string(scene.frame_time) + " s), got " + std::to_string(a.warmup) + " s");
   options.warmup = a.warmup;
   // "Not given" is told by the option's count, not a value: --seed -1 and --duration -1 (the old
   // sentinels) ran as if not given, where any other negative was refused.
@@ -194,6 +207,7 @@ int Run(const SimulateArgs& a) {
     s["wall_seconds"] = t.wall_seconds;
     s["simulated_seconds"] = simulated;
     s["recorded_seconds"] = (t.num_frames() - 1) * t.frame_time;
+    s["warmup_seconds"] = a.warmup;  // simulated before frame 0, not recorded
     s["wall_seconds_per_simulated_second"] = simulated > 0 ? t.wall_seconds / simulated : 0.0;
     s["times_real_time"] = t.wall_seconds > 0 ? simulated / t.wall_seconds : 0.0;
     s["trajectory"] = traj;
@@ -225,7 +239,8 @@ const VerbRegistrar kRegistrar{"simulate", [](CLI::App& app) -> std::function<in
   sub->add_option("--out", args->out, "output folder")->required();
   auto* duration = sub->add_option("--duration", args->duration, "simulated seconds, > 0 (default: the scene's)");
   sub->add_option("--wind", args->wind, "mean wind VX,VY,VZ [m/s] (replaces the scene's)");
-  sub->add_option("--turbulence", args->turbulence, "turbulence intensity and length scale I,L [-, m]");
+  sub->add_option("--turbulence", args->turbulence,
+                  "turbulence intensity and length scale I,L [-, m]: I in 0..10, L in 0.01..10000 m");
   auto* seed = sub->add_option("--seed", args->seed, "seed of the wind's turbulence and gusts, >= 0");
   sub->add_option("--max-edge", args->max_edge,
                   "refine uniformly to this edge length [m] (default: the scene's: uniformly to the upper end of its "
@@ -234,8 +249,8 @@ const VerbRegistrar kRegistrar{"simulate", [](CLI::App& app) -> std::function<in
                   "time steps per frame, 0..10000 (0, the default: the scene's; fewer is faster but damps flapping)")
       ->check(CLI::Range(0, 10000));
   sub->add_option("--warmup", args->warmup,
-                  "simulated seconds before the first written frame (the release transient) [s]")
-      ->check(CLI::NonNegativeNumber);
+                  "simulated seconds before the first written frame (the release transient), 0..3600 s in whole "
+                  "frames [s]");
   sub->add_option("--param", args->params, "set a theta entry, NAME=VALUE (repeatable; e.g. area_weight=0.3)");
   sub->add_flag("--no-obj", args->no_obj, "skip the per-frame OBJ files");
   return [args, duration, seed] {

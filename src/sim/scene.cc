@@ -15,6 +15,7 @@
 #include "common/json_file.h"
 #include "sim/json_comments.h"
 #include "sim/strain_limiter.h"
+#include "sim/turbulent_wind.h"
 
 namespace clothwind::sim {
 namespace {
@@ -33,7 +34,7 @@ constexpr double kMaxMultiplier = 1e6;     // thicken and the density/stretching
 constexpr double kMaxDamping = 1000;       // stiffness-proportional damping [s] (cloth: ~0.01 s)
 constexpr double kMaxAirDensity = 1e4;     // wind density [kg/m^3] (water: 1000)
 constexpr double kMaxAirDrag = 1e6;        // wind drag [kg/(m^2 s)]
-constexpr double kMaxTurbulence = 10;      // turbulence intensity and component ratios (~0.1-0.3 outdoors)
+constexpr double kMaxTurbulence = kMaxTurbulenceIntensity;  // intensity and component ratios (~0.1-0.3 outdoors)
 
 const char* TypeName(const json& j) { return j.type_name(); }
 
@@ -345,7 +346,11 @@ TurbulenceParams ParseTurbulence(const Reader& r, const json& j, const std::stri
   if (j.contains("intensity")) {
     t.intensity = r.NonNegativeAtMost(j["intensity"], path + ".intensity", kMaxTurbulence, " (sigma / mean speed)");
   }
-  if (j.contains("length_scale")) t.length_scale = r.Positive(j["length_scale"], path + ".length_scale");
+  if (j.contains("length_scale")) {
+    t.length_scale = r.Number(j["length_scale"], path + ".length_scale");
+    if (!(t.length_scale >= kMinTurbulenceLengthScale && t.length_scale <= kMaxTurbulenceLengthScale))
+      r.Fail(path + ".length_scale", "expected a length in 0.01..10000 m, got " + std::to_string(t.length_scale));
+  }
   if (j.contains("component_ratios")) {
     const auto v = r.Numbers(j["component_ratios"], path + ".component_ratios", 3, 3);
     for (int i = 0; i < 3; ++i) {

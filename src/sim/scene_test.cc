@@ -368,6 +368,9 @@ TEST_F(SceneFiles, PhysicallyAbsurdMagnitudesAreRefusedNamingFileAndField) {
       {"gusts", SceneText(", \"wind\": {\"gusts\": {\"amplitude\": -2000}}"), "wind.gusts.amplitude", "1000 m/s"},
       {"turbulence", SceneText(", \"wind\": {\"turbulence\": {\"intensity\": 1e300}}"), "wind.turbulence.intensity",
        "[0, 10]"},
+      // (1e-300 m: the field's wavenumbers overflowed, "non-finite force" steps later.)
+      {"turbulence_length", SceneText(", \"wind\": {\"turbulence\": {\"length_scale\": 1e-300}}"),
+       "wind.turbulence.length_scale", "0.01..10000 m"},
       {"air", SceneText(", \"wind\": {\"density\": 1e300}"), "wind.density", "kg/m^3"},
   };
   for (const Case& c : cases) {

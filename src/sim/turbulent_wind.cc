@@ -40,11 +40,12 @@ Eigen::Matrix3d WindFrame(const Eigen::Vector3d& mean) {
 
 TurbulentWind::TurbulentWind(const TurbulenceParams& p, const Eigen::Vector3d& mean_velocity)
     : mean_(mean_velocity), frame_(WindFrame(mean_velocity)) {
-  if (!(p.intensity >= 0.0) || !std::isfinite(p.intensity)) {
-    throw std::invalid_argument("turbulence intensity must be finite and >= 0");
+  if (!(p.intensity >= 0.0 && p.intensity <= kMaxTurbulenceIntensity)) {
+    throw std::invalid_argument("turbulence intensity must be in 0.." + std::to_string(kMaxTurbulenceIntensity) +
+                                ", got " + std::to_string(p.intensity));
   }
-  if (!(p.length_scale > 0.0) || !std::isfinite(p.length_scale)) {
-    throw std::invalid_argument("turbulence length_scale must be finite and > 0 [m]");
+  if (!(p.length_scale >= kMinTurbulenceLengthScale && p.length_scale <= kMaxTurbulenceLengthScale)) {
+    throw std::invalid_argument("turbulence length_scale must be in 0.01..10000 m, got " + std::to_string(p.length_scale));
   }
   if (p.modes < 1) throw std::invalid_argument("turbulence needs at least one mode");
   const double sigma_u = p.intensity * mean_velocity.norm();

@@ -8,6 +8,14 @@
 
 namespace clothwind::sim {
 
+// The turbulence a scene or `simulate --turbulence` may ask for: an intensity up to 10 (outdoors
+// ~0.1-0.3) and an integral length scale from 1 cm to 10 km (outdoors ~10-300 m). Below a
+// centimetre the field's wavenumbers outrun any time step, and near 1e-300 m they overflow: such
+// a run failed steps later with "non-finite force", naming neither.
+inline constexpr double kMaxTurbulenceIntensity = 10;
+inline constexpr double kMinTurbulenceLengthScale = 0.01;  // [m]
+inline constexpr double kMaxTurbulenceLengthScale = 1e4;   // [m]
+
 struct TurbulenceParams {
   double intensity = 0.0;     // I = sigma_u / |U| [-] (longitudinal)
   double length_scale = 10.0; // longitudinal integral length scale L_u [m]

@@ -176,6 +176,18 @@ TEST(TurbulentWind, ZeroIntensityIsStillAndBadParamsThrow) {
   p.length_scale = 10;
   p.intensity = std::nan("");
   EXPECT_THROW(TurbulentWind(p, Eigen::Vector3d(5, 0, 0)), std::invalid_argument);
+  // The bounds a scene or simulate --turbulence may ask for: past them the field overflowed (a
+  // length scale of 1e-300 m) or the cloth blew up (an intensity of 50) steps later.
+  p.intensity = 50;
+  EXPECT_THROW(TurbulentWind(p, Eigen::Vector3d(5, 0, 0)), std::invalid_argument);
+  p.intensity = kMaxTurbulenceIntensity;
+  EXPECT_NO_THROW(TurbulentWind(p, Eigen::Vector3d(5, 0, 0)));
+  for (const double L : {1e-300, 0.009, 1e5}) {
+    p.length_scale = L;
+    EXPECT_THROW(TurbulentWind(p, Eigen::Vector3d(5, 0, 0)), std::invalid_argument) << L;
+  }
+  p.length_scale = kMinTurbulenceLengthScale;
+  EXPECT_NO_THROW(TurbulentWind(p, Eigen::Vector3d(5, 0, 0)));
 }
 
 }  // namespace
