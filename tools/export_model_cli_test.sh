@@ -71,6 +71,13 @@ grep -q -- "--calibrate-std $work/noval: the dataset has no val split" "$work/ms
   grep -q "leave --calibrate-std out" "$work/msg.txt" ||
   fail "no val split: the message does not name the option and the way out: $(cat "$work/msg.txt")"
 [ ! -e "$work/noval-export/sdn.pt" ] || fail "no val split: an export was written"
+# --threads without --calibrate-std (only the calibration runs the network) was accepted and ignored.
+status=0
+"$bin" export-model --model "$work/run/model.pt" --out "$work/threads-export/sdn.pt" --threads 7 \
+  >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "--threads requires --calibrate-std" "$work/msg.txt" &&
+  [ ! -e "$work/threads-export/sdn.pt" ] ||
+  fail "export-model --threads 7 without --calibrate-std: not refused (status $status): $(cat "$work/msg.txt")"
 
 "$bin" export-model --model "$work/run/model.pt" --out "$work/export/sdn.pt" --calibrate-std "$work/toy" \
   --threads 1 >"$work/msg.txt" 2>&1 || fail "with a val split: $(cat "$work/msg.txt")"

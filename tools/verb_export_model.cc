@@ -36,10 +36,12 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
   sub->add_option("--precision", a->precision, "precision of the parameters in the file")
       ->check(CLI::IsMember({"float16", "float32"}))
       ->capture_default_str();
-  sub->add_option("--calibrate-std", a->calibrate_data,
-                  "dataset folder whose val split sets the std's scale (errors one std rms)");
-  sub->add_option("--threads", a->threads, "torch threads for the calibration")
+  auto* calibrate = sub->add_option("--calibrate-std", a->calibrate_data,
+                                    "dataset folder whose val split sets the std's scale (errors one std rms)");
+  // Only the calibration runs the network: without it --threads was accepted and did nothing.
+  sub->add_option("--threads", a->threads, "torch threads for the calibration (with --calibrate-std)")
       ->check(CLI::Range(1, 256))
+      ->needs(calibrate)
       ->capture_default_str();
   return [a]() {
     if (std::filesystem::exists(a->out) && std::filesystem::equivalent(a->model, a->out)) {
