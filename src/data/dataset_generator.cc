@@ -58,7 +58,10 @@ void Check(bool ok, const std::string& what) {
 }
 
 void ValidateOptions(const DatasetOptions& o) {
-  Check(o.count >= 0, "--count must be >= 0");
+  // At most a million: an example's name holds six digits of its simulation (flag-000123-v0), and
+  // e5 holds 6,000. 1e11 hung without a word, building its to-do list (~800 GB).
+  Check(o.count >= 0 && o.count <= kMaxSimulations,
+        "--count must be in 0.." + std::to_string(kMaxSimulations) + ", got " + std::to_string(o.count));
   Check(o.views >= 1 && o.views <= 64, "--views must be in 1..64");
   Check(!o.out.empty(), "--out is required");
   Check(o.shards >= 1 && o.shard >= 0 && o.shard < o.shards, "--shard i/N needs 0 <= i < N");
@@ -128,6 +131,7 @@ struct Prepared {
   SamplingRanges ranges;
   std::string scene_name;
   std::string scene_files;  // SceneFilesFingerprint: the contents the examples were simulated from
+  std::string background_files;  // FilesFingerprint of the background photos ("" without photos)
   Eigen::Vector2d rest_size = Eigen::Vector2d::Zero();  // [m] the cloth's material-space extent
 };
 
@@ -136,11 +140,12 @@ struct Prepared {
 // settings named the scene file only, so a scene or material edited between two runs (or two
 // shards) mixed two physics in one dataset without a word. Any byte counts, comments included:
 // resuming is refused rather than trusted.
-std::string SceneFilesFingerprint(const sim::Scene& scene, const std::vector<std::string>& extra_files) {
+// `what` names the kind of file in an error ("a file of the scene").
+std::string FilesFingerprint(const std::vector<std::string>& files, const std::string& what) {
   uint64_t h = 14695981039346656037ull;
   auto add = [&](const std::string& path) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error("cannot read " + path + " (a file of the scene)");
+    if (!in) throw std::runtime_error("cannot read " + path + " (" + what + ")");
     char buffer[65536];
     while (in.read(buffer, sizeof(buffer)) || in.gcount() > 0) {
       for (std::streamsize k = 0; k < in.gcount(); ++k) {
@@ -151,15 +156,20 @@ std::string SceneFilesFingerprint(const sim::Scene& scene, const std::vector<std
     h ^= 0xff;  // a file boundary, so moving bytes between files changes the value
     h *= 1099511628211ull;
   };
-  add(scene.path);
-  for (const auto& cloth : scene.cloths) {
-    add(cloth.mesh);
-    for (const auto& m : cloth.materials) add(m.data);
-  }
-  for (const auto& f : extra_files) add(f);
+  for (const auto& f : files) add(f);
   char text[32];
   std::snprintf(text, sizeof(text), "fnv1a64:%016llx", static_cast<unsigned long long>(h));
   return text;
+}
+
+std::string SceneFilesFingerprint(const sim::Scene& scene, const std::vector<std::string>& extra_files) {
+  std::vector<std::string> files = {scene.path};
+  for (const auto& cloth : scene.cloths) {
+    files.push_back(cloth.mesh);
+    for (const auto& m : cloth.materials) files.push_back(m.data);
+  }
+  files.insert(files.end(), extra_files.begin(), extra_files.end());
+  return FilesFingerprint(files, "a file of the scene");
 }
 
 std::vector<std::string> FabricNames(const std::vector<Fabric>& fabrics) {
@@ -209,6 +219,9 @@ Prepared Prepare(const DatasetOptions& o) {
   std::vector<std::string> fabric_files;
   for (const auto& f : p.fabrics) fabric_files.push_back(f.path);
   p.scene_files = SceneFilesFingerprint(scene, fabric_files);
+  // The photos' bytes too: the settings name them by file name alone, so a resume (or a shard on
+  // another machine) with other photos of the same names mixed two backdrops in one dataset.
+  if (!o.background_images.empty()) p.background_files = FilesFingerprint(o.background_images, "a background photo");
   return p;
 }
 
@@ -549,7 +562,8 @@ void CheckCompatible(const std::string& dir, const nlohmann::json& settings, con
                              ")");
   }
   for (auto it = settings.begin(); it != settings.end(); ++it) {
-    if (it.key() == ignored || (it.key() == "scene_files" && !old.contains(it.key()))) continue;
+    if (it.key() == ignored || ((it.key() == "scene_files" || it.key() == "background_files") && !old.contains(it.key())))
+      continue;
     if (!old.contains(it.key()) || old[it.key()] != it.value())
       throw std::runtime_error((fs::path(dir) / "index.json").string() + ": field 'dataset." + it.key() +
                                "' is " + (old.contains(it.key()) ? old[it.key()].dump() : "missing") +
@@ -560,6 +574,9 @@ void CheckCompatible(const std::string& dir, const nlohmann::json& settings, con
                                     : it.key() == "scene_files"
                                           ? " (the scene, a mesh or a material file changed since the dataset was "
                                             "made: restore them, or use another --out)"
+                                    : it.key() == "background_files"
+                                          ? " (the background photos differ from those the dataset was made with, "
+                                            "though named alike: give those, or use another --out)"
                                           : it.key() == "generator_version"
                                                 ? " (an older make-dataset made those frames, and this one "
                                                   "renders them differently: make the dataset again in another "
@@ -705,7 +722,7 @@ std::vector<Fabric> LoadFabrics(const std::string& folder, const std::string& sc
 }
 
 nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<std::string>& fabric_names,
-                                   const std::string& scene_files) {
+                                   const std::string& scene_files, const std::string& background_files) {
   const std::string scene_path = o.scene.empty() ? DefaultScenePath(o.kind) : o.scene;
   nlohmann::json backgrounds = nlohmann::json::array();
   for (const auto& b : o.background_images) backgrounds.push_back(fs::path(b).filename().string());
@@ -729,6 +746,7 @@ nlohmann::json DatasetSettingsJson(const DatasetOptions& o, const std::vector<st
           {"generator_version", kGeneratorVersion}};
   if (o.tracks) settings["tracks"] = {o.tracks->cols, o.tracks->rows};
   if (!scene_files.empty()) settings["scene_files"] = scene_files;
+  if (!background_files.empty()) settings["background_files"] = background_files;
   // ClothSim's wind has one direction since 2026-12-06; a folder made with directions over the
   // circle lacks this and is refused on resume rather than mixed.
   if (o.kind == render::SceneKind::kCloth) settings["wind_direction_deg"] = kClothWindAzimuth * 180 / M_PI;
@@ -788,7 +806,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCal
   ValidateOptions(o);
   const auto start = Clock::now();
   const Prepared prep = Prepare(o);
-  nlohmann::json settings = DatasetSettingsJson(o, FabricNames(prep.fabrics), prep.scene_files);
+  nlohmann::json settings = DatasetSettingsJson(o, FabricNames(prep.fabrics), prep.scene_files, prep.background_files);
   const nlohmann::json existing = ReadIndex(o.out);
   if (o.add_tracks && existing.is_null())
     throw std::runtime_error("--add-tracks: " + (fs::path(o.out) / "index.json").string() +

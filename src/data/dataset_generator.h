@@ -15,6 +15,9 @@
 
 namespace clothwind::data {
 
+// The most simulations one dataset holds (an example's name holds six digits of its index).
+inline constexpr int64_t kMaxSimulations = 1000000;
+
 // `clothwind make-dataset`: FlagSim / ClothSim datasets (docs/datasets.md).
 //
 // Simulation i (0 <= i < count) draws θ from SimulationSeed(seed, i), is simulated past the
@@ -26,7 +29,7 @@ namespace clothwind::data {
 // renamed into place).
 struct DatasetOptions {
   render::SceneKind kind = render::SceneKind::kFlag;
-  int64_t count = 0;           // simulations (examples = count × views)
+  int64_t count = 0;           // simulations (examples = count × views), at most kMaxSimulations
   int views = 1;               // camera poses per simulation
   std::string out;             // dataset folder (created)
   uint64_t seed = 1;           // global seed
@@ -116,10 +119,11 @@ DatasetSummary GenerateDataset(const DatasetOptions& options,
 
 // The settings block ("dataset") stored in index.json: everything that defines the examples'
 // content (not shard, jobs or count), so resumed runs and shards can check they agree.
-// `scene_files`: the fingerprint of the scene's files ("" leaves it out; GenerateDataset gives it).
+// `scene_files`, `background_files`: the fingerprints of the scene's files and of the background
+// photos' ("" leaves one out; GenerateDataset gives them).
 nlohmann::json DatasetSettingsJson(const DatasetOptions& options,
                                    const std::vector<std::string>& fabric_names,
-                                   const std::string& scene_files = "");
+                                   const std::string& scene_files = "", const std::string& background_files = "");
 
 // Rebuilds DIR/index.json (and the contact sheet) from the example folders present, keeping the
 // existing header: the final merge after shards ran on several machines.

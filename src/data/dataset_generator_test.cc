@@ -459,6 +459,35 @@ TEST_F(DatasetGeneratorTest, AnEditedSceneIsNotMixedIn) {
   EXPECT_TRUE(nlohmann::json::parse(Bytes(dir / "index.json"))["dataset"].contains("scene_files"));
 }
 
+// Background photos are named by file name in the settings; other photos of the same names (a
+// resume, or a shard on a machine whose folder differs) are refused by their bytes, not mixed in.
+TEST_F(DatasetGeneratorTest, OtherBackgroundPhotosOfTheSameNamesAreNotMixedIn) {
+  const fs::path red = root_ / "photos-red", blue = root_ / "photos-blue";
+  for (const auto& [folder, colour] : {std::pair{red, cv::Scalar(0, 0, 255)}, std::pair{blue, cv::Scalar(255, 0, 0)}}) {
+    fs::create_directories(folder);
+    ASSERT_TRUE(cv::imwrite((folder / "p.png").string(), cv::Mat(48, 64, CV_8UC3, colour)));
+  }
+  const fs::path dir = root_ / "photos";
+  DatasetOptions o = Tiny(dir.string());
+  o.count = 1;
+  o.background_images = {(red / "p.png").string()};
+  ASSERT_EQ(GenerateError(o), "");
+  const nlohmann::json header = nlohmann::json::parse(Bytes(dir / "index.json"))["dataset"];
+  ASSERT_TRUE(header.contains("background_files")) << header.dump();
+  o.count = 2;
+  o.background_images = {(blue / "p.png").string()};
+  const std::string error = GenerateError(o);
+  EXPECT_NE(error.find("field 'dataset.background_files'"), std::string::npos) << error;
+  EXPECT_FALSE(fs::exists(dir / "flag-000001-v0"));
+  // The same photos again resume; a header made before the fingerprint is taken as it is.
+  o.background_images = {(red / "p.png").string()};
+  nlohmann::json index = nlohmann::json::parse(Bytes(dir / "index.json"));
+  index["dataset"].erase("background_files");
+  std::ofstream(dir / "index.json") << index.dump(2) << "\n";
+  EXPECT_EQ(GenerateError(o), "");
+  EXPECT_TRUE(fs::exists(dir / "flag-000001-v0"));
+}
+
 TEST_F(DatasetGeneratorTest, ALiveRunsTemporaryFolderIsLeftAlone) {
   // A run of another split into the same folder may be writing this shard's simulations: its
   // folders were removed under it (its rename then failed). Only a stopped process's go.
@@ -486,9 +515,13 @@ TEST_F(DatasetGeneratorTest, AnExampleFolderWithoutItsLabelIsMadeAgain) {
   // A copy that went in the folder's hashed order: the label came, a frame did not. It was counted
   // complete and indexed.
   fs::remove(dir / "flag-000002-v0" / "003.jpg");
+  // The file being copied when the copy stopped: there, but cut short (each format's ending, and
+  // an empty file: FrameFileWholeTest). It was counted complete and indexed, and readers failed on
+  // it later.
+  fs::resize_file(dir / "flag-000000-v0" / "004.jpg", 100);
   const DatasetSummary s = GenerateDataset(Tiny(dir.string()));
   ASSERT_TRUE(s.errors.empty()) << s.errors[0];
-  EXPECT_EQ(s.examples_written, 2);
+  EXPECT_EQ(s.examples_written, 3);
   EXPECT_EQ(Files(dir), Files(Ref()));
 }
 
@@ -1052,6 +1085,14 @@ TEST(DatasetOptionsTest, BadOptionsAreRejected) {
   EXPECT_THROW(GenerateDataset(o), std::invalid_argument);
   o.warmup = warmup;
   o.frame_ext = "jpg";
+  o.count = 100000000000;  // hung without a word, building a to-do list of 1e11 entries
+  try {
+    GenerateDataset(o);
+    ADD_FAILURE() << "--count 1e11 was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--count must be in 0..1000000"), std::string::npos) << e.what();
+  }
+  o.count = 1;
   // Split fractions that cannot be: refused before the folder's header records them.
   o.val_fraction = 0.9;
   o.test_fraction = 0.5;

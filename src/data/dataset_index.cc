@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <tuple>
 #include <vector>
@@ -208,11 +209,39 @@ void CheckLabelAgainstSettings(const std::string& path, const nlohmann::json& la
 
 std::string FramePattern(const std::string& ext) { return "%03d." + ext; }
 
+bool FrameFileWhole(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return false;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size <= 0) return false;
+  const std::string ext = file.extension().string();
+  auto ends_with = [&](const std::string& tail) {
+    if (size < static_cast<std::streamoff>(tail.size())) return false;
+    std::string last(tail.size(), '\0');
+    in.seekg(size - static_cast<std::streamoff>(tail.size()));
+    return static_cast<bool>(in.read(last.data(), static_cast<std::streamsize>(last.size()))) && last == tail;
+  };
+  if (ext == ".jpg" || ext == ".jpeg") return ends_with("\xFF\xD9");
+  if (ext == ".png") return ends_with(std::string("IEND\xAE\x42\x60\x82", 8));
+  if (ext == ".pgm") {
+    // "P5 <width> <height> <maxval>" and one whitespace byte, then the pixels (2 bytes each past 255).
+    in.seekg(0);
+    std::string magic;
+    int64_t width = 0, height = 0, maxval = 0;
+    if (!(in >> magic >> width >> height >> maxval) || magic != "P5" || width <= 0 || height <= 0 || maxval <= 0)
+      return false;
+    const std::streamoff header = static_cast<std::streamoff>(in.tellg()) + 1;
+    return size >= header + width * height * (maxval > 255 ? 2 : 1);
+  }
+  return true;
+}
+
 bool FramesPresent(const fs::path& folder, int64_t frames, const std::string& pattern) {
   std::vector<char> name(pattern.size() + 32);
   for (int64_t k = 0; k < frames; ++k) {
     std::snprintf(name.data(), name.size(), pattern.c_str(), static_cast<int>(k));
-    if (!fs::exists(folder / name.data())) return false;
+    if (!FrameFileWhole(folder / name.data())) return false;
   }
   return true;
 }

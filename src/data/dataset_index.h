@@ -67,14 +67,21 @@ nlohmann::json IndexEntry(const nlohmann::json& label);
 // label.json's frame_pattern.
 std::string FramePattern(const std::string& ext);
 
-// Whether an example folder holds all its frames: an interrupted copy (cp goes in the folder's
-// hashed order, so label.json can come before 047.jpg) leaves a label beside missing frames.
+// Whether an example folder holds all its frames, whole: an interrupted copy (cp goes in the
+// folder's hashed order, so label.json can come before 047.jpg) leaves a label beside missing
+// frames, and the frame it was copying cut short (or empty).
 // Inputs:
 //   folder   the example's folder
 //   frames   how many (0 .. frames-1)
 //   pattern  the frame file pattern, label.json's frame_pattern (a valid one: ValidFramePattern)
-// Returns false at the first frame file that is not there.
+// Returns false at the first frame file that is not there or not whole (FrameFileWhole).
 bool FramesPresent(const std::filesystem::path& folder, int64_t frames, const std::string& pattern);
+
+// Whether an image file ends as a whole one does, judged by its ending, not by decoding it (a
+// resume reads every frame of every example): a JPEG's end-of-image marker (FF D9), a PNG's IEND
+// chunk, a binary PGM's size from its header; another extension: not empty.
+// Inputs: file  the image's path. Returns false for a file that is missing, empty or cut short.
+bool FrameFileWhole(const std::filesystem::path& file);
 
 // Rebuilds index.json of `dir` from the example folders present (every non-hidden subfolder
 // with a label.json), sorted by name, so that any set of runs (shards, resumed runs) that left

@@ -6,6 +6,8 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "render/render_params.h"
 
@@ -35,6 +37,28 @@ TEST(SimExampleLabelTest, RecordsTheBackgroundPhotoByItsFileNameAlone) {
   // Procedural backdrops name none.
   zeta.background_image.clear();
   EXPECT_EQ(SimExampleLabel("flag-000001-v0", s, zeta, info)["zeta"]["background_image"], "");
+}
+
+// A frame is whole by its ending: each format the generator writes, whole, one byte short, and
+// empty (the file an interrupted copy was writing), and a missing one.
+TEST(FrameFileWholeTest, EachFormatWholeIsAndCutShortOrEmptyIsNot) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("clothwind_frame_whole_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  cv::Mat image(24, 32, CV_8UC1);
+  cv::randu(image, 0, 256);
+  for (const char* ext : {"jpg", "png", "pgm"}) {
+    SCOPED_TRACE(ext);
+    const std::filesystem::path file = dir / (std::string("000.") + ext);
+    ASSERT_TRUE(cv::imwrite(file.string(), image));
+    EXPECT_TRUE(FrameFileWhole(file));
+    std::filesystem::resize_file(file, std::filesystem::file_size(file) - 1);
+    EXPECT_FALSE(FrameFileWhole(file));
+    std::filesystem::resize_file(file, 0);
+    EXPECT_FALSE(FrameFileWhole(file));
+  }
+  EXPECT_FALSE(FrameFileWhole(dir / "missing.jpg"));
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ReadLabelTest, AFrameCountBeyondAnyClipIsRefused) {
