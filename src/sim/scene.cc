@@ -325,7 +325,15 @@ ShearProfile ParseShear(const Reader& r, const json& j, const std::string& path)
   if (j.contains("reference_height")) {
     s.reference_height = r.Positive(j["reference_height"], path + ".reference_height");
   }
-  if (j.contains("ground_z")) s.ground_z = r.Number(j["ground_z"], path + ".ground_z");
+  // Required with a profile: the scene's z is not height above the ground. The flag scene's hoist
+  // runs z 0..2 and FlagSim mounts it 4.6 m up, so its ground is at z -4.6; the old default 0 put
+  // the ground at the hoist's foot, and `"shear": {}` left the flag hanging in almost no wind.
+  if (j.contains("ground_z")) {
+    s.ground_z = r.Number(j["ground_z"], path + ".ground_z");
+  } else if (s.kind != ShearProfile::Kind::kNone) {
+    r.Fail(path + ".ground_z", "expected the ground's z in the scene's frame [m] (required with a profile: z is "
+                               "not height above the ground; a flag hoisted 4.6 m up at z 0 has its ground at -4.6)");
+  }
   if (s.kind == ShearProfile::Kind::kLog && s.reference_height <= s.roughness) {
     r.Fail(path + ".reference_height", "must exceed the roughness length");
   }

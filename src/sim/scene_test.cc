@@ -199,7 +199,7 @@ TEST_F(SceneFiles, ValidSceneWithCommentsTransformAndExtensions) {
           SceneText(",\n /* wind with our extensions */ \"wind\": {\"velocity\": [2, 0, 0],"
                     " \"drag\": 0.5, \"turbulence\": {\"intensity\": 0.1, \"length_scale\": 30,"
                     " \"seed\": 4}, \"gusts\": {\"rate\": 0.1, \"amplitude\": 1.5},"
-                    " \"shear\": {\"profile\": \"log\", \"roughness\": 0.05}}",
+                    " \"shear\": {\"profile\": \"log\", \"roughness\": 0.05, \"ground_z\": -4.6}}",
                     "\"transform\": {\"translate\": [1, 2, 3], \"rotate\": [90, 0, 0, 1],"
                     " \"scale\": 2},"));
   const Scene s = LoadScene(path, w.sink());
@@ -208,6 +208,7 @@ TEST_F(SceneFiles, ValidSceneWithCommentsTransformAndExtensions) {
   EXPECT_DOUBLE_EQ(s.wind.turbulence.intensity, 0.1);
   EXPECT_EQ(s.wind.turbulence.seed, 4u);
   EXPECT_EQ(s.wind.shear.kind, ShearProfile::Kind::kLog);
+  EXPECT_DOUBLE_EQ(s.wind.shear.ground_z, -4.6);
   // Found in the scene folder's parent (ArcSim's root), as ArcSim's relative paths are.
   EXPECT_EQ(fs::path(s.cloths[0].mesh), (root_ / "meshes/quad.obj").lexically_normal());
   const SceneSetup setup = BuildScene(s);
@@ -371,6 +372,10 @@ TEST_F(SceneFiles, PhysicallyAbsurdMagnitudesAreRefusedNamingFileAndField) {
       // (1e-300 m: the field's wavenumbers overflowed, "non-finite force" steps later.)
       {"turbulence_length", SceneText(", \"wind\": {\"turbulence\": {\"length_scale\": 1e-300}}"),
        "wind.turbulence.length_scale", "0.01..10000 m"},
+      // A profile without its ground: z 0 was taken as the ground, the flag's foot, and the flag
+      // hung in almost no wind.
+      {"shear_ground", SceneText(", \"wind\": {\"velocity\": [3, 0, 0], \"shear\": {}}"), "wind.shear.ground_z",
+       "required with a profile"},
       {"air", SceneText(", \"wind\": {\"density\": 1e300}"), "wind.density", "kg/m^3"},
   };
   for (const Case& c : cases) {

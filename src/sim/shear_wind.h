@@ -12,7 +12,7 @@ struct ShearProfile {
   double exponent = 1.0 / 7.0;     // power law alpha [-] (1/7: open terrain)
   double roughness = 0.03;         // log law roughness length z0 [m] (0.03: open grass)
   double reference_height = 4.6;   // height above ground where the mean wind is given [m]
-  double ground_z = 0.0;           // world z of the ground [m]
+  double ground_z = 0.0;           // world z of the ground [m] (a scene must give it with a profile)
 
   // Returns U(h)/U(reference_height) at world height z: (h/h_ref)^alpha or
   // ln(h/z0)/ln(h_ref/z0), with h = z - ground_z; 0 at or below the ground (or below z0 for
