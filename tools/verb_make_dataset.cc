@@ -165,7 +165,8 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
                                  "label; resumable, parallel, shardable");
   sub->add_option("--kind", a->kind, "flag (FlagSim) or cloth (ClothSim)")
       ->check(CLI::IsMember({"flag", "cloth"}))->capture_default_str();
-  sub->add_option("--count", a->o.count, "number of simulations, at most 1000000 (examples = count x views); required unless --reindex");
+  sub->add_option("--count", a->o.count,
+                  "number of simulations, at most 1000000 (examples = count x views); required unless --reindex");
   sub->add_option("--out", a->o.out, "dataset folder")->required();
   sub->add_option("--seed", a->o.seed, "global seed (0..2^64-1)")->check(CLI::NonNegativeNumber)->capture_default_str();
   sub->add_option("--shard", a->shard, "i/N: do the simulations with index % N == i")->capture_default_str();

@@ -229,7 +229,9 @@ bool FrameFileWhole(const fs::path& file) {
     in.seekg(0);
     std::string magic;
     int64_t width = 0, height = 0, maxval = 0;
-    if (!(in >> magic >> width >> height >> maxval) || magic != "P5" || width <= 0 || height <= 0 || maxval <= 0)
+    // (Sides past 2^20 are no frame of ours, and their product could overflow.)
+    if (!(in >> magic >> width >> height >> maxval) || magic != "P5" || width <= 0 || height <= 0 ||
+        width > (1 << 20) || height > (1 << 20) || maxval <= 0)
       return false;
     const std::streamoff header = static_cast<std::streamoff>(in.tellg()) + 1;
     return size >= header + width * height * (maxval > 255 ? 2 : 1);

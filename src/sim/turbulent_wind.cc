@@ -45,7 +45,8 @@ TurbulentWind::TurbulentWind(const TurbulenceParams& p, const Eigen::Vector3d& m
                                 ", got " + std::to_string(p.intensity));
   }
   if (!(p.length_scale >= kMinTurbulenceLengthScale && p.length_scale <= kMaxTurbulenceLengthScale)) {
-    throw std::invalid_argument("turbulence length_scale must be in 0.01..10000 m, got " + std::to_string(p.length_scale));
+    throw std::invalid_argument("turbulence length_scale must be in 0.01..10000 m, got " +
+                                std::to_string(p.length_scale));
   }
   if (p.modes < 1) throw std::invalid_argument("turbulence needs at least one mode");
   const double sigma_u = p.intensity * mean_velocity.norm();
