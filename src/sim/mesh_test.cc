@@ -10,6 +10,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -18,8 +19,19 @@
 namespace clothwind::sim {
 namespace {
 
+// The files the tests write, removed when the test program ends (each run left 27 in /tmp).
+struct WrittenFiles {
+  std::vector<std::string> paths;
+  ~WrittenFiles() {
+    for (const std::string& p : paths) std::remove(p.c_str());
+  }
+};
+WrittenFiles written_files;
+
 std::string TempPath(const std::string& name) {
-  return ::testing::TempDir() + "/clothwind_mesh_test_" + std::to_string(::getpid()) + "_" + name;
+  const std::string path = ::testing::TempDir() + "/clothwind_mesh_test_" + std::to_string(::getpid()) + "_" + name;
+  written_files.paths.push_back(path);
+  return path;
 }
 
 std::string WriteText(const std::string& name, const std::string& text) {
