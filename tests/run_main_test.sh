@@ -10,6 +10,15 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 out="$(mktemp -d /tmp/clothwind_run_main_test.XXXXXX)"
 trap 'rm -rf "$out"' EXIT
 fail() { echo "run_main_test: $*" >&2; tail -30 "$out/run-main.txt" >&2 || true; exit 1; }
+# A second run into a sessions folder in use is refused at once, naming it (it removed the first
+# run's dataset, and each overwrote the other's report).
+exec 8>"$out/.run-main.lock"
+flock -n 8 || fail "could not take the lock"
+status=0
+CLOTHWIND_SESSIONS="$out" "$root/scripts/run-main" "$build" >"$out/run-main.txt" 2>&1 8>&- || status=$?
+exec 8>&-  # released: the run below takes it
+[ "$status" -eq 1 ] && grep -q "another run-main is using $out" "$out/run-main.txt" ||
+  fail "a second run into a folder in use was not refused (status $status)"
 CLOTHWIND_SESSIONS="$out" CLOTHWIND_SESSION_FRAMES=procedural CLOTHWIND_SESSION_MINUTES=0.4 \
   CLOTHWIND_SDN_THREADS=1 "$root/scripts/run-main" "$build" >"$out/run-main.txt" 2>&1 ||
   fail "run-main exited $?"
