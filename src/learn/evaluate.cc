@@ -13,6 +13,7 @@
 #include <malloc.h>
 #include <unistd.h>
 
+#include "common/atomic_file.h"
 #include "learn/dataset.h"
 #include "learn/fly_direction.h"
 #include "learn/predictor.h"
@@ -392,8 +393,18 @@ bool Plotting(std::string* error, F body) {
 
 bool RunGnuplot(const std::string& script, const fs::path& png, std::string* error) {
   return Plotting(error, [&] {
-  // "<png>.tmp-<pid>.png": the temporary form a run's --overwrite clears (".tmp<pid>" was left behind).
-  const std::string tmp = png.string() + ".tmp-" + std::to_string(::getpid()) + ".png";
+  // "<png>.tmp-<tag>-<n>" (TemporaryNameFor; a run's --overwrite clears it too). Those of runs that
+  // stopped while gnuplot drew go first: a killed run's stayed beside every later curve, resumes
+  // included.
+  {
+    std::error_code ec;
+    const std::string prefix = png.filename().string() + ".tmp-";
+    for (const auto& entry : fs::directory_iterator(png.parent_path().empty() ? "." : png.parent_path(), ec)) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind(prefix, 0) == 0 && IsTemporaryOfStoppedProcess(name)) fs::remove(entry.path(), ec);
+    }
+  }
+  const std::string tmp = TemporaryNameFor(png.string());
   const fs::path script_path = png.string() + ".gp";
   WriteFileAtomically(script_path, "set terminal pngcairo size 800,600 noenhanced\nset output " + GnuplotQuoted(tmp) +
                                        "\n" + script);

@@ -330,6 +330,16 @@ TEST_F(TrainTest, SdnLearnsTheWindSpeedFromTheOscillationFrequency) {
   EXPECT_NE(error.find("plot_folder.png"), std::string::npos) << error;
   for (const auto& entry : fs::directory_iterator(r.model.parent_path()))
     EXPECT_EQ(entry.path().filename().string().find("plot_folder.png.tmp"), std::string::npos) << entry.path();
+  // A stopped run's temporary (killed while gnuplot drew) goes at the next plot of that name; a
+  // live process's stays. It stayed beside every later curve, resumes included.
+  const fs::path stale = r.model.parent_path() / "eval_val.png.tmp-999999999-0";
+  const fs::path live = r.model.parent_path() / ("eval_val.png.tmp-" + std::to_string(::getpid()) + "-0");
+  std::ofstream(stale) << "a half-drawn plot";
+  std::ofstream(live) << "being drawn";
+  ASSERT_TRUE(PlotPredictions(e, png, &error)) << error;
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_TRUE(fs::exists(live));
+  fs::remove(live);
   const fs::path quoted = r.model.parent_path() / "it's here.png";
   ASSERT_TRUE(PlotPredictions(e, quoted, &error)) << error;
   EXPECT_GT(fs::file_size(quoted), 1000u);
