@@ -19,7 +19,8 @@ namespace clothwind::sensors {
 struct ClipSourceInfo {
   std::string frame_id;     // camera optical frame
   std::string description;  // e.g. "clip_buffer_node /camera/image_raw"
-  nlohmann::json camera;    // optional camera_info summary (K, D, size); null when unknown
+  // Optional camera_info summary (width, height, frame_id, distortion_model, D, K); null when unknown.
+  nlohmann::json camera;
   std::string split = "test";  // dataset split (docs/dataset.md); real clips evaluate, as FlagReal
   std::string wind_frame_id;  // frame of the label's mean direction (WindDirectionFrameGate)
 };
