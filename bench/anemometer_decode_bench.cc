@@ -42,7 +42,9 @@ void Run(const char* name, const std::string& record, int n) {
 }  // namespace
 
 int Main(int argc, char** argv) {
-  const int n = argc > 1 ? std::atoi(argv[1]) : 200000;
+  if (clothwind::bench::HelpAsked(argc, argv, "Usage: anemometer_decode_bench [records per protocol]   (prints a table)"))
+    return 0;
+  const int n = clothwind::bench::OptionalCount(argc, argv, "records per protocol", 200000, 1);
   std::printf("%-14s %9s %9s %12s %10s\n", "protocol", "records", "readings", "records/s", "us/record");
   Run("nmea_mwv", "$IIMWV,229.0,R,5.8,N,A*39", n);
   Run("nmea_mwd", clothwind::sensors::WithNmeaChecksum("WIMWD,270.0,T,265.5,M,10.0,N,5.1,M"), n);

@@ -36,6 +36,29 @@ inline int Integer(const std::string& option, const std::string& text) {
   return static_cast<int>(v);
 }
 
+// Whether the arguments ask for help (-h or --help); if so, prints `usage` (a line) on stdout.
+inline bool HelpAsked(int argc, char** argv, const char* usage) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "-h" || a == "--help") {
+      std::printf("%s\n", usage);
+      return true;
+    }
+  }
+  return false;
+}
+
+// The bench's one optional positional number (argv[1]), or `fallback` when there is none; at
+// least `min`. Throws std::invalid_argument naming `what` for anything else, or for a second
+// argument: atoi read "--help" as 0, and the bench ran.
+inline int OptionalCount(int argc, char** argv, const std::string& what, int fallback, int min) {
+  if (argc > 2) throw std::invalid_argument(std::string("one argument at most (") + what + "), got " + argv[2]);
+  if (argc < 2) return fallback;
+  const int n = Integer(what, argv[1]);
+  if (n < min) throw std::invalid_argument(what + ": expected at least " + std::to_string(min) + ", got " + argv[1]);
+  return n;
+}
+
 // Runs body(argc, argv) and returns its status; an exception is printed as
 // "<name>: error: <what>" and gives status 1.
 inline int Guarded(const char* name, int argc, char** argv, int (*body)(int, char**)) {

@@ -40,4 +40,12 @@ refuses "--duration: expected a finite number" sim_bench --duration x
 refuses "--winds" sim_bench --winds ,
 refuses "--duration" sim_bench --duration 0.2 --winds 3
 refuses "--model /nonexistent.pt" sdn_bench --model /nonexistent.pt
+# The benches with a positional count read "--help" with atoi as 0 and ran: help is printed, and a
+# count that is not one is refused naming it.
+runs "Usage: anemometer_decode_bench" anemometer_decode_bench --help
+runs "Usage: camera_convert_bench" camera_convert_bench -h
+runs "Usage: sensors_clip_bench" sensors_clip_bench --help
+refuses "records per protocol" anemometer_decode_bench x
+refuses "repetitions" camera_convert_bench 0
+refuses "takes no arguments" sensors_clip_bench 5
 echo "bench_smoke_test: OK"

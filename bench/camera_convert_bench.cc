@@ -63,7 +63,8 @@ std::vector<uint8_t> Buffer(PixelFormat f, const cv::Mat& bgr) {
 }  // namespace
 
 int Main(int argc, char** argv) {
-  const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 50;
+  if (clothwind::bench::HelpAsked(argc, argv, "Usage: camera_convert_bench [repetitions]   (prints a table)")) return 0;
+  const int reps = clothwind::bench::OptionalCount(argc, argv, "repetitions", 50, 1);
   cv::setNumThreads(1);  // the node converts on its capture thread
   std::printf("%-6s %-10s %10s %12s %10s\n", "format", "size", "bytes", "ms/frame", "max fps");
   const std::vector<std::pair<int, int>> sizes{{640, 480}, {1280, 720}, {1920, 1080}};

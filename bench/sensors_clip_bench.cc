@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 
 #include <unistd.h>
@@ -24,7 +25,9 @@ double Seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::d
 
 }  // namespace
 
-int Main(int, char**) {
+int Main(int argc, char** argv) {
+  if (clothwind::bench::HelpAsked(argc, argv, "Usage: sensors_clip_bench   (no arguments; prints a table)")) return 0;
+  if (argc > 1) throw std::invalid_argument(std::string("takes no arguments, got ") + argv[1]);
   std::printf("%-22s %8s %12s %12s %14s\n", "camera", "frames", "ms/frame", "realtime x", "clips");
   struct Case {
     int width, height;
