@@ -30,6 +30,27 @@ TEST(ImageViewTest, TheCoreLayoutsAreViewedWithoutACopy) {
   EXPECT_EQ(view.at<cv::Vec3b>(5, 7), cv::Vec3b(10, 20, 30));
 }
 
+// A padded image (step past width x pixel size, as some drivers publish) is viewed row by row at
+// its step: each row has its own value and the padding another (unpadded images hid a dropped
+// step).
+TEST(ImageViewTest, APaddedImageIsViewedAtItsStep) {
+  sensor_msgs::Image msg;
+  msg.width = 5;
+  msg.height = 4;
+  msg.encoding = "mono8";
+  msg.step = 8;  // 3 bytes of padding a row
+  msg.data.assign(msg.step * msg.height, 0xEE);
+  for (uint32_t r = 0; r < msg.height; ++r)
+    for (uint32_t c = 0; c < msg.width; ++c) msg.data[r * msg.step + c] = static_cast<uint8_t>(10 * r + c);
+  cv::Mat view;
+  sensors::ClipSourceEncoding encoding;
+  ImageView(msg, &view, &encoding);
+  ASSERT_EQ(view.rows, 4);
+  ASSERT_EQ(view.cols, 5);
+  for (int r = 0; r < view.rows; ++r)
+    for (int c = 0; c < view.cols; ++c) EXPECT_EQ(view.at<uint8_t>(r, c), 10 * r + c) << r << "," << c;
+}
+
 TEST(ImageViewTest, CameraLayoutsTheCoreDoesNotReadAreConvertedToBgr) {
   cv::Mat view;
   sensors::ClipSourceEncoding encoding;

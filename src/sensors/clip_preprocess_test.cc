@@ -35,13 +35,19 @@ TEST(ClipPreprocessTest, CropsGreysAndResizes) {
   // in its right half, so the output's left half is the luma of blue and its right half of red.
   cv::Mat image(240, 320, CV_8UC3, cv::Scalar(255, 0, 0));
   image(cv::Rect(100, 0, 220, 240)).setTo(cv::Scalar(0, 0, 255));
+  // And a green band across rows 110-129, which the roi (rows 20-119) ends in: output rows 45-49.
+  // Read there, the roi's y counts (columns alone passed with y ignored, or x and y swapped).
+  image(cv::Rect(0, 110, 320, 20)).setTo(cv::Scalar(0, 255, 0));
   const cv::Mat out = PreprocessClipFrame(image, ClipSourceEncoding::kBgr8, {50, 20, 100}, 50);
   ASSERT_EQ(out.type(), CV_8UC1);
   ASSERT_EQ(out.rows, 50);
   ASSERT_EQ(out.cols, 50);
-  // BT.601 luma: blue 0.114 * 255 = 29, red 0.299 * 255 = 76.
+  // BT.601 luma: blue 0.114 * 255 = 29, red 0.299 * 255 = 76, green 0.587 * 255 = 150.
   EXPECT_NEAR(out.at<uint8_t>(25, 10), 29, 1);
   EXPECT_NEAR(out.at<uint8_t>(25, 40), 76, 1);
+  EXPECT_NEAR(out.at<uint8_t>(47, 10), 150, 1);
+  EXPECT_NEAR(out.at<uint8_t>(47, 40), 150, 1);
+  EXPECT_NEAR(out.at<uint8_t>(43, 10), 29, 1);  // above the band
   // rgb8 of the same bytes reads red and blue swapped.
   const cv::Mat swapped = PreprocessClipFrame(image, ClipSourceEncoding::kRgb8, {50, 20, 100}, 50);
   EXPECT_NEAR(swapped.at<uint8_t>(25, 10), 76, 1);

@@ -17,7 +17,8 @@ TEST(ClockCourseTest, AJumpBackRemembersWhereTheClockWasUntilItPassesItAgain) {
   EXPECT_TRUE(c.IsPreviousPass(1023.9, 5.0));
   EXPECT_TRUE(c.IsPreviousPass(1028.9, 5.0));
   EXPECT_FALSE(c.IsPreviousPass(1030.0, 5.0));  // past where it ever was: the future
-  c.Note(1000.5);  // jitter under a second is no jump
+  c.Note(1000.5);
+  c.Note(1000.1);  // jitter under a second back is no jump (1000.5 forward of 1000.0 tested nothing)
   EXPECT_NEAR(c.before_last_jump(), 1024.0, 1e-9);
   c.Note(1024.5);  // past the old end: no previous pass pending
   EXPECT_FALSE(c.IsPreviousPass(1020.0, 5.0));

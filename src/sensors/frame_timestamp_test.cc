@@ -59,7 +59,9 @@ TEST(FrameTimestamperTest, MonotonicDriverStampsFollowCaptureNotDequeueTime) {
   for (int i = 0; i < 100; ++i, capture += 33 * kMs) {
     const int64_t dequeue = capture + latency_ms(rng) * kMs;
     clock.Advance(dequeue - clock.MonotonicNs());
-    if (i % 4 == 1) clock.DelayNextRosRead(15 * kMs);  // preempted between the two reads
+    // Preempted between the two reads: read in the other order (ROS time first), this delay
+    // would shrink the offset the minimum keeps, and every later stamp would come 15 ms early.
+    if (i % 4 == 1) clock.DelayAfterNextRead(15 * kMs);
     const int64_t stamp = stamper.Map(capture, DriverClock::kMonotonic);
     const int64_t truth = capture + clock.ros_offset_ns();
     if (i == 1) {

@@ -76,6 +76,32 @@ std::vector<uint8_t> UniformYuyv(int w, int h, int stride, uint8_t y, uint8_t u,
   return buf;
 }
 
+// A padded YUYV buffer (the driver's bytesperline past 2 x width) gives the image its unpadded
+// twin gives: rows are read at the stride. Each row has its own Y and the padding is 0xEE, so a
+// row read from the wrong offset shows (uniform rows hid a wrong step).
+TEST(PixelFormatTest, YuyvRowsAreReadByTheDriversStride) {
+  const int w = 4, h = 3;
+  auto rows = [&](int stride) {
+    std::vector<uint8_t> buf(stride * h, 0xEE);
+    for (int r = 0; r < h; ++r)
+      for (int c = 0; c < w; c += 2) {
+        uint8_t* p = &buf[r * stride + 2 * c];
+        p[0] = p[2] = static_cast<uint8_t>(40 + 70 * r);
+        p[1] = p[3] = 128;
+      }
+    return buf;
+  };
+  const auto padded = rows(12), tight = rows(8);
+  cv::Mat from_padded, from_tight;
+  std::string error;
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kYuyv, padded.data(), padded.size(), w, h, 12, &from_padded, &error))
+      << error;
+  ASSERT_TRUE(ConvertToImage(PixelFormat::kYuyv, tight.data(), tight.size(), w, h, 8, &from_tight, &error)) << error;
+  EXPECT_EQ(cv::norm(from_padded, from_tight, cv::NORM_INF), 0.0);
+  for (int r = 1; r < h; ++r)
+    EXPECT_GT(from_padded.at<cv::Vec3b>(r, 0)[1], from_padded.at<cv::Vec3b>(r - 1, 0)[1] + 50) << r;
+}
+
 TEST(PixelFormatTest, YuyvConvertsWithBt601Colours) {
   const int w = 4, h = 2, stride = 12;  // 8 bytes of pixels + 4 of padding per row
   cv::Mat image;
