@@ -43,4 +43,7 @@ done
 (cd "$work" && "$bin" contact-sheet nan --out sheet.JPEG >"$work/msg.txt" 2>&1) ||
   fail "contact-sheet nan --out sheet.JPEG was refused: $(cat "$work/msg.txt")"
 [ -s "$work/sheet.JPEG" ] || fail "contact-sheet --out sheet.JPEG wrote no sheet"
+# Written as a JPEG by its extension, whatever its case (a PNG under that name passed the size check).
+[ "$(head -c3 "$work/sheet.JPEG" | od -An -tx1 | tr -d ' \n')" = ffd8ff ] ||
+  fail "contact-sheet --out sheet.JPEG is not a JPEG: $(head -c8 "$work/sheet.JPEG" | od -An -tx1)"
 echo "contact_sheet_cli_test: OK"

@@ -258,6 +258,11 @@ inline void WriteFilePairAtomically(const std::string& first, const std::string&
 // at `to`. Throws std::runtime_error naming `from` when it cannot be read, or `to` when it cannot
 // be written.
 inline void CopyFileAtomically(const std::string& from, const std::string& to) {
+  // A folder opens as a stream, and libstdc++ then throws "basic_filebuf::underflow ... Is a
+  // directory" from the read, naming no file.
+  std::error_code ec;
+  if (std::filesystem::is_directory(from, ec))
+    throw std::runtime_error("cannot read " + from + " (a folder, not a file to copy to " + to + ")");
   std::ifstream in(from, std::ios::binary);
   if (!in) throw std::runtime_error("cannot read " + from + " (to copy it to " + to + ")");
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -153,10 +153,15 @@ TEST_F(AtomicFileTest, LinkOrCopyLinksWhereItCanAndCopiesWholeWhereItCannot) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("cannot read " + (dir_ / "missing.pt").string()), std::string::npos) << e.what();
   }
-  // A folder is no file to copy: refused, not copied as an empty file.
+  // A folder is no file to copy: refused naming it, not copied as an empty file (libstdc++'s own
+  // "Is a directory" from the read named no file).
   fs::create_directories(dir_ / "folder");
-  EXPECT_THROW(LinkOrCopyFile((dir_ / "folder").string(), (dir_ / "folder_copy").string(), NoHardLinks),
-               std::runtime_error);
+  try {
+    LinkOrCopyFile((dir_ / "folder").string(), (dir_ / "folder_copy").string(), NoHardLinks);
+    ADD_FAILURE() << "a folder was copied";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot read " + (dir_ / "folder").string()), std::string::npos) << e.what();
+  }
   EXPECT_FALSE(fs::exists(dir_ / "nowhere.pt"));
   EXPECT_FALSE(fs::exists(dir_ / "folder_copy"));
 }

@@ -87,6 +87,13 @@ TEST(ReadLabelTest, AFrameCountBeyondAnyClipIsRefused) {
               std::string::npos)
         << e.what();
   }
+  // The bound itself: 100000 is read, 100001 refused (1e12 alone passed any bound below it).
+  label["num_frames"] = 100000;
+  std::ofstream(file) << label.dump();
+  EXPECT_NO_THROW(ReadLabel(file.string()));
+  label["num_frames"] = 100001;
+  std::ofstream(file) << label.dump();
+  EXPECT_THROW(ReadLabel(file.string()), std::runtime_error);
   fs::remove(file);
 }
 

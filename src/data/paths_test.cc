@@ -49,6 +49,9 @@ TEST(DefaultScenePath, NamesTheSceneOfItsKindInTheConfigFolder) {
   EXPECT_EQ(flag.filename(), "flag.json");
   EXPECT_EQ(flag.parent_path(), fs::path(ConfigDir()) / "scenes");
   EXPECT_TRUE(fs::exists(flag)) << flag;
+  const fs::path cloth = DefaultScenePath(render::SceneKind::kCloth);  // (the flag's alone passed a fixed name)
+  EXPECT_EQ(cloth.filename(), "cloth.json");
+  EXPECT_TRUE(fs::exists(cloth)) << cloth;
 }
 
 }  // namespace

@@ -159,7 +159,13 @@ TEST(SessionBagTest, ADurationThatMakesNoSessionIsRefused) {
     std::ifstream in(log);
     return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   };
-  for (const char* minutes : {"inf", "nan", "0.0001", "1e30"}) refused(std::string("--minutes ") + minutes);
+  // Each refused naming --minutes: inf, nan and 1e30 were refused by other checks (the finite-number
+  // check, --start-time's), so the bound itself went untested; 0.04 and 1441 only it refuses.
+  for (const char* minutes : {"inf", "nan", "0.0001", "1e30", "0.04", "1441"}) {
+    const std::string text = refused(std::string("--minutes ") + minutes);
+    EXPECT_NE(text.find("--minutes"), std::string::npos) << minutes << ": " << text;
+  }
+  EXPECT_NE(refused("--minutes 0.04").find("--minutes must be in 0.05..1440"), std::string::npos);
   // A camera too slow for a clip (every interval a hole; at 10 fps its jitter makes half of them
   // holes, and no stretch lasts a clip), nearly every frame dropped (no images),
   // a start so early a frame's jitter put it before time 0 (failed mid-write for some seeds).
