@@ -611,7 +611,30 @@ TEST_F(DatasetGeneratorTest, ClothSimUsesTheFabricsOfAFolder) {
     EXPECT_LE(label["theta"][0].get<double>(), 0.4);
     EXPECT_EQ(label["wind_velocity"][2].get<double>(), 0.0);
     EXPECT_EQ(label["zeta"]["texture_kind"], "fabric");
+    EXPECT_TRUE(label["fabric"] == "fabric-a" || label["fabric"] == "fabric-b") << label["fabric"];
   }
+  // The drawn fabric reaches the simulation: the same sample with the fabric's stretching scaled
+  // down makes other frames. (Labels could not tell: θ is drawn from the list of names, and
+  // density and bending come from θ; the fabrics above are copies of one file.)
+  std::ifstream base_in(base);
+  nlohmann::json soft = nlohmann::json::parse(base_in, nullptr, true, /*ignore_comments=*/true);
+  for (auto& row : soft["stretching"])
+    for (auto& v : row) v = v.get<double>() * 0.05;
+  std::string frames[2];
+  for (int k = 0; k < 2; ++k) {
+    const fs::path folder = root_ / ("one-fabric-" + std::to_string(k));
+    fs::create_directories(folder);
+    if (k == 0) fs::copy_file(base, folder / "fabric-a.json");
+    else std::ofstream(folder / "fabric-a.json") << soft.dump(2);
+    DatasetOptions one = Tiny((root_ / ("cloth-" + std::to_string(k))).string());
+    one.kind = render::SceneKind::kCloth;
+    one.materials_dir = folder.string();
+    one.count = 1;
+    ASSERT_TRUE(GenerateDataset(one).errors.empty());
+    frames[k] = Bytes(root_ / ("cloth-" + std::to_string(k)) / "cloth-000000-v0" / "005.jpg");
+  }
+  EXPECT_FALSE(frames[0].empty());
+  EXPECT_NE(frames[0], frames[1]) << "a fabric 20 times as stretchy left the frames unchanged";
 }
 
 TEST_F(DatasetGeneratorTest, ReindexMergesFoldersCopiedFromOtherMachines) {
