@@ -2,11 +2,9 @@
 // (YUYV -> bgr8 with cv::cvtColor, MJPEG -> bgr8 with cv::imdecode, GREY copy), at common sizes.
 // At 30 fps a frame has 33 ms; this shows how much of it conversion takes on this machine.
 // Usage: camera_convert_bench [repetitions]   (prints a table)
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <vector>
 

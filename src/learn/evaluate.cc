@@ -253,9 +253,9 @@ namespace {
 // An empty group has no figures: null, not NaN (which JSON lacks).
 nlohmann::json Number(double x) { return std::isnan(x) ? nlohmann::json(nullptr) : nlohmann::json(x); }
 
-// CalibrationScale, NaN where it has nothing to fit (no stds, or one not positive).
+// CalibrationScale, NaN where it has nothing to fit (no stds, lists of other lengths, or a std
+// that is not positive: each of which it refuses).
 double CalibrationScaleOrNaN(const EvalResult& r) {
-  if (std::isnan(StdCoverage(r, 1))) return std::numeric_limits<double>::quiet_NaN();
   try {
     return CalibrationScale(r);
   } catch (const std::invalid_argument&) {
