@@ -241,7 +241,7 @@ class ClipBufferNode {
     // force_update once a wall second: Updater::update() waits for ROS time, which stands still
     // while a bag is paused and jumps back when it loops. (WallThrottle: again at once after the
     // wall clock steps back, which held every report until it caught up.)
-    if (diagnostics_throttle_.Due(diagnostic_period_)) updater_.force_update();
+    if (diagnostics_throttle_.Due(diagnostic_period_)) clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);
   }
 
   void Publish(const std::vector<sensors::LabelledClip>& clips) {

@@ -96,7 +96,9 @@ class SdnNode {
     // paused and jumps back when it restarts.
     diag_timer_ =
         nh.createSteadyTimer(ros::WallDuration(clothwind::ros_bridge::DiagnosticPeriod(updater_)),
-                             [this](const ros::SteadyTimerEvent&) { updater_.force_update(); });
+                             [this](const ros::SteadyTimerEvent&) {
+                               clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);
+                             });
     // Subscribed before the model loads (libtorch, the weights and the warm-up take seconds):
     // clips that come meanwhile wait in the queue, as callbacks run only once spin() starts, rather
     // than going to no subscriber at all (a replay starts as soon as the bag's topics have theirs).
@@ -187,7 +189,7 @@ class SdnNode {
       if (load_error_ != e.what()) ROS_ERROR("sdn_node: cannot load the model: %s (retrying)", e.what());
       load_error_ = e.what();
     }
-    updater_.force_update();
+    clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);
   }
 
   // ~fly_judge, when set, replaces the judge beside the model; one that cannot load is a WARN and
@@ -276,7 +278,7 @@ class SdnNode {
       last_error_ = "clip " + std::to_string(clip->sequence) + ": " + e.what();
       clip_error_ = (malformed ? "malformed clip: " : "the model failed on a clip: ") + last_error_;
       WALL_ERROR_THROTTLE(5.0, "sdn_node: %s", clip_error_.c_str());
-      updater_.force_update();
+      clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);
     }
   }
 

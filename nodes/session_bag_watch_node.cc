@@ -26,8 +26,10 @@ class SessionBagWatchNode {
     updater_.setHardwareID("bag:" + params.Get("bag_prefix", ""));
     updater_.add("session bag", this, &SessionBagWatchNode::Diagnose);
     timer_ = nh.createSteadyTimer(ros::WallDuration(clothwind::ros_bridge::DiagnosticPeriod(updater_)),
-                                  [this](const ros::SteadyTimerEvent&) { updater_.force_update(); });
-    updater_.force_update();
+                                  [this](const ros::SteadyTimerEvent&) {
+                                    clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);
+                                  });
+    clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);
   }
 
  private:

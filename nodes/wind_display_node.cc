@@ -121,7 +121,7 @@ class WindDisplayNode {
     updater_.add("wind display", this, &WindDisplayNode::Diagnose);
     diagnostics_timer_ = nh.createSteadyTimer(
         ros::WallDuration(clothwind::ros_bridge::DiagnosticPeriod(updater_)), [this](const ros::SteadyTimerEvent&) {
-      updater_.force_update();  // wall time: a paused bag must not stop them
+      clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);  // wall time: a paused bag must not stop them
     });
   }
 

@@ -10,6 +10,7 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/console.h>
+#include <ros/node_handle.h>
 #include <ros/time.h>
 
 #include "ros_bridge/strict_param.h"
@@ -46,6 +47,24 @@ inline double DiagnosticPeriod(diagnostic_updater::Updater& updater) {
   return 1.0;
 }
 
+// updater.force_update(), keeping ~diagnostic_period valid first. Why: force_update re-reads the
+// parameter (cached, so a `rosparam set` reaches it) into a ros::Duration, which throws for NaN,
+// inf or more than 2^31 s: `rosparam set /wind_display/diagnostic_period 1.0e+10` ended a running
+// node with "Duration is out of dual 32-bit range", naming no parameter. A value out of (0, 3600] s
+// is refused with an ERROR naming it, and the parameter is set back to the period in use (what
+// the updater read last, valid: checked at start and before every read since).
+inline void ForceDiagnosticUpdate(diagnostic_updater::Updater& updater) {
+  ros::NodeHandle private_nh("~");  // the Updater's own: diagnostic_updater reads "~diagnostic_period"
+  double period = 0;
+  if (private_nh.getParamCached("diagnostic_period", period) && !DiagnosticPeriodIsValid(period)) {
+    const double in_use = updater.getPeriod();
+    ROS_ERROR_STREAM("~diagnostic_period: expected a time in (0, 3600] s, got " << period << "; set back to the "
+                     << in_use << " s in use");
+    private_nh.setParam("diagnostic_period", in_use);  // roscpp updates its cache of the key too
+  }
+  updater.force_update();
+}
+
 // Call Update() as often as convenient (each loop of a node's own spin); it publishes the
 // updater's status when `period` wall seconds have passed since it last did.
 class WallDiagnostics {
@@ -56,7 +75,7 @@ class WallDiagnostics {
   void Update() {
     // WallThrottle: due again at once should the wall clock step back (NTP), where a next-due
     // instant held every report until the clock caught up (an hour's step: an hour of silence).
-    if (throttle_.Due(period_)) updater_->force_update();
+    if (throttle_.Due(period_)) ForceDiagnosticUpdate(*updater_);
   }
 
  private:

@@ -331,6 +331,60 @@ class NodeParamsTest(unittest.TestCase):
         self.assertIn("wind_display: private parameter ~rat set but not read by this node", s.output())
         self.assertNotIn("~plot_window", s.output())
 
+    # ~diagnostic_period set out of range while a node runs: diagnostic_updater re-reads it (cached,
+    # so `rosparam set` reaches it) in every force_update into a ros::Duration, which threw for 1e10:
+    # wind_display_node ended with "Duration is out of dual 32-bit range", naming no parameter. Each
+    # node (the three ways they publish: a wall timer, a throttle in the spin, WallDiagnostics)
+    # refuses it naming it, sets it back to the period in use and goes on publishing diagnostics.
+    def test_a_diagnostic_period_set_out_of_range_while_running_is_refused_and_set_back(self):
+        from diagnostic_msgs.msg import DiagnosticArray
+        model = os.path.join(roslib.packages.get_pkg_dir("clothwind"), "models", "sdn.pt")
+        nodes = [
+            ("wind_display_node", "running_display", {}),
+            ("session_bag_watch_node", "running_bag_watch", {"bag_prefix": os.path.join(self.folder, "session")}),
+            ("clip_buffer_node", "running_clip_buffer", {}),
+            ("anemometer_node", "running_anemometer", {"input": "topic"}),
+            ("sdn_node", "running_sdn", {"model": model}),
+        ]
+        seen = {}
+        lock = threading.Lock()
+
+        def heard(msg):
+            with lock:
+                for status in msg.status:
+                    for _, name, _ in nodes:
+                        if status.name.startswith(name + ":"):
+                            seen.setdefault(name, []).append(time.time())
+
+        sub = rospy.Subscriber("/diagnostics", DiagnosticArray, heard)
+        started = []
+        for node, name, params in nodes:
+            for key, value in params.items():
+                rospy.set_param("/%s/%s" % (name, key), value)
+            started.append(self.spawn(node, ["__name:=" + name], cwd=self.folder))
+
+        def heard_after(name, t):
+            with lock:
+                return any(s > t for s in seen.get(name, []))
+
+        deadline = time.time() + 60
+        while time.time() < deadline and not all(heard_after(name, 0) for _, name, _ in nodes):
+            time.sleep(0.1)
+        for (node, name, _), s in zip(nodes, started):
+            self.assertTrue(heard_after(name, 0), "%s published no diagnostics; it said:\n%s" % (node, s.output()))
+        for _, name, _ in nodes:
+            rospy.set_param("/%s/diagnostic_period" % name, 1e10)
+        changed = time.time()
+        expected = "~diagnostic_period: expected a time in (0, 3600] s, got 1e+10; set back to the 1 s in use"
+        for (node, name, _), s in zip(nodes, started):
+            self.assertTrue(s.wait_for_output(expected, 20), "%s:\n%s" % (node, s.output()))
+        time.sleep(2.5)
+        for (node, name, _), s in zip(nodes, started):
+            self.assertIsNone(s.process.poll(), "%s ended; it said:\n%s" % (node, s.output()))
+            self.assertEqual(rospy.get_param("/%s/diagnostic_period" % name), 1.0, node)
+            self.assertTrue(heard_after(name, changed + 1.0), "%s published no diagnostics since" % node)
+        sub.unregister()
+
     # ~diagnostic_period sets how often a node publishes its diagnostics. The nodes publish on wall
     # timers of their own (a paused bag stops ROS time), which ran every second whatever it said.
     def test_the_diagnostic_period_is_kept(self):
