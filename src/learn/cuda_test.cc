@@ -19,6 +19,7 @@
 #include <torch/optim/adam.h>
 #include <torch/serialize.h>
 
+#include "learn/full_float32.h"
 #include "learn/networks.h"
 #include "learn/spectral_layer.h"
 #include "learn/test_small_sdn.h"
@@ -35,14 +36,6 @@ namespace {
 double RelativeDifference(const at::Tensor& a, const at::Tensor& b) {
   const at::Tensor da = a.detach().to(at::kCPU).to(at::kDouble), db = b.detach().to(at::kCPU).to(at::kDouble);
   return (da - db).norm().item<double>() / std::max(db.norm().item<double>(), 1e-300);
-}
-
-// Turns off TF32, which libtorch allows in cuDNN's convolutions by default: it rounds their
-// inputs to 10 mantissa bits (errors ~1e-3), and the comparisons here are of the same float32
-// arithmetic on two devices.
-void UseFullFloat32() {
-  at::globalContext().setAllowTF32CuDNN(false);
-  at::globalContext().setAllowTF32CuBLAS(false);
 }
 
 // A clip of travelling waves plus noise, [nb, 1, nt, h, w]: every pixel has a clear strongest
@@ -108,7 +101,7 @@ ModelConfig SmallPooledSdn() {
 
 TEST(Cuda, SdnForwardAndGradientsMatchTheCpu) {
   SKIP_WITHOUT_CUDA();
-  UseFullFloat32();
+  UseFullFloat32OnCuda();  // the comparisons are of the same float32 arithmetic on two devices
   at::manual_seed(3);
   WindNet net(SmallPooledSdn());
   net->train();  // batch statistics, as in training
@@ -146,7 +139,7 @@ TEST(Cuda, ShippedModelGivesTheSameEstimateOnTheGpu) {
   SKIP_WITHOUT_CUDA();
   const char* source = std::getenv("CLOTHWIND_SOURCE_DIR");
   ASSERT_NE(source, nullptr) << "CLOTHWIND_SOURCE_DIR is set by CTest and scripts/device-check";
-  UseFullFloat32();
+  UseFullFloat32OnCuda();  // the comparisons are of the same float32 arithmetic on two devices
   WindNet net = LoadWindNet(std::filesystem::path(source) / "models/sdn.pt");
   const ModelConfig& config = net->config();
   at::Tensor clip = WaveClip(8, config.frames, config.input_size, config.input_size, at::kFloat, 5);
@@ -168,7 +161,7 @@ TEST(Cuda, ANetworkTrainedOnTheGpuSavesAndLoadsOnTheCpu) {
   // must gather the CUDA tensors, and LoadWindNet must give the trained network's answer on
   // the CPU. With CLOTHWIND_CUDA_TEST_KEEP=DIR the model and a clip with its expected output
   // stay in DIR, so that another libtorch (Debian's, on the CPU machine) can be checked too.
-  UseFullFloat32();
+  UseFullFloat32OnCuda();  // the comparisons are of the same float32 arithmetic on two devices
   at::manual_seed(6);
   WindNet net(SmallPooledSdn());
   net->to(at::kCUDA);

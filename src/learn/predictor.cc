@@ -11,24 +11,11 @@
 #include <ATen/core/grad_mode.h>
 
 #include "learn/fly_judge.h"
+#include "learn/full_float32.h"
 #include "learn/networks.h"
 #include "learn/spectral_layer.h"
 
 namespace clothwind::learn {
-
-namespace {
-
-// Turns off TF32 for this process's CUDA convolutions and matrix products. libtorch allows it in
-// cuDNN's convolutions by default, rounding their inputs to 10 mantissa bits (~1e-3 relative), so
-// eval --device auto on a GPU scored another network than the float32 one the CPU runs and the
-// figures were measured with. Estimates cost a little more GPU time; they are worth the same.
-// Process-wide (libtorch has no per-module switch): set only once a Predictor runs on CUDA.
-void UseFullFloat32OnCuda() {
-  at::globalContext().setAllowTF32CuDNN(false);
-  at::globalContext().setAllowTF32CuBLAS(false);
-}
-
-}  // namespace
 
 struct Predictor::Impl {
   WindNet net{nullptr};

@@ -33,6 +33,7 @@
 #include "learn/aux_targets.h"
 #include "learn/dataset.h"
 #include "learn/frame_cache.h"
+#include "learn/full_float32.h"
 #include "learn/networks.h"
 #include "learn/predictor.h"
 #include "learn/track_targets.h"
@@ -381,6 +382,7 @@ Validation Validate(WindNet& model, const std::vector<ClipInfo>& val, int batch,
                     const std::function<void(int)>& clips_done = {}) {
   model->eval();
   at::NoGradGuard no_grad;
+  const FullFloat32Scope full_float32;  // on a GPU: pick the epoch by the network eval and the node run
   const float mean = static_cast<float>(config.label_mean), inv_std = static_cast<float>(1.0 / config.label_std);
   std::vector<size_t> all(val.size());
   std::iota(all.begin(), all.end(), 0);
