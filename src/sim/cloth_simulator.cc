@@ -282,12 +282,20 @@ void ClothSimulator::Impl::Build() {
 
   x = mesh.V;
   v = Eigen::MatrixX3d::Zero(nv, 3);
-  double mean_edge = 0;
+  double mean_edge = 0, longest_edge = 0;
   for (const Face& face : faces)
-    for (int c = 0; c < 3; ++c)
-      mean_edge += (mesh.U.row(face.v[c]) - mesh.U.row(face.v[(c + 1) % 3])).norm();
+    for (int c = 0; c < 3; ++c) {
+      const double edge = (mesh.U.row(face.v[c]) - mesh.U.row(face.v[(c + 1) % 3])).norm();
+      mean_edge += edge;
+      longest_edge = std::max(longest_edge, edge);
+    }
   mean_edge /= 3.0 * faces.size();
-  proximity = std::make_unique<VertexFaceProximity>(mesh.F, nv, mean_edge);
+  // The proximity grid's cell: the mean rest edge, raised to an eighth of the longest, so that
+  // every face of the unstretched mesh spans at most about 8 cells. The grid skips a face spanning
+  // more than 32 (an exploded state, where looping over its cells would hang): sized from the
+  // mean edge alone, a mesh whose edges differ a hundredfold (a coarse panel beside a fine one)
+  // had its large faces skipped, and nothing repelled from them.
+  proximity = std::make_unique<VertexFaceProximity>(mesh.F, nv, std::max(mean_edge, longest_edge / 8));
   limiter = std::make_unique<StrainLimiter>(mesh, mass, pinned);
   Eigen::VectorXd inverse_mass(nv);
   for (int i = 0; i < nv; ++i) inverse_mass[i] = pinned[i] ? 0.0 : 1.0 / mass[i];

@@ -697,6 +697,37 @@ TEST(ClothSimulatorTest, RepulsionStiffnessIsTheSmallerOfTheVertexAndFaceAreas) 
                                                                    << expected;
 }
 
+// A coarse panel beside a fine one in one mesh: a 2 m square of two faces and, 5 mm above its
+// middle, a 0.2 m sheet of ~1 cm edges (so the mean rest edge is under 2 cm). The proximity
+// grid's cell was the mean edge, raised to twice the 1 cm thickness: 2 cm, across which each large
+// face spans about 100 cells, and the grid skips a face past 32 as an exploded one: no fine
+// vertex was repelled from the panel under it. Each must be, upwards (its faces' own sheet is flat
+// and adds nothing along z).
+TEST(ClothSimulatorTest, RepulsionReachesAFaceFarLargerThanTheMeanEdge) {
+  const Mesh fine = Sheet(0.2, 0.2, 0.01, [](double u, double v) { return Eigen::Vector3d(0.9 + u, 0.9 + v, 5e-3); });
+  Mesh m;
+  const int n = static_cast<int>(fine.V.rows());
+  m.V.resize(4 + n, 3);
+  m.V.topRows(4) << 0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0;
+  m.V.bottomRows(n) = fine.V;
+  m.U = m.V.leftCols(2);
+  m.F.resize(2 + fine.F.rows(), 3);
+  m.F.topRows(2) << 0, 1, 2, 0, 2, 3;
+  m.F.bottomRows(fine.F.rows()) = (fine.F.array() + 4).matrix();
+  SimOptions o = QuietOptions();
+  o.gravity.setZero();
+  ASSERT_EQ(o.repulsion_thickness, 0.01);
+  ClothSimulator apart(m, ConstantStiffnessMaterial(), o, nullptr);
+  o.self_collision = true;
+  ClothSimulator close(m, ConstantStiffnessMaterial(), o, nullptr);
+  const Eigen::MatrixX3d repulsion = close.Forces() - apart.Forces();
+  int repelled = 0;
+  for (int p = 4; p < 4 + n; ++p) repelled += repulsion(p, 2) > 0 ? 1 : 0;
+  EXPECT_EQ(repelled, n) << "of the fine sheet's " << n << " vertices, 5 mm over the panel, only " << repelled
+                         << " were pushed up";
+  EXPECT_LT(repulsion.topRows(4).col(2).sum(), 0) << "the panel is not pushed down";
+}
+
 // Two free sheets in contact, no gravity, no air, no handles: every internal force and every
 // Jacobian block comes in pairs that sum to zero, so the total momentum is kept step after step
 // (to the linear solve's tolerance). A term that is not translation-invariant, or a block added on

@@ -24,13 +24,15 @@ class VertexFaceProximity {
   // Inputs:
   //   F             #F by 3 faces (indices < num_vertices)
   //   num_vertices  #V
-  //   cell_size     hash grid cell [m] (> 0), e.g. the mean edge length; raised to 2 thickness
+  //   cell_size     hash grid cell [m] (> 0), e.g. the mean edge length but at least an eighth
+  //                 of the longest (see Update); raised to 2 thickness
   VertexFaceProximity(const Eigen::MatrixX3i& F, int num_vertices, double cell_size);
 
   // Recomputes the pairs for positions X (#V by 3) [m] and thickness [m] (> 0). Stays bounded
   // (about 33^3 cells per face at most) on any input: non-finite or astronomically far vertices
   // are left out, and faces whose bounding box is non-finite or spans more than 32 cells along an
-  // axis (an exploded state, never a cloth's face: the cell is about an edge) are skipped.
+  // axis are skipped (an exploded state, never a cloth's face when the cell is at least an eighth
+  // of the longest rest edge, as the simulator sizes it).
   void Update(const Eigen::MatrixX3d& X, double thickness);
 
   // The same pairs as Update (same order), looked for only among `candidates` (vertex, face)
