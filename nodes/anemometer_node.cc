@@ -185,7 +185,9 @@ class AnemometerNode {
       if (port_.Open(serial_, &error)) {
         ROS_INFO("anemometer_node: opened %s at %d baud", serial_.port.c_str(), serial_.baud);
         framer_.Reset();
-        backoff_.Reset();
+        // The back-off restarts when the instrument's bytes arrive, not when the port opens (as
+        // for USB below): a port that opens and fails every read was reopened every 0.1 s, with
+        // two log lines each time, for as long as it stayed so.
         state_ = "connected";
         ++connects_;
       } else {
@@ -201,6 +203,7 @@ class AnemometerNode {
     std::string error;
     const auto status = port_.Read(buffer, sizeof(buffer), 50, &n, &error);
     if (status == clothwind::sensors::SerialPort::ReadStatus::kData) {
+      backoff_.Reset();
       // All bytes of one read share its arrival time; a record is stamped with its first byte's.
       const ros::Time arrival = ros::Time::now();
       std::vector<clothwind::sensors::RawRecord> records;

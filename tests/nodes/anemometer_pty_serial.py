@@ -243,6 +243,56 @@ class AnemometerPtySerialTest(unittest.TestCase):
             self.assertEqual([w.source for w in self.winds], ['nmea_mwv'])
             self.assertTrue(any(r.data.startswith('\x02Q,229') for r in self.raws))
 
+    def test_5_a_port_that_opens_and_fails_every_read_is_reopened_ever_more_slowly(self):
+        # A device whose port opens and whose every read fails (here each pty's master closes as
+        # soon as the node holds its slave: the read gets EIO) was reopened every 0.1 s: the
+        # back-off restarted at each open. It restarts when bytes arrive: the delays before the
+        # next open grow to ~reconnect_max_delay (0.5 s here: 0.1, 0.2, 0.4, 0.5, 0.5).
+        try:
+            self.dev.vanish()
+        except OSError:
+            pass
+        gaps = []
+        for i in range(6):
+            self.dev = type(self).dev = FakeInstrument(self.port)
+            made = time.time()
+            self.assertTrue(self.wait_until_held(self.dev, 20.0), 'the node did not open the port (%d)' % i)
+            if i > 0:
+                gaps.append(time.time() - made)
+            self.dev.vanish()
+        self.assertGreaterEqual(min(gaps[-2:]), 0.35, 'delays before each reopen [s]: %s' % gaps)
+        # Bytes from the instrument restart it: lost after a reading, the port is reopened soon.
+        self.dev = type(self).dev = FakeInstrument(self.port)
+        self.clear()
+        self.assertTrue(self.wait_for_wind(nmea('IIMWV,010.0,R,3.0,M,A'), 20.0), 'no reading after the reopen')
+        self.dev.vanish()
+        self.dev = type(self).dev = FakeInstrument(self.port)
+        made = time.time()
+        self.assertTrue(self.wait_until_held(self.dev, 20.0), 'the node did not open the port again')
+        self.assertLess(time.time() - made, 0.3, 'the back-off did not restart after a reading (gaps before: %s)' % gaps)
+
+    @staticmethod
+    def wait_until_held(dev, timeout):
+        """Waits until another process holds dev's pty slave open (the node opened the port)."""
+        path = os.ttyname(dev.slave)
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            for pid in os.listdir('/proc'):
+                if not pid.isdigit() or int(pid) == os.getpid():
+                    continue
+                try:
+                    fds = os.listdir('/proc/%s/fd' % pid)
+                except OSError:
+                    continue
+                for fd in fds:
+                    try:
+                        if os.readlink('/proc/%s/fd/%s' % (pid, fd)) == path:
+                            return True
+                    except OSError:
+                        pass
+            time.sleep(0.005)
+        return False
+
 
 if __name__ == '__main__':
     rostest.rosrun('clothwind', 'anemometer_pty_serial', AnemometerPtySerialTest)
