@@ -179,7 +179,15 @@ int Run(const SimulateArgs& a) {
     bar_options.rate_unit = "sim s/s";
     ProgressBar bar(bar_options);
     options.progress = [&bar](int done, int total) { return bar.Update(done, total); };
-    const sim::Trajectory t = sim::SimulateTrajectory(setup, theta, options);
+    // A failure mid-run (a blow-up) names the scene and cloth: its message names a step and a
+    // vertex, and a scene's values are what the user can change.
+    const sim::Trajectory t = [&] {
+      try {
+        return sim::SimulateTrajectory(setup, theta, options);
+      } catch (const std::exception& e) {
+        throw std::runtime_error(scene.path + ", cloths[" + std::to_string(c) + "]: " + e.what());
+      }
+    }();
     total_wall += t.wall_seconds;
     const std::string traj = (fs::path(a.out) / (c == 0 ? std::string("trajectory.cwtraj")
                                                          : "trajectory_" + std::to_string(c) + ".cwtraj"))

@@ -93,6 +93,10 @@ double Material::BendingStiffnessFromRow(double curvature, const std::array<doub
   // Curvature samples every 10 1/m (ArcSim: value = curv/2 * 0.2, clamped to [0, 4]). ArcSim
   // passes a signed curvature and so extrapolates below the first sample for negative dihedrals,
   // which depends on the arbitrary edge orientation; the measured tables are for a magnitude.
+  // A NaN curvature (a state already broken) gives a NaN stiffness, which the step's force check
+  // reports; cast to an index it was undefined behaviour (a scene with a repulsion thickness of
+  // 1e200 crashed here).
+  if (std::isnan(curvature)) return curvature;
   double value = std::min(std::abs(curvature) * 0.1, 4.0);
   const int value_i = std::clamp(static_cast<int>(value), 0, 3);
   value -= value_i;
@@ -251,6 +255,17 @@ Material LoadArcSimMaterial(const std::string& path, const MaterialMultipliers& 
   // Every bending stiffness enters θ, which requires > 0: a zero here failed later naming no file.
   if (!(bending.array() > 0).all())
     throw std::runtime_error(path + ": field 'bending' must hold stiffnesses > 0 [N m]");
+  // Each entry at most its bound, named by row and column (see kMaxStretchingEntry).
+  auto bounded = [&](const Eigen::MatrixXd& t, const char* field, double max, const char* unit) {
+    for (int r = 0; r < t.rows(); ++r)
+      for (int c = 0; c < t.cols(); ++c)
+        if (!(std::abs(t(r, c)) <= max))
+          throw std::runtime_error(path + ": field '" + field + "[" + std::to_string(r) + "][" + std::to_string(c) +
+                                   "]' is " + Formatted("%g", t(r, c)) + ", expected at most " + Formatted("%g", max) +
+                                   unit + " in magnitude");
+  };
+  bounded(stretching, "stretching", kMaxStretchingEntry, "");
+  bounded(bending, "bending", kMaxBendingEntry, " N m");
   try {
     return MakeMaterial(density, stretching, bending, mult);
   } catch (const std::invalid_argument& e) {

@@ -14,6 +14,11 @@ namespace clothwind::sim {
 // Area weights above this are no cloth (1000 kg/m^2: a 13 cm steel plate; fabrics weigh 0.05-1,
 // ArcSim's heaviest material 0.324), and far above it the step's numbers overflow.
 constexpr double kMaxAreaWeight = 1e3;  // [kg/m^2]
+// Bounds on a material file's table entries, far past any measured material (ArcSim's fabrics:
+// stretching up to ~2e3, its aluminium 1.8e6; bending up to 4e-4 N m for its paper): a typo
+// such as 1e30 is refused naming the entry, where it blew the simulation up naming nothing.
+constexpr double kMaxStretchingEntry = 1e9;
+constexpr double kMaxBendingEntry = 1e3;  // [N m]
 
 struct MaterialMultipliers {
   double density = 1.0;

@@ -2,11 +2,13 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -171,6 +173,35 @@ TEST(MaterialTest, AreaWeightsFarBeyondAnyClothAreRefusedNamingFileAndField) {
   rigid.thicken = 1e5;
   rigid.density = 1e-5;
   ExpectThrowContaining([&] { MakeMaterial(0.2, Table6x4(10), Table3x5(), rigid); }, "bending table x bending_mult");
+}
+
+TEST(MaterialTest, TableEntriesFarBeyondAnyMaterialAreRefusedNamingTheEntry) {
+  // A stretching entry of 1e30 loaded, and the simulation "blew up at t = 0.0100 s (step 2)",
+  // naming neither the file nor the entry. Refused past 1e9 (stretching) and 1e3 N m (bending);
+  // the bounds themselves load.
+  auto file = [&](const std::string& name, const std::string& first_stretching, const std::string& first_bending) {
+    return WriteText(name, "{\"density\": 0.2, \"stretching\": [[" + first_stretching +
+                               ",2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4],[1,2,3,4]], \"bending\": [[1,2,3,4,5],[1,2," +
+                               first_bending + ",4,5],[1,2,3,4,5]]}");
+  };
+  const std::string stiff = file("stiff.json", "1e30", "3");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(stiff); },
+                        stiff + ": field 'stretching[0][0]' is 1e+30, expected at most 1e+09 in magnitude");
+  const std::string negative = file("negstiff.json", "-2e9", "3");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(negative); }, negative + ": field 'stretching[0][0]' is -2e+09");
+  const std::string rigid = file("rigid.json", "1", "1e4");
+  ExpectThrowContaining([&] { LoadArcSimMaterial(rigid); },
+                        rigid + ": field 'bending[1][2]' is 10000, expected at most 1000 N m in magnitude");
+  EXPECT_NO_THROW(LoadArcSimMaterial(file("bounds.json", "1e9", "1000")));
+}
+
+TEST(MaterialTest, ANotANumberCurvatureGivesANotANumberStiffness) {
+  // Cast to a table index, a NaN curvature was undefined behaviour (a scene whose repulsion
+  // thickness was 1e200 crashed there); a NaN stiffness makes a non-finite force the step reports.
+  const std::array<double, 5> row = {1, 2, 3, 4, 5};
+  EXPECT_TRUE(std::isnan(Material::BendingStiffnessFromRow(std::nan(""), row)));
+  EXPECT_EQ(Material::BendingStiffnessFromRow(std::numeric_limits<double>::infinity(), row), 5);
+  EXPECT_EQ(Material::BendingStiffnessFromRow(-std::numeric_limits<double>::infinity(), row), 5);
 }
 
 TEST(MaterialTest, IgnoredKeysAreNamed) {

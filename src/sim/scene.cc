@@ -599,10 +599,13 @@ Scene ParseScene(const std::string& text, const std::string& path, const Warning
                 {"fixed_high_res_mesh", "handle_stiffness", "projection_thickness",
                  "edge_flip_threshold", "rib_stiffening", "combine_tensors", "preserve_creases"});
     if (m.contains("repulsion_thickness")) {
-      s.magic.repulsion_thickness = r.NonNegative(m["repulsion_thickness"], "magic.repulsion_thickness");
+      // At most 0.1 m (ArcSim's default is 1 mm, ours 10 mm): 10, a typo for 10e-3, blew the
+      // simulation up naming nothing, and 1e200 crashed it.
+      s.magic.repulsion_thickness = r.NonNegativeAtMost(m["repulsion_thickness"], "magic.repulsion_thickness", 0.1, " m");
     }
     if (m.contains("collision_stiffness")) {
-      s.magic.collision_stiffness = r.NonNegative(m["collision_stiffness"], "magic.collision_stiffness");
+      // At most 1e12 (ArcSim's default 1e9).
+      s.magic.collision_stiffness = r.NonNegativeAtMost(m["collision_stiffness"], "magic.collision_stiffness", 1e12);
     }
   }
   return s;

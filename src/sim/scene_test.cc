@@ -377,6 +377,12 @@ TEST_F(SceneFiles, PhysicallyAbsurdMagnitudesAreRefusedNamingFileAndField) {
       {"shear_ground", SceneText(", \"wind\": {\"velocity\": [3, 0, 0], \"shear\": {}}"), "wind.shear.ground_z",
        "required with a profile"},
       {"air", SceneText(", \"wind\": {\"density\": 1e300}"), "wind.density", "kg/m^3"},
+      // 1e200 crashed the simulator (a NaN curvature cast to an index); 10, a typo for 10e-3,
+      // blew it up naming nothing.
+      {"repulsion_thickness", SceneText(", \"magic\": {\"repulsion_thickness\": 10}"), "magic.repulsion_thickness",
+       "[0, 0.1] m"},
+      {"collision_stiffness", SceneText(", \"magic\": {\"collision_stiffness\": 1e200}"), "magic.collision_stiffness",
+       "[0, 1e+12]"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
