@@ -37,4 +37,27 @@ roslaunch --dump-params clothwind field.launch bag:=true bag_prefix:=/data/sessi
   fail "roslaunch --dump-params field.launch bag:=true: $(cat "$work/params.txt")"
 grep -q "^/session_bag_watch/bag_prefix: /data/session$" "$work/params.txt" ||
   fail "field.launch bag:=true has no session_bag_watch on the bag's prefix: $(grep -i bag "$work/params.txt")"
+# Every clothwind node's parameters are cleared before its launch sets them (roslaunch's own
+# reading of the files, every optional node on): a value an earlier launch set and this one leaves
+# out (sdn's ~camera_heading, the anemometer YAML's ~magnetic_declination) was kept on a running
+# master and used without a word.
+/usr/bin/env python3 - "$(rospack find clothwind)/launch" <<'PY' || fail "a clothwind node keeps an earlier launch's parameters"
+import sys
+import roslaunch.config
+folder = sys.argv[1]
+args = {"field.launch": ["bag:=true"], "replay.launch": ["bag:=/tmp/none.bag", "report:=true", "model:=/tmp/m.pt"],
+        "sdn.launch": ["model:=/tmp/m.pt"], "monitor.launch": ["model:=/tmp/m.pt", "rviz:=false"]}
+bad = []
+for name, extra in args.items():
+    sys.argv = ["roslaunch"] + extra
+    config = roslaunch.config.load_config_default([folder + "/" + name], None)
+    nodes = [n for n in config.nodes if n.package == "clothwind"]
+    assert nodes, name
+    for n in nodes:
+        ns = n.namespace.rstrip("/") + "/" + n.name + "/"
+        if ns not in config.clear_params:
+            bad.append("%s: %s" % (name, ns))
+print("\n".join(bad), file=sys.stderr)
+sys.exit(1 if bad else 0)
+PY
 echo "launch_params_test: OK"
