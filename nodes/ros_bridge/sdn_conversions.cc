@@ -27,6 +27,13 @@ std::vector<cv::Mat> ClipFrames(const clothwind::Clip& msg) {
                                 std::to_string(msg.width) + " x " + std::to_string(msg.height) + ", " +
                                 std::to_string(msg.num_frames) + " frames)");
   }
+  // Square, as the clip buffer crops it (msg/Clip.msg): the network resizes a clip to its square
+  // input, and a 2000 x 2 strip was stretched into one and estimated, diagnostics OK.
+  if (msg.width != msg.height || msg.width < kMinClipSide) {
+    throw std::invalid_argument("Clip width and height must be equal (a square crop) and at least " +
+                                std::to_string(kMinClipSide) + " px (got " + std::to_string(msg.width) + " x " +
+                                std::to_string(msg.height) + ")");
+  }
   const size_t frame = static_cast<size_t>(msg.width) * msg.height * channels;
   const size_t expected = frame * msg.num_frames;
   if (msg.data.size() != expected) {

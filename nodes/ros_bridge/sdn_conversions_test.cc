@@ -51,10 +51,23 @@ TEST(ClipFramesTest, SizesWhoseProductWrapsAreRefusedBeforeTheyAreMultiplied) {
   clothwind::Clip many = GreyClip();
   many.num_frames = kMaxClipFrames + 1;
   EXPECT_NE(Refusal(many).find("num_frames at most 100000"), std::string::npos) << Refusal(many);
-  clothwind::Clip edge = GreyClip(2, 1);  // the largest side passes
+  clothwind::Clip edge = GreyClip(2, 1);  // the largest side passes this check (not the next: square)
   edge.width = kMaxClipSide;
   edge.data.assign(2 * kMaxClipSide, 7);
-  EXPECT_EQ(Refusal(edge), "accepted");
+  EXPECT_EQ(Refusal(edge).find("at most 16384 px"), std::string::npos) << Refusal(edge);
+}
+
+TEST(ClipFramesTest, AClipMustBeASquareOfAtLeastEightPixels) {
+  // A 2000 x 2 strip and a 1 x 1 clip were stretched to the network's square input and estimated
+  // (6.4 m/s), diagnostics OK.
+  clothwind::Clip strip = GreyClip(30, 2);
+  strip.width = 2000;
+  strip.data.assign(30 * 2000 * 2, 7);
+  EXPECT_NE(Refusal(strip).find("must be equal (a square crop) and at least 8 px (got 2000 x 2)"), std::string::npos)
+      << Refusal(strip);
+  EXPECT_NE(Refusal(GreyClip(30, 1)).find("(got 1 x 1)"), std::string::npos) << Refusal(GreyClip(30, 1));
+  EXPECT_NE(Refusal(GreyClip(30, 7)).find("(got 7 x 7)"), std::string::npos) << Refusal(GreyClip(30, 7));
+  EXPECT_EQ(Refusal(GreyClip(30, 8)), "accepted");
 }
 
 TEST(ClipFramesTest, AClipStampedZeroIsRefused) {
