@@ -312,6 +312,15 @@ nlohmann::json ReadIndex(const std::string& dir) {
     throw std::runtime_error(path + ": field 'format' must be \"clothwind-dataset\"");
   if (!j.contains("clips") || !j["clips"].is_array())
     throw std::runtime_error(path + ": field 'clips' must be an array");
+  // make-dataset's header fields, where present (a recording's or a toy dataset's index has
+  // neither): "dataset": "x" made a resume fail on a bare "cannot use key() for non-object
+  // iterators", and --reindex wrote it back; a count of "2" was taken without a word.
+  if (j.contains("dataset") && !j["dataset"].is_object())
+    throw std::runtime_error(path + ": field 'dataset' must be an object (make-dataset's settings), got " +
+                             j["dataset"].dump());
+  if (j.contains("count") && !(j["count"].is_number_unsigned() || (j["count"].is_number_integer() && j["count"] >= 0)))
+    throw std::runtime_error(path + ": field 'count' must be a whole number >= 0 (the simulations), got " +
+                             j["count"].dump());
   return j;
 }
 

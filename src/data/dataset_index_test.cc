@@ -117,6 +117,22 @@ TEST(ReadIndexTest, AFolderOrAWrongTypedFormatIsRefusedNamingTheFile) {
       << refusal();
   std::ofstream(dir / "index.json") << R"({"format": "clothwind-dataset", "clips": []})";
   EXPECT_EQ(refusal(), "accepted");
+  // make-dataset's header fields: "dataset": "x" failed a resume on a bare iterator error (and
+  // --reindex wrote it back), a count of "2" was taken.
+  std::ofstream(dir / "index.json") << R"({"format": "clothwind-dataset", "dataset": "x", "clips": []})";
+  EXPECT_NE(refusal().find("index.json: field 'dataset' must be an object (make-dataset's settings), got \"x\""),
+            std::string::npos)
+      << refusal();
+  for (const char* count : {"\"2\"", "-1", "2.5"}) {
+    std::ofstream(dir / "index.json") << R"({"format": "clothwind-dataset", "dataset": {}, "count": )" << count
+                                      << R"(, "clips": []})";
+    EXPECT_NE(refusal().find("index.json: field 'count' must be a whole number >= 0 (the simulations), got " +
+                             std::string(count)),
+              std::string::npos)
+        << refusal();
+  }
+  std::ofstream(dir / "index.json") << R"({"format": "clothwind-dataset", "dataset": {}, "count": 2, "clips": []})";
+  EXPECT_EQ(refusal(), "accepted");
   fs::remove_all(dir);
 }
 

@@ -56,13 +56,23 @@ ClipView ReadClipView(const fs::path& label_json) {
                              ": no zeta object (the rendering parameters of a simulated clip; a real clip has none)");
   }
   const nlohmann::json& z = label["zeta"];
-  const double aspect = ZetaNumber(z, "mesh_aspect_ratio", label_json);
-  if (!(aspect > 0)) throw std::runtime_error(label_json.string() + ": zeta.mesh_aspect_ratio must be > 0");
-  const double centre = ZetaNumber(z, "mesh_height", label_json) + ZetaNumber(z, "mesh_width", label_json) / aspect / 2;
+  // Within the renderer's ranges (render::ValidateRenderParams; the angle within a turn): a
+  // radius of -3 m or 1e300 was binned as it was, into a 300-digit "camera distance" bin, and an
+  // angle of 1e300 deg overflowed its bin's index.
+  auto in = [&](const char* field, double lo, double hi, const char* range) {
+    const double x = ZetaNumber(z, field, label_json);
+    if (!(x >= lo && x <= hi))
+      throw std::runtime_error(label_json.string() + ": zeta." + field + " is " + std::to_string(x) + ", expected " +
+                               range);
+    return x;
+  };
+  const double aspect = in("mesh_aspect_ratio", 0.1, 10, "in [0.1, 10]");
+  const double width = in("mesh_width", 1e-9, 1e3, "in (0, 1000] m");
+  const double centre = in("mesh_height", 0, 1e3, "in [0, 1000] m") + width / aspect / 2;
   ClipView v;
-  v.radius_m = ZetaNumber(z, "camera_radius", label_json);
-  v.elevation_deg = std::atan2(centre - ZetaNumber(z, "camera_height", label_json), v.radius_m) * 180.0 / M_PI;
-  v.angle_deg = std::abs(ZetaNumber(z, "camera_angle_deg", label_json));
+  v.radius_m = in("camera_radius", 0.1, 1e4, "in [0.1, 10000] m");
+  v.elevation_deg = std::atan2(centre - in("camera_height", 1e-9, 1e3, "in (0, 1000] m"), v.radius_m) * 180.0 / M_PI;
+  v.angle_deg = std::abs(in("camera_angle_deg", -360, 360, "in [-360, 360] deg"));
   if (!z.contains("texture_name") || !z["texture_name"].is_string()) {
     throw std::runtime_error(label_json.string() + ": zeta.texture_name is missing or not a string");
   }

@@ -74,6 +74,31 @@ TEST(ViewBreakdownTest, ALabelWithoutAViewIsRefusedByFileAndField) {
   fs::remove_all(d);
 }
 
+TEST(ViewBreakdownTest, AViewOutsideTheRenderersRangesIsRefusedByFileAndField) {
+  // A radius of -3 m or 1e300 was binned as it was (a 300-digit "camera distance" bin holding
+  // both), and an angle of 1e300 deg overflowed its bin's index (undefined behaviour).
+  const fs::path d = TempDir("range");
+  struct Case {
+    double height, radius, angle;
+    const char* says;
+  };
+  for (const Case& c : {Case{0.6, -3.0, 0.0, "zeta.camera_radius is -3.000000, expected in [0.1, 10000] m"},
+                        Case{0.6, 1e300, 0.0, "zeta.camera_radius is 1000000"},
+                        Case{0.6, 5.0, 1e300, "zeta.camera_angle_deg is 1000000"},
+                        Case{0.6, 5.0, -361.0, "zeta.camera_angle_deg is -361.000000, expected in [-360, 360] deg"},
+                        Case{-1.0, 5.0, 0.0, "zeta.camera_height is -1.000000, expected in (0, 1000] m"}}) {
+    const fs::path label = WriteLabel(d / "a", c.height, c.radius, c.angle, "x");
+    try {
+      ReadClipView(label);
+      ADD_FAILURE() << c.says << ": read";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(label.string() + ": " + c.says), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(ReadClipView(WriteLabel(d / "a", 1000.0, 1e4, -360.0, "x")));
+  fs::remove_all(d);
+}
+
 TEST(ViewBreakdownTest, BinsStartAtTheLowestKeyAndHoldOnlyTheirExamples) {
   // Keys 21, 24, 33 in 5-wide bins from 20: [20, 25) holds two, [25, 30) none (left out), [30, 35) one.
   const std::vector<BinMetrics> b = ComputeBinnedMetrics({21, 33, 24}, {1, 2, 3}, {1.2, 2.0, 2.0}, 5.0);
