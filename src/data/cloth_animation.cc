@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <stdexcept>
 
 #include "sim/mesh.h"
@@ -23,9 +24,21 @@ Eigen::MatrixXd NormalizeTextureCoordinates(const Eigen::MatrixXd& U, const Eige
 }
 
 namespace {
-void Bounds(const Eigen::MatrixXd& U, Eigen::Vector2d* lo, Eigen::Vector2d* hi) {
-  *lo = U.colwise().minCoeff().transpose();
-  *hi = U.colwise().maxCoeff().transpose();
+// The material-space box of the vertices the faces F use (#F by 3 into U's rows). Why not all of
+// U: an OBJ vertex no face uses (a stray point of a modelling tool) sized a 1 m cloth as 5 m,
+// rendered small, framed for the larger one, and a correct --zeta was refused.
+void Bounds(const Eigen::MatrixXd& U, const Eigen::MatrixXi& F, Eigen::Vector2d* lo, Eigen::Vector2d* hi) {
+  lo->setConstant(std::numeric_limits<double>::infinity());
+  hi->setConstant(-std::numeric_limits<double>::infinity());
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < F.cols(); ++c) {
+      const int v = F(f, c);
+      if (v < 0 || v >= U.rows())
+        throw std::invalid_argument("face " + std::to_string(f) + " names vertex " + std::to_string(v) + " of " +
+                                    std::to_string(U.rows()));
+      *lo = lo->cwiseMin(U.row(v).transpose());
+      *hi = hi->cwiseMax(U.row(v).transpose());
+    }
 }
 }  // namespace
 
@@ -40,7 +53,7 @@ ClothAnimation AnimationFromTrajectory(const sim::Trajectory& t, int first, int 
   a.F = t.faces;
   const Eigen::MatrixXd U = t.uv.cast<double>();
   Eigen::Vector2d lo, hi;
-  Bounds(U, &lo, &hi);
+  Bounds(U, t.faces, &lo, &hi);
   a.UV = NormalizeTextureCoordinates(U, lo, hi);
   a.rest_size = hi - lo;
   a.frames.resize(count);
@@ -61,7 +74,7 @@ ClothAnimation ReadObjSequence(const std::string& folder, int cloth, double fram
     const sim::Mesh m = sim::ReadObj(path.string(), /*topology=*/false);  // drawn, not simulated
     const Eigen::MatrixXd U = m.U;
     if (f == 0) {
-      Bounds(U, &lo, &hi);
+      Bounds(U, m.F, &lo, &hi);
       a.rest_size = hi - lo;
     }
     ClothFrame frame;

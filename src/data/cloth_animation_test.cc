@@ -61,6 +61,26 @@ TEST(ClothAnimationTest, TextureCoordinatesSpanTheUnitSquareHoistToFly) {
   }
 }
 
+TEST(ClothAnimationTest, AVertexNoFaceUsesDoesNotSizeTheCloth) {
+  // A 1 m square of two faces and a stray vertex at u = 5 (an OBJ from a modelling tool): the
+  // cloth measured 5 m across, rendered small and framed for the larger one.
+  const fs::path dir = fs::temp_directory_path() / ("clothwind_anim_stray" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  sim::Mesh m;
+  m.V.resize(5, 3);
+  m.V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 5, 0, 0;
+  m.U = m.V.leftCols(2);
+  m.F.resize(2, 3);
+  m.F << 0, 1, 2, 0, 2, 3;
+  sim::WriteObj((dir / "0000_00.obj").string(), m);
+  const ClothAnimation a = ReadObjSequence(dir.string(), 0, 0.04);
+  EXPECT_DOUBLE_EQ(a.rest_size.x(), 1.0);
+  EXPECT_DOUBLE_EQ(a.rest_size.y(), 1.0);
+  EXPECT_DOUBLE_EQ(a.UV(2, 0), 1.0);  // the square's far corner spans the texture
+  fs::remove_all(dir);
+}
+
 TEST(ClothAnimationTest, ObjFramesRenderExactlyLikeTheTrajectory) {
   const sim::Trajectory t = ShortFlag();
   const fs::path dir = WriteObjs(t, "same");
