@@ -60,4 +60,13 @@ for name, extra in args.items():
 print("\n".join(bad), file=sys.stderr)
 sys.exit(1 if bad else 0)
 PY
+# roslaunch --ros-args is how a user learns a launch file's arguments: every declared arg needs a
+# doc= (what it does, its unit, what empty means), or the user reads 'undocumented' for it.
+for launch in field.launch replay.launch sdn.launch monitor.launch; do
+  roslaunch --ros-args "$(rospack find clothwind)/launch/$launch" >"$work/args.txt" 2>&1 ||
+    fail "roslaunch --ros-args $launch: $(cat "$work/args.txt")"
+  if grep -q undocumented "$work/args.txt"; then
+    fail "$launch has args without doc=: $(grep undocumented "$work/args.txt" | sed 's/^ *//; s/[ (:].*//' | paste -sd ' ' -)"
+  fi
+done
 echo "launch_params_test: OK"
