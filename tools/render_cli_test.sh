@@ -277,4 +277,37 @@ status=0
   >"$work/out.txt" 2>&1 || status=$?
 [ "$status" -ne 0 ] && grep -q "missing field 'camera_height'; key 'camera_hieght' is not a render parameter (did you mean camera_height?)" "$work/out.txt" ||
   fail "a misspelt zeta key alone (status $status): $(cat "$work/out.txt")"
+# Inputs that are not what they are named, and values out of range inside an input: each error
+# names the input. A folder named as a trajectory or an OBJ frame read as empty ("truncated
+# header", "no vertices"), a pipe was "no such file or folder", a background photo's path naming a
+# folder "no such file", and a frame beyond the renderer's range or texture coordinates spanning
+# 2 km named no file.
+expect_refused() {  # expect_refused MESSAGE ARGS...: render ARGS fails (status 1) saying MESSAGE
+  local says="$1" status=0
+  shift
+  "$bin" render "$@" --count 1 --samples 1 --threads 1 >"$work/out.txt" 2>&1 || status=$?
+  [ "$status" -eq 1 ] && grep -qF -- "$says" "$work/out.txt" ||
+    fail "render $* (status $status) did not say '$says': $(cat "$work/out.txt")"
+}
+mkfifo "$work/pipe.cwtraj"
+expect_refused "$work/pipe.cwtraj: not a file or folder (a pipe or a device)" "$work/pipe.cwtraj" --out "$work/bad"
+mkdir -p "$work/dirtraj/trajectory.cwtraj" "$work/dirobj/0000_00.obj"
+expect_refused "$work/dirtraj/trajectory.cwtraj: a folder, expected a trajectory file" "$work/dirtraj" --out "$work/bad"
+expect_refused "$work/dirobj/0000_00.obj: a folder, expected an OBJ file" "$work/dirobj" --out "$work/bad"
+square() {  # square FOLDER FAR_X FAR_U: a two-face OBJ frame, its far corners at x and u as given
+  mkdir -p "$1"
+  printf 'v 0 0 0\nv %s 0 0\nv %s 1 0\nv 0 1 0\nvt 0 0\nvt %s 0\nvt %s 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n' \
+    "$2" "$2" "$3" "$3" >"$1/0000_00.obj"
+}
+square "$work/far" 2e6 1
+expect_refused "OBJ frames in $work/far, frame at 0.000000 s: SetCloth: vertex 1 has V coordinate x = 2e+06" \
+  "$work/far" --out "$work/bad"
+square "$work/wide" 1 2000
+expect_refused "OBJ frames in $work/wide: render params: field 'mesh_width'" "$work/wide" --out "$work/bad"
+square "$work/ok" 1 1
+"$bin" render "$work/ok" --out "$work/okr" --count 1 --samples 1 --threads 1 >/dev/null 2>&1 || fail "the square did not render"
+sed 's#"background_image": *"[^"]*"#"background_image": "'"$work"'"#' "$work/okr/zeta.json" >"$work/zeta-folder.json"
+grep -q "\"background_image\": \"$work\"" "$work/zeta-folder.json" || fail "no background_image to set in zeta.json"
+expect_refused "background_image '$work': not a file (a folder, a pipe or a device)" "$work/ok" --out "$work/bad" \
+  --zeta "$work/zeta-folder.json" --keep-zeta
 echo "render_cli_test: OK"

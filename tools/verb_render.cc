@@ -106,7 +106,10 @@ data::ClothAnimation LoadInput(const RenderArgs& a, std::string* what) {
     *what = "trajectory " + in.string();
     return AnimationOfTrajectory(in);
   }
-  if (!fs::is_directory(in)) throw std::runtime_error(a.input + ": no such file or folder");
+  if (!fs::is_directory(in))
+    throw std::runtime_error(a.input + (fs::exists(in) ? ": not a file or folder (a pipe or a device), expected a "
+                                                         ".cwtraj file or a simulation folder"
+                                                       : ": no such file or folder"));
   const fs::path traj = in / (a.cloth == 0 ? std::string("trajectory.cwtraj")
                                             : "trajectory_" + std::to_string(a.cloth) + ".cwtraj");
   if (!a.obj && fs::exists(traj)) {
@@ -174,7 +177,13 @@ int Run(const RenderArgs& a) {
     throw std::invalid_argument("--format: expected jpg (or jpeg) or png, got '" + a.format + "'");
   std::string what;
   const data::ClothAnimation anim = LoadInput(a, &what);
-  FitMeshSize(anim, a, &zeta);
+  // Errors about what the input holds name it: "render params: field 'mesh_width' is 3e+38"
+  // and "SetCloth: vertex 1 has V coordinate x = 1e+38" named no file.
+  try {
+    FitMeshSize(anim, a, &zeta);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(what + ": " + e.what());
+  }
   // NaN passed a range check written as (start < 0 || start > duration), and a frame count
   // computed from it or from a huge rate overflowed int: nothing rendered, the earlier run's
   // frames deleted, exit 0.
@@ -219,7 +228,13 @@ int Run(const RenderArgs& a) {
                a.fps, a.start, zeta.width, zeta.height, zeta.texture_kind.c_str(), zeta.texture_name.c_str());
   for (int k = 0; k < count; ++k) {
     const data::ClothFrame f = data::FrameAt(anim, a.start + k / a.fps);
-    const cv::Mat image = renderer.RenderFrame(f.V, f.F, f.UV);
+    const cv::Mat image = [&] {
+      try {
+        return renderer.RenderFrame(f.V, f.F, f.UV);
+      } catch (const std::invalid_argument& e) {  // the cloth's own values (not I/O)
+        throw std::invalid_argument(what + ", frame at " + std::to_string(a.start + k / a.fps) + " s: " + e.what());
+      }
+    }();
     char name[32];
     std::snprintf(name, sizeof(name), "%03d.%s", k, a.format.c_str());
     render::WriteFrameAtomic((fs::path(a.out) / name).string(), image, a.jpeg_quality);

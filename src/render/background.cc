@@ -40,7 +40,10 @@ Backdrop MakeBackdrop(const RenderParams& p, const PinholeCamera& camera) {
   } else {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(p.background_image, ec))
-      throw std::runtime_error("background_image '" + p.background_image + "': no such file");
+      throw std::runtime_error("background_image '" + p.background_image + "': " +
+                               (std::filesystem::exists(p.background_image, ec)
+                                    ? "not a file (a folder, a pipe or a device), expected an image file"
+                                    : "no such file"));
     // Whole or refused (common/image_file.h): cv::imread rendered a JPEG cut short with its
     // missing rows grey, saying only "Premature end of JPEG file" on stderr.
     std::string why;

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -136,6 +137,9 @@ class EdgeMidpoints {
 }  // namespace
 
 Mesh ReadObj(const std::string& path, bool topology) {
+  // A folder opened as a stream read as empty: "no vertices ('v' lines)".
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": a folder, expected an OBJ file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open OBJ file");
   std::ostringstream contents;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -82,6 +83,10 @@ void WriteTrajectory(const std::string& path, const Trajectory& t) {
 }
 
 Trajectory ReadTrajectory(const std::string& path) {
+  // A folder opened as a stream read as empty: "truncated header (0 bytes, need 32)".
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw std::runtime_error(path + ": a folder, expected a trajectory file (.cwtraj)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open trajectory");
   std::ostringstream ss;
