@@ -175,6 +175,28 @@ inline bool IsTemporaryOfStoppedProcess(const std::string& name, size_t* at = nu
   return true;
 }
 
+// Removes the temporaries TemporaryNameFor gave `path` in processes that no longer run (a run
+// killed while it wrote `path`), which nothing else removes: a model's or judge's pair written
+// again, a copy of model.pt made again, left a killed run's .tmp files beside them for ever. A
+// live writer's stay. For files written now and then (not per frame: it lists the folder).
+// Returns how many went.
+inline int RemoveStaleTemporariesOf(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  const std::string prefix = p.filename().string() + ".tmp-";
+  std::error_code ec;
+  int removed = 0;
+  for (const auto& entry : fs::directory_iterator(p.parent_path().empty() ? fs::path(".") : p.parent_path(), ec)) {
+    const std::string name = entry.path().filename().string();
+    size_t at = 0;
+    if (name.rfind(prefix, 0) == 0 && IsTemporaryOfStoppedProcess(name, &at) && at + 5 == prefix.size()) {
+      std::error_code ignored;
+      removed += fs::remove(entry.path(), ignored) ? 1 : 0;
+    }
+  }
+  return removed;
+}
+
 // Writes `bytes` to `path` through a temporary file in the same folder (WriteFileDurably), a
 // rename and an fsync of the folder. Throws std::runtime_error naming the file when it fails; the
 // temporary is removed then and `path` keeps what it had.
@@ -214,6 +236,9 @@ inline void WriteFilePairAtomically(const std::string& first, const std::string&
   auto remove_temporaries = [&] {
     for (const std::string* p : {&tmp_first, &tmp_second, &backup}) fs::remove(*p, ignored);
   };
+  // A run killed between the two renames left its temporaries and the backup (a torn pair, which
+  // the loaders refuse against the copy inside the weights): this write replaces the pair whole.
+  for (const std::string& p : {first, second, first + ".old"}) RemoveStaleTemporariesOf(p);
   // The first file's old content is kept under a hard link (a durable copy where the filesystem
   // has none: vfat, exFAT, some network mounts) until the pair is in place. Without it nothing is
   // renamed: a failed second rename would then have no way back.
@@ -267,6 +292,7 @@ inline void CopyFileAtomically(const std::string& from, const std::string& to) {
   if (!in) throw std::runtime_error("cannot read " + from + " (to copy it to " + to + ")");
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw std::runtime_error("cannot read " + from + " (to copy it to " + to + ")");
+  RemoveStaleTemporariesOf(to);  // a killed copy's (train's model.pt, published again on --resume)
   WriteFileAtomically(to, bytes);
 }
 

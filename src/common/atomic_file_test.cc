@@ -227,5 +227,29 @@ TEST_F(AtomicFileTest, ATemporaryIsAStoppedProcessesByItsPidBootAndStartTime) {
   EXPECT_FALSE(IsTemporaryOfStoppedProcess("x.tmp-" + pid + ".garbled")) << "not a name it gives";
 }
 
+TEST_F(AtomicFileTest, WritingAPairOrACopyAgainClearsAKilledWritersTemporaries) {
+  // A run killed between a pair's two renames (or while copying model.pt) left its temporaries and
+  // the first file's backup beside the files for ever; the next write of the pair (or copy) clears
+  // them. A live writer's, and other files' temporaries, stay.
+  const std::string weights = (dir_ / "m.pt").string(), card = (dir_ / "m.json").string();
+  const std::string dead = ".tmp-999999999-0";  // a pid that does not run
+  for (const std::string& p : {weights + dead, card + dead, weights + ".old" + dead, (dir_ / "other.pt").string() + dead})
+    std::ofstream(p) << "left";
+  const std::string live = TemporaryNameFor(weights);
+  std::ofstream(live) << "being written";
+  WriteFilePairAtomically(weights, "w", card, "c");
+  EXPECT_FALSE(fs::exists(weights + dead));
+  EXPECT_FALSE(fs::exists(card + dead));
+  EXPECT_FALSE(fs::exists(weights + ".old" + dead));
+  EXPECT_TRUE(fs::exists(live)) << "a live writer's temporary went";
+  EXPECT_TRUE(fs::exists((dir_ / "other.pt").string() + dead)) << "another file's temporary went";
+  EXPECT_EQ(Read(weights), "w");
+  const std::string copy = (dir_ / "copy.pt").string();
+  std::ofstream(copy + dead) << "left";
+  CopyFileAtomically(weights, copy);
+  EXPECT_FALSE(fs::exists(copy + dead));
+  EXPECT_EQ(Read(copy), "w");
+}
+
 }  // namespace
 }  // namespace clothwind

@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/atomic_file.h"
 #include "common/dataset_names.h"
 #include "common/image_file.h"
 #include "data/dataset_index.h"
@@ -106,6 +107,7 @@ bool WriteContactSheet(const std::string& dir, const nlohmann::json& index, cons
                        const ContactSheetOptions& options, const std::function<void(int, int)>& progress) {
   const cv::Mat sheet = MakeContactSheet(dir, index, options, progress);
   if (sheet.empty()) return false;
+  RemoveStaleTemporariesOf(path);  // a killed run's sheet.png.tmp-<pid> stayed beside it for ever
   render::WriteFrameAtomic(path, sheet);
   return true;
 }

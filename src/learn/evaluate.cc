@@ -396,14 +396,7 @@ bool RunGnuplot(const std::string& script, const fs::path& png, std::string* err
   // "<png>.tmp-<tag>-<n>" (TemporaryNameFor; a run's --overwrite clears it too). Those of runs that
   // stopped while gnuplot drew go first: a killed run's stayed beside every later curve, resumes
   // included.
-  {
-    std::error_code ec;
-    const std::string prefix = png.filename().string() + ".tmp-";
-    for (const auto& entry : fs::directory_iterator(png.parent_path().empty() ? "." : png.parent_path(), ec)) {
-      const std::string name = entry.path().filename().string();
-      if (name.rfind(prefix, 0) == 0 && IsTemporaryOfStoppedProcess(name)) fs::remove(entry.path(), ec);
-    }
-  }
+  RemoveStaleTemporariesOf(png.string());
   const std::string tmp = TemporaryNameFor(png.string());
   const fs::path script_path = png.string() + ".gp";
   WriteFileAtomically(script_path, "set terminal pngcairo size 800,600 noenhanced\nset output " + GnuplotQuoted(tmp) +

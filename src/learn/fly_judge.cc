@@ -87,6 +87,38 @@ FlyJudge::FlyJudge(Eigen::MatrixXf hidden_weights, Eigen::VectorXf hidden_bias, 
   }
 }
 
+namespace {
+
+// Throws naming the card unless it is the one saved inside the weights (`stored`, its JSON; empty
+// for a judge saved before the card was stored there: nothing to compare), but for the margin,
+// which a user may set on the card. Why: a train-fly-judge stopped between the pair's two renames
+// left new weights beside the old card, and the judge ran with the other judge's margin, silently.
+void CheckCardMatchesWeights(const nlohmann::json& card, const std::filesystem::path& card_path,
+                             const std::string& stored, const std::filesystem::path& weights) {
+  if (stored.empty()) return;
+  nlohmann::json saved = nlohmann::json::parse(stored, nullptr, /*allow_exceptions=*/false);
+  if (!saved.is_object())
+    throw std::runtime_error(weights.string() + ": the card stored in the weights is not a JSON object");
+  nlohmann::json given = card;
+  for (const char* key : {"margin", "margin_note"}) {
+    saved.erase(key);
+    given.erase(key);
+  }
+  if (given == saved) return;
+  std::string field;
+  for (auto it = saved.begin(); it != saved.end() && field.empty(); ++it)
+    if (!given.contains(it.key()) || given[it.key()] != it.value()) field = it.key();
+  for (auto it = given.begin(); it != given.end() && field.empty(); ++it)
+    if (!saved.contains(it.key())) field = it.key();
+  throw std::runtime_error(card_path.string() + ": field \"" + field + "\" is " +
+                           (given.contains(field) ? given[field].dump() : "missing") + ", but " + weights.string() +
+                           " was saved with " + (saved.contains(field) ? saved[field].dump() : "none") +
+                           ": not the card written with these weights (a train-fly-judge stopped while it replaced "
+                           "them leaves such a pair: train the judge again)");
+}
+
+}  // namespace
+
 FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
   RefuseFolderAsWeightsFile(path, "a fly judge");
   const std::filesystem::path card_path = ConfigPathFor(path);
@@ -127,7 +159,9 @@ FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
   }
   const int h = card["hidden"].get<int>();
   JudgeModule module(h);
-  LoadModuleWeights(module, path);
+  std::string stored;
+  LoadModuleWeights(module, path, &stored);
+  CheckCardMatchesWeights(card, card_path, stored, path);
   const at::Tensor w1 = module.hidden->weight.detach().contiguous();
   const at::Tensor b1 = module.hidden->bias.detach().contiguous();
   const at::Tensor w2 = module.output->weight.detach().contiguous();
@@ -164,9 +198,10 @@ void FlyJudge::Save(const std::filesystem::path& path, nlohmann::json card) cons
   card["grid"] = kMotionMapGrid;
   card["side"] = kMotionMapSide;
   card["margin"] = margin_;
-  // The weights and their card as a pair (WriteFilePairAtomically), as a model's.
-  clothwind::WriteFilePairAtomically(path.string(), SerializeModuleWeights(module, WeightPrecision::kFloat32),
-                          ConfigPathFor(path).string(), card.dump(2) + "\n");
+  // The weights and their card as a pair (WriteFilePairAtomically), as a model's; the card also
+  // inside the weights, as a model's configuration (CheckCardMatchesWeights).
+  clothwind::WriteFilePairAtomically(path.string(), SerializeModuleWeights(module, WeightPrecision::kFloat32, card.dump()),
+                                     ConfigPathFor(path).string(), card.dump(2) + "\n");
 }
 
 double FlyJudge::Logit(const Eigen::VectorXf& map) const {

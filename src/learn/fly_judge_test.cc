@@ -254,6 +254,34 @@ TEST(FlyJudgeTest, SaveLoadRoundTripKeepsScoresAndCard) {
   fs::remove_all(dir);
 }
 
+TEST(FlyJudgeTest, WeightsBesideAnotherJudgesCardAreRefusedNamingTheField) {
+  // A train-fly-judge stopped between the pair's two renames left the new weights beside the old
+  // card, and the judge loaded with the other's margin and provenance, silently. The card is kept
+  // inside the weights too; the margin alone may be set on the card.
+  const fs::path dir = fs::temp_directory_path() / ("fly_judge_pair_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  RandomJudge(12, 6).Save(dir / "judge.pt", {{"data", "synthetic"}, {"seed", 1}});
+  const std::string old_card = ReadJson(dir / "judge.json").dump();
+  RandomJudge(12, 7).Save(dir / "judge.pt", {{"data", "synthetic"}, {"seed", 7}});
+  EXPECT_NO_THROW(FlyJudge::Load(dir / "judge.pt"));
+  WriteFileAtomically(dir / "judge.json", old_card);  // the old card beside the new weights
+  try {
+    FlyJudge::Load(dir / "judge.pt");
+    FAIL() << "new weights loaded with the old card";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("judge.json: field \"seed\" is 1, but " + (dir / "judge.pt").string() +
+                                         " was saved with 7"),
+              std::string::npos)
+        << e.what();
+  }
+  nlohmann::json card = ReadJson(dir / "judge.json");
+  card["seed"] = 7;
+  card["margin"] = 2.5;  // set by hand: allowed
+  WriteFileAtomically(dir / "judge.json", card.dump());
+  EXPECT_EQ(FlyJudge::Load(dir / "judge.pt").margin(), 2.5);
+  fs::remove_all(dir);
+}
+
 TEST(FlyJudgeTest, RefusesWeightsOfTheWrongShape) {
   EXPECT_THROW(FlyJudge(Eigen::MatrixXf::Zero(4, 10), Eigen::VectorXf::Zero(4), Eigen::VectorXf::Zero(4), 0),
                std::invalid_argument);
