@@ -310,4 +310,9 @@ sed 's#"background_image": *"[^"]*"#"background_image": "'"$work"'"#' "$work/okr
 grep -q "\"background_image\": \"$work\"" "$work/zeta-folder.json" || fail "no background_image to set in zeta.json"
 expect_refused "background_image '$work': not a file (a folder, a pipe or a device)" "$work/ok" --out "$work/bad" \
   --zeta "$work/zeta-folder.json" --keep-zeta
+# Rendering into a folder from its own zeta.json: refused, the file kept (the run removes it until
+# its frames are whole, and a Ctrl-C lost it).
+cp "$work/okr/zeta.json" "$work/okr-zeta-before.json"
+expect_refused "--zeta $work/okr/zeta.json is --out's own zeta.json" "$work/ok" --out "$work/okr" --zeta "$work/okr/zeta.json"
+cmp -s "$work/okr/zeta.json" "$work/okr-zeta-before.json" || fail "render from --out's own zeta.json changed it"
 echo "render_cli_test: OK"

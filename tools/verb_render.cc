@@ -18,6 +18,7 @@
 #include "closest_name.h"
 #include "common/json_file.h"
 #include "data/cloth_animation.h"
+#include "output_paths.h"
 #include "progress_bar.h"
 #include "stale_frames.h"
 #include "render/render_params.h"
@@ -153,6 +154,12 @@ void FitMeshSize(const data::ClothAnimation& anim, const RenderArgs& a, render::
 }
 
 int Run(const RenderArgs& a) {
+  // --out's zeta.json goes before the first frame and comes back after the last (below): read as
+  // --zeta, a run stopped half way lost the frames' only record of how they were made.
+  if (!a.zeta.empty() && SameFile(a.zeta, fs::path(a.out) / "zeta.json"))
+    throw std::invalid_argument("--zeta " + a.zeta + " is --out's own zeta.json, which render removes until its frames "
+                                "are whole (a run stopped half way would lose it): copy it elsewhere first, or render "
+                                "into another --out");
   render::RenderParams zeta = a.zeta.empty()
                                   ? render::SampleRenderParams(render::SceneKindFromName(a.kind), a.seed)
                                   : LoadZeta(a.zeta);
