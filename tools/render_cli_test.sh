@@ -315,4 +315,9 @@ expect_refused "background_image '$work': not a file (a folder, a pipe or a devi
 cp "$work/okr/zeta.json" "$work/okr-zeta-before.json"
 expect_refused "--zeta $work/okr/zeta.json is --out's own zeta.json" "$work/ok" --out "$work/okr" --zeta "$work/okr/zeta.json"
 cmp -s "$work/okr/zeta.json" "$work/okr-zeta-before.json" || fail "render from --out's own zeta.json changed it"
+# A simulate folder without its summary.json (a run stopped while it wrote its OBJs): --obj is
+# refused, the OBJs may stop short (they rendered 5 s of a 20 s run, exit 0).
+"$bin" simulate "$src/config/scenes/flag.json" --out "$work/killed" --duration 0.08 --max-edge 1 >/dev/null 2>&1
+rm "$work/killed/summary.json" "$work/killed/0002_00.obj"
+expect_refused "simulate did not finish there (no summary.json)" "$work/killed" --obj --out "$work/bad"
 echo "render_cli_test: OK"

@@ -120,6 +120,13 @@ data::ClothAnimation LoadInput(const RenderArgs& a, std::string* what) {
     *what = "trajectory " + traj.string();
     return AnimationOfTrajectory(traj);
   }
+  // A simulate folder (its trajectory there) without summary.json, which simulate writes last: a
+  // run stopped while it wrote its OBJs, whose sequence ends early (5 s of a 20 s run rendered,
+  // exit 0, where the trajectory holds all 20).
+  if (fs::exists(traj) && !fs::exists(in / "summary.json"))
+    throw std::runtime_error("OBJ frames in " + in.string() + ": simulate did not finish there (no summary.json), so "
+                             "its OBJ frames may stop short; render " + traj.string() + " without --obj, or simulate "
+                             "again");
   *what = "OBJ frames in " + in.string();
   return data::ReadObjSequence(in.string(), a.cloth, a.frame_time);
 }
