@@ -582,6 +582,11 @@ std::vector<double> WriteToyDataset(const fs::path& dir, const ToyDatasetOptions
     int number = -1;
     char rest = 0;
     if (std::sscanf(file.c_str(), "toy-%d%c", &number, &rest) == 1 && number >= o.clips) fs::remove_all(e.path());
+    // A stopped run's example being written (".toy-00089.tmp"): only the next run writing that
+    // number removed it, and a run of fewer clips left it for good.
+    char tail[8] = {0};
+    if (std::sscanf(file.c_str(), ".toy-%d.%4s%c", &number, tail, &rest) == 2 && std::string(tail) == "tmp")
+      fs::remove_all(e.path());
   }
   nlohmann::json clips = nlohmann::json::array();
   std::vector<double> frequencies;

@@ -633,6 +633,13 @@ TEST_F(DatasetTest, AToyDatasetOverAnotherReplacesItWhole) {
   EXPECT_FALSE(fs::exists(copy / "toy-00003"));
   EXPECT_FALSE(fs::exists(copy / "toy-00009"));
   for (const ClipInfo& c : d.clips) EXPECT_EQ(c.num_frames, 4);
+  // A stopped run's example being written, numbered past this run's: it stayed for good.
+  fs::create_directories(copy / ".toy-00089.tmp");
+  std::ofstream(copy / ".toy-00089.tmp" / "000.jpg") << "half";
+  fs::create_directories(copy / ".toy-notes");  // not one: stays
+  WriteToyDataset(copy, o);
+  EXPECT_FALSE(fs::exists(copy / ".toy-00089.tmp"));
+  EXPECT_TRUE(fs::exists(copy / ".toy-notes"));
 
   // Over a dataset of another kind (a FlagSim one's index, its settings in the header): refused,
   // its index kept (it was removed and replaced by a toy one).
