@@ -21,19 +21,31 @@ status=0
 [ -f bags/s.bag ] && [ -f previews/p.png ] || fail "make-session wrote $(ls -R)"
 rm -rf bags previews
 
-"$bin" make-session --minutes 5 --width 512 --height 512 --out big.bag >out.txt 2>&1 &
+# Over an earlier session and its preview (--overwrite): both stay as they were when the run is
+# stopped (the preview was replaced at the first frame, beside the old bag).
+"$bin" make-session --minutes 0.05 --width 16 --height 16 --out big.bag --preview big.png --seed 1 >out.txt 2>&1 ||
+  fail "make-session (the earlier session): $(cat out.txt)"
+cp big.bag before.bag.keep
+cp big.png before.png.keep
+"$bin" make-session --minutes 5 --width 512 --height 512 --out big.bag --preview big.png --seed 9 --overwrite \
+  >out.txt 2>&1 &
 pid=$!
+# Until the temporary bag holds a few frames (786 kB each): past the first, which the preview is.
+grown() { [ -n "$(find . -maxdepth 1 -name 'big.bag.tmp-*' -size +2M)" ]; }
 for _ in $(seq 200); do
-  compgen -G "big.bag.tmp-*" >/dev/null && break
+  grown && break
   sleep 0.1
 done
-compgen -G "big.bag.tmp-*" >/dev/null || { kill "$pid"; fail "no temporary bag after 20 s: $(cat out.txt)"; }
+grown || { kill "$pid"; fail "no temporary bag of 2 MB after 20 s: $(cat out.txt)"; }
 # SIGTERM: a non-interactive shell starts background jobs with SIGINT ignored (the unit test
 # covers SIGINT).
 kill -TERM "$pid"
 status=0
 wait "$pid" || status=$?
 [ "$status" -eq 143 ] || fail "make-session did not end by SIGTERM (status $status): $(tail -3 out.txt)"
-left="$(ls)"
-[ "$left" = "out.txt" ] || fail "an interrupted make-session left: $left"
+left="$(LC_ALL=C ls)"
+[ "$left" = "$(printf 'before.bag.keep\nbefore.png.keep\nbig.bag\nbig.png\nout.txt')" ] ||
+  fail "an interrupted make-session left: $left"
+cmp -s big.bag before.bag.keep || fail "an interrupted make-session changed the earlier bag"
+cmp -s big.png before.png.keep || fail "an interrupted make-session replaced the earlier bag's preview"
 echo "make_session_cli_test: OK"

@@ -223,6 +223,7 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
   const auto& readings = rendered ? model_readings : session.readings();
   size_t fi = 0, ri = 0;
   double speed_sum = 0.0;
+  std::vector<uchar> preview_bytes;  // the first frame, as --preview's format
   try {
     // Merge both streams in stamp order, as they were "recorded".
     while (fi < stamps.size() || ri < readings.size()) {
@@ -230,12 +231,10 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
       if (frame_next) {
         const ros::Time t(stamps[fi]);
         const cv::Mat img = session.RenderFrame(fi);
-        if (fi == 0 && !a.preview.empty()) {
-          std::vector<uchar> bytes;
-          if (!cv::imencode(preview_extension, img, bytes))
-            throw std::runtime_error("--preview " + a.preview + ": OpenCV could not encode the frame");
-          WriteFileAtomically(a.preview, bytes.data(), bytes.size());
-        }
+        // Encoded now, written once the bag is in place: written here, a run stopped mid-bag left
+        // the old bag beside the new run's preview.
+        if (fi == 0 && !a.preview.empty() && !cv::imencode(preview_extension, img, preview_bytes))
+          throw std::runtime_error("--preview " + a.preview + ": OpenCV could not encode the frame");
         sensor_msgs::Image msg;
         msg.header.seq = static_cast<uint32_t>(fi);
         msg.header.stamp = t;
@@ -272,6 +271,7 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
     SyncFile(tmp);
     fs::rename(tmp, out);
     SyncDirectory(out.has_parent_path() ? out.parent_path().string() : ".");
+    if (!a.preview.empty()) WriteFileAtomically(a.preview, preview_bytes.data(), preview_bytes.size());
   } catch (const std::exception& e) {
     try {
       bag.close();
