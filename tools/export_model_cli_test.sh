@@ -53,6 +53,14 @@ for out in "$work/toy" "$work/toy/toy-00000"; do
   [ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "--out $out is .*the dataset" "$work/msg.txt" &&
     [ ! -e "$out/model.pt" ] || fail "train --out $out: not refused (status $status): $(cat "$work/msg.txt")"
 done
+# An earlier run's plot goes before the new figures are written: a run whose plot failed (here no
+# gnuplot on PATH) or that was stopped while gnuplot drew left the old picture beside them.
+printf 'old picture' >"$work/q.png"
+status=0
+env PATH=/nonexistent "$bin" eval --model "$work/run/model.pt" --data "$work/toy" --split all --plot "$work/q.png" \
+  --json "$work/q.json" --threads 1 >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 1 ] && grep -q "plot not drawn" "$work/msg.txt" && [ -f "$work/q.json" ] && [ ! -e "$work/q.png" ] ||
+  fail "eval whose plot failed (status $status) left: $(ls "$work" | grep '^q') $(cat "$work/msg.txt")"
 # eval --plot draws a PNG whatever the name: p.txt was written as one.
 status=0
 "$bin" eval --model "$work/run/model.pt" --data "$work/toy" --split all --plot "$work/p.txt" --threads 1 \

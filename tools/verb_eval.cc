@@ -172,6 +172,12 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
         std::cout << "track head rows: " << a->track_head_rows << "\n";
       }
     }
+    // An earlier run's plot goes before this run's figures are written: left, a run stopped while
+    // gnuplot drew (or whose plot failed) left the old picture beside the new figures.
+    {
+      std::error_code ec;
+      std::filesystem::remove(plot, ec);
+    }
     // The figures first: a plot that cannot be written (a read-only model folder) costs only itself.
     if (!a->json.empty()) {
       learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
