@@ -9,6 +9,7 @@
 #include <torch/serialize/output-archive.h>
 
 #include "learn/model_config.h"
+#include "learn/zip_checksums.h"
 
 namespace clothwind::learn {
 namespace {
@@ -124,6 +125,9 @@ WeightPrecision LoadModuleWeights(torch::nn::Module& module, const std::filesyst
   } catch (const c10::Error& e) {
     throw std::runtime_error(path.string() + ": not a torch weights file: " + e.what_without_backtrace());
   }
+  // An archive libtorch reads, checked entry by entry before its tensors are trusted (libtorch
+  // does not check the checksums: learn/zip_checksums.h).
+  VerifyZipChecksums(path);
   bool any_half = false;
   try {
     Read(module, "", archive, path, &any_half);
