@@ -106,6 +106,14 @@ nlohmann::json ReadLabel(const std::string& path) {
           "a file pattern with one integer conversion, e.g. \"%03d.jpg\"");
   Require(j, "wind_speed", has("wind_speed") && (j["wind_speed"].is_number() || j["wind_speed"].is_null()),
           path, "a number");
+  // Where a label has them (a simulated clip's): indexed as they are, "simulation": 1.5 or "view":
+  // 99 of 1 went into the index, and eval then blamed index.json for them.
+  auto whole = [&](const char* f) { return j[f].is_number_integer() && j[f] >= 0; };
+  if (has("simulation")) Require(j, "simulation", whole("simulation"), path, "a whole number >= 0");
+  if (has("views")) Require(j, "views", whole("views") && j["views"] >= 1, path, "a whole number >= 1");
+  if (has("view"))
+    Require(j, "view", whole("view") && (!has("views") || !j["views"].is_number_integer() || j["view"] < j["views"]),
+            path, "a whole number >= 0, below 'views'");
   return j;
 }
 

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <tuple>
+
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -94,6 +96,25 @@ TEST(ReadLabelTest, AFrameCountBeyondAnyClipIsRefused) {
   label["num_frames"] = 100001;
   std::ofstream(file) << label.dump();
   EXPECT_THROW(ReadLabel(file.string()), std::runtime_error);
+  // A simulated clip's simulation and view: "simulation": 1.5 or "view": 99 of 1 was indexed as it
+  // was, and eval blamed index.json.
+  label["num_frames"] = 30;
+  ASSERT_EQ(label["views"], 1);
+  for (const auto& [field, value, says] :
+       {std::tuple{"simulation", nlohmann::json(1.5), "field 'simulation' is 1.5, expected a whole number >= 0"},
+        std::tuple{"simulation", nlohmann::json(-1), "field 'simulation' is -1"},
+        std::tuple{"view", nlohmann::json(99), "field 'view' is 99, expected a whole number >= 0, below 'views'"},
+        std::tuple{"views", nlohmann::json(0), "field 'views' is 0, expected a whole number >= 1"}}) {
+    nlohmann::json bad = label;
+    bad[field] = value;
+    std::ofstream(file) << bad.dump();
+    try {
+      ReadLabel(file.string());
+      ADD_FAILURE() << field << " " << value << " accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(file.string() + ": " + says), std::string::npos) << e.what();
+    }
+  }
   fs::remove(file);
 }
 
