@@ -106,12 +106,37 @@ std::string CheckCalibrationFile(const std::string& path) {
     return path + " is not YAML: " + e.what();
   }
   if (!doc.IsMap()) return path + " is not a YAML mapping (image_width, camera_matrix, ...)";
+  // A key given twice (an edit pasted below the old value): the parser took the first without a
+  // word, so "image_width: 64" above "image_width: 640" calibrated 640-px frames for 64.
+  std::set<std::string> keys;
+  for (const auto& entry : doc) {
+    const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : std::string("(not text)");
+    if (!keys.insert(key).second) return path + ": key " + key + " is given twice";
+  }
   for (const auto& [key, rows, cols] : {std::tuple<const char*, int, int>{"camera_matrix", 3, 3},
                                         {"distortion_coefficients", -1, -1},
                                         {"rectification_matrix", 3, 3},
                                         {"projection_matrix", 3, 4}}) {
     const std::string problem = CheckMatrix(doc, key, rows, cols);
     if (!problem.empty()) return path + ": " + problem;
+  }
+  // Focal lengths > 0 and image sizes > 0: a camera_matrix with fx = -5 (a sign lost in an edit)
+  // was taken, and every consumer then projected through a mirrored camera.
+  if (doc["camera_matrix"]) {
+    const YAML::Node k = doc["camera_matrix"]["data"];
+    if (!(k[0].as<double>() > 0 && k[4].as<double>() > 0))
+      return path + ": camera_matrix's fx and fy (data[0], data[4]) must be > 0 [px], got " + k[0].Scalar() + " and " +
+             k[4].Scalar();
+  }
+  for (const char* key : {"image_width", "image_height"}) {
+    if (!doc[key]) continue;
+    long value = 0;
+    try {
+      value = doc[key].as<long>();
+    } catch (const YAML::Exception&) {
+      return path + ": " + key + " must be a whole number of pixels";
+    }
+    if (value <= 0) return path + ": " + key + " must be > 0 [px], got " + std::to_string(value);
   }
   // The models image_geometry undistorts with: another name (a typo, "plumb_bobb") was taken, and
   // every consumer then rectified with no distortion at all.

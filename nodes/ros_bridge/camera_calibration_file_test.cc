@@ -89,6 +89,20 @@ TEST_F(CameraCalibrationFileTest, BrokenYamlAndNonNumbersAreRefused) {
   EXPECT_EQ(CheckCalibrationFile(Write("c.ini", "[image]\n")), "");
 }
 
+// A key given twice was read as its first ("image_width: 64" over "image_width: 640"), a negative
+// focal length (a sign lost in an edit) and a size of 0 were taken.
+TEST_F(CameraCalibrationFileTest, AKeyGivenTwiceANegativeFocalLengthOrAnEmptySizeIsRefused) {
+  EXPECT_THAT(CheckCalibrationFile(Write("twice.yaml", "image_width: 64\n" + Calibration())),
+              AllOf(HasSubstr("twice.yaml"), HasSubstr("key image_width is given twice")));
+  EXPECT_THAT(CheckCalibrationFile(Write("fx.yaml", Calibration("3", "[-5, 0, 19.5, 0, 36, 14.5, 0, 0, 1]"))),
+              AllOf(HasSubstr("fx.yaml"), HasSubstr("fx and fy (data[0], data[4]) must be > 0 [px], got -5 and 36")));
+  EXPECT_THAT(CheckCalibrationFile(Write("fy.yaml", Calibration("3", "[35, 0, 19.5, 0, 0, 14.5, 0, 0, 1]"))),
+              HasSubstr("got 35 and 0"));
+  std::string empty = Calibration();
+  empty.replace(empty.find("image_height: 30"), 16, "image_height: 0");
+  EXPECT_THAT(CheckCalibrationFile(Write("h0.yaml", empty)), HasSubstr("image_height must be > 0 [px], got 0"));
+}
+
 // A distortion model image_geometry does not know (a typo) was taken, and every consumer then
 // rectified with no distortion at all.
 TEST_F(CameraCalibrationFileTest, AnUnknownDistortionModelIsRefused) {
