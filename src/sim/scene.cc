@@ -188,7 +188,13 @@ SceneTransform ParseTransform(const Reader& r, const json& j, const std::string&
       r.Fail(path + ".rotate", "rotation axis [1..3] must not be zero");
     }
   }
-  if (j.contains("scale")) t.scale = r.Positive(j["scale"], path + ".scale");
+  // Within [1e-4, 1e4] (a mesh modelled in mm takes 1e-3): 1e-300 made every face "degenerate",
+  // blamed on the OBJ.
+  if (j.contains("scale")) {
+    t.scale = r.Positive(j["scale"], path + ".scale");
+    if (!(t.scale >= 1e-4 && t.scale <= 1e4))
+      r.Fail(path + ".scale", "expected a scale in [1e-4, 1e4], got " + Formatted("%g", t.scale));
+  }
   return t;
 }
 

@@ -216,10 +216,11 @@ TEST_F(SceneFiles, ValidSceneWithCommentsTransformAndExtensions) {
   // x -> translate + Rz(90) (2 x): (1, 0, 0) -> (1, 2 + 2, 3).
   EXPECT_LT((m.V.row(1) - Eigen::RowVector3d(1, 4, 3)).norm(), 1e-9);
   EXPECT_NEAR(RestArea(m), 4.0, 1e-9);  // rest shape scaled too
-  // A transform that puts the cloth beyond 100 m (or past a double) is named as the transform's:
-  // it was the OBJ's "vertex 2 has a non-finite position" (one below the OBJ's own number), or a
-  // degenerate face at scale 1e300.
-  for (const std::string transform : {"\"scale\": 1e308", "\"scale\": 1e300", "\"translate\": [0, 150, 0]"}) {
+  // A transform that puts the cloth beyond 100 m is named as the transform's: it was the OBJ's
+  // "vertex 2 has a non-finite position" (one below the OBJ's own number) at scale 1e308, or a
+  // degenerate face at 1e300 (scales past 1e4 are refused by the reader now: SceneFiles's
+  // PhysicallyAbsurdMagnitudes).
+  for (const std::string transform : {"\"scale\": 1e4", "\"translate\": [0, 150, 0]"}) {
     const std::string far = Write("conf/far.json", SceneText("", "\"transform\": {" + transform + "},"));
     ExpectErrorNaming([&] { BuildScene(LoadScene(far)); }, {far, "cloths[0].transform", "within +-100 m"});
   }
@@ -383,6 +384,9 @@ TEST_F(SceneFiles, PhysicallyAbsurdMagnitudesAreRefusedNamingFileAndField) {
        "[0, 0.1] m"},
       {"collision_stiffness", SceneText(", \"magic\": {\"collision_stiffness\": 1e200}"), "magic.collision_stiffness",
        "[0, 1e+12]"},
+      // 1e-300 made every face "degenerate", blamed on the OBJ.
+      {"scale", SceneText("", "\"transform\": {\"scale\": 1e-300}, "), "cloths[0].transform.scale",
+       "[1e-4, 1e4], got 1e-300"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
