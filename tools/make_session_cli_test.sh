@@ -28,9 +28,10 @@ rm -rf bags previews
 cp big.bag before.bag.keep
 cp big.png before.png.keep
 "$bin" make-session --minutes 5 --width 512 --height 512 --out big.bag --preview big.png --seed 9 --overwrite \
-  >out.txt 2>&1 &
+  --compression none >out.txt 2>&1 &
 pid=$!
-# Until the temporary bag holds a few frames (786 kB each): past the first, which the preview is.
+# Until the temporary bag holds a few frames (786 kB each, uncompressed): past the first, which the
+# preview is.
 grown() { [ -n "$(find . -maxdepth 1 -name 'big.bag.tmp-*' -size +2M)" ]; }
 for _ in $(seq 200); do
   grown && break

@@ -291,7 +291,11 @@ expect_refused() {  # expect_refused MESSAGE ARGS...: render ARGS fails (status 
 }
 mkfifo "$work/pipe.cwtraj"
 expect_refused "$work/pipe.cwtraj: not a file or folder (a pipe or a device)" "$work/pipe.cwtraj" --out "$work/bad"
-mkdir -p "$work/dirtraj/trajectory.cwtraj" "$work/dirobj/0000_00.obj"
+mkdir -p "$work/dirtraj/trajectory.cwtraj" "$work/dirobj/0000_00.obj" "$work/pipetraj" "$work/pipeobj"
+# A pipe inside a simulation folder waited for a writer for ever.
+mkfifo "$work/pipetraj/trajectory.cwtraj" "$work/pipeobj/0000_00.obj"
+expect_refused "$work/pipetraj/trajectory.cwtraj: not a regular file (a pipe or a device)" "$work/pipetraj" --out "$work/bad"
+expect_refused "$work/pipeobj/0000_00.obj: not a regular file (a pipe or a device)" "$work/pipeobj" --out "$work/bad"
 expect_refused "$work/dirtraj/trajectory.cwtraj: a folder, expected a trajectory file" "$work/dirtraj" --out "$work/bad"
 expect_refused "$work/dirobj/0000_00.obj: a folder, expected an OBJ file" "$work/dirobj" --out "$work/bad"
 square() {  # square FOLDER FAR_X FAR_U: a two-face OBJ frame, its far corners at x and u as given

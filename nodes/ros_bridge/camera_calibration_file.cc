@@ -38,6 +38,20 @@ std::string Kind(const struct stat& st) {
   return "not a regular file";
 }
 
+// The first key given twice in a mapping of `node` or of any mapping under it, as its path
+// ("camera_matrix.data"); "" when none.
+std::string KeyGivenTwice(const YAML::Node& node, const std::string& prefix) {
+  if (!node.IsMap()) return "";
+  std::set<std::string> keys;
+  for (const auto& entry : node) {
+    const std::string key = prefix + (entry.first.IsScalar() ? entry.first.Scalar() : std::string("(not text)"));
+    if (!keys.insert(key).second) return key;
+    const std::string below = KeyGivenTwice(entry.second, key + ".");
+    if (!below.empty()) return below;
+  }
+  return "";
+}
+
 // One calibration matrix of the YAML; "" when whole. rows/cols < 0: any (D).
 std::string CheckMatrix(const YAML::Node& doc, const char* key, int rows, int cols) {
   const YAML::Node m = doc[key];
@@ -106,13 +120,11 @@ std::string CheckCalibrationFile(const std::string& path) {
     return path + " is not YAML: " + e.what();
   }
   if (!doc.IsMap()) return path + " is not a YAML mapping (image_width, camera_matrix, ...)";
-  // A key given twice (an edit pasted below the old value): the parser took the first without a
-  // word, so "image_width: 64" above "image_width: 640" calibrated 640-px frames for 64.
-  std::set<std::string> keys;
-  for (const auto& entry : doc) {
-    const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : std::string("(not text)");
-    if (!keys.insert(key).second) return path + ": key " + key + " is given twice";
-  }
+  // A key given twice (an edit pasted below the old value), at any depth: the parser took the
+  // first without a word, so "image_width: 64" above "image_width: 640" calibrated 640-px frames
+  // for 64.
+  const std::string twice = KeyGivenTwice(doc, "");
+  if (!twice.empty()) return path + ": key " + twice + " is given twice";
   for (const auto& [key, rows, cols] : {std::tuple<const char*, int, int>{"camera_matrix", 3, 3},
                                         {"distortion_coefficients", -1, -1},
                                         {"rectification_matrix", 3, 3},

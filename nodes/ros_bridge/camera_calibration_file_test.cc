@@ -94,6 +94,9 @@ TEST_F(CameraCalibrationFileTest, BrokenYamlAndNonNumbersAreRefused) {
 TEST_F(CameraCalibrationFileTest, AKeyGivenTwiceANegativeFocalLengthOrAnEmptySizeIsRefused) {
   EXPECT_THAT(CheckCalibrationFile(Write("twice.yaml", "image_width: 64\n" + Calibration())),
               AllOf(HasSubstr("twice.yaml"), HasSubstr("key image_width is given twice")));
+  std::string nested = Calibration();
+  nested.replace(nested.find("  rows: 3\n  cols: 3\n  data: [35"), 0, "  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n");
+  EXPECT_THAT(CheckCalibrationFile(Write("nested.yaml", nested)), HasSubstr("key camera_matrix.data is given twice"));
   EXPECT_THAT(CheckCalibrationFile(Write("fx.yaml", Calibration("3", "[-5, 0, 19.5, 0, 36, 14.5, 0, 0, 1]"))),
               AllOf(HasSubstr("fx.yaml"), HasSubstr("fx and fy (data[0], data[4]) must be > 0 [px], got -5 and 36")));
   EXPECT_THAT(CheckCalibrationFile(Write("fy.yaml", Calibration("3", "[35, 0, 19.5, 0, 0, 14.5, 0, 0, 1]"))),

@@ -20,9 +20,8 @@ namespace clothwind::ros_bridge {
 // Bounds of a Clip message's sizes: the clip buffer's (sensors/clip_pipeline.h).
 constexpr uint32_t kMaxClipSide = sensors::kMaxClipSide;
 constexpr uint32_t kMaxClipFrames = sensors::kMaxClipFrames;
-// The smallest clip sdn_node reads [px a side]: the network reads 64-96 px, and a clip of a few
-// pixels holds no flag (a 1 x 1 clip was estimated at 6.4 m/s, diagnostics OK).
-constexpr uint32_t kMinClipSide = 8;
+// The smallest clip sdn_node reads [px a side] (the clip buffer makes none smaller).
+constexpr uint32_t kMinClipSide = sensors::kMinClipSide;
 
 // The frames of a Clip as num_frames images viewing msg.data (no copy: valid while `msg` lives):
 // CV_8UC1 for a mono8 clip, CV_8UC3 BGR for a bgr8 one. Throws std::invalid_argument naming the

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/formatted.h"
 #include "learn/dataset.h"
 
 namespace clothwind::learn {
@@ -62,7 +63,7 @@ ClipView ReadClipView(const fs::path& label_json) {
   auto in = [&](const char* field, double lo, double hi, const char* range) {
     const double x = ZetaNumber(z, field, label_json);
     if (!(x >= lo && x <= hi))
-      throw std::runtime_error(label_json.string() + ": zeta." + field + " is " + std::to_string(x) + ", expected " +
+      throw std::runtime_error(label_json.string() + ": zeta." + field + " is " + Formatted("%g", x) + ", expected " +
                                range);
     return x;
   };

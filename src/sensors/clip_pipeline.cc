@@ -24,7 +24,8 @@ void ValidateClipPipelineOptions(const ClipPipelineOptions& o) {
   if (o.num_frames < 1 || o.num_frames > kMaxClipFrames)
     fail("num_frames", "in 1.." + std::to_string(kMaxClipFrames), o.num_frames);
   if (o.stride < 1) fail("stride", ">= 1", o.stride);
-  if (o.size < 1 || o.size > kMaxClipSide) fail("size", "in 1.." + std::to_string(kMaxClipSide) + " px", o.size);
+  if (o.size < kMinClipSide || o.size > kMaxClipSide)
+    fail("size", "in " + std::to_string(kMinClipSide) + ".." + std::to_string(kMaxClipSide) + " px", o.size);
   if (o.roi.size < 0 || o.roi.x < 0 || o.roi.y < 0) fail("roi", "[x >= 0, y >= 0, size >= 0] in source pixels",
                                                          std::min({o.roi.x, o.roi.y, o.roi.size}));
   if (!(std::isfinite(o.label_window) && o.label_window > 0.0))

@@ -21,6 +21,9 @@ namespace clothwind::sensors {
 // Bounds of a clip's sizes (a 16K camera; the datasets' bound on frames per clip): sdn_node,
 // train and eval refuse clips beyond them, so the clip buffer refuses to make them.
 constexpr int kMaxClipSide = 16384;     // [px]
+// The smallest clip: the network reads 64-96 px, and a clip of a few pixels holds no flag
+// (sdn_node estimated a 1 x 1 clip at 6.4 m/s); sdn_node refuses smaller ones as malformed.
+constexpr int kMinClipSide = 8;  // [px]
 constexpr int kMaxClipFrames = 100000;
 
 // Settings of the clip buffer (ROS parameters of clip_buffer_node of the same names).

@@ -524,7 +524,12 @@ TEST(ClipPipelineTest, OptionsOutOfRangeAreNamed) {
   EXPECT_NE(message([](auto& o) { o.size = 0; }).find("size"), std::string::npos);
   // Clips sdn_node, train and eval would refuse are not made (16385 px started, then every clip
   // was dropped downstream).
-  EXPECT_NE(message([](auto& o) { o.size = kMaxClipSide + 1; }).find("size must be in 1..16384 px, got 16385"),
+  // At least kMinClipSide: a smaller clip buffer ran with its diagnostics OK while sdn_node
+  // refused every clip it made as malformed.
+  EXPECT_NE(message([](auto& o) { o.size = kMinClipSide - 1; }).find("size must be in 8..16384 px, got 7"),
+            std::string::npos);
+  EXPECT_EQ(message([](auto& o) { o.size = kMinClipSide; }), "accepted");
+  EXPECT_NE(message([](auto& o) { o.size = kMaxClipSide + 1; }).find("size must be in 8..16384 px, got 16385"),
             std::string::npos);
   EXPECT_NE(message([](auto& o) { o.num_frames = kMaxClipFrames + 1; }).find("num_frames must be in 1..100000"),
             std::string::npos);

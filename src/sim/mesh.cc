@@ -137,9 +137,12 @@ class EdgeMidpoints {
 }  // namespace
 
 Mesh ReadObj(const std::string& path, bool topology) {
-  // A folder opened as a stream read as empty: "no vertices ('v' lines)".
+  // A folder opened as a stream read as empty ("no vertices ('v' lines)"), and a pipe waited for a
+  // writer for ever.
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": a folder, expected an OBJ file");
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw std::runtime_error(path + ": not a regular file (a pipe or a device), expected an OBJ file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open OBJ file");
   std::ostringstream contents;
