@@ -60,8 +60,14 @@ inline int OptionalCount(int argc, char** argv, const std::string& what, int fal
 }
 
 // Runs body(argc, argv) and returns its status; an exception is printed as
-// "<name>: error: <what>" and gives status 1.
+// "<name>: error: <what>" and gives status 1. A bench built otherwise than Release says so first
+// on stderr (the sanitizer builds make them too, and their figures read like any others).
 inline int Guarded(const char* name, int argc, char** argv, int (*body)(int, char**)) {
+#ifdef CLOTHWIND_BENCH_BUILD_TYPE
+  if (std::string(CLOTHWIND_BENCH_BUILD_TYPE) != "Release")
+    std::fprintf(stderr, "%s: built as '%s', not Release: its figures are not the ones the docs report\n", name,
+                 CLOTHWIND_BENCH_BUILD_TYPE);
+#endif
   try {
     return body(argc, argv);
   } catch (const std::exception& e) {

@@ -2,9 +2,11 @@
 # Every bench program runs on its quickest settings and prints its table, and refuses a bad
 # number naming the option with status 1 (no SIGABRT): a bench that broke left `make test` green,
 # and benches ended with "terminate called ... stod". The figures are not checked: speed is read
-# by hand from Release builds (docs), not asserted in tests. Usage: bench_smoke_test.sh BIN_DIR
+# by hand from Release builds (docs), not asserted in tests; a bench built otherwise says so.
+# Usage: bench_smoke_test.sh BIN_DIR [BUILD_TYPE]
 set -euo pipefail
 bin="$1"
+build_type="${2:-Release}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 fail() { echo "bench_smoke_test: FAIL: $*" >&2; exit 1; }
@@ -16,6 +18,11 @@ runs() {  # runs EXPECTED_TEXT BENCH ARGS...: exits 0 and prints the text
   [ -x "$bin/$name" ] || { echo "bench_smoke_test: $name not built (skipped)"; return 0; }
   "$bin/$name" "$@" >out.txt 2>&1 || fail "$name $*: status $?: $(tail -5 out.txt)"
   grep -qF -- "$text" out.txt || fail "$name $*: no '$text' in its output: $(tail -5 out.txt)"
+  if [ "$build_type" = Release ]; then
+    ! grep -q "not Release" out.txt || fail "$name (a Release build) says it is not one: $(grep 'not Release' out.txt)"
+  else
+    grep -qF "built as '$build_type', not Release" out.txt || fail "$name (built as '$build_type') does not say so"
+  fi
 }
 refuses() {  # refuses OPTION BENCH ARGS...: status 1 (not a signal), the message names OPTION
   local option="$1" name="$2" status=0

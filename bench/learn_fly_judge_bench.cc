@@ -140,7 +140,10 @@ int Main(int argc, char** argv) {
     }
   }
   // Every benchmark from the same heap state: with glibc returning freed memory to the kernel,
-  // BM_FlyJudge took 2.4 ms run alone and 0.1 ms after BM_MotionCues (the node keeps its heap too).
+  // BM_FlyJudge took 2.4 ms run alone and 0.1 ms after BM_MotionCues. sdn_node leaves glibc's
+  // defaults (only `train` calls this); glibc raises its mmap threshold when the first large
+  // blocks are freed, so a node reading clip after clip comes near this steady state, but its
+  // first clips can cost more than these figures.
   clothwind::learn::KeepFreedHeapForReuse();
   at::globalContext().setFlushDenormal(true);
   int n = static_cast<int>(rest.size());

@@ -1,8 +1,10 @@
 // Wind network inference latency per clip as sdn_node sees it: 30 frames of 300x300 mono8 in
 // (bgr8 for a colour model, converted to YCrCb as the node does), crop/resize/normalise +
 // forward pass, for the SDN and the frame-stack baseline at several widths and input sizes, on 1
-// and 2 threads (the goal: <= 50 ms per 30-frame clip on 2 cores at the shipped size). Models are
-// initialised in a temporary folder (speed does not depend on the weights). Prints a table.
+// and 2 threads (the goal: <= 50 ms per 30-frame clip on 2 cores at the shipped size: time it
+// with `--model models/sdn.pt --flag-flies auto`, as sdn_node reads it; the default cases are other
+// sizes, without phase steps). Models are initialised in a temporary folder (speed does not depend
+// on the weights). "threads" are torch's (OpenCV's resize uses its own pool). Prints a table.
 // --model benches given trained models (e.g. the shipped models/sdn.pt) instead of the
 // initialised ones. Clips are read as filmed (--flag-flies right) unless --flag-flies says
 // otherwise: auto adds judging each clip's way (with the fly judge beside a model when there is
