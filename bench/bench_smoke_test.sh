@@ -43,6 +43,13 @@ runs "mean [ms]" sdn_bench --quick --repeats 1
 runs "128" learn_train_step_bench --repeats 1 --batch 2 --width 8
 runs "BM_MotionMapOnly" learn_fly_judge_bench --benchmark_min_time=0.01
 
+# Counts read with atoi ran on: "--repeats x" ran once, "--frames 2.9" two frames.
+refuses "--count: expected a finite number" dataset_bench --count x
+refuses "--max-edge: expected a finite number" dataset_bench --max-edge 0.5m
+refuses "--repeats: expected a finite number" learn_train_step_bench --repeats x
+refuses "--frames: expected a whole number" render_bench --frames 2.9
+refuses "--seed: expected a whole number >= 0" render_bench --seed -1
+refuses "--repeats: expected a finite number" sdn_bench --repeats x
 refuses "--duration: expected a finite number" sim_bench --duration x
 refuses "--winds" sim_bench --winds ,
 refuses "--duration" sim_bench --duration 0.2 --winds 3

@@ -50,11 +50,11 @@ int Main(int argc, char** argv) {
       return argv[++i];
     };
     if (!std::strcmp(argv[i], "--kind")) kind_name = next();
-    else if (!std::strcmp(argv[i], "--count")) count = std::atoi(next());
-    else if (!std::strcmp(argv[i], "--views")) views = std::atoi(next());
-    else if (!std::strcmp(argv[i], "--jobs")) jobs = std::atoi(next());
-    else if (!std::strcmp(argv[i], "--max-edge")) max_edge = std::atof(next());
-    else if (!std::strcmp(argv[i], "--samples")) samples = std::atoi(next());
+    else if (!std::strcmp(argv[i], "--count")) count = clothwind::bench::Integer("--count", next());
+    else if (!std::strcmp(argv[i], "--views")) views = clothwind::bench::Integer("--views", next());
+    else if (!std::strcmp(argv[i], "--jobs")) jobs = clothwind::bench::Integer("--jobs", next());
+    else if (!std::strcmp(argv[i], "--max-edge")) max_edge = clothwind::bench::Number("--max-edge", next());
+    else if (!std::strcmp(argv[i], "--samples")) samples = clothwind::bench::Integer("--samples", next());
     else {
       std::fprintf(stderr, "usage: dataset_bench [--kind flag|cloth] [--count N] [--views K] [--jobs J] [--max-edge M] [--samples S]\n");
       return 2;

@@ -104,10 +104,10 @@ int Main(int argc, char** argv) {
   for (int i = 1; i < argc && ok; ++i) {
     if (!std::strcmp(argv[i], "--glibc-heap")) glibc_heap = true;
     else if (!std::strcmp(argv[i], "--channels-last")) channels_last = true;
-    else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--batch") && i + 1 < argc) batch = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--width") && i + 1 < argc) width = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, clothwind::bench::Integer("--repeats", argv[++i]));
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::max(1, clothwind::bench::Integer("--threads", argv[++i]));
+    else if (!std::strcmp(argv[i], "--batch") && i + 1 < argc) batch = std::max(1, clothwind::bench::Integer("--batch", argv[++i]));
+    else if (!std::strcmp(argv[i], "--width") && i + 1 < argc) width = std::max(1, clothwind::bench::Integer("--width", argv[++i]));
     else if (!std::strcmp(argv[i], "--device") && i + 1 < argc) device_name = argv[++i];
     else if (!std::strcmp(argv[i], "--cases") && i + 1 < argc) ok = ParseCases(argv[++i], &cases);
     else ok = false;

@@ -92,9 +92,19 @@ int Main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (!std::strcmp(argv[i], "--frames")) frames = std::atoi(next("--frames"));
-    else if (!std::strcmp(argv[i], "--samples")) samples = std::atoi(next("--samples"));
-    else if (!std::strcmp(argv[i], "--seed")) seed = std::strtoull(next("--seed"), nullptr, 10);
+    if (!std::strcmp(argv[i], "--frames")) frames = clothwind::bench::Integer("--frames", next("--frames"));
+    else if (!std::strcmp(argv[i], "--samples")) samples = clothwind::bench::Integer("--samples", next("--samples"));
+    else if (!std::strcmp(argv[i], "--seed")) {
+      const std::string text = next("--seed");
+      size_t used = 0;
+      try {
+        seed = std::stoull(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != text.size() || text[0] == '-')
+        throw std::invalid_argument("--seed: expected a whole number >= 0, got '" + text + "'");
+    }
     else if (!std::strcmp(argv[i], "--write")) write_dir = next("--write");
     else if (!std::strcmp(argv[i], "--cloth")) cloth = true;
     else {

@@ -59,7 +59,7 @@ int Main(int argc, char** argv) {
   std::string flag_flies;
   bool both_orders = false;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
+    if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, clothwind::bench::Integer("--repeats", argv[++i]));
     else if (!std::strcmp(argv[i], "--quick")) quick = true;
     else if (!std::strcmp(argv[i], "--model") && i + 1 < argc) given.push_back(argv[++i]);
     else if (!std::strcmp(argv[i], "--flag-flies") && i + 1 < argc) flag_flies = argv[++i];
