@@ -1,5 +1,6 @@
 // Per-frame cost of turning a captured V4L2 buffer into the image camera_node publishes
-// (YUYV -> bgr8 with cv::cvtColor, MJPEG -> bgr8 with cv::imdecode, GREY copy), at common sizes.
+// (sensors::ConvertToImage, as camera_node calls it: YUYV -> bgr8 with cv::cvtColor, MJPEG -> bgr8
+// with libjpeg through common::DecodeJpegBgr, GREY copy), at common sizes.
 // At 30 fps a frame has 33 ms; this shows how much of it conversion takes on this machine.
 // Usage: camera_convert_bench [repetitions]   (prints a table)
 #include <chrono>
