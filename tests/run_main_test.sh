@@ -62,3 +62,18 @@ assert s["total_clips"] >= 15, s["total_clips"]
 assert "estimates" not in s, "estimates reported without a model"
 print("run_main_test: without a model, %d clips" % s["total_clips"])
 PY
+# A replay cut at its wall-time limit (here 10 s, before the 12 s replay of the 24 s session at 2x
+# and its start ends): the report and summary of what was replayed, and exit status 3, not 0 (a
+# cut run read as a whole one to a script).
+status=0
+rm -f "$out/default-replay.json"
+CLOTHWIND_MODEL=none CLOTHWIND_REPLAY_MAX_WALL=10 CLOTHWIND_SESSIONS="$out" CLOTHWIND_SESSION_FRAMES=procedural \
+  CLOTHWIND_SESSION_MINUTES=0.4 "$root/scripts/run-main" "$build" >"$out/run-main.txt" 2>&1 || status=$?
+[ "$status" -eq 3 ] && grep -q "the replay was cut at max_wall = 10 s" "$out/run-main.txt" ||
+  fail "a replay cut at its wall-time limit exited $status"
+/usr/bin/python3 - "$out/default-replay.json" <<'PY' || fail "no summary of the cut replay"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["total_clips"] >= 1, s["total_clips"]
+print("run_main_test: cut at 10 s, %d clips reported, exit 3" % s["total_clips"])
+PY
