@@ -6,9 +6,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
+#include <mutex>
+#include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -136,6 +140,43 @@ class EdgeMidpoints {
 
 }  // namespace
 
+namespace {
+
+// Says on stderr (once per file and pair) when two vertices the faces use lie at the same point:
+// an unwelded seam (an exporter's duplicate), where the simulated cloth comes apart without a
+// word (a square's middle row copied: half the cloth fell away from the other). A slit may be
+// meant (a swallowtail flag's), so it is said, not refused.
+void WarnOfCoincidentVertices(const Mesh& mesh, const std::string& path, const std::vector<int>& lines) {
+  std::vector<int> used;
+  std::vector<char> in_face(mesh.V.rows(), 0);
+  for (int f = 0; f < mesh.F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) in_face[mesh.F(f, c)] = 1;
+  for (int v = 0; v < mesh.V.rows(); ++v)
+    if (in_face[v]) used.push_back(v);
+  auto point = [&](int v) { return std::make_tuple(mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)); };
+  std::sort(used.begin(), used.end(), [&](int a, int b) { return point(a) < point(b) || (point(a) == point(b) && a < b); });
+  int pairs = 0, first_a = -1, first_b = -1;
+  for (size_t k = 1; k < used.size(); ++k) {
+    if (point(used[k]) != point(used[k - 1])) continue;
+    if (pairs++ == 0) {
+      first_a = used[k - 1];
+      first_b = used[k];
+    }
+  }
+  if (pairs == 0) return;
+  static std::mutex mutex;
+  static std::set<std::string> said;
+  std::ostringstream what;
+  what << path << ": vertices " << first_a + 1 << " and " << first_b + 1 << " (lines " << lines[first_a] << " and "
+       << lines[first_b] << ") are at the same point"
+       << (pairs > 1 ? ", and " + std::to_string(pairs - 1) + " more such pairs" : std::string())
+       << ": the cloth is cut there (not welded); merge them if it should hold together";
+  std::lock_guard<std::mutex> lock(mutex);
+  if (said.insert(what.str()).second) std::cerr << "warning: " << what.str() << "\n";
+}
+
+}  // namespace
+
 Mesh ReadObj(const std::string& path, bool topology) {
   // A folder opened as a stream read as empty ("no vertices ('v' lines)"), and a pipe waited for a
   // writer for ever.
@@ -155,6 +196,7 @@ Mesh ReadObj(const std::string& path, bool topology) {
   std::vector<Eigen::Vector3i> faces;
   std::vector<Eigen::Vector3i> face_tex;  // -1 when a corner has no vt
   std::vector<int> face_lines;            // the line of each triangle's f
+  std::vector<int> position_lines;        // the line of each v
   int line_no = 0;
   auto read_numbers = [&](std::istringstream& s, int n, double* out, const char* what) {
     for (int i = 0; i < n; ++i) {
@@ -180,6 +222,7 @@ Mesh ReadObj(const std::string& path, bool topology) {
       double x[3];
       read_numbers(s, 3, x, "v");
       positions.emplace_back(x[0], x[1], x[2]);
+      position_lines.push_back(line_no);
     } else if (key == "vt") {
       double u[2];
       read_numbers(s, 2, u, "vt");
@@ -258,6 +301,7 @@ Mesh ReadObj(const std::string& path, bool topology) {
     }
   }
   ValidateMesh(mesh, path, face_lines, topology);
+  if (topology) WarnOfCoincidentVertices(mesh, path, position_lines);
   return mesh;
 }
 

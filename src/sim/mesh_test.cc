@@ -166,6 +166,28 @@ TEST(ObjTest, UnknownKeywordsAreErrorsNamingTheLineAndKnownOnesAreSkipped) {
   EXPECT_EQ(m.F.rows(), 1);
 }
 
+TEST(ObjTest, VerticesAtOnePointAreSaidAsACutNamingTheirLines) {
+  // Two triangles sharing an edge by position only (vertices 5 and 6 copy 1 and 3): the simulated
+  // cloth came apart there without a word. Said once per file, naming the vertices and lines; the
+  // same mesh welded says nothing.
+  const std::string cut = WriteText("cut.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 0\nv 1 1 0\n"
+                                               "f 1 2 3\nf 5 6 4\n");
+  ::testing::internal::CaptureStderr();
+  EXPECT_NO_THROW(ReadObj(cut));
+  EXPECT_NO_THROW(ReadObj(cut));
+  const std::string said = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(said.find("warning: " + cut + ": vertices 1 and 5 (lines 1 and 5) are at the same point, and 1 more such "
+                      "pairs: the cloth is cut there"),
+            std::string::npos)
+      << said;
+  EXPECT_EQ(said.find("warning", said.find("warning") + 1), std::string::npos) << "said twice: " << said;
+  const std::string welded = WriteText("welded.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
+  ::testing::internal::CaptureStderr();
+  EXPECT_NO_THROW(ReadObj(welded));
+  const std::string quiet = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(quiet, "");
+}
+
 TEST(ValidateMeshTest, RejectsNaNRangeAndDegenerate) {
   Mesh m = Rectangle();
   m.V(1, 2) = std::numeric_limits<double>::quiet_NaN();
