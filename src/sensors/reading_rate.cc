@@ -3,10 +3,12 @@
 namespace clothwind::sensors {
 
 void ReadingRate::Add(double t) {
-  if (!times_.empty() && t < times_.back()) times_.clear();  // the clock went back
+  const bool back = !times_.empty() && t < times_.back();  // the clock went back
+  if (back) times_.clear();
   // A reading stamped 0 (topic input before a replay's /clock) is no first time: the rate would
-  // read over the whole time since 0 once the clock starts.
-  if (times_.empty() && (first_ <= 0 || t < first_)) first_ = t;
+  // read over the whole time since 0 once the clock starts. After the clock went back the first
+  // time is this reading's, also when it is later than the old first one.
+  if (back || (times_.empty() && (first_ <= 0 || t < first_))) first_ = t;
   times_.push_back(t);
   if (times_.size() > max_kept_) times_.pop_front();
 }

@@ -34,6 +34,17 @@ TEST(ReadingRateTest, TheClockGoingBackStartsAfresh) {
   EXPECT_DOUBLE_EQ(rate.Rate(14.0, 10.0), 1.0);  // 4 intervals over 4 s, none of the old pass's
 }
 
+TEST(ReadingRateTest, TheClockGoingBackLessThanItsRunStartsAfreshToo) {
+  // The clock back to a time after the first reading (a /clock glitch, or a loop whose pass
+  // starts later than the first one did): the first time was kept, and the new pass's 1 Hz read
+  // as 1 reading over 6 s.
+  ReadingRate rate;
+  for (int i = 0; i <= 10; ++i) rate.Add(10.0 + i);
+  rate.Add(15.0);
+  rate.Add(16.0);
+  EXPECT_DOUBLE_EQ(rate.Rate(16.0, 60.0), 1.0);  // 1 interval over the 1 s since 15
+}
+
 TEST(ReadingRateTest, AReadingAtTimeZeroIsNoFirstTime) {
   // Topic input on a replay's clock: a record before /clock is stamped 0, and the diagnostics at
   // 1000 forget it; the rate from the readings at 2 Hz since 1000.5 is not read over 1003 s.
