@@ -192,17 +192,9 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
   if (out.has_parent_path()) fs::create_directories(out.parent_path());
   if (fs::path(a.preview).has_parent_path()) fs::create_directories(fs::path(a.preview).parent_path());
   // A run killed mid-write (Ctrl-C) leaves its temporary bag: clear those of dead processes.
-  {
-    std::error_code ec;
-    const std::string stem = out.filename().string() + ".tmp-";
-    const fs::path folder = out.has_parent_path() ? out.parent_path() : fs::path(".");
-    for (const auto& e : fs::directory_iterator(folder, ec)) {
-      const std::string name = e.path().filename().string();
-      if (name.rfind(stem, 0) != 0 || !IsTemporaryOfStoppedProcess(name)) continue;
-      std::fprintf(stderr, "make-session: removing %s, left by a run that stopped\n", e.path().c_str());
-      fs::remove(e.path(), ec);
-    }
-  }
+  RemoveStaleTemporariesOf(a.out, [](const std::string& path) {
+    std::fprintf(stderr, "make-session: removing %s, left by a run that stopped\n", path.c_str());
+  });
   if (a.compression != "none" && a.compression != "lz4" && a.compression != "bz2")
     throw std::invalid_argument("--compression: expected none, lz4 or bz2, got '" + a.compression + "'");
   const std::string tmp = TemporaryNameFor(a.out);

@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
@@ -179,8 +180,9 @@ inline bool IsTemporaryOfStoppedProcess(const std::string& name, size_t* at = nu
 // killed while it wrote `path`), which nothing else removes: a model's or judge's pair written
 // again, a copy of model.pt made again, left a killed run's .tmp files beside them for ever. A
 // live writer's stay. For files written now and then (not per frame: it lists the folder).
-// Returns how many went.
-inline int RemoveStaleTemporariesOf(const std::string& path) {
+// `removing` (when set) is told each one's path first. Returns how many went.
+inline int RemoveStaleTemporariesOf(const std::string& path,
+                                    const std::function<void(const std::string&)>& removing = {}) {
   namespace fs = std::filesystem;
   const fs::path p(path);
   const std::string prefix = p.filename().string() + ".tmp-";
@@ -190,6 +192,7 @@ inline int RemoveStaleTemporariesOf(const std::string& path) {
     const std::string name = entry.path().filename().string();
     size_t at = 0;
     if (name.rfind(prefix, 0) == 0 && IsTemporaryOfStoppedProcess(name, &at) && at + 5 == prefix.size()) {
+      if (removing) removing(entry.path().string());
       std::error_code ignored;
       removed += fs::remove(entry.path(), ignored) ? 1 : 0;
     }

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <iostream>
-#include <mutex>
 #include <set>
 #include <stdexcept>
 
@@ -14,6 +12,7 @@
 #include "common/formatted.h"
 #include "common/json_file.h"
 #include "sim/json_comments.h"
+#include "sim/warn_once.h"
 
 namespace clothwind::sim {
 namespace {
@@ -191,15 +190,6 @@ std::vector<std::string> IgnoredKeyWarnings(const nlohmann::json& j, const std::
                             : "is not a material field (density, stretching, bending), ignored"));
   }
   return warnings;
-}
-
-// Prints each warning to stderr the first time this process sees it.
-void WarnOnce(const std::vector<std::string>& warnings) {
-  static std::mutex mutex;
-  static std::set<std::string> given;
-  std::lock_guard<std::mutex> lock(mutex);
-  for (const std::string& w : warnings)
-    if (given.insert(w).second) std::cerr << "warning: " << w << "\n";
 }
 
 }  // namespace

@@ -4,12 +4,8 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
-#include <iostream>
 #include <map>
-#include <mutex>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
@@ -19,6 +15,8 @@
 #include <Eigen/Geometry>
 
 #include "common/atomic_file.h"
+#include "common/regular_file.h"
+#include "sim/warn_once.h"
 
 namespace clothwind::sim {
 namespace {
@@ -142,7 +140,7 @@ class EdgeMidpoints {
 
 namespace {
 
-// Says on stderr (once per file and pair) when two vertices the faces use lie at the same point:
+// Says on stderr (WarnOnce) when two vertices the faces use lie at the same point:
 // an unwelded seam (an exporter's duplicate), where the simulated cloth comes apart without a
 // word (a square's middle row copied: half the cloth fell away from the other). A slit may be
 // meant (a swallowtail flag's), so it is said, not refused.
@@ -154,7 +152,10 @@ void WarnOfCoincidentVertices(const Mesh& mesh, const std::string& path, const s
   for (int v = 0; v < mesh.V.rows(); ++v)
     if (in_face[v]) used.push_back(v);
   auto point = [&](int v) { return std::make_tuple(mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)); };
-  std::sort(used.begin(), used.end(), [&](int a, int b) { return point(a) < point(b) || (point(a) == point(b) && a < b); });
+  // By position, then number: equal points side by side, the lower-numbered first.
+  std::sort(used.begin(), used.end(), [&](int a, int b) {
+    return std::tuple_cat(point(a), std::make_tuple(a)) < std::tuple_cat(point(b), std::make_tuple(b));
+  });
   int pairs = 0, first_a = -1, first_b = -1;
   for (size_t k = 1; k < used.size(); ++k) {
     if (point(used[k]) != point(used[k - 1])) continue;
@@ -164,15 +165,12 @@ void WarnOfCoincidentVertices(const Mesh& mesh, const std::string& path, const s
     }
   }
   if (pairs == 0) return;
-  static std::mutex mutex;
-  static std::set<std::string> said;
   std::ostringstream what;
   what << path << ": vertices " << first_a + 1 << " and " << first_b + 1 << " (lines " << lines[first_a] << " and "
        << lines[first_b] << ") are at the same point"
        << (pairs > 1 ? ", and " + std::to_string(pairs - 1) + " more such pairs" : std::string())
        << ": the cloth is cut there (not welded); merge them if it should hold together";
-  std::lock_guard<std::mutex> lock(mutex);
-  if (said.insert(what.str()).second) std::cerr << "warning: " << what.str() << "\n";
+  WarnOnce({what.str()});
 }
 
 }  // namespace
@@ -180,10 +178,7 @@ void WarnOfCoincidentVertices(const Mesh& mesh, const std::string& path, const s
 Mesh ReadObj(const std::string& path, bool topology) {
   // A folder opened as a stream read as empty ("no vertices ('v' lines)"), and a pipe waited for a
   // writer for ever.
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": a folder, expected an OBJ file");
-  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
-    throw std::runtime_error(path + ": not a regular file (a pipe or a device), expected an OBJ file");
+  RefuseNonRegularFile(path, "an OBJ file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open OBJ file");
   std::ostringstream contents;

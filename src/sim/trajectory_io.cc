@@ -1,12 +1,12 @@
 #include "sim/trajectory_io.h"
 
 #include "common/atomic_file.h"
+#include "common/regular_file.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -85,11 +85,7 @@ void WriteTrajectory(const std::string& path, const Trajectory& t) {
 Trajectory ReadTrajectory(const std::string& path) {
   // A folder opened as a stream read as empty ("truncated header (0 bytes, need 32)"), and a pipe
   // waited for a writer for ever.
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw std::runtime_error(path + ": a folder, expected a trajectory file (.cwtraj)");
-  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
-    throw std::runtime_error(path + ": not a regular file (a pipe or a device), expected a trajectory file (.cwtraj)");
+  RefuseNonRegularFile(path, "a trajectory file (.cwtraj)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open trajectory");
   std::ostringstream ss;
