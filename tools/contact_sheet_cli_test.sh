@@ -9,23 +9,24 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 fail() { echo "contact_sheet_cli_test: FAIL: $*" >&2; exit 1; }
 
-refused() {  # refused TEXT ARGS...: exits 1 (not a crash), its message holds TEXT, no sheet written
-  local text="$1"
-  shift
+refused() {  # refused STATUS TEXT ARGS...: exits STATUS (2: the command line, 1: the input; not a
+             # crash), its message holds TEXT, no sheet written
+  local expected="$1" text="$2"
+  shift 2
   local status=0
   "$bin" contact-sheet "$work/ds" "$@" >"$work/msg.txt" 2>&1 || status=$?
-  [ "$status" -eq 1 ] || fail "contact-sheet $* exited $status: $(cat "$work/msg.txt")"
+  [ "$status" -eq "$expected" ] || fail "contact-sheet $* exited $status: $(cat "$work/msg.txt")"
   grep -qF -- "$text" "$work/msg.txt" || fail "contact-sheet $*: the message lacks '$text': $(cat "$work/msg.txt")"
   [ ! -e "$work/ds/contact_sheet.png" ] || fail "contact-sheet $* wrote a sheet"
 }
 
 mkdir -p "$work/ds"
 echo '{"format":"clothwind-dataset","version":1,"kind":"toy","clips":[{"name":"a"}]}' > "$work/ds/index.json"
-refused "--tiles x --tile-size^2 x 3 bytes" --tiles 10000 --tile-size 1024
+refused 2 "--tiles x --tile-size^2 x 3 bytes" --tiles 10000 --tile-size 1024
 echo '{"format":"clothwind-dataset","version":1,"kind":"toy","clips":[{"name":5}]}' > "$work/ds/index.json"
-refused "$work/ds/index.json: clips[0].name must be a string"
+refused 1 "$work/ds/index.json: clips[0].name must be a string"
 echo '{"format":"clothwind-dataset","version":1,"kind":"toy","clips":["a"]}' > "$work/ds/index.json"
-refused "$work/ds/index.json"
+refused 1 "$work/ds/index.json"
 # An --out the sheet cannot be written as (PNG or JPEG by its extension, any case) is refused
 # naming --out before a tile is read (it failed after reading every tile, naming
 # WriteFrameAtomic); a dataset folder named nan is a name, not a number that is not finite.
@@ -34,7 +35,7 @@ refused "$work/ds/index.json"
 for out in sheet.tiff sheet inf; do
   status=0
   (cd "$work" && "$bin" contact-sheet nan --out "$out" >"$work/msg.txt" 2>&1) || status=$?
-  [ "$status" -eq 1 ] || fail "contact-sheet --out $out exited $status: $(cat "$work/msg.txt")"
+  [ "$status" -eq 2 ] || fail "contact-sheet --out $out exited $status: $(cat "$work/msg.txt")"
   grep -qF -- "--out $out: expected a file name ending in .png, .jpg or .jpeg" "$work/msg.txt" ||
     fail "contact-sheet --out $out: the message does not name --out: $(cat "$work/msg.txt")"
   ! grep -q "contact-sheet.*tiles" "$work/msg.txt" || fail "contact-sheet --out $out read tiles: $(cat "$work/msg.txt")"

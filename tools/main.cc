@@ -13,6 +13,7 @@
 
 #include "closest_name.h"
 #include "range_message.h"
+#include "usage_error.h"
 #include "verb_registry.h"
 
 // package.xml's version, defined by tools/CMakeLists.txt; scripts/device-train compiles this file
@@ -22,7 +23,9 @@
 #endif
 
 int main(int argc, char** argv) {
-  CLI::App app{"clothwind: wind and cloth measurement through simulation (offline tools)"};
+  CLI::App app{"clothwind: wind and cloth measurement through simulation (offline tools)", "clothwind"};
+  app.footer("Exit status: 0 done; 1 the work failed (an input refused, a write failed, bag-check: a bag not\n"
+             "fit for replay); 2 the command line is wrong (nothing was done); Ctrl-C: the signal's (130).");
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("clothwind ") + CLOTHWIND_VERSION);
   auto& verbs = clothwind::tools::Verbs();
@@ -34,12 +37,15 @@ int main(int argc, char** argv) {
   // nan` ran as the default taken for given, `render --fps nan` reached the renderer. Refused for
   // every floating-point option (CLI11's type name FLOAT, its validators' descriptions after a
   // ':'), naming it; not for text, where `--out inf` or a folder named nan is a name.
+  // A transform, not a check: CLI11 runs transforms before an option's own checks, which said
+  // "Value abc must be > 0" of a word and "must be > 0" of `--lr inf`.
   const CLI::Validator finite(
       [](std::string& value) -> std::string {
         char* end = nullptr;
         const double v = std::strtod(value.c_str(), &end);
-        if (end == value.c_str() || *end != '\0' || std::isfinite(v)) return "";  // not a number, or finite
-        return "expected a finite number, got " + value;
+        if (end == value.c_str() || *end != '\0') return "expected a number, got " + value;
+        if (!std::isfinite(v)) return "expected a finite number, got " + value;  // nan, inf, 1e400
+        return "";
       },
       "", "finite");
   // An unsigned option (seeds, counts) takes digits within 0..2^64-1: "-1" wrapped to 2^64-1 and
@@ -55,13 +61,35 @@ int main(int argc, char** argv) {
         return "";
       },
       "", "whole");
+  // A signed whole-number option (counts, epochs, jobs) likewise: CLI11 read "010" as 8 and "0x10"
+  // as 16 without a word (`make-dataset --count 010` ran 8 simulations), as a script's zero-padded
+  // `printf %03d` writes them.
+  const CLI::Validator signed_whole(
+      [](std::string& value) -> std::string {
+        const size_t sign = !value.empty() && (value[0] == '-' || value[0] == '+') ? 1 : 0;
+        const bool digits = value.size() > sign && value.find_first_not_of("0123456789", sign) == std::string::npos;
+        errno = 0;
+        const long long v = digits ? std::strtoll(value.c_str(), nullptr, 10) : 0;
+        if (!digits || errno == ERANGE) return "expected a whole number, got " + value;
+        value = std::to_string(v);
+        return "";
+      },
+      "", "whole");
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
     for (CLI::Option* option : sub->get_options()) {
       if (option->get_type_size() == 0) continue;
-      if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
-      // transform, not check: a check may not change the value (010 must reach CLI11 as 10).
-      if (option->get_type_name().rfind("UINT", 0) == 0) option->transform(whole);
+      // transform, not check: a check may not change the value (010 must reach CLI11 as 10), and
+      // transforms run first.
+      const std::string type = option->get_type_name();
+      if (type.rfind("FLOAT", 0) == 0) option->transform(finite);
+      if (type.rfind("UINT", 0) == 0) option->transform(whole);
+      if (type.rfind("INT", 0) == 0) option->transform(signed_whole);
     }
+  // No verb: the verbs are listed (CLI11 said only "A subcommand is required").
+  if (argc < 2) {
+    std::cerr << app.help() << "\nclothwind: a verb is required (above)\n";
+    return clothwind::tools::kExitUsage;
+  }
   // A word where the verb goes that names none: CLI11 said only "A subcommand is required".
   if (argc >= 2 && argv[1][0] != '-' && run.count(argv[1]) == 0) {
     std::cerr << "clothwind: unknown verb '" << argv[1] << "'";
@@ -70,7 +98,7 @@ int main(int argc, char** argv) {
     const std::string closest = clothwind::tools::ClosestName(argv[1], names);
     if (!closest.empty()) std::cerr << "; did you mean " << closest << "?";
     std::cerr << " (clothwind --help lists the verbs)\n";
-    return 2;
+    return clothwind::tools::kExitUsage;
   }
   try {
     app.parse(argc, argv);
@@ -83,16 +111,22 @@ int main(int argc, char** argv) {
         if (what.rfind(option->get_name() + ":", 0) == 0)
           positive = option->get_type_name().find(":POSITIVE") != std::string::npos;
     std::cerr << clothwind::tools::ReadableRangeMessage(what, positive) << "\nRun with --help for more information.\n";
-    return e.get_exit_code();
+    return clothwind::tools::kExitUsage;
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; every other parse error is a wrong command line, status 2 (CLI11's
+    // own codes, 104 to 114, told a script nothing it could use).
+    const int status = app.exit(e);
+    return status == 0 ? 0 : clothwind::tools::kExitUsage;
   }
   for (auto* sub : app.get_subcommands()) {
     try {
       return run.at(sub->get_name())();
+    } catch (const clothwind::tools::UsageError& e) {
+      std::cerr << "clothwind " << sub->get_name() << ": error: " << e.what() << "\nRun with --help for more information.\n";
+      return clothwind::tools::kExitUsage;
     } catch (const std::exception& e) {
       std::cerr << "clothwind " << sub->get_name() << ": error: " << e.what() << "\n";
-      return 1;
+      return clothwind::tools::kExitFailed;
     }
   }
   return 2;

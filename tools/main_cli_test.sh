@@ -2,7 +2,9 @@
 # CLI test of `clothwind` itself: a mistyped verb is named with the verb it was likely meant to be
 # (it was told only "A subcommand is required"), an unknown word is named, status 2 for both;
 # unsigned options are refused beyond 0..2^64-1 (and ranges said readably); --version prints
-# package.xml's version.
+# package.xml's version; signed whole-number options read decimal too, words and non-finite numbers
+# are named as such; and the exit statuses: 2 for any wrong command line (CLI11's own errors and
+# the verbs' checks alike), 1 for work that failed, 0 for --help.
 # Usage: main_cli_test.sh CLOTHWIND_BINARY SOURCE_DIR
 set -euo pipefail
 bin="$1"
@@ -32,6 +34,33 @@ done
 "$bin" make-toy-dataset --seed 10 --clips 1 --frames 2 --size 16 --out "$work/s10" >/dev/null 2>&1
 cmp -s "$work/s010/index.json" "$work/s10/index.json" && ! cmp -s "$work/s010/index.json" "$work/s8/index.json" ||
   fail "--seed 010 is not seed 10"
+# Signed whole numbers likewise: --clips 010 wrote 8 examples and 0x10 16.
+"$bin" make-toy-dataset --clips 010 --frames 2 --size 16 --out "$work/c010" >/dev/null 2>&1
+[ "$(/usr/bin/python3 -c 'import json, sys; print(len(json.load(open(sys.argv[1]))["clips"]))' "$work/c010/index.json")" = 10 ] ||
+  fail "--clips 010 did not write 10 examples"
+expect_usage() {  # expect_usage MESSAGE_PATTERN ARGS...: status 2, the message on stderr
+  local pattern="$1" status=0 out
+  shift
+  out="$("$bin" "$@" 2>&1 >/dev/null)" || status=$?
+  [ "$status" -eq 2 ] && grep -q -- "$pattern" <<<"$out" || fail "$* (status $status, expected 2 and '$pattern'): $out"
+}
+expect_usage "--clips: expected a whole number, got 0x10" make-toy-dataset --clips 0x10 --out "$work/x"
+expect_usage "--clips: expected a whole number, got abc" make-toy-dataset --clips abc --out "$work/x"
+expect_usage "--size: expected a whole number, got 1e3" make-toy-dataset --size 1e3 --out "$work/x"
+expect_usage "--lr: expected a finite number, got inf" train --lr inf --data "$work" --out "$work/run"
+expect_usage "--lr: expected a finite number, got 1e400" train --lr 1e400 --data "$work" --out "$work/run"
+expect_usage "--lr: expected a number, got fast" train --lr fast --data "$work" --out "$work/run"
+expect_usage "--model is required" eval                                  # CLI11's own (was 106)
+expect_usage "a verb is required" # no verb: the verbs listed (was 106, "A subcommand is required")
+{ "$bin" 2>&1 || true; } | grep -q "^  make-dataset " || fail "clothwind with no verb does not list the verbs"
+expect_usage "--warmup must be in 0..3600 s" simulate "$src/config/scenes/flag.json" --out "$work/sim" --warmup -1
+[ ! -e "$work/x" ] && [ ! -e "$work/sim" ] || fail "a refused command line wrote something"
+# Work that failed is 1: a scene that is not JSON.
+echo "{" >"$work/bad.json"
+status=0
+out="$("$bin" simulate "$work/bad.json" --out "$work/sim" 2>&1)" || status=$?
+[ "$status" -eq 1 ] && grep -q "bad.json" <<<"$out" || fail "a scene that is not JSON (status $status): $out"
+"$bin" simulate --help >/dev/null || fail "simulate --help did not exit 0"
 out="$("$bin" train --epochs -3 --data "$work" --out "$work/run" 2>&1)" || true
 grep -q -- "--epochs: Value -3 must be > 0$" <<<"$out" || fail "--epochs -3: $out"
 "$bin" make-toy-dataset --seed 18446744073709551615 --clips 1 --frames 2 --size 16 --out "$work/toy" >/dev/null 2>&1 ||

@@ -12,7 +12,7 @@ fail() { echo "make_session_cli_test: FAIL: $*" >&2; exit 1; }
 cd "$work"
 status=0
 "$bin" make-session --minutes 0.05 --width 16 --height 16 --out same.png --preview same.png >out.txt 2>&1 || status=$?
-[ "$status" -eq 1 ] && grep -q -- "--preview same.png is the bag --out names" out.txt && [ ! -e same.png ] ||
+[ "$status" -eq 2 ] && grep -q -- "--preview same.png is the bag --out names" out.txt && [ ! -e same.png ] ||
   fail "--preview equal to --out was not refused (status $status): $(cat out.txt)"
 
 # A --preview in a folder not there yet is made, as --out's folder is (it was refused).

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "common/atomic_file.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 
@@ -28,26 +29,26 @@ inline bool SameFile(const std::filesystem::path& a, const std::filesystem::path
   return std::filesystem::absolute(a).lexically_normal() == std::filesystem::absolute(b).lexically_normal();
 }
 
-// Throws std::invalid_argument naming `option` and the input when `output` (empty: none) is one
+// Throws UsageError naming `option` and the input when `output` (empty: none) is one
 // of `inputs` (the files the verb reads: a model, its .json, a dataset's index.json, ...).
 inline void RefuseOutputOverInput(const std::string& option, const std::filesystem::path& output,
                                   const std::vector<std::filesystem::path>& inputs) {
   if (output.empty()) return;
   for (const auto& input : inputs)
     if (!input.empty() && SameFile(output, input))
-      throw std::invalid_argument(option + " " + output.string() + " is an input (" + input.string() +
+      throw UsageError(option + " " + output.string() + " is an input (" + input.string() +
                                   "); write it elsewhere");
 }
 
-// Throws std::invalid_argument naming `option` when `output` is a folder: the verbs that make a
+// Throws UsageError naming `option` when `output` is a folder: the verbs that make a
 // missing output folder themselves failed only when saving, after the work.
 inline void RefuseFolderAsOutput(const std::string& option, const std::filesystem::path& output) {
   std::error_code ec;
   if (!output.empty() && std::filesystem::is_directory(output, ec))
-    throw std::invalid_argument(option + " " + output.string() + " is a folder; expected a file name");
+    throw UsageError(option + " " + output.string() + " is a folder; expected a file name");
 }
 
-// Throws std::invalid_argument naming `option` when `output` is `folder` or lies inside it: `train
+// Throws UsageError naming `option` when `output` is `folder` or lies inside it: `train
 // --out DATA` wrote its run among the dataset's clips.
 inline void RefuseOutputInsideFolder(const std::string& option, const std::filesystem::path& output,
                                      const std::filesystem::path& folder, const std::string& what) {
@@ -62,11 +63,11 @@ inline void RefuseOutputInsideFolder(const std::string& option, const std::files
   const std::filesystem::path out = normal(output), in = normal(folder);
   const auto mismatch = std::mismatch(in.begin(), in.end(), out.begin(), out.end());
   if (mismatch.first == in.end())
-    throw std::invalid_argument(option + " " + output.string() + " is " + (mismatch.second == out.end() ? "" : "inside ") +
+    throw UsageError(option + " " + output.string() + " is " + (mismatch.second == out.end() ? "" : "inside ") +
                                 what + " " + folder.string() + "; write it elsewhere");
 }
 
-// Throws std::invalid_argument naming `option` when no file can be made where `output` (empty: none)
+// Throws UsageError naming `option` when no file can be made where `output` (empty: none)
 // goes: a file is made and removed in its folder, or in the nearest folder above that exists (a
 // verb that makes the missing ones). `eval --json /proc/x.json` ran the whole evaluation and then
 // failed to write.
@@ -79,13 +80,13 @@ inline void RefuseUnwritableFolder(const std::string& option, const std::filesys
   const std::string probe = TemporaryNameFor((folder / output.filename()).string());
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0)
-    throw std::invalid_argument(option + " " + output.string() + ": cannot write in " + folder.string() + " (" +
+    throw UsageError(option + " " + output.string() + ": cannot write in " + folder.string() + " (" +
                                 std::strerror(errno) + ")");
   ::close(fd);
   ::unlink(probe.c_str());
 }
 
-// Throws std::invalid_argument naming `option` unless `output` (empty: none) could be written: its
+// Throws UsageError naming `option` unless `output` (empty: none) could be written: its
 // folder exists and takes a new file, and it is not a folder itself. Checked before the work, which used to run to its
 // end (a whole evaluation) and then fail to write or, for a plot, exit 0.
 inline void RefuseUnwritableOutput(const std::string& option, const std::filesystem::path& output) {
@@ -93,7 +94,7 @@ inline void RefuseUnwritableOutput(const std::string& option, const std::filesys
   std::error_code ec;
   const std::filesystem::path folder = output.has_parent_path() ? output.parent_path() : ".";
   if (!std::filesystem::is_directory(folder, ec))
-    throw std::invalid_argument(option + " " + output.string() + ": folder " + folder.string() + " does not exist");
+    throw UsageError(option + " " + output.string() + ": folder " + folder.string() + " does not exist");
   RefuseFolderAsOutput(option, output);
   RefuseUnwritableFolder(option, output);
 }

@@ -16,7 +16,7 @@ fail() { echo "render_cli_test: FAIL: $*" >&2; exit 1; }
 # refused naming --duration before its --out is made.)
 status=0
 "$bin" simulate "$src/config/scenes/flag.json" --out "$work/day" --duration 86000 --no-obj >"$work/out.txt" 2>&1 || status=$?
-[ "$status" -eq 1 ] && grep -q -- "--duration 86000" "$work/out.txt" && [ ! -e "$work/day" ] ||
+[ "$status" -eq 2 ] && grep -q -- "--duration 86000" "$work/out.txt" && [ ! -e "$work/day" ] ||
   fail "simulate --duration 86000 was not refused before the work: $(cat "$work/out.txt")"
 # --duration and --seed given as -1 (once the "not given" sentinels) are refused like any other
 # negative, naming the option, before --out is made.
@@ -25,7 +25,7 @@ for bad in "--duration -1" "--seed -1 --duration 0.04"; do
   # (--max-edge 1: the old code simulated the scene's whole duration, coarse.)
   # shellcheck disable=SC2086
   "$bin" simulate "$src/config/scenes/flag.json" --out "$work/neg" --max-edge 1 $bad --no-obj >"$work/out.txt" 2>&1 || status=$?
-  [ "$status" -eq 1 ] && grep -q -- "${bad%% *} must be" "$work/out.txt" && [ ! -e "$work/neg" ] ||
+  [ "$status" -eq 2 ] && grep -q -- "${bad%% *} must be" "$work/out.txt" && [ ! -e "$work/neg" ] ||
     fail "simulate $bad was not refused before the work (status $status): $(cat "$work/out.txt")"
 done
 "$bin" simulate "$src/config/scenes/flag.json" --out "$work/sim" --duration 0.2 --max-edge 1 --no-obj >/dev/null
@@ -54,7 +54,7 @@ for bad in "area_weight=abc" "nosuch=1" "area_weight=-1" "area_weight" "area_wei
   # shellcheck disable=SC2086
   "$bin" simulate "$src/config/scenes/flag.json" --out "$work/rerun" --duration 0.04 --max-edge 1 --param $bad \
     >"$work/out.txt" 2>&1 || status=$?
-  [ "$status" -eq 1 ] && grep -q -- "--param\|parameter" "$work/out.txt" ||
+  [ "$status" -eq 2 ] && grep -q -- "--param\|parameter" "$work/out.txt" ||
     fail "simulate --param $bad was not refused naming it (status $status): $(cat "$work/out.txt")"
   left="$(cd "$work/rerun" && LC_ALL=C ls)"
   [ "$left" = "$(printf 'summary.json\ntrajectory.cwtraj')" ] || fail "simulate --param $bad removed the earlier run: $left"
@@ -282,11 +282,13 @@ status=0
 # header", "no vertices"), a pipe was "no such file or folder", a background photo's path naming a
 # folder "no such file", and a frame beyond the renderer's range or texture coordinates spanning
 # 2 km named no file.
-expect_refused() {  # expect_refused MESSAGE ARGS...: render ARGS fails (status 1) saying MESSAGE
-  local says="$1" status=0
+expect_refused() {  # expect_refused MESSAGE ARGS...: render ARGS fails (status 1, or 2 when MESSAGE
+                   # names an option: the command line) saying MESSAGE
+  local says="$1" status=0 expected=1
   shift
+  [ "${says#--}" = "$says" ] || expected=2
   "$bin" render "$@" --count 1 --samples 1 --threads 1 >"$work/out.txt" 2>&1 || status=$?
-  [ "$status" -eq 1 ] && grep -qF -- "$says" "$work/out.txt" ||
+  [ "$status" -eq "$expected" ] && grep -qF -- "$says" "$work/out.txt" ||
     fail "render $* (status $status) did not say '$says': $(cat "$work/out.txt")"
 }
 mkfifo "$work/pipe.cwtraj"

@@ -38,6 +38,7 @@
 #include "sensors/anemometer_protocol.h"
 #include "sensors/wind_reading.h"
 #include "verb_registry.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 namespace {
@@ -254,19 +255,19 @@ int Check(const BagCheckArgs& a);
 int Run(const BagCheckArgs& a) {
   auto in = [](double v, double hi) { return v > 0 && v <= hi; };  // NaN passed CLI's range checks
   if (!in(a.gap_tolerance, 3600))
-    throw std::invalid_argument("--gap-tolerance must be in (0, 3600] s, got " + std::to_string(a.gap_tolerance));
+    throw UsageError("--gap-tolerance must be in (0, 3600] s, got " + std::to_string(a.gap_tolerance));
   if (!in(a.max_future, 86400))
-    throw std::invalid_argument("--max-future must be in (0, 86400] s, got " + std::to_string(a.max_future));
+    throw UsageError("--max-future must be in (0, 86400] s, got " + std::to_string(a.max_future));
   if (!in(a.clip_duration, 3600))
-    throw std::invalid_argument("--clip-duration must be in (0, 3600] s, got " + std::to_string(a.clip_duration));
+    throw UsageError("--clip-duration must be in (0, 3600] s, got " + std::to_string(a.clip_duration));
   if (!in(a.label_window, 86400))
-    throw std::invalid_argument("--label-window must be in (0, 86400] s, got " + std::to_string(a.label_window));
+    throw UsageError("--label-window must be in (0, 86400] s, got " + std::to_string(a.label_window));
   if (!(a.label_delay >= 0 && a.label_delay <= 86400))
-    throw std::invalid_argument("--label-delay must be in [0, 86400] s, got " + std::to_string(a.label_delay));
+    throw UsageError("--label-delay must be in [0, 86400] s, got " + std::to_string(a.label_delay));
   if (!in(a.flush_after, 86400))
-    throw std::invalid_argument("--flush-after must be in (0, 86400] s, got " + std::to_string(a.flush_after));
+    throw UsageError("--flush-after must be in (0, 86400] s, got " + std::to_string(a.flush_after));
   if (!in(a.replay_rate, 1000))
-    throw std::invalid_argument("--replay-rate must be in (0, 1000], got " + std::to_string(a.replay_rate));
+    throw UsageError("--replay-rate must be in (0, 1000], got " + std::to_string(a.replay_rate));
   {
     // A file that is no bag at all: rosbag says "Error reading version line", which the repair
     // hint below also matched.
@@ -444,7 +445,7 @@ int Check(const BagCheckArgs& a) {
 
 const VerbRegistrar kRegistrar{"bag-check", [](CLI::App& app) -> std::function<int()> {
   auto args = std::make_shared<BagCheckArgs>();
-  auto* sub = app.add_subcommand("bag-check", "Check a session bag for replay (topics, rates, stamps, holes)");
+  auto* sub = app.add_subcommand("bag-check", "check a session bag for replay (topics, rates, stamps, holes)");
   sub->add_option("bag", args->bag, "session bag")->required()->check(CLI::ExistingFile);
   sub->add_option("--gap-tolerance", args->gap_tolerance, "camera hole that breaks a clip [s] (clip_buffer's)")
       ->capture_default_str();

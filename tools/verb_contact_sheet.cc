@@ -12,6 +12,7 @@
 #include "progress_bar.h"
 #include "render/sensor_model.h"
 #include "verb_registry.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 namespace {
@@ -26,7 +27,7 @@ int Run(const ContactSheetArgs& a) {
   // The sheet is written as PNG or JPEG by its name's extension (any case): another failed only
   // after every tile was read, naming WriteFrameAtomic rather than --out.
   if (!a.out.empty() && !render::IsFrameFileName(a.out))
-    throw std::invalid_argument("--out " + a.out + ": expected a file name ending in .png, .jpg or .jpeg");
+    throw UsageError("--out " + a.out + ": expected a file name ending in .png, .jpg or .jpeg");
   const nlohmann::json index = data::ReadIndex(a.dir);
   if (index.is_null()) throw std::runtime_error(a.dir + "/index.json not found: not a dataset folder");
   const std::string out =
@@ -45,14 +46,14 @@ int Run(const ContactSheetArgs& a) {
     if (name.empty()) continue;
     const std::filesystem::path folder = dir / name;
     if (SameFile(out_folder, folder))
-      throw std::invalid_argument("--out " + out + " is inside the example folder " + folder.string() +
+      throw UsageError("--out " + out + " is inside the example folder " + folder.string() +
                                   "; write it elsewhere");
   }
   RefuseUnwritableOutput("--out", out);
   // The sheet is held whole in memory (3 bytes a pixel): 10000 tiles of 1024 px were 31 GB.
   const double sheet_bytes = static_cast<double>(a.options.max_tiles) * a.options.tile * a.options.tile * 3;
   if (sheet_bytes > 4.0 * (1ull << 30))
-    throw std::invalid_argument("--tiles x --tile-size^2 x 3 bytes (the sheet, held in memory) must be at most 4 GiB, "
+    throw UsageError("--tiles x --tile-size^2 x 3 bytes (the sheet, held in memory) must be at most 4 GiB, "
                                 "got " + std::to_string(sheet_bytes / (1ull << 30)) + " GiB");
   ProgressBar::Options b;
   b.label = "contact-sheet";

@@ -10,6 +10,7 @@
 #include "progress_bar.h"
 #include "output_paths.h"
 #include "verb_registry.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 namespace {
@@ -108,20 +109,20 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     // The plot and its gnuplot data file replaced the JSON written just before them.
     for (const std::filesystem::path& drawn : {plot, std::filesystem::path(plot.string() + ".dat")})
       if (!a->json.empty() && SameFile(a->json, drawn))
-        throw std::invalid_argument("--json " + a->json + " is where the plot goes (" + drawn.string() +
+        throw UsageError("--json " + a->json + " is where the plot goes (" + drawn.string() +
                                     "); write one of them elsewhere");
     RefuseUnwritableOutput("--json", a->json);
     RefuseUnwritableOutput("--plot", a->plot);
     // gnuplot draws a PNG whatever the name: `--plot p.txt` wrote one named .txt.
     if (!a->plot.empty() && std::filesystem::path(a->plot).extension() != ".png")
-      throw std::invalid_argument("--plot " + a->plot + ": expected a file name ending in .png (the plot is a PNG)");
+      throw UsageError("--plot " + a->plot + ": expected a file name ending in .png (the plot is a PNG)");
     if (a->track_head) {
       // Before the evaluation, which ran whole and then lost its results to a model without a head,
       // a window of the wrong length or a rows file over the model's configuration.
       RefuseOutputOverInput("--track-head-rows", a->track_head_rows, inputs);
       for (const std::string& other : {a->json, plot.string()})
         if (!a->track_head_rows.empty() && !other.empty() && SameFile(a->track_head_rows, other))
-          throw std::invalid_argument("--track-head-rows " + a->track_head_rows + " is where another result goes (" +
+          throw UsageError("--track-head-rows " + a->track_head_rows + " is where another result goes (" +
                                       other + "); write one of them elsewhere");
       RefuseUnwritableOutput("--track-head-rows", a->track_head_rows);
       learn::CheckTrackHead(a->model, a->track_head_window);

@@ -17,6 +17,7 @@
 #include "progress_bar.h"
 #include "output_paths.h"
 #include "verb_registry.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 namespace {
@@ -58,7 +59,7 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
     RefuseFolderAsOutput("--out", a->out);
     RefuseFolderAsOutput("--out's .json", out_config);
     if (SameFile(a->out, out_config))
-      throw std::invalid_argument("--out " + a->out + ": the weights' configuration is written beside them with "
+      throw UsageError("--out " + a->out + ": the weights' configuration is written beside them with "
                                   "the extension .json, so --out needs another (e.g. .pt)");
     // As `train --out`, the output's folder is made when missing, before the minute of loading and
     // calibrating rather than at the write after it.
@@ -75,7 +76,7 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
       // Checked before the work, with the way out: Evaluate's "no examples in split val" left the
       // user to guess that the option needs one.
       if (learn::SelectSplit(learn::ReadDataset(a->calibrate_data), "val").empty())
-        throw std::invalid_argument("--calibrate-std " + a->calibrate_data +
+        throw UsageError("--calibrate-std " + a->calibrate_data +
                                     ": the dataset has no val split, which calibration reads; give one that has, or "
                                     "leave --calibrate-std out (the std is then the network's own)");
       ProgressBar::Options b;

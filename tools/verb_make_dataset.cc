@@ -12,6 +12,7 @@
 #include "render/background.h"
 #include "progress_bar.h"
 #include "verb_registry.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 namespace {
@@ -39,16 +40,16 @@ struct MakeDatasetArgs {
 void ParseShard(const std::string& text, int* shard, int* shards) {
   const auto stoi = [](const std::string& t, size_t* n) { return std::stoi(t, n); };
   if (!ParsePair(text, '/', stoi, shard, shards))
-    throw std::invalid_argument("--shard: expected i/N (e.g. 3/8), got '" + text + "'");
+    throw UsageError("--shard: expected i/N (e.g. 3/8), got '" + text + "'");
   if (*shards < 1 || *shard < 0 || *shard >= *shards)
-    throw std::invalid_argument("--shard " + text + ": expected 0 <= i < N");
+    throw UsageError("--shard " + text + ": expected 0 <= i < N");
 }
 
 // "MIN:MAX" -> (min, max), for the option named `option`.
 void ParseRange(const std::string& option, const std::string& text, double* lo, double* hi) {
   const auto stod = [](const std::string& t, size_t* n) { return std::stod(t, n); };
   if (!ParsePair(text, ':', stod, lo, hi))
-    throw std::invalid_argument(option + ": expected MIN:MAX in metres (e.g. 5.1:6.1), got '" + text + "'");
+    throw UsageError(option + ": expected MIN:MAX in metres (e.g. 5.1:6.1), got '" + text + "'");
 }
 
 int Run(MakeDatasetArgs& a) {
@@ -79,10 +80,10 @@ int Run(MakeDatasetArgs& a) {
                                       {"--bending-spread", a.bending_spread},
                                       {"--bending-jitter", a.bending_jitter}})
       if (given(value))
-        throw std::invalid_argument(std::string(name) + " is FlagSim's (--kind flag); ClothSim draws its fabrics "
+        throw UsageError(std::string(name) + " is FlagSim's (--kind flag); ClothSim draws its fabrics "
                                     "from --materials");
   } else if (!o.materials_dir.empty()) {
-    throw std::invalid_argument("--materials is ClothSim's (--kind cloth); FlagSim's material is the scene's");
+    throw UsageError("--materials is ClothSim's (--kind cloth); FlagSim's material is the scene's");
   }
   if (given(a.wind_min) || given(a.wind_max) || given(a.area_weight_spread) || given(a.bending_spread) ||
       given(a.bending_jitter) || !a.camera_height.empty() || !a.camera_radius.empty() || given(a.camera_angle)) {
@@ -236,18 +237,18 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
   return [a, sub, quality] {
     // Lossless frames take no quality: it was accepted, unused, and written into the header.
     if (quality->count() > 0 && (a->format == "png" || a->format == "pgm"))
-      throw std::invalid_argument("--jpeg-quality is for JPEG frames; --format " + a->format + " is lossless");
+      throw UsageError("--jpeg-quality is for JPEG frames; --format " + a->format + " is lossless");
     // --reindex reads the header and labels as they are: any other option was accepted and
     // ignored (--count 99 --kind cloth --tracks 9x9 rebuilt the same index under the old header).
     if (a->reindex) {
       for (const CLI::Option* option : sub->get_options()) {
         const std::string name = option->get_name();
         if (option->count() > 0 && name != "--out" && name != "--reindex" && name != "--no-contact-sheet")
-          throw std::invalid_argument(name + " is not used by --reindex, which rebuilds the index under the header "
+          throw UsageError(name + " is not used by --reindex, which rebuilds the index under the header "
                                       "the dataset was made with (give only --out and --no-contact-sheet)");
       }
     }
-    if (!a->reindex && a->o.count <= 0) throw std::invalid_argument("--count N (N >= 1) is required");
+    if (!a->reindex && a->o.count <= 0) throw UsageError("--count N (N >= 1) is required");
     return Run(*a);
   };
 }};

@@ -28,6 +28,7 @@
 #include "remove_on_interrupt.h"
 #include "sensors/synthetic_session.h"
 #include "verb_registry.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 namespace {
@@ -72,45 +73,45 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
   // Settings of the rendered flag do nothing to a procedural session: accepted and ignored, a
   // procedural bag came out of a command that asked for a rendered one's settings.
   if (a.frames != "rendered" && !rendered_only.empty())
-    throw std::invalid_argument(rendered_only.front() + " is a setting of --frames rendered; this session's frames are " +
+    throw UsageError(rendered_only.front() + " is a setting of --frames rendered; this session's frames are " +
                                 a.frames);
   // Bounded and long enough for a clip and a reading: infinity (cast to a frame count, undefined)
   // and a few milliseconds both wrote an empty bag and exited 0.
   if (!(a.minutes >= 0.05 && a.minutes <= 1440.0))
-    throw std::invalid_argument("--minutes must be in 0.05..1440 (3 s to a day), got " + std::to_string(a.minutes));
+    throw UsageError("--minutes must be in 0.05..1440 (3 s to a day), got " + std::to_string(a.minutes));
   if (!(std::isfinite(a.wind_mean) && a.wind_mean >= 0 && a.wind_mean <= 60))
-    throw std::invalid_argument("--wind-mean must be in 0..60 m/s, got " + std::to_string(a.wind_mean));
+    throw UsageError("--wind-mean must be in 0..60 m/s, got " + std::to_string(a.wind_mean));
   // The session's own checks, named by option before the work (they said "synthetic session:
   // image must be ..." naming none, or came after a scene build).
-  if (!(a.fps <= 1000.0)) throw std::invalid_argument("--fps must be at most 1000 Hz, got " + std::to_string(a.fps));
+  if (!(a.fps <= 1000.0)) throw UsageError("--fps must be at most 1000 Hz, got " + std::to_string(a.fps));
   for (const auto& [option, value] : {std::pair<const char*, int>{"--width", a.width}, {"--height", a.height}})
     if (value < 16 || value > 16384)
-      throw std::invalid_argument(std::string(option) + " must be in 16..16384 px, got " + std::to_string(value));
+      throw UsageError(std::string(option) + " must be in 16..16384 px, got " + std::to_string(value));
   if (!(a.start_time >= 1.0 && a.start_time + a.minutes * 60.0 + 10.0 < 4294967295.0))
-    throw std::invalid_argument("--start-time must be >= 1 s and leave the session within ROS time's 32-bit seconds, got " +
+    throw UsageError("--start-time must be >= 1 s and leave the session within ROS time's 32-bit seconds, got " +
                                 std::to_string(a.start_time));
   if (!(a.drop_probability >= 0.0 && a.drop_probability < 1.0))
-    throw std::invalid_argument("--drop-probability must be in [0, 1), got " + std::to_string(a.drop_probability));
+    throw UsageError("--drop-probability must be in [0, 1), got " + std::to_string(a.drop_probability));
   // Every message carries its frame (REP 103): an empty one made a bag bag-check passed.
-  if (a.camera_frame.empty()) throw std::invalid_argument("--camera-frame must not be empty");
-  if (a.anemometer_frame.empty()) throw std::invalid_argument("--anemometer-frame must not be empty");
+  if (a.camera_frame.empty()) throw UsageError("--camera-frame must not be empty");
+  if (a.anemometer_frame.empty()) throw UsageError("--anemometer-frame must not be empty");
   if (!(std::isfinite(a.rendered.max_edge) && a.rendered.max_edge >= 0))
-    throw std::invalid_argument("--max-edge must be a finite length >= 0 m (0: the scene's), got " +
+    throw UsageError("--max-edge must be a finite length >= 0 m (0: the scene's), got " +
                                 std::to_string(a.rendered.max_edge));
   // A bag file's name: "" and "dir/" generated the whole session and failed at the final rename
   // (the latter leaving dir/ made and empty).
   {
     const std::string name = std::filesystem::path(a.out).filename().string();
     if (name.empty() || name == "." || name == "..")
-      throw std::invalid_argument("--out '" + a.out + "': expected a bag file name (e.g. session.bag)");
+      throw UsageError("--out '" + a.out + "': expected a bag file name (e.g. session.bag)");
   }
   // The clip buffer's gap tolerance (0.1 s by default) makes every interval of a slower camera a
   // hole: such a session replays into no clip at all (exit 0, an empty report).
   if (!(a.fps >= 10.0))
-    throw std::invalid_argument("--fps must be at least 10 Hz (a slower camera's every frame interval is a hole "
+    throw UsageError("--fps must be at least 10 Hz (a slower camera's every frame interval is a hole "
                                 "to the clip buffer, and no clip forms), got " + std::to_string(a.fps));
   if (a.zeta_seed < -1)
-    throw std::invalid_argument("--zeta-seed must be >= 0 (or -1: the session's --seed), got " +
+    throw UsageError("--zeta-seed must be >= 0 (or -1: the session's --seed), got " +
                                 std::to_string(a.zeta_seed));
   // --out checked before the long work: a folder failed only at the final rename (a rendered
   // session of hours lost), and an existing bag, perhaps a recorded field session, was replaced.
@@ -118,20 +119,20 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
   {
     std::error_code ec;
     if (std::filesystem::exists(a.out, ec) && !a.overwrite)
-      throw std::invalid_argument("--out " + a.out + " exists (a recorded session?); --overwrite replaces it");
+      throw UsageError("--out " + a.out + " exists (a recorded session?); --overwrite replaces it");
   }
   // Checked before the long work, where a bad name used to be ignored after it (imwrite's result).
   std::string preview_extension;
   if (!a.preview.empty()) {
     preview_extension = std::filesystem::path(a.preview).extension().string();
     if (preview_extension.empty() || !cv::haveImageWriter(a.preview))
-      throw std::invalid_argument("--preview " + a.preview +
+      throw UsageError("--preview " + a.preview +
                                   ": expected an image file name OpenCV can write (.png, .jpg, .ppm, ...)");
     // Its folder is made as --out's is, after the checks (it was refused where --out's was made).
     RefuseUnwritableFolder("--preview", a.preview);
     // The bag replaced the preview written beside it (exit 0, the image lost).
     if (SameFile(a.preview, a.out))
-      throw std::invalid_argument("--preview " + a.preview + " is the bag --out names; give the image another name");
+      throw UsageError("--preview " + a.preview + " is the bag --out names; give the image another name");
   }
   sensors::SyntheticSessionOptions o;
   o.duration = a.minutes * 60.0;
@@ -150,7 +151,7 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
     ro.zeta_seed = a.zeta_seed >= 0 ? static_cast<uint64_t>(a.zeta_seed) : a.seed;
     rendered = std::make_shared<data::RenderedFlagGenerator>(o, ro);
   } else if (a.frames != "procedural") {
-    throw std::invalid_argument("--frames: expected procedural or rendered, got '" + a.frames + "'");
+    throw UsageError("--frames: expected procedural or rendered, got '" + a.frames + "'");
   }
   const sensors::SyntheticSession session(o, rendered);
   // What was drawn must hold a clip (the clip buffer's 30 frames): a drop probability near 1 wrote
@@ -170,7 +171,7 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
       longest = std::max(longest, t[i] - run_start);
     }
     if (longest < 1.16)
-      throw std::invalid_argument("--fps " + std::to_string(a.fps) + " with --drop-probability " +
+      throw UsageError("--fps " + std::to_string(a.fps) + " with --drop-probability " +
                                   std::to_string(a.drop_probability) + ": no stretch of frames without a gap over " +
                                   "0.1 s lasts a clip's 1.16 s (longest " + std::to_string(longest) + " s)");
   }
@@ -196,7 +197,7 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
     std::fprintf(stderr, "make-session: removing %s, left by a run that stopped\n", path.c_str());
   });
   if (a.compression != "none" && a.compression != "lz4" && a.compression != "bz2")
-    throw std::invalid_argument("--compression: expected none, lz4 or bz2, got '" + a.compression + "'");
+    throw UsageError("--compression: expected none, lz4 or bz2, got '" + a.compression + "'");
   const std::string tmp = TemporaryNameFor(a.out);
   // Ctrl-C midway removes the temporary bag (it stayed until a later run into the same name).
   const RemoveOnInterrupt remove_on_interrupt(tmp);
@@ -288,7 +289,7 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
 const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::function<int()> {
   auto args = std::make_shared<MakeSessionArgs>();
   auto* sub = app.add_subcommand("make-session",
-                                 "Write a synthetic field session (camera + NMEA anemometer) as a rosbag");
+                                 "write a synthetic field session (camera + NMEA anemometer) as a rosbag");
   sub->add_option("--minutes", args->minutes, "session length [min] (0.05..1440)")->capture_default_str();
   sub->add_option("--out", args->out, "output bag (refused if it exists, unless --overwrite)")->required();
   sub->add_flag("--overwrite", args->overwrite, "replace an existing --out");

@@ -26,6 +26,7 @@
 #include "render/sensor_model.h"
 #include "sim/trajectory_io.h"
 #include "verb_registry.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 namespace {
@@ -102,7 +103,7 @@ data::ClothAnimation LoadInput(const RenderArgs& a, std::string* what) {
     for (const auto& [given, option] : {std::pair{a.cloth_given, "--cloth"}, std::pair{a.obj, "--obj"},
                                         std::pair{a.frame_time_given, "--frame-time"}})
       if (given)
-        throw std::invalid_argument(std::string(option) + " is for a simulation folder; " + a.input +
+        throw UsageError(std::string(option) + " is for a simulation folder; " + a.input +
                                     " is a trajectory file (one cloth, its own frame times)");
     *what = "trajectory " + in.string();
     return AnimationOfTrajectory(in);
@@ -115,7 +116,7 @@ data::ClothAnimation LoadInput(const RenderArgs& a, std::string* what) {
                                             : "trajectory_" + std::to_string(a.cloth) + ".cwtraj");
   if (!a.obj && fs::exists(traj)) {
     if (a.frame_time_given)
-      throw std::invalid_argument("--frame-time is for OBJ frames; " + traj.string() +
+      throw UsageError("--frame-time is for OBJ frames; " + traj.string() +
                                   " has its own frame times (give --obj to render the OBJ frames)");
     *what = "trajectory " + traj.string();
     return AnimationOfTrajectory(traj);
@@ -152,7 +153,7 @@ void FitMeshSize(const data::ClothAnimation& anim, const RenderArgs& a, render::
     return;
   }
   if (!a.zeta.empty())
-    throw std::invalid_argument("--zeta " + a.zeta + ": " + why +
+    throw UsageError("--zeta " + a.zeta + ": " + why +
                                 " (render it with --seed to fit zeta to it, or --keep-zeta to render it as given)");
   render::SetMeshSize(size, zeta);
   std::fprintf(stderr, "render: the cloth measures %.4g x %.4g m; zeta's mesh_width and mesh_aspect_ratio follow it\n",
@@ -164,7 +165,7 @@ int Run(const RenderArgs& a) {
   // --out's zeta.json goes before the first frame and comes back after the last (below): read as
   // --zeta, a run stopped half way lost the frames' only record of how they were made.
   if (!a.zeta.empty() && SameFile(a.zeta, fs::path(a.out) / "zeta.json"))
-    throw std::invalid_argument("--zeta " + a.zeta + " is --out's own zeta.json, which render removes until its frames "
+    throw UsageError("--zeta " + a.zeta + " is --out's own zeta.json, which render removes until its frames "
                                 "are whole (a run stopped half way would lose it): copy it elsewhere first, or render "
                                 "into another --out");
   render::RenderParams zeta = a.zeta.empty()
@@ -179,7 +180,7 @@ int Run(const RenderArgs& a) {
   // A path with a folder (as an older render wrote it) is taken from the current folder.
   if (!photo.empty() && photo.is_relative()) {
     if (a.backgrounds.empty() && !photo.has_parent_path())
-      throw std::invalid_argument("--zeta " + a.zeta + " names its background photo '" + zeta.background_image +
+      throw UsageError("--zeta " + a.zeta + " names its background photo '" + zeta.background_image +
                                   "' by file name: pass --backgrounds DIR, the folder make-dataset was given");
     zeta.background_image =
         std::filesystem::absolute(std::filesystem::path(a.backgrounds) / photo).lexically_normal().string();
@@ -188,7 +189,7 @@ int Run(const RenderArgs& a) {
   zeta.fps = a.fps;
   render::ValidateRenderParams(zeta);
   if (a.format != "jpg" && a.format != "png")
-    throw std::invalid_argument("--format: expected jpg (or jpeg) or png, got '" + a.format + "'");
+    throw UsageError("--format: expected jpg (or jpeg) or png, got '" + a.format + "'");
   std::string what;
   const data::ClothAnimation anim = LoadInput(a, &what);
   // Errors about what the input holds name it: "render params: field 'mesh_width' is 3e+38"
@@ -202,16 +203,16 @@ int Run(const RenderArgs& a) {
   // computed from it or from a huge rate overflowed int: nothing rendered, the earlier run's
   // frames deleted, exit 0.
   if (!(a.start >= 0 && a.start <= anim.duration()))
-    throw std::invalid_argument("--start " + std::to_string(a.start) + " s is outside the animation's " +
+    throw UsageError("--start " + std::to_string(a.start) + " s is outside the animation's " +
                                 std::to_string(anim.duration()) + " s");
   const double frames_in_animation = std::floor((anim.duration() - a.start) * a.fps + 1e-9) + 1;
   if (!(frames_in_animation >= 1 && frames_in_animation <= 1e6))
-    throw std::invalid_argument("--fps " + std::to_string(a.fps) + " gives " + std::to_string(frames_in_animation) +
+    throw UsageError("--fps " + std::to_string(a.fps) + " gives " + std::to_string(frames_in_animation) +
                                 " frames from --start; expected 1 to 1e6");
   const int available = static_cast<int>(frames_in_animation);
   const int count = a.count > 0 ? a.count : available;
   if (count > available)
-    throw std::invalid_argument("--count " + std::to_string(count) + ": only " + std::to_string(available) +
+    throw UsageError("--count " + std::to_string(count) + ": only " + std::to_string(available) +
                                 " frames at " + std::to_string(a.fps) + " fps from --start");
   // The folder's zeta.json says its frames are whole and this run's: it goes before the first
   // frame is written and comes back after the last, so a run killed or failing half way leaves
@@ -312,7 +313,7 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
     // PNG is lossless: a quality beside it was accepted and ignored.
     if (a->format == "jpeg") a->format = "jpg";  // as make-dataset takes it
     if (quality->count() > 0 && a->format == "png")
-      throw std::invalid_argument("--jpeg-quality is for JPEG frames; --format png is lossless");
+      throw UsageError("--jpeg-quality is for JPEG frames; --format png is lossless");
     return Run(*a);
   };
 }};

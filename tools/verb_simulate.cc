@@ -24,6 +24,7 @@
 #include "progress_bar.h"
 #include "stale_frames.h"
 #include "verb_registry.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 namespace {
@@ -56,12 +57,12 @@ std::vector<double> ParseList(const std::string& text, size_t n, const std::stri
       v.push_back(std::stod(item, &used));
       if (used != item.size()) throw std::invalid_argument(item);
     } catch (const std::exception&) {
-      throw std::invalid_argument(flag + ": '" + item + "' is not a number");
+      throw UsageError(flag + ": '" + item + "' is not a number");
     }
-    if (!std::isfinite(v.back())) throw std::invalid_argument(flag + ": values must be finite");
+    if (!std::isfinite(v.back())) throw UsageError(flag + ": values must be finite");
   }
   if (v.size() != n) {
-    throw std::invalid_argument(flag + ": expected " + std::to_string(n) +
+    throw UsageError(flag + ": expected " + std::to_string(n) +
                                 " comma-separated numbers, got '" + text + "'");
   }
   return v;
@@ -84,7 +85,7 @@ int Run(const SimulateArgs& a) {
     setup.wind.velocity = Eigen::Vector3d(v[0], v[1], v[2]);
     // The scene reader's bound (3x the speed of sound); stableNorm: 1e200 squared is infinite.
     if (!(setup.wind.velocity.stableNorm() <= 1000))
-      throw std::invalid_argument("--wind: expected a speed of at most 1000 m/s, got " + a.wind);
+      throw UsageError("--wind: expected a speed of at most 1000 m/s, got " + a.wind);
   }
   if (!a.turbulence.empty()) {
     const auto v = ParseList(a.turbulence, 2, "--turbulence");
@@ -92,7 +93,7 @@ int Run(const SimulateArgs& a) {
     // naming neither the option nor the value, after the earlier run in --out was removed.
     if (!(v[0] >= 0 && v[0] <= sim::kMaxTurbulenceIntensity && v[1] >= sim::kMinTurbulenceLengthScale &&
           v[1] <= sim::kMaxTurbulenceLengthScale))
-      throw std::invalid_argument("--turbulence: expected I in 0..10 and L in 0.01..10000 m, got " + a.turbulence);
+      throw UsageError("--turbulence: expected I in 0..10 and L in 0.01..10000 m, got " + a.turbulence);
     setup.wind.turbulence.intensity = v[0];
     setup.wind.turbulence.length_scale = v[1];
   }
@@ -101,24 +102,24 @@ int Run(const SimulateArgs& a) {
   // own check came after, and named no option); a whole number of frames, as make-dataset's: a
   // warm-up of 0.03 s at 0.04 s frames ran as 0.04 s without a word.
   if (!(a.warmup >= 0 && a.warmup <= 3600))
-    throw std::invalid_argument("--warmup must be in 0..3600 s, got " + std::to_string(a.warmup));
+    throw UsageError("--warmup must be in 0..3600 s, got " + std::to_string(a.warmup));
   if (std::abs(a.warmup / scene.frame_time - std::round(a.warmup / scene.frame_time)) > 1e-6)
-    throw std::invalid_argument("--warmup must be a whole number of " + a.scene + "'s frames (a multiple of " +
+    throw UsageError("--warmup must be a whole number of " + a.scene + "'s frames (a multiple of " +
                                 std::to_string(scene.frame_time) + " s), got " + std::to_string(a.warmup) + " s");
   options.warmup = a.warmup;
   // "Not given" is told by the option's count, not a value: --seed -1 and --duration -1 (the old
   // sentinels) ran as if not given, where any other negative was refused.
-  if (a.seed_given && a.seed < 0) throw std::invalid_argument("--seed must be >= 0, got " + std::to_string(a.seed));
+  if (a.seed_given && a.seed < 0) throw UsageError("--seed must be >= 0, got " + std::to_string(a.seed));
   if (a.seed_given) options.seed = static_cast<uint64_t>(a.seed);
   // NaN used to fall through to the scene's duration and inf to undefined behaviour.
   if (a.duration_given && !(std::isfinite(a.duration) && a.duration > 0 && a.duration <= 86400)) {
-    throw std::invalid_argument("--duration must be a time > 0 and <= 86400 s, got " + std::to_string(a.duration));
+    throw UsageError("--duration must be a time > 0 and <= 86400 s, got " + std::to_string(a.duration));
   }
   if (a.duration_given) options.duration = a.duration;  // else SimulateOptions' default: the scene's
   // The scene's own bound on its frames (held in memory, then copied to write the trajectory):
   // a day at the flag's 0.04 s was 2.16 million frames.
   if (a.duration_given && !(a.duration / scene.frame_time <= 1e6)) {
-    throw std::invalid_argument("--duration " + std::to_string(a.duration) + " s is " +
+    throw UsageError("--duration " + std::to_string(a.duration) + " s is " +
                                 std::to_string(a.duration / scene.frame_time) + " frames of " + a.scene +
                                 "'s frame_time " + std::to_string(scene.frame_time) + " s; at most 1e6");
   }
@@ -127,10 +128,16 @@ int Run(const SimulateArgs& a) {
   std::map<int, double> given;  // --param's index -> value
   for (const auto& p : a.params) {
     const auto eq = p.find('=');
-    if (eq == std::string::npos) throw std::invalid_argument("--param: expected NAME=VALUE, got '" + p + "'");
-    const int index = sim::ParameterIndex(p.substr(0, eq));
+    if (eq == std::string::npos) throw UsageError("--param: expected NAME=VALUE, got '" + p + "'");
+    const int index = [&] {
+      try {
+        return sim::ParameterIndex(p.substr(0, eq));
+      } catch (const std::exception& e) {
+        throw UsageError(std::string("--param: ") + e.what());
+      }
+    }();
     if (given.count(index))
-      throw std::invalid_argument("--param " + p.substr(0, eq) + " is given twice (the last would silently win)");
+      throw UsageError("--param " + p.substr(0, eq) + " is given twice (the last would silently win)");
     given[index] = ParseList(p.substr(eq + 1), 1, "--param " + p)[0];
   }
   std::vector<sim::Theta> thetas;
@@ -140,7 +147,8 @@ int Run(const SimulateArgs& a) {
     try {
       sim::ValidateTheta(theta);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string(given.empty() ? "" : "with --param: ") + e.what());
+      if (given.empty()) throw;  // the scene's own values: an input refused, not the command line
+      throw UsageError(std::string("with --param: ") + e.what());
     }
     thetas.push_back(theta);
   }

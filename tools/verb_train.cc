@@ -11,6 +11,7 @@
 #include "output_paths.h"
 #include "progress_bar.h"
 #include "verb_registry.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 namespace {
@@ -172,11 +173,11 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
     // k has a default, so ModelConfig cannot tell it given: a resnet18 or lstm sweep over --k
     // made identical runs, each recording its k.
     if (k->count() > 0 && args->o.model.arch != "sdn")
-      throw std::invalid_argument("--k is the SDN's (spectral peaks per pixel); --model " + args->o.model.arch +
+      throw UsageError("--k is the SDN's (spectral peaks per pixel); --model " + args->o.model.arch +
                                   " has no spectral layer");
     // The cosine schedule has no decay epoch: accepted, recorded in state.json and never used.
     if (lr_decay_epoch->count() > 0 && args->o.lr_schedule == "cosine")
-      throw std::invalid_argument("--lr-decay-epoch is the step schedule's; --lr-schedule cosine decays over every epoch");
+      throw UsageError("--lr-decay-epoch is the step schedule's; --lr-schedule cosine decays over every epoch");
     // Every batch allocates and frees the same tensors: keep the freed memory instead of faulting
     // its pages in again (a training step 7 % faster at 64 px, 13 % at 96, on 2 cores).
     learn::KeepFreedHeapForReuse();

@@ -21,6 +21,7 @@
 #include "progress_bar.h"
 #include "output_paths.h"
 #include "verb_registry.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 namespace {
@@ -89,15 +90,15 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
       ->capture_default_str();
   return [a, margin, frames]() {
     // CLI11's range lets NaN through: refused here, before the training, not after it.
-    if (!std::isfinite(a->margin)) throw std::invalid_argument("--margin must be a number in 0..100, got nan");
-    if (a->out.empty() && a->measure.empty()) throw std::invalid_argument("--out (to train a judge) or --measure (to measure one) is required");
+    if (!std::isfinite(a->margin)) throw UsageError("--margin must be a number in 0..100, got nan");
+    if (a->out.empty() && a->measure.empty()) throw UsageError("--out (to train a judge) or --measure (to measure one) is required");
     if (a->measure.empty()) {
       // The weights and their card beside them: on neither the dataset's index nor each other,
       // checked before the training, not after it.
       const std::filesystem::path card = learn::ConfigPathFor(a->out);
       const std::filesystem::path index = std::filesystem::path(a->data) / "index.json";
       if (SameFile(a->out, card))
-        throw std::invalid_argument("--out " + a->out + ": the judge's card is written beside it with the "
+        throw UsageError("--out " + a->out + ": the judge's card is written beside it with the "
                                     "extension .json, so --out needs another (e.g. .pt)");
       RefuseOutputOverInput("--out", a->out, {index});
       RefuseOutputOverInput("--out's card", card, {index});
@@ -111,7 +112,7 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
     // FlagSim's, or recorded ones (make run's rendered session records such). A toy dataset's
     // stripes or a hanging cloth show no flag: a judge trained on stripes scored 0 %, exit 0.
     if (dataset.kind == "toy" || dataset.kind == "cloth")
-      throw std::invalid_argument("--data " + a->data + " is a \"" + dataset.kind +
+      throw UsageError("--data " + a->data + " is a \"" + dataset.kind +
                                   "\" dataset, with no flag; the fly judge is trained and measured on flags flying right "
                                   "(a FlagSim dataset, make-dataset --kind flag, or recorded flags)");
     // Measured: the judge first, so a wrong path fails before the frames are read.
