@@ -424,9 +424,15 @@ int main(int argc, char** argv) {
     clothwind::ClipBufferNode node(nh, params);
     params.WarnUnread("clip_buffer");
     ros::spin();
+    // A second Ctrl-C (or SIGTERM) ends the process at once, the clips not yet written lost: what
+    // is on disk is whole and listed (each clip lands under a temporary name, then is renamed and
+    // listed). roscpp's handler only asked again for the shutdown already under way, so a hung
+    // disk left the node to `kill -9`.
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
     node.Finish();
   } catch (const std::exception& e) {
-    ROS_FATAL("clip_buffer: %s", e.what());
+    clothwind::ros_bridge::RosFatal(std::string("clip_buffer: ") + e.what());
     return 1;
   }
   return 0;

@@ -29,6 +29,7 @@
 #include <clothwind/WindEstimate.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "ros_bridge/ros_log.h"
 #include "ros_bridge/strict_param.h"
 #include "sensors/clip_report.h"
 #include "sensors/dataset_writer.h"
@@ -146,7 +147,9 @@ class ClipReport {
       std::printf("estimate plot: %s\n", estimate_plot_path_.c_str());
       return true;
     } catch (const std::exception& e) {
-      ROS_ERROR("clip_report: no estimate plot: %s", e.what());
+      // Also after spin() (Ctrl-C), when only stderr still prints (ros_bridge/ros_log.h).
+      clothwind::ros_bridge::RosLog(clothwind::sensors::LogLevel::kError,
+                                    std::string("clip_report: no estimate plot: ") + e.what());
       return false;
     }
   }
@@ -204,7 +207,8 @@ class ClipReport {
       try {
         clothwind::sensors::WriteFileAtomically(summary_path_, j.dump(1) + "\n");
       } catch (const std::exception& e) {
-        ROS_ERROR("clip_report: no summary: %s", e.what());
+        clothwind::ros_bridge::RosLog(clothwind::sensors::LogLevel::kError,
+                                      std::string("clip_report: no summary: ") + e.what());
         ok_ = false;
       }
     }
@@ -241,7 +245,7 @@ int main(int argc, char** argv) {
     ros::spin();
     return report.Finish() ? 0 : 1;  // Ctrl-C ends spin() before the timer printed: print now
   } catch (const std::exception& e) {
-    ROS_FATAL("clip_report: %s", e.what());
+    clothwind::ros_bridge::RosFatal(std::string("clip_report: ") + e.what());
     return 1;
   }
 }

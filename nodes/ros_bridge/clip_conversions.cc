@@ -61,6 +61,12 @@ void ImageView(const sensor_msgs::Image& msg, cv::Mat* view, sensors::ClipSource
   }
   if (!ReadAsItIs(msg)) {
     // cv_bridge's conversions (debayering, YUV, depth and byte order) rather than our own.
+    // OpenCV converts YUV 4:2:2 a pair of pixels (four bytes) at a time: with an odd width and
+    // packed rows it read two bytes past the image's data.
+    if ((msg.encoding == "yuv422" || msg.encoding == "yuv422_yuy2") && msg.width % 2 != 0)
+      throw std::invalid_argument("image encoding '" + msg.encoding +
+                                  "' needs an even width (two pixels share their colour), got " +
+                                  std::to_string(msg.width));
     int bytes_per_pixel = 1;  // an encoding sensor_msgs does not know: cv_bridge refuses it below
     try {
       bytes_per_pixel = std::max(1, sensor_msgs::image_encodings::numChannels(msg.encoding) *

@@ -127,6 +127,18 @@ TEST(ImageViewTest, BadImagesAreNamed) {
   sensor_msgs::Image narrow = Uniform("yuv422", 2, {128, 60});
   narrow.step = narrow.width;  // 1 byte a pixel where yuv422 has 2
   EXPECT_NE(what(narrow).find("image step 8 < width * pixel size 16"), std::string::npos) << what(narrow);
+  // YUV 4:2:2 holds two pixels in four bytes: OpenCV converts pairs, and an odd width with packed
+  // rows read 2 bytes past the data (a SIGSEGV against a guard page).
+  for (const std::string odd_encoding : {"yuv422", "yuv422_yuy2"}) {
+    sensor_msgs::Image odd = Uniform(odd_encoding, 2, {128, 60});
+    odd.width = 5;
+    odd.height = 3;
+    odd.step = 10;
+    odd.data.resize(30);
+    EXPECT_NE(what(odd).find("'" + odd_encoding + "' needs an even width (two pixels share their colour), got 5"),
+              std::string::npos)
+        << what(odd);
+  }
   sensor_msgs::Image empty = Uniform("mono8", 1, {7});
   empty.width = 0;
   EXPECT_NE(what(empty).find("image is empty"), std::string::npos);

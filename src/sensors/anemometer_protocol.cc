@@ -71,16 +71,23 @@ ParseResult AnemometerDecoder::Decode(const std::string& record, AnemometerProto
   if (used) *used = p;
   ParseResult r = ParseAnemometerRecord(record, p);
   if (p == AnemometerProtocol::kNmea && (r.status == ParseStatus::kOk || r.status == ParseStatus::kNotWind)) {
+    // Per talker: a multiplexer merging a GPS that sends checksums with a wind sensor that sends
+    // none ($GPGGA...*47 between $WIMWV... without) had every wind sentence refused, as one
+    // instrument whose '*' was lost.
+    const std::string talker = record.substr(1, 2);
+    if (nmea_habits_.size() >= kMaxNmeaTalkers && nmea_habits_.count(talker) == 0) nmea_habits_.clear();
+    NmeaChecksumHabit& habit = nmea_habits_[talker];
     if (record.find('*') != std::string::npos) {
-      ++nmea_checksummed_;
-      nmea_unchecked_run_ = 0;
-    } else if (nmea_checksummed_ >= lock_after_) {
-      if (++nmea_unchecked_run_ >= unlock_after_) {
-        nmea_checksummed_ = nmea_unchecked_run_ = 0;  // reconfigured: sentences without are the norm now
+      ++habit.checksummed;
+      habit.unchecked_run = 0;
+    } else if (habit.checksummed >= lock_after_) {
+      if (++habit.unchecked_run >= unlock_after_) {
+        habit = NmeaChecksumHabit();  // reconfigured: sentences without are the norm now
       } else {
         r = ParseResult();
         r.status = ParseStatus::kChecksumError;
-        r.error = "NMEA: no checksum, where this instrument's sentences carry one (its '*' lost to line noise?)";
+        r.error = "NMEA: no checksum, where talker " + talker +
+                  "'s sentences carry one (its '*' lost to line noise?)";
       }
     }
   }

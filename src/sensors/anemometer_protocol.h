@@ -5,6 +5,7 @@
 #define CLOTHWIND_SENSORS_ANEMOMETER_PROTOCOL_H_
 
 #include <cstdint>
+#include <map>
 #include <string>
 
 #include "sensors/wind_reading.h"
@@ -52,9 +53,11 @@ struct DecoderCounters {
 // protocols (noise that happens to look like a CSV line cannot then produce readings). After
 // `unlock_after` consecutive good records of one other protocol it switches (the instrument was
 // reconfigured). NMEA checksums are optional, but an instrument that sends them sends them on
-// every sentence: once `lock_after` good sentences carried one, a sentence without (its '*' lost
-// to line noise, and with it the check of every other byte) is a checksum failure, until
-// `unlock_after` such sentences in a row would have been good (the instrument was reconfigured).
+// every sentence: once `lock_after` good sentences of one talker (the two letters after '$')
+// carried one, a sentence of that talker without (its '*' lost to line noise, and with it the
+// check of every other byte) is a checksum failure, until `unlock_after` such sentences in a row
+// would have been good (the instrument was reconfigured). Talkers are told apart because a
+// multiplexer merges instruments that differ (a GPS with checksums, a wind sensor without).
 class AnemometerDecoder {
  public:
   // Inputs:
@@ -85,8 +88,12 @@ class AnemometerDecoder {
   int candidate_count_ = 0;
   int lock_after_;
   int unlock_after_;
-  int nmea_checksummed_ = 0;  // good NMEA sentences with a checksum since the last without were accepted
-  int nmea_unchecked_run_ = 0;  // good-looking NMEA sentences without one in a row, refused
+  struct NmeaChecksumHabit {
+    int checksummed = 0;    // good sentences with a checksum since the last without was accepted
+    int unchecked_run = 0;  // good-looking sentences without one in a row, refused
+  };
+  static constexpr size_t kMaxNmeaTalkers = 16;  // more (line noise's talkers) start the habits afresh
+  std::map<std::string, NmeaChecksumHabit> nmea_habits_;  // by talker ("II", "WI", "GP", "PG")
   DecoderCounters counters_;
   std::string last_error_;
 };

@@ -147,7 +147,7 @@ TEST(AnemometerDecoder, NmeaWithoutAChecksumFromAnInstrumentThatSendsThemIsAChec
   EXPECT_EQ(r.status, ParseStatus::kChecksumError) << r.error;
   EXPECT_NE(r.error.find("no checksum"), std::string::npos) << r.error;
   EXPECT_EQ(d.counters().checksum_failures, 1u);
-  const std::string xdr = "$WIXDR,A,225.0,D,WINDDIR,N,7.5,M,WINDSPEED+49";  // the '*' flipped to '+'
+  const std::string xdr = "$IIXDR,A,225.0,D,WINDDIR,N,7.5,M,WINDSPEED+49";  // the '*' flipped to '+'
   EXPECT_EQ(d.Decode(xdr).status, ParseStatus::kChecksumError);
   EXPECT_EQ(d.Decode("$IIMWV,12").status, ParseStatus::kMalformed);  // malformed is said as such
   EXPECT_EQ(d.Decode(kMwv).status, ParseStatus::kOk);
@@ -156,6 +156,26 @@ TEST(AnemometerDecoder, NmeaWithoutAChecksumFromAnInstrumentThatSendsThemIsAChec
   for (int i = 0; i < 5; ++i) EXPECT_EQ(d.Decode(bare).status, ParseStatus::kOk) << i;
   AnemometerDecoder never;
   for (int i = 0; i < 20; ++i) EXPECT_EQ(never.Decode(bare).status, ParseStatus::kOk) << i;
+}
+
+// A multiplexer merging a GPS that sends checksums with a wind sensor that sends none: the wind
+// sentences are read (they were refused 98 times in 100, one habit for the whole line), and the
+// GPS's talker keeps its own check.
+TEST(AnemometerDecoder, NmeaChecksumHabitsAreKeptPerTalker) {
+  const std::string gga = WithNmeaChecksum("GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,");
+  const std::string wind = "$WIMWV,229.0,R,5.8,N,A";
+  AnemometerDecoder d;
+  int readings = 0;
+  for (int i = 0; i < 50; ++i) {
+    ASSERT_EQ(d.Decode(gga).status, ParseStatus::kNotWind) << i;
+    const ParseResult r = d.Decode(wind);
+    readings += r.status == ParseStatus::kOk;
+  }
+  EXPECT_EQ(readings, 50);
+  EXPECT_EQ(d.counters().checksum_failures, 0u);
+  const ParseResult lost = d.Decode("$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,");
+  EXPECT_EQ(lost.status, ParseStatus::kChecksumError) << lost.error;
+  EXPECT_NE(lost.error.find("talker GP"), std::string::npos) << lost.error;
 }
 
 TEST(AnemometerDecoder, FixedProtocolParsesEverythingWithIt) {

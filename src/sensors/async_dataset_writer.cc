@@ -67,8 +67,11 @@ bool AsyncDatasetWriter::DrainBy(std::chrono::steady_clock::time_point deadline,
   flush_first_ = true;
   flush_requested_ = true;
   wake_.notify_one();
-  auto done = [this] { return queue_.empty() && !busy_ && !flush_requested_ && !flush_first_ && !flushing_; };
-  if (idle_.wait_until(lock, deadline, done)) return true;
+  start_by_ = deadline;
+  auto done = [this] {
+    return (queue_.empty() || gave_up_) && !busy_ && !flush_requested_ && !flush_first_ && !flushing_;
+  };
+  if (idle_.wait_until(lock, deadline, done) && queue_.empty()) return true;
   for (const auto& item : queue_) {
     ++stats_.abandoned;
     if (abandoned)
@@ -114,7 +117,7 @@ void AsyncDatasetWriter::FlushIndex(std::unique_lock<std::mutex>* lock) {
 void AsyncDatasetWriter::Run() {
   std::unique_lock<std::mutex> lock(mutex_);
   const auto interval = std::chrono::duration<double>(writer_->index_interval());
-  auto has_work = [this] { return stop_ || flush_requested_ || flush_first_ || !queue_.empty(); };
+  auto has_work = [this] { return stop_ || flush_requested_ || flush_first_ || (!queue_.empty() && !gave_up_); };
   for (;;) {
     // Clips waiting to be listed: wake after the interval even if nothing else comes.
     if (stats_.unlisted > 0 && interval.count() > 0) {
@@ -131,7 +134,13 @@ void AsyncDatasetWriter::Run() {
       idle_.notify_all();
       continue;
     }
-    if (queue_.empty()) {  // stop_ or a flush asked for, and nothing left to write
+    if (!queue_.empty() && !gave_up_ && start_by_ &&
+        std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                std::chrono::duration<double>(stats_.last_write_s)) >
+            *start_by_) {
+      gave_up_ = true;  // the next clip would land after DrainBy's deadline: it names them instead
+    }
+    if (queue_.empty() || gave_up_) {  // stop_ or a flush asked for, and nothing left to write
       // Cleared before the rewrite, so a request made while it runs (FlushIndex unlocks) is
       // served by another one: cleared after, it was lost, and Drain returned with a clip
       // written during the rewrite unlisted.

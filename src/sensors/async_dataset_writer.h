@@ -7,6 +7,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -71,8 +72,10 @@ class AsyncDatasetWriter {
   //   deadline   when to give up on the clips still queued
   // Outputs:
   //   abandoned  (appended) folder names of the clips given up, for the log; may be null
-  // Returns true when every queued clip was recorded (or failed) and listed by the deadline. On
-  // false a clip being written at the deadline is still finished by the thread (and listed).
+  // A clip is started only if it would land by the deadline, at the pace of the last write: one
+  // started just before it ran past it (a slow card's 10 s clip past roslaunch's SIGKILL). Returns
+  // true when every queued clip was recorded (or failed) and listed by the deadline. On false a
+  // clip being written is still finished by the thread (and listed).
   bool DrainBy(std::chrono::steady_clock::time_point deadline, std::vector<std::string>* abandoned);
 
   // Asks the thread to rewrite index.json once the clips queued now are written (if any clip is
@@ -103,6 +106,9 @@ class AsyncDatasetWriter {
   bool busy_ = false, stop_ = false, flush_requested_ = false, flushing_ = false;
   bool list_each_clip_ = false;  // DrainBy: rewrite the index before the next clip and after each
   bool flush_first_ = false;     // DrainBy: rewrite it before the next clip
+  // DrainBy: no clip is started that would land after this (at the last write's pace)
+  std::optional<std::chrono::steady_clock::time_point> start_by_;
+  bool gave_up_ = false;  // the thread starts no more clips (start_by_ too near); DrainBy names them
   // Rewrites the index now if clips are unlisted (thread only, mutex not held); updates stats_.
   void FlushIndex(std::unique_lock<std::mutex>* lock);
   Stats stats_;

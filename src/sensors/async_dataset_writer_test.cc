@@ -195,6 +195,37 @@ TEST_F(AsyncDatasetWriterTest, DrainByGivesUpWhatIsQueuedAtItsDeadlineAndNamesIt
   EXPECT_EQ(IndexSize(), on_disk);
 }
 
+// A clip is started at shutdown only if it would land by the deadline, at the last write's pace:
+// one started just before the deadline ran a whole write past it (on a slow card, past
+// roslaunch's SIGKILL). Here the deadline leaves time for one clip more: the second is given up
+// and named, where it was started and written after the deadline.
+TEST_F(AsyncDatasetWriterTest, DrainByStartsNoClipThatWouldLandAfterItsDeadline) {
+  auto noisy_clip = [](uint64_t sequence) {
+    LabelledClip c = MakeClip(sequence, 60);
+    cv::RNG rng(sequence);
+    for (auto& f : c.clip.frames) {
+      f.image = cv::Mat(256, 256, CV_8UC1);
+      rng.fill(f.image, cv::RNG::UNIFORM, 0, 256);  // noise: slow to encode, large to write
+    }
+    return c;
+  };
+  std::vector<std::string> abandoned;
+  double pace = 0;
+  {
+    AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string(), 95, 3600.0), 16);
+    ASSERT_TRUE(w.Enqueue(noisy_clip(0), {}));
+    w.Drain();
+    pace = w.stats().last_write_s;
+    ASSERT_GT(pace, 0.0);
+    for (uint64_t k = 1; k <= 3; ++k) ASSERT_TRUE(w.Enqueue(noisy_clip(k), {}));
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(1.3 * pace));
+    EXPECT_FALSE(w.DrainBy(deadline, &abandoned));
+  }
+  EXPECT_EQ(abandoned.size(), 2u) << "pace " << pace << " s a clip";
+  EXPECT_EQ(IndexSize(), 2u);
+}
+
 // A shutdown drain killed mid-way (roslaunch's SIGKILL 17 s after Ctrl-C, a slow card): every
 // clip folder on disk is listed, bar the one whose folder landed just before the kill. Before
 // DrainBy listed each clip, the index kept only what its interval had let through (here the

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace clothwind::sensors {
 namespace {
@@ -63,15 +64,19 @@ WindReading FineOffsetToReading(const FineOffsetRecord& r) {
   WindReading w;
   w.source = "fine_offset";
   w.relative = false;
-  w.speed = r.wind_average;
-  w.gust = r.wind_gust;
+  w.valid = !r.lost_contact && std::isfinite(r.wind_average);
+  // A void reading (lost contact, no average) keeps what is possible of its fields: a lost
+  // sensor's average of 389 m/s reached anemometer/wind's subscribers (MWV's void filler is
+  // dropped the same way). A valid one's are checked by the decoder, which refuses it whole.
+  auto possible = [](double v) { return v <= kMaxPlausibleWindSpeed ? v : std::numeric_limits<double>::quiet_NaN(); };
+  w.speed = w.valid ? r.wind_average : possible(r.wind_average);
+  w.gust = w.valid ? r.wind_gust : possible(r.wind_gust);
   // The vane keeps pointing somewhere in calm air; like other Fine Offset software, report no
   // direction when the average is zero.
   if (r.direction_index >= 0 && !(r.wind_average == 0.0)) {
     w.from_angle_deg = r.direction_index * 22.5;
     w.reference = AngleReference::kEarth;
   }
-  w.valid = !r.lost_contact && std::isfinite(r.wind_average);
   w.status = r.lost_contact                      ? "lost contact with outdoor sensor"
              : !std::isfinite(r.wind_average) ? "no wind average"
              : r.direction_index < 0          ? "direction invalid"

@@ -37,6 +37,36 @@ TEST(FineOffsetRecord, HighNibblesExtendBothSpeeds) {
   EXPECT_NEAR(r.wind_gust, (0x2A + 0x200) * 0.1, 1e-9);
 }
 
+// A void reading keeps only possible speeds: a lost sensor's record with an average of 389 m/s
+// (found by fuzzing) was published, flagged invalid, at 389 m/s.
+TEST(FineOffsetRecord, AVoidReadingCarriesNoImpossibleSpeed) {
+  std::vector<uint8_t> b = kRecord;
+  b[9] = 0xF3;
+  b[10] = 0x0F;
+  b[11] = 0x0F;  // average 0xFF3 (409.1 m/s), gust 0x00F (1.5 m/s)
+  b[15] = 0x40;  // lost contact
+  FineOffsetRecord r;
+  std::string err;
+  ASSERT_TRUE(ParseFineOffsetRecord(b, &r, &err)) << err;
+  const WindReading lost = FineOffsetToReading(r);
+  EXPECT_FALSE(lost.valid);
+  EXPECT_TRUE(std::isnan(lost.speed)) << lost.speed;
+  EXPECT_NEAR(lost.gust, 1.5, 1e-9);  // possible: kept
+  b[15] = 0x00;
+  b[9] = 0xFF;
+  b[10] = 0xFE;
+  b[11] = 0xFF;  // no average (0xFFF), gust 0xFFE: void, and the gust of 409.4 m/s dropped
+  ASSERT_TRUE(ParseFineOffsetRecord(b, &r, &err)) << err;
+  const WindReading no_average = FineOffsetToReading(r);
+  EXPECT_FALSE(no_average.valid);
+  EXPECT_TRUE(std::isnan(no_average.gust)) << no_average.gust;
+  b[9] = 0x1C;
+  b[10] = 0x2A;
+  b[11] = 0x10;  // the documented record: valid, its values as they are
+  ASSERT_TRUE(ParseFineOffsetRecord(b, &r, &err)) << err;
+  EXPECT_NEAR(FineOffsetToReading(r).gust, 29.8, 1e-9);
+}
+
 TEST(FineOffsetRecord, NegativeTemperatureIsSignMagnitude) {
   std::vector<uint8_t> b = kRecord;
   b[5] = 0x05;

@@ -1,5 +1,6 @@
 #include "sensors/nmea.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,10 @@ ParseResult Fail(ParseStatus s, std::string msg) {
   return r;
 }
 
+// [m/s] MWD's knots and m/s may differ by their rounding (0.1 kn and 0.1 m/s: at most 0.08 m/s),
+// plus 1 % of the speed for instruments that convert before rounding.
+constexpr double kMwdSpeedAgreement = 0.1;
+
 bool NmeaSpeedUnit(const std::string& f, SpeedUnit* unit) {
   if (f == "M") *unit = SpeedUnit::kMetresPerSecond;
   else if (f == "N") *unit = SpeedUnit::kKnots;
@@ -29,6 +34,13 @@ bool NmeaSpeedUnit(const std::string& f, SpeedUnit* unit) {
   else if (f == "F") *unit = SpeedUnit::kFeetPerMinute;
   else return false;
   return true;
+}
+
+// XDR's speed units: the standard's M, N, K and S only. Gill's P and F are MWV's (its manual);
+// in an XDR, F is a temperature's Fahrenheit, and a WINDCHILL of 40 F was read as a wind speed of
+// 40 ft/min, over the sentence's own WSPD.
+bool XdrSpeedUnit(const std::string& f, SpeedUnit* unit) {
+  return (f == "M" || f == "N" || f == "K" || f == "S") && NmeaSpeedUnit(f, unit);
 }
 
 ParseResult ParseMwv(const NmeaSentence& s) {
@@ -150,6 +162,17 @@ ParseResult ParseMwd(const NmeaSentence& s) {
     return Fail(ParseStatus::kMalformed, where + (metres ? " field 7 (speed, m/s)" : " field 5 (speed, knots)") +
                                              ": expected >= 0, got " + s.fields[metres ? 6 : 4]);
   }
+  // Both given: they must say one speed, within their rounding (a corrupt field whose checksum
+  // still matched, or a sentence without one, read "20 N, 1 M" as 1 m/s).
+  if (std::isfinite(v[2]) && std::isfinite(v[3])) {
+    const double from_knots = SpeedToMetresPerSecond(v[2], SpeedUnit::kKnots);
+    if (std::abs(from_knots - v[3]) > kMwdSpeedAgreement + 0.01 * std::max(from_knots, v[3])) {
+      char what[640];  // (fields are at most a record's 256 bytes)
+      std::snprintf(what, sizeof what, ": field 5 (%s kn, %.3g m/s) and field 7 (%s m/s) disagree",
+                    s.fields[4].c_str(), from_knots, s.fields[6].c_str());
+      return Fail(ParseStatus::kMalformed, where + what);
+    }
+  }
   r.status = ParseStatus::kOk;
   return r;
 }
@@ -172,6 +195,7 @@ ParseResult ParseXdr(const NmeaSentence& s) {
   WindReading& w = r.reading;
   w.source = "nmea_xdr";
   bool any = false;
+  std::string direction_name, speed_name, gust_name;  // the quadruplets read, by name
   for (size_t q = 0; q < s.fields.size(); q += 4) {
     const std::string name = Upper(s.fields[q + 3]);
     const bool windish = name.find("WIND") != std::string::npos || name.rfind("WSPD", 0) == 0 ||
@@ -190,7 +214,7 @@ ParseResult ParseXdr(const NmeaSentence& s) {
     SpeedUnit unused;
     const bool surely_wind = name.rfind("WSPD", 0) == 0 || name.rfind("WGUST", 0) == 0 ||
                              name.find("DIR") != std::string::npos || name.find("SPEED") != std::string::npos;
-    if (!surely_wind && units != "D" && !NmeaSpeedUnit(units, &unused)) continue;
+    if (!surely_wind && units != "D" && !XdrSpeedUnit(units, &unused)) continue;
     if (name.find("DIR") != std::string::npos) {
       if (units != "D")
         return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] +
@@ -200,19 +224,31 @@ ParseResult ParseXdr(const NmeaSentence& s) {
         return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] + "' field " +
                                                  std::to_string(q + 2) + " (direction): expected 0..360 deg, got " +
                                                  s.fields[q + 1]);
+      if (!direction_name.empty())
+        return Fail(ParseStatus::kMalformed, where + ": two wind directions, '" + direction_name + "' and '" +
+                                                 s.fields[q + 3] + "' (one of each is read)");
+      direction_name = s.fields[q + 3];
       w.from_angle_deg = value;
       w.reference = AngleReference::kInstrument;
       any = true;
     } else {
       SpeedUnit unit;
-      if (!NmeaSpeedUnit(units, &unit))
+      if (!XdrSpeedUnit(units, &unit))
         return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] +
                                                  "': speed units expected M, N, K or S, got '" + units + "'");
       if (value < 0.0)
         return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] + "' field " +
                                                  std::to_string(q + 2) + " (speed): expected >= 0, got " +
                                                  s.fields[q + 1]);
-      if (name.find("GUST") != std::string::npos) w.gust = SpeedToMetresPerSecond(value, unit);
+      // A second speed (or gust) overwrote the first without a word: which one the instrument
+      // means is not for the parser to guess.
+      std::string& first = name.find("GUST") != std::string::npos ? gust_name : speed_name;
+      if (!first.empty())
+        return Fail(ParseStatus::kMalformed, where + ": two wind " +
+                                                 (&first == &gust_name ? "gusts" : "speeds") + ", '" + first +
+                                                 "' and '" + s.fields[q + 3] + "' (one of each is read)");
+      first = s.fields[q + 3];
+      if (&first == &gust_name) w.gust = SpeedToMetresPerSecond(value, unit);
       else w.speed = SpeedToMetresPerSecond(value, unit);
       any = true;
     }

@@ -228,10 +228,40 @@ TEST(Nmea, XdrWindQuadruplets) {
   ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
   EXPECT_DOUBLE_EQ(r.reading.speed, 5.0);
   EXPECT_DOUBLE_EQ(r.reading.from_angle_deg, 120.0);
+  // F and P are Gill's MWV units, not XDR's: a wind chill of 40 F was read as 40 ft/min of wind,
+  // over the sentence's own WSPD.
+  r = ParseNmea(WithNmeaChecksum("WIXDR,A,120,D,WDIR,S,5.0,M,WSPD,C,40,F,WINDCHILL"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_DOUBLE_EQ(r.reading.speed, 5.0);
+  r = ParseNmea(WithNmeaChecksum("WIXDR,A,120,D,WDIR,S,5.0,M,WSPD,C,-4,F,WINDCHILL"));
+  EXPECT_EQ(r.status, ParseStatus::kOk) << r.error;  // (it voided the sentence: a negative speed)
+  r = ParseNmea(WithNmeaChecksum("WIXDR,S,5.0,P,WSPD"));
+  EXPECT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("speed units expected M, N, K or S, got 'P'"), std::string::npos) << r.error;
+  // Two speeds, gusts or directions: the later overwrote the earlier without a word.
+  for (const std::string& two : {std::string("WIXDR,A,120,D,WINDDIR,A,200,D,WINDDIR2,S,5.0,M,WSPD"),
+                                 std::string("WIXDR,S,5.0,M,WSPD,S,7.0,M,WINDSPEED"),
+                                 std::string("WIXDR,S,5.0,M,WSPD,S,8.0,M,WGUST,S,9.0,M,WINDGUST")}) {
+    r = ParseNmea(WithNmeaChecksum(two));
+    EXPECT_EQ(r.status, ParseStatus::kMalformed) << two;
+    EXPECT_NE(r.error.find("two wind "), std::string::npos) << r.error;
+  }
   // WSPD is wind whatever its units, so wrong ones are still an error.
   r = ParseNmea(WithNmeaChecksum("WIXDR,S,5.0,C,WSPD"));
   EXPECT_EQ(r.status, ParseStatus::kMalformed);
   EXPECT_NE(r.error.find("WSPD"), std::string::npos) << r.error;
+}
+
+// MWD's knots and m/s must say one speed within their rounding: "20 N, 1 M" was read as 1 m/s.
+TEST(Nmea, MwdSpeedsThatDisagreeAreRefused) {
+  ParseResult r = ParseNmea(WithNmeaChecksum("WIMWD,270,T,,M,20,N,1,M"));
+  ASSERT_EQ(r.status, ParseStatus::kMalformed);
+  EXPECT_NE(r.error.find("field 5 (20 kn, 10.3 m/s) and field 7 (1 m/s) disagree"), std::string::npos) << r.error;
+  // Rounded to 0.1 each: 19.4 kn is 9.98 m/s, said as 10.0.
+  r = ParseNmea(WithNmeaChecksum("WIMWD,270,T,,M,19.4,N,10.0,M"));
+  EXPECT_EQ(r.status, ParseStatus::kOk) << r.error;
+  r = ParseNmea(WithNmeaChecksum("WIMWD,270,T,,M,0.1,N,0.0,M"));
+  EXPECT_EQ(r.status, ParseStatus::kOk) << r.error;
 }
 
 TEST(Nmea, MwdDirectionOutOfRangeNamesTheFieldAndValue) {

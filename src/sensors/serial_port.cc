@@ -80,7 +80,11 @@ void ConfigureTermios(const SerialConfig& c, termios* tio_ptr) {
   // Linux keeps a port's termios between opens: clear every framing bit a previous program may
   // have left, CMSPAR included (with it, parity 'E' would put space parity on the wire).
   tio.c_cflag &= ~(CSIZE | PARENB | PARODD | CMSPAR | CSTOPB | CRTSCTS);
-  tio.c_iflag &= ~INPCK;
+  // IGNPAR (which cfmakeraw keeps, and an earlier `stty` may have set) dropped a byte with a
+  // parity error without a trace: a CSV record has no checksum, and "12.35,270" read as
+  // "1.35,270". Clear, such a byte arrives as NUL, which every parser refuses (PARMRK would
+  // insert 0xFF 0x00 before it instead).
+  tio.c_iflag &= ~(INPCK | IGNPAR | PARMRK);
   switch (c.data_bits) {
     case 5: tio.c_cflag |= CS5; break;
     case 6: tio.c_cflag |= CS6; break;

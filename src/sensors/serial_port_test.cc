@@ -115,12 +115,15 @@ TEST(SerialPort, ConfigureTermiosSetsLineSettings) {
   EXPECT_FALSE(t.c_cflag & PARENB);
   // Mark/space parity and parity checking left by a previous program: Linux keeps a port's
   // termios between opens, and with CMSPAR still set, 'E' would be space parity on the wire.
+  // IGNPAR or PARMRK left by `stty`: a byte with a parity error was dropped (or marked), not read
+  // as the NUL the parsers refuse.
   t.c_cflag |= CMSPAR | PARENB;
-  t.c_iflag |= INPCK;
+  t.c_iflag |= INPCK | IGNPAR | PARMRK;
   ConfigureTermios({"x", 9600, 8, 'E', 1}, &t);
   EXPECT_FALSE(t.c_cflag & CMSPAR);
   EXPECT_TRUE(t.c_cflag & PARENB);
   EXPECT_TRUE(t.c_iflag & INPCK);
+  EXPECT_FALSE(t.c_iflag & (IGNPAR | PARMRK));
   ConfigureTermios({"x", 9600, 8, 'N', 1}, &t);
   EXPECT_FALSE(t.c_iflag & INPCK);
 }
