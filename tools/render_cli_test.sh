@@ -29,6 +29,15 @@ for bad in "--duration -1" "--seed -1 --duration 0.04"; do
     fail "simulate $bad was not refused before the work (status $status): $(cat "$work/out.txt")"
 done
 "$bin" simulate "$src/config/scenes/flag.json" --out "$work/sim" --duration 0.2 --max-edge 1 --no-obj >/dev/null
+# The mesh simulated is said, and the scene's warnings (here an ArcSim key this simulator ignores,
+# which changes the physics) are kept in summary.json as well as said: stderr is lost in a batch.
+sed -e "s|\"meshes/|\"$src/config/meshes/|; s|\"materials/|\"$src/config/materials/|; 5a \"friction\": 0.5," \
+  "$src/config/scenes/flag.json" >"$work/friction.json"
+"$bin" simulate "$work/friction.json" --out "$work/fric" --duration 0.04 --no-obj >/dev/null 2>"$work/out.txt"
+grep -q "^simulate: cloths\[0\]: 413 vertices, 768 faces, the OBJ's 63 refined once to edges of at most 0.2 m (from remeshing.size" \
+  "$work/out.txt" || fail "simulate did not say the mesh it simulates: $(cat "$work/out.txt")"
+/usr/bin/python3 -c 'import json, sys; w = json.load(open(sys.argv[1]))["scene_warnings"]; sys.exit(not (len(w) == 1 and "friction: ArcSim key not supported" in w[0]))' \
+  "$work/fric/summary.json" || fail "summary.json does not keep the scene's warning: $(grep -A3 scene_warnings "$work/fric/summary.json")"
 # A rerun into the folder of an earlier run: its frame OBJs (here cloth 0's, and cloth 1's of a
 # run of two cloths) and its trajectory of cloth 1 go, whether this run writes OBJs or not (with
 # --no-obj they stayed beside the new summary, and `render DIR --obj` rendered the old cloth).

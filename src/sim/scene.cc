@@ -278,7 +278,7 @@ SceneCloth ParseCloth(const Reader& r, const json& j, const std::string& path) {
 SceneHandle ParseHandle(const Reader& r, const json& j, const std::string& path, int n_motions) {
   r.ExpectObject(j, path);
   r.CheckKeys(j, path, {"nodes", "cloth", "motion", "start_time", "end_time", "type"},
-              {"label", "center", "radius", "obstacle", "pivot"});
+              {"label", "center", "radius", "obstacle", "pivot", "fade_time", "circumference", "u", "axis0", "axis1"});
   SceneHandle h;
   if (j.contains("type")) {
     const std::string type = r.String(j["type"], path + ".type");

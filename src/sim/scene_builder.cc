@@ -12,7 +12,9 @@ namespace clothwind::sim {
 
 double DefaultMaxEdge(const SceneRemeshing& remeshing) {
   if (!remeshing.present) return 0.0;
-  return 0.4 * remeshing.size_max;
+  // Never below the scene's own smallest size: for [0.3, 0.5] m, 0.4 size_max split to 0.2 m,
+  // finer than ArcSim itself refines.
+  return std::max(0.4 * remeshing.size_max, remeshing.size_min);
 }
 
 double DefaultUniformEdge(const SceneRemeshing& remeshing) {

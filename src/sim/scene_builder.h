@@ -72,7 +72,7 @@ constexpr double kMaxSceneCoordinate = 100.0;
 SceneSetup BuildScene(const Scene& scene, const BuildOptions& options = {});
 
 // The default resolution BuildScene picks for a remeshing block (see BuildOptions::max_edge):
-// the longest edge [m], 0.4 size_max (0 without a remeshing block). The mesh is first refined
+// the longest edge [m], 0.4 size_max but at least size_min (0 without a remeshing block). The mesh is first refined
 // uniformly to DefaultUniformEdge (size_max), then its longer edges are split.
 double DefaultMaxEdge(const SceneRemeshing& remeshing);
 double DefaultUniformEdge(const SceneRemeshing& remeshing);

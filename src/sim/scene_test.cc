@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <stdexcept>
 #include <fstream>
 #include <limits>
 
@@ -17,9 +18,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Run outside ctest, "." failed 15 tests with "./config/scenes/flag.json: cannot open".
 std::string SourceDir() {
   const char* s = std::getenv("CLOTHWIND_SOURCE_DIR");
-  return s ? s : ".";
+  if (!s) throw std::runtime_error("CLOTHWIND_SOURCE_DIR is not set (ctest sets it to the source tree)");
+  return s;
 }
 
 std::string SharedDir() {
@@ -175,6 +178,21 @@ TEST(LoadScene, ReadsOurFlagAndClothScenes) {
   for (int n : c.cloths[0].options.handles) EXPECT_NEAR(c.cloths[0].mesh.V(n, 2), 1.0, 1e-9);
 }
 
+// The split length is 0.4 size_max, never below size_min: [0.3, 0.5] m split to 0.2 m, finer
+// than ArcSim itself refines.
+TEST(BuildScene, TheDefaultResolutionStaysWithinTheRemeshingSizeRange) {
+  SceneRemeshing r;
+  r.present = true;
+  r.size_min = 0.02;
+  r.size_max = 0.5;
+  EXPECT_DOUBLE_EQ(DefaultMaxEdge(r), 0.2);
+  r.size_min = 0.3;
+  EXPECT_DOUBLE_EQ(DefaultMaxEdge(r), 0.3);
+  EXPECT_DOUBLE_EQ(DefaultUniformEdge(r), 0.5);
+  r.present = false;
+  EXPECT_EQ(DefaultMaxEdge(r), 0.0);
+}
+
 TEST(BuildScene, RefusesANegativeOrNotANumberEdgeLength) {
   const Scene flag = LoadScene(SourceDir() + "/config/scenes/flag.json");
   for (double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
@@ -312,6 +330,13 @@ TEST_F(SceneFiles, ArcSimScenesThisSimulatorReadsDifferentlySaySo) {
   labelled.replace(labelled.find("\"nodes\": [0, 3]"), 15, "\"label\": 1");
   const std::string label = Write("conf/label.json", labelled);
   ExpectErrorNaming([&] { LoadScene(label); }, {label, "handles[0].label", "not supported"});
+  // ArcSim's own handle keys are said as ArcSim's, not as typos ("unknown key").
+  Warnings faded;
+  std::string fade = SceneText();
+  fade.replace(fade.find("\"nodes\": [0, 3]"), 15, "\"nodes\": [0, 3], \"fade_time\": 1");
+  LoadScene(Write("conf/fade.json", fade), faded.sink());
+  ASSERT_EQ(faded.list.size(), 1u);
+  EXPECT_NE(faded.list[0].find("handles[0].fade_time: ArcSim key not supported"), std::string::npos) << faded.list[0];
 }
 
 TEST_F(SceneFiles, WrongTypesNameTheJsonPathAndFile) {
