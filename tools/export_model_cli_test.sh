@@ -109,6 +109,28 @@ scaled "$work/run/model.json" "$work/msg.txt" "$work/export/sdn.json"
 "$bin" export-model --model "$work/export/sdn.pt" --out "$work/export2/sdn.pt" --calibrate-std "$work/toy" \
   --precision float32 --threads 1 >"$work/msg.txt" 2>&1 || fail "calibrating again: $(cat "$work/msg.txt")"
 scaled "$work/export/sdn.json" "$work/msg.txt" "$work/export2/sdn.json"
+# An existing export is replaced only with --overwrite (export-model --out models/sdn.pt replaced
+# the shipped model without a word); an --out that cannot be written is refused before the
+# calibration's work, naming --out, not after it naming a temporary file; a missing --model is
+# named as itself and leaves no empty output folder behind.
+cp "$work/export2/sdn.pt" "$work/export2-before.pt"
+status=0
+"$bin" export-model --model "$work/export/sdn.pt" --out "$work/export2/sdn.pt" >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 2 ] && grep -qF -- "--out: $work/export2/sdn.pt exists; --overwrite replaces it" "$work/msg.txt" &&
+  cmp -s "$work/export2/sdn.pt" "$work/export2-before.pt" ||
+  fail "an existing --out without --overwrite (status $status): $(cat "$work/msg.txt")"
+"$bin" export-model --model "$work/export/sdn.pt" --out "$work/export2/sdn.pt" --overwrite >"$work/msg.txt" 2>&1 ||
+  fail "--overwrite: $(cat "$work/msg.txt")"
+status=0
+"$bin" export-model --model "$work/run/model.pt" --out /proc/clothwind-export.pt --calibrate-std "$work/toy" \
+  --threads 1 >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 2 ] && grep -qF -- "--out /proc/clothwind-export.pt: cannot write in /proc" "$work/msg.txt" &&
+  ! grep -q "calibrat" "$work/msg.txt" ||
+  fail "an unwritable --out was not refused before the calibration (status $status): $(cat "$work/msg.txt")"
+status=0
+"$bin" export-model --model "$work/nope.pt" --out "$work/none-export/sdn.pt" >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 1 ] && grep -qF "$work/nope.pt: no such file" "$work/msg.txt" && [ ! -e "$work/none-export" ] ||
+  fail "a missing --model (status $status): $(cat "$work/msg.txt"); $(ls -d "$work/none-export" 2>&1)"
 
 # Calibration reads the val clips as filmed (FlagSim's flags fly right; docs/sdn.md says why), not
 # turned round as the node's auto turns them. With every clip mirrored (flags flying left), the

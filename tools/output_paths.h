@@ -99,6 +99,20 @@ inline void RefuseUnwritableOutput(const std::string& option, const std::filesys
   RefuseUnwritableFolder(option, output);
 }
 
+// Throws UsageError naming `option` and the file when one of `outputs` exists and `overwrite` is
+// false: the verbs that write a model or a judge replace one only with --overwrite, as
+// make-session a bag and train a run (`export-model --out models/sdn.pt` replaced the shipped
+// model without a word).
+inline void RefuseExistingOutput(const std::string& option, const std::vector<std::filesystem::path>& outputs,
+                                 bool overwrite) {
+  if (overwrite) return;
+  for (const auto& output : outputs) {
+    std::error_code ec;
+    if (std::filesystem::exists(output, ec))
+      throw UsageError(option + ": " + output.string() + " exists; --overwrite replaces it");
+  }
+}
+
 }  // namespace clothwind::tools
 
 #endif  // CLOTHWIND_TOOLS_OUTPUT_PATHS_H_

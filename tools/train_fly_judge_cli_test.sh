@@ -29,4 +29,16 @@ status=0
 "$bin" train-fly-judge --data "$work/toy" --measure "$(dirname "$0")/../models/fly_judge.pt" >"$work/msg.txt" 2>&1 || status=$?
 [ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "with no flag" "$work/msg.txt" ||
   fail "train-fly-judge --measure on a toy dataset (status $status): $(cat "$work/msg.txt")"
+# An existing judge is replaced only with --overwrite, checked before the training's minutes
+# (train-fly-judge --out models/fly_judge.pt replaced the shipped judge without a word).
+mkdir -p "$work/judges"
+echo x >"$work/judges/j.json"
+status=0
+"$bin" train-fly-judge --data "$work/toy" --out "$work/judges/j.pt" >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 2 ] && grep -qF -- "--out: $work/judges/j.json exists; --overwrite replaces it" "$work/msg.txt" &&
+  [ "$(cat "$work/judges/j.json")" = x ] ||
+  fail "an existing judge's card without --overwrite (status $status): $(cat "$work/msg.txt")"
+status=0
+"$bin" train-fly-judge --data "$work/toy" --out "$work/judges/j.pt" --overwrite >"$work/msg.txt" 2>&1 || status=$?
+grep -q "with no flag" "$work/msg.txt" || fail "--overwrite was not taken: $(cat "$work/msg.txt")"
 echo "train_fly_judge_cli_test: OK"

@@ -25,6 +25,7 @@ namespace {
 struct ExportArgs {
   std::string model, out, precision = "float16", calibrate_data;
   int threads = 2;
+  bool overwrite = false;
 };
 
 VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()> {
@@ -34,6 +35,7 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
                                  "weights, optionally a std calibrated on the validation split");
   sub->add_option("--model", a->model, "trained model.pt (model.json beside it)")->required();
   sub->add_option("--out", a->out, "output .pt (its .json is written beside it)")->required();
+  sub->add_flag("--overwrite", a->overwrite, "replace an existing --out and its .json");
   sub->add_option("--precision", a->precision, "precision of the parameters in the file")
       ->check(CLI::IsMember({"float16", "float32"}))
       ->capture_default_str();
@@ -61,10 +63,10 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
     if (SameFile(a->out, out_config))
       throw UsageError("--out " + a->out + ": the weights' configuration is written beside them with "
                                   "the extension .json, so --out needs another (e.g. .pt)");
-    // As `train --out`, the output's folder is made when missing, before the minute of loading and
-    // calibrating rather than at the write after it.
-    const std::filesystem::path folder = std::filesystem::path(a->out).parent_path();
-    if (!folder.empty()) std::filesystem::create_directories(folder);
+    RefuseExistingOutput("--out", {a->out, out_config}, a->overwrite);
+    // Before the minute of loading and calibrating: /proc/NAME.pt failed after it, naming a
+    // temporary file.
+    RefuseUnwritableFolder("--out", a->out);
     learn::WindNet net = learn::LoadWindNet(a->model);
     // A head trained beside the wind's (--aux-tracks) only shaped the trunk: no estimate reads it.
     if (net->config().aux_outputs > 0) {
@@ -79,6 +81,12 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
         throw UsageError("--calibrate-std " + a->calibrate_data +
                                     ": the dataset has no val split, which calibration reads; give one that has, or "
                                     "leave --calibrate-std out (the std is then the network's own)");
+    }
+    // Made once the inputs have loaded (a missing --model or dataset left an empty folder behind),
+    // still before the calibration's minute rather than at the write after it.
+    const std::filesystem::path folder = std::filesystem::path(a->out).parent_path();
+    if (!folder.empty()) std::filesystem::create_directories(folder);
+    if (!a->calibrate_data.empty()) {
       ProgressBar::Options b;
       b.label = "calibrate";
       b.unit = "clips";

@@ -30,6 +30,7 @@ struct JudgeArgs {
   std::string data, out, measure;
   int windows = 3, frames = 30, threads = 2;
   double margin = 1.0;  // scores closer to 0 tell nothing (FlyJudge::margin)
+  bool overwrite = false;
   learn::FlyJudgeTrainOptions train;
   // The test split is also judged slid by each of these many cells (ShiftedMotionMaps).
   static constexpr int kShiftedRows = 3;
@@ -54,6 +55,7 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
                                  "dataset of flags that fly right, and measure it on every split");
   sub->add_option("--data", a->data, "dataset folder (its flags must all fly right, as FlagSim's do)")->required();
   auto* out = sub->add_option("--out", a->out, "weights file, e.g. models/fly_judge.pt (its card .json is written beside it)");
+  sub->add_flag("--overwrite", a->overwrite, "replace an existing --out and its card")->needs(out);
   auto* measure = sub->add_option("--measure", a->measure,
                                   "measure this judge (e.g. models/fly_judge.pt, its margin from its card) on every "
                                   "split instead of training one; writes nothing");
@@ -105,6 +107,7 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
       RefuseFolderAsOutput("--out", a->out);
       RefuseFolderAsOutput("--out's card", card);
       RefuseUnwritableFolder("--out", a->out);
+      RefuseExistingOutput("--out", {a->out, card}, a->overwrite);
     }
     at::set_num_threads(a->threads);
     const learn::Dataset dataset = learn::ReadDataset(a->data);

@@ -120,7 +120,7 @@ void CheckCardMatchesWeights(const nlohmann::json& card, const std::filesystem::
 }  // namespace
 
 FlyJudge FlyJudge::Load(const std::filesystem::path& path) {
-  RefuseFolderAsWeightsFile(path, "a fly judge");
+  RequireWeightsFile(path, "a fly judge");
   const std::filesystem::path card_path = ConfigPathFor(path);
   const nlohmann::json card = ReadJson(card_path);
   // Bounded as train-fly-judge bounds it: the module is built from the card before the weights'

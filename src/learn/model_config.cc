@@ -341,10 +341,14 @@ std::filesystem::path ConfigPathFor(const std::filesystem::path& weights) {
   return p.replace_extension(".json");
 }
 
-void RefuseFolderAsWeightsFile(const std::filesystem::path& weights, const std::string& what) {
+void RequireWeightsFile(const std::filesystem::path& weights, const std::string& what) {
   std::error_code ec;
   if (std::filesystem::is_directory(weights, ec))
     throw std::runtime_error(weights.string() + ": a folder, expected " + what +
+                             "'s weights file (a .pt with its .json beside it)");
+  // Named before its .json is read: a mistyped --model said only "nope.json: cannot open".
+  if (!std::filesystem::exists(weights, ec))
+    throw std::runtime_error(weights.string() + ": no such file, expected " + what +
                              "'s weights file (a .pt with its .json beside it)");
 }
 

@@ -167,11 +167,10 @@ ModelConfig ModelConfigFromJson(const nlohmann::json& j, const std::string& wher
 // The JSON file that goes with a weights file: "run/model.pt" -> "run/model.json".
 std::filesystem::path ConfigPathFor(const std::filesystem::path& weights);
 
-// Throws std::runtime_error naming `weights` when it is a folder, before its JSON is looked for: a
-// folder given as the model was told "<folder>.json: cannot open". (A missing file is named by
-// its JSON's error, which says whose architecture it is.)
+// Throws std::runtime_error naming `weights` when it is a folder or no file, before its JSON is
+// looked for: a folder or a mistyped name given as the model was told "<name>.json: cannot open".
 // Inputs: weights  the weights file given; what  what it should be ("a model", "a fly judge").
-void RefuseFolderAsWeightsFile(const std::filesystem::path& weights, const std::string& what);
+void RequireWeightsFile(const std::filesystem::path& weights, const std::string& what);
 
 // Writes `text` to `path` atomically (temporary file in the same folder, then rename).
 void WriteFileAtomically(const std::filesystem::path& path, const std::string& text);

@@ -330,7 +330,7 @@ WindNet BuildWindNet(const ModelConfig& config, const std::filesystem::path& con
 }  // namespace
 
 WindNet LoadWindNet(const std::filesystem::path& weights) {
-  RefuseFolderAsWeightsFile(weights, "a model");
+  RequireWeightsFile(weights, "a model");
   const std::filesystem::path config_path = ConfigPathFor(weights);
   const nlohmann::json j = ReadJsonFile(config_path.string(), "the architecture of the model " + weights.string());
   WindNet net = BuildWindNet(ModelConfigFromJson(j, config_path.string()), config_path);

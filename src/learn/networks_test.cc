@@ -105,6 +105,14 @@ TEST(LoadWindNetTest, AFolderGivenAsTheModelIsNamedAsOne) {
     // It was told "<folder>.json: cannot open".
     EXPECT_EQ(std::string(e.what()), dir.string() + ": a folder, expected a model's weights file (a .pt with its .json beside it)");
   }
+  // A mistyped name: it was told "<name>.json: cannot open", the .pt unnamed.
+  const std::filesystem::path none = dir / "nope.pt";
+  try {
+    LoadWindNet(none);
+    ADD_FAILURE() << "a missing file loaded as a model";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), none.string() + ": no such file, expected a model's weights file (a .pt with its .json beside it)");
+  }
   std::filesystem::remove_all(dir);
 }
 
@@ -114,6 +122,7 @@ TEST(LoadWindNetTest, AModelJsonTheNetworkCannotBeBuiltFromIsNamed) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("clothwind_networks_load_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
+  std::ofstream(dir / "model.pt") << "";  // there (a missing one is named first), never read
   for (const auto& [field, value] : std::vector<std::pair<std::string, int>>{{"k", 20}, {"frame_channels", 40}}) {
     nlohmann::json j = ToJson(SmallSdn());
     j[field] = value;

@@ -35,7 +35,7 @@ if [ ! -f "$model" ] || [ "$cli" -nt "$model" ] || [ "$0" -nt "$model" ] || [ "$
     "$cli" make-toy-dataset --out "$toy" --clips 100 --frames 60 --size 32 --seed 1 >&2
     if [ "$half" = 1 ]; then
       "$cli" train --overwrite --data "$toy" --out "$(dirname "$model")/full" "${opts[@]}" >&2
-      "$cli" export-model --model "$(dirname "$model")/full/model.pt" --out "$model" --precision float16 \
+      "$cli" export-model --overwrite --model "$(dirname "$model")/full/model.pt" --out "$model" --precision float16 \
         --calibrate-std "$toy" >&2
     else
       "$cli" train --overwrite --data "$toy" --out "$(dirname "$model")" "${opts[@]}" >&2
