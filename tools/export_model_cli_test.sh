@@ -16,6 +16,12 @@ fail() { echo "export_model_cli_test: FAIL: $*" >&2; exit 1; }
 grep -q '"split": "val"' "$work/toy/index.json" || fail "the toy dataset drew no val clip: $(cat "$work/toy/index.json")"
 "$bin" train --model sdn --frames 30 --data "$work/toy" --out "$work/run" --input-size 32 --width 8 --k 3 \
   --threads 1 --init-only >"$work/msg.txt" 2>&1 || fail "train --init-only: $(cat "$work/msg.txt")"
+# A run of epochs says the whole run's time left after each epoch but the last (the bar's ETA is
+# the epoch's own).
+"$bin" train --model sdn --frames 30 --data "$work/toy" --out "$work/run2" --input-size 32 --width 8 --k 3 \
+  --threads 1 --epochs 2 --batch 8 >"$work/msg.txt" 2>&1 || fail "train --epochs 2: $(cat "$work/msg.txt")"
+grep -q "^epoch 1/2 .* s  (run: ~[0-9]* s left)$" "$work/msg.txt" && ! grep -q "^epoch 2/2 .*left" "$work/msg.txt" ||
+  fail "train did not say the run's time left: $(grep "^epoch" "$work/msg.txt")"
 
 # (train's options that were accepted and ignored, or wrapped: refused naming them.)
 for case in "--lr-decay-epoch|--lr-schedule cosine --lr-decay-epoch 5" "--overwrite|--resume --overwrite" \

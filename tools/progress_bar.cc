@@ -1,9 +1,11 @@
 #include "progress_bar.h"
 
+#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 namespace clothwind::tools {
 
@@ -58,16 +60,40 @@ void ProgressBar::Print(int64_t done, int64_t total, const std::string& note, do
                 end ? FormatDuration(now).c_str() : (units_per_s > 0 ? FormatDuration(eta).c_str() : "?"));
   const std::string label = o_.label.empty() ? "" : o_.label + " ";
   if (tty_) {
-    constexpr int kWidth = 30;
-    const int filled = total > 0 ? static_cast<int>(kWidth * std::min(done, total) / total) : kWidth;
-    std::fprintf(o_.stream, "\r%s[%s%s] %s  %s\033[K", label.c_str(), std::string(filled, '#').c_str(),
-                 std::string(kWidth - filled, '.').c_str(), text, note.c_str());
+    const double fraction = total > 0 ? static_cast<double>(std::min(done, total)) / total : 1.0;
+    std::fprintf(o_.stream, "\r%s\033[K", RedrawnLine(label, fraction, text, note, Columns()).c_str());
     open_line_ = done < total;
     if (!open_line_) std::fprintf(o_.stream, "\n");
   } else {
     std::fprintf(o_.stream, "%s%s  %s\n", label.c_str(), text, note.c_str());
   }
   std::fflush(o_.stream);
+}
+
+int ProgressBar::Columns() const {
+  if (o_.columns > 0) return o_.columns;
+  winsize size{};
+  if (::ioctl(::fileno(o_.stream), TIOCGWINSZ, &size) == 0 && size.ws_col > 0) return size.ws_col;
+  const char* env = std::getenv("COLUMNS");
+  const int columns = env ? std::atoi(env) : 0;
+  return columns > 0 ? columns : 80;
+}
+
+std::string RedrawnLine(const std::string& label, double fraction, const std::string& text, const std::string& note,
+                        int columns) {
+  const size_t room = static_cast<size_t>(std::max(columns - 1, 1));
+  auto line = [&](int cells, const std::string& tail) {
+    const int filled = static_cast<int>(cells * std::clamp(fraction, 0.0, 1.0));
+    return label + "[" + std::string(filled, '#') + std::string(cells - filled, '.') + "] " + text +
+           (tail.empty() ? "" : "  " + tail);
+  };
+  std::string full = line(30, note);
+  if (full.size() <= room) return full;
+  const std::string bare = line(30, "");
+  if (bare.size() + 2 < room) return full.substr(0, room);  // the note cut
+  for (int cells = 29; cells >= 10; --cells)
+    if (line(cells, "").size() <= room) return line(cells, "");
+  return line(10, "").substr(0, room);
 }
 
 void ProgressBar::Finish() {

@@ -24,6 +24,7 @@ class ProgressBar {
     double plain_interval = 10.0;   // [s] between plain lines when not on a terminal
     std::FILE* stream = stderr;
     int tty = -1;                   // -1: detect (isatty); 0: plain lines; 1: redraw
+    int columns = -1;               // the terminal's width; -1: ask it (TIOCGWINSZ, else $COLUMNS, else 80)
   };
 
   explicit ProgressBar(Options options);
@@ -47,6 +48,7 @@ class ProgressBar {
 
  private:
   void Print(int64_t done, int64_t total, const std::string& note, double now);
+  int Columns() const;  // the width a redrawn line fits (Options::columns)
 
   Options o_;
   bool tty_;
@@ -63,6 +65,15 @@ class ProgressBar {
   int64_t first_done_ = 0;
   double first_time_ = 0;  // [s since start]
 };
+
+// The line a terminal's bar redraws, fitted to `columns` - 1 characters (a line as wide as the
+// terminal, or wider, wraps, and each "\r" redraw then returns to the start of its last row only:
+// half-lines piled up on an 80-column terminal, five a second): the note is cut first, then the
+// bar narrowed from 30 cells to 10, then the line cut.
+// Inputs: label (with its trailing space, or ""), fraction done in [0, 1], text (percent, counts,
+//         rate, ETA), note, columns (> 0).
+std::string RedrawnLine(const std::string& label, double fraction, const std::string& text, const std::string& note,
+                        int columns);
 
 // "12 s", "3 min 05 s", "2 h 04 min": a duration [s] for people.
 std::string FormatDuration(double seconds);

@@ -77,6 +77,44 @@ TEST(ProgressBar, PaceIsMeasuredFromTheFirstReport) {
   EXPECT_EQ(second.find(" h "), std::string::npos) << second;
 }
 
+// A redrawn line fits the terminal: 102-108 characters on an 80-column one wrapped, and each
+// redraw returned to the start of its last row only (half-lines piled up, five a second). The note
+// goes first, then the bar narrows, then the line is cut; a wide terminal shows it all.
+TEST(ProgressBar, ARedrawnLineFitsTheTerminal) {
+  const std::string text = " 38%  5/13 batches  44.4 clips/s  ETA 3 min 10 s";
+  const std::string note = "loss 0.1234, validating 120/300 clip runs";
+  const std::string wide = RedrawnLine("train epoch 1/20 ", 0.38, text, note, 200);
+  EXPECT_EQ(wide, "train epoch 1/20 [###########...................] " + text + "  " + note);
+  for (int columns : {120, 100, 80, 60, 40, 10, 1}) {
+    const std::string fitted = RedrawnLine("train epoch 1/20 ", 0.38, text, note, columns);
+    EXPECT_LE(fitted.size(), static_cast<size_t>(std::max(columns - 1, 1))) << columns << ": " << fitted;
+    if (columns >= 40) {
+      EXPECT_EQ(fitted.rfind("train epoch 1/20 [", 0), 0u) << fitted;
+    }
+  }
+  // At 80 columns the note is dropped before the bar narrows: the counts and ETA stay whole.
+  const std::string eighty = RedrawnLine("train epoch 1/20 ", 0.38, text, note, 80);
+  EXPECT_NE(eighty.find("ETA 3 min 10 s"), std::string::npos) << eighty;
+  // Through the bar, at a width given.
+  std::FILE* f = std::tmpfile();
+  ASSERT_NE(f, nullptr);
+  ProgressBar::Options o;
+  o.label = "make-dataset";
+  o.unit = "simulations";
+  o.stream = f;
+  o.tty = 1;
+  o.columns = 80;
+  ProgressBar bar(o);
+  bar.Update(0, 3, "a note long enough to wrap an eighty-column terminal if it were printed whole, and more");
+  bar.Finish();
+  std::string written = Written(f);
+  std::fclose(f);
+  const size_t start = written.find('\r'), end = written.find("\033[K");
+  ASSERT_NE(start, std::string::npos);
+  ASSERT_NE(end, std::string::npos);
+  EXPECT_LE(end - start - 1, 79u) << written;
+}
+
 TEST(ProgressBar, FormatsDurationsForPeople) {
   EXPECT_EQ(FormatDuration(12.4), "12 s");
   EXPECT_EQ(FormatDuration(185), "3 min 05 s");

@@ -190,10 +190,20 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
     RefuseOutputInsideFolder("--out", o.out, o.data, "the dataset");
     std::unique_ptr<ProgressBar> bar;
     int bar_epoch = 0;
+    // The whole run's time left, from this process's mean epoch (the bar's ETA is the epoch's:
+    // nothing said how long a 20-epoch run had to go). A resumed run's earlier epochs ran elsewhere.
+    int epochs_timed = 0;
+    double epoch_seconds = 0;
+    auto run_left = [&](int epochs_left) {
+      return epochs_timed > 0 && epochs_left > 0 ? FormatDuration(epochs_left * epoch_seconds / epochs_timed)
+                                                 : std::string();
+    };
     o.progress = [&](const learn::TrainProgress& p) {
       if (p.epoch != bar_epoch) {
         ProgressBar::Options b;
         b.label = "train epoch " + std::to_string(p.epoch) + "/" + std::to_string(p.epochs);
+        const std::string left = run_left(p.epochs - p.epoch + 1);
+        if (!left.empty()) b.label += " (run ~" + left + " left)";
         b.unit = "batches";
         b.rate_scale = o.batch;
         b.rate_unit = "clips/s";
@@ -213,7 +223,12 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
                 << " rmse " << e.val_rmse << " acc@0.5 " << e.val_acc05;
       if (o.aux_tracks > 0) std::cout << "  aux loss " << e.train_aux_loss;
       if (o.weight_average > 0) std::cout << "  (trained weights: val rmse " << e.raw_val_rmse << ")";
-      std::cout << "  " << std::setprecision(1) << e.seconds << " s" << std::endl;
+      std::cout << "  " << std::setprecision(1) << e.seconds << " s";
+      ++epochs_timed;
+      epoch_seconds += e.seconds;
+      const std::string left = run_left(o.epochs - e.epoch);
+      if (!left.empty()) std::cout << "  (run: ~" << left << " left)";
+      std::cout << std::endl;
     };
     const learn::TrainResult r = learn::Train(o);
     if (o.init_only) {
