@@ -22,6 +22,16 @@ grep -q '"split": "val"' "$work/toy/index.json" || fail "the toy dataset drew no
   --threads 1 --epochs 2 --batch 8 >"$work/msg.txt" 2>&1 || fail "train --epochs 2: $(cat "$work/msg.txt")"
 grep -q "^epoch 1/2 .* s  (run: ~[0-9]* s left)$" "$work/msg.txt" && ! grep -q "^epoch 2/2 .*left" "$work/msg.txt" ||
   fail "train did not say the run's time left: $(grep "^epoch" "$work/msg.txt")"
+# --resume takes the options the run started with from its state.json: the defaults were refused
+# one option per try (--frames, then --input-size, --width, --batch, --epochs).
+"$bin" train --data "$work/toy" --out "$work/run2" --resume --threads 1 >"$work/msg.txt" 2>&1 ||
+  fail "train --resume without the run's options: $(cat "$work/msg.txt")"
+grep -q "^resuming $work/run2 with the run's own --model --frames --input-size --width --k .* --epochs --batch .* (its state.json)$" \
+  "$work/msg.txt" || fail "train --resume did not say the options it took: $(cat "$work/msg.txt")"
+# One given that differs is still refused, naming it.
+status=0
+"$bin" train --data "$work/toy" --out "$work/run2" --resume --threads 1 --width 16 >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 1 ] && grep -q "width" "$work/msg.txt" || fail "train --resume --width 16 (status $status): $(cat "$work/msg.txt")"
 
 # (train's options that were accepted and ignored, or wrapped: refused naming them.)
 for case in "--lr-decay-epoch|--lr-schedule cosine --lr-decay-epoch 5" "--overwrite|--resume --overwrite" \
