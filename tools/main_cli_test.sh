@@ -55,6 +55,15 @@ expect_usage "a verb is required" # no verb: the verbs listed (was 106, "A subco
 { "$bin" 2>&1 || true; } | grep -q "^  make-dataset " || fail "clothwind with no verb does not list the verbs"
 expect_usage "--warmup must be in 0..3600 s" simulate "$src/config/scenes/flag.json" --out "$work/sim" --warmup -1
 [ ! -e "$work/x" ] && [ ! -e "$work/sim" ] || fail "a refused command line wrote something"
+# An --out no file can be made in is named as the option, before any work (it was "filesystem
+# error: cannot create directories: ... [/proc/x]"); render's --cloth is two digits.
+for verb in "make-toy-dataset" "make-dataset --count 1" "simulate $src/config/scenes/flag.json" "train --data $work" \
+            "render $work"; do
+  # shellcheck disable=SC2086
+  expect_usage "--out /proc/clothwind-x: cannot write in /proc" $verb --out /proc/clothwind-x
+done
+expect_usage "--cloth: Value -1 not in range 0 to 99" render "$work" --out "$work/r" --cloth -1
+expect_usage "--max-edge must be a finite length" simulate "$src/config/scenes/flag.json" --out "$work/sim" --max-edge -1
 # Work that failed is 1: a scene that is not JSON.
 echo "{" >"$work/bad.json"
 status=0

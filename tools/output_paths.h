@@ -99,6 +99,26 @@ inline void RefuseUnwritableOutput(const std::string& option, const std::filesys
   RefuseUnwritableFolder(option, output);
 }
 
+// Throws UsageError naming `option` unless files can be made in the folder `output_folder` (made
+// later if missing: then in its nearest existing ancestor): `--out /proc/x` failed with
+// "filesystem error: cannot create directories: ... [/proc/x]", naming no option.
+inline void RefuseUnwritableOutputFolder(const std::string& option, const std::filesystem::path& output_folder) {
+  if (output_folder.empty()) return;
+  std::error_code ec;
+  std::filesystem::path folder = std::filesystem::absolute(output_folder, ec);
+  while (!folder.empty() && !std::filesystem::exists(folder, ec) && folder != folder.parent_path())
+    folder = folder.parent_path();
+  if (!std::filesystem::is_directory(folder, ec))
+    throw UsageError(option + " " + output_folder.string() + ": " + folder.string() + " is a file, not a folder");
+  const std::string probe = TemporaryNameFor((folder / ".clothwind-write-probe").string());
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0)
+    throw UsageError(option + " " + output_folder.string() + ": cannot write in " + folder.string() + " (" +
+                     std::strerror(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
 // Throws UsageError naming `option` and the file when one of `outputs` exists and `overwrite` is
 // false: the verbs that write a model or a judge replace one only with --overwrite, as
 // make-session a bag and train a run (`export-model --out models/sdn.pt` replaced the shipped

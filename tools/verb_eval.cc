@@ -37,7 +37,8 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       ->capture_default_str();
   sub->add_option("--json", a->json, "write {\"rmse\", \"acc05\", \"count\", ...} to this file");
   sub->add_option("--plot", a->plot, "predicted-vs-true PNG (default: <model folder>/eval_<split>.png, with a suffix such as _w3 for a reading "
-                  "other than Table 1's)");
+                  "other than Table 1's); its data (.dat, every clip's truth, prediction and std) and gnuplot script "
+                  "(.gp) are written beside it");
   sub->add_option("--threads", a->threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--batch", a->batch, "clips per forward pass")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--windows", a->windows,

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/parse_pair.h"
+#include "output_paths.h"
 #include "data/dataset_generator.h"
 #include "render/background.h"
 #include "progress_bar.h"
@@ -54,6 +55,7 @@ void ParseRange(const std::string& option, const std::string& text, double* lo, 
 
 int Run(MakeDatasetArgs& a) {
   data::DatasetOptions& o = a.o;
+  RefuseUnwritableOutputFolder("--out", o.out);
   if (a.reindex) {
     ProgressBar::Options b;
     b.label = "make-dataset --reindex";
@@ -103,6 +105,13 @@ int Run(MakeDatasetArgs& a) {
   // The renderer's own listing (any case, .bmp too, files only): this verb's copy refused .JPG.
   if (!a.backgrounds.empty()) o.background_images = render::ListBackgroundImages(a.backgrounds);
 
+  // Before the line that says what it will make: "--views must be in 1..64" came after it, and
+  // exited 1 as a failed run.
+  try {
+    data::ValidateDatasetOptions(o);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
   ProgressBar::Options bar_options;
   bar_options.label = "make-dataset";
   bar_options.unit = "simulations";
@@ -248,7 +257,9 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
                                       "the dataset was made with (give only --out and --no-contact-sheet)");
       }
     }
-    if (!a->reindex && a->o.count <= 0) throw UsageError("--count N (N >= 1) is required");
+    if (!a->reindex && sub->get_option("--count")->count() == 0) throw UsageError("--count N (N >= 1) is required");
+    if (!a->reindex && a->o.count <= 0)
+      throw UsageError("--count must be >= 1, got " + std::to_string(a->o.count));
     return Run(*a);
   };
 }};

@@ -322,7 +322,7 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
       sub->add_option("--warmup", args->rendered.warmup, "rendered: flag simulated before the session starts [s]")
           ->capture_default_str(),
       sub->add_option("--zeta-seed", args->zeta_seed,
-                      "rendered: seed of sun, sky, backdrop and flag design (default: --seed)"),
+                      "rendered: seed of sun, sky, backdrop and flag design (default, or -1: --seed)"),
       sub->add_option("--camera-distance", args->rendered.camera_radius, "rendered: camera's horizontal distance from the flag's centre [m] (0.1..10000)")
           ->capture_default_str()};
   return [args, rendered_only] {

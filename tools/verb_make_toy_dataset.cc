@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "learn/dataset.h"
+#include "output_paths.h"
 #include "progress_bar.h"
 #include "verb_registry.h"
 
@@ -26,6 +27,7 @@ VerbRegistrar registrar("make-toy-dataset", [](CLI::App& app) -> std::function<i
   sub->add_option("--size", a->o.size, "frame side [px]")->check(CLI::Range(16, 2048))->capture_default_str();
   sub->add_option("--seed", a->o.seed, "seed (0..2^64-1)")->check(CLI::NonNegativeNumber)->capture_default_str();
   return [a]() {
+    RefuseUnwritableOutputFolder("--out", a->out);
     ProgressBar::Options b;
     b.label = "make-toy-dataset";
     b.unit = "examples";

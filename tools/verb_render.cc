@@ -162,6 +162,7 @@ void FitMeshSize(const data::ClothAnimation& anim, const RenderArgs& a, render::
 }
 
 int Run(const RenderArgs& a) {
+  RefuseUnwritableOutputFolder("--out", a.out);
   // --out's zeta.json goes before the first frame and comes back after the last (below): read as
   // --zeta, a run stopped half way lost the frames' only record of how they were made.
   if (!a.zeta.empty() && SameFile(a.zeta, fs::path(a.out) / "zeta.json"))
@@ -265,7 +266,7 @@ int Run(const RenderArgs& a) {
 const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int()> {
   auto a = std::make_shared<RenderArgs>();
   auto* sub = app.add_subcommand("render",
-                                 "render a cloth trajectory (.cwtraj) or OBJ frame sequence to 25 fps frames");
+                                 "render a cloth trajectory (.cwtraj) or OBJ frame sequence to frames (25 fps unless --fps)");
   sub->add_option("input", a->input, ".cwtraj file, or a folder with trajectory.cwtraj or NNNN_CC.obj frames")
       ->required();
   sub->add_option("--out", a->out, "output folder (000.jpg ..., zeta.json)")->required();
@@ -287,7 +288,9 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
   sub->add_option("--backgrounds", a->backgrounds,
                   "folder of the background photo a --zeta names by file name (make-dataset --backgrounds)")
       ->needs(zeta);
-  sub->add_option("--format", a->format, "jpg (or jpeg) or png")->capture_default_str();
+  sub->add_option("--format", a->format, "jpg (or jpeg) or png")
+      ->check(CLI::IsMember({"jpg", "jpeg", "png"}))
+      ->capture_default_str();
   auto* quality =
       sub->add_option("--jpeg-quality", a->jpeg_quality, "JPEG quality")->check(CLI::Range(1, 100))->capture_default_str();
   sub->add_option("--start", a->start, "first frame's time in the animation [s]")->capture_default_str();
@@ -298,7 +301,10 @@ const VerbRegistrar kRegistrar{"render", [](CLI::App& app) -> std::function<int(
   CLI::Option* frame_time = sub->add_option("--frame-time", a->frame_time, "time between OBJ frames [s] (0.001..10)")
                                 ->check(CLI::Range(1e-3, 10.0))
                                 ->capture_default_str();
-  CLI::Option* cloth = sub->add_option("--cloth", a->cloth, "which cloth (the CC of NNNN_CC.obj)")->capture_default_str();
+  // Two digits, as simulate names them: -1 looked for 0000_-1.obj.
+  CLI::Option* cloth = sub->add_option("--cloth", a->cloth, "which cloth (the CC of NNNN_CC.obj)")
+                           ->check(CLI::Range(0, 99))
+                           ->capture_default_str();
   sub->add_flag("--obj", a->obj, "read the folder's OBJ frames even if it has a trajectory");
   sub->add_option("--samples", a->samples, "anti-aliasing samples per pixel (0: zeta's; at most 1024)")
       ->check(CLI::Range(0, 1024))

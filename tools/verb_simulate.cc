@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/atomic_file.h"
+#include "output_paths.h"
 #include "sim/mesh.h"
 #include "sim/parameters.h"
 #include "sim/scene.h"
@@ -75,6 +76,11 @@ std::string FrameName(int frame, int cloth) {
 }
 
 int Run(const SimulateArgs& a) {
+  RefuseUnwritableOutputFolder("--out", a.out);
+  // Named as the option (the builder's own check said "BuildOptions.max_edge must be ...").
+  if (!(std::isfinite(a.max_edge) && a.max_edge >= 0))
+    throw UsageError("--max-edge must be a finite length >= 0 m (0: the scene's resolution), got " +
+                     std::to_string(a.max_edge));
   // The scene's warnings (ArcSim keys ignored, features not simulated) are said and kept in
   // summary.json: stderr is easily lost in a batch, and they change the physics.
   std::vector<std::string> scene_warnings;

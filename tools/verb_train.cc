@@ -197,6 +197,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
     o.data = args->data;
     o.out = args->out;
     RefuseOutputInsideFolder("--out", o.out, o.data, "the dataset");
+    RefuseUnwritableOutputFolder("--out", o.out);
     std::unique_ptr<ProgressBar> bar;
     int bar_epoch = 0;
     // The whole run's time left, from this process's mean epoch (the bar's ETA is the epoch's:

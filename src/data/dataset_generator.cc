@@ -54,50 +54,7 @@ double Seconds(Clock::time_point since) {
 }
 
 void Check(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("make-dataset: " + what);
-}
-
-void ValidateOptions(const DatasetOptions& o) {
-  // At most a million: an example's name holds six digits of its simulation (flag-000123-v0), and
-  // e5 holds 6,000. 1e11 hung without a word, building its to-do list (~800 GB).
-  Check(o.count >= 0 && o.count <= kMaxSimulations,
-        "--count must be in 0.." + std::to_string(kMaxSimulations) + ", got " + std::to_string(o.count));
-  Check(o.views >= 1 && o.views <= 64, "--views must be in 1..64");
-  Check(!o.out.empty(), "--out is required");
-  Check(o.shards >= 1 && o.shard >= 0 && o.shard < o.shards, "--shard i/N needs 0 <= i < N");
-  Check(o.jobs >= 0, "--jobs must be >= 0");
-  // Finite as well: infinity passed ">= 0", ran as a warm-up of 0 (lround(inf)) and went into the
-  // header as null, which every later run was then refused against.
-  Check(std::isfinite(o.warmup) && o.warmup >= 0 && o.warmup <= 3600, "--warmup must be in 0..3600 s");
-  // At most what a label may hold (dataset_index.cc): more ran for hours and then every example
-  // was refused when the index was built.
-  Check(o.frames >= 1 && o.frames <= 100000, "--frames must be in 1..100000 (a label's bound)");
-  Check(std::isfinite(o.fps) && o.fps > 0 && o.fps <= 1000, "--fps must be in (0, 1000] Hz");
-  // The first kept frame is a whole frame: a warm-up between two was rounded without a word, and
-  // the header recorded the value asked for while the labels recorded the rounded one.
-  Check(std::abs(o.warmup * o.fps - std::round(o.warmup * o.fps)) < 1e-6,
-        "--warmup must be a whole number of frames (a multiple of 1/fps = " + std::to_string(1.0 / o.fps) +
-            " s), got " + std::to_string(o.warmup) + " s");
-  Check(o.samples >= 0 && o.samples <= 1024, "--samples must be in 0..1024 (0: zeta's default)");
-  Check(o.size >= 16 && o.size <= 4096, "--size must be in 16..4096 px");
-  // Each job renders an example's frames in memory (RenderAnimation, 3 bytes a pixel) before
-  // writing them: refused past 16 GiB an example, which no machine here holds once per job.
-  Check(static_cast<double>(o.frames) * o.size * o.size * 3 <= 16.0 * (1ull << 30),
-        "--frames x --size^2 x 3 bytes (one example's frames, held in memory while it is written) must be at "
-        "most 16 GiB, got " + std::to_string(static_cast<double>(o.frames) * o.size * o.size * 3 / (1ull << 30)) +
-            " GiB");
-  Check(o.frame_ext == "jpg" || o.frame_ext == "png" || o.frame_ext == "pgm",
-        "frame format must be jpg, png or pgm");
-  Check(o.jpeg_quality >= 1 && o.jpeg_quality <= 100, "--jpeg-quality must be in 1..100");
-  Check(std::isfinite(o.max_edge) && o.max_edge >= 0, "--max-edge must be a finite length >= 0 m");
-  Check(!o.add_tracks || o.tracks, "--add-tracks needs the grid of the tracks (--tracks COLSxROWS)");
-  Check(o.split.empty() || o.split == "train" || o.split == "val" || o.split == "test",
-        "--split must be train, val or test");
-  // Checked before the index's header records them: a run refused for them later would leave a
-  // folder whose header every corrected run is refused against.
-  Check(o.val_fraction >= 0 && o.test_fraction >= 0 && o.val_fraction + o.test_fraction <= 1,  // NaN fails too
-        "--val and --test must be fractions >= 0 that add up to at most 1 (got " + std::to_string(o.val_fraction) +
-            " and " + std::to_string(o.test_fraction) + ")");
+  if (!ok) throw std::invalid_argument(what);  // (the verb's error line names make-dataset)
 }
 
 std::string TempPrefix(const std::string& name) { return "." + name + ".tmp-"; }
@@ -699,6 +656,52 @@ void SayIncomplete(const char* who, const std::vector<std::string>& incomplete) 
 
 }  // namespace
 
+void ValidateDatasetOptions(const DatasetOptions& o) {
+  // At most a million: an example's name holds six digits of its simulation (flag-000123-v0), and
+  // e5 holds 6,000. 1e11 hung without a word, building its to-do list (~800 GB).
+  Check(o.count >= 0 && o.count <= kMaxSimulations,
+        "--count must be in 0.." + std::to_string(kMaxSimulations) + ", got " + std::to_string(o.count));
+  Check(o.views >= 1 && o.views <= 64, "--views must be in 1..64");
+  Check(!o.out.empty(), "--out is required");
+  Check(o.shards >= 1 && o.shard >= 0 && o.shard < o.shards, "--shard i/N needs 0 <= i < N");
+  // TBB runs at most the cores' threads: --jobs 100000 ran on 2 and reported "on 100000 jobs".
+  Check(o.jobs >= 0 && o.jobs <= kMaxJobs,
+        "--jobs must be in 0.." + std::to_string(kMaxJobs) + " (0: all cores), got " + std::to_string(o.jobs));
+  // Finite as well: infinity passed ">= 0", ran as a warm-up of 0 (lround(inf)) and went into the
+  // header as null, which every later run was then refused against.
+  Check(std::isfinite(o.warmup) && o.warmup >= 0 && o.warmup <= 3600, "--warmup must be in 0..3600 s");
+  // At most what a label may hold (dataset_index.cc): more ran for hours and then every example
+  // was refused when the index was built.
+  Check(o.frames >= 1 && o.frames <= 100000, "--frames must be in 1..100000 (a label's bound)");
+  Check(std::isfinite(o.fps) && o.fps > 0 && o.fps <= 1000, "--fps must be in (0, 1000] Hz");
+  // The first kept frame is a whole frame: a warm-up between two was rounded without a word, and
+  // the header recorded the value asked for while the labels recorded the rounded one.
+  Check(std::abs(o.warmup * o.fps - std::round(o.warmup * o.fps)) < 1e-6,
+        "--warmup must be a whole number of frames (a multiple of 1/fps = " + std::to_string(1.0 / o.fps) +
+            " s), got " + std::to_string(o.warmup) + " s");
+  Check(o.samples >= 0 && o.samples <= 1024, "--samples must be in 0..1024 (0: zeta's default)");
+  Check(o.size >= 16 && o.size <= 4096, "--size must be in 16..4096 px");
+  // Each job renders an example's frames in memory (RenderAnimation, 3 bytes a pixel) before
+  // writing them: refused past 16 GiB an example, which no machine here holds once per job.
+  Check(static_cast<double>(o.frames) * o.size * o.size * 3 <= 16.0 * (1ull << 30),
+        "--frames x --size^2 x 3 bytes (one example's frames, held in memory while it is written) must be at "
+        "most 16 GiB, got " + std::to_string(static_cast<double>(o.frames) * o.size * o.size * 3 / (1ull << 30)) +
+            " GiB");
+  Check(o.frame_ext == "jpg" || o.frame_ext == "png" || o.frame_ext == "pgm",
+        "frame format must be jpg, png or pgm");
+  Check(o.jpeg_quality >= 1 && o.jpeg_quality <= 100, "--jpeg-quality must be in 1..100");
+  Check(std::isfinite(o.max_edge) && o.max_edge >= 0, "--max-edge must be a finite length >= 0 m");
+  Check(!o.add_tracks || o.tracks, "--add-tracks needs the grid of the tracks (--tracks COLSxROWS)");
+  Check(o.split.empty() || o.split == "train" || o.split == "val" || o.split == "test",
+        "--split must be train, val or test");
+  // Checked before the index's header records them: a run refused for them later would leave a
+  // folder whose header every corrected run is refused against.
+  Check(o.val_fraction >= 0 && o.test_fraction >= 0 && o.val_fraction + o.test_fraction <= 1,  // NaN fails too
+        "--val and --test must be fractions >= 0 that add up to at most 1 (got " + std::to_string(o.val_fraction) +
+            " and " + std::to_string(o.test_fraction) + ")");
+}
+
+
 std::vector<Fabric> LoadFabrics(const std::string& folder, const std::string& scene_path,
                                 const std::vector<std::string>& exclude) {
   if (!fs::is_directory(folder))
@@ -803,7 +806,7 @@ int64_t ReindexDataset(const std::string& dir, bool contact_sheet, const std::fu
 
 DatasetSummary GenerateDataset(const DatasetOptions& o, const DatasetProgressCallback& progress,
                                const std::function<void(int, int)>& index_progress) {
-  ValidateOptions(o);
+  ValidateDatasetOptions(o);
   const auto start = Clock::now();
   const Prepared prep = Prepare(o);
   nlohmann::json settings = DatasetSettingsJson(o, FabricNames(prep.fabrics), prep.scene_files, prep.background_files);

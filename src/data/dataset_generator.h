@@ -107,6 +107,14 @@ struct DatasetSummary {
   std::string index_path, contact_sheet_path;
 };
 
+// The most parallel simulations (--jobs).
+inline constexpr int kMaxJobs = 1024;
+
+// Throws std::invalid_argument naming the option (e.g. "--views must be in 1..64") when `options`
+// are out of range; GenerateDataset checks them first too. For the verb, before it says what it
+// will make.
+void ValidateDatasetOptions(const DatasetOptions& options);
+
 // Generates (or resumes) a dataset. Throws std::invalid_argument on bad options and
 // std::runtime_error when DIR holds a dataset made with different settings (naming the field),
 // or the scene/materials cannot be loaded. Failures of single simulations do not stop the run:
