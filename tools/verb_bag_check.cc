@@ -201,7 +201,7 @@ void NoteMessage(const rosbag::MessageInstance& m, TopicStats& s, double t, cons
                  sensors::AnemometerDecoder& decoder, size_t index, double data_time) {
   if (auto img = m.instantiate<sensor_msgs::Image>()) {
     if (s.first_data.empty())
-      s.first_data = img->encoding + " " + std::to_string(img->width) + "x" + std::to_string(img->height) +
+      s.first_data = img->encoding + " " + Num(img->width) + "x" + Num(img->height) +
                      " frame " + img->header.frame_id;
     // As the clip buffer reads it (an encoding it cannot convert, a step or data too short): a
     // frame it drops, which "ok for replay" passed when no frame could be read.
@@ -220,7 +220,7 @@ void NoteMessage(const rosbag::MessageInstance& m, TopicStats& s, double t, cons
     // By its bag time: the clip buffer copies the calibration and reads no stamp of it.
     Note(s, t, t, 1e9, a.max_future, index);
     if (s.first_data.empty())
-      s.first_data = std::to_string(info->width) + "x" + std::to_string(info->height) + " " + info->distortion_model;
+      s.first_data = Num(info->width) + "x" + Num(info->height) + " " + info->distortion_model;
   } else if (auto raw = m.instantiate<clothwind::RawSentence>()) {
     Note(s, raw->header.stamp.toSec(), t, 1e9, a.max_future, index);
     if (s.first_data.empty()) s.first_data = raw->data + " (" + raw->protocol + ")";
@@ -255,19 +255,19 @@ int Check(const BagCheckArgs& a);
 int Run(const BagCheckArgs& a) {
   auto in = [](double v, double hi) { return v > 0 && v <= hi; };  // NaN passed CLI's range checks
   if (!in(a.gap_tolerance, 3600))
-    throw UsageError("--gap-tolerance must be in (0, 3600] s, got " + std::to_string(a.gap_tolerance));
+    throw UsageError("--gap-tolerance must be in (0, 3600] s, got " + Num(a.gap_tolerance));
   if (!in(a.max_future, 86400))
-    throw UsageError("--max-future must be in (0, 86400] s, got " + std::to_string(a.max_future));
+    throw UsageError("--max-future must be in (0, 86400] s, got " + Num(a.max_future));
   if (!in(a.clip_duration, 3600))
-    throw UsageError("--clip-duration must be in (0, 3600] s, got " + std::to_string(a.clip_duration));
+    throw UsageError("--clip-duration must be in (0, 3600] s, got " + Num(a.clip_duration));
   if (!in(a.label_window, 86400))
-    throw UsageError("--label-window must be in (0, 86400] s, got " + std::to_string(a.label_window));
+    throw UsageError("--label-window must be in (0, 86400] s, got " + Num(a.label_window));
   if (!(a.label_delay >= 0 && a.label_delay <= 86400))
-    throw UsageError("--label-delay must be in [0, 86400] s, got " + std::to_string(a.label_delay));
+    throw UsageError("--label-delay must be in [0, 86400] s, got " + Num(a.label_delay));
   if (!in(a.flush_after, 86400))
-    throw UsageError("--flush-after must be in (0, 86400] s, got " + std::to_string(a.flush_after));
+    throw UsageError("--flush-after must be in (0, 86400] s, got " + Num(a.flush_after));
   if (!in(a.replay_rate, 1000))
-    throw UsageError("--replay-rate must be in (0, 1000], got " + std::to_string(a.replay_rate));
+    throw UsageError("--replay-rate must be in (0, 1000], got " + Num(a.replay_rate));
   {
     // A file that is no bag at all: rosbag says "Error reading version line", which the repair
     // hint below also matched.
@@ -322,8 +322,8 @@ int Check(const BagCheckArgs& a) {
     // A message whose bytes do not deserialise (a length field that overruns) threw a bare
     // "Buffer Overrun" naming nothing; messages beyond 1 GiB are refused before reading.
     if (m.size() > (1u << 30))
-      throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " of the bag (on " + m.getTopic() + ")" + " is " +
-                               std::to_string(m.size()) + " bytes (a corrupt record?)");
+      throw std::runtime_error(a.bag + ": message " + Num(index) + " of the bag (on " + m.getTopic() + ")" + " is " +
+                               Num(m.size()) + " bytes (a corrupt record?)");
     const double camera_time = camera_topic != topics.end() && camera_topic->second.kept > 0
                                    ? camera_topic->second.last
                                    : -std::numeric_limits<double>::infinity();
@@ -337,8 +337,8 @@ int Check(const BagCheckArgs& a) {
     try {
       NoteMessage(m, s, t, a, decoder, index, data_time);
     } catch (const ros::Exception& e) {
-      throw std::runtime_error(a.bag + ": message " + std::to_string(index) + " of the bag (on " + m.getTopic() + ")" + " (" +
-                               m.getDataType() + ", bag time " + std::to_string(t) + " s) does not deserialise: " +
+      throw std::runtime_error(a.bag + ": message " + Num(index) + " of the bag (on " + m.getTopic() + ")" + " (" +
+                               m.getDataType() + ", bag time " + Num(t) + " s) does not deserialise: " +
                                e.what());
     }
   }
@@ -357,15 +357,15 @@ int Check(const BagCheckArgs& a) {
                 s.first_data.c_str());
     const bool camera = name.find("image") != std::string::npos;
     if (s.backwards > 0)
-      warn(name + ": " + std::to_string(s.backwards) + " header stamps go back (the first at " + s.first_backwards +
+      warn(name + ": " + Num(s.backwards) + " header stamps go back (the first at " + s.first_backwards +
            (camera ? "; a frame a little early is dropped; one more than the gap tolerance back is dropped as stale (" +
-                         std::to_string(s.stale - s.stale_ahead) + " here) unless the next follows it, a new timeline)"
+                         Num(s.stale - s.stale_ahead) + " here) unless the next follows it, a new timeline)"
                    : ")"));
     if (camera && s.stale_ahead > 0)
-      warn(name + ": " + std::to_string(s.stale_ahead) + " lone frames stamped more than the gap tolerance ahead of "
+      warn(name + ": " + Num(s.stale_ahead) + " lone frames stamped more than the gap tolerance ahead of "
            "the next (the first at " + s.first_stale_ahead + "); the clip buffer drops them as stale");
     if (camera && s.repeated > 0)
-      warn(name + ": " + std::to_string(s.repeated) + " frames repeat a stamp (the first at " + s.first_repeated +
+      warn(name + ": " + Num(s.repeated) + " frames repeat a stamp (the first at " + s.first_repeated +
            "; the clip buffer drops them)");
     const bool replayed = std::find(std::begin(kReplayTopics), std::end(kReplayTopics), name) != std::end(kReplayTopics);
     if (!replayed) {
@@ -380,14 +380,14 @@ int Check(const BagCheckArgs& a) {
     // nodes drop them one at a time and go on.
     const size_t dropped = s.zero + s.far_from_bag_time;
     if (dropped > 0) {
-      const std::string what = name + ": " + std::to_string(s.zero) + " messages stamped 0 and " +
-                               std::to_string(s.far_from_bag_time) + " more than " + std::to_string(a.max_future) +
+      const std::string what = name + ": " + Num(s.zero) + " messages stamped 0 and " +
+                               Num(s.far_from_bag_time) + " more than " + Num(a.max_future) +
                                " s ahead of their bag time (the replay's clock; another time base?), the first at " +
                                s.first_dropped + "; the nodes drop them";
       if (dropped == s.count) fail(what + ": every message"); else warn(what);
     }
     if (s.unreadable > 0) {
-      const std::string what = name + ": " + std::to_string(s.unreadable) + " of " + std::to_string(s.count) +
+      const std::string what = name + ": " + Num(s.unreadable) + " of " + Num(s.count) +
                                " frames the clip buffer cannot read (the first, " + s.first_unreadable + ")";
       if (s.unreadable == s.count) fail(what); else warn(what);
     }
@@ -396,14 +396,14 @@ int Check(const BagCheckArgs& a) {
   for (const char* required : {"camera/image_raw", "anemometer/raw"})
     if (!topics.count(required)) fail(std::string("missing: ") + required + " (replay.launch needs it)");
   if (camera != topics.end() && camera->second.count > 0 && camera->second.longest_run < a.clip_duration)
-    fail("camera/image_raw: no stretch of frames without a hole (> " + std::to_string(a.gap_tolerance) +
-         " s) lasts a clip's " + std::to_string(a.clip_duration) + " s (longest " +
-         std::to_string(camera->second.longest_run) + " s)");
+    fail("camera/image_raw: no stretch of frames without a hole (> " + Num(a.gap_tolerance) +
+         " s) lasts a clip's " + Num(a.clip_duration) + " s (longest " +
+         Num(camera->second.longest_run) + " s)");
   if (wind != topics.end() && wind->second.count > 0 && wind->second.decoded == 0)
-    fail("anemometer/raw: no sentence gives a wind reading (" + std::to_string(wind->second.undecoded) +
+    fail("anemometer/raw: no sentence gives a wind reading (" + Num(wind->second.undecoded) +
          " refused, the first: " + wind->second.first_error + ")");
   else if (wind != topics.end() && wind->second.decoded > 0 && wind->second.usable.empty())
-    fail("anemometer/raw: no reading the clip buffer can label with: " + std::to_string(wind->second.void_readings) +
+    fail("anemometer/raw: no reading the clip buffer can label with: " + Num(wind->second.void_readings) +
          " void (the instrument's status V or error code, or a speed outside 0..150 m/s), the rest stamped 0 or far "
          "ahead (dropped by the anemometer node)");
   // A clip ending at e is labelled by the usable readings stamped in [e - label window, e] that
@@ -424,9 +424,9 @@ int Check(const BagCheckArgs& a) {
   };
   if (camera != topics.end() && wind != topics.end() && camera->second.kept > 0 && !wind->second.usable.empty() &&
       !labels_a_clip(wind->second.usable))
-    fail("no usable anemometer/raw reading's stamp falls in a clip's label window (the " + std::to_string(a.label_window) +
+    fail("no usable anemometer/raw reading's stamp falls in a clip's label window (the " + Num(a.label_window) +
          " s up to its last frame, over camera/image_raw's stamps) and is recorded before that clip is labelled (" +
-         std::to_string(a.label_delay) + " s after its last frame): no clip gets a label");
+         Num(a.label_delay) + " s after its last frame): no clip gets a label");
   std::printf("  (back: header stamps going back; same: equal to the previous (fine for anemometer records of "
               "one serial read, not for camera frames); holes: camera intervals > %.3f s, which break clips; "
               "bagt: bag time != header stamp)\n",

@@ -54,7 +54,7 @@ int Run(const ContactSheetArgs& a) {
   const double sheet_bytes = static_cast<double>(a.options.max_tiles) * a.options.tile * a.options.tile * 3;
   if (sheet_bytes > 4.0 * (1ull << 30))
     throw UsageError("--tiles x --tile-size^2 x 3 bytes (the sheet, held in memory) must be at most 4 GiB, "
-                                "got " + std::to_string(sheet_bytes / (1ull << 30)) + " GiB");
+                                "got " + Num(sheet_bytes / (1ull << 30)) + " GiB");
   ProgressBar::Options b;
   b.label = "contact-sheet";
   b.unit = "tiles";

@@ -259,7 +259,7 @@ const VerbRegistrar kRegistrar{"make-dataset", [](CLI::App& app) -> std::functio
     }
     if (!a->reindex && sub->get_option("--count")->count() == 0) throw UsageError("--count N (N >= 1) is required");
     if (!a->reindex && a->o.count <= 0)
-      throw UsageError("--count must be >= 1, got " + std::to_string(a->o.count));
+      throw UsageError("--count must be >= 1, got " + Num(a->o.count));
     return Run(*a);
   };
 }};

@@ -78,26 +78,26 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
   // Bounded and long enough for a clip and a reading: infinity (cast to a frame count, undefined)
   // and a few milliseconds both wrote an empty bag and exited 0.
   if (!(a.minutes >= 0.05 && a.minutes <= 1440.0))
-    throw UsageError("--minutes must be in 0.05..1440 (3 s to a day), got " + std::to_string(a.minutes));
+    throw UsageError("--minutes must be in 0.05..1440 (3 s to a day), got " + Num(a.minutes));
   if (!(std::isfinite(a.wind_mean) && a.wind_mean >= 0 && a.wind_mean <= 60))
-    throw UsageError("--wind-mean must be in 0..60 m/s, got " + std::to_string(a.wind_mean));
+    throw UsageError("--wind-mean must be in 0..60 m/s, got " + Num(a.wind_mean));
   // The session's own checks, named by option before the work (they said "synthetic session:
   // image must be ..." naming none, or came after a scene build).
-  if (!(a.fps <= 1000.0)) throw UsageError("--fps must be at most 1000 Hz, got " + std::to_string(a.fps));
+  if (!(a.fps <= 1000.0)) throw UsageError("--fps must be at most 1000 Hz, got " + Num(a.fps));
   for (const auto& [option, value] : {std::pair<const char*, int>{"--width", a.width}, {"--height", a.height}})
     if (value < 16 || value > 16384)
-      throw UsageError(std::string(option) + " must be in 16..16384 px, got " + std::to_string(value));
+      throw UsageError(std::string(option) + " must be in 16..16384 px, got " + Num(value));
   if (!(a.start_time >= 1.0 && a.start_time + a.minutes * 60.0 + 10.0 < 4294967295.0))
     throw UsageError("--start-time must be >= 1 s and leave the session within ROS time's 32-bit seconds, got " +
-                                std::to_string(a.start_time));
+                                Num(a.start_time));
   if (!(a.drop_probability >= 0.0 && a.drop_probability < 1.0))
-    throw UsageError("--drop-probability must be in [0, 1), got " + std::to_string(a.drop_probability));
+    throw UsageError("--drop-probability must be in [0, 1), got " + Num(a.drop_probability));
   // Every message carries its frame (REP 103): an empty one made a bag bag-check passed.
   if (a.camera_frame.empty()) throw UsageError("--camera-frame must not be empty");
   if (a.anemometer_frame.empty()) throw UsageError("--anemometer-frame must not be empty");
   if (!(std::isfinite(a.rendered.max_edge) && a.rendered.max_edge >= 0))
     throw UsageError("--max-edge must be a finite length >= 0 m (0: the scene's), got " +
-                                std::to_string(a.rendered.max_edge));
+                                Num(a.rendered.max_edge));
   // A bag file's name: "" and "dir/" generated the whole session and failed at the final rename
   // (the latter leaving dir/ made and empty).
   {
@@ -109,10 +109,10 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
   // hole: such a session replays into no clip at all (exit 0, an empty report).
   if (!(a.fps >= 10.0))
     throw UsageError("--fps must be at least 10 Hz (a slower camera's every frame interval is a hole "
-                                "to the clip buffer, and no clip forms), got " + std::to_string(a.fps));
+                                "to the clip buffer, and no clip forms), got " + Num(a.fps));
   if (a.zeta_seed < -1)
     throw UsageError("--zeta-seed must be >= 0 (or -1: the session's --seed), got " +
-                                std::to_string(a.zeta_seed));
+                                Num(a.zeta_seed));
   // --out checked before the long work: a folder failed only at the final rename (a rendered
   // session of hours lost), and an existing bag, perhaps a recorded field session, was replaced.
   RefuseFolderAsOutput("--out", a.out);
@@ -157,8 +157,8 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
   // What was drawn must hold a clip (the clip buffer's 30 frames): a drop probability near 1 wrote
   // a bag without images, exit 0.
   if (session.frame_stamps().size() < 30)
-    throw std::invalid_argument("the session holds " + std::to_string(session.frame_stamps().size()) +
-                                " frames after --drop-probability " + std::to_string(a.drop_probability) +
+    throw std::invalid_argument("the session holds " + Num(session.frame_stamps().size()) +
+                                " frames after --drop-probability " + Num(a.drop_probability) +
                                 ", fewer than one clip's 30");
   // And a stretch without holes as long as a clip (bag-check's rule, with the clip buffer's
   // defaults: gaps over 0.1 s break clips of 30 frames at 25 fps, 1.16 s): at 10 fps the frames'
@@ -171,9 +171,9 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
       longest = std::max(longest, t[i] - run_start);
     }
     if (longest < 1.16)
-      throw UsageError("--fps " + std::to_string(a.fps) + " with --drop-probability " +
-                                  std::to_string(a.drop_probability) + ": no stretch of frames without a gap over " +
-                                  "0.1 s lasts a clip's 1.16 s (longest " + std::to_string(longest) + " s)");
+      throw UsageError("--fps " + Num(a.fps) + " with --drop-probability " +
+                                  Num(a.drop_probability) + ": no stretch of frames without a gap over " +
+                                  "0.1 s lasts a clip's 1.16 s (longest " + Num(longest) + " s)");
   }
   // Rendered sessions: the anemometer's sensor model samples the wind field the flag flew in.
   const std::vector<sensors::SyntheticReading> model_readings =

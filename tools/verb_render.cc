@@ -113,7 +113,7 @@ data::ClothAnimation LoadInput(const RenderArgs& a, std::string* what) {
                                                          ".cwtraj file or a simulation folder"
                                                        : ": no such file or folder"));
   const fs::path traj = in / (a.cloth == 0 ? std::string("trajectory.cwtraj")
-                                            : "trajectory_" + std::to_string(a.cloth) + ".cwtraj");
+                                            : "trajectory_" + Num(a.cloth) + ".cwtraj");
   if (!a.obj && fs::exists(traj)) {
     if (a.frame_time_given)
       throw UsageError("--frame-time is for OBJ frames; " + traj.string() +
@@ -204,17 +204,17 @@ int Run(const RenderArgs& a) {
   // computed from it or from a huge rate overflowed int: nothing rendered, the earlier run's
   // frames deleted, exit 0.
   if (!(a.start >= 0 && a.start <= anim.duration()))
-    throw UsageError("--start " + std::to_string(a.start) + " s is outside the animation's " +
-                                std::to_string(anim.duration()) + " s");
+    throw UsageError("--start " + Num(a.start) + " s is outside the animation's " +
+                                Num(anim.duration()) + " s");
   const double frames_in_animation = std::floor((anim.duration() - a.start) * a.fps + 1e-9) + 1;
   if (!(frames_in_animation >= 1 && frames_in_animation <= 1e6))
-    throw UsageError("--fps " + std::to_string(a.fps) + " gives " + std::to_string(frames_in_animation) +
+    throw UsageError("--fps " + Num(a.fps) + " gives " + Num(frames_in_animation) +
                                 " frames from --start; expected 1 to 1e6");
   const int available = static_cast<int>(frames_in_animation);
   const int count = a.count > 0 ? a.count : available;
   if (count > available)
-    throw UsageError("--count " + std::to_string(count) + ": only " + std::to_string(available) +
-                                " frames at " + std::to_string(a.fps) + " fps from --start");
+    throw UsageError("--count " + Num(count) + ": only " + Num(available) +
+                                " frames at " + Num(a.fps) + " fps from --start");
   // The folder's zeta.json says its frames are whole and this run's: it goes before the first
   // frame is written and comes back after the last, so a run killed or failing half way leaves
   // no zeta.json beside a mix of its frames and an earlier run's (a rerun with another seed left
@@ -248,7 +248,7 @@ int Run(const RenderArgs& a) {
       try {
         return renderer.RenderFrame(f.V, f.F, f.UV);
       } catch (const std::invalid_argument& e) {  // the cloth's own values (not I/O)
-        throw std::invalid_argument(what + ", frame at " + std::to_string(a.start + k / a.fps) + " s: " + e.what());
+        throw std::invalid_argument(what + ", frame at " + Num(a.start + k / a.fps) + " s: " + e.what());
       }
     }();
     char name[32];

@@ -63,7 +63,7 @@ std::vector<double> ParseList(const std::string& text, size_t n, const std::stri
     if (!std::isfinite(v.back())) throw UsageError(flag + ": values must be finite");
   }
   if (v.size() != n) {
-    throw UsageError(flag + ": expected " + std::to_string(n) +
+    throw UsageError(flag + ": expected " + Num(n) +
                                 " comma-separated numbers, got '" + text + "'");
   }
   return v;
@@ -80,7 +80,7 @@ int Run(const SimulateArgs& a) {
   // Named as the option (the builder's own check said "BuildOptions.max_edge must be ...").
   if (!(std::isfinite(a.max_edge) && a.max_edge >= 0))
     throw UsageError("--max-edge must be a finite length >= 0 m (0: the scene's resolution), got " +
-                     std::to_string(a.max_edge));
+                     Num(a.max_edge));
   // The scene's warnings (ArcSim keys ignored, features not simulated) are said and kept in
   // summary.json: stderr is easily lost in a batch, and they change the physics.
   std::vector<std::string> scene_warnings;
@@ -128,26 +128,26 @@ int Run(const SimulateArgs& a) {
   // own check came after, and named no option); a whole number of frames, as make-dataset's: a
   // warm-up of 0.03 s at 0.04 s frames ran as 0.04 s without a word.
   if (!(a.warmup >= 0 && a.warmup <= 3600))
-    throw UsageError("--warmup must be in 0..3600 s, got " + std::to_string(a.warmup));
+    throw UsageError("--warmup must be in 0..3600 s, got " + Num(a.warmup));
   if (std::abs(a.warmup / scene.frame_time - std::round(a.warmup / scene.frame_time)) > 1e-6)
     throw UsageError("--warmup must be a whole number of " + a.scene + "'s frames (a multiple of " +
-                                std::to_string(scene.frame_time) + " s), got " + std::to_string(a.warmup) + " s");
+                                Num(scene.frame_time) + " s), got " + Num(a.warmup) + " s");
   options.warmup = a.warmup;
   // "Not given" is told by the option's count, not a value: --seed -1 and --duration -1 (the old
   // sentinels) ran as if not given, where any other negative was refused.
-  if (a.seed_given && a.seed < 0) throw UsageError("--seed must be >= 0, got " + std::to_string(a.seed));
+  if (a.seed_given && a.seed < 0) throw UsageError("--seed must be >= 0, got " + Num(a.seed));
   if (a.seed_given) options.seed = static_cast<uint64_t>(a.seed);
   // NaN used to fall through to the scene's duration and inf to undefined behaviour.
   if (a.duration_given && !(std::isfinite(a.duration) && a.duration > 0 && a.duration <= 86400)) {
-    throw UsageError("--duration must be a time > 0 and <= 86400 s, got " + std::to_string(a.duration));
+    throw UsageError("--duration must be a time > 0 and <= 86400 s, got " + Num(a.duration));
   }
   if (a.duration_given) options.duration = a.duration;  // else SimulateOptions' default: the scene's
   // The scene's own bound on its frames (held in memory, then copied to write the trajectory):
   // a day at the flag's 0.04 s was 2.16 million frames.
   if (a.duration_given && !(a.duration / scene.frame_time <= 1e6)) {
-    throw UsageError("--duration " + std::to_string(a.duration) + " s is " +
-                                std::to_string(a.duration / scene.frame_time) + " frames of " + a.scene +
-                                "'s frame_time " + std::to_string(scene.frame_time) + " s; at most 1e6");
+    throw UsageError("--duration " + Num(a.duration) + " s is " +
+                                Num(a.duration / scene.frame_time) + " frames of " + a.scene +
+                                "'s frame_time " + Num(scene.frame_time) + " s; at most 1e6");
   }
   // Every cloth's theta, checked before anything of an earlier run is removed: a --param typo
   // used to be refused only after the old run's frames and summary were gone.
@@ -220,12 +220,12 @@ int Run(const SimulateArgs& a) {
       try {
         return sim::SimulateTrajectory(setup, theta, options);
       } catch (const std::exception& e) {
-        throw std::runtime_error(scene.path + ", cloths[" + std::to_string(c) + "]: " + e.what());
+        throw std::runtime_error(scene.path + ", cloths[" + Num(c) + "]: " + e.what());
       }
     }();
     total_wall += t.wall_seconds;
     const std::string traj = (fs::path(a.out) / (c == 0 ? std::string("trajectory.cwtraj")
-                                                         : "trajectory_" + std::to_string(c) + ".cwtraj"))
+                                                         : "trajectory_" + Num(c) + ".cwtraj"))
                                  .string();
     sim::WriteTrajectory(traj, t);
     if (!a.no_obj) {

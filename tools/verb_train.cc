@@ -211,7 +211,7 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
     o.progress = [&](const learn::TrainProgress& p) {
       if (p.epoch != bar_epoch) {
         ProgressBar::Options b;
-        b.label = "train epoch " + std::to_string(p.epoch) + "/" + std::to_string(p.epochs);
+        b.label = "train epoch " + Num(p.epoch) + "/" + Num(p.epochs);
         const std::string left = run_left(p.epochs - p.epoch + 1);
         if (!left.empty()) b.label += " (run ~" + left + " left)";
         b.unit = "batches";

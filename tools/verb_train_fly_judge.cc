@@ -152,7 +152,7 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
       b.unit = "epochs";
       ProgressBar bar(b);
       learn::FlyJudge trained = learn::TrainFlyJudge(train.maps, a->train, [&](int epoch, int epochs, double loss) {
-        bar.Update(epoch, epochs, "loss " + std::to_string(loss));
+        bar.Update(epoch, epochs, "loss " + Num(loss));
       });
       bar.Finish();
       trained.set_margin(a->margin);
@@ -176,8 +176,8 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
     // d cells of 16 in the 8 directions (card: accuracy.test_shifted_<d>).
     for (int d = 1; d <= JudgeArgs::kShiftedRows && !test.maps.empty(); ++d) {
       const learn::FlyJudgeAccuracy acc = learn::MeasureFlyJudge(judge, learn::ShiftedMotionMaps(test, d));
-      accuracy["test_shifted_" + std::to_string(d)] = learn::ToJson(acc);
-      add_row("test±" + std::to_string(d), acc);
+      accuracy["test_shifted_" + Num(d)] = learn::ToJson(acc);
+      add_row("test±" + Num(d), acc);
     }
     std::cout << table.str()
               << "(accuracy [%] overall and by the clips' wind speed; each clip's mirror image is judged left "
