@@ -197,33 +197,31 @@ TEST_F(AsyncDatasetWriterTest, DrainByGivesUpWhatIsQueuedAtItsDeadlineAndNamesIt
 
 // A clip is started at shutdown only if it would land by the deadline, at the last write's pace:
 // one started just before the deadline ran a whole write past it (on a slow card, past
-// roslaunch's SIGKILL). Here the deadline leaves time for one clip more: the second is given up
-// and named, where it was started and written after the deadline.
+// roslaunch's SIGKILL). Here the deadline leaves time for the clip being written and not for a
+// second: the other two are named, where the second was started and written after the deadline
+// (and one named at most).
+// (The pace is the fastest of three writes, so a write slower than usual under load still reads
+// as too slow to fit.)
 TEST_F(AsyncDatasetWriterTest, DrainByStartsNoClipThatWouldLandAfterItsDeadline) {
-  auto noisy_clip = [](uint64_t sequence) {
-    LabelledClip c = MakeClip(sequence, 60);
-    cv::RNG rng(sequence);
-    for (auto& f : c.clip.frames) {
-      f.image = cv::Mat(256, 256, CV_8UC1);
-      rng.fill(f.image, cv::RNG::UNIFORM, 0, 256);  // noise: slow to encode, large to write
-    }
-    return c;
-  };
   std::vector<std::string> abandoned;
-  double pace = 0;
+  double pace = 1e9;
   {
     AsyncDatasetWriter w(std::make_unique<DatasetWriter>(root_.string(), 95, 3600.0), 16);
-    ASSERT_TRUE(w.Enqueue(noisy_clip(0), {}));
-    w.Drain();
-    pace = w.stats().last_write_s;
+    for (uint64_t k = 0; k < 3; ++k) {
+      ASSERT_TRUE(w.Enqueue(MakeClip(k), {}));
+      w.Drain();
+      pace = std::min(pace, w.stats().last_write_s);
+    }
     ASSERT_GT(pace, 0.0);
-    for (uint64_t k = 1; k <= 3; ++k) ASSERT_TRUE(w.Enqueue(noisy_clip(k), {}));
+    for (uint64_t k = 3; k < 6; ++k) ASSERT_TRUE(w.Enqueue(MakeClip(k), {}));
     const auto deadline = std::chrono::steady_clock::now() +
-                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(1.3 * pace));
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(1.2 * pace));
     EXPECT_FALSE(w.DrainBy(deadline, &abandoned));
   }
-  EXPECT_EQ(abandoned.size(), 2u) << "pace " << pace << " s a clip";
-  EXPECT_EQ(IndexSize(), 2u);
+  // Two, or all three when the writer had not yet taken the first when DrainBy came (under load,
+  // its index rewrite then leaves too little time for one).
+  EXPECT_GE(abandoned.size(), 2u) << "pace " << pace << " s a clip";
+  EXPECT_EQ(IndexSize(), 6u - abandoned.size());
 }
 
 // A shutdown drain killed mid-way (roslaunch's SIGKILL 17 s after Ctrl-C, a slow card): every
