@@ -244,6 +244,23 @@ class SdnNode {
       const bool want_maps = power_pub_.getNumSubscribers() > 0 || frequency_pub_.getNumSubscribers() > 0;
       clothwind::learn::PeakMaps maps;
       const clothwind::learn::Prediction p = predictor_->PredictFrames(frames, want_maps ? &maps : nullptr);
+      // No motion to read (a frozen camera, a covered lens): the network's answer looks like a
+      // measurement, std included, and is not one. Said, not published.
+      if (p.no_motion) {
+        ++no_motion_;
+        char what[200];
+        std::snprintf(what, sizeof what,
+                      "clip %llu has no motion (pixels vary by %.2f grey levels over time, below %.1f): a frozen "
+                      "camera or a covered lens? not estimated",
+                      static_cast<unsigned long long>(clip->sequence), p.motion, clothwind::learn::kMinClipMotion);
+        const bool first = still_clip_.empty();
+        still_clip_ = what;
+        if (first) clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);  // said at once, as an error is
+        WALL_WARN_THROTTLE(30.0, "sdn_node: %s", what);
+        clip_error_.clear();
+        return;
+      }
+      still_clip_.clear();
       // Not published: a reader would average it into everything after it.
       if (!std::isfinite(p.speed) || !std::isfinite(p.speed_std))
         throw std::runtime_error("the estimate is not finite (speed " + std::to_string(p.speed) + " m/s, std " +
@@ -417,6 +434,7 @@ class SdnNode {
                       static_cast<unsigned long long>(missing), missing == 1 ? "" : "s", queue_size_, mean);
         stat.mergeSummary(warn, what);
       }
+      if (!still_clip_.empty()) stat.mergeSummary(warn, still_clip_);
       if (!judge_error_.empty()) stat.mergeSummary(warn, "estimating; ~fly_judge did not load: " + judge_error_);
       // ~flag_flies wind whose wind has never said the way (cups without a vane, a direction in
       // another frame than ~camera_heading_frame, the wind end-on): every clip is read as filmed,
@@ -475,6 +493,7 @@ class SdnNode {
     }
     stat.add("clips turned round (flag flying left)", turned_);
     stat.add("clips the fly judge could not tell (the last way kept)", undecided_);
+    stat.add("clips without motion (not estimated)", no_motion_);
     stat.add("trailing mean [m/s]", trailing_.Mean());
     stat.add("clips in the trailing mean", trailing_.Count());
     stat.add("malformed clips", errors_);
@@ -515,7 +534,8 @@ class SdnNode {
   std::deque<double> latencies_, stamps_, ages_;  // ages_: [s] ROS time from clip end to its estimate
   clothwind::sensors::TrailingMean trailing_;  // tagged with each clip's start [ns]
   uint64_t estimates_ = 0, errors_ = 0, model_errors_ = 0, dropped_ = 0, turned_ = 0, undecided_ = 0,
-           wind_unknown_ = 0;
+           wind_unknown_ = 0, no_motion_ = 0;
+  std::string still_clip_;  // why the last clip was not estimated (no motion); cleared by an estimate
   double last_estimate_wall_ = 0;                  // [s] wall time of the last estimate
   double loaded_wall_ = 0;                         // [s] wall time the model loaded
   std::string clip_error_;                          // the last clip's failure; cleared by a good clip

@@ -118,9 +118,27 @@ Sample Predictor::Prepare(const std::vector<cv::Mat>& frames) const {
   return MakeSample(last, options, unused);
 }
 
+double ClipMotion(const std::vector<cv::Mat>& frames) {
+  if (frames.empty()) return 0.0;
+  cv::Mat sum = cv::Mat::zeros(frames[0].size(), CV_64F), squares = sum.clone(), grey;
+  for (const cv::Mat& f : frames) {
+    if (f.channels() == 1) grey = f;
+    else cv::extractChannel(f, grey, 0);
+    cv::accumulate(grey, sum);
+    cv::accumulateSquare(grey, squares);
+  }
+  const double n = static_cast<double>(frames.size());
+  cv::Mat variance = squares / n - (sum / n).mul(sum / n);
+  cv::max(variance, 0.0, variance);  // rounding
+  cv::sqrt(variance, variance);
+  return cv::mean(variance)[0];
+}
+
 Prediction Predictor::PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps* maps) {
   Sample sample = Prepare(frames);
   Prediction p = Predict({&sample})[0];
+  p.motion = ClipMotion(std::vector<cv::Mat>(frames.end() - config().frames, frames.end()));
+  p.no_motion = p.motion < kMinClipMotion;
   p.turned = sample.turned;
   p.undecided = sample.undecided;
   if (flag_flies_ == FlagFlies::kAuto && !sample.undecided) last_turned_ = sample.turned;

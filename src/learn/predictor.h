@@ -26,7 +26,24 @@ struct Prediction {
   double speed_std = 0;  // [m/s] predicted standard deviation (the network's uncertainty)
   bool turned = false;   // PredictFrames mirrored the clip first: its flag flies left (flag_flies())
   bool undecided = false;  // with flag_flies auto: the judge could not tell; the last way it knew was kept
+  // [grey levels, 0..255] the clip's motion (ClipMotion of the frames read), measured before the
+  // per-clip normalisation, which stretches any residue to unit spread.
+  double motion = 0;
+  // motion below kMinClipMotion: a frozen camera (a driver republishing its last frame), a covered
+  // lens. The network still answers, with a std like a live clip's (a repeated FlagSim frame read
+  // 5-7 m/s ± 0.4, a constant image 1.2 ± 0.2): callers must not take it as a measurement.
+  bool no_motion = false;
 };
+
+// [grey levels] Below this mean temporal spread a clip has no motion to read: a camera's own noise
+// is 0.5-3 grey levels over a still scene, a republished frame exactly 0.
+inline constexpr double kMinClipMotion = 0.2;
+
+// The motion of a clip: the mean over its pixels of each pixel's standard deviation over time, in
+// grey levels, of the frames' first channel (grey, or Y of YCrCb).
+// Inputs: frames  at least one, 8-bit, one size (1 or 3 channels).
+// Returns it (0 for identical frames).
+double ClipMotion(const std::vector<cv::Mat>& frames);
 
 // The strongest spectral peak of every pixel of a clip (SDN models only), at input resolution.
 struct PeakMaps {

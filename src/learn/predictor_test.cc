@@ -102,6 +102,39 @@ TEST_F(PredictorTest, AFlyJudgeBesideTheModelThatCannotLoadLeavesTheModelWorking
   EXPECT_EQ(with_judge.fly_judge_path(), dir_ / kFlyJudgeFile);
 }
 
+// A clip's motion is its pixels' mean spread over time, in grey levels, of grey or of Y.
+TEST(ClipMotionTest, IsThePixelsMeanTemporalSpread) {
+  std::vector<cv::Mat> frozen(30, cv::Mat(8, 8, CV_8UC1, cv::Scalar(77)));
+  EXPECT_EQ(ClipMotion(frozen), 0.0);
+  // Half the pixels alternate 100/110 (spread 5), the rest stay: a mean of 2.5.
+  std::vector<cv::Mat> blinking;
+  for (int t = 0; t < 30; ++t) {
+    cv::Mat f(8, 8, CV_8UC1, cv::Scalar(100));
+    f.rowRange(0, 4).setTo(t % 2 ? 110 : 100);
+    blinking.push_back(f);
+  }
+  EXPECT_NEAR(ClipMotion(blinking), 2.5, 1e-9);
+  // Colour (YCrCb): Y alone; Cr and Cb moving are no motion of the picture's brightness.
+  std::vector<cv::Mat> ycrcb;
+  for (int t = 0; t < 30; ++t) ycrcb.push_back(cv::Mat(8, 8, CV_8UC3, cv::Scalar(100 + (t % 2) * 10, t, 200 - t)));
+  EXPECT_NEAR(ClipMotion(ycrcb), 5.0, 1e-9);
+}
+
+// A frozen camera's clip (one frame republished) is no measurement: the network answers it with
+// a std like a live clip's, so the prediction says it has no motion, and a moving clip does not.
+TEST_F(PredictorTest, AClipWithoutMotionIsSaidToHaveNone) {
+  Predictor predictor(dir_ / "model.pt", 1, "cpu");
+  const std::vector<cv::Mat> moving = LopsidedClip();
+  const Prediction live = predictor.PredictFrames(moving);
+  EXPECT_FALSE(live.no_motion);
+  EXPECT_GT(live.motion, 10.0);
+  const std::vector<cv::Mat> frozen(30, moving[7]);
+  const Prediction still = predictor.PredictFrames(frozen);
+  EXPECT_TRUE(still.no_motion);
+  EXPECT_LT(still.motion, 1e-6);  // (0 but for the variance's rounding)
+  EXPECT_TRUE(std::isfinite(still.speed));  // the network still answers: the flag says not to trust it
+}
+
 TEST_F(PredictorTest, MapsOfAClipTurnedRoundShowTheCamerasPicture) {
   Predictor predictor(dir_ / "model.pt", 1, "cpu");
   const std::vector<cv::Mat> clip = LopsidedClip();

@@ -332,6 +332,18 @@ class SdnNodeTest(unittest.TestCase):
         with self.lock:
             pair = {e.clip_sequence: e.speed for e in self.estimates if e.clip_sequence >= 200}
         self.assertAlmostEqual(pair[200], pair[201], places=6)
+        # A frozen camera (one frame republished, stripes at 0 Hz): no motion, so no estimate,
+        # where the network's answer looked like any other; said in the diagnostics. The next
+        # clip that moves is estimated.
+        self.pub.publish(make_clip(300, later + rospy.Duration.from_sec(10.0), size, 0.0, 4.0))
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.WARN and "clip 300 has no motion" in s.message
+                                  for s in self.statuses), 30, "a WARN for the clip without motion")
+        self.pub.publish(make_clip(301, later + rospy.Duration.from_sec(12.0), size, frequency, 4.0))
+        self.wait_for(lambda: 301 in {e.clip_sequence for e in self.estimates}, 30, "the moving clip after it")
+        with self.lock:
+            self.assertNotIn(300, {e.clip_sequence for e in self.estimates})
+        values = self.wait_for_estimates(self.statuses, len(self.estimates))
+        self.assertEqual(values["clips without motion (not estimated)"], "1", values)
 
     def test_colour_model(self):
         """A model trained with --colour: bgr8 clips get estimates, a mono8 clip an ERROR that names
