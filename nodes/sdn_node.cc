@@ -387,8 +387,7 @@ class SdnNode {
     }
     if (frequency_pub_.getNumSubscribers() > 0) {
       frequency_pub_.publish(clothwind::ros_bridge::BgrImageMsg(
-          clothwind::learn::ColourMapped(maps.frequency, 0, predictor_->config().frame_rate / 2, cv::COLORMAP_JET),
-          header));
+          clothwind::learn::FrequencyMapImage(maps, predictor_->config().frame_rate / 2), header));
     }
   }
 

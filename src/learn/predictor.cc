@@ -177,4 +177,12 @@ cv::Mat ColourMapped(const cv::Mat& value, double lo, double hi, int colormap) {
   return colour;
 }
 
+cv::Mat FrequencyMapImage(const PeakMaps& maps, double nyquist) {
+  cv::Mat image = ColourMapped(maps.frequency, 0, nyquist, cv::COLORMAP_JET);
+  double strongest = 0;
+  cv::minMaxLoc(maps.power, nullptr, &strongest);
+  image.setTo(cv::Scalar::all(0), maps.power < kFrequencyMapPowerFraction * strongest);
+  return image;
+}
+
 }  // namespace clothwind::learn

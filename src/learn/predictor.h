@@ -130,6 +130,17 @@ inline constexpr const char* kFlyJudgeFile = "fly_judge.pt";
 // `colormap` (e.g. cv::COLORMAP_INFERNO); values outside are clamped.
 cv::Mat ColourMapped(const cv::Mat& value, double lo, double hi, int colormap);
 
+// Pixels whose strongest peak holds under this fraction of the frame's strongest: their frequency
+// is noise's (still sky, the backdrop), left black in the frequency image.
+inline constexpr double kFrequencyMapPowerFraction = 0.01;
+
+// The frequency map as rviz shows it (sdn/frequency): jet from 0 to `nyquist` [Hz], black where
+// the peak's power is under kFrequencyMapPowerFraction of the map's strongest (all of it painted,
+// a still sky read as 8.33 Hz and the camera's noise as anything).
+// Inputs: maps  power and frequency of one size (PeakMaps); nyquist  the top of the scale [Hz].
+// Returns a BGR image of the maps' size.
+cv::Mat FrequencyMapImage(const PeakMaps& maps, double nyquist);
+
 }  // namespace clothwind::learn
 
 #endif  // CLOTHWIND_LEARN_PREDICTOR_H_

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <torch/utils.h>
 
 #include "learn/fly_judge.h"
@@ -133,6 +134,21 @@ TEST_F(PredictorTest, AClipWithoutMotionIsSaidToHaveNone) {
   EXPECT_TRUE(still.no_motion);
   EXPECT_LT(still.motion, 1e-6);  // (0 but for the variance's rounding)
   EXPECT_TRUE(std::isfinite(still.speed));  // the network still answers: the flag says not to trust it
+}
+
+// The frequency image leaves black the pixels whose peak is too weak to mean anything (still sky
+// read as 8.33 Hz was painted like the flag), and colours the rest by frequency.
+TEST(FrequencyMapImageTest, WeakPeaksAreBlack) {
+  PeakMaps maps;
+  maps.power = cv::Mat(4, 4, CV_32F, cv::Scalar(100.0f));
+  maps.power.row(0).setTo(0.5f);  // 0.5 % of the strongest
+  maps.frequency = cv::Mat(4, 4, CV_32F, cv::Scalar(3.0f));
+  const cv::Mat image = FrequencyMapImage(maps, 12.5);
+  ASSERT_EQ(image.type(), CV_8UC3);
+  EXPECT_EQ(image.at<cv::Vec3b>(0, 2), cv::Vec3b(0, 0, 0));
+  const cv::Vec3b lit = image.at<cv::Vec3b>(2, 2);
+  EXPECT_NE(lit, cv::Vec3b(0, 0, 0));
+  EXPECT_EQ(lit, ColourMapped(maps.frequency, 0, 12.5, cv::COLORMAP_JET).at<cv::Vec3b>(2, 2));
 }
 
 TEST_F(PredictorTest, MapsOfAClipTurnedRoundShowTheCamerasPicture) {

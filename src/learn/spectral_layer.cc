@@ -138,6 +138,11 @@ SpectralMaps SpectralDecomposition(const at::Tensor& x, const SpectralOptions& o
     throw std::invalid_argument("SpectralDecomposition: expected a [N_b, C, N_t, H, W] tensor, got " +
                                 std::to_string(x.dim()) + " dimensions");
   }
+  // Float32 or float64: libtorch's CPU window and DFT have no float16 kernels, and a half tensor
+  // failed deep inside them ("cos_vml_cpu not implemented for 'Half'", with a stack trace).
+  if (x.scalar_type() != at::kFloat && x.scalar_type() != at::kDouble)
+    throw std::invalid_argument(std::string("SpectralDecomposition: expected a float32 or float64 tensor, got ") +
+                                c10::toString(x.scalar_type()));
   const int64_t nb = x.size(0), c = x.size(1), nt = x.size(2), h = x.size(3), w = x.size(4);
   if (nt < 2) throw std::invalid_argument("SpectralDecomposition: N_t must be at least 2");
   if (options.dft_size != 0 && options.dft_size < nt) {

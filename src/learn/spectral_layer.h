@@ -56,7 +56,10 @@ struct SpectralOptions {
 
 // Power and frequency maps of a batch of clips.
 struct SpectralMaps {
-  at::Tensor power;      // [N_b, kC, H, W] periodogram of the selected bins (unit: input² )
+  // [N_b, kC, H, W] periodogram of the selected bins, |X_j|² / Σw² (unit: input² · samples: a
+  // cosine of amplitude A at an interior bin reads A² N_t / 6 with the periodic Hann window, 4 times
+  // that at Nyquist; one-sided bins are not doubled, which is one scale at a fixed N_t)
+  at::Tensor power;
   at::Tensor frequency;  // [N_b, kC, H, W] their frequencies [Hz]
   // With SpectralOptions::phase_steps, else undefined: [N_b, 4C, H, W], per input channel c the
   // channels 4c..4c+3 = cos, sin of the step to the right (x+1), cos, sin of the step down (y+1):

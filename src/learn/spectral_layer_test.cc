@@ -569,6 +569,26 @@ TEST(SpectralLayer, RejectsBadShapesAndK) {
   EXPECT_NO_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), short_dft));
   short_dft.k = 61;
   EXPECT_THROW(SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}), short_dft), std::invalid_argument);
+  // A float16 clip is refused as such (it failed inside libtorch's window with a stack trace).
+  try {
+    SpectralDecomposition(at::zeros({1, 1, 30, 4, 4}, at::kHalf), 1, kFps);
+    ADD_FAILURE() << "a float16 clip was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("expected a float32 or float64 tensor, got Half"), std::string::npos) << e.what();
+  }
+}
+
+// The power's scale, as spectral_layer.h says it: a cosine of amplitude A at an interior bin reads
+// A² N_t / 6 (periodic Hann window, |X|² / Σw²), at Nyquist 4 times that.
+TEST(SpectralLayer, PowerOfACosineIsAmplitudeSquaredTimesNtOverSix) {
+  const int nt = 30;
+  for (const auto& [bin, expected] : {std::pair{5, 2.0 * 2.0 * nt / 6.0}, std::pair{15, 4 * 2.0 * 2.0 * nt / 6.0}}) {
+    at::Tensor x = at::zeros({1, 1, nt, 1, 1}, at::kDouble);
+    for (int t = 0; t < nt; ++t) x[0][0][t][0][0] = 2.0 * std::cos(2 * M_PI * bin * t / nt);
+    const SpectralMaps m = SpectralDecomposition(x, 1, kFps);
+    EXPECT_NEAR(m.power.item<double>(), expected, 1e-9 * expected) << "bin " << bin;
+    EXPECT_NEAR(m.frequency.item<double>(), bin * kFps / nt, 1e-12);
+  }
 }
 
 TEST(SpectralLayer, IsDifferentiableWithRespectToTheClip) {
