@@ -365,7 +365,7 @@ class WindDisplayNode {
     text.pose.position.y = 7.0;
     text.pose.position.z = 1.5;
     text.pose.orientation.w = 1.0;
-    text.scale.z = 0.6;  // [m] letter height
+    text.scale.z = 0.45;  // [m] letter height: three lines within the view's ±5 m at 30 px/m
     text.color.r = text.color.g = text.color.b = 1.0;
     text.color.a = 1.0;
     // sdn_node's own mean when it is of the latest estimate (its window is ~mean_window too under
@@ -374,9 +374,18 @@ class WindDisplayNode {
                             : have_mean_ && last_mean_.header.stamp == last_estimate_.header.stamp
                                 ? last_mean_.speed
                                 : estimates_.Mean(t_now, mean_window_);
-    text.text = clothwind::sensors::WindSummaryText(est, est_std, mean, mean_window_, est_mean);
-    const size_t bar = text.text.find(" | ");  // two lines: the 3-D view is narrow beside the images
+    // What each mean spans: sdn_node's mean from its clips' first start to its last end.
+    const bool own_mean = est_live && have_mean_ && last_mean_.header.stamp == last_estimate_.header.stamp;
+    const double est_span = own_mean ? (last_mean_.clip_end - last_mean_.clip_start).toSec()
+                                     : estimates_.Span(t_now, mean_window_);
+    text.text = clothwind::sensors::WindSummaryText(est, est_std, mean, mean_window_, est_mean,
+                                                    anemometer_.Span(t_now, mean_window_), est_span);
+    // Three lines: the 3-D view is narrow beside the images (one line of 0.6 m letters lost its
+    // ends past 10 m/s: "stimate 12.6 ± 1.3 m/s, 60 s mean 12.(6)").
+    const size_t bar = text.text.find(" | ");
     if (bar != std::string::npos) text.text.replace(bar, 3, "\n");
+    const size_t comma = text.text.find(", ");
+    if (comma != std::string::npos && comma < text.text.find('\n')) text.text.replace(comma, 2, "\n");
     array.markers.push_back(text);
 
     visualization_msgs::Marker arrow;
@@ -389,9 +398,11 @@ class WindDisplayNode {
     arrow.action = has_vector ? visualization_msgs::Marker::ADD : visualization_msgs::Marker::DELETE;
     if (has_vector) {
       geometry_msgs::Point tail, tip;
-      tip.x = last_vector_.velocity.x;  // 1 m per m/s
-      tip.y = last_vector_.velocity.y;
-      tip.z = std::isfinite(last_vector_.velocity.z) ? last_vector_.velocity.z : 0.0;
+      const double vz = std::isfinite(last_vector_.velocity.z) ? last_vector_.velocity.z : 0.0;
+      const double scale = clothwind::sensors::WindArrowScale(last_vector_.velocity.x, last_vector_.velocity.y, vz);
+      tip.x = scale * last_vector_.velocity.x;
+      tip.y = scale * last_vector_.velocity.y;
+      tip.z = scale * vz;
       arrow.points = {tail, tip};
       arrow.scale.x = 0.1;  // shaft diameter [m]
       arrow.scale.y = 0.25; // head diameter

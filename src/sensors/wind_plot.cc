@@ -105,21 +105,45 @@ double WindHistory::Mean(double t_now, double window, int* count) const {
   return n > 0 ? sum / n : std::numeric_limits<double>::quiet_NaN();
 }
 
+double WindHistory::Span(double t_now, double window) const {
+  double oldest = std::numeric_limits<double>::infinity();
+  for (const WindSample& s : samples_)
+    if (s.t > t_now - window && s.t <= t_now) oldest = std::min(oldest, s.t);
+  return std::isfinite(oldest) ? std::min(window, t_now - oldest) : 0.0;
+}
+
+namespace {
+
+// "60 s mean", or "14 s mean (of 60)" while the mean spans less than the window.
+std::string MeanLabel(double window, double span) {
+  if (!std::isfinite(span) || span >= window - 1.0) return Formatted("%.0f s mean", window);
+  return Formatted("%.0f s mean (of %.0f)", std::max(span, 0.0), window);
+}
+
+}  // namespace
+
 std::string WindSummaryText(double estimate, double estimate_std, double anemometer_mean, double window,
-                            double estimate_mean) {
+                            double estimate_mean, double anemometer_span, double estimate_mean_span) {
   std::string text = "estimate ";
   if (std::isfinite(estimate)) {
     text += Formatted("%.1f", estimate);
     if (std::isfinite(estimate_std) && estimate_std > 0) text += Formatted(" \xC2\xB1 %.1f", estimate_std);
     text += " m/s";
-    if (std::isfinite(estimate_mean)) text += Formatted(", %.0f s mean %.1f", window, estimate_mean);
+    if (std::isfinite(estimate_mean))
+      text += ", " + MeanLabel(window, estimate_mean_span) + Formatted(" %.1f", estimate_mean);
   } else {
     text += "--";
   }
   text += " | anemometer ";
   text += std::isfinite(anemometer_mean) ? Formatted("%.1f m/s", anemometer_mean) : std::string("--");
-  text += Formatted(" (%.0f s mean)", window);
+  text += " (" + MeanLabel(window, std::isfinite(anemometer_mean) ? anemometer_span : std::nan("")) + ")";
   return text;
+}
+
+double WindArrowScale(double vx, double vy, double vz) {
+  const double speed = std::sqrt(vx * vx + vy * vy + vz * vz);
+  if (!(std::isfinite(speed) && speed > 0)) return 0.0;
+  return std::min(kWindArrowMetresPerMps, kWindArrowMaxLength / speed);
 }
 
 double WindPlotAxisMax(double max_speed) {

@@ -40,6 +40,11 @@ class WindHistory {
   //   count   number of samples averaged (may be null)
   double Mean(double t_now, double window, int* count = nullptr) const;
 
+  // [s] The part of the window (t_now - window, t_now] its samples span: t_now less the oldest
+  // sample in it, at most `window`; 0 when none. What a mean "over the window" is over while the
+  // history is younger than the window.
+  double Span(double t_now, double window) const;
+
   const std::deque<WindSample>& samples() const { return samples_; }
   bool empty() const { return samples_.empty(); }
   const WindSample& back() const { return samples_.back(); }
@@ -58,8 +63,21 @@ class WindHistory {
 //   window                  [s] the means' window
 //   estimate_mean           [m/s] the estimates' mean over the same window (what compares with
 //                           the anemometer's mean: one clip shows its own 1.2 s of gusts)
+//   anemometer_span, estimate_mean_span
+//                           [s] what each mean spans (WindHistory::Span); NaN: the whole window.
+//                           Shorter than the window by over a second, the mean is said as
+//                           "14 s mean (of 60)": early in a session a 14 s mean read as a minute's.
 std::string WindSummaryText(double estimate, double estimate_std, double anemometer_mean, double window,
-                            double estimate_mean = std::numeric_limits<double>::quiet_NaN());
+                            double estimate_mean = std::numeric_limits<double>::quiet_NaN(),
+                            double anemometer_span = std::numeric_limits<double>::quiet_NaN(),
+                            double estimate_mean_span = std::numeric_limits<double>::quiet_NaN());
+
+// The monitor's top-down view shows about ±5 m around the anemometer: its wind arrow is drawn at
+// kWindArrowMetresPerMps, at most kWindArrowMaxLength long (1 m per m/s ran off the view past
+// 5 m/s, its head lost). Returns the factor [m per m/s] that scales velocity (vx, vy, vz) [m/s]
+// to the arrow; 0 for a zero or non-finite velocity.
+inline constexpr double kWindArrowMetresPerMps = 0.3, kWindArrowMaxLength = 4.5;
+double WindArrowScale(double vx, double vy, double vz);
 
 // Colours (BGR) of the plot's series; the legend and docs/monitor.md name them.
 const cv::Scalar kEstimateColour(0, 140, 255);   // orange line, with a pale ±std band

@@ -93,6 +93,29 @@ TEST(WindPlotTest, SummaryText) {
   EXPECT_EQ(WindSummaryText(3.42, 0.31, 3.18, 60, 3.64),
             "estimate 3.4 \xC2\xB1 0.3 m/s, 60 s mean 3.6 | anemometer 3.2 m/s (60 s mean)");
   EXPECT_EQ(WindSummaryText(kNaN, kNaN, 2.0, 30, 2.5), "estimate -- | anemometer 2.0 m/s (30 s mean)");
+  // Early in a session the means span less than the window, and say so.
+  EXPECT_EQ(WindSummaryText(6.2, 0.4, 4.3, 60, 6.2, 13.6, 14.2),
+            "estimate 6.2 \xC2\xB1 0.4 m/s, 14 s mean (of 60) 6.2 | anemometer 4.3 m/s (14 s mean (of 60))");
+  EXPECT_EQ(WindSummaryText(6.2, 0.4, 4.3, 60, 6.2, 59.5, 60.0),
+            "estimate 6.2 \xC2\xB1 0.4 m/s, 60 s mean 6.2 | anemometer 4.3 m/s (60 s mean)");
+}
+
+TEST(WindPlotTest, SpanIsWhatTheWindowsSamplesCover) {
+  WindHistory h(300);
+  EXPECT_EQ(h.Span(100, 60), 0.0);
+  for (int t = 90; t <= 100; ++t) h.Add({static_cast<double>(t), 3.0});
+  EXPECT_DOUBLE_EQ(h.Span(100, 60), 10.0);
+  for (int t = 0; t < 90; ++t) h.Add({static_cast<double>(t), 3.0});
+  EXPECT_DOUBLE_EQ(h.Span(100, 60), 59.0);  // the oldest in (40, 100] is 41
+}
+
+// The arrow stays in the monitor's ±5 m view: 0.3 m per m/s, at most 4.5 m.
+TEST(WindPlotTest, TheWindArrowFitsTheView) {
+  EXPECT_DOUBLE_EQ(WindArrowScale(5.0, 0.0, 0.0), kWindArrowMetresPerMps);
+  EXPECT_DOUBLE_EQ(12.4 * WindArrowScale(12.4, 0.0, 0.0), 3.72);
+  EXPECT_NEAR(30.0 * WindArrowScale(0.0, -30.0, 0.0), kWindArrowMaxLength, 1e-12);
+  EXPECT_EQ(WindArrowScale(0.0, 0.0, 0.0), 0.0);
+  EXPECT_EQ(WindArrowScale(kNaN, 1.0, 0.0), 0.0);
 }
 
 TEST(WindPlotTest, SeriesDrawnAtTheirSpeeds) {
