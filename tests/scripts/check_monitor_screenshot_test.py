@@ -13,14 +13,16 @@ SCRIPT = os.path.join(ROOT, 'scripts', 'check-monitor-screenshot')
 W, H = 128, 96
 
 
-def screenshot_pixels(first):
-    """W x H RGB bytes that pass every check: random colours (thousands, every tile busy), 60
-    pixels of each wind plot series' colour, and `first` as the first pixel."""
+def screenshot_pixels(first, estimate_pixels=400):
+    """W x H RGB bytes that pass every check: random colours (thousands, every tile busy), 400
+    pixels of each wind plot series' colour (`estimate_pixels` of the estimate's), and `first` as
+    the first pixel."""
     rng = random.Random(5)
     pixels = [(rng.randrange(256), rng.randrange(256), rng.randrange(256)) for _ in range(W * H)]
     pixels[0] = first
-    for i in range(60):
+    for i in range(estimate_pixels):
         pixels[1000 + i] = (255, 140, 0)    # estimate orange
+    for i in range(400):
         pixels[3000 + i] = (0, 110, 200)    # anemometer blue
     return b''.join(bytes(p) for p in pixels)
 
@@ -57,6 +59,13 @@ class CheckMonitorScreenshotTest(unittest.TestCase):
         r = self.check(f'P6 # made by a test\n{W}\t{H}\r\n# a comment\n255 '.encode() + pixels)
         self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
         self.assertIn(f'{W}x{H}', r.stdout)
+
+    def test_a_plot_without_its_estimate_series_fails(self):
+        # A monitor with no estimate showed 135 orange pixels (the legend's swatch, rviz's status
+        # labels) and passed a threshold of 40.
+        r = self.check(f'P6\n{W} {H}\n255\n'.encode() + screenshot_pixels((32, 32, 32), estimate_pixels=135))
+        self.assertNotEqual(r.returncode, 0, r.stdout)
+        self.assertIn('estimate-coloured pixels (expected >= 300', r.stderr)
 
     def test_what_is_not_an_8_bit_p6_is_refused_naming_the_file(self):
         pixels = screenshot_pixels((32, 32, 32))
