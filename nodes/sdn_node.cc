@@ -250,8 +250,8 @@ class SdnNode {
         ++no_motion_;
         char what[200];
         std::snprintf(what, sizeof what,
-                      "clip %llu has no motion (pixels vary by %.2f grey levels over time, below %.1f): a frozen "
-                      "camera or a covered lens? not estimated",
+                      "clip %llu has no motion (its frames are the same: pixels vary by %.3f grey levels over "
+                      "time, below %.2f): a frozen camera? not estimated",
                       static_cast<unsigned long long>(clip->sequence), p.motion, clothwind::learn::kMinClipMotion);
         const bool first = still_clip_.empty();
         still_clip_ = what;

@@ -29,15 +29,18 @@ struct Prediction {
   // [grey levels, 0..255] the clip's motion (ClipMotion of the frames read), measured before the
   // per-clip normalisation, which stretches any residue to unit spread.
   double motion = 0;
-  // motion below kMinClipMotion: a frozen camera (a driver republishing its last frame), a covered
-  // lens. The network still answers, with a std like a live clip's (a repeated FlagSim frame read
-  // 5-7 m/s ± 0.4, a constant image 1.2 ± 0.2): callers must not take it as a measurement.
+  // motion below kMinClipMotion: every frame the same (a frozen camera, a driver republishing its
+  // last frame; a constant image). The network still answers, with a std like a live clip's (a
+  // repeated FlagSim frame read 5-7 m/s ± 0.4, a constant image 1.2 ± 0.2): callers must not take
+  // it as a measurement.
   bool no_motion = false;
 };
 
-// [grey levels] Below this mean temporal spread a clip has no motion to read: a camera's own noise
-// is 0.5-3 grey levels over a still scene, a republished frame exactly 0.
-inline constexpr double kMinClipMotion = 0.2;
+// [grey levels] Below this mean temporal spread a clip's frames are all the same (a frozen camera:
+// 0 but for rounding). Not a noise floor: a live still scene's noise, once the clip buffer has
+// shrunk a 1080 px camera to 300 px and rounded to 8 bits, is 0.14-0.2 grey levels, and a small or
+// limp flag's motion is as little averaged over the frame; those are estimated.
+inline constexpr double kMinClipMotion = 0.01;
 
 // The motion of a clip: the mean over its pixels of each pixel's standard deviation over time, in
 // grey levels, of the frames' first channel (grey, or Y of YCrCb).

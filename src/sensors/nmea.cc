@@ -19,9 +19,13 @@ ParseResult Fail(ParseStatus s, std::string msg) {
   return r;
 }
 
-// [m/s] MWD's knots and m/s may differ by their rounding (0.1 kn and 0.1 m/s: at most 0.08 m/s),
-// plus 1 % of the speed for instruments that convert before rounding.
-constexpr double kMwdSpeedAgreement = 0.1;
+// Half a unit of a number's last printed digit: "12" 0.5, "6.17" 0.005 (the rounding it may carry).
+double HalfLastDigit(const std::string& field) {
+  const std::string t = field.substr(0, field.find_first_of("eE"));
+  const size_t dot = t.find('.');
+  const size_t decimals = dot == std::string::npos ? 0 : t.size() - dot - 1;
+  return 0.5 * std::pow(10.0, -static_cast<double>(decimals));
+}
 
 bool NmeaSpeedUnit(const std::string& f, SpeedUnit* unit) {
   if (f == "M") *unit = SpeedUnit::kMetresPerSecond;
@@ -166,7 +170,11 @@ ParseResult ParseMwd(const NmeaSentence& s) {
   // still matched, or a sentence without one, read "20 N, 1 M" as 1 m/s).
   if (std::isfinite(v[2]) && std::isfinite(v[3])) {
     const double from_knots = SpeedToMetresPerSecond(v[2], SpeedUnit::kKnots);
-    if (std::abs(from_knots - v[3]) > kMwdSpeedAgreement + 0.01 * std::max(from_knots, v[3])) {
+    // Within each field's rounding (half its last printed digit: whole numbers differ by up to
+    // 0.76 m/s, "12 N, 6 M"), plus 1 % for instruments that convert before rounding.
+    const double rounding = SpeedToMetresPerSecond(HalfLastDigit(s.fields[4]), SpeedUnit::kKnots) +
+                            HalfLastDigit(s.fields[6]);
+    if (std::abs(from_knots - v[3]) > rounding + 0.01 * std::max(from_knots, v[3])) {
       char what[640];  // (fields are at most a record's 256 bytes)
       std::snprintf(what, sizeof what, ": field 5 (%s kn, %.3g m/s) and field 7 (%s m/s) disagree",
                     s.fields[4].c_str(), from_knots, s.fields[6].c_str());
@@ -195,7 +203,20 @@ ParseResult ParseXdr(const NmeaSentence& s) {
   WindReading& w = r.reading;
   w.source = "nmea_xdr";
   bool any = false;
-  std::string direction_name, speed_name, gust_name;  // the quadruplets read, by name
+  // One value of each kind is read, where a station may send several (WSPD and WSPD_AVG, WINDSPEED
+  // and WINDSPEEDMAX, WDIR and WDIR_AVG): the plain name's, else the first's. (The last used to
+  // overwrite the others without a word.)
+  struct Chosen {
+    bool plain = false, set = false;
+  } direction, speed, gust;
+  auto take = [](Chosen* c, const std::string& name, std::initializer_list<const char*> plain_names) {
+    bool plain = false;
+    for (const char* p : plain_names) plain = plain || name == p;
+    if (c->set && (c->plain || !plain)) return false;
+    c->set = true;
+    c->plain = plain;
+    return true;
+  };
   for (size_t q = 0; q < s.fields.size(); q += 4) {
     const std::string name = Upper(s.fields[q + 3]);
     const bool windish = name.find("WIND") != std::string::npos || name.rfind("WSPD", 0) == 0 ||
@@ -224,12 +245,10 @@ ParseResult ParseXdr(const NmeaSentence& s) {
         return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] + "' field " +
                                                  std::to_string(q + 2) + " (direction): expected 0..360 deg, got " +
                                                  s.fields[q + 1]);
-      if (!direction_name.empty())
-        return Fail(ParseStatus::kMalformed, where + ": two wind directions, '" + direction_name + "' and '" +
-                                                 s.fields[q + 3] + "' (one of each is read)");
-      direction_name = s.fields[q + 3];
-      w.from_angle_deg = value;
-      w.reference = AngleReference::kInstrument;
+      if (take(&direction, name, {"WDIR", "WINDDIR", "WIND_DIR", "WINDDIRECTION", "WIND_DIRECTION"})) {
+        w.from_angle_deg = value;
+        w.reference = AngleReference::kInstrument;
+      }
       any = true;
     } else {
       SpeedUnit unit;
@@ -240,16 +259,11 @@ ParseResult ParseXdr(const NmeaSentence& s) {
         return Fail(ParseStatus::kMalformed, where + " quadruplet '" + s.fields[q + 3] + "' field " +
                                                  std::to_string(q + 2) + " (speed): expected >= 0, got " +
                                                  s.fields[q + 1]);
-      // A second speed (or gust) overwrote the first without a word: which one the instrument
-      // means is not for the parser to guess.
-      std::string& first = name.find("GUST") != std::string::npos ? gust_name : speed_name;
-      if (!first.empty())
-        return Fail(ParseStatus::kMalformed, where + ": two wind " +
-                                                 (&first == &gust_name ? "gusts" : "speeds") + ", '" + first +
-                                                 "' and '" + s.fields[q + 3] + "' (one of each is read)");
-      first = s.fields[q + 3];
-      if (&first == &gust_name) w.gust = SpeedToMetresPerSecond(value, unit);
-      else w.speed = SpeedToMetresPerSecond(value, unit);
+      if (name.find("GUST") != std::string::npos) {
+        if (take(&gust, name, {"WGUST", "WINDGUST", "WIND_GUST", "GUST"})) w.gust = SpeedToMetresPerSecond(value, unit);
+      } else if (take(&speed, name, {"WSPD", "WINDSPEED", "WIND_SPEED", "WIND"})) {
+        w.speed = SpeedToMetresPerSecond(value, unit);
+      }
       any = true;
     }
   }

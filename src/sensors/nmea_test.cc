@@ -238,14 +238,16 @@ TEST(Nmea, XdrWindQuadruplets) {
   r = ParseNmea(WithNmeaChecksum("WIXDR,S,5.0,P,WSPD"));
   EXPECT_EQ(r.status, ParseStatus::kMalformed);
   EXPECT_NE(r.error.find("speed units expected M, N, K or S, got 'P'"), std::string::npos) << r.error;
-  // Two speeds, gusts or directions: the later overwrote the earlier without a word.
-  for (const std::string& two : {std::string("WIXDR,A,120,D,WINDDIR,A,200,D,WINDDIR2,S,5.0,M,WSPD"),
-                                 std::string("WIXDR,S,5.0,M,WSPD,S,7.0,M,WINDSPEED"),
-                                 std::string("WIXDR,S,5.0,M,WSPD,S,8.0,M,WGUST,S,9.0,M,WINDGUST")}) {
-    r = ParseNmea(WithNmeaChecksum(two));
-    EXPECT_EQ(r.status, ParseStatus::kMalformed) << two;
-    EXPECT_NE(r.error.find("two wind "), std::string::npos) << r.error;
-  }
+  // Several speeds, gusts or directions (an average or maximum beside the value): the plain
+  // name's is read, else the first's; the last overwrote the others without a word.
+  r = ParseNmea(WithNmeaChecksum("WIXDR,S,4.8,M,WSPD_AVG,S,5.2,M,WSPD,A,270,D,WDIR,A,265,D,WDIR_AVG"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_DOUBLE_EQ(r.reading.speed, 5.2);
+  EXPECT_DOUBLE_EQ(r.reading.from_angle_deg, 270.0);
+  r = ParseNmea(WithNmeaChecksum("WIXDR,S,7.9,M,WINDSPEEDMAX,S,6.0,M,WINDSPEEDAVG,S,9.0,M,WGUSTMAX,S,8.0,M,WINDGUST"));
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.error;
+  EXPECT_DOUBLE_EQ(r.reading.speed, 7.9);  // no plain name: the first
+  EXPECT_DOUBLE_EQ(r.reading.gust, 8.0);
   // WSPD is wind whatever its units, so wrong ones are still an error.
   r = ParseNmea(WithNmeaChecksum("WIXDR,S,5.0,C,WSPD"));
   EXPECT_EQ(r.status, ParseStatus::kMalformed);
@@ -262,6 +264,11 @@ TEST(Nmea, MwdSpeedsThatDisagreeAreRefused) {
   EXPECT_EQ(r.status, ParseStatus::kOk) << r.error;
   r = ParseNmea(WithNmeaChecksum("WIMWD,270,T,,M,0.1,N,0.0,M"));
   EXPECT_EQ(r.status, ParseStatus::kOk) << r.error;
+  // Whole numbers carry half a unit each: 12 kn is 6.17 m/s, printed 6; 3 kn, 1.54, printed 2.
+  for (const char* whole : {"WIMWD,270,T,,M,12,N,6,M", "WIMWD,270,T,,M,3,N,2,M"}) {
+    r = ParseNmea(WithNmeaChecksum(whole));
+    EXPECT_EQ(r.status, ParseStatus::kOk) << whole << ": " << r.error;
+  }
 }
 
 TEST(Nmea, MwdDirectionOutOfRangeNamesTheFieldAndValue) {
