@@ -28,6 +28,32 @@ grep -q "^epoch 1/2 .* s  (run: ~[0-9]* s left)$" "$work/msg.txt" && ! grep -q "
   fail "train --resume without the run's options: $(cat "$work/msg.txt")"
 grep -q "^resuming $work/run2 with the run's own --model --frames --input-size --width --k .* --epochs --batch .* (its state.json)$" \
   "$work/msg.txt" || fail "train --resume did not say the options it took: $(cat "$work/msg.txt")"
+# A run of an older build, whose state.json records no schedule, batch, weight decay or gradient
+# clip: those left out are refused, named (they ran as the defaults, a cosine run going on as a
+# 40-epoch step one), and given, it resumes.
+cp -r "$work/run2" "$work/old-run"
+/usr/bin/python3 - "$work/old-run/state.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+for key in ("epochs", "lr", "lr_schedule", "lr_decay_epoch", "batch", "weight_decay", "grad_clip"):
+    s.pop(key)
+json.dump(s, open(sys.argv[1], "w"))
+PY
+status=0
+"$bin" train --data "$work/toy" --out "$work/old-run" --resume --threads 1 >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 2 ] && grep -qF "does not record --epochs, --batch, --lr, --lr-schedule, --lr-decay-epoch, --weight-decay, --grad-clip" "$work/msg.txt" ||
+  fail "train --resume of an older run without its schedule (status $status): $(cat "$work/msg.txt")"
+"$bin" train --data "$work/toy" --out "$work/old-run" --resume --threads 1 --epochs 2 --batch 8 --lr 1e-2 \
+  --lr-schedule step --lr-decay-epoch -1 --weight-decay 2e-3 --grad-clip -1 >"$work/msg.txt" 2>&1 ||
+  fail "train --resume of an older run with its schedule given: $(cat "$work/msg.txt")"
+# The verb's own checks judge the run's options, filled first: a cosine run resumed with
+# --lr-decay-epoch was checked against the default step schedule and passed.
+"$bin" train --model sdn --frames 30 --data "$work/toy" --out "$work/cosine" --input-size 32 --width 8 --k 3 \
+  --threads 1 --epochs 1 --batch 8 --lr-schedule cosine >"$work/msg.txt" 2>&1 || fail "a cosine run: $(cat "$work/msg.txt")"
+status=0
+"$bin" train --data "$work/toy" --out "$work/cosine" --resume --threads 1 --lr-decay-epoch 5 >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 2 ] && grep -q -- "--lr-decay-epoch is the step schedule's" "$work/msg.txt" ||
+  fail "a cosine run resumed with --lr-decay-epoch (status $status): $(cat "$work/msg.txt")"
 # One given that differs is still refused, naming it.
 status=0
 "$bin" train --data "$work/toy" --out "$work/run2" --resume --threads 1 --width 16 >"$work/msg.txt" 2>&1 || status=$?

@@ -12,6 +12,7 @@
 
 #include "learn/model_config.h"
 #include "learn/train.h"
+#include "usage_error.h"
 
 namespace clothwind::tools {
 
@@ -26,7 +27,8 @@ namespace clothwind::tools {
 // Outputs:
 //   o       (in/out) the training options; its model's fields too
 //   frames  (in/out) the model's N_t (the verb's own variable)
-// Returns the flags filled, in order, for the log.
+// Returns the flags filled, in order, for the log. Throws UsageError naming the flags a run of an
+// older build did not record (its schedule, batch, weight decay, gradient clip) unless given.
 inline std::vector<std::string> FillFromRunState(const std::filesystem::path& state_path,
                                                  const std::function<bool(const std::string&)>& given,
                                                  learn::TrainOptions* o, int* frames) {
@@ -69,8 +71,22 @@ inline std::vector<std::string> FillFromRunState(const std::filesystem::path& st
   fill("--frame-channels", [&] { m.frame_channels = ran.frame_channels; });
   fill("--mean-map", [&] { m.mean_map = ran.mean_map; });
   // (--still-floor: Train takes the run's own when it is not given.)
-  // Training options, where the state records them (runs before 2026-12-05 recorded fewer: Train
-  // checks those against the log).
+  // Training options, where the state records them. Runs before 2026-12-05 recorded none of the
+  // schedule, batch, weight decay and gradient clip: Train could check only the log's rates against
+  // them, which after one epoch cannot tell cosine from step or 20 epochs from 40, so those left out
+  // would have run as the defaults: refused, naming the flags to give.
+  std::vector<std::string> unrecorded;
+  for (const auto& [key, flag] : {std::pair{"epochs", "--epochs"}, std::pair{"batch", "--batch"},
+                                  std::pair{"lr", "--lr"}, std::pair{"lr_schedule", "--lr-schedule"},
+                                  std::pair{"lr_decay_epoch", "--lr-decay-epoch"},
+                                  std::pair{"weight_decay", "--weight-decay"}, std::pair{"grad_clip", "--grad-clip"}})
+    if (!state.contains(key) && !given(flag)) unrecorded.push_back(flag);
+  if (!unrecorded.empty()) {
+    std::string flags;
+    for (const std::string& flag : unrecorded) flags += (flags.empty() ? "" : ", ") + flag;
+    throw UsageError(state_path.string() + " (a run of an older build) does not record " + flags +
+                     ": give them as the run started with");
+  }
   auto recorded = [&](const char* key, const std::string& flag, const std::function<void(const nlohmann::json&)>& set) {
     if (!state.contains(key)) return;
     try {

@@ -171,6 +171,16 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   return [args, lr_decay_epoch, k, sub]() {
+    // First, so the checks below judge the run's own options (a cosine run resumed with
+    // --lr-decay-epoch passed them against the default step schedule).
+    if (args->o.resume) {
+      const std::vector<std::string> filled = FillFromRunState(
+          std::filesystem::path(args->out) / "state.json",
+          [sub](const std::string& flag) { return sub->get_option(flag)->count() > 0; }, &args->o, &args->frames);
+      std::string flags;
+      for (const std::string& flag : filled) flags += " " + flag;
+      if (!filled.empty()) std::cout << "resuming " << args->out << " with the run's own" << flags << " (its state.json)\n";
+    }
     // k has a default, so ModelConfig cannot tell it given: a resnet18 or lstm sweep over --k
     // made identical runs, each recording its k.
     if (k->count() > 0 && args->o.model.arch != "sdn")
@@ -182,14 +192,6 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
     // Every batch allocates and frees the same tensors: keep the freed memory instead of faulting
     // its pages in again (a training step 7 % faster at 64 px, 13 % at 96, on 2 cores).
     learn::KeepFreedHeapForReuse();
-    if (args->o.resume) {
-      const std::vector<std::string> filled = FillFromRunState(
-          std::filesystem::path(args->out) / "state.json",
-          [sub](const std::string& flag) { return sub->get_option(flag)->count() > 0; }, &args->o, &args->frames);
-      std::string flags;
-      for (const std::string& flag : filled) flags += " " + flag;
-      if (!filled.empty()) std::cout << "resuming " << args->out << " with the run's own" << flags << " (its state.json)\n";
-    }
     learn::TrainOptions o = args->o;
     o.model.frames = args->frames;
     o.model.still_floor = args->still_floor >= 0 ? args->still_floor : o.model.arch == "sdn" ? 1e-6 : 0.0;
