@@ -67,23 +67,36 @@ inline void RefuseOutputInsideFolder(const std::string& option, const std::files
                                 what + " " + folder.string() + "; write it elsewhere");
 }
 
-// Throws UsageError naming `option` when no file can be made where `output` (empty: none)
-// goes: a file is made and removed in its folder, or in the nearest folder above that exists (a
-// verb that makes the missing ones). `eval --json /proc/x.json` ran the whole evaluation and then
-// failed to write.
+// Throws UsageError naming `option` (and `shown`, what was given) unless a file can be made in
+// `folder`, or in the nearest folder above it that exists (the verbs make the missing ones):
+// a file is made and removed there. A dangling symbolic link on the way is no folder that exists
+// (`exists` follows it, and the work failed later with "cannot create directories: File exists").
+inline void RefuseUnwritableIn(const std::string& option, const std::string& shown, std::filesystem::path folder) {
+  std::error_code ec;
+  folder = std::filesystem::absolute(folder, ec);
+  while (!folder.empty() && !std::filesystem::exists(std::filesystem::symlink_status(folder, ec)) &&
+         folder != folder.parent_path())
+    folder = folder.parent_path();
+  if (!std::filesystem::is_directory(folder, ec))
+    throw UsageError(option + " " + shown + ": " + folder.string() +
+                     (std::filesystem::is_symlink(std::filesystem::symlink_status(folder, ec))
+                          ? " is a symbolic link to nothing"
+                          : " is a file, not a folder"));
+  const std::string probe = TemporaryNameFor((folder / ".clothwind-write-probe").string());
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0)
+    throw UsageError(option + " " + shown + ": cannot write in " + folder.string() + " (" + std::strerror(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
+// Throws UsageError naming `option` when no file can be made where the file `output` (empty:
+// none) goes (RefuseUnwritableIn of its folder). `eval --json /proc/x.json` ran the whole
+// evaluation and then failed to write.
 inline void RefuseUnwritableFolder(const std::string& option, const std::filesystem::path& output) {
   if (output.empty()) return;
   std::error_code ec;
-  std::filesystem::path folder = std::filesystem::absolute(output, ec).parent_path();
-  while (!folder.empty() && !std::filesystem::exists(folder, ec) && folder != folder.parent_path())
-    folder = folder.parent_path();
-  const std::string probe = TemporaryNameFor((folder / output.filename()).string());
-  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0)
-    throw UsageError(option + " " + output.string() + ": cannot write in " + folder.string() + " (" +
-                                std::strerror(errno) + ")");
-  ::close(fd);
-  ::unlink(probe.c_str());
+  RefuseUnwritableIn(option, output.string(), std::filesystem::absolute(output, ec).parent_path());
 }
 
 // Throws UsageError naming `option` unless `output` (empty: none) could be written: its
@@ -100,23 +113,10 @@ inline void RefuseUnwritableOutput(const std::string& option, const std::filesys
 }
 
 // Throws UsageError naming `option` unless files can be made in the folder `output_folder` (made
-// later if missing: then in its nearest existing ancestor): `--out /proc/x` failed with
-// "filesystem error: cannot create directories: ... [/proc/x]", naming no option.
+// later if missing; RefuseUnwritableIn): `--out /proc/x` failed with "filesystem error: cannot
+// create directories: ... [/proc/x]", naming no option.
 inline void RefuseUnwritableOutputFolder(const std::string& option, const std::filesystem::path& output_folder) {
-  if (output_folder.empty()) return;
-  std::error_code ec;
-  std::filesystem::path folder = std::filesystem::absolute(output_folder, ec);
-  while (!folder.empty() && !std::filesystem::exists(folder, ec) && folder != folder.parent_path())
-    folder = folder.parent_path();
-  if (!std::filesystem::is_directory(folder, ec))
-    throw UsageError(option + " " + output_folder.string() + ": " + folder.string() + " is a file, not a folder");
-  const std::string probe = TemporaryNameFor((folder / ".clothwind-write-probe").string());
-  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0)
-    throw UsageError(option + " " + output_folder.string() + ": cannot write in " + folder.string() + " (" +
-                     std::strerror(errno) + ")");
-  ::close(fd);
-  ::unlink(probe.c_str());
+  if (!output_folder.empty()) RefuseUnwritableIn(option, output_folder.string(), output_folder);
 }
 
 // Throws UsageError naming `option` and the file when one of `outputs` exists and `overwrite` is

@@ -62,6 +62,22 @@ TEST(OutputPathsTest, AnOutputInAMissingFolderOrOnAFolderIsRefusedBeforeTheWork)
   EXPECT_NO_THROW(RefuseUnwritableFolder("--out", dir / "a" / "b" / "m.pt"));  // made by the verb
   EXPECT_FALSE(fs::exists(dir / "a"));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir / "sub"), {}), 0);
+  // Output folders: one that exists or will be made is fine, one under a file or a symbolic link
+  // to nothing is refused (the link passed, and the work failed later: "File exists").
+  EXPECT_NO_THROW(RefuseUnwritableOutputFolder("--out", dir / "sub"));
+  EXPECT_NO_THROW(RefuseUnwritableOutputFolder("--out", dir / "new" / "deeper"));
+  std::ofstream(dir / "plain") << "x";
+  fs::create_symlink(dir / "nowhere", dir / "dangling");
+  for (const auto& [bad, says] : {std::pair{dir / "plain" / "run", "plain is a file, not a folder"},
+                                  std::pair{dir / "dangling" / "run", "dangling is a symbolic link to nothing"}}) {
+    try {
+      RefuseUnwritableOutputFolder("--out", bad);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir / "sub"), {}), 0);  // no probe left behind
   // A run written into the dataset, or into one of its clips, is refused; beside it is not.
   fs::create_directories(dir / "data" / "toy-00000");
   EXPECT_THROW(RefuseOutputInsideFolder("--out", dir / "data", dir / "data", "the dataset"), std::invalid_argument);
