@@ -191,7 +191,8 @@ class ClipReport {
   bool Print(double wall) {
     printed_ = true;
     if (const size_t missing = Unestimated())
-      std::printf("clip_report: %zu of %zu clips have no estimate (sdn_node still working, or it refused them): "
+      std::printf("clip_report: %zu of %zu clips have no estimate (sdn_node still working, or it refused them or "
+                  "found no motion in them): "
                   "the estimates' report covers the others\n", missing, rows_.size());
     std::printf("\nclip_report: %zu clip(s) from the replay\n", rows_.size());
     // Times from the earliest clip start there is (a clip without frame_stamps has none); else

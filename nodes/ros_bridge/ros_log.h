@@ -18,6 +18,8 @@ namespace clothwind::ros_bridge {
 // ros::shutdown(), which shuts rosconsole down with it: every ROS_* line after it printed nothing,
 // on the screen or /rosout, so what a node said once spin() returned (the clips the clip buffer
 // gave up, by name; a summary clip_report could not write, with its exit status 1) was lost.
+// (Also false between ros::init and the first NodeHandle, when rosconsole works: lines there go to
+// stderr too, in its format. Every node makes its NodeHandle before logging.)
 inline bool RosConsoleUp() { return ros::ok() && !ros::isShuttingDown(); }
 
 // Inputs: severity  "INFO", "WARN", "ERROR" or "FATAL"; message.

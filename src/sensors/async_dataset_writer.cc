@@ -43,7 +43,9 @@ bool AsyncDatasetWriter::Enqueue(LabelledClip clip, ClipSourceInfo source,
 
 bool AsyncDatasetWriter::Queue(LabelledClip clip, ClipSourceInfo source, std::unique_lock<std::mutex>* lock,
                                uint64_t* refused) {
-  if (queue_.size() >= max_queue_) {
+  // After DrainBy gave up (the shutdown's deadline) nothing more is written: refused and counted,
+  // where it would have waited in the queue unwritten and uncounted.
+  if (queue_.size() >= max_queue_ || gave_up_) {
     ++*refused;
     return false;
   }
@@ -57,7 +59,8 @@ void AsyncDatasetWriter::Drain() {
   std::unique_lock<std::mutex> lock(mutex_);
   flush_requested_ = true;
   wake_.notify_one();
-  idle_.wait(lock, [this] { return queue_.empty() && !busy_ && !flush_requested_ && !flushing_; });
+  // (queue_ holds nothing once DrainBy gave up: it names and clears what it gives up.)
+  idle_.wait(lock, [this] { return (queue_.empty() || gave_up_) && !busy_ && !flush_requested_ && !flushing_; });
 }
 
 bool AsyncDatasetWriter::DrainBy(std::chrono::steady_clock::time_point deadline,
@@ -79,6 +82,7 @@ bool AsyncDatasetWriter::DrainBy(std::chrono::steady_clock::time_point deadline,
                                                           : ClipFolderName(item.first.clip.frames.front().stamp));
   }
   queue_.clear();
+  gave_up_ = true;  // (also at the deadline itself): nothing more is started or queued
   room_.notify_all();
   return false;
 }

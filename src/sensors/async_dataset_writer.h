@@ -76,6 +76,8 @@ class AsyncDatasetWriter {
   // started just before it ran past it (a slow card's 10 s clip past roslaunch's SIGKILL). Returns
   // true when every queued clip was recorded (or failed) and listed by the deadline. On false a
   // clip being written is still finished by the thread (and listed).
+  // It is for a shutdown: once it has given up, the writer starts no clip again, and Enqueue
+  // refuses (counted dropped) what comes after.
   bool DrainBy(std::chrono::steady_clock::time_point deadline, std::vector<std::string>* abandoned);
 
   // Asks the thread to rewrite index.json once the clips queued now are written (if any clip is

@@ -217,6 +217,12 @@ TEST_F(AsyncDatasetWriterTest, DrainByStartsNoClipThatWouldLandAfterItsDeadline)
     const auto deadline = std::chrono::steady_clock::now() +
                           std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(1.2 * pace));
     EXPECT_FALSE(w.DrainBy(deadline, &abandoned));
+    // Given up, it is over: a clip after it is refused and counted (it waited in the queue
+    // unwritten and uncounted), and Drain returns.
+    const uint64_t dropped = w.stats().dropped;
+    EXPECT_FALSE(w.Enqueue(MakeClip(9), {}));
+    EXPECT_EQ(w.stats().dropped, dropped + 1);
+    w.Drain();
   }
   // Two, or all three when the writer had not yet taken the first when DrainBy came (under load,
   // its index rewrite then leaves too little time for one).
