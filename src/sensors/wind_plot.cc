@@ -114,10 +114,10 @@ double WindHistory::Span(double t_now, double window) const {
 
 namespace {
 
-// "60 s mean", or "14 s mean (of 60)" while the mean spans less than the window.
+// "60 s mean", or "14 of 60 s mean" while the mean spans less than the window.
 std::string MeanLabel(double window, double span) {
   if (!std::isfinite(span) || span >= window - 1.0) return Formatted("%.0f s mean", window);
-  return Formatted("%.0f s mean (of %.0f)", std::max(span, 0.0), window);
+  return Formatted("%.0f of %.0f s mean", std::max(span, 0.0), window);
 }
 
 }  // namespace

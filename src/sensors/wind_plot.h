@@ -66,7 +66,7 @@ class WindHistory {
 //   anemometer_span, estimate_mean_span
 //                           [s] what each mean spans (WindHistory::Span); NaN: the whole window.
 //                           Shorter than the window by over a second, the mean is said as
-//                           "14 s mean (of 60)": early in a session a 14 s mean read as a minute's.
+//                           "14 of 60 s mean": early in a session a 14 s mean read as a minute's.
 std::string WindSummaryText(double estimate, double estimate_std, double anemometer_mean, double window,
                             double estimate_mean = std::numeric_limits<double>::quiet_NaN(),
                             double anemometer_span = std::numeric_limits<double>::quiet_NaN(),

@@ -95,7 +95,7 @@ TEST(WindPlotTest, SummaryText) {
   EXPECT_EQ(WindSummaryText(kNaN, kNaN, 2.0, 30, 2.5), "estimate -- | anemometer 2.0 m/s (30 s mean)");
   // Early in a session the means span less than the window, and say so.
   EXPECT_EQ(WindSummaryText(6.2, 0.4, 4.3, 60, 6.2, 13.6, 14.2),
-            "estimate 6.2 \xC2\xB1 0.4 m/s, 14 s mean (of 60) 6.2 | anemometer 4.3 m/s (14 s mean (of 60))");
+            "estimate 6.2 \xC2\xB1 0.4 m/s, 14 of 60 s mean 6.2 | anemometer 4.3 m/s (14 of 60 s mean)");
   EXPECT_EQ(WindSummaryText(6.2, 0.4, 4.3, 60, 6.2, 59.5, 60.0),
             "estimate 6.2 \xC2\xB1 0.4 m/s, 60 s mean 6.2 | anemometer 4.3 m/s (60 s mean)");
 }
