@@ -24,8 +24,8 @@
 
 int main(int argc, char** argv) {
   CLI::App app{"clothwind: wind and cloth measurement through simulation (offline tools)", "clothwind"};
-  app.footer("Exit status: 0 done; 1 the work failed (an input refused, a write failed, bag-check: a bag not\n"
-             "fit for replay); 2 the command line is wrong (nothing was done); Ctrl-C: the signal's (130).");
+  app.footer("Exit status: 0 done; 1 the work failed (an input missing or refused, a write failed, bag-check: a\n"
+             "bag not fit for replay); 2 the command line is wrong (nothing was done); Ctrl-C: the signal's (130).");
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("clothwind ") + CLOTHWIND_VERSION);
   auto& verbs = clothwind::tools::Verbs();

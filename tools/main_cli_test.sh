@@ -69,6 +69,15 @@ echo "{" >"$work/bad.json"
 status=0
 out="$("$bin" simulate "$work/bad.json" --out "$work/sim" 2>&1)" || status=$?
 [ "$status" -eq 1 ] && grep -q "bad.json" <<<"$out" || fail "a scene that is not JSON (status $status): $out"
+# So is an input that is not there, for every verb (simulate and bag-check said 2, as CLI11 checked
+# the file before the verb ran; eval, train and the rest 1).
+for verb in "simulate $work/none.json --out $work/sim" "bag-check $work/none.bag" \
+            "eval --model $work/none.pt --data $work" "train --data $work/none --out $work/run"; do
+  status=0
+  # shellcheck disable=SC2086
+  out="$("$bin" $verb 2>&1)" || status=$?
+  [ "$status" -eq 1 ] && grep -q "$work/none" <<<"$out" || fail "$verb: a missing input (status $status): $out"
+done
 "$bin" simulate --help >/dev/null || fail "simulate --help did not exit 0"
 out="$("$bin" train --epochs -3 --data "$work" --out "$work/run" 2>&1)" || true
 grep -q -- "--epochs: Value -3 must be > 0$" <<<"$out" || fail "--epochs -3: $out"

@@ -10,8 +10,8 @@
 namespace clothwind::tools {
 
 // Exit statuses, the same for every verb (README, `clothwind --help`):
-constexpr int kExitFailed = 1;      // the work failed: an input refused, a write that failed, a bag not fit
-                                    // for replay (bag-check)
+constexpr int kExitFailed = 1;      // the work failed: an input missing or refused, a write that failed, a
+                                    // bag not fit for replay (bag-check)
 constexpr int kExitUsage = 2;       // the command line is wrong: an unknown verb or option, a value out of
                                     // range, options that exclude each other; nothing was done
 // Ctrl-C or SIGTERM: the verb removes what it had half written and dies of the signal (a shell

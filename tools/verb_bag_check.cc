@@ -446,7 +446,8 @@ int Check(const BagCheckArgs& a) {
 const VerbRegistrar kRegistrar{"bag-check", [](CLI::App& app) -> std::function<int()> {
   auto args = std::make_shared<BagCheckArgs>();
   auto* sub = app.add_subcommand("bag-check", "check a session bag for replay (topics, rates, stamps, holes)");
-  sub->add_option("bag", args->bag, "session bag")->required()->check(CLI::ExistingFile);
+  // (A missing bag is the work failing, status 1, named by rosbag, as every verb's missing input.)
+  sub->add_option("bag", args->bag, "session bag")->required();
   sub->add_option("--gap-tolerance", args->gap_tolerance, "camera hole that breaks a clip [s] (clip_buffer's)")
       ->capture_default_str();
   sub->add_option("--max-future", args->max_future,

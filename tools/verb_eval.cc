@@ -59,8 +59,7 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       ->capture_default_str();
   sub->add_option("--fly-judge", a->fly_judge,
                   "with --flag-flies auto: the judge that decides (train-fly-judge's file; default: fly_judge.pt "
-                  "beside the model when there is one, else the clip's motion cues)")
-      ->check(CLI::ExistingFile);
+                  "beside the model when there is one, else the clip's motion cues)");
   sub->add_flag("--by-view", a->by_view,
                "also break the errors down by the clips' views (camera elevation, angle, distance; texture), "
                "read from each simulated clip's label.json");
