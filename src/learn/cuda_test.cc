@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -135,24 +137,37 @@ TEST(Cuda, SdnForwardAndGradientsMatchTheCpu) {
   }
 }
 
-TEST(Cuda, ShippedModelGivesTheSameEstimateOnTheGpu) {
-  SKIP_WITHOUT_CUDA();
+// The shipped model's outputs [N, 2] on the CPU and on the GPU for the clip `make` gives for its
+// configuration, normalised per clip as the dataset reader and the Predictor do.
+struct BothDevices {
+  at::Tensor cpu, gpu;
+  double label_std = 1;
+};
+BothDevices ShippedModelOnBothDevices(const std::function<at::Tensor(const ModelConfig&)>& make) {
   const char* source = std::getenv("CLOTHWIND_SOURCE_DIR");
-  ASSERT_NE(source, nullptr) << "CLOTHWIND_SOURCE_DIR is set by CTest and scripts/device-check";
+  if (source == nullptr) throw std::runtime_error("CLOTHWIND_SOURCE_DIR is set by CTest and scripts/device-check");
   UseFullFloat32OnCuda();  // the comparisons are of the same float32 arithmetic on two devices
   WindNet net = LoadWindNet(std::filesystem::path(source) / "models/sdn.pt");
-  const ModelConfig& config = net->config();
-  at::Tensor clip = WaveClip(8, config.frames, config.input_size, config.input_size, at::kFloat, 5);
-  // Per-clip normalisation, as the dataset reader and the Predictor apply it.
+  at::Tensor clip = make(net->config());
   clip = (clip - clip.mean({1, 2, 3, 4}, true)) / clip.std({1, 2, 3, 4}, true, true);
   at::NoGradGuard no_grad;
-  const at::Tensor cpu = net->forward(clip);
+  BothDevices out;
+  out.label_std = net->config().label_std;
+  out.cpu = net->forward(clip);
   net->to(at::kCUDA);
-  const at::Tensor gpu = net->forward(clip.to(at::kCUDA)).to(at::kCPU);
+  out.gpu = net->forward(clip.to(at::kCUDA)).to(at::kCPU);
+  return out;
+}
+
+TEST(Cuda, ShippedModelGivesTheSameEstimateOnTheGpu) {
+  SKIP_WITHOUT_CUDA();
+  const BothDevices r = ShippedModelOnBothDevices([](const ModelConfig& c) {
+    return WaveClip(8, c.frames, c.input_size, c.input_size, at::kFloat, 5);
+  });
   // Column 0 in m/s: the estimate a user reads.
-  const at::Tensor speed_difference = (gpu.select(1, 0) - cpu.select(1, 0)).abs() * config.label_std;
+  const at::Tensor speed_difference = (r.gpu.select(1, 0) - r.cpu.select(1, 0)).abs() * r.label_std;
   EXPECT_LT(speed_difference.max().item<double>(), 1e-3) << "m/s";
-  EXPECT_LT((gpu.select(1, 1) - cpu.select(1, 1)).abs().max().item<double>(), 1e-3) << "log variance";
+  EXPECT_LT((r.gpu.select(1, 1) - r.cpu.select(1, 1)).abs().max().item<double>(), 1e-3) << "log variance";
 }
 
 // The same with still pixels, as FlagSim's and a camera's clips have (sky, backdrop: 6-85 % of
@@ -163,21 +178,14 @@ TEST(Cuda, ShippedModelGivesTheSameEstimateOnTheGpu) {
 // whether the node's estimate on a GPU is the CPU's.
 TEST(Cuda, ShippedModelGivesTheSameEstimateOnTheGpuWithStillPixels) {
   SKIP_WITHOUT_CUDA();
-  const char* source = std::getenv("CLOTHWIND_SOURCE_DIR");
-  ASSERT_NE(source, nullptr) << "CLOTHWIND_SOURCE_DIR is set by CTest and scripts/device-check";
-  UseFullFloat32OnCuda();
-  WindNet net = LoadWindNet(std::filesystem::path(source) / "models/sdn.pt");
-  const ModelConfig& config = net->config();
-  at::Tensor clip = WaveClip(8, config.frames, config.input_size, config.input_size, at::kFloat, 5);
-  // The upper half of every frame still (a sky): one value over time, per pixel.
-  const int64_t half = config.input_size / 2;
-  clip.narrow(3, 0, half).copy_(clip.narrow(3, 0, half).narrow(2, 0, 1).clone().expand_as(clip.narrow(3, 0, half)));
-  clip = (clip - clip.mean({1, 2, 3, 4}, true)) / clip.std({1, 2, 3, 4}, true, true);
-  at::NoGradGuard no_grad;
-  const at::Tensor cpu = net->forward(clip);
-  net->to(at::kCUDA);
-  const at::Tensor gpu = net->forward(clip.to(at::kCUDA)).to(at::kCPU);
-  const at::Tensor speed_difference = (gpu.select(1, 0) - cpu.select(1, 0)).abs() * config.label_std;
+  const BothDevices r = ShippedModelOnBothDevices([](const ModelConfig& c) {
+    at::Tensor clip = WaveClip(8, c.frames, c.input_size, c.input_size, at::kFloat, 5);
+    // The upper half of every frame still (a sky): one value over time, per pixel.
+    at::Tensor sky = clip.narrow(3, 0, c.input_size / 2);
+    sky.copy_(sky.narrow(2, 0, 1).clone().expand_as(sky));
+    return clip;
+  });
+  const at::Tensor speed_difference = (r.gpu.select(1, 0) - r.cpu.select(1, 0)).abs() * r.label_std;
   EXPECT_LT(speed_difference.max().item<double>(), 0.05) << "m/s, with still pixels";
 }
 
