@@ -49,7 +49,24 @@ cloth = text[start:end].rstrip().rstrip(",").rstrip().rstrip("]")
 open(sys.argv[2], "w").write(text[:start] + cloth + "," + cloth + "]," + text[end:])
 PY
 refused "cloths' holds 2 cloths" --scene "$work/two.json"
+# A scene whose wind gusts: its clips' labels said the steady speed while the gusts moved the flag.
+python3 - "$src/config/scenes/flag.json" "$work/gusty.json" <<'PY'
+import re, sys
+text = re.sub(r"//[^\n]*", "", open(sys.argv[1]).read())
+text = text.replace('"meshes/', '"' + sys.argv[1].rsplit("/", 1)[0] + '/../meshes/')
+text = text.replace('"materials/', '"' + sys.argv[1].rsplit("/", 1)[0] + '/../materials/')
+text = text.replace('"wind": {"velocity": [3, 0, 0]}', '"wind": {"velocity": [3, 0, 0], "gusts": {"rate": 0.5, "amplitude": 8}}')
+assert '"gusts"' in text
+open(sys.argv[2], "w").write(text)
+PY
+refused "field 'wind' has gusts; make-dataset labels each clip with a steady wind speed" --scene "$work/gusty.json"
 refused --jpeg-quality --format png --jpeg-quality 5  # lossless: unused, yet written into the header
+# ClothSim from this repository's one fabric (no CLOTHWIND_SHARED_DIR, no --materials) is said: it
+# looked like the paper's many-fabric ClothSim.
+CLOTHWIND_SHARED_DIR="" "$bin" make-dataset --kind cloth --count 1 --views 1 --size 16 --frames 2 --jobs 1 \
+  --out "$work/one-fabric" >"$work/msg.txt" 2>&1 || fail "a one-fabric ClothSim: $(cat "$work/msg.txt")"
+grep -q "warning: ClothSim draws from 1 fabric in .*set CLOTHWIND_SHARED_DIR or give --materials DIR" "$work/msg.txt" ||
+  fail "a one-fabric ClothSim was not said: $(cat "$work/msg.txt")"
 refused --jpeg-quality --format pgm --jpeg-quality 5
 refused --warmup --warmup 0.019
 # More frames than a label may hold ran for hours, then every example was refused by the index; a

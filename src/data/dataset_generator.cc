@@ -169,6 +169,14 @@ Prepared Prepare(const DatasetOptions& o) {
   sim::BuildOptions build;
   build.max_edge = o.max_edge;
   p.setup = sim::BuildScene(scene, build);
+  // Each clip is labelled with its steady wind speed: gusts (which only add wind) and turbulence
+  // ran, moving the flag, while the label said the steady speed (4 m/s low at rate 0.5, 8 m/s).
+  const sim::WindSpec& wind = p.setup.wind;
+  if (wind.turbulence.intensity > 0 || (wind.gusts.rate > 0 && wind.gusts.amplitude > 0))
+    throw std::runtime_error(scene_path + ": field 'wind' has " +
+                             (wind.turbulence.intensity > 0 ? std::string("turbulence") : std::string("gusts")) +
+                             "; make-dataset labels each clip with a steady wind speed, which they would not be "
+                             "(give a scene with a steady wind)");
   const Eigen::MatrixXd& U = p.setup.cloths[0].mesh.U;
   if (U.rows() > 0 && U.cols() == 2) p.rest_size = (U.colwise().maxCoeff() - U.colwise().minCoeff()).transpose();
   p.base_theta = sim::SceneTheta(p.setup);
@@ -177,9 +185,17 @@ Prepared Prepare(const DatasetOptions& o) {
   // Before any folder is made: a bad range fails the run here instead of failing every simulation
   // (the samplers check again, cheaply, for callers that use them directly).
   ValidateRanges(p.ranges);
-  if (o.kind == render::SceneKind::kCloth)
-    p.fabrics = LoadFabrics(o.materials_dir.empty() ? DefaultMaterialsDir() : o.materials_dir,
-                            scene_path, o.exclude_fabrics);
+  if (o.kind == render::SceneKind::kCloth) {
+    const std::string dir = o.materials_dir.empty() ? DefaultMaterialsDir() : o.materials_dir;
+    p.fabrics = LoadFabrics(dir, scene_path, o.exclude_fabrics);
+    // The paper's ClothSim draws from ArcSim's fabrics; this repository holds one (its folder is
+    // the fallback without CLOTHWIND_SHARED_DIR), and a one-fabric ClothSim looked like any other.
+    if (p.fabrics.size() < 2)
+      std::fprintf(stderr,
+                   "make-dataset: warning: ClothSim draws from %zu fabric%s in %s; ArcSim's fabrics (the paper's) "
+                   "are in shared/arcsim/materials: set CLOTHWIND_SHARED_DIR or give --materials DIR\n",
+                   p.fabrics.size(), p.fabrics.size() == 1 ? "" : "s", dir.c_str());
+  }
   std::vector<std::string> fabric_files;
   for (const auto& f : p.fabrics) fabric_files.push_back(f.path);
   p.scene_files = SceneFilesFingerprint(scene, fabric_files);

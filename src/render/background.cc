@@ -201,14 +201,16 @@ std::vector<std::string> ListBackgroundImages(const std::string& folder) {
       out.push_back(e.path().string());
   }
   if (out.empty())
-    throw std::runtime_error("background folder '" + folder +
-                             "' holds no .jpg/.jpeg/.png/.bmp image");
+    throw std::runtime_error("background folder '" + folder + "' holds no .jpg/.jpeg/.png/.bmp image");
   std::sort(out.begin(), out.end());
   // Each read whole now: one that cannot be read was found only when a simulation drew it, after
   // its simulation, and every simulation that drew it failed.
   for (const std::string& image : out) {
     std::string why;
-    if (common::ReadImageFile(image, cv::IMREAD_REDUCED_COLOR_8, &why).empty())
+    // Read at an eighth (quick for a folder of photos); a PNG under 8 px, which that scale makes
+    // 0 px, whole (it was refused as unreadable: "inv_scale_x > 0").
+    if (common::ReadImageFile(image, cv::IMREAD_REDUCED_COLOR_8, &why).empty() &&
+        common::ReadImageFile(image, cv::IMREAD_COLOR, &why).empty())
       throw std::runtime_error("background folder '" + folder + "': cannot read " + image + " as an image (" + why +
                                ")");
   }

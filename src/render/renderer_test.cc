@@ -670,7 +670,10 @@ TEST(Backdrop, AFolderHoldingAnUnreadableImageIsRefusedNamingIt) {
   const std::string dir = testing::TempDir() + "/render_bg_bad_" + std::to_string(::getpid());
   std::filesystem::create_directories(dir);
   ASSERT_TRUE(cv::imwrite(dir + "/a.png", cv::Mat(8, 16, CV_8UC3, cv::Scalar(10, 20, 30))));
-  EXPECT_EQ(ListBackgroundImages(dir).size(), 1u);
+  // A PNG under 8 px is an image too (read at an eighth of its size it was 0 px, "unreadable").
+  ASSERT_TRUE(cv::imwrite(dir + "/a4.png", cv::Mat(4, 4, CV_8UC3, cv::Scalar(10, 20, 30))));
+  EXPECT_EQ(ListBackgroundImages(dir).size(), 2u);
+  std::filesystem::remove(dir + "/a4.png");
   std::ofstream(dir + "/b.jpg") << "notanimage";
   try {
     ListBackgroundImages(dir);
