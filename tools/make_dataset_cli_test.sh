@@ -28,12 +28,14 @@ refused --materials --kind flag --materials "$work"
 refused --seed --seed -1
 # Out of range: status 2 (the command line), said before the line naming what it would make,
 # once ("make-dataset: error: make-dataset: ..." named the verb twice); --jobs beyond what TBB runs.
-for bad in "--count 1 --views 99" "--count -2" "--count 1 --jobs 100000"; do
+for bad in "--count 1 --views 99" "--count -2" "--count 1 --jobs 100000" "--count 1 --wind-min 5 --wind-max 2"; do
   status=0
   # shellcheck disable=SC2086
   "$bin" make-dataset --out "$work/out" $bad >"$work/msg.txt" 2>&1 || status=$?
   named="${bad##--count 1 }"
-  [ "$status" -eq 2 ] && grep -q -- "${named%% *} must be" "$work/msg.txt" && ! grep -q "simulations x" "$work/msg.txt" &&
+  says="${named%% *} must be"
+  [ "$named" != "${named#--wind-min}" ] && says="expected 0 <= wind_min <= wind_max"
+  [ "$status" -eq 2 ] && grep -q -- "$says" "$work/msg.txt" && ! grep -q "simulations x" "$work/msg.txt" &&
     [ "$(grep -c "make-dataset" "$work/msg.txt")" -eq 1 ] && [ ! -e "$work/out" ] ||
     fail "make-dataset $bad (status $status): $(cat "$work/msg.txt")"
 done

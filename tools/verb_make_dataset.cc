@@ -10,6 +10,7 @@
 #include "common/parse_pair.h"
 #include "output_paths.h"
 #include "data/dataset_generator.h"
+#include "data/example_sampling.h"
 #include "render/background.h"
 #include "progress_bar.h"
 #include "verb_registry.h"
@@ -100,6 +101,13 @@ int Run(MakeDatasetArgs& a) {
     if (!a.camera_radius.empty())
       ParseRange("--camera-radius", a.camera_radius, &r.camera.radius_min, &r.camera.radius_max);
     if (given(a.camera_angle)) r.camera.angle_max_deg = a.camera_angle;
+    // The command line's ranges, checked as options (status 2) before the line saying what the run
+    // makes: they failed after it, as a failed run.
+    try {
+      data::ValidateRanges(r);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
     o.ranges = r;
   }
   // The renderer's own listing (any case, .bmp too, files only): this verb's copy refused .JPG.
