@@ -13,11 +13,13 @@ export ROS_LOG_DIR="$work/log" ROS_HOME="$work/ros"
 # Our own master on a free port (as scripts/run-main): other tests' masters and nodes are left alone.
 port="$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])')"
 export ROS_MASTER_URI="http://localhost:$port"
-roscore -p "$port" >"$work/roscore.txt" 2>&1 &
-core=$!
-trap 'kill -INT $core 2>/dev/null; wait $core 2>/dev/null; rm -rf "$work"' EXIT
+# The master alone, stopped by SIGTERM: a roscore started in the background of a script ignores
+# SIGINT, and the rosmaster it had started outlived the test (one per run, each on its own port).
+rosmaster --core -p "$port" -w 3 >"$work/rosmaster.txt" 2>&1 &
+master=$!
+trap 'kill -TERM $master 2>/dev/null; wait $master 2>/dev/null; rm -rf "$work"' EXIT
 for _ in $(seq 100); do rosparam list >/dev/null 2>&1 && break; sleep 0.2; done
-rosparam list >/dev/null 2>&1 || fail "roscore did not start: $(cat "$work/roscore.txt")"
+rosparam list >/dev/null 2>&1 || fail "rosmaster did not start: $(cat "$work/rosmaster.txt")"
 
 # run_then_interrupt NAME COMMAND...: starts it, waits for its node to register, sends SIGINT;
 # its output in $work/NAME.txt, its status in $status.
