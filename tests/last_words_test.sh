@@ -17,7 +17,7 @@ export ROS_MASTER_URI="http://localhost:$port"
 # SIGINT, and the rosmaster it had started outlived the test (one per run, each on its own port).
 rosmaster --core -p "$port" -w 3 >"$work/rosmaster.txt" 2>&1 &
 master=$!
-trap 'kill -TERM $master 2>/dev/null; wait $master 2>/dev/null; rm -rf "$work"' EXIT
+trap 'kill -TERM $master 2>/dev/null; wait $master 2>/dev/null || true; rm -rf "$work"' EXIT
 for _ in $(seq 100); do rosparam list >/dev/null 2>&1 && break; sleep 0.2; done
 rosparam list >/dev/null 2>&1 || fail "rosmaster did not start: $(cat "$work/rosmaster.txt")"
 

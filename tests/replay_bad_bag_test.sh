@@ -5,7 +5,9 @@
 # Usage: replay_bad_bag_test.sh
 set -euo pipefail
 work="$(mktemp -d)"
-trap 'rm -rf "$work"' EXIT
+# (A master roslaunch started for a launch it then refused stayed running after the test: the
+# one on this test's port is stopped at its end.)
+trap 'pkill -TERM -f "rosmaster --core -p $port " 2>/dev/null || true; rm -rf "$work"' EXIT
 fail() { echo "replay_bad_bag_test: FAIL: $*" >&2; exit 1; }
 export ROS_LOG_DIR="$work/log"
 # Our own master on a free port (as scripts/run-main): other tests' masters and nodes are left alone.
