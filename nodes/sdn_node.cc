@@ -248,15 +248,13 @@ class SdnNode {
       // measurement, std included, and is not one. Said, not published.
       if (p.no_motion) {
         ++no_motion_;
-        char what[200];
-        std::snprintf(what, sizeof what,
-                      "clip %llu has no motion (its frames are the same: pixels vary by %.3f grey levels over "
-                      "time, below %.2f): a frozen camera? not estimated",
-                      static_cast<unsigned long long>(clip->sequence), p.motion, clothwind::learn::kMinClipMotion);
         const bool first = still_clip_.empty();
-        still_clip_ = what;
+        still_clip_ = clothwind::Formatted(
+            "clip %llu has no motion (its frames are the same: pixels vary by %.3f grey levels over time, below "
+            "%.2f): a frozen camera? not estimated",
+            static_cast<unsigned long long>(clip->sequence), p.motion, clothwind::learn::kMinClipMotion);
         if (first) clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);  // said at once, as an error is
-        WALL_WARN_THROTTLE(30.0, "sdn_node: %s", what);
+        WALL_WARN_THROTTLE(30.0, "sdn_node: %s", still_clip_.c_str());
         clip_error_.clear();
         return;
       }

@@ -2,10 +2,11 @@
 #ifndef CLOTHWIND_TOOLS_USAGE_ERROR_H_
 #define CLOTHWIND_TOOLS_USAGE_ERROR_H_
 
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+
+#include "common/formatted.h"
 
 namespace clothwind::tools {
 
@@ -26,11 +27,7 @@ struct UsageError : std::invalid_argument {
 
 // A number as a message says it: "5" and "0.05", not std::to_string's "5.000000" and
 // "0.050000" ("--minutes ... got 0.000000"); whole numbers as they are.
-inline std::string Num(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.12g", v);  // (a bag time of 1.7e9 s keeps its decimals)
-  return text;
-}
+inline std::string Num(double v) { return FormattedNumber(v); }
 template <typename T, typename = std::enable_if_t<std::is_integral_v<T>>>
 std::string Num(T v) {
   return std::to_string(v);

@@ -18,6 +18,10 @@ std::string Formatted(const char* format, Args... args) {
   return text;
 }
 
+// A number as a message says it: "0.04" and "5", not std::to_string's "0.040000" and
+// "5.000000"; twelve significant digits keep a bag time's decimals (1700000000.123).
+inline std::string FormattedNumber(double v) { return Formatted("%.12g", v); }
+
 }  // namespace clothwind
 
 #endif  // CLOTHWIND_COMMON_FORMATTED_H_

@@ -29,6 +29,7 @@
 #include <tbb/task_arena.h>
 
 #include "common/atomic_file.h"
+#include "common/formatted.h"
 #include "common/image_file.h"
 #include "data/cloth_animation.h"
 #include "data/contact_sheet.h"
@@ -51,13 +52,6 @@ using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
-}
-
-// A number as a message says it: 0.04, not std::to_string's 0.040000.
-std::string Number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.12g", v);
-  return text;
 }
 
 void Check(bool ok, const std::string& what) {
@@ -700,15 +694,15 @@ void ValidateDatasetOptions(const DatasetOptions& o) {
   // The first kept frame is a whole frame: a warm-up between two was rounded without a word, and
   // the header recorded the value asked for while the labels recorded the rounded one.
   Check(std::abs(o.warmup * o.fps - std::round(o.warmup * o.fps)) < 1e-6,
-        "--warmup must be a whole number of frames (a multiple of 1/fps = " + Number(1.0 / o.fps) +
-            " s), got " + Number(o.warmup) + " s");
+        "--warmup must be a whole number of frames (a multiple of 1/fps = " + FormattedNumber(1.0 / o.fps) +
+            " s), got " + FormattedNumber(o.warmup) + " s");
   Check(o.samples >= 0 && o.samples <= 1024, "--samples must be in 0..1024 (0: zeta's default)");
   Check(o.size >= 16 && o.size <= 4096, "--size must be in 16..4096 px");
   // Each job renders an example's frames in memory (RenderAnimation, 3 bytes a pixel) before
   // writing them: refused past 16 GiB an example, which no machine here holds once per job.
   Check(static_cast<double>(o.frames) * o.size * o.size * 3 <= 16.0 * (1ull << 30),
         "--frames x --size^2 x 3 bytes (one example's frames, held in memory while it is written) must be at "
-        "most 16 GiB, got " + Number(static_cast<double>(o.frames) * o.size * o.size * 3 / (1ull << 30)) +
+        "most 16 GiB, got " + FormattedNumber(static_cast<double>(o.frames) * o.size * o.size * 3 / (1ull << 30)) +
             " GiB");
   Check(o.frame_ext == "jpg" || o.frame_ext == "png" || o.frame_ext == "pgm",
         "frame format must be jpg, png or pgm");
@@ -720,8 +714,8 @@ void ValidateDatasetOptions(const DatasetOptions& o) {
   // Checked before the index's header records them: a run refused for them later would leave a
   // folder whose header every corrected run is refused against.
   Check(o.val_fraction >= 0 && o.test_fraction >= 0 && o.val_fraction + o.test_fraction <= 1,  // NaN fails too
-        "--val and --test must be fractions >= 0 that add up to at most 1 (got " + Number(o.val_fraction) +
-            " and " + Number(o.test_fraction) + ")");
+        "--val and --test must be fractions >= 0 that add up to at most 1 (got " + FormattedNumber(o.val_fraction) +
+            " and " + FormattedNumber(o.test_fraction) + ")");
 }
 
 

@@ -1,9 +1,9 @@
 #include "data/example_sampling.h"
 
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 
+#include "common/formatted.h"
 #include "common/random.h"
 
 namespace clothwind::data {
@@ -26,13 +26,9 @@ double LogUniform(Rng& rng, double factor) {
 
 void ValidateRanges(const SamplingRanges& r) {
   if (!(r.wind_min >= 0 && r.wind_max >= r.wind_min && std::isfinite(r.wind_max)))
-  {
-    char what[160];  // the numbers as written (%g), not std::to_string's 5.000000
-    std::snprintf(what, sizeof what,
-                  "sampling ranges: expected 0 <= wind_min <= wind_max, finite [m/s] (--wind-min, --wind-max), got "
-                  "%g, %g", r.wind_min, r.wind_max);
-    throw std::invalid_argument(what);
-  }
+    throw std::invalid_argument(
+        "sampling ranges: expected 0 <= wind_min <= wind_max, finite [m/s] (--wind-min, --wind-max), got " +
+        FormattedNumber(r.wind_min) + ", " + FormattedNumber(r.wind_max));
   if (!(r.cloth_area_weight_min > 0 && r.cloth_area_weight_max >= r.cloth_area_weight_min &&
         std::isfinite(r.cloth_area_weight_max)))
     throw std::invalid_argument("sampling ranges: expected 0 < cloth area weight min <= max, finite");

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "common/formatted.h"
 #include "sensors/gill_windsonic.h"
 #include "sensors/protocol_fields.h"
 
@@ -175,10 +176,9 @@ ParseResult ParseMwd(const NmeaSentence& s) {
     const double rounding = SpeedToMetresPerSecond(HalfLastDigit(s.fields[4]), SpeedUnit::kKnots) +
                             HalfLastDigit(s.fields[6]);
     if (std::abs(from_knots - v[3]) > rounding + 0.01 * std::max(from_knots, v[3])) {
-      char what[640];  // (fields are at most a record's 256 bytes)
-      std::snprintf(what, sizeof what, ": field 5 (%s kn, %.3g m/s) and field 7 (%s m/s) disagree",
-                    s.fields[4].c_str(), from_knots, s.fields[6].c_str());
-      return Fail(ParseStatus::kMalformed, where + what);
+      return Fail(ParseStatus::kMalformed,
+                  where + Formatted(": field 5 (%s kn, %.3g m/s) and field 7 (%s m/s) disagree", s.fields[4].c_str(),
+                                    from_knots, s.fields[6].c_str()));
     }
   }
   r.status = ParseStatus::kOk;
