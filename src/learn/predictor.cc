@@ -120,18 +120,41 @@ Sample Predictor::Prepare(const std::vector<cv::Mat>& frames) const {
 
 double ClipMotion(const std::vector<cv::Mat>& frames) {
   if (frames.empty()) return 0.0;
-  cv::Mat sum = cv::Mat::zeros(frames[0].size(), CV_64F), squares = sum.clone(), grey;
-  for (const cv::Mat& f : frames) {
-    if (f.channels() == 1) grey = f;
-    else cv::extractChannel(f, grey, 0);
-    cv::accumulate(grey, sum);
-    cv::accumulateSquare(grey, squares);
+  const int rows = frames[0].rows, cols = frames[0].cols;
+  // Each pixel's differences from the first frame, summed and squared in integers: exact (a
+  // frozen clip reads 0, and 29 squares of 255 fit), and on sdn_node's path per clip, where
+  // cv::accumulate's doubles took 1.9 ms of a 300 px clip's 13. The spread of x is that of x - x0.
+  std::vector<int32_t> sum(static_cast<size_t>(rows) * cols, 0), squares(sum.size(), 0);
+  const int first_step = frames[0].channels();
+  for (size_t t = 1; t < frames.size(); ++t) {
+    const int step = frames[t].channels();  // the first channel: grey, or Y
+    for (int y = 0; y < rows; ++y) {
+      const uint8_t* first = frames[0].ptr<uint8_t>(y);
+      const uint8_t* row = frames[t].ptr<uint8_t>(y);
+      int32_t* s = sum.data() + static_cast<size_t>(y) * cols;
+      int32_t* q = squares.data() + static_cast<size_t>(y) * cols;
+      if (step == 1 && first_step == 1) {  // grey: contiguous, which the compiler vectorises
+        for (int x = 0; x < cols; ++x) {
+          const int32_t d = row[x] - first[x];
+          s[x] += d;
+          q[x] += d * d;
+        }
+      } else {
+        for (int x = 0; x < cols; ++x) {
+          const int32_t d = row[x * step] - first[x * first_step];
+          s[x] += d;
+          q[x] += d * d;
+        }
+      }
+    }
   }
   const double n = static_cast<double>(frames.size());
-  cv::Mat variance = squares / n - (sum / n).mul(sum / n);
-  cv::max(variance, 0.0, variance);  // rounding
-  cv::sqrt(variance, variance);
-  return cv::mean(variance)[0];
+  double total = 0;
+  for (size_t i = 0; i < sum.size(); ++i) {
+    const double mean = sum[i] / n;
+    total += std::sqrt(std::max(squares[i] / n - mean * mean, 0.0));
+  }
+  return sum.empty() ? 0.0 : total / static_cast<double>(sum.size());
 }
 
 Prediction Predictor::PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps* maps) {
