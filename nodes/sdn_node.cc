@@ -258,6 +258,20 @@ class SdnNode {
         clip_error_.clear();
         return;
       }
+      // A picture without a scene (a covered lens, darkness): its noise moves, and the network reads
+      // some wind into it (not a measurement either). Said, not published.
+      if (p.no_scene) {
+        ++no_scene_;
+        const bool first = still_clip_.empty();
+        still_clip_ = clothwind::Formatted(
+            "clip %llu shows no scene (its picture's contrast is %.2f grey levels, below %.1f: noise or one "
+            "level): a covered lens or darkness? not estimated",
+            static_cast<unsigned long long>(clip->sequence), p.contrast, clothwind::learn::kMinClipContrast);
+        if (first) clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);
+        WALL_WARN_THROTTLE(30.0, "sdn_node: %s", still_clip_.c_str());
+        clip_error_.clear();
+        return;
+      }
       still_clip_.clear();
       // Not published: a reader would average it into everything after it.
       if (!std::isfinite(p.speed) || !std::isfinite(p.speed_std))
@@ -491,6 +505,7 @@ class SdnNode {
     stat.add("clips turned round (flag flying left)", turned_);
     stat.add("clips the fly judge could not tell (the last way kept)", undecided_);
     stat.add("clips without motion (not estimated)", no_motion_);
+    stat.add("clips without a scene (not estimated)", no_scene_);
     stat.add("trailing mean [m/s]", trailing_.Mean());
     stat.add("clips in the trailing mean", trailing_.Count());
     stat.add("malformed clips", errors_);
@@ -531,8 +546,8 @@ class SdnNode {
   std::deque<double> latencies_, stamps_, ages_;  // ages_: [s] ROS time from clip end to its estimate
   clothwind::sensors::TrailingMean trailing_;  // tagged with each clip's start [ns]
   uint64_t estimates_ = 0, errors_ = 0, model_errors_ = 0, dropped_ = 0, turned_ = 0, undecided_ = 0,
-           wind_unknown_ = 0, no_motion_ = 0;
-  std::string still_clip_;  // why the last clip was not estimated (no motion); cleared by an estimate
+           wind_unknown_ = 0, no_motion_ = 0, no_scene_ = 0;
+  std::string still_clip_;  // why the last clip was not estimated (no motion or scene); cleared by an estimate
   double last_estimate_wall_ = 0;                  // [s] wall time of the last estimate
   double loaded_wall_ = 0;                         // [s] wall time the model loaded
   std::string clip_error_;                          // the last clip's failure; cleared by a good clip

@@ -47,4 +47,9 @@ done
 # Written as a JPEG by its extension, whatever its case (a PNG under that name passed the size check).
 [ "$(head -c3 "$work/sheet.JPEG" | od -An -tx1 | tr -d ' \n')" = ffd8ff ] ||
   fail "contact-sheet --out sheet.JPEG is not a JPEG: $(head -c8 "$work/sheet.JPEG" | od -An -tx1)"
+# A sheet in a folder that does not exist yet is written there, the folder made (as every verb's
+# outputs; contact-sheet refused it before 2026-12-07).
+"$bin" contact-sheet "$work/nan" --out "$work/sheets/new/s.png" >"$work/msg.txt" 2>&1 ||
+  fail "contact-sheet into a new folder: $(cat "$work/msg.txt")"
+[ -s "$work/sheets/new/s.png" ] || fail "contact-sheet into a new folder wrote no sheet: $(cat "$work/msg.txt")"
 echo "contact_sheet_cli_test: OK"

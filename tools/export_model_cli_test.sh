@@ -110,6 +110,14 @@ status=0
 [ "$status" -ne 0 ] && [ "$status" -lt 128 ] && grep -q -- "--plot $work/p.txt: expected a file name ending in .png" "$work/msg.txt" &&
   [ ! -e "$work/p.txt" ] || fail "eval --plot p.txt: not refused (status $status): $(cat "$work/msg.txt")"
 
+# Results in folders that do not exist yet are written there, the folders made (as simulate,
+# render, train and export-model make theirs; eval refused them after stop 84's checks).
+"$bin" eval --model "$work/run/model.pt" --data "$work/toy" --split all --json "$work/results/a/e.json" \
+  --plot "$work/results/b/e.png" --threads 1 >"$work/msg.txt" 2>&1 ||
+  fail "eval into new folders: $(cat "$work/msg.txt")"
+[ -s "$work/results/a/e.json" ] && [ -s "$work/results/b/e.png" ] ||
+  fail "eval into new folders wrote: $(find "$work/results" -type f) $(cat "$work/msg.txt")"
+
 # The same clips with the val split moved to train.
 cp -r "$work/toy" "$work/noval"
 sed -i 's/"split": "val"/"split": "train"/' "$work/noval/index.json" "$work"/noval/*/label.json

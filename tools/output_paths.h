@@ -99,17 +99,24 @@ inline void RefuseUnwritableFolder(const std::string& option, const std::filesys
   RefuseUnwritableIn(option, output.string(), std::filesystem::absolute(output, ec).parent_path());
 }
 
-// Throws UsageError naming `option` unless `output` (empty: none) could be written: its
-// folder exists and takes a new file, and it is not a folder itself. Checked before the work, which used to run to its
-// end (a whole evaluation) and then fail to write or, for a plot, exit 0.
+// Throws UsageError naming `option` unless `output` (empty: none) could be written: it is not a
+// folder itself, and its folder, or the nearest one above it that exists, takes a new file (the
+// verb makes the missing folders with MakeFoldersFor, as every verb does for its outputs: eval
+// and contact-sheet refused a missing one where simulate, render, train and export-model made
+// it). Checked before the work, which used to run to its end (a whole evaluation) and then fail
+// to write or, for a plot, exit 0.
 inline void RefuseUnwritableOutput(const std::string& option, const std::filesystem::path& output) {
   if (output.empty()) return;
-  std::error_code ec;
-  const std::filesystem::path folder = output.has_parent_path() ? output.parent_path() : ".";
-  if (!std::filesystem::is_directory(folder, ec))
-    throw UsageError(option + " " + output.string() + ": folder " + folder.string() + " does not exist");
   RefuseFolderAsOutput(option, output);
   RefuseUnwritableFolder(option, output);
+}
+
+// Makes the missing folders `output` (a file; empty: none) goes in, as `mkdir -p` its folder.
+// Throws std::filesystem::filesystem_error naming them when they cannot be made.
+inline void MakeFoldersFor(const std::filesystem::path& output) {
+  if (output.empty()) return;
+  const std::filesystem::path folder = std::filesystem::absolute(output).parent_path();
+  std::filesystem::create_directories(folder);
 }
 
 // Throws UsageError naming `option` unless files can be made in the folder `output_folder` (made

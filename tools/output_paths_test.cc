@@ -35,11 +35,12 @@ TEST(OutputPathsTest, AnOutputThatIsAnInputIsRefusedHoweverSpelt) {
   fs::remove_all(dir);
 }
 
-TEST(OutputPathsTest, AnOutputInAMissingFolderOrOnAFolderIsRefusedBeforeTheWork) {
+TEST(OutputPathsTest, AnOutputOnAFolderOrUnderAFileIsRefusedBeforeTheWork) {
   const fs::path dir = fs::temp_directory_path() / ("clothwind_output_writable_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "sub");
-  for (const fs::path& bad : {dir / "no_such_folder" / "e.json", dir / "sub"}) {
+  std::ofstream(dir / "file") << "x";
+  for (const fs::path& bad : {dir / "sub", dir / "file" / "e.json", dir / "file" / "a" / "e.json"}) {
     try {
       RefuseUnwritableOutput("--json", bad);
       ADD_FAILURE() << bad << " accepted";
@@ -48,6 +49,14 @@ TEST(OutputPathsTest, AnOutputInAMissingFolderOrOnAFolderIsRefusedBeforeTheWork)
     }
   }
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", dir / "sub" / "e.json"));
+  // A missing folder is made by the verb, as every verb's outputs' (eval refused it, simulate
+  // made it): accepted, checked where it will be made, and made by MakeFoldersFor.
+  EXPECT_NO_THROW(RefuseUnwritableOutput("--json", dir / "new" / "deeper" / "e.json"));
+  EXPECT_FALSE(fs::exists(dir / "new"));
+  MakeFoldersFor(dir / "new" / "deeper" / "e.json");
+  EXPECT_TRUE(fs::is_directory(dir / "new" / "deeper"));
+  EXPECT_FALSE(fs::exists(dir / "new" / "deeper" / "e.json"));
+  EXPECT_THROW(RefuseUnwritableOutput("--json", "/proc/new/e.json"), std::invalid_argument);
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", "e.json"));  // the working folder
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", fs::path()));
   // A folder that takes no new file (root writes everywhere but /proc): refused before the work,

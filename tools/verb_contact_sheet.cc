@@ -59,6 +59,7 @@ int Run(const ContactSheetArgs& a) {
   b.label = "contact-sheet";
   b.unit = "tiles";
   ProgressBar bar(b);
+  MakeFoldersFor(out);
   const bool written =
       data::WriteContactSheet(a.dir, index, out, a.options, [&](int done, int total) { bar.Update(done, total); });
   bar.Finish();

@@ -36,7 +36,7 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       ->check(CLI::IsMember({"test", "val", "train", "all"}))
       ->capture_default_str();
   sub->add_option("--json", a->json, "write {\"rmse\", \"acc05\", \"count\", ...} to this file");
-  sub->add_option("--plot", a->plot, "predicted-vs-true PNG (default: <model folder>/eval_<split>.png, with a suffix such as _w3 for a reading "
+  sub->add_option("--plot", a->plot, "predicted-vs-true PNG, its folder made if missing (default: <model folder>/eval_<split>.png, with a suffix such as _w3 for a reading "
                   "other than Table 1's); its data (.dat, every clip's truth, prediction and std) and gnuplot script "
                   "(.gp) are written beside it");
   sub->add_option("--threads", a->threads, "torch threads")->check(CLI::Range(1, 256))->capture_default_str();
@@ -150,6 +150,9 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
         by_view_error = e.what();
       }
     }
+    for (const std::filesystem::path& output :
+         {std::filesystem::path(a->json), plot, std::filesystem::path(a->track_head ? a->track_head_rows : "")})
+      MakeFoldersFor(output);
     // The evaluation's figures are kept whatever the track head does after them.
     if (!a->json.empty() && a->track_head) learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
     if (a->track_head) {

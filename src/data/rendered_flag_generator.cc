@@ -61,8 +61,8 @@ RenderedFlagGenerator::RenderedFlagGenerator(const sensors::SyntheticSessionOpti
   const Eigen::MatrixXd U = cloth.mesh.U;
   UV_ = NormalizeTextureCoordinates(U, U.colwise().minCoeff().transpose(), U.colwise().maxCoeff().transpose());
   // The simulator's clock starts `warmup` before the session does.
-  sim_ = std::make_unique<sim::ClothSimulator>(cloth.mesh, cloth.material, cloth.options,
-                                               std::make_shared<TimeShiftedWind>(field_, -options.warmup));
+  sim_ = std::make_unique<sim::ClothSimulator>(sim::StartClothSimulator(
+      cloth, cloth.material, cloth.options, std::make_shared<TimeShiftedWind>(field_, -options.warmup)));
   previous_ = sim_->positions();
   render::RenderOptions ro;
   ro.threads = options.threads;

@@ -157,11 +157,30 @@ double ClipMotion(const std::vector<cv::Mat>& frames) {
   return sum.empty() ? 0.0 : total / static_cast<double>(sum.size());
 }
 
+double ClipContrast(const std::vector<cv::Mat>& frames) {
+  if (frames.empty()) return 0.0;
+  double total = 0;
+  int counted = 0;
+  for (size_t t = 0; t < frames.size(); t += 5) {
+    cv::Mat blurred;
+    cv::blur(frames[t], blurred, cv::Size(9, 9), cv::Point(-1, -1), cv::BORDER_REFLECT);
+    cv::Scalar mean, spread;
+    cv::meanStdDev(blurred, mean, spread);
+    double largest = 0;
+    for (int c = 0; c < frames[t].channels(); ++c) largest = std::max(largest, spread[c]);
+    total += largest;
+    ++counted;
+  }
+  return total / counted;
+}
+
 Prediction Predictor::PredictFrames(const std::vector<cv::Mat>& frames, PeakMaps* maps) {
   Sample sample = Prepare(frames);
   Prediction p = Predict({&sample})[0];
   p.motion = ClipMotion(std::vector<cv::Mat>(frames.end() - config().frames, frames.end()));
   p.no_motion = p.motion < kMinClipMotion;
+  p.contrast = ClipContrast(std::vector<cv::Mat>(frames.end() - config().frames, frames.end()));
+  p.no_scene = p.contrast < kMinClipContrast;
   p.turned = sample.turned;
   p.undecided = sample.undecided;
   if (flag_flies_ == FlagFlies::kAuto && !sample.undecided) last_turned_ = sample.turned;

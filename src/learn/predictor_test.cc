@@ -148,6 +148,63 @@ TEST_F(PredictorTest, AClipWithoutMotionIsSaidToHaveNone) {
   EXPECT_LT(live_still.motion, 0.3);
 }
 
+// A clip's contrast is its picture's spread once pixel noise is blurred away: a scene's shapes
+// keep theirs, noise and flicker of one level have none.
+TEST(ClipContrastTest, IsTheBlurredPicturesSpreadNotItsNoise) {
+  std::vector<cv::Mat> flicker;  // one level, flickering 100/110: much motion, no scene
+  for (int t = 0; t < 30; ++t) flicker.push_back(cv::Mat(32, 32, CV_8UC1, cv::Scalar(t % 2 ? 110 : 100)));
+  EXPECT_EQ(ClipContrast(flicker), 0.0);
+  EXPECT_GT(ClipMotion(flicker), 4.0);
+  std::vector<cv::Mat> halves;  // a dark half against a bright one: spread 50, a little less blurred
+  for (int t = 0; t < 30; ++t) {
+    cv::Mat f(32, 32, CV_8UC1, cv::Scalar(50));
+    f.colRange(16, 32).setTo(150);
+    halves.push_back(f);
+  }
+  EXPECT_GT(ClipContrast(halves), 40.0);
+  EXPECT_LE(ClipContrast(halves), 50.0);
+  // A covered lens: the dark level 4 and sensor noise of 3 grey levels a pixel.
+  std::vector<cv::Mat> covered;
+  cv::RNG rng(5);
+  for (int t = 0; t < 30; ++t) {
+    cv::Mat noise(32, 32, CV_32F), f;
+    rng.fill(noise, cv::RNG::NORMAL, 4.0, 3.0);
+    noise.convertTo(f, CV_8U);
+    covered.push_back(f);
+  }
+  EXPECT_GT(ClipMotion(covered), 1.0);  // it moves: the motion check alone let it through
+  EXPECT_LT(ClipContrast(covered), 0.6);
+  // Colour: a red half against a green one of the same grey (Y level) is a scene in its chroma.
+  std::vector<cv::Mat> chroma;
+  for (int t = 0; t < 30; ++t) {
+    cv::Mat f(32, 32, CV_8UC3, cv::Scalar(120, 90, 128));
+    f.colRange(16, 32).setTo(cv::Scalar(120, 170, 128));
+    chroma.push_back(f);
+  }
+  EXPECT_GT(ClipContrast(chroma), 30.0);
+}
+
+// A covered lens's clip (noise on black) is no measurement either: the network reads some wind
+// into the noise, so the prediction says it shows no scene; a clip of a scene does not.
+TEST_F(PredictorTest, AClipWithoutASceneIsSaidToHaveNone) {
+  Predictor predictor(dir_ / "model.pt", 1, "cpu");
+  const Prediction live = predictor.PredictFrames(LopsidedClip());
+  EXPECT_FALSE(live.no_scene) << live.contrast;
+  EXPECT_GT(live.contrast, 5.0);
+  std::vector<cv::Mat> covered;
+  cv::RNG rng(6);
+  for (int t = 0; t < 30; ++t) {
+    cv::Mat noise(32, 32, CV_32F), f;
+    rng.fill(noise, cv::RNG::NORMAL, 4.0, 3.0);
+    noise.convertTo(f, CV_8U);
+    covered.push_back(f);
+  }
+  const Prediction dark = predictor.PredictFrames(covered);
+  EXPECT_TRUE(dark.no_scene) << dark.contrast;
+  EXPECT_FALSE(dark.no_motion) << dark.motion;
+  EXPECT_TRUE(std::isfinite(dark.speed));  // the network still answers: the flag says not to trust it
+}
+
 // The frequency image leaves black the pixels whose peak is too weak to mean anything (still sky
 // read as 8.33 Hz was painted like the flag), and colours the rest by frequency.
 TEST(FrequencyMapImageTest, WeakPeaksAreBlack) {

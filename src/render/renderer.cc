@@ -103,11 +103,26 @@ Renderer::StaticSample Renderer::ComputeStatic(const Eigen::Vector3f& org,
   float tb, alpha;
   Rgb bg;
   if (backdrop_.Intersect(org, dir, &tb, &bg, &alpha) && (!any || tb < hit.t)) {
+    // What shows through the backdrop's transparent texels: the sky, or, for a ray going down
+    // past its top (a camera higher than its hills, 100 m up), the ground beyond it. It was sky
+    // always, and such a camera saw a band of sky below the horizon.
+    StaticSample behind;
+    if (any && alpha < 1.0f) {
+      behind = ShadeStatic(hit, sun);
+    } else {
+      behind.base = lighting_.SkyRadiance(dir);
+      behind.what = kSky;
+    }
     s.t = tb;
-    s.what = alpha > 0.5f ? kBackdrop : kSky;
+    s.what = alpha > 0.5f ? static_cast<uint8_t>(kBackdrop) : behind.what;
     // Transparent texels hold colour 0, so the filtered colour is already premultiplied by alpha:
     // multiplying again drew a dark fringe where a procedural backdrop meets the sky.
-    s.base = alpha >= 1.0f ? bg : Rgb(bg + (1.0f - alpha) * lighting_.SkyRadiance(dir));
+    s.base = alpha >= 1.0f ? bg : Rgb(bg + (1.0f - alpha) * behind.base);
+    if (alpha < 1.0f && behind.can_see_sun) {
+      s.can_see_sun = true;
+      s.shadow_org = behind.shadow_org;
+      s.sunlit = (1.0f - alpha) * behind.sunlit;
+    }
     return s;
   }
   if (!any) {
@@ -116,6 +131,14 @@ Renderer::StaticSample Renderer::ComputeStatic(const Eigen::Vector3f& org,
     s.base = lighting_.SkyRadiance(dir);
     return s;
   }
+  StaticSample shaded = ShadeStatic(hit, sun);
+  shaded.dir = dir;
+  shaded.sun = sun;
+  return shaded;
+}
+
+Renderer::StaticSample Renderer::ShadeStatic(const Hit& hit, const Eigen::Vector3f& sun) const {
+  StaticSample s;
   s.t = hit.t;
   Rgb albedo;
   switch (hit.surface) {

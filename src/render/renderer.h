@@ -88,6 +88,9 @@ class Renderer {
   // Radiance of one camera sample this frame; `what` gets the surface it saw.
   Rgb Resolve(const Eigen::Vector3f& org, const StaticSample& s, uint8_t* what) const;
   Rgb ShadeCloth(const Hit& hit, const Eigen::Vector3f& sun) const;
+  // A static surface's sample (ground, pole) at `hit`, lit by the sun sample `sun`; dir and sun
+  // left for the caller.
+  StaticSample ShadeStatic(const Hit& hit, const Eigen::Vector3f& sun) const;
   Rgb GroundAlbedo(const Eigen::Vector3f& p) const;
   void BuildCache();
 

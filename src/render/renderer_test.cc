@@ -434,12 +434,16 @@ TEST(EmbreeScene, GroundReachesPastItsTriangles) {
   EXPECT_FALSE(scene.IntersectStatic(Eigen::Vector3f(0, -700, -1), dir, 1e4f, &hit));
 }
 
-TEST(Renderer, AFarCameraSeesGroundBelowTheHorizon) {
+// Far away, or high above the backdrop's hills (100 m up, looking down past its transparent top,
+// where the sky showed: the ground beyond it shows now).
+class FarCamera : public ::testing::TestWithParam<std::pair<double, double>> {};
+
+TEST_P(FarCamera, SeesGroundBelowTheHorizon) {
   RenderParams p = TestParams();
   p.samples = 1;
   p.width = p.height = 40;
-  p.camera_radius = 700.0;
-  p.camera_height = 3.0;
+  p.camera_radius = GetParam().first;
+  p.camera_height = GetParam().second;
   Renderer r(p);
   const ClothMesh m = WavingFlag(25, 17, 3.0, 2.0, 0.0);
   const cv::Mat img = r.RenderLinear(m.V, m.F, m.UV);
@@ -456,6 +460,9 @@ TEST(Renderer, AFarCameraSeesGroundBelowTheHorizon) {
     }
   EXPECT_GT(below, 300);
 }
+
+INSTANTIATE_TEST_SUITE_P(Renderer, FarCamera,
+                         ::testing::Values(std::pair{700.0, 3.0}, std::pair{60.0, 100.0}));
 
 // A SetCloth refused half way (a bad index in its last face) leaves the previous cloth: it
 // rewrote the faces up to the bad one while Embree kept the old geometry, so hits read the new

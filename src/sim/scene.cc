@@ -30,6 +30,12 @@ using nlohmann::json;
 // multipliers 1).
 constexpr double kMaxAcceleration = 1000;  // |gravity| [m/s^2]: 100 g
 constexpr double kMaxWindSpeed = 1000;     // |wind velocity|, gust amplitude [m/s]: 3x the speed of sound
+// A cloth's initial velocity: the simulator's default max_speed (a faster node ends the first
+// step as exploded); the spin 1000 rad/s (~160 turns a second), the origin's distance 1e4 m (the
+// builder keeps the cloth itself within 100 m, and refuses initial node speeds past max_speed).
+constexpr double kMaxClothSpeed = 1000;    // [m/s]
+constexpr double kMaxClothSpin = 1000;     // [rad/s]
+constexpr double kMaxVelocityOrigin = 1e4; // [m]
 constexpr double kMaxMultiplier = 1e6;     // thicken and the density/stretching/bending multipliers
 constexpr double kMaxDamping = 1000;       // stiffness-proportional damping [s] (cloth: ~0.01 s)
 constexpr double kMaxAirDensity = 1e4;     // wind density [kg/m^3] (water: 1000)
@@ -255,13 +261,30 @@ SceneRemeshing ParseRemeshing(const Reader& r, const json& j, const std::string&
   return m;
 }
 
+// ArcSim's object form ({"linear", "angular", "origin"}); a bare [vx, vy, vz], as the wind's, is
+// refused rather than guessed at.
+SceneVelocity ParseVelocity(const Reader& r, const json& j, const std::string& path) {
+  if (j.is_array())
+    r.Fail(path, "expected an object {\"linear\": [m/s], \"angular\": [rad/s], \"origin\": [m]} (ArcSim's form), "
+                 "got an array: write [vx, vy, vz] as {\"linear\": [vx, vy, vz]}");
+  r.ExpectObject(j, path);
+  r.CheckKeys(j, path, {"linear", "angular", "origin"});
+  SceneVelocity v;
+  if (j.contains("linear")) v.linear = r.BoundedVector3(j["linear"], path + ".linear", kMaxClothSpeed, "m/s");
+  if (j.contains("angular"))
+    v.angular = r.BoundedVector3(j["angular"], path + ".angular", kMaxClothSpin, "rad/s");
+  if (j.contains("origin")) v.origin = r.BoundedVector3(j["origin"], path + ".origin", kMaxVelocityOrigin, "m");
+  return v;
+}
+
 SceneCloth ParseCloth(const Reader& r, const json& j, const std::string& path) {
   r.ExpectObject(j, path);
-  r.CheckKeys(j, path, {"mesh", "transform", "materials", "remeshing"}, {"velocity"});
+  r.CheckKeys(j, path, {"mesh", "transform", "velocity", "materials", "remeshing"});
   SceneCloth c;
   if (!j.contains("mesh")) r.Fail(path + ".mesh", "missing (the cloth's OBJ file)");
   c.mesh = r.File(j["mesh"], path + ".mesh");
   if (j.contains("transform")) c.transform = ParseTransform(r, j["transform"], path + ".transform");
+  if (j.contains("velocity")) c.velocity = ParseVelocity(r, j["velocity"], path + ".velocity");
   if (!j.contains("materials")) r.Fail(path + ".materials", "missing (at least one material)");
   r.ExpectArray(j["materials"], path + ".materials");
   if (j["materials"].empty()) r.Fail(path + ".materials", "expected at least one material");

@@ -48,9 +48,18 @@ struct SceneRemeshing {
   bool present = false;
 };
 
+// ArcSim's `cloths[i].velocity`: every node starts at linear + angular x (x - origin), x its
+// position after the transform (ArcSim's apply_velocity).
+struct SceneVelocity {
+  Eigen::Vector3d linear = Eigen::Vector3d::Zero();   // [m/s]
+  Eigen::Vector3d angular = Eigen::Vector3d::Zero();  // [rad/s], about `origin`
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();   // [m], world
+};
+
 struct SceneCloth {
   std::string mesh;  // absolute path of the OBJ
   SceneTransform transform;
+  SceneVelocity velocity;
   std::vector<SceneMaterial> materials;
   SceneRemeshing remeshing;
 };

@@ -32,6 +32,24 @@ Eigen::MatrixX3d ApplyTransform(const SceneTransform& t, const Eigen::MatrixX3d&
   return out;
 }
 
+Eigen::MatrixX3d RigidVelocities(const SceneVelocity& velocity, const Eigen::MatrixX3d& V) {
+  Eigen::MatrixX3d out(V.rows(), 3);
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const Eigen::Vector3d r = V.row(i).transpose() - velocity.origin;
+    out.row(i) = (velocity.linear + velocity.angular.cross(r)).transpose();
+  }
+  return out;
+}
+
+ClothSimulator StartClothSimulator(const ClothSetup& cloth, const Material& material, const SimOptions& options,
+                                   std::shared_ptr<const WindField> wind) {
+  ClothSimulator sim(cloth.mesh, material, options, std::move(wind));
+  // Only when moving: a still start is the constructor's own, bit for bit.
+  if (cloth.velocities.rows() == cloth.mesh.V.rows() && !cloth.velocities.isZero(0))
+    sim.SetState(cloth.mesh.V, cloth.velocities);
+  return sim;
+}
+
 SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
   if (options.frame_steps < 0) throw std::invalid_argument("BuildOptions.frame_steps must be >= 0");
   // NaN and negative lengths used to fall through the "> 0" tests below as "the scene's default".
@@ -134,6 +152,18 @@ SceneSetup BuildScene(const Scene& scene, const BuildOptions& options) {
     o.collision_stiffness = scene.magic.collision_stiffness;
     o.self_collision = scene.self_collision;
     if (!scene.crossing_correction) o.crossing_sweeps = 0;
+    // After refinement, so new vertices move with the cloth as ArcSim's remeshed nodes do.
+    cloth.velocities = RigidVelocities(sc.velocity, cloth.mesh.V);
+    if (cloth.velocities.rows() > 0) {
+      Eigen::Index row = 0;
+      const double fastest = cloth.velocities.rowwise().norm().maxCoeff(&row);
+      if (!(fastest <= o.max_speed)) {
+        std::ostringstream what;
+        what << "starts vertex " << row << " at " << fastest << " m/s, expected at most the simulator's "
+             << o.max_speed << " m/s (the angular velocity times the distance from the origin counts)";
+        fail(key + ".velocity", what.str());
+      }
+    }
     setup.cloths.push_back(std::move(cloth));
   }
   // Handles index the ORIGINAL mesh; RefineMesh keeps original vertices first, so the indices

@@ -18,6 +18,10 @@ struct ClothSetup {
   Mesh mesh;          // world positions, rest coordinates, faces (refined)
   Material material;  // multipliers applied
   SimOptions options; // dt, gravity, wind density/drag, handles (refined indices), limits, magic
+  // #V by 3 initial velocities [m/s] (ArcSim's cloths[i].velocity, at the refined vertices);
+  // zero when the scene gives none. Pinned nodes start still whatever it says. Start a simulator
+  // with StartClothSimulator (below) so they are used.
+  Eigen::MatrixX3d velocities;
   int original_vertices = 0;  // #V of the OBJ before refinement (handles index these)
   double max_edge = 0.0;      // longest edge the mesh was refined to [m] (0: not refined)
 };
@@ -68,7 +72,8 @@ constexpr double kMaxSceneCoordinate = 100.0;
 // "cloths[0].mesh", "handles[0].nodes[1]") when a mesh or material cannot be read or is invalid
 // (degenerate triangles, NaN, faces oriented inconsistently, unused vertices, an area more than
 // kMaxInitialAreaRatio from the rest area, a vertex beyond kMaxSceneCoordinate, named under
-// ".transform" when the transform put it there), or a handle node is out of range.
+// ".transform" when the transform put it there), an initial velocity that moves a node faster
+// than the simulator's max_speed (".velocity"), or a handle node is out of range.
 SceneSetup BuildScene(const Scene& scene, const BuildOptions& options = {});
 
 // The default resolution BuildScene picks for a remeshing block (see BuildOptions::max_edge):
@@ -76,6 +81,17 @@ SceneSetup BuildScene(const Scene& scene, const BuildOptions& options = {});
 // uniformly to DefaultUniformEdge (size_max), then its longer edges are split.
 double DefaultMaxEdge(const SceneRemeshing& remeshing);
 double DefaultUniformEdge(const SceneRemeshing& remeshing);
+
+// Node velocities of a rigid motion: linear + angular x (x - origin), ArcSim's apply_velocity.
+// Inputs: velocity (SceneVelocity), V #V by 3 positions [m]. Returns #V by 3 velocities [m/s].
+Eigen::MatrixX3d RigidVelocities(const SceneVelocity& velocity, const Eigen::MatrixX3d& V);
+
+// A simulator for `cloth` started as the scene says: at the mesh's positions, moving at
+// cloth.velocities (why not the constructor alone: it starts every cloth still, and ArcSim's
+// cloths[i].velocity was silently dropped). `material` and `options` are the cloth's own unless
+// the caller changed them (theta, wind); `wind` as ClothSimulator's.
+ClothSimulator StartClothSimulator(const ClothSetup& cloth, const Material& material, const SimOptions& options,
+                                   std::shared_ptr<const WindField> wind);
 
 // Applies a scene transform to positions: x -> translate + R(rotate) (scale x).
 // Inputs: V #V by 3 [m]. Returns #V by 3 [m].

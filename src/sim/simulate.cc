@@ -50,8 +50,8 @@ Trajectory SimulateTrajectory(const SceneSetup& setup, const Theta& theta,
   SimOptions sim_options = cloth.options;
   sim_options.wind_density = wind.density;  // the setup's wind may have been edited
   sim_options.wind_drag = wind.drag;
-  ClothSimulator sim(cloth.mesh, material, sim_options,
-                     options.make_wind ? options.make_wind(wind) : MakeWindField(wind));
+  ClothSimulator sim = StartClothSimulator(cloth, material, sim_options,
+                                           options.make_wind ? options.make_wind(wind) : MakeWindField(wind));
   Trajectory t;
   t.faces = cloth.mesh.F;
   t.uv = cloth.mesh.U.cast<float>();

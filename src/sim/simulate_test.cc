@@ -116,6 +116,42 @@ TEST(SimulateTrajectory, WarmupDropsLeadingFramesOfTheSameRun) {
   }
 }
 
+// ArcSim's cloths[i].velocity starts the cloth moving. Without gravity, air or handles a cloth at
+// its rest shape feels no force, so every node keeps its initial velocity: x(t) = x(0) + v t
+// (momentum conservation, the free-flight invariant). Pinned nodes start still whatever the scene
+// says. (The velocity was read and dropped with a warning before 2026-12-07.)
+TEST(SimulateTrajectory, TheScenesInitialVelocityMovesAFreeClothRigidly) {
+  BuildOptions b;
+  b.max_edge = 0.6;
+  Scene scene = LoadScene(SourceDir() + "/config/scenes/flag.json");
+  scene.gravity.setZero();
+  scene.wind = WindSpec{};
+  scene.wind.density = 0;  // no air: no drag on the moving cloth
+  const Eigen::Vector3d v(1.5, -2.0, 0.5);
+  scene.cloths[0].velocity.linear = v;
+  const std::vector<SceneHandle> handles = scene.handles;
+  scene.handles.clear();
+  const SceneSetup free = BuildScene(scene, b);
+  SimulateOptions o;
+  o.duration = 0.4;
+  const Trajectory t = SimulateTrajectory(free, SceneTheta(free), o);
+  ASSERT_EQ(t.num_frames(), 11);
+  for (int f = 0; f < t.num_frames(); ++f) {
+    const Eigen::MatrixX3d expected = (free.cloths[0].mesh.V.rowwise() + (v * f * t.frame_time).transpose());
+    EXPECT_LT((t.frames[f].cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-4) << "frame " << f;
+  }
+  // With the flag's handles back, the hoist stays where it is and the rest moves off.
+  scene.handles = handles;
+  const SceneSetup held = BuildScene(scene, b);
+  const Trajectory h = SimulateTrajectory(held, SceneTheta(held), o);
+  const std::vector<int>& pinned = held.cloths[0].options.handles;
+  ASSERT_FALSE(pinned.empty());
+  for (int n : pinned) EXPECT_EQ(h.frames[1].row(n), h.frames[0].row(n)) << "pinned node " << n;
+  int moved = 0;
+  for (Eigen::Index n = 0; n < h.frames[1].rows(); ++n) moved += (h.frames[1].row(n) - h.frames[0].row(n)).norm() > 0.01;
+  EXPECT_GT(moved, h.frames[1].rows() / 2);
+}
+
 // The scene reader's limits hold for a duration given in code: inf went to lround (undefined),
 // 1e9 s overflowed the frame count, NaN ran the scene's duration.
 TEST(SimulateTrajectory, ADurationPastTheScenesLimitsIsRefused) {

@@ -3,6 +3,7 @@
 their trailing mean, the diagnostics and the spectral images."""
 import math
 import os
+import random
 import shutil
 import subprocess
 import sys
@@ -344,6 +345,20 @@ class SdnNodeTest(unittest.TestCase):
             self.assertNotIn(300, {e.clip_sequence for e in self.estimates})
         values = self.wait_for_estimates(self.statuses, len(self.estimates))
         self.assertEqual(values["clips without motion (not estimated)"], "1", values)
+        # A covered lens (sensor noise of a few grey levels on black): it moves, but shows no scene,
+        # so no estimate, where the network read some wind into the noise; said likewise.
+        covered = make_clip(302, later + rospy.Duration.from_sec(14.0), size, frequency, 4.0)
+        noise_levels = bytes(1 + b % 7 for b in range(256))  # 1..7: a dark level 4, spread 2
+        covered.data = random.Random(7).randbytes(len(covered.data)).translate(noise_levels)
+        self.pub.publish(covered)
+        self.wait_for(lambda: any(s.level == DiagnosticStatus.WARN and "clip 302 shows no scene" in s.message
+                                  for s in self.statuses), 30, "a WARN for the clip without a scene")
+        self.pub.publish(make_clip(303, later + rospy.Duration.from_sec(16.0), size, frequency, 4.0))
+        self.wait_for(lambda: 303 in {e.clip_sequence for e in self.estimates}, 30, "the clip of a scene after it")
+        with self.lock:
+            self.assertNotIn(302, {e.clip_sequence for e in self.estimates})
+        values = self.wait_for_estimates(self.statuses, len(self.estimates))
+        self.assertEqual(values["clips without a scene (not estimated)"], "1", values)
 
     def test_colour_model(self):
         """A model trained with --colour: bgr8 clips get estimates, a mono8 clip an ERROR that names
