@@ -52,4 +52,9 @@ done
 "$bin" contact-sheet "$work/nan" --out "$work/sheets/new/s.png" >"$work/msg.txt" 2>&1 ||
   fail "contact-sheet into a new folder: $(cat "$work/msg.txt")"
 [ -s "$work/sheets/new/s.png" ] || fail "contact-sheet into a new folder wrote no sheet: $(cat "$work/msg.txt")"
+# ...but not below a clip's folder, where it was written once its folder could be made.
+status=0
+"$bin" contact-sheet "$work/nan" --out "$work/nan/toy-00000/new/s.png" >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 2 ] && grep -q "inside the example folder" "$work/msg.txt" && [ ! -e "$work/nan/toy-00000/new" ] ||
+  fail "contact-sheet --out inside a clip's folder (status $status): $(cat "$work/msg.txt")"
 echo "contact_sheet_cli_test: OK"

@@ -111,12 +111,17 @@ inline void RefuseUnwritableOutput(const std::string& option, const std::filesys
   RefuseUnwritableFolder(option, output);
 }
 
-// Makes the missing folders `output` (a file; empty: none) goes in, as `mkdir -p` its folder.
-// Throws std::filesystem::filesystem_error naming them when they cannot be made.
-inline void MakeFoldersFor(const std::filesystem::path& output) {
+// Makes the missing folders `output` (a file; empty: none) goes in, as `mkdir -p` its folder; the
+// verbs call it once the checks pass, before the work (made after it, a failure lost the work).
+// Throws std::runtime_error naming `option`, the output and the folder when they cannot be made.
+inline void MakeFoldersFor(const std::string& option, const std::filesystem::path& output) {
   if (output.empty()) return;
-  const std::filesystem::path folder = std::filesystem::absolute(output).parent_path();
-  std::filesystem::create_directories(folder);
+  std::error_code ec;
+  const std::filesystem::path folder = std::filesystem::absolute(output, ec).parent_path();
+  if (!ec) std::filesystem::create_directories(folder, ec);
+  if (ec)
+    throw std::runtime_error(option + " " + output.string() + ": cannot make its folder " + folder.string() + " (" +
+                             ec.message() + ")");
 }
 
 // Throws UsageError naming `option` unless files can be made in the folder `output_folder` (made

@@ -53,9 +53,17 @@ TEST(OutputPathsTest, AnOutputOnAFolderOrUnderAFileIsRefusedBeforeTheWork) {
   // made it): accepted, checked where it will be made, and made by MakeFoldersFor.
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", dir / "new" / "deeper" / "e.json"));
   EXPECT_FALSE(fs::exists(dir / "new"));
-  MakeFoldersFor(dir / "new" / "deeper" / "e.json");
+  MakeFoldersFor("--json", dir / "new" / "deeper" / "e.json");
   EXPECT_TRUE(fs::is_directory(dir / "new" / "deeper"));
   EXPECT_FALSE(fs::exists(dir / "new" / "deeper" / "e.json"));
+  // One that cannot be made is named by its option, output and folder.
+  try {
+    MakeFoldersFor("--plot", dir / "file" / "p.png");
+    ADD_FAILURE() << "a folder made where a file is";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("--plot " + (dir / "file" / "p.png").string() + ": cannot make its folder " +
+                                              (dir / "file").string(), 0), 0u) << e.what();
+  }
   EXPECT_THROW(RefuseUnwritableOutput("--json", "/proc/new/e.json"), std::invalid_argument);
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", "e.json"));  // the working folder
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", fs::path()));

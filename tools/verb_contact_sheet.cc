@@ -35,8 +35,6 @@ int Run(const ContactSheetArgs& a) {
   // Not over the dataset: `--out DIR/<clip>/003.jpg` replaced a clip's frame with the sheet.
   const std::filesystem::path dir(a.dir);
   RefuseOutputOverInput("--out", out, {dir / "index.json"});
-  const std::filesystem::path out_folder =
-      std::filesystem::path(out).has_parent_path() ? std::filesystem::path(out).parent_path() : ".";
   // Entries of another shape are the core's to refuse naming the field (WriteContactSheet); here
   // they are skipped: value() on a string entry, or a number for a name, threw bare type errors.
   const nlohmann::json clips = index.contains("clips") && index["clips"].is_array() ? index["clips"] : nlohmann::json::array();
@@ -45,9 +43,9 @@ int Run(const ContactSheetArgs& a) {
     const std::string name = clip["name"].get<std::string>();
     if (name.empty()) continue;
     const std::filesystem::path folder = dir / name;
-    if (SameFile(out_folder, folder))
-      throw UsageError("--out " + out + " is inside the example folder " + folder.string() +
-                                  "; write it elsewhere");
+    // Below one too: its missing folders are made now, and a sheet in a clip's subfolder was
+    // written there (the test above compared the sheet's own folder alone).
+    RefuseOutputInsideFolder("--out", out, folder, "the example folder");
   }
   RefuseUnwritableOutput("--out", out);
   // The sheet is held whole in memory (3 bytes a pixel): 10000 tiles of 1024 px were 31 GB.
@@ -59,7 +57,7 @@ int Run(const ContactSheetArgs& a) {
   b.label = "contact-sheet";
   b.unit = "tiles";
   ProgressBar bar(b);
-  MakeFoldersFor(out);
+  MakeFoldersFor("--out", out);
   const bool written =
       data::WriteContactSheet(a.dir, index, out, a.options, [&](int done, int total) { bar.Update(done, total); });
   bar.Finish();

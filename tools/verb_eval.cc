@@ -127,6 +127,9 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       RefuseUnwritableOutput("--track-head-rows", a->track_head_rows);
       learn::CheckTrackHead(a->model, a->track_head_window);
     }
+    MakeFoldersFor("--json", a->json);
+    MakeFoldersFor("--plot", plot);
+    if (a->track_head) MakeFoldersFor("--track-head-rows", a->track_head_rows);
     ProgressBar::Options b;
     b.label = "eval";
     b.unit = "clips";
@@ -150,9 +153,6 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
         by_view_error = e.what();
       }
     }
-    for (const std::filesystem::path& output :
-         {std::filesystem::path(a->json), plot, std::filesystem::path(a->track_head ? a->track_head_rows : "")})
-      MakeFoldersFor(output);
     // The evaluation's figures are kept whatever the track head does after them.
     if (!a->json.empty() && a->track_head) learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
     if (a->track_head) {

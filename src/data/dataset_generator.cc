@@ -179,6 +179,8 @@ Prepared Prepare(const DatasetOptions& o) {
   // Before any folder is made: a bad range fails the run here instead of failing every simulation
   // (the samplers check again, cheaply, for callers that use them directly).
   ValidateRanges(p.ranges);
+  for (const std::string& w : CameraRangeWarnings(p.ranges.camera, p.rest_size.maxCoeff(), o.size))
+    std::fprintf(stderr, "make-dataset: warning: %s\n", w.c_str());
   if (o.kind == render::SceneKind::kCloth) {
     const std::string dir = o.materials_dir.empty() ? DefaultMaterialsDir() : o.materials_dir;
     p.fabrics = LoadFabrics(dir, scene_path, o.exclude_fabrics);

@@ -43,6 +43,17 @@ SamplingRanges DefaultRanges(render::SceneKind kind);
 // are >= 1, the cloth area weights 0 < min <= max and the cameras valid (ValidateCameraRanges).
 void ValidateRanges(const SamplingRanges& r);
 
+// What the camera ranges would make of a cloth of `cloth_length` metres (its longest rest side)
+// in frames of `frame_px`, seen through the samplers' 45 deg field of view (widened, never
+// narrowed, to fit the cloth: so the sizes below are the largest it can show):
+//   - at the farthest radius it spans fewer than 16 px: "clips show next to nothing of it";
+//   - the nearest radius (from the cloth's centre) is within half its length: the camera can
+//     stand inside its sweep, and clips show little of it, or of its motion.
+// Returns one sentence per finding (none for Table 2's ranges and cloths). Why warnings, not
+// refusals: a far or near camera is a legitimate experiment; an unwarned one was not (clips
+// without a visible flag, labelled with the wind, went into a dataset without a word).
+std::vector<std::string> CameraRangeWarnings(const render::CameraRanges& camera, double cloth_length, int frame_px);
+
 // One fabric of ClothSim.
 struct Fabric {
   std::string name;       // file stem, e.g. "gray-interlock"

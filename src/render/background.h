@@ -18,7 +18,8 @@ namespace clothwind::render {
 // horizontal viewing direction; at background_scale = 1 it is kBackdropHeight metres tall and
 // as wide as the picture's aspect says; background_offset shifts the picture sideways [m]. It
 // repeats mirrored sideways so no offset uncovers a gap. Above its top (and where the picture
-// is transparent, as procedural skies are) the renderer's sky shows. Texels hold radiance, so
+// is transparent, as procedural skies are) what lies beyond shows: the renderer's sky, or the
+// ground for a ray going down (a camera above the picture's field or hills). Texels hold radiance, so
 // the wall is not lit again: a photograph carries its own light.
 struct Backdrop {
   static constexpr float kBackdropDistance = 22.0f;  // [m]

@@ -19,7 +19,7 @@ struct ClothSetup {
   Material material;  // multipliers applied
   SimOptions options; // dt, gravity, wind density/drag, handles (refined indices), limits, magic
   // #V by 3 initial velocities [m/s] (ArcSim's cloths[i].velocity, at the refined vertices);
-  // zero when the scene gives none. Pinned nodes start still whatever it says. Start a simulator
+  // zero when the scene gives none, and for pinned nodes (they start still). Start a simulator
   // with StartClothSimulator (below) so they are used.
   Eigen::MatrixX3d velocities;
   int original_vertices = 0;  // #V of the OBJ before refinement (handles index these)

@@ -267,8 +267,8 @@ TEST_F(SceneFiles, AClothsInitialVelocityIsArcSimsRigidMotion) {
   const Eigen::MatrixX3d& vel = setup.cloths[0].velocities;
   ASSERT_EQ(vel.rows(), 4);
   // (0,0,0): r = (-0.5,-0.5,0), w x r = (1,-1,0); (1,0,0): r = (0.5,-0.5,0), w x r = (1,1,0);
-  // (1,1,0): (-1,1,0); (0,1,0): (-1,-1,0).
-  const Eigen::Matrix<double, 4, 3> expected = (Eigen::Matrix<double, 4, 3>() << 2, 1, 0, 2, 3, 0, 0, 3, 0, 0, 1, 0).finished();
+  // (1,1,0): (-1,1,0); (0,1,0): (-1,-1,0). Nodes 0 and 3, the scene's handles, start still.
+  const Eigen::Matrix<double, 4, 3> expected = (Eigen::Matrix<double, 4, 3>() << 0, 0, 0, 2, 3, 0, 0, 3, 0, 0, 0, 0).finished();
   EXPECT_LT((vel - expected).cwiseAbs().maxCoeff(), 1e-12) << vel;
   // No velocity: still.
   EXPECT_TRUE(BuildScene(LoadScene(Write("conf/still.json", SceneText()))).cloths[0].velocities.isZero(0));
@@ -280,7 +280,32 @@ TEST_F(SceneFiles, AClothsInitialVelocityIsArcSimsRigidMotion) {
   ExpectErrorNaming([&] { LoadScene(fast); }, {fast, "cloths[0].velocity.linear", "at most 1000 m/s"});
   const std::string spin = Write("conf/spin.json", SceneText("", "\"velocity\": {\"angular\": [0, 0, 10], "
                                                                  "\"origin\": [300, 0, 0]},"));
-  ExpectErrorNaming([&] { BuildScene(LoadScene(spin)); }, {spin, "cloths[0].velocity", "vertex 3 at 3000.02 m/s", "at most the simulator's 1000 m/s"});
+  ExpectErrorNaming([&] { BuildScene(LoadScene(spin)); }, {spin, "cloths[0].velocity", "vertex 2 at 2990.02 m/s", "at most the simulator's 1000 m/s"});
+  // After the transform and the refinement, about a world point: the quad turned 90 deg about z
+  // and moved to (1, 2, 3), split to 0.2 m edges, spinning at 2 rad/s about (1, 2, 3). Its OBJ
+  // vertex 1, (1, 0, 0), is at (1, 3, 3): r = (0, 1, 0), w x r = (-2, 0, 0); vertex 2, (1, 1, 0),
+  // at (0, 3, 3): r = (-1, 1, 0), w x r = (-2, -2, 0). Pinned nodes (0 and 3) start still.
+  const std::string moved = Write(
+      "conf/moved.json", SceneText("", "\"transform\": {\"translate\": [1, 2, 3], \"rotate\": [90, 0, 0, 1]}, "
+                                       "\"velocity\": {\"angular\": [0, 0, 2], \"origin\": [1, 2, 3]}, "
+                                       "\"remeshing\": {\"size\": [0.2, 0.5]},"));
+  const SceneSetup m = BuildScene(LoadScene(moved));
+  const Eigen::MatrixX3d& mv = m.cloths[0].velocities;
+  ASSERT_GT(m.cloths[0].mesh.V.rows(), 20) << "the quad must be refined for this test";
+  ASSERT_EQ(mv.rows(), m.cloths[0].mesh.V.rows());
+  EXPECT_LT((mv.row(1) - Eigen::RowVector3d(-2, 0, 0)).norm(), 1e-9) << mv.row(1);
+  EXPECT_LT((mv.row(2) - Eigen::RowVector3d(-2, -2, 0)).norm(), 1e-9) << mv.row(2);
+  EXPECT_TRUE(mv.row(0).isZero(0) && mv.row(3).isZero(0)) << mv.row(0) << " " << mv.row(3);
+  for (Eigen::Index i = 4; i < mv.rows(); ++i) {  // the refinement's new vertices spin with the cloth
+    const Eigen::Vector3d r = m.cloths[0].mesh.V.row(i).transpose() - Eigen::Vector3d(1, 2, 3);
+    EXPECT_LT((mv.row(i).transpose() - Eigen::Vector3d(-2 * r.y(), 2 * r.x(), 0)).norm(), 1e-9) << i;
+  }
+  // A pinned node's speed does not count: spun fast about (1, 0.5, 0), the pinned corners would
+  // move at 1118 m/s, the free ones move at 500.
+  const std::string pinned_fast = Write("conf/pinned_fast.json", SceneText("", "\"velocity\": {\"angular\": [0, 0, 1000], "
+                                                                               "\"origin\": [1, 0.5, 0]},"));
+  const SceneSetup pf = BuildScene(LoadScene(pinned_fast));
+  EXPECT_NEAR(pf.cloths[0].velocities.rowwise().norm().maxCoeff(), 500.0, 1e-9);
   Warnings typo;
   LoadScene(Write("conf/typo.json", SceneText("", "\"velocity\": {\"linaer\": [1, 0, 0]},")), typo.sink());
   ASSERT_EQ(typo.list.size(), 1u);
