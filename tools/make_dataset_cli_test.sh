@@ -69,6 +69,10 @@ CLOTHWIND_SHARED_DIR="" "$bin" make-dataset --kind cloth --count 1 --views 1 --s
   --out "$work/one-fabric" >"$work/msg.txt" 2>&1 || fail "a one-fabric ClothSim: $(cat "$work/msg.txt")"
 grep -q "warning: ClothSim draws from 1 fabric in .*set CLOTHWIND_SHARED_DIR or give --materials DIR" "$work/msg.txt" ||
   fail "a one-fabric ClothSim was not said: $(cat "$work/msg.txt")"
+# The 16 px frames of that run show the 1 m cloth over 7.7 px at most (2.5 m away): said, before
+# the work (clips without a visible cloth went into datasets without a word).
+grep -q "warning: cameras up to 2.5 m away (--camera-radius) see the 1 m cloth over about 7.73 px of the 16 px frame" \
+  "$work/msg.txt" || fail "a cloth of a few pixels was not said: $(cat "$work/msg.txt")"
 refused --jpeg-quality --format pgm --jpeg-quality 5
 refused --warmup --warmup 0.019
 # More frames than a label may hold ran for hours, then every example was refused by the index; a

@@ -258,6 +258,30 @@ TEST(ExampleSamplingTest, SplitsFollowTheFractions) {
   }
 }
 
+// Cameras so far that the cloth is a few pixels, or so near they stand in its sweep, are said
+// (clips without a visible flag went into a dataset without a word); Table 2's are not.
+TEST(ExampleSamplingTest, CameraRangesThatShowLittleOfTheClothWarn) {
+  EXPECT_TRUE(CameraRangeWarnings(DefaultRanges(render::SceneKind::kFlag).camera, 3.0, 300).empty());
+  EXPECT_TRUE(CameraRangeWarnings(DefaultRanges(render::SceneKind::kCloth).camera, 1.0, 300).empty());
+  render::CameraRanges far = DefaultRanges(render::SceneKind::kFlag).camera;
+  far.radius_min = 900;
+  far.radius_max = 1000;
+  // The frame spans 2 x 1000 x tan(22.5 deg) = 828.4 m; the 3 m flag 300 x 3 / 828.4 = 1.09 px.
+  const std::vector<std::string> w = CameraRangeWarnings(far, 3.0, 300);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("1000 m away (--camera-radius)"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("about 1.09 px of the 300 px frame"), std::string::npos) << w[0];
+  // 16 px is the bar: a 3 m flag at 6 m spans 181 px of 300, 9.7 of a 16 px frame.
+  EXPECT_EQ(CameraRangeWarnings(DefaultRanges(render::SceneKind::kFlag).camera, 3.0, 16).size(), 1u);
+  render::CameraRanges near = DefaultRanges(render::SceneKind::kFlag).camera;
+  near.radius_min = 1.0;  // within half the 3 m flag's length of its centre
+  const std::vector<std::string> n = CameraRangeWarnings(near, 3.0, 300);
+  ASSERT_EQ(n.size(), 1u);
+  EXPECT_NE(n[0].find("from 1 m from the cloth's centre"), std::string::npos) << n[0];
+  EXPECT_NE(n[0].find("inside its sweep"), std::string::npos) << n[0];
+  EXPECT_TRUE(CameraRangeWarnings(near, 0.0, 300).empty());  // size unknown: nothing said
+}
+
 TEST(ExampleSamplingTest, ExampleNames) {
   EXPECT_EQ(ExampleName(render::SceneKind::kFlag, 12, 1), "flag-000012-v1");
   EXPECT_EQ(ExampleName(render::SceneKind::kCloth, 1234567, 0), "cloth-1234567-v0");
