@@ -128,7 +128,8 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       learn::CheckTrackHead(a->model, a->track_head_window);
     }
     MakeFoldersFor("--json", a->json);
-    MakeFoldersFor("--plot", plot);
+    // The default plot's folder is the model's: made, it would outlive a misspelt --model.
+    if (!a->plot.empty()) MakeFoldersFor("--plot", plot);
     if (a->track_head) MakeFoldersFor("--track-head-rows", a->track_head_rows);
     ProgressBar::Options b;
     b.label = "eval";

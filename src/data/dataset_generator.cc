@@ -35,6 +35,7 @@
 #include "data/contact_sheet.h"
 #include "data/dataset_index.h"
 #include "data/paths.h"
+#include "render/camera.h"
 #include "render/render_params.h"
 #include "render/renderer.h"
 #include "sim/scene.h"
@@ -179,8 +180,17 @@ Prepared Prepare(const DatasetOptions& o) {
   // Before any folder is made: a bad range fails the run here instead of failing every simulation
   // (the samplers check again, cheaply, for callers that use them directly).
   ValidateRanges(p.ranges);
-  for (const std::string& w : CameraRangeWarnings(p.ranges.camera, p.rest_size.maxCoeff(), o.size))
-    std::fprintf(stderr, "make-dataset: warning: %s\n", w.c_str());
+  // Not for --add-tracks, which renders no clip.
+  if (!o.add_tracks) {
+    render::RenderParams framing = render::SampleRenderParams(o.kind, 0, {}, p.ranges.camera);
+    if (p.rest_size.minCoeff() > 0) {
+      framing.mesh_width = p.rest_size.x();
+      framing.mesh_aspect_ratio = p.rest_size.x() / p.rest_size.y();
+    }
+    for (const std::string& w : CameraRangeWarnings(p.ranges.camera, p.rest_size.maxCoeff(),
+                                                    render::MeshCentre(framing).z(), o.size))
+      std::fprintf(stderr, "make-dataset: warning: %s\n", w.c_str());
+  }
   if (o.kind == render::SceneKind::kCloth) {
     const std::string dir = o.materials_dir.empty() ? DefaultMaterialsDir() : o.materials_dir;
     p.fabrics = LoadFabrics(dir, scene_path, o.exclude_fabrics);

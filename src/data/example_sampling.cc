@@ -38,22 +38,25 @@ void ValidateRanges(const SamplingRanges& r) {
   render::ValidateCameraRanges(r.camera);
 }
 
-std::vector<std::string> CameraRangeWarnings(const render::CameraRanges& camera, double cloth_length, int frame_px) {
+std::vector<std::string> CameraRangeWarnings(const render::CameraRanges& camera, double cloth_length,
+                                             double centre_height, int frame_px) {
   std::vector<std::string> warnings;
   if (!(cloth_length > 0) || frame_px <= 0) return warnings;
   constexpr double kFovDeg = 45.0;  // SampleRenderParams' field of view
-  constexpr double kMinSpanPx = 16.0;
-  const double frame_width_m = 2.0 * camera.radius_max * std::tan(kFovDeg / 2 * M_PI / 180.0);
-  const double span_px = frame_px * cloth_length / frame_width_m;
-  if (span_px < kMinSpanPx)
-    warnings.push_back("cameras up to " + FormattedNumber(camera.radius_max) + " m away (--camera-radius) see the " +
-                       FormattedNumber(cloth_length) + " m cloth over about " + Formatted("%.3g", span_px) +
-                       " px of the " + std::to_string(frame_px) + " px frame at most: clips show next to nothing of it");
+  constexpr double kMinFraction = 0.05;
+  const double rise = std::max(std::abs(camera.height_max - centre_height), std::abs(camera.height_min - centre_height));
+  const double farthest = std::hypot(camera.radius_max, rise);
+  const double fraction = cloth_length / (2.0 * farthest * std::tan(kFovDeg / 2 * M_PI / 180.0));
+  if (fraction < kMinFraction)
+    warnings.push_back("cameras up to " + Formatted("%.4g", farthest) + " m away (--camera-radius, --camera-height) see "
+                       "the " + FormattedNumber(cloth_length) + " m cloth over about " +
+                       Formatted("%.3g", fraction * frame_px) + " px of the " + std::to_string(frame_px) +
+                       " px frame at most: clips show next to nothing of it");
   // The radius is measured from the cloth's centre, so its far end reaches half its length from it.
   if (camera.radius_min < cloth_length / 2)
     warnings.push_back("cameras from " + FormattedNumber(camera.radius_min) + " m from the cloth's centre "
                        "(--camera-radius) stand within half its length (" + FormattedNumber(cloth_length) +
-                       " m): inside its sweep, clips show little of it");
+                       " m): it overflows the frame, and clips show little of it");
   return warnings;
 }
 

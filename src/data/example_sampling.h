@@ -44,15 +44,17 @@ SamplingRanges DefaultRanges(render::SceneKind kind);
 void ValidateRanges(const SamplingRanges& r);
 
 // What the camera ranges would make of a cloth of `cloth_length` metres (its longest rest side)
-// in frames of `frame_px`, seen through the samplers' 45 deg field of view (widened, never
-// narrowed, to fit the cloth: so the sizes below are the largest it can show):
-//   - at the farthest radius it spans fewer than 16 px: "clips show next to nothing of it";
-//   - the nearest radius (from the cloth's centre) is within half its length: the camera can
-//     stand inside its sweep, and clips show little of it, or of its motion.
+// whose centre is `centre_height` metres up (render::MeshCentre), in frames of `frame_px`, seen
+// through the samplers' 45 deg field of view:
+//   - at the farthest camera (its radius and the height farthest from the centre's) it spans
+//     under 5 % of the frame: "clips show next to nothing of it";
+//   - the nearest radius (from the cloth's centre) is within half its length: the cloth overflows
+//     the frame (or passes the camera), and clips show little of it, or of its motion.
 // Returns one sentence per finding (none for Table 2's ranges and cloths). Why warnings, not
 // refusals: a far or near camera is a legitimate experiment; an unwarned one was not (clips
 // without a visible flag, labelled with the wind, went into a dataset without a word).
-std::vector<std::string> CameraRangeWarnings(const render::CameraRanges& camera, double cloth_length, int frame_px);
+std::vector<std::string> CameraRangeWarnings(const render::CameraRanges& camera, double cloth_length,
+                                             double centre_height, int frame_px);
 
 // One fabric of ClothSim.
 struct Fabric {

@@ -258,28 +258,39 @@ TEST(ExampleSamplingTest, SplitsFollowTheFractions) {
   }
 }
 
-// Cameras so far that the cloth is a few pixels, or so near they stand in its sweep, are said
-// (clips without a visible flag went into a dataset without a word); Table 2's are not.
+// Cameras so far that the cloth is a few pixels, or so near it overflows the frame, are said
+// (clips without a visible flag went into a dataset without a word); Table 2's are not, at any
+// frame size.
 TEST(ExampleSamplingTest, CameraRangesThatShowLittleOfTheClothWarn) {
-  EXPECT_TRUE(CameraRangeWarnings(DefaultRanges(render::SceneKind::kFlag).camera, 3.0, 300).empty());
-  EXPECT_TRUE(CameraRangeWarnings(DefaultRanges(render::SceneKind::kCloth).camera, 1.0, 300).empty());
-  render::CameraRanges far = DefaultRanges(render::SceneKind::kFlag).camera;
+  const render::CameraRanges flag = DefaultRanges(render::SceneKind::kFlag).camera;
+  for (int px : {16, 64, 300}) {
+    EXPECT_TRUE(CameraRangeWarnings(flag, 3.0, 5.6, px).empty()) << px;
+    EXPECT_TRUE(CameraRangeWarnings(DefaultRanges(render::SceneKind::kCloth).camera, 1.0, 2.5, px).empty()) << px;
+  }
+  render::CameraRanges far = flag;
   far.radius_min = 900;
   far.radius_max = 1000;
-  // The frame spans 2 x 1000 x tan(22.5 deg) = 828.4 m; the 3 m flag 300 x 3 / 828.4 = 1.09 px.
-  const std::vector<std::string> w = CameraRangeWarnings(far, 3.0, 300);
+  // 1000 m away and 5.4 m below the centre: the frame spans 2 x 1000.01 x tan(22.5 deg) = 828.4 m,
+  // the 3 m flag 300 x 3 / 828.4 = 1.09 px.
+  const std::vector<std::string> w = CameraRangeWarnings(far, 3.0, 5.6, 300);
   ASSERT_EQ(w.size(), 1u);
-  EXPECT_NE(w[0].find("1000 m away (--camera-radius)"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("up to 1000 m away (--camera-radius, --camera-height)"), std::string::npos) << w[0];
   EXPECT_NE(w[0].find("about 1.09 px of the 300 px frame"), std::string::npos) << w[0];
-  // 16 px is the bar: a 3 m flag at 6 m spans 181 px of 300, 9.7 of a 16 px frame.
-  EXPECT_EQ(CameraRangeWarnings(DefaultRanges(render::SceneKind::kFlag).camera, 3.0, 16).size(), 1u);
-  render::CameraRanges near = DefaultRanges(render::SceneKind::kFlag).camera;
+  // Far by height alone: 90-100 m up at Table 2's radii, 94.6 m from the centre: 11.5 px of 300.
+  render::CameraRanges high = flag;
+  high.height_min = 90;
+  high.height_max = 100;
+  const std::vector<std::string> h = CameraRangeWarnings(high, 3.0, 5.6, 300);
+  ASSERT_EQ(h.size(), 1u);
+  EXPECT_NE(h[0].find("up to 94.59 m away"), std::string::npos) << h[0];
+  EXPECT_NE(h[0].find("about 11.5 px"), std::string::npos) << h[0];
+  render::CameraRanges near = flag;
   near.radius_min = 1.0;  // within half the 3 m flag's length of its centre
-  const std::vector<std::string> n = CameraRangeWarnings(near, 3.0, 300);
+  const std::vector<std::string> n = CameraRangeWarnings(near, 3.0, 5.6, 300);
   ASSERT_EQ(n.size(), 1u);
   EXPECT_NE(n[0].find("from 1 m from the cloth's centre"), std::string::npos) << n[0];
-  EXPECT_NE(n[0].find("inside its sweep"), std::string::npos) << n[0];
-  EXPECT_TRUE(CameraRangeWarnings(near, 0.0, 300).empty());  // size unknown: nothing said
+  EXPECT_NE(n[0].find("it overflows the frame"), std::string::npos) << n[0];
+  EXPECT_TRUE(CameraRangeWarnings(near, 0.0, 5.6, 300).empty());  // size unknown: nothing said
 }
 
 TEST(ExampleSamplingTest, ExampleNames) {

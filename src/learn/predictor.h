@@ -60,12 +60,11 @@ double ClipMotion(const std::vector<cv::Mat>& frames);
 inline constexpr double kMinClipContrast = 1.0;
 
 // The contrast of a clip: its frames' spatial standard deviation after a 9 x 9 box blur (which
-// averages pixel noise away and keeps the scene's shapes), about the best quadratic surface over
-// the frame (which takes out a vignette or a light leak's gradient across a covered lens, and
-// leaves a step such as a horizon or a flag's edge about half its height), in grey levels, the
-// largest over the channels (a colour clip's red flag against green may share one grey), the
-// mean over every fifth frame (the scene does not change within a clip). Not caught: noise past ~9 grey levels a pixel (a dark camera at full gain), a
-// timestamp or logo burned into the dark frame (it is a scene to this measure).
+// averages pixel noise away and keeps the scene's shapes), in grey levels, the largest over the
+// channels (a colour clip's red flag against green may share one grey), the mean over every
+// fifth frame (the scene does not change within a clip). Not caught: noise past ~9 grey levels a
+// pixel (a dark camera at full gain), a timestamp or logo burned into the dark frame, a light
+// leak's or a vignette's gradient across a covered lens (each a scene to this measure).
 // Inputs: frames  at least one, 8-bit, one size (1 or 3 channels).
 // Returns it (0, to rounding, for a uniform picture, however it flickers).
 double ClipContrast(const std::vector<cv::Mat>& frames);
