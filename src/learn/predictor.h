@@ -56,7 +56,8 @@ double ClipMotion(const std::vector<cv::Mat>& frames);
 
 // [grey levels] Below this a clip's picture is flat: no flag, pole or horizon, noise alone. Why
 // 1: a 9 x 9 box blur leaves 1/9 of a pixel's noise, so sensor noise up to ~9 grey levels a pixel
-// reads under it, where a flag against the sky, even in fog or at dusk, spreads over tens.
+// reads under it, where a flag against the sky spreads over tens (a faint flag in thick fog, a few
+// grey levels from it, may not: it is not estimated).
 inline constexpr double kMinClipContrast = 1.0;
 
 // The contrast of a clip: its frames' spatial standard deviation after a 9 x 9 box blur (which
