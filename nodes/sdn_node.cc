@@ -244,30 +244,22 @@ class SdnNode {
       const bool want_maps = power_pub_.getNumSubscribers() > 0 || frequency_pub_.getNumSubscribers() > 0;
       clothwind::learn::PeakMaps maps;
       const clothwind::learn::Prediction p = predictor_->PredictFrames(frames, want_maps ? &maps : nullptr);
-      // No motion to read (a frozen camera, a covered lens): the network's answer looks like a
-      // measurement, std included, and is not one. Said, not published.
-      if (p.no_motion) {
-        ++no_motion_;
+      // No motion to read (a frozen camera), or no scene (a covered lens, darkness: its noise moves,
+      // and the network reads wind into it): the network's answer looks like a measurement, std
+      // included, and is not one. Said, not published.
+      if (p.no_motion || p.no_scene) {
+        ++(p.no_motion ? no_motion_ : no_scene_);
         const bool first = still_clip_.empty();
-        still_clip_ = clothwind::Formatted(
-            "clip %llu has no motion (its frames are the same: pixels vary by %.3f grey levels over time, below "
-            "%.2f): a frozen camera? not estimated",
-            static_cast<unsigned long long>(clip->sequence), p.motion, clothwind::learn::kMinClipMotion);
+        const auto sequence = static_cast<unsigned long long>(clip->sequence);
+        still_clip_ =
+            p.no_motion
+                ? clothwind::Formatted("clip %llu has no motion (its frames are the same: pixels vary by %.3f grey "
+                                       "levels over time, below %.2f): a frozen camera? not estimated",
+                                       sequence, p.motion, clothwind::learn::kMinClipMotion)
+                : clothwind::Formatted("clip %llu shows no scene (its picture's contrast is %.2f grey levels, below "
+                                       "%.1f: noise or one level): a covered lens or darkness? not estimated",
+                                       sequence, p.contrast, clothwind::learn::kMinClipContrast);
         if (first) clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);  // said at once, as an error is
-        WALL_WARN_THROTTLE(30.0, "sdn_node: %s", still_clip_.c_str());
-        clip_error_.clear();
-        return;
-      }
-      // A picture without a scene (a covered lens, darkness): its noise moves, and the network reads
-      // some wind into it (not a measurement either). Said, not published.
-      if (p.no_scene) {
-        ++no_scene_;
-        const bool first = still_clip_.empty();
-        still_clip_ = clothwind::Formatted(
-            "clip %llu shows no scene (its picture's contrast is %.2f grey levels, below %.1f: noise or one "
-            "level): a covered lens or darkness? not estimated",
-            static_cast<unsigned long long>(clip->sequence), p.contrast, clothwind::learn::kMinClipContrast);
-        if (first) clothwind::ros_bridge::ForceDiagnosticUpdate(updater_);
         WALL_WARN_THROTTLE(30.0, "sdn_node: %s", still_clip_.c_str());
         clip_error_.clear();
         return;

@@ -54,6 +54,19 @@ std::vector<cv::Mat> LopsidedClip() {
   return frames;
 }
 
+// A covered lens's 30 frames of 32 px: the dark level 4 and sensor noise of 3 grey levels a pixel.
+std::vector<cv::Mat> CoveredLensClip(uint64_t seed) {
+  std::vector<cv::Mat> frames;
+  cv::RNG rng(seed);
+  for (int t = 0; t < 30; ++t) {
+    cv::Mat noise(32, 32, CV_32F), f;
+    rng.fill(noise, cv::RNG::NORMAL, 4.0, 3.0);
+    noise.convertTo(f, CV_8U);
+    frames.push_back(f);
+  }
+  return frames;
+}
+
 double MaxAbsDiff(const cv::Mat& a, const cv::Mat& b) { return cv::norm(a, b, cv::NORM_INF); }
 
 // A network's output placed below 0 by the label scale is read as calm (0 m/s), one above it as
@@ -170,14 +183,7 @@ TEST(ClipContrastTest, IsTheBlurredPicturesSpreadNotItsNoise) {
   EXPECT_LE(ClipContrast(halves), 50.0);
   EXPECT_GT(ClipContrast(tiny), 20.0);
   // A covered lens: the dark level 4 and sensor noise of 3 grey levels a pixel.
-  std::vector<cv::Mat> covered;
-  cv::RNG rng(5);
-  for (int t = 0; t < 30; ++t) {
-    cv::Mat noise(32, 32, CV_32F), f;
-    rng.fill(noise, cv::RNG::NORMAL, 4.0, 3.0);
-    noise.convertTo(f, CV_8U);
-    covered.push_back(f);
-  }
+  const std::vector<cv::Mat> covered = CoveredLensClip(5);
   EXPECT_GT(ClipMotion(covered), 1.0);  // it moves: the motion check alone let it through
   EXPECT_LT(ClipContrast(covered), 0.6);
   // Colour: a red half against a green one of the same grey (Y level) is a scene in its chroma.
@@ -197,14 +203,7 @@ TEST_F(PredictorTest, AClipWithoutASceneIsSaidToHaveNone) {
   const Prediction live = predictor.PredictFrames(LopsidedClip());
   EXPECT_FALSE(live.no_scene) << live.contrast;
   EXPECT_GT(live.contrast, 5.0);
-  std::vector<cv::Mat> covered;
-  cv::RNG rng(6);
-  for (int t = 0; t < 30; ++t) {
-    cv::Mat noise(32, 32, CV_32F), f;
-    rng.fill(noise, cv::RNG::NORMAL, 4.0, 3.0);
-    noise.convertTo(f, CV_8U);
-    covered.push_back(f);
-  }
+  const std::vector<cv::Mat> covered = CoveredLensClip(6);
   const Prediction dark = predictor.PredictFrames(covered);
   EXPECT_TRUE(dark.no_scene) << dark.contrast;
   EXPECT_FALSE(dark.no_motion) << dark.motion;
