@@ -70,7 +70,7 @@ namespace {
 class SdnNode {
  public:
   // Throws ParamError for a parameter of the wrong type (main ends on it); one out of its range is
-  // an ERROR in diagnostics and its default is used.
+  // logged as an error, a WARN in diagnostics, and its default is used.
   SdnNode(ros::NodeHandle& nh, clothwind::ros_bridge::StrictParams& params)
       : transport_(nh), trailing_(MeanWindow(params)) {
     model_path_ = clothwind::ros_bridge::AbsolutePathParam("sdn_node: ~model", params.Get("model", ""));

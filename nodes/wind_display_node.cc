@@ -1,8 +1,9 @@
 // wind_display_node: turns the latest wind estimate and anemometer readings into things rviz
 // shows (rviz cannot plot custom scalar messages), for launch/monitor.launch:
-//   monitor/wind_markers (visualization_msgs/MarkerArray): a view-facing text, two lines
-//     "estimate 3.4 ± 0.3 m/s, 60 s mean 3.6" / "anemometer 3.2 m/s (60 s mean)", and an arrow along the
-//     anemometer's latest air velocity (REP 103: where the wind blows TO), 1 m per m/s, in the
+//   monitor/wind_markers (visualization_msgs/MarkerArray): a view-facing text, three lines
+//     "estimate 3.4 ± 0.3 m/s" / "60 s mean 3.6" / "anemometer 3.2 m/s (60 s mean)", and an arrow along
+//     the anemometer's latest air velocity (REP 103: where the wind blows TO), 0.3 m per m/s up to
+//     4.5 m (sensors/wind_plot.h WindArrowScale), in the
 //     anemometer's frame (header.frame_id of anemometer/wind, so rviz needs no transform when its
 //     fixed frame is that frame);
 //   monitor/wind_plot (sensor_msgs/Image, bgr8): estimate (with ±std band) vs anemometer over the

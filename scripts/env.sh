@@ -2,7 +2,8 @@
 # - /usr/bin first: a pyenv/conda python3 earlier on PATH breaks catkin and rospy.
 # - ROS_HOME inside the build folder (logs, test results, nodes' relative outputs), even when set
 #   before: the tests' cached bags and results live there. ROS_HOSTNAME=localhost so nothing
-#   depends on the host name resolving.
+#   depends on the host name resolving, unless ROS_HOSTNAME or ROS_IP is set already: forced, the
+#   nodes advertised localhost to a remote rviz, which then listed the topics and got nothing.
 # - OMP_WAIT_POLICY=PASSIVE: libtorch's spinning OpenMP threads slow other nodes down 5-15x.
 CLOTHWIND_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 CLOTHWIND_BUILD="${CLOTHWIND_BUILD:-$CLOTHWIND_ROOT/build}"
@@ -11,7 +12,7 @@ CLOTHWIND_BUILD="$(realpath -ms -- "$CLOTHWIND_BUILD")"  # as scripts/build
 # The build's bin first: `clothwind` and the benches by name, as every doc types them.
 export PATH="$CLOTHWIND_BUILD/bin:/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 export ROS_HOME="$CLOTHWIND_BUILD/ros_home"
-export ROS_HOSTNAME=localhost
+if [ -z "${ROS_HOSTNAME:-}" ] && [ -z "${ROS_IP:-}" ]; then export ROS_HOSTNAME=localhost; fi
 export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"
 export OMP_WAIT_POLICY=PASSIVE
 export PYTHONUNBUFFERED=1

@@ -57,4 +57,15 @@ status=0
 "$bin" contact-sheet "$work/nan" --out "$work/nan/toy-00000/new/s.png" >"$work/msg.txt" 2>&1 || status=$?
 [ "$status" -eq 2 ] && grep -q "inside the example folder" "$work/msg.txt" && [ ! -e "$work/nan/toy-00000/new" ] ||
   fail "contact-sheet --out inside a clip's folder (status $status): $(cat "$work/msg.txt")"
+# A dataset with nothing to show (no clips; a clip whose frames are missing) writes no sheet and
+# leaves none of the folders made for it (an empty one was left behind).
+for case in '[]|has no clips' '[{"name":"a","wind":1}]|'"$work/ds/a"; do
+  clips="${case%%|*}" text="${case#*|}"
+  echo '{"format":"clothwind-dataset","version":1,"kind":"toy","clips":'"$clips"'}' > "$work/ds/index.json"
+  status=0
+  "$bin" contact-sheet "$work/ds" --out "$work/gone/deeper/s.png" >"$work/msg.txt" 2>&1 || status=$?
+  [ "$status" -eq 1 ] && grep -qF -- "$text" "$work/msg.txt" ||
+    fail "contact-sheet of clips $clips exited $status without '$text': $(cat "$work/msg.txt")"
+  [ ! -e "$work/gone" ] || fail "contact-sheet of clips $clips left the folders made for its sheet: $(cat "$work/msg.txt")"
+done
 echo "contact_sheet_cli_test: OK"

@@ -117,6 +117,15 @@ status=0
   fail "eval into new folders: $(cat "$work/msg.txt")"
 [ -s "$work/results/a/e.json" ] && [ -s "$work/results/b/e.png" ] ||
   fail "eval into new folders wrote: $(find "$work/results" -type f) $(cat "$work/msg.txt")"
+# ...and taken away again when nothing was written into them: an evaluation that failed (a clip's
+# frame missing) left its results' new folders behind, empty.
+cp -r "$work/toy" "$work/broken"
+rm "$work/broken/toy-00000/015.jpg"
+status=0
+"$bin" eval --model "$work/run/model.pt" --data "$work/broken" --split all --plot "$work/gone/p/e.png" \
+  --json "$work/gone/e.json" --threads 1 >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 1 ] && grep -q "toy-00000" "$work/msg.txt" && [ ! -e "$work/gone" ] ||
+  fail "eval that failed (status $status) left its folders: $(find "$work/gone" 2>&1) $(cat "$work/msg.txt")"
 
 # The same clips with the val split moved to train.
 cp -r "$work/toy" "$work/noval"

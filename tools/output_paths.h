@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/atomic_file.h"
@@ -111,17 +112,64 @@ inline void RefuseUnwritableOutput(const std::string& option, const std::filesys
   RefuseUnwritableFolder(option, output);
 }
 
+// The folders MakeFoldersFor made, outermost first. Unless Keep() is called, the ones still empty
+// are removed again when it goes (innermost first; a folder something was written into stays):
+// a verb that failed, or found nothing to write (contact-sheet of a dataset without clips), left
+// the empty folders of its output behind.
+class MadeFolders {
+ public:
+  MadeFolders() = default;
+  explicit MadeFolders(std::vector<std::filesystem::path> made) : made_(std::move(made)) {}
+  MadeFolders(MadeFolders&& other) noexcept : made_(std::move(other.made_)) { other.made_.clear(); }
+  MadeFolders& operator=(MadeFolders&& other) noexcept {
+    if (this != &other) {
+      RemoveEmpty();
+      made_ = std::move(other.made_);
+      other.made_.clear();
+    }
+    return *this;
+  }
+  MadeFolders(const MadeFolders&) = delete;
+  MadeFolders& operator=(const MadeFolders&) = delete;
+  ~MadeFolders() { RemoveEmpty(); }
+
+  // The output was written: its folders stay.
+  void Keep() { made_.clear(); }
+  const std::vector<std::filesystem::path>& made() const { return made_; }
+
+ private:
+  void RemoveEmpty() {
+    for (auto it = made_.rbegin(); it != made_.rend(); ++it) {
+      std::error_code ec;
+      if (std::filesystem::is_empty(*it, ec) && !ec) std::filesystem::remove(*it, ec);
+    }
+    made_.clear();
+  }
+
+  std::vector<std::filesystem::path> made_;
+};
+
 // Makes the missing folders `output` (a file; empty: none) goes in, as `mkdir -p` its folder; the
 // verbs call it once the checks pass, before the work (made after it, a failure lost the work).
+// Returns the folders it made (MadeFolders: removed again, if still empty, unless kept).
 // Throws std::runtime_error naming `option`, the output and the folder when they cannot be made.
-inline void MakeFoldersFor(const std::string& option, const std::filesystem::path& output) {
-  if (output.empty()) return;
+[[nodiscard]] inline MadeFolders MakeFoldersFor(const std::string& option, const std::filesystem::path& output) {
+  if (output.empty()) return {};
   std::error_code ec;
   const std::filesystem::path folder = std::filesystem::absolute(output, ec).parent_path();
+  std::vector<std::filesystem::path> missing;
+  std::error_code missing_ec;  // symlink_status reports a missing path in it too
+  if (!ec)
+    for (std::filesystem::path f = folder;
+         !f.empty() && f != f.parent_path() &&
+         !std::filesystem::exists(std::filesystem::symlink_status(f, missing_ec));
+         f = f.parent_path())
+      missing.insert(missing.begin(), f);
   if (!ec) std::filesystem::create_directories(folder, ec);
   if (ec)
     throw std::runtime_error(option + " " + output.string() + ": cannot make its folder " + folder.string() + " (" +
                              ec.message() + ")");
+  return MadeFolders(std::move(missing));
 }
 
 // Throws UsageError naming `option` unless files can be made in the folder `output_folder` (made

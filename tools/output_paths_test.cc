@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -53,12 +54,31 @@ TEST(OutputPathsTest, AnOutputOnAFolderOrUnderAFileIsRefusedBeforeTheWork) {
   // made it): accepted, checked where it will be made, and made by MakeFoldersFor.
   EXPECT_NO_THROW(RefuseUnwritableOutput("--json", dir / "new" / "deeper" / "e.json"));
   EXPECT_FALSE(fs::exists(dir / "new"));
-  MakeFoldersFor("--json", dir / "new" / "deeper" / "e.json");
-  EXPECT_TRUE(fs::is_directory(dir / "new" / "deeper"));
-  EXPECT_FALSE(fs::exists(dir / "new" / "deeper" / "e.json"));
+  {
+    MadeFolders made = MakeFoldersFor("--json", dir / "new" / "deeper" / "e.json");
+    EXPECT_TRUE(fs::is_directory(dir / "new" / "deeper"));
+    EXPECT_FALSE(fs::exists(dir / "new" / "deeper" / "e.json"));
+    EXPECT_EQ(made.made(), (std::vector<fs::path>{dir / "new", dir / "new" / "deeper"}));
+    made.Keep();
+  }
+  EXPECT_TRUE(fs::is_directory(dir / "new" / "deeper")) << "kept folders were removed";
+  // Not kept (the verb failed, or had nothing to write): the folders it made go again while empty,
+  // innermost first; a folder that was there before stays, and so does one a file went into.
+  {
+    const MadeFolders made = MakeFoldersFor("--plot", dir / "new" / "a" / "b" / "p.png");
+    EXPECT_EQ(made.made(), (std::vector<fs::path>{dir / "new" / "a", dir / "new" / "a" / "b"}));
+  }
+  EXPECT_FALSE(fs::exists(dir / "new" / "a")) << "an unused folder was left behind";
+  EXPECT_TRUE(fs::is_directory(dir / "new" / "deeper")) << "a folder made before was removed";
+  {
+    const MadeFolders made = MakeFoldersFor("--plot", dir / "new" / "c" / "d" / "p.png");
+    std::ofstream(dir / "new" / "c" / "kept.txt") << "x";
+  }
+  EXPECT_TRUE(fs::exists(dir / "new" / "c" / "kept.txt")) << "a folder holding a file was removed";
+  EXPECT_FALSE(fs::exists(dir / "new" / "c" / "d"));
   // One that cannot be made is named by its option, output and folder.
   try {
-    MakeFoldersFor("--plot", dir / "file" / "p.png");
+    const MadeFolders made = MakeFoldersFor("--plot", dir / "file" / "p.png");
     ADD_FAILURE() << "a folder made where a file is";
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()).rfind("--plot " + (dir / "file" / "p.png").string() + ": cannot make its folder " +

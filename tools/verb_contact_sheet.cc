@@ -57,10 +57,13 @@ int Run(const ContactSheetArgs& a) {
   b.label = "contact-sheet";
   b.unit = "tiles";
   ProgressBar bar(b);
-  MakeFoldersFor("--out", out);
+  // Made before the tiles are read, and taken away again if no sheet is written (no clips, or a
+  // frame that cannot be read): an empty folder was left behind.
+  MadeFolders made = MakeFoldersFor("--out", out);
   const bool written =
       data::WriteContactSheet(a.dir, index, out, a.options, [&](int done, int total) { bar.Update(done, total); });
   bar.Finish();
+  if (written) made.Keep();
   if (!written) {
     std::fprintf(stderr, "contact-sheet: %s has no clips\n", a.dir.c_str());
     return 1;

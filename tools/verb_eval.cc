@@ -127,10 +127,13 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       RefuseUnwritableOutput("--track-head-rows", a->track_head_rows);
       learn::CheckTrackHead(a->model, a->track_head_window);
     }
-    MakeFoldersFor("--json", a->json);
+    // Held to the end: a folder still empty then (an evaluation that failed, a plot not drawn) is
+    // taken away again; one a result was written into stays.
+    const MadeFolders json_folders = MakeFoldersFor("--json", a->json);
     // The default plot's folder is the model's: made, it would outlive a misspelt --model.
-    if (!a->plot.empty()) MakeFoldersFor("--plot", plot);
-    if (a->track_head) MakeFoldersFor("--track-head-rows", a->track_head_rows);
+    const MadeFolders plot_folders = a->plot.empty() ? MadeFolders() : MakeFoldersFor("--plot", plot);
+    const MadeFolders rows_folders = a->track_head ? MakeFoldersFor("--track-head-rows", a->track_head_rows)
+                                                   : MadeFolders();
     ProgressBar::Options b;
     b.label = "eval";
     b.unit = "clips";
@@ -193,7 +196,8 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     if (learn::PlotPredictions(r, plot, &error)) {
       std::cout << "plot: " << plot.string() << "\n";
     } else {
-      std::cerr << "plot not drawn: " << error << "\n";
+      // The default goes beside the model, which an install's models folder does not take.
+      std::cerr << "plot not drawn: " << error << (a->plot.empty() ? " (--plot PNG draws it elsewhere)" : "") << "\n";
       plot_failed = !a->plot.empty();  // the default plot is a courtesy; an asked-for one is a result
     }
     if (!by_view_error.empty()) {
