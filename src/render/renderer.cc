@@ -72,8 +72,6 @@ Rgb Renderer::GroundAlbedo(const Eigen::Vector3f& p) const {
 }
 
 namespace {
-enum What : uint8_t { kSky = 0, kBackdrop = 1, kGroundSeen = 2, kPoleSeen = 3, kClothSeen = 4 };
-
 // Slab test: can the ray org + t dir, t in (0, t_max), meet the box? Cheaper than asking
 // Embree, and most rays of a frame pass far from the cloth.
 inline bool RayMeetsBox(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t_max,
@@ -113,17 +111,10 @@ Renderer::StaticSample Renderer::ComputeStatic(const Eigen::Vector3f& org,
       behind.base = lighting_.SkyRadiance(dir);
       behind.what = kSky;
     }
-    s.t = tb;
-    s.what = alpha > 0.5f ? static_cast<uint8_t>(kBackdrop) : behind.what;
-    // Transparent texels hold colour 0, so the filtered colour is already premultiplied by alpha:
-    // multiplying again drew a dark fringe where a procedural backdrop meets the sky.
-    s.base = alpha >= 1.0f ? bg : Rgb(bg + (1.0f - alpha) * behind.base);
-    if (alpha < 1.0f && behind.can_see_sun) {
-      s.can_see_sun = true;
-      s.shadow_org = behind.shadow_org;
-      s.sunlit = (1.0f - alpha) * behind.sunlit;
-    }
-    return s;
+    StaticSample seen = OverBackdrop(bg, alpha, tb, behind);
+    seen.dir = dir;
+    seen.sun = sun;
+    return seen;
   }
   if (!any) {
     s.t = kFar;
@@ -135,6 +126,22 @@ Renderer::StaticSample Renderer::ComputeStatic(const Eigen::Vector3f& org,
   shaded.dir = dir;
   shaded.sun = sun;
   return shaded;
+}
+
+Renderer::StaticSample Renderer::OverBackdrop(const Rgb& colour, float alpha, float t,
+                                              const StaticSample& behind) {
+  StaticSample s;
+  s.dir = behind.dir;
+  s.sun = behind.sun;
+  s.t = t;
+  s.what = alpha > 0.5f ? static_cast<uint8_t>(kBackdrop) : behind.what;
+  s.base = alpha >= 1.0f ? colour : Rgb(colour + (1.0f - alpha) * behind.base);
+  if (alpha < 1.0f && behind.can_see_sun) {
+    s.can_see_sun = true;
+    s.shadow_org = behind.shadow_org;
+    s.sunlit = (1.0f - alpha) * behind.sunlit;
+  }
+  return s;
 }
 
 Renderer::StaticSample Renderer::ShadeStatic(const Hit& hit, const Eigen::Vector3f& sun) const {

@@ -68,14 +68,17 @@ class Renderer {
   }
   const RenderOptions& options() const { return options_; }
 
- private:
+  // What a camera sample saw, for the edge test (antialiasing where it changes).
+  enum What : uint8_t { kSky = 0, kBackdrop = 1, kGroundSeen = 2, kPoleSeen = 3, kClothSeen = 4 };
+
   // What one camera sample sees of the static scene (pole, ground, backdrop, sky), which does
   // not change during a clip: computed on the first frame, reused on the others, so that a
   // frame costs little more than the rays that meet the cloth or its shadow.
   struct StaticSample {
-    Eigen::Vector3f dir;         // camera ray direction (unit)
-    Eigen::Vector3f shadow_org;  // where a shadow ray to the sun leaves the surface
-    Eigen::Vector3f sun;         // the sun-disc direction this sample uses
+    // Zero until set: a sky sample has no shadow ray, and copies of it were of uninitialised memory.
+    Eigen::Vector3f dir = Eigen::Vector3f::Zero();         // camera ray direction (unit)
+    Eigen::Vector3f shadow_org = Eigen::Vector3f::Zero();  // where a shadow ray to the sun leaves
+    Eigen::Vector3f sun = Eigen::Vector3f::Zero();         // the sun-disc direction this sample uses
     Rgb base = Rgb::Zero();      // radiance without direct sun (sky, backdrop, ambient)
     Rgb sunlit = Rgb::Zero();    // radiance added when the sun sample is not blocked
     float t = 0.0f;              // distance to the static surface / backdrop [m]
@@ -83,6 +86,22 @@ class Renderer {
     bool can_see_sun = false;    // lit unless the cloth is in the way
   };
 
+  // The sample of a ray meeting the backdrop in front of whatever lies behind it: the backdrop's
+  // filtered colour over it, by its coverage. Why a function of its own: a ray going down past a
+  // backdrop's top (a camera above its hills) sees the ground through its transparent texels, and
+  // the sky always shown there drew a band of sky below the horizon.
+  // Inputs:
+  //   colour  the backdrop's filtered texel colour, already premultiplied by alpha (transparent
+  //           texels hold 0; multiplying again drew a dark fringe where hills meet the sky)
+  //   alpha   its coverage in [0, 1]
+  //   t       distance to the backdrop [m]
+  //   behind  what the ray meets beyond it (sky, or the ground's ShadeStatic sample)
+  // Returns behind's sample with base = colour + (1 - alpha) behind.base, sunlit scaled by
+  // (1 - alpha) (the sun and shadows reach only what shows through), t = t, and `what` the
+  // backdrop where alpha > 0.5, else behind's; alpha 1 is the backdrop alone, with no sun.
+  static StaticSample OverBackdrop(const Rgb& colour, float alpha, float t, const StaticSample& behind);
+
+ private:
   StaticSample ComputeStatic(const Eigen::Vector3f& org, const Eigen::Vector3f& dir,
                              const Eigen::Vector3f& sun) const;
   // Radiance of one camera sample this frame; `what` gets the surface it saw.

@@ -467,6 +467,46 @@ INSTANTIATE_TEST_SUITE_P(Renderer, FarCamera,
 // A SetCloth refused half way (a bad index in its last face) leaves the previous cloth: it
 // rewrote the faces up to the bad one while Embree kept the old geometry, so hits read the new
 // faces' vertices (here: the old ones in another order, other texture coordinates).
+// The backdrop over what lies behind it, by its coverage (hand-worked values): the premultiplied
+// colour plus (1 - alpha) of what shows through, the sun only on that part, and the backdrop
+// counted as seen where it covers more than half.
+TEST(Renderer, TheBackdropCoversWhatIsBehindItByItsAlpha) {
+  Renderer::StaticSample ground;
+  ground.base = Rgb(0.2f, 0.4f, 0.1f);
+  ground.sunlit = Rgb(1.0f, 0.8f, 0.6f);
+  ground.can_see_sun = true;
+  ground.shadow_org = Eigen::Vector3f(5, 6, 0);
+  ground.what = Renderer::kGroundSeen;
+  ground.t = 90.0f;
+  const Rgb colour(0.05f, 0.1f, 0.15f);  // premultiplied by alpha 0.25
+  const Renderer::StaticSample quarter = Renderer::OverBackdrop(colour, 0.25f, 40.0f, ground);
+  EXPECT_NEAR(quarter.base.x(), 0.05f + 0.75f * 0.2f, 1e-6f);
+  EXPECT_NEAR(quarter.base.y(), 0.1f + 0.75f * 0.4f, 1e-6f);
+  EXPECT_NEAR(quarter.base.z(), 0.15f + 0.75f * 0.1f, 1e-6f);
+  EXPECT_TRUE(quarter.can_see_sun);
+  EXPECT_NEAR(quarter.sunlit.x(), 0.75f, 1e-6f);
+  EXPECT_NEAR(quarter.sunlit.z(), 0.45f, 1e-6f);
+  EXPECT_EQ(quarter.shadow_org, ground.shadow_org);  // the shadow is the ground's
+  EXPECT_EQ(quarter.what, Renderer::kGroundSeen);     // mostly ground
+  EXPECT_EQ(quarter.t, 40.0f);                        // the backdrop is what the ray meets first
+  const Renderer::StaticSample most = Renderer::OverBackdrop(colour, 0.75f, 40.0f, ground);
+  EXPECT_EQ(most.what, Renderer::kBackdrop);
+  EXPECT_NEAR(most.sunlit.y(), 0.25f * 0.8f, 1e-6f);
+  // Opaque: the backdrop alone, its colour as filtered, no sun through it.
+  const Renderer::StaticSample opaque = Renderer::OverBackdrop(colour, 1.0f, 40.0f, ground);
+  EXPECT_EQ(opaque.base, colour);
+  EXPECT_FALSE(opaque.can_see_sun);
+  EXPECT_EQ(opaque.sunlit, Rgb::Zero());
+  // Transparent over the sky: the sky as it is (no sun term to carry).
+  Renderer::StaticSample sky;
+  sky.base = Rgb(0.3f, 0.5f, 0.9f);
+  sky.what = Renderer::kSky;
+  const Renderer::StaticSample clear = Renderer::OverBackdrop(Rgb::Zero(), 0.0f, 40.0f, sky);
+  EXPECT_EQ(clear.base, sky.base);
+  EXPECT_FALSE(clear.can_see_sun);
+  EXPECT_EQ(clear.what, Renderer::kSky);
+}
+
 TEST(EmbreeScene, RefusedClothLeavesThePreviousOne) {
   Renderer r(TestParams());
   const ClothMesh a = WavingFlag(25, 17, 3.0, 2.0, 0.1);
