@@ -127,6 +127,29 @@ status=0
 [ "$status" -eq 1 ] && grep -q "toy-00000" "$work/msg.txt" && [ ! -e "$work/gone" ] ||
   fail "eval that failed (status $status) left its folders: $(find "$work/gone" 2>&1) $(cat "$work/msg.txt")"
 
+# No result lands on a clip's label or frames (only index.json was guarded: eval --json onto a
+# label exited 0, and the next read of the dataset failed on it); export-model's --overwrite
+# covers an earlier model, not a clip of the calibration data.
+cp "$work/toy/toy-00001/label.json" "$work/label-before.json"
+for args in "eval --json $work/toy/toy-00001/label.json" "eval --plot $work/toy/toy-00001/new/e.png" \
+            "eval --track-head --track-head-rows $work/toy/toy-00001/rows.tsv" \
+            "export-model --overwrite --calibrate-std $work/toy --out $work/toy/toy-00001/label.pt"; do
+  verb="${args%% *}" rest="${args#* }"
+  status=0
+  if [ "$verb" = eval ]; then
+    # shellcheck disable=SC2086
+    "$bin" eval --model "$work/run/model.pt" --data "$work/toy" --split all --threads 1 $rest >"$work/msg.txt" 2>&1 ||
+      status=$?
+  else
+    # shellcheck disable=SC2086
+    "$bin" export-model --model "$work/run/model.pt" $rest >"$work/msg.txt" 2>&1 || status=$?
+  fi
+  [ "$status" -eq 2 ] && grep -q "is inside the example folder $work/toy/toy-00001" "$work/msg.txt" ||
+    fail "$args: not refused (status $status): $(cat "$work/msg.txt")"
+  cmp -s "$work/toy/toy-00001/label.json" "$work/label-before.json" && [ ! -e "$work/toy/toy-00001/new" ] ||
+    fail "$args: changed the clip's folder: $(ls "$work/toy/toy-00001")"
+done
+
 # The same clips with the val split moved to train.
 cp -r "$work/toy" "$work/noval"
 sed -i 's/"split": "val"/"split": "train"/' "$work/noval/index.json" "$work"/noval/*/label.json

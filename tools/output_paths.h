@@ -49,11 +49,9 @@ inline void RefuseFolderAsOutput(const std::string& option, const std::filesyste
     throw UsageError(option + " " + output.string() + " is a folder; expected a file name");
 }
 
-// Throws UsageError naming `option` when `output` is `folder` or lies inside it: `train
-// --out DATA` wrote its run among the dataset's clips.
-inline void RefuseOutputInsideFolder(const std::string& option, const std::filesystem::path& output,
-                                     const std::filesystem::path& folder, const std::string& what) {
-  if (output.empty() || folder.empty()) return;
+// Whether `path` is `folder` or lies inside it, compared as absolute paths with symbolic links
+// resolved where they exist.
+inline bool IsAtOrInside(const std::filesystem::path& path, const std::filesystem::path& folder) {
   std::error_code ec;
   const auto normal = [&](const std::filesystem::path& p) {
     // Absolute first: weakly_canonical("run") of a missing relative path stays relative.
@@ -61,11 +59,18 @@ inline void RefuseOutputInsideFolder(const std::string& option, const std::files
     const std::filesystem::path c = std::filesystem::weakly_canonical(a, ec);
     return (ec ? a : c).lexically_normal();
   };
-  const std::filesystem::path out = normal(output), in = normal(folder);
-  const auto mismatch = std::mismatch(in.begin(), in.end(), out.begin(), out.end());
-  if (mismatch.first == in.end())
-    throw UsageError(option + " " + output.string() + " is " + (mismatch.second == out.end() ? "" : "inside ") +
-                                what + " " + folder.string() + "; write it elsewhere");
+  const std::filesystem::path out = normal(path), in = normal(folder);
+  return std::mismatch(in.begin(), in.end(), out.begin(), out.end()).first == in.end();
+}
+
+// Throws UsageError naming `option` when `output` is `folder` or lies inside it: `train
+// --out DATA` wrote its run among the dataset's clips.
+inline void RefuseOutputInsideFolder(const std::string& option, const std::filesystem::path& output,
+                                     const std::filesystem::path& folder, const std::string& what) {
+  if (output.empty() || folder.empty() || !IsAtOrInside(output, folder)) return;
+  const bool same = IsAtOrInside(folder, output);
+  throw UsageError(option + " " + output.string() + " is " + (same ? "" : "inside ") + what + " " + folder.string() +
+                   "; write it elsewhere");
 }
 
 // Throws UsageError naming `option` (and `shown`, what was given) unless a file can be made in

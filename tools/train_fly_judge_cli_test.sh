@@ -41,4 +41,14 @@ status=0
 status=0
 "$bin" train-fly-judge --data "$work/toy" --out "$work/judges/j.pt" --overwrite >"$work/msg.txt" 2>&1 || status=$?
 grep -q "with no flag" "$work/msg.txt" || fail "--overwrite was not taken: $(cat "$work/msg.txt")"
+# --overwrite replaces an earlier judge, never a clip's frame or label (a judge's weights went over
+# a frame, its card over a label.json, exit 0).
+cp "$work/toy/toy-00001/label.json" "$work/label-before.json"
+for out in "$work/toy/toy-00001/003.jpg" "$work/toy/toy-00001/label.pt"; do
+  status=0
+  "$bin" train-fly-judge --data "$work/toy" --out "$out" --overwrite >"$work/msg.txt" 2>&1 || status=$?
+  [ "$status" -eq 2 ] && grep -q "inside the example folder $work/toy/toy-00001" "$work/msg.txt" ||
+    fail "train-fly-judge --out $out: not refused (status $status): $(cat "$work/msg.txt")"
+  cmp -s "$work/toy/toy-00001/label.json" "$work/label-before.json" || fail "--out $out changed the clip's label"
+done
 echo "train_fly_judge_cli_test: OK"

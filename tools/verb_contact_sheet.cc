@@ -8,6 +8,7 @@
 
 #include "data/contact_sheet.h"
 #include "data/dataset_index.h"
+#include "dataset_outputs.h"
 #include "output_paths.h"
 #include "progress_bar.h"
 #include "render/sensor_model.h"
@@ -35,18 +36,9 @@ int Run(const ContactSheetArgs& a) {
   // Not over the dataset: `--out DIR/<clip>/003.jpg` replaced a clip's frame with the sheet.
   const std::filesystem::path dir(a.dir);
   RefuseOutputOverInput("--out", out, {dir / "index.json"});
-  // Entries of another shape are the core's to refuse naming the field (WriteContactSheet); here
-  // they are skipped: value() on a string entry, or a number for a name, threw bare type errors.
-  const nlohmann::json clips = index.contains("clips") && index["clips"].is_array() ? index["clips"] : nlohmann::json::array();
-  for (const auto& clip : clips) {
-    if (!clip.is_object() || !clip.contains("name") || !clip["name"].is_string()) continue;
-    const std::string name = clip["name"].get<std::string>();
-    if (name.empty()) continue;
-    const std::filesystem::path folder = dir / name;
-    // Below one too: its missing folders are made now, and a sheet in a clip's subfolder was
-    // written there (the test above compared the sheet's own folder alone).
-    RefuseOutputInsideFolder("--out", out, folder, "the example folder");
-  }
+  // Nor below a clip's folder: its missing folders are made now, and a sheet in a clip's subfolder
+  // was written there (the test above compared the sheet's own folder alone).
+  RefuseOutputInsideExamples("--out", out, dir, index);
   RefuseUnwritableOutput("--out", out);
   // The sheet is held whole in memory (3 bytes a pixel): 10000 tiles of 1024 px were 31 GB.
   const double sheet_bytes = static_cast<double>(a.options.max_tiles) * a.options.tile * a.options.tile * 3;

@@ -8,6 +8,7 @@
 #include "learn/track_head_eval.h"
 #include "learn/view_breakdown.h"
 #include "progress_bar.h"
+#include "dataset_outputs.h"
 #include "output_paths.h"
 #include "verb_registry.h"
 #include "usage_error.h"
@@ -111,6 +112,9 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       if (!a->json.empty() && SameFile(a->json, drawn))
         throw UsageError("--json " + a->json + " is where the plot goes (" + drawn.string() +
                                     "); write one of them elsewhere");
+    // Nor on a clip's label or frames (only index.json was guarded).
+    RefuseOutputInsideExamples("--json", a->json, a->data);
+    RefuseOutputInsideExamples("--plot", plot, a->data);
     RefuseUnwritableOutput("--json", a->json);
     RefuseUnwritableOutput("--plot", a->plot);
     // gnuplot draws a PNG whatever the name: `--plot p.txt` wrote one named .txt.
@@ -124,6 +128,7 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
         if (!a->track_head_rows.empty() && !other.empty() && SameFile(a->track_head_rows, other))
           throw UsageError("--track-head-rows " + a->track_head_rows + " is where another result goes (" +
                                       other + "); write one of them elsewhere");
+      RefuseOutputInsideExamples("--track-head-rows", a->track_head_rows, a->data);
       RefuseUnwritableOutput("--track-head-rows", a->track_head_rows);
       learn::CheckTrackHead(a->model, a->track_head_window);
     }

@@ -15,6 +15,7 @@
 #include "learn/networks.h"
 #include "learn/weights_io.h"
 #include "progress_bar.h"
+#include "dataset_outputs.h"
 #include "output_paths.h"
 #include "verb_registry.h"
 #include "usage_error.h"
@@ -58,6 +59,8 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
         a->calibrate_data.empty() ? std::filesystem::path() : std::filesystem::path(a->calibrate_data) / "index.json"};
     RefuseOutputOverInput("--out", a->out, inputs);
     RefuseOutputOverInput("--out's .json", out_config, inputs);
+    RefuseOutputInsideExamples("--out", a->out, a->calibrate_data);
+    RefuseOutputInsideExamples("--out's .json", out_config, a->calibrate_data);
     RefuseFolderAsOutput("--out", a->out);
     RefuseFolderAsOutput("--out's .json", out_config);
     if (SameFile(a->out, out_config))

@@ -111,7 +111,12 @@ int Run(MakeDatasetArgs& a) {
     o.ranges = r;
   }
   // The renderer's own listing (any case, .bmp too, files only): this verb's copy refused .JPG.
-  if (!a.backgrounds.empty()) o.background_images = render::ListBackgroundImages(a.backgrounds);
+  if (!a.backgrounds.empty()) {
+    // Not into the photos' folder: the dataset's contact sheet became a backdrop of the next
+    // dataset made from it, and a resume was refused for photos that had changed.
+    RefuseOutputInsideFolder("--out", o.out, a.backgrounds, "the --backgrounds folder");
+    o.background_images = render::ListBackgroundImages(a.backgrounds);
+  }
 
   // Before the line that says what it will make: "--views must be in 1..64" came after it, and
   // exited 1 as a failed run.

@@ -19,6 +19,7 @@
 #include "learn/model_config.h"
 #include "fly_judge_table.h"
 #include "progress_bar.h"
+#include "dataset_outputs.h"
 #include "output_paths.h"
 #include "verb_registry.h"
 #include "usage_error.h"
@@ -104,6 +105,8 @@ VerbRegistrar registrar("train-fly-judge", [](CLI::App& app) -> std::function<in
                                     "extension .json, so --out needs another (e.g. .pt)");
       RefuseOutputOverInput("--out", a->out, {index});
       RefuseOutputOverInput("--out's card", card, {index});
+      RefuseOutputInsideExamples("--out", a->out, a->data);
+      RefuseOutputInsideExamples("--out's card", card, a->data);
       RefuseFolderAsOutput("--out", a->out);
       RefuseFolderAsOutput("--out's card", card);
       RefuseUnwritableFolder("--out", a->out);

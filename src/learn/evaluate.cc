@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <iomanip>
@@ -11,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <malloc.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "common/atomic_file.h"
@@ -404,8 +406,22 @@ bool RunGnuplot(const std::string& script, const fs::path& png, std::string* err
   const std::string command =
       "gnuplot " + ShellQuoted(script_path.string()) + " 2>" + ShellQuoted(script_path.string() + ".err");
   const int rc = std::system(command.c_str());
+  // system() ignores SIGINT and SIGQUIT in its caller while the child runs: a Ctrl-C that reached
+  // gnuplot (the same process group) was the caller's too, and was lost with it (train ran on to
+  // its last epoch and exited 0). Raised again here, as POSIX's system() advises; the shell's
+  // 128 + signal counts as the signal too.
+  const int stop_signal = rc == -1 ? 0
+                          : WIFSIGNALED(rc) ? WTERMSIG(rc)
+                          : WIFEXITED(rc) && WEXITSTATUS(rc) > 128 ? WEXITSTATUS(rc) - 128
+                                                                     : 0;
+  if (stop_signal == SIGINT || stop_signal == SIGQUIT) std::raise(stop_signal);
   if (rc != 0 || !fs::exists(tmp)) {
-    if (error) *error = "gnuplot failed (exit " + std::to_string(rc) + "), see " + script_path.string() + ".err";
+    // The wait status itself ("exit 2" was signal 2, SIGINT).
+    const std::string how = rc == -1            ? std::string("could not be started")
+                            : WIFSIGNALED(rc)   ? "ended by signal " + std::to_string(WTERMSIG(rc))
+                            : WIFEXITED(rc)     ? "exit " + std::to_string(WEXITSTATUS(rc))
+                                                : "status " + std::to_string(rc);
+    if (error) *error = "gnuplot failed (" + how + "), see " + script_path.string() + ".err";
     fs::remove(tmp);
     return false;
   }

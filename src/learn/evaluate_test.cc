@@ -4,6 +4,9 @@
 #include "learn/evaluate.h"
 
 #include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -22,6 +25,45 @@
 namespace clothwind::learn {
 namespace {
 namespace fs = std::filesystem;
+
+// A gnuplot on PATH that ends as `ending` says (a shell line), for RunGnuplot's tests.
+std::filesystem::path FakeGnuplotFolder(const std::string& name, const std::string& ending) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("clothwind_fake_gnuplot_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "gnuplot") << "#!/bin/sh\n" << ending << "\n";
+  std::filesystem::permissions(dir / "gnuplot", std::filesystem::perms::owner_all);
+  return dir;
+}
+
+// A Ctrl-C while gnuplot draws reaches gnuplot (the same process group), and system() ignores it
+// in its caller meanwhile: it was lost, and train ran on to its last epoch and exited 0. The
+// caller now ends by the signal too; a gnuplot that merely fails only fails the plot, its
+// status said as an exit status (a signal's "exit 2" read as gnuplot's own).
+TEST(GnuplotDeathTest, AnInterruptedPlotInterruptsTheCaller) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const std::string old_path = std::getenv("PATH") ? std::getenv("PATH") : "/usr/bin:/bin";
+  const std::filesystem::path interrupted = FakeGnuplotFolder("int", "kill -INT $$");
+  EXPECT_EXIT(
+      {
+        ::setenv("PATH", (interrupted.string() + ":" + old_path).c_str(), 1);
+        std::string error;
+        RunGnuplot("plot x\n", interrupted / "p.png", &error);
+        std::fprintf(stderr, "carried on after the plot: %s\n", error.c_str());
+        std::exit(0);
+      },
+      ::testing::KilledBySignal(SIGINT), "");
+  const std::filesystem::path failing = FakeGnuplotFolder("fail", "exit 3");
+  ::setenv("PATH", (failing.string() + ":" + old_path).c_str(), 1);
+  std::string error;
+  const bool drawn = RunGnuplot("plot x\n", failing / "p.png", &error);
+  ::setenv("PATH", old_path.c_str(), 1);
+  EXPECT_FALSE(drawn);
+  EXPECT_NE(error.find("gnuplot failed (exit 3)"), std::string::npos) << error;
+  EXPECT_FALSE(std::filesystem::exists(failing / "p.png"));
+  std::filesystem::remove_all(interrupted);
+  std::filesystem::remove_all(failing);
+}
 
 TEST(EvaluateTest, MetricsOfAHandWorkedExample) {
   // Errors +0.2, -0.5, +0.6, -0.9, 0: |e| <= 0.5 for three of five (the bound is inclusive).

@@ -935,6 +935,9 @@ TrainResult Train(const TrainOptions& o) {
         fs::remove_all(entry.path());
     }
     WriteFileAtomically(o.out / "log.tsv", LogTsv(result.log));
+    // The last epoch's plot is the one reported: an earlier one's failure stayed, naming a .gp.err
+    // a later plot had removed.
+    result.plot_error.clear();
     if (!PlotLearningCurve(result.log, o.out / "learning_curve.png", &result.plot_error, result.validated_on)) {
       // The plot is a convenience; training goes on without it.
     }
