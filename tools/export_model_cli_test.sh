@@ -73,6 +73,32 @@ for case in "--lr-decay-epoch|--lr-schedule cosine --lr-decay-epoch 5" "--overwr
   [ ! -e "$work/bad/model.pt" ] || fail "train $bad trained"
 done
 
+# Options out of their range are command-line errors (exit 2, as CLI11's own; they exited 1, as a
+# failed run), said as numbers are written (--lr 1e308 was 309 digits), nothing made; --frames 4
+# with the default --k 3 named the configuration's field alone.
+mkdir -p "$work/existing" && cp "$work/run/model.pt" "$work/existing/model.pt"
+for case in "--lr must be in (0, 10], got 1e+308|--frames 30 --lr 1e308" \
+            "--batch must be at least 2|--frames 30 --batch 1" \
+            "--lr-decay-epoch must be >= 0 (or -1: --epochs / 2), got -7|--frames 30 --lr-decay-epoch -7" \
+            "\"k\" is --k|--frames 4"; do
+  said="${case%%|*}"
+  bad="${case#*|}"
+  status=0
+  # shellcheck disable=SC2086
+  "$bin" train --model sdn --data "$work/toy" --out "$work/bad" --input-size 32 --width 8 \
+    --threads 1 --epochs 1 $bad >"$work/msg.txt" 2>&1 || status=$?
+  [ "$status" -eq 2 ] && grep -qF -- "$said" "$work/msg.txt" ||
+    fail "train $bad: not refused as a command line saying '$said' (status $status): $(cat "$work/msg.txt")"
+  [ ! -e "$work/bad" ] || fail "train $bad made its run folder"
+done
+# An earlier run without --resume or --overwrite too (export-model and make-session exit 2 for theirs).
+status=0
+"$bin" train --model sdn --frames 30 --data "$work/toy" --out "$work/existing" --input-size 32 --width 8 \
+  --threads 1 --epochs 1 >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 2 ] && grep -qF "a run is already in $work/existing" "$work/msg.txt" &&
+  cmp -s "$work/existing/model.pt" "$work/run/model.pt" ||
+  fail "train into an earlier run: not refused as a command line (status $status): $(cat "$work/msg.txt")"
+
 # --k off the SDN: a resnet18 or lstm sweep over k made identical runs.
 status=0
 "$bin" train --model resnet18 --frames 30 --data "$work/toy" --out "$work/bad" --input-size 32 --k 3 \

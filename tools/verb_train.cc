@@ -200,6 +200,12 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
     o.out = args->out;
     RefuseOutputInsideFolder("--out", o.out, o.data, "the dataset");
     RefuseUnwritableOutputFolder("--out", o.out);
+    // The options' own checks, before any work, as a command-line error (exit 2, not 1).
+    try {
+      learn::ValidateTrainOptions(o);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
     std::unique_ptr<ProgressBar> bar;
     int bar_epoch = 0;
     // The whole run's time left, from this process's mean epoch (the bar's ETA is the epoch's:

@@ -28,6 +28,7 @@
 #include <torch/serialize.h>
 
 #include "common/atomic_file.h"
+#include "common/formatted.h"
 #include "common/json_file.h"
 #include "common/regular_file.h"
 #include "learn/aux_targets.h"
@@ -451,38 +452,30 @@ double LearningRateAt(const TrainOptions& o, int epoch) {
   throw std::invalid_argument("lr_schedule must be step or cosine, got \"" + o.lr_schedule + "\"");
 }
 
-TrainResult Train(const TrainOptions& o) {
-  // Flush denormals to zero: weight decay drives many weights and activations towards zero, and
-  // denormal floats made CPU training epochs 3x slower after ~10 epochs. Set before the intra-op
-  // threads exist: new threads inherit this thread's floating-point mode.
-  at::globalContext().setFlushDenormal(true);
-  if (o.threads > 0) at::set_num_threads(o.threads);
+void ValidateTrainOptions(const TrainOptions& o) {
   if (o.device != "cpu" && o.device != "cuda" && o.device != "auto") {
-    throw std::runtime_error("device must be cpu, cuda or auto, got \"" + o.device + "\"");
+    throw std::invalid_argument("device must be cpu, cuda or auto, got \"" + o.device + "\"");
   }
-  if (o.device == "cuda" && !torch::cuda::is_available()) {
-    throw std::runtime_error("device cuda requested but libtorch finds no CUDA device");
-  }
-  if (o.epochs < 1 || o.batch < 1) throw std::runtime_error("epochs and batch must be at least 1");
+  if (o.epochs < 1 || o.batch < 1) throw std::invalid_argument("epochs and batch must be at least 1");
   // Batch normalisation normalises each channel over the batch: one clip leaves nothing to
   // normalise over once the trunk's feature map is 1x1, and libtorch failed mid-epoch with a
   // backtrace naming no option.
   if (o.batch < 2 && !o.init_only)
-    throw std::runtime_error("--batch must be at least 2 to train (batch normalisation needs two clips), got " +
-                             std::to_string(o.batch));
-  if (o.crop_scales.empty()) throw std::runtime_error("crop_scales: expected at least one scale in (0, 1]");
+    throw std::invalid_argument("--batch must be at least 2 to train (batch normalisation needs two clips), got " +
+                                std::to_string(o.batch));
+  if (o.crop_scales.empty()) throw std::invalid_argument("crop_scales: expected at least one scale in (0, 1]");
   for (double s : o.crop_scales) {
     if (!(s > 0 && s <= 1)) {
-      throw std::runtime_error("crop_scales: each scale must lie in (0, 1], got " + std::to_string(s));
+      throw std::invalid_argument("crop_scales: each scale must lie in (0, 1], got " + FormattedNumber(s));
     }
   }
   if (o.lr_schedule != "step" && o.lr_schedule != "cosine") {
-    throw std::runtime_error("lr schedule must be step or cosine, got \"" + o.lr_schedule + "\"");
+    throw std::invalid_argument("lr schedule must be step or cosine, got \"" + o.lr_schedule + "\"");
   }
   // NaN passes CLI11's range checks; these ran a run to its end (NaN dropout, gradient clip), or
   // failed deep in libtorch with a backtrace naming no option (NaN lr, weight decay).
   const auto require = [](bool ok, const char* option, const char* expected, double value) {
-    if (!ok) throw std::runtime_error(std::string(option) + " must be " + expected + ", got " + std::to_string(value));
+    if (!ok) throw std::invalid_argument(std::string(option) + " must be " + expected + ", got " + FormattedNumber(value));
   };
   require(std::isfinite(o.lr) && o.lr > 0 && o.lr <= 10, "--lr", "in (0, 10]", o.lr);
   require(std::isfinite(o.lr_decay_factor) && o.lr_decay_factor > 0, "--lr-decay-factor", "finite and > 0",
@@ -493,21 +486,46 @@ TrainResult Train(const TrainOptions& o) {
   require(std::isfinite(o.aux_tracks) && o.aux_tracks >= 0, "--aux-tracks", "finite and >= 0", o.aux_tracks);
   require(o.weight_average >= 0 && o.weight_average < 1, "--weight-average", "in [0, 1)", o.weight_average);
   require(o.model.dropout >= 0 && o.model.dropout < 1, "--dropout", "in [0, 1)", o.model.dropout);
-  const at::Device device = (o.device != "cpu" && torch::cuda::is_available()) ? at::Device(at::kCUDA)
-                                                                                 : at::Device(at::kCPU);
+  if (o.data.empty() && !o.init_only) throw std::invalid_argument("training needs --data");
   if (!o.resume && !o.overwrite) {
     for (const char* file : {"state.json", "model.pt"}) {
       if (fs::exists(o.out / file))
-        throw std::runtime_error((o.out / file).string() + ": a run is already in " + o.out.string() +
-                                 "; --resume continues it, --overwrite starts it again (or choose another --out)");
+        throw std::invalid_argument((o.out / file).string() + ": a run is already in " + o.out.string() +
+                                    "; --resume continues it, --overwrite starts it again (or choose another --out)");
     }
   }
-  if (o.data.empty() && !o.init_only) throw std::runtime_error("training needs --data");
   // --init-only writes an untrained model.pt and stops; with --resume it wrote the last epoch's
   // raw weights over the run's best model and called them untrained.
   if (o.init_only && o.resume)
-    throw std::runtime_error("--init-only and --resume cannot be combined: --init-only writes an untrained model, "
-                             "--resume continues a run's training");
+    throw std::invalid_argument("--init-only and --resume cannot be combined: --init-only writes an untrained model, "
+                                "--resume continues a run's training");
+  // The model's shape (peaks a DFT of --frames offers, frame channels): "--frames 4" with the
+  // default --k 3 failed naming only the configuration's field "k". A resumed run's are its own.
+  if (!o.resume) {
+    ModelConfig config = o.model;
+    config.channels = config.ChannelsForInput();
+    try {
+      ModelConfigFromJson(ToJson(config), "the model options");
+    } catch (const std::exception& e) {
+      throw std::invalid_argument(std::string(e.what()) +
+                                  " (its fields are the options of those names: \"k\" is --k, \"frame_channels\" "
+                                  "--frame-channels)");
+    }
+  }
+}
+
+TrainResult Train(const TrainOptions& o) {
+  // Flush denormals to zero: weight decay drives many weights and activations towards zero, and
+  // denormal floats made CPU training epochs 3x slower after ~10 epochs. Set before the intra-op
+  // threads exist: new threads inherit this thread's floating-point mode.
+  at::globalContext().setFlushDenormal(true);
+  if (o.threads > 0) at::set_num_threads(o.threads);
+  ValidateTrainOptions(o);
+  if (o.device == "cuda" && !torch::cuda::is_available()) {
+    throw std::runtime_error("device cuda requested but libtorch finds no CUDA device");
+  }
+  const at::Device device = (o.device != "cpu" && torch::cuda::is_available()) ? at::Device(at::kCUDA)
+                                                                                 : at::Device(at::kCPU);
   TrainResult result;
   result.device = device.is_cuda() ? "cuda" : "cpu";
   result.model = o.out / "model.pt";

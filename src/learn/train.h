@@ -105,6 +105,13 @@ double LearningRateAt(const TrainOptions& options, int epoch);
 // or names a folder that is not there.
 std::filesystem::path CheckpointDir(const std::filesystem::path& out);
 
+// The checks of `options` that need no data (ranges, combinations, the model's shape, an earlier
+// run in `out` without --resume or --overwrite), which Train makes first: the CLI makes them
+// before its work and exits 2 for them, as for its own option errors (they exited 1, as a failed
+// run; export-model exited 2 for an existing output).
+// Throws std::invalid_argument naming the option and what it may be.
+void ValidateTrainOptions(const TrainOptions& options);
+
 // Trains (or resumes) and writes to options.out:
 //   model.pt + model.json   best validation RMSE so far (what eval and sdn_node load)
 //   checkpoint-eNNNN/{last.pt, last_optim.pt[, last_average.pt]}  the latest epoch (for --resume);

@@ -94,7 +94,7 @@ void ExpectTrainRefused(const TrainOptions& o, const std::string& accepted, cons
   try {
     Train(o);
     ADD_FAILURE() << accepted;
-  } catch (const std::runtime_error& e) {
+  } catch (const std::exception& e) {  // invalid_argument for options (ValidateTrainOptions), else runtime_error
     const std::string what = e.what();
     for (const std::string& w : words) EXPECT_NE(what.find(w), std::string::npos) << what;
   }
