@@ -16,6 +16,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "common/dataset_names.h"
+#include "common/formatted.h"
 #include "common/image_file.h"
 #include "common/json_file.h"
 #include "common/random.h"
@@ -171,7 +172,7 @@ Dataset ReadDataset(const fs::path& dir) {
                                  got);
     };
     check(std::isfinite(clip.wind_speed) && clip.wind_speed >= 0 && clip.wind_speed <= 100,
-          "wind_speed", std::to_string(clip.wind_speed), "a speed in 0..100 m/s");
+          "wind_speed", FormattedNumber(clip.wind_speed), "a speed in 0..100 m/s");
     // The index repeats each clip's wind (tools sort and pick clips by it); two winds for one clip
     // mean one file was edited or belongs to another dataset, and which one the scores used
     // would be a guess.
@@ -179,14 +180,14 @@ Dataset ReadDataset(const fs::path& dir) {
       const double listed = Field<double>(entry, "wind_speed", index_path, "a number [m/s]", where);
       if (!(std::abs(listed - clip.wind_speed) <= 1e-6 * std::max(1.0, std::abs(clip.wind_speed)))) {
         throw std::runtime_error(index_path.string() + ": clips[" + std::to_string(i) + "].wind_speed is " +
-                                 std::to_string(listed) + " m/s but " + label_path.string() + " says " +
-                                 std::to_string(clip.wind_speed));
+                                 FormattedNumber(listed) + " m/s but " + label_path.string() + " says " +
+                                 FormattedNumber(clip.wind_speed));
       }
     }
     check(clip.num_frames >= 1 && clip.num_frames <= 100000, "num_frames", std::to_string(clip.num_frames),
           "in 1..100000");
     check(std::isfinite(clip.frame_rate) && clip.frame_rate > 0 && clip.frame_rate <= 10000, "frame_rate",
-          std::to_string(clip.frame_rate), "a rate in (0, 10000] Hz");
+          FormattedNumber(clip.frame_rate), "a rate in (0, 10000] Hz");
     check(clip.width >= 1 && clip.width <= 16384, "width", std::to_string(clip.width), "in 1..16384 px");
     check(clip.height >= 1 && clip.height <= 16384, "height", std::to_string(clip.height), "in 1..16384 px");
     if (!ValidFramePattern(clip.frame_pattern)) {
@@ -204,8 +205,8 @@ Dataset ReadDataset(const fs::path& dir) {
       if (!fresh && std::abs(it->second.first - clip.wind_speed) > 1e-9) {
         throw std::runtime_error(index_path.string() + ": simulation " + std::to_string(clip.simulation) +
                                  " has clips of two winds (\"" + it->second.second + "\" " +
-                                 std::to_string(it->second.first) + " m/s, \"" + clip.name + "\" " +
-                                 std::to_string(clip.wind_speed) + " m/s): its views film one wind");
+                                 FormattedNumber(it->second.first) + " m/s, \"" + clip.name + "\" " +
+                                 FormattedNumber(clip.wind_speed) + " m/s): its views film one wind");
       }
     }
     if (clip.simulation >= 0 && !split_by_clip) {
@@ -235,8 +236,8 @@ void CheckClipsSuitModel(const std::vector<ClipInfo>& clips, double model_rate, 
                                ": field \"encoding\" is \"mono8\", the model reads colour (rgb8) clips");
     if (std::abs(c.frame_rate - model_rate) > 0.01 * model_rate)
       throw std::runtime_error((c.dir / "label.json").string() + ": field \"frame_rate\" is " +
-                               std::to_string(c.frame_rate) + " Hz, the model reads clips at " +
-                               std::to_string(model_rate) + " Hz");
+                               FormattedNumber(c.frame_rate) + " Hz, the model reads clips at " +
+                               FormattedNumber(model_rate) + " Hz");
   }
 }
 

@@ -218,6 +218,14 @@ TEST_F(DatasetTest, BadInputErrorsNameTheFileAndField) {
     const fs::path d = Copy("wind" + std::to_string(speed > 0));
     EditJson(d / "toy-00003" / "label.json", [speed](nlohmann::json& j) { j["wind_speed"] = speed; });
     expect_error(d, (d / "toy-00003" / "label.json").string(), "\"wind_speed\" must be a speed in 0..100 m/s");
+    // Said as written (std::to_string wrote 1e300 as 301 digits, -50 as -50.000000).
+    try {
+      ReadDataset(d);
+      ADD_FAILURE() << "wind " << speed << " accepted";
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what(), said = speed > 0 ? "got 1e+300" : "got -50";
+      EXPECT_EQ(what.substr(what.size() - std::min(what.size(), said.size())), said) << what;
+    }
   }
   {
     const fs::path d = Copy("twice");

@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 
 #include "common/atomic_file.h"
+#include "common/formatted.h"
 #include "common/regular_file.h"
 #include "sim/warn_once.h"
 
@@ -403,7 +404,7 @@ Mesh RefineMesh(const Mesh& input, double max_edge) {
     // on towards 134M faces and gigabytes before the level limit). Cloths here have ~1e3-1e4.
     constexpr int kMaxFaces = 2000000;
     if (nf > kMaxFaces / 4)
-      throw std::invalid_argument("RefineMesh: max_edge " + std::to_string(max_edge) + " m would make more than " +
+      throw std::invalid_argument("RefineMesh: max_edge " + FormattedNumber(max_edge) + " m would make more than " +
                                   std::to_string(kMaxFaces) + " faces");
     EdgeMidpoints mid(mesh);
     Eigen::MatrixX3i F(4 * nf, 3);
