@@ -118,6 +118,20 @@ int main(int argc, char** argv) {
     const int status = app.exit(e);
     return status == 0 ? 0 : clothwind::tools::kExitUsage;
   }
+  // An empty value (`--out ""`, a shell variable that was not set) is no value: `eval --json ""`
+  // ran as if no --json was given, and `train --out ""` failed after its checks with "cannot
+  // create directories: Invalid argument []", naming no option. No option means anything by "".
+  for (CLI::App* sub : app.get_subcommands())
+    for (const CLI::Option* option : sub->get_options()) {
+      if (option->count() == 0 || option->get_type_size_max() == 0) continue;  // not given, or a flag
+      for (const std::string& value : option->results())
+        if (value.empty()) {
+          std::cerr << "clothwind " << sub->get_name() << ": error: " << option->get_name()
+                    << ": an empty value; expected " << (option->get_type_name().empty() ? "one" : option->get_type_name())
+                    << "\nRun with --help for more information.\n";
+          return clothwind::tools::kExitUsage;
+        }
+    }
   for (auto* sub : app.get_subcommands()) {
     try {
       return run.at(sub->get_name())();

@@ -83,6 +83,17 @@ out="$("$bin" train --epochs -3 --data "$work" --out "$work/run" 2>&1)" || true
 grep -q -- "--epochs: Value -3 must be > 0$" <<<"$out" || fail "--epochs -3: $out"
 "$bin" make-toy-dataset --seed 18446744073709551615 --clips 1 --frames 2 --size 16 --out "$work/toy" >/dev/null 2>&1 ||
   fail "make-toy-dataset --seed 2^64-1 was refused"
+# An empty value is refused as a command line naming the option (eval --json "" ran without
+# writing JSON; make-toy-dataset --out "" failed with "cannot create directories: Invalid argument").
+for verb in "make-toy-dataset --clips 1 --frames 2 --size 16 --out|--out" "eval --model $work/m.pt --data $work --json|--json" \
+            "contact-sheet|dir"; do
+  args="${verb%%|*}" named="${verb#*|}"
+  status=0
+  # shellcheck disable=SC2086
+  out="$("$bin" $args "" 2>&1)" || status=$?
+  [ "$status" -eq 2 ] && grep -qF -- "$named: an empty value" <<<"$out" ||
+    fail "$args \"\": not refused naming $named (status $status): $out"
+done
 version="$(sed -n 's:.*<version>\(.*\)</version>.*:\1:p' "$src/package.xml")"
 [ "$("$bin" --version)" = "clothwind $version" ] || fail "--version: $("$bin" --version 2>&1)"
 echo "main_cli_test: OK"
