@@ -83,6 +83,11 @@ out="$("$bin" train --epochs -3 --data "$work" --out "$work/run" 2>&1)" || true
 grep -q -- "--epochs: Value -3 must be > 0$" <<<"$out" || fail "--epochs -3: $out"
 "$bin" make-toy-dataset --seed 18446744073709551615 --clips 1 --frames 2 --size 16 --out "$work/toy" >/dev/null 2>&1 ||
   fail "make-toy-dataset --seed 2^64-1 was refused"
+# A trailing comma is no number (--wind 1,2,3, was read as 1,2,3).
+status=0
+out="$("$bin" simulate "$src/config/scenes/flag.json" --out "$work/sim" --wind 1,2,3, 2>&1)" || status=$?
+[ "$status" -eq 2 ] && grep -qF -- "--wind: expected 3 comma-separated numbers, got '1,2,3,'" <<<"$out" ||
+  fail "--wind 1,2,3,: not refused (status $status): $out"
 # An empty value is refused as a command line naming the option (eval --json "" ran without
 # writing JSON; make-toy-dataset --out "" failed with "cannot create directories: Invalid argument").
 for verb in "make-toy-dataset --clips 1 --frames 2 --size 16 --out|--out" "eval --model $work/m.pt --data $work --json|--json" \

@@ -21,6 +21,14 @@ status=0
 [ -f bags/s.bag ] && [ -f previews/p.png ] || fail "make-session wrote $(ls -R)"
 rm -rf bags previews
 
+# An existing preview is replaced only with --overwrite, as the bag (it was replaced without a word).
+printf 'a photo' >kept.png
+status=0
+"$bin" make-session --minutes 0.05 --width 16 --height 16 --out new.bag --preview kept.png >out.txt 2>&1 || status=$?
+[ "$status" -eq 2 ] && grep -qF -- "--preview: kept.png exists; --overwrite replaces it" out.txt && [ ! -e new.bag ] &&
+  [ "$(cat kept.png)" = "a photo" ] || fail "an existing --preview without --overwrite (status $status): $(cat out.txt)"
+rm -f kept.png out.txt
+
 # Over an earlier session and its preview (--overwrite): both stay as they were when the run is
 # stopped (the preview was replaced at the first frame, beside the old bag).
 "$bin" make-session --minutes 0.05 --width 16 --height 16 --out big.bag --preview big.png --seed 1 >out.txt 2>&1 ||

@@ -133,6 +133,8 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
     // The bag replaced the preview written beside it (exit 0, the image lost).
     if (SameFile(a.preview, a.out))
       throw UsageError("--preview " + a.preview + " is the bag --out names; give the image another name");
+    // As the bag: an existing image (perhaps a recorded session's) was replaced without a word.
+    RefuseExistingOutput("--preview", {a.preview}, a.overwrite);
   }
   sensors::SyntheticSessionOptions o;
   o.duration = a.minutes * 60.0;
@@ -292,7 +294,7 @@ const VerbRegistrar kRegistrar{"make-session", [](CLI::App& app) -> std::functio
                                  "write a synthetic field session (camera + NMEA anemometer) as a rosbag");
   sub->add_option("--minutes", args->minutes, "session length [min] (0.05..1440)")->capture_default_str();
   sub->add_option("--out", args->out, "output bag (refused if it exists, unless --overwrite)")->required();
-  sub->add_flag("--overwrite", args->overwrite, "replace an existing --out");
+  sub->add_flag("--overwrite", args->overwrite, "replace an existing --out (and --preview)");
   sub->add_option("--seed", args->seed, "random seed (0..2^64-1)")->check(CLI::NonNegativeNumber)->capture_default_str();
   sub->add_option("--fps", args->fps, "camera rate [Hz] (above 10 to 1000: at 10, with the camera's jitter, no stretch lasts a clip)")->capture_default_str();
   sub->add_option("--width", args->width, "image width [px] (16..16384; rendered: 16..8192, width x height at most 2^24)")->capture_default_str();

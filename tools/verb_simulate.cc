@@ -49,6 +49,9 @@ struct SimulateArgs {
 };
 
 std::vector<double> ParseList(const std::string& text, size_t n, const std::string& flag) {
+  // getline drops a last empty item: "1,2,3," read as three numbers.
+  if (!text.empty() && text.back() == ',')
+    throw UsageError(flag + ": expected " + Num(n) + " comma-separated numbers, got '" + text + "' (a trailing comma)");
   std::vector<double> v;
   std::stringstream ss(text);
   std::string item;
