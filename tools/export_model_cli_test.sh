@@ -153,6 +153,15 @@ status=0
 [ "$status" -eq 1 ] && grep -q "toy-00000" "$work/msg.txt" && [ ! -e "$work/gone" ] ||
   fail "eval that failed (status $status) left its folders: $(find "$work/gone" 2>&1) $(cat "$work/msg.txt")"
 
+# export-model's folder too, when its calibration fails (every clip missing a frame here).
+cp -r "$work/toy" "$work/broken-all"
+rm "$work"/broken-all/*/015.jpg
+status=0
+"$bin" export-model --model "$work/run/model.pt" --out "$work/gone/x/sdn.pt" --calibrate-std "$work/broken-all" \
+  >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 1 ] && grep -q "015" "$work/msg.txt" && [ ! -e "$work/gone" ] ||
+  fail "export-model whose calibration failed (status $status) left: $(find "$work/gone" 2>&1) $(cat "$work/msg.txt")"
+
 # No result lands on a clip's label or frames (only index.json was guarded: eval --json onto a
 # label exited 0, and the next read of the dataset failed on it); export-model's --overwrite
 # covers an earlier model, not a clip of the calibration data.

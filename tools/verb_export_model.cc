@@ -87,8 +87,8 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
     }
     // Made once the inputs have loaded (a missing --model or dataset left an empty folder behind),
     // still before the calibration's minute rather than at the write after it.
-    const std::filesystem::path folder = std::filesystem::path(a->out).parent_path();
-    if (!folder.empty()) std::filesystem::create_directories(folder);
+    // Taken away again, while empty, when the calibration fails (MadeFolders).
+    const MadeFolders folders = MakeFoldersFor("--out", a->out);
     if (!a->calibrate_data.empty()) {
       ProgressBar::Options b;
       b.label = "calibrate";

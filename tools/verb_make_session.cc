@@ -192,8 +192,9 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
 
   namespace fs = std::filesystem;
   const fs::path out(a.out);
-  if (out.has_parent_path()) fs::create_directories(out.parent_path());
-  if (fs::path(a.preview).has_parent_path()) fs::create_directories(fs::path(a.preview).parent_path());
+  // Taken away again, while empty, when the session fails (MadeFolders).
+  MadeFolders out_folders = MakeFoldersFor("--out", out);
+  MadeFolders preview_folders = MakeFoldersFor("--preview", a.preview);
   // A run killed mid-write (Ctrl-C) leaves its temporary bag: clear those of dead processes.
   RemoveStaleTemporariesOf(a.out, [](const std::string& path) {
     std::fprintf(stderr, "make-session: removing %s, left by a run that stopped\n", path.c_str());
@@ -267,6 +268,8 @@ int Run(const MakeSessionArgs& a, const std::vector<std::string>& rendered_only)
     fs::rename(tmp, out);
     SyncDirectory(out.has_parent_path() ? out.parent_path().string() : ".");
     if (!a.preview.empty()) WriteFileAtomically(a.preview, preview_bytes.data(), preview_bytes.size());
+    out_folders.Keep();
+    preview_folders.Keep();
   } catch (const std::exception& e) {
     try {
       bag.close();
