@@ -12,7 +12,16 @@ CLOTHWIND_BUILD="$(realpath -ms -- "$CLOTHWIND_BUILD")"  # as scripts/build
 # The build's bin first: `clothwind` and the benches by name, as every doc types them.
 export PATH="$CLOTHWIND_BUILD/bin:/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 export ROS_HOME="$CLOTHWIND_BUILD/ros_home"
-if [ -z "${ROS_HOSTNAME:-}" ] && [ -z "${ROS_IP:-}" ]; then export ROS_HOSTNAME=localhost; fi
+# Sourced again after ROS_IP was set (README's remote rviz), its own earlier localhost goes: ROS
+# prefers ROS_HOSTNAME, and the nodes went on saying localhost.
+if [ "${CLOTHWIND_SET_ROS_HOSTNAME:-}" = 1 ] && [ "${ROS_HOSTNAME:-}" = localhost ] && [ -n "${ROS_IP:-}" ]; then
+  unset ROS_HOSTNAME
+fi
+if [ -z "${ROS_HOSTNAME:-}" ] && [ -z "${ROS_IP:-}" ]; then
+  export ROS_HOSTNAME=localhost CLOTHWIND_SET_ROS_HOSTNAME=1
+elif [ "${ROS_HOSTNAME:-}" != localhost ]; then
+  unset CLOTHWIND_SET_ROS_HOSTNAME
+fi
 export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"
 export OMP_WAIT_POLICY=PASSIVE
 export PYTHONUNBUFFERED=1

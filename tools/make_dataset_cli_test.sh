@@ -21,14 +21,14 @@ refused() {  # refused OPTION_NAMED ARGS...: exits non-zero, names the option, m
   [ ! -e "$work/out" ] || fail "make-dataset $* made its --out folder"
 }
 
-# Not into the background photos' folder (its contact sheet became a backdrop of the next dataset).
+# Not the background photos' folder (its contact sheet became a backdrop of the next dataset).
 mkdir -p "$work/out"
 "$bin" make-toy-dataset --out "$work/photos" --clips 1 --frames 2 --size 16 >/dev/null 2>&1 || fail "make-toy-dataset"
 cp "$work/photos/toy-00000/000.jpg" "$work/out/field.jpg"
 status=0
-"$bin" make-dataset --count 1 --out "$work/out/ds" --backgrounds "$work/out" >"$work/msg.txt" 2>&1 || status=$?
-[ "$status" -eq 2 ] && grep -q -- "--out $work/out/ds is inside the --backgrounds folder" "$work/msg.txt" &&
-  [ ! -e "$work/out/ds" ] || fail "make-dataset --out inside --backgrounds (status $status): $(cat "$work/msg.txt")"
+"$bin" make-dataset --count 1 --out "$work/out/" --backgrounds "$work/out" >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 2 ] && grep -q -- "--out $work/out/ is the --backgrounds folder" "$work/msg.txt" &&
+  [ "$(ls "$work/out")" = field.jpg ] || fail "make-dataset --out the --backgrounds folder (status $status): $(cat "$work/msg.txt")"
 rm -rf "$work/out"
 refused --area-weight-spread --kind cloth --area-weight-spread 50
 refused --bending-spread --kind cloth --bending-spread 2

@@ -49,17 +49,19 @@ inline void RefuseFolderAsOutput(const std::string& option, const std::filesyste
     throw UsageError(option + " " + output.string() + " is a folder; expected a file name");
 }
 
-// Whether `path` is `folder` or lies inside it, compared as absolute paths with symbolic links
-// resolved where they exist.
-inline bool IsAtOrInside(const std::filesystem::path& path, const std::filesystem::path& folder) {
+// `p` absolute, with symbolic links resolved where they exist, and normal: the form IsAtOrInside
+// compares.
+inline std::filesystem::path NormalPath(const std::filesystem::path& p) {
   std::error_code ec;
-  const auto normal = [&](const std::filesystem::path& p) {
-    // Absolute first: weakly_canonical("run") of a missing relative path stays relative.
-    const std::filesystem::path a = std::filesystem::absolute(p, ec);
-    const std::filesystem::path c = std::filesystem::weakly_canonical(a, ec);
-    return (ec ? a : c).lexically_normal();
-  };
-  const std::filesystem::path out = normal(path), in = normal(folder);
+  // Absolute first: weakly_canonical("run") of a missing relative path stays relative.
+  const std::filesystem::path a = std::filesystem::absolute(p, ec);
+  const std::filesystem::path c = std::filesystem::weakly_canonical(a, ec);
+  return (ec ? a : c).lexically_normal();
+}
+
+// Whether `path` is `folder` or lies inside it, compared as NormalPath.
+inline bool IsAtOrInside(const std::filesystem::path& path, const std::filesystem::path& folder) {
+  const std::filesystem::path out = NormalPath(path), in = NormalPath(folder);
   return std::mismatch(in.begin(), in.end(), out.begin(), out.end()).first == in.end();
 }
 
@@ -175,6 +177,17 @@ class MadeFolders {
     throw std::runtime_error(option + " " + output.string() + ": cannot make its folder " + folder.string() + " (" +
                              ec.message() + ")");
   return MadeFolders(std::move(missing));
+}
+
+// Makes `output`'s folder again if it went while the verb worked (errors are left to the write
+// that follows, which names them). Why: runs of a sweep share a new results folder, and one that
+// failed took it away again, still empty (MadeFolders), while another worked towards writing
+// into it: that one's whole evaluation was lost at its write.
+inline void RemakeFolderFor(const std::filesystem::path& output) {
+  if (output.empty()) return;
+  std::error_code ec;
+  const std::filesystem::path folder = std::filesystem::absolute(output, ec).parent_path();
+  if (!ec) std::filesystem::create_directories(folder, ec);
 }
 
 // Throws UsageError naming `option` unless files can be made in the folder `output_folder` (made

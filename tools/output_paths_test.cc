@@ -69,7 +69,15 @@ TEST(OutputPathsTest, AnOutputOnAFolderOrUnderAFileIsRefusedBeforeTheWork) {
     EXPECT_EQ(made.made(), (std::vector<fs::path>{dir / "new" / "a", dir / "new" / "a" / "b"}));
   }
   EXPECT_FALSE(fs::exists(dir / "new" / "a")) << "an unused folder was left behind";
-  EXPECT_TRUE(fs::is_directory(dir / "new" / "deeper")) << "a folder made before was removed";
+  // An empty folder that was there before, on the way: not the verb's to take away.
+  fs::create_directories(dir / "empty_before");
+  { const MadeFolders made = MakeFoldersFor("--plot", dir / "empty_before" / "x" / "p.png"); }
+  EXPECT_FALSE(fs::exists(dir / "empty_before" / "x"));
+  EXPECT_TRUE(fs::is_directory(dir / "empty_before")) << "an empty folder there before was removed";
+  // A folder another run took away while this one worked is made again before the write.
+  RemakeFolderFor(dir / "shared" / "results" / "b.json");
+  EXPECT_TRUE(fs::is_directory(dir / "shared" / "results"));
+  EXPECT_NO_THROW(RemakeFolderFor(dir / "file" / "x.json"));  // the write that follows names it
   {
     const MadeFolders made = MakeFoldersFor("--plot", dir / "new" / "c" / "d" / "p.png");
     std::ofstream(dir / "new" / "c" / "kept.txt") << "x";

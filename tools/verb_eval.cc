@@ -163,7 +163,10 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
       }
     }
     // The evaluation's figures are kept whatever the track head does after them.
-    if (!a->json.empty() && a->track_head) learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
+    if (!a->json.empty() && a->track_head) {
+      RemakeFolderFor(a->json);
+      learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
+    }
     if (a->track_head) {
       ProgressBar::Options h = b;
       h.label = "track head";
@@ -181,6 +184,7 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
                             {"amplitude_r2", head.amplitude_r2},
                             {"standardised_mse", head.standardised_mse}};
       if (!a->track_head_rows.empty()) {
+        RemakeFolderFor(a->track_head_rows);
         learn::WriteTrackHeadRows(head, a->track_head_rows);
         std::cout << "track head rows: " << a->track_head_rows << "\n";
       }
@@ -193,11 +197,13 @@ VerbRegistrar registrar("eval", [](CLI::App& app) -> std::function<int()> {
     }
     // The figures first: a plot that cannot be written (a read-only model folder) costs only itself.
     if (!a->json.empty()) {
+      RemakeFolderFor(a->json);
       learn::WriteFileAtomically(a->json, json.dump(2) + "\n");
       std::cout << "json: " << a->json << "\n";
     }
     std::string error;
     bool plot_failed = false;
+    if (!a->plot.empty()) RemakeFolderFor(plot);  // the default's is the model's, not made
     if (learn::PlotPredictions(r, plot, &error)) {
       std::cout << "plot: " << plot.string() << "\n";
     } else {

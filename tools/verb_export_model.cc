@@ -111,6 +111,7 @@ VerbRegistrar registrar("export-model", [](CLI::App& app) -> std::function<int()
                 << one << " / " << two << " before, " << one_k << " / " << two_k << " after)\n";
       net->set_std_scale(net->config().std_scale * k);
     }
+    RemakeFolderFor(a->out);
     learn::SaveWindNet(net, a->out, learn::ParseWeightPrecision(a->precision));
     const double in_mb = std::filesystem::file_size(a->model) / 1e6;
     const double out_mb = std::filesystem::file_size(a->out) / 1e6;

@@ -112,9 +112,12 @@ int Run(MakeDatasetArgs& a) {
   }
   // The renderer's own listing (any case, .bmp too, files only): this verb's copy refused .JPG.
   if (!a.backgrounds.empty()) {
-    // Not into the photos' folder: the dataset's contact sheet became a backdrop of the next
-    // dataset made from it, and a resume was refused for photos that had changed.
-    RefuseOutputInsideFolder("--out", o.out, a.backgrounds, "the --backgrounds folder");
+    // Not the photos' folder itself: the dataset's contact sheet became a backdrop of the next
+    // dataset made from it, and a resume was refused for photos that had changed. (The photos are
+    // listed from its top level only, so a dataset in a subfolder of it is harmless.)
+    if (IsAtOrInside(o.out, a.backgrounds) && IsAtOrInside(a.backgrounds, o.out))
+      throw UsageError("--out " + o.out + " is the --backgrounds folder; its contact sheet would become a "
+                       "background photo: write the dataset elsewhere (a subfolder will do)");
     o.background_images = render::ListBackgroundImages(a.backgrounds);
   }
 

@@ -107,6 +107,13 @@ bool WriteContactSheet(const std::string& dir, const nlohmann::json& index, cons
                        const ContactSheetOptions& options, const std::function<void(int, int)>& progress) {
   const cv::Mat sheet = MakeContactSheet(dir, index, options, progress);
   if (sheet.empty()) return false;
+  // Its folder again, if it went while the tiles were read (another run sharing a new folder took
+  // it away, empty, on failing: tools/output_paths.h RemakeFolderFor); a failure is the write's.
+  {
+    std::error_code ec;
+    const std::filesystem::path folder = std::filesystem::absolute(path, ec).parent_path();
+    if (!ec) std::filesystem::create_directories(folder, ec);
+  }
   RemoveStaleTemporariesOf(path);  // a killed run's sheet.png.tmp-<pid> stayed beside it for ever
   render::WriteFrameAtomic(path, sheet);
   return true;

@@ -1,17 +1,20 @@
 #include "learn/evaluate.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <iomanip>
 #include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <fcntl.h>
 #include <malloc.h>
+#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -365,13 +368,6 @@ std::string EvalTable(const EvalResult& r) {
 
 namespace {
 
-// `text` as one word for /bin/sh: in single quotes, each ' written as '\''.
-std::string ShellQuoted(const std::string& text) {
-  std::string out = "'";
-  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 // `text` as a gnuplot string in single quotes (where '' stands for one ').
 std::string GnuplotQuoted(const std::string& text) {
   std::string out = "'";
@@ -403,25 +399,40 @@ bool RunGnuplot(const std::string& script, const fs::path& png, std::string* err
   const fs::path script_path = png.string() + ".gp";
   WriteFileAtomically(script_path, "set terminal pngcairo size 800,600 noenhanced\nset output " + GnuplotQuoted(tmp) +
                                        "\n" + script);
-  const std::string command =
-      "gnuplot " + ShellQuoted(script_path.string()) + " 2>" + ShellQuoted(script_path.string() + ".err");
-  const int rc = std::system(command.c_str());
-  // system() ignores SIGINT and SIGQUIT in its caller while the child runs: a Ctrl-C that reached
-  // gnuplot (the same process group) was the caller's too, and was lost with it (train ran on to
-  // its last epoch and exited 0). Raised again here, as POSIX's system() advises; the shell's
-  // 128 + signal counts as the signal too.
-  const int stop_signal = rc == -1 ? 0
-                          : WIFSIGNALED(rc) ? WTERMSIG(rc)
-                          : WIFEXITED(rc) && WEXITSTATUS(rc) > 128 ? WEXITSTATUS(rc) - 128
-                                                                     : 0;
-  if (stop_signal == SIGINT || stop_signal == SIGQUIT) std::raise(stop_signal);
+  // Started directly, not through std::system: system() ignores SIGINT and SIGQUIT in its caller
+  // while the child runs, and gnuplot catches a Ctrl-C and exits 1, so the Ctrl-C was lost (train
+  // ran on to its last epoch and exited 0). Here the caller keeps its own handling of it.
+  const std::string err_path = script_path.string() + ".err";
+  int rc = -1;  // wait status; -1: not started
+  std::string start_error;
+  {
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    std::string arg0 = "gnuplot", arg1 = script_path.string();
+    char* argv[] = {arg0.data(), arg1.data(), nullptr};
+    pid_t pid = -1;
+    const int spawned = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (spawned != 0) {
+      start_error = std::strerror(spawned);
+    } else {
+      int status = 0;
+      pid_t waited;
+      do {
+        waited = ::waitpid(pid, &status, 0);
+      } while (waited < 0 && errno == EINTR);
+      if (waited == pid) rc = status;
+      else start_error = std::string("waitpid: ") + std::strerror(errno);
+    }
+  }
   if (rc != 0 || !fs::exists(tmp)) {
     // The wait status itself ("exit 2" was signal 2, SIGINT).
-    const std::string how = rc == -1            ? std::string("could not be started")
+    const std::string how = rc == -1            ? "could not be started: " + start_error + "; is it on PATH?"
                             : WIFSIGNALED(rc)   ? "ended by signal " + std::to_string(WTERMSIG(rc))
                             : WIFEXITED(rc)     ? "exit " + std::to_string(WEXITSTATUS(rc))
                                                 : "status " + std::to_string(rc);
-    if (error) *error = "gnuplot failed (" + how + "), see " + script_path.string() + ".err";
+    if (error) *error = "gnuplot failed (" + how + ")" + (rc == -1 ? "" : ", see " + err_path);
     fs::remove(tmp);
     return false;
   }

@@ -36,14 +36,17 @@ std::filesystem::path FakeGnuplotFolder(const std::string& name, const std::stri
   return dir;
 }
 
-// A Ctrl-C while gnuplot draws reaches gnuplot (the same process group), and system() ignores it
-// in its caller meanwhile: it was lost, and train ran on to its last epoch and exited 0. The
-// caller now ends by the signal too; a gnuplot that merely fails only fails the plot, its
-// status said as an exit status (a signal's "exit 2" read as gnuplot's own).
+// A Ctrl-C while gnuplot draws reaches gnuplot and its caller (the terminal's process group).
+// gnuplot catches it and exits 1; std::system, which started it, ignored it in the caller
+// meanwhile, so it was lost: train ran on to its last epoch and exited 0. The fake gnuplot here
+// does as a Ctrl-C would: SIGINT to its parent and itself, which it catches, exiting 1. The caller
+// now ends by the signal. A gnuplot that merely fails only fails the plot, its status said as an
+// exit status (a signal's "exit 2" had read as gnuplot's own), and one not found says so.
 TEST(GnuplotDeathTest, AnInterruptedPlotInterruptsTheCaller) {
+  const std::string old_style = GTEST_FLAG_GET(death_test_style);
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   const std::string old_path = std::getenv("PATH") ? std::getenv("PATH") : "/usr/bin:/bin";
-  const std::filesystem::path interrupted = FakeGnuplotFolder("int", "kill -INT $$");
+  const std::filesystem::path interrupted = FakeGnuplotFolder("int", "trap 'exit 1' INT\nkill -INT $PPID $$\nexit 1");
   EXPECT_EXIT(
       {
         ::setenv("PATH", (interrupted.string() + ":" + old_path).c_str(), 1);
@@ -53,14 +56,19 @@ TEST(GnuplotDeathTest, AnInterruptedPlotInterruptsTheCaller) {
         std::exit(0);
       },
       ::testing::KilledBySignal(SIGINT), "");
+  GTEST_FLAG_SET(death_test_style, old_style);
   const std::filesystem::path failing = FakeGnuplotFolder("fail", "exit 3");
   ::setenv("PATH", (failing.string() + ":" + old_path).c_str(), 1);
   std::string error;
   const bool drawn = RunGnuplot("plot x\n", failing / "p.png", &error);
-  ::setenv("PATH", old_path.c_str(), 1);
   EXPECT_FALSE(drawn);
-  EXPECT_NE(error.find("gnuplot failed (exit 3)"), std::string::npos) << error;
+  EXPECT_NE(error.find("gnuplot failed (exit 3), see " + (failing / "p.png.gp.err").string()), std::string::npos)
+      << error;
   EXPECT_FALSE(std::filesystem::exists(failing / "p.png"));
+  ::setenv("PATH", "/nonexistent", 1);
+  EXPECT_FALSE(RunGnuplot("plot x\n", failing / "q.png", &error));
+  EXPECT_NE(error.find("gnuplot failed (could not be started: No such file or directory"), std::string::npos) << error;
+  ::setenv("PATH", old_path.c_str(), 1);
   std::filesystem::remove_all(interrupted);
   std::filesystem::remove_all(failing);
 }

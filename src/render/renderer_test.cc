@@ -464,9 +464,6 @@ TEST_P(FarCamera, SeesGroundBelowTheHorizon) {
 INSTANTIATE_TEST_SUITE_P(Renderer, FarCamera,
                          ::testing::Values(std::pair{700.0, 3.0}, std::pair{60.0, 100.0}));
 
-// A SetCloth refused half way (a bad index in its last face) leaves the previous cloth: it
-// rewrote the faces up to the bad one while Embree kept the old geometry, so hits read the new
-// faces' vertices (here: the old ones in another order, other texture coordinates).
 // The backdrop over what lies behind it, by its coverage (hand-worked values): the premultiplied
 // colour plus (1 - alpha) of what shows through, the sun only on that part, and the backdrop
 // counted as seen where it covers more than half.
@@ -507,6 +504,9 @@ TEST(Renderer, TheBackdropCoversWhatIsBehindItByItsAlpha) {
   EXPECT_EQ(clear.what, Renderer::kSky);
 }
 
+// A SetCloth refused half way (a bad index in its last face) leaves the previous cloth: it
+// rewrote the faces up to the bad one while Embree kept the old geometry, so hits read the new
+// faces' vertices (here: the old ones in another order, other texture coordinates).
 TEST(EmbreeScene, RefusedClothLeavesThePreviousOne) {
   Renderer r(TestParams());
   const ClothMesh a = WavingFlag(25, 17, 3.0, 2.0, 0.1);

@@ -21,4 +21,13 @@ got="$(after ROS_IP=192.0.2.7)"
 [ "$got" = "|192.0.2.7|http://localhost:11311" ] || fail "ROS_IP set before: $got"
 got="$(after ROS_HOSTNAME=flagpole.local ROS_MASTER_URI=http://base:11311)"
 [ "$got" = "flagpole.local||http://base:11311" ] || fail "ROS_HOSTNAME and ROS_MASTER_URI set before: $got"
+# Sourced once (a .bashrc), then again after the README's `export ROS_IP=...`: its own localhost
+# goes (ROS prefers ROS_HOSTNAME, so the nodes went on saying localhost); a user's own stays.
+got="$(env -i HOME="$HOME" PATH=/usr/bin:/bin CLOTHWIND_BUILD="$build" bash -c \
+  'set -u; source "$0"; export ROS_IP=192.0.2.9; source "$0"; echo "${ROS_HOSTNAME:-}|${ROS_IP:-}"' "$env_sh")"
+[ "$got" = "|192.0.2.9" ] || fail "sourced again after ROS_IP was set: $got"
+got="$(env -i HOME="$HOME" PATH=/usr/bin:/bin CLOTHWIND_BUILD="$build" bash -c \
+  'set -u; export ROS_HOSTNAME=flagpole.local; source "$0"; export ROS_IP=192.0.2.9; source "$0"; echo "${ROS_HOSTNAME:-}"' \
+  "$env_sh")"
+[ "$got" = "flagpole.local" ] || fail "a user's ROS_HOSTNAME, sourced twice: $got"
 echo "env_sh_test: OK"
