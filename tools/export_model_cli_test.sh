@@ -162,6 +162,13 @@ status=0
 [ "$status" -eq 1 ] && grep -q "015" "$work/msg.txt" && [ ! -e "$work/gone" ] ||
   fail "export-model whose calibration failed (status $status) left: $(find "$work/gone" 2>&1) $(cat "$work/msg.txt")"
 
+# train's run folder too, when training fails before writing (every clip missing a frame).
+status=0
+"$bin" train --model sdn --frames 30 --data "$work/broken-all" --out "$work/gone/run" --input-size 32 --width 8 \
+  --threads 1 --epochs 1 >"$work/msg.txt" 2>&1 || status=$?
+[ "$status" -eq 1 ] && grep -q "015.jpg: missing frame" "$work/msg.txt" && [ ! -e "$work/gone" ] ||
+  fail "train that failed (status $status) left: $(find "$work/gone" 2>&1) $(cat "$work/msg.txt")"
+
 # No result lands on a clip's label or frames (only index.json was guarded: eval --json onto a
 # label exited 0, and the next read of the dataset failed on it); export-model's --overwrite
 # covers an earlier model, not a clip of the calibration data.

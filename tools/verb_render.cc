@@ -219,7 +219,8 @@ int Run(const RenderArgs& a) {
   // frame is written and comes back after the last, so a run killed or failing half way leaves
   // no zeta.json beside a mix of its frames and an earlier run's (a rerun with another seed left
   // frames of two designs under the new one's zeta.json).
-  fs::create_directories(a.out);
+  // Taken away again, while still empty, when the render fails before a frame (MadeFolders).
+  const MadeFolders out_folders = MakeFoldersFor("--out", fs::path(a.out) / "zeta.json");
 
   render::RenderOptions ro;
   ro.threads = a.threads;

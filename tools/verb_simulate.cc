@@ -181,7 +181,8 @@ int Run(const SimulateArgs& a) {
     }
     thetas.push_back(theta);
   }
-  fs::create_directories(a.out);
+  // Taken away again, while still empty, when the run fails before writing (MadeFolders).
+  const MadeFolders out_folders = MakeFoldersFor("--out", fs::path(a.out) / "summary.json");
   // summary.json marks a finished run (scripts/window-oracle reuses a folder that has one): the
   // old run's goes before new frames are written, so a run stopped midway leaves none.
   {

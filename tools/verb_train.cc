@@ -248,6 +248,9 @@ VerbRegistrar registrar("train", [](CLI::App& app) -> std::function<int()> {
       if (!left.empty()) std::cout << "  (run: ~" << left << " left)";
       std::cout << std::endl;
     };
+    // The run's folder, taken away again while still empty when training fails before writing
+    // (a dataset it cannot read left an empty run folder; MadeFolders).
+    const MadeFolders run_folders = MakeFoldersFor("--out", std::filesystem::path(o.out) / "state.json");
     const learn::TrainResult r = learn::Train(o);
     if (o.init_only) {
       std::cout << "initialised (untrained) model: " << r.model.string() << "\n";
